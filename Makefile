@@ -1,0 +1,120 @@
+# fdemd build. Sources are found by folder, so adding a file needs no edit here.
+#
+#   make            bin/fdemd and bin/fdemctl (installs missing Debian packages first)
+#   make test       unit tests, then integration tests against the real daemon
+#   make test-san   the same under AddressSanitizer + UndefinedBehaviorSanitizer
+#   make bench      speed and memory figures (never part of the tests)
+#   make demo       start a daemon, run a bundled example end to end, draw a PNG
+#
+# SAN=1 builds everything instrumented into build-san/ and bin-san/.
+
+CC      ?= cc
+PYTHON  := /usr/bin/python3
+PKGS    := libmicrohttpd jansson hdf5 libcurl
+
+ifeq ($(SAN),1)
+BUILD   := build-san
+BIN     := bin-san
+OPT     := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all
+LDSAN   := -fsanitize=address,undefined
+else
+BUILD   := build
+BIN     := bin
+OPT     := -O2 -g
+LDSAN   :=
+endif
+
+WARN    := -Wall -Wextra -Werror -Wshadow -Wno-unused-parameter
+CSTD    := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
+CFLAGS  += $(CSTD) $(OPT) $(WARN) -MMD -MP
+PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS   = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+
+CORE_SRC   := $(wildcard core/*.c)
+PROTO_SRC  := $(wildcard proto/*.c)
+SERVER_SRC := $(wildcard server/*.c)
+CTL_SRC    := $(wildcard clients/fdemctl/*.c)
+UNIT_SRC   := $(wildcard tests/unit/test_*.c)
+BENCH_SRC  := $(wildcard bench/*.c)
+FUZZ_SRC   := $(wildcard tests/fuzz/*.c)
+
+CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/%.o)
+PROTO_OBJ  := $(PROTO_SRC:%.c=$(BUILD)/%.o)
+SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
+CTL_OBJ    := $(CTL_SRC:%.c=$(BUILD)/%.o)
+UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+
+LIBCORE    := $(BUILD)/libfdemcore.a
+LIBPROTO   := $(BUILD)/libfdemproto.a
+
+.PHONY: all deps test test-unit test-integration test-san bench demo fuzz clean
+
+all: deps $(BIN)/fdemd $(BIN)/fdemctl
+
+# Installs what is missing (apt-get) once; a stamp keeps later runs quiet.
+deps: $(BUILD)/.deps
+$(BUILD)/.deps: scripts/install-deps.sh
+	@mkdir -p $(BUILD)
+	@bash scripts/install-deps.sh
+	@touch $@
+
+$(BUILD)/core/%.o: core/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fopenmp -c $< -o $@
+$(BUILD)/proto/%.o: proto/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -c $< -o $@
+$(BUILD)/server/%.o: server/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -c $< -o $@
+$(BUILD)/clients/%.o: clients/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -c $< -o $@
+
+$(LIBCORE): $(CORE_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+$(LIBPROTO): $(PROTO_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BIN)/fdemd: $(SERVER_OBJ) $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(BIN)
+	$(CC) $(LDSAN) -fopenmp -o $@ $(SERVER_OBJ) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+$(BIN)/fdemctl: $(CTL_OBJ)
+	@mkdir -p $(BIN)
+	$(CC) $(LDSAN) -o $@ $(CTL_OBJ) $(PKG_LIBS) -lm
+
+# Unit tests link everything below the server; each file is one binary.
+$(BUILD)/tests/%: tests/unit/%.c tests/unit/check.h $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
+	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+
+$(BUILD)/bench/%: bench/%.c $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -O3 -march=native $(PKG_CFLAGS) -Icore -Iproto $(LDSAN) -fopenmp -o $@ $< \
+	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+
+test: all $(UNIT_BIN)
+	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) bash tests/run_tests.sh
+
+test-unit: deps $(UNIT_BIN)
+	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) UNIT_ONLY=1 bash tests/run_tests.sh
+
+test-san:
+	$(MAKE) SAN=1 test
+
+bench: deps $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%) $(BIN)/fdemd
+	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) bash bench/run.sh
+
+demo: all
+	@BIN=$(BIN) PYTHON=$(PYTHON) bash scripts/demo.sh
+
+fuzz: deps
+	@bash tests/fuzz/run.sh
+
+clean:
+	rm -rf build build-san bin bin-san
+
+-include $(shell find build build-san -name '*.d' 2>/dev/null)

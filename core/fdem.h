@@ -1,0 +1,239 @@
+/*
+ * fdem.h - the public C API of the fdemd engine (2D combined finite-discrete
+ * element method, after Munjiza 2004).
+ *
+ * Contract:
+ *  - A model is built in two phases. Phase 1 (building): add materials, parts
+ *    (explicit meshes or generated ones), per-part initial velocities,
+ *    constraints and gravity. Phase 2 (running): fdem_model_finalize() lumps
+ *    masses, precomputes element data and the stable step; from then on only
+ *    fdem_step() and the read-only accessors are allowed.
+ *  - Every function that can fail returns a negative value (or NULL) and fills
+ *    an fdem_error that names the offending item (part, triangle, node,
+ *    constraint) and says why in a sentence a user can act on.
+ *  - The engine owns all its memory; accessors return pointers into it that
+ *    stay valid until the next fdem_step() or fdem_model_destroy().
+ *  - No global mutable state: two models may be stepped from two threads.
+ *  - Units are SI; 2D plane strain, unit thickness.
+ */
+#ifndef FDEM_H
+#define FDEM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define FDEM_VERSION "0.1.0"
+
+typedef struct fdem_model fdem_model;
+
+/* What went wrong, and with which item. `item` is the index of the offending
+ * part/triangle/node/constraint (or -1); `kind` says which of those. */
+typedef enum fdem_item_kind {
+    FDEM_ITEM_NONE = 0,
+    FDEM_ITEM_MATERIAL,
+    FDEM_ITEM_PART,
+    FDEM_ITEM_NODE,
+    FDEM_ITEM_TRIANGLE,
+    FDEM_ITEM_CONSTRAINT,
+    FDEM_ITEM_ELEMENT, /* engine element index (after finalize) */
+} fdem_item_kind;
+
+typedef struct fdem_error {
+    fdem_item_kind kind;
+    int item;
+    char message[512];
+} fdem_error;
+
+/* ---------------------------------------------------------------- materials */
+
+typedef struct fdem_fracture_params {
+    double tensile_strength; /* Pa */
+    double cohesion;         /* Pa */
+    double friction_angle;   /* degrees */
+    double energy_I;         /* J/m^2 */
+    double energy_II;        /* J/m^2 */
+} fdem_fracture_params;
+
+typedef struct fdem_material_def {
+    double density; /* kg/m^3 */
+    double young;   /* Pa */
+    double poisson; /* -, in (-1, 0.5) */
+    double damping; /* fraction of critical damping of the element's stiffest mode */
+    double penalty; /* normal contact penalty, Pa; <= 0 means 10 * young */
+    double friction;/* Coulomb coefficient */
+    int has_fracture;
+    fdem_fracture_params fracture;
+} fdem_material_def;
+
+/* ------------------------------------------------------------------- meshes */
+
+/* A triangle mesh as plain arrays: nodes are (x, y) pairs, triangles are
+ * 0-based node index triples. Generators allocate with malloc; free with
+ * fdem_mesh_free(). */
+typedef struct fdem_mesh {
+    int node_count;
+    int triangle_count;
+    double *xy;    /* 2 * node_count */
+    int32_t *tri;  /* 3 * triangle_count */
+} fdem_mesh;
+
+void fdem_mesh_free(fdem_mesh *mesh);
+
+/* Structured rectangle, each of the nx*ny cells split into two triangles
+ * (alternating diagonals, so the mesh has no preferred direction). */
+int fdem_mesh_rectangle(double ox, double oy, double width, double height,
+                        int nx, int ny, fdem_mesh *out, fdem_error *err);
+
+/* Disc with `divisions` nodes on the rim: concentric rings of nodes, ring k
+ * with about divisions*k/rings nodes, triangulated between rings so every
+ * triangle is close to equilateral (no slivers, no fan at the centre). */
+int fdem_mesh_disc(double cx, double cy, double radius, int divisions,
+                   fdem_mesh *out, fdem_error *err);
+
+/* Checks index range, finiteness, zero or negative area after orientation;
+ * reorients clockwise triangles in place (counted in *reoriented). */
+int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err);
+
+/* ------------------------------------------------------------------ building */
+
+fdem_model *fdem_model_create(void);
+void fdem_model_destroy(fdem_model *model);
+
+/* Returns the material index (>= 0) or -1. */
+int fdem_add_material(fdem_model *model, const fdem_material_def *def, fdem_error *err);
+
+/* Adds a part (a separate body) meshed by `mesh` (copied, validated and
+ * reoriented). `fracture` != 0 makes it breakable along interior edges (the
+ * material must then have fracture parameters). Returns part index or -1. */
+int fdem_add_part(fdem_model *model, const fdem_mesh *mesh, int material,
+                  int fracture, fdem_error *err);
+
+/* Initial velocity of every node of a part. */
+int fdem_set_part_velocity(fdem_model *model, int part, double vx, double vy,
+                           fdem_error *err);
+
+void fdem_set_gravity(fdem_model *model, double gx, double gy);
+
+/* Node selection for a constraint: all nodes of a part, or every node whose
+ * initial position lies in [xmin, xmax] x [ymin, ymax] (inclusive). */
+typedef enum fdem_select_kind { FDEM_SELECT_PART, FDEM_SELECT_BOX } fdem_select_kind;
+
+typedef enum fdem_constraint_kind {
+    FDEM_CONSTRAINT_FIX,      /* fix_x / fix_y */
+    FDEM_CONSTRAINT_VELOCITY, /* prescribed velocity; free_x/free_y leave a component free */
+    FDEM_CONSTRAINT_FORCE,    /* total force shared equally by the selected nodes */
+} fdem_constraint_kind;
+
+typedef struct fdem_constraint_def {
+    fdem_select_kind select;
+    int part;           /* FDEM_SELECT_PART */
+    double box[4];      /* FDEM_SELECT_BOX: xmin, ymin, xmax, ymax */
+    fdem_constraint_kind kind;
+    int fix_x, fix_y;   /* FIX */
+    double value[2];    /* VELOCITY: vx, vy; FORCE: fx, fy (N per unit thickness) */
+    int free_x, free_y; /* VELOCITY: component left free (JSON null) */
+} fdem_constraint_def;
+
+/* Returns the constraint index or -1 (e.g. a selection with no node).
+ * Node selection happens at fdem_model_finalize(), so constraints may be
+ * added before or after the parts they select. */
+int fdem_add_constraint(fdem_model *model, const fdem_constraint_def *def, fdem_error *err);
+
+/* Lumps masses, builds element and contact data, selects constraint nodes,
+ * computes the stable step. Returns 0 or -1. */
+int fdem_model_finalize(fdem_model *model, fdem_error *err);
+
+/* ------------------------------------------------------------------- running */
+
+/* Largest stable step of the finalized model: the smallest of the elements'
+ * dilatational-wave limit (reduced for damping) and the contact penalty
+ * limit (only if some body can touch another). Multiply by a safety factor. */
+double fdem_stable_dt(const fdem_model *model);
+
+/* Step size of the next step; may change between steps (central difference
+ * with h_current != h_next, seed eq. 5.9). Must be > 0. */
+void fdem_set_dt(fdem_model *model, double dt);
+double fdem_get_dt(const fdem_model *model);
+
+/* Advances one step. Returns 0, or -1 if the state became non-finite; then
+ * err names the element (FDEM_ITEM_ELEMENT) or node and the step. The model
+ * is left as it was after the failing step (do not step it again). */
+int fdem_step(fdem_model *model, fdem_error *err);
+
+/* ----------------------------------------------------------------- accessors */
+
+typedef struct fdem_energy {
+    double kinetic;       /* sum 1/2 m v^2 (half-step velocities) */
+    double elastic;       /* strain energy of all elements */
+    double contact;       /* energy taken by contact forces: minus their work (stored + dissipated) */
+    double damping;       /* energy dissipated by viscous damping (>= 0) */
+    double gravity_work;  /* work done by gravity since t = 0 */
+    double external_work; /* work of applied forces and constraint reactions since t = 0 */
+} fdem_energy;
+
+typedef struct fdem_counts {
+    int nodes, elements, parts, materials, constraints;
+    int joints, broken_joints;
+    int contacts;      /* candidate pairs currently in contact (non-zero force) */
+    int contact_pairs; /* candidate pairs from the last detection */
+    long detections;   /* how many times detection ran */
+} fdem_counts;
+
+int64_t fdem_get_step(const fdem_model *model);
+double fdem_get_time(const fdem_model *model);
+fdem_counts fdem_get_counts(const fdem_model *model);
+fdem_energy fdem_get_energy(const fdem_model *model);
+
+/* Node arrays, 2 doubles per node, engine order. */
+const double *fdem_positions(const fdem_model *model);
+const double *fdem_initial_positions(const fdem_model *model);
+const double *fdem_velocities(const fdem_model *model);
+const double *fdem_node_masses(const fdem_model *model);
+const int32_t *fdem_node_parts(const fdem_model *model);
+/* Element arrays: 3 node indices per element (counter-clockwise), part index. */
+const int32_t *fdem_triangles(const fdem_model *model);
+const int32_t *fdem_element_parts(const fdem_model *model);
+/* Joint arrays (4 node indices per joint: a0, a1 on one face, b0, b1 on the
+ * other, a0 opposite b0), and damage 0..1 per joint. NULL when no joints. */
+const int32_t *fdem_joints(const fdem_model *model);
+const double *fdem_joint_damage(const fdem_model *model);
+
+/* Cauchy stress (sxx, syy, sxy) of every element into out[3*elements]. */
+void fdem_element_stress(const fdem_model *model, double *out);
+
+/* Total reaction (fix, velocity) or applied (force) force of each
+ * constraint during the last step, 2 doubles per constraint. */
+const double *fdem_constraint_forces(const fdem_model *model);
+
+/* Number of nodes selected by constraint c (valid after finalize). */
+int fdem_constraint_node_count(const fdem_model *model, int c);
+
+/* ------------------------------------------------------------- checkpoints */
+
+/* The dynamic state (step, time, dt, positions, velocities, joint and
+ * friction history, energy accumulators) as one flat byte buffer, so a
+ * daemon can persist a case as {case document, checkpoint} and rebuild it by
+ * re-running the case through the same builder and restoring the state.
+ * fdem_checkpoint_size() is the exact size fdem_checkpoint_write() needs. */
+size_t fdem_checkpoint_size(const fdem_model *model);
+int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
+/* Fails (with a message) if the buffer does not belong to a model of the
+ * same shape (node/element/joint counts). */
+int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
+
+/* Bytes the engine holds for this model (for memory limits and bench). */
+size_t fdem_memory_bytes(const fdem_model *model);
+
+/* Estimated bytes a model with this many nodes, elements and joints will
+ * need once finalized (to reject oversized cases before building them). */
+size_t fdem_memory_estimate(long nodes, long elements, long joints);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FDEM_H */

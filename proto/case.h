@@ -1,0 +1,51 @@
+/*
+ * case.h - the case document (contract section 3) turned into a finalized
+ * engine model.
+ *
+ * Contract:
+ *  - case_build() parses with JSON_REJECT_DUPLICATES; malformed JSON is one
+ *    400 problem; otherwise every problem in the document is collected (not
+ *    only the first) with its JSON Pointer and the model is not built (422).
+ *  - A case whose model would exceed memory_limit bytes (estimated before
+ *    building) is rejected with 422 saying how large it would be.
+ *  - time.dt "auto" = safety x fdem_stable_dt(); a number above the stable
+ *    step is rejected with 422 naming the stable value.
+ *  - On success the model is finalized, its dt set, and `info` filled.
+ */
+#ifndef FDEM_CASE_H
+#define FDEM_CASE_H
+
+#include <stddef.h>
+#include "fdem.h"
+#include "problems.h"
+
+enum case_field {
+    CASE_FIELD_POSITION = 1u << 0,
+    CASE_FIELD_VELOCITY = 1u << 1,
+    CASE_FIELD_STRESS   = 1u << 2,
+    CASE_FIELD_DAMAGE   = 1u << 3,
+};
+
+#define CASE_MAX_PARTS 1024
+
+typedef struct case_info {
+    char name[128];
+    double end_time;        /* time.end */
+    double dt;              /* the step in use */
+    double stable_dt;       /* fdem_stable_dt() of the model */
+    double safety;          /* time.safety (default 0.5) */
+    double output_interval; /* simulated seconds between snapshots */
+    unsigned fields;        /* CASE_FIELD_* written to snapshots */
+    int part_count;
+    int constraint_count;
+    int fracture;           /* some part fractures */
+} case_info;
+
+fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
+                       case_info *info, problems *out);
+
+/* Parses "position,velocity,..." (the ?fields= of GET /state) into
+ * CASE_FIELD_* bits; unknown names are added to `out` (400). */
+unsigned case_parse_fields(const char *csv, problems *out);
+
+#endif

@@ -1,0 +1,37 @@
+/*
+ * problems.h - a list of {JSON Pointer, message} problems found in a request,
+ * reported all at once as RFC 9457 problem details by the server.
+ *
+ * Contract: problems_add() never fails visibly (on allocation failure the
+ * problem is dropped and `dropped` counts it); pointers are RFC 6901 strings
+ * ("" is the whole document); `status` is 400 for malformed JSON and 422 for
+ * a well-formed but invalid case.
+ */
+#ifndef FDEM_PROBLEMS_H
+#define FDEM_PROBLEMS_H
+
+#include <stddef.h>
+
+typedef struct problem {
+    char pointer[256];
+    char message[512];
+} problem;
+
+typedef struct problems {
+    int status;        /* 400 or 422 once a problem is added; 0 when none */
+    char title[64];    /* "Malformed JSON", "Invalid case", ... */
+    problem *items;
+    int count, capacity, dropped;
+} problems;
+
+void problems_init(problems *p);
+void problems_free(problems *p);
+/* Adds one problem; the first call also sets status and title when unset. */
+void problems_add(problems *p, int status, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Appends "/token" to a JSON Pointer with RFC 6901 escaping (~0, ~1). */
+void pointer_join(char *out, size_t size, const char *base, const char *token);
+void pointer_join_index(char *out, size_t size, const char *base, long index);
+
+#endif

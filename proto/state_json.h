@@ -1,0 +1,16 @@
+/*
+ * state_json.h - engine state as the JSON of GET /cases/ID/state.
+ *
+ * Contract: {"step", "time", "<field>": ...} with position/velocity as
+ * [[x, y], ...] per node, stress as [[sxx, syy, sxy], ...] per element and
+ * damage as a number per joint; only the fields present in the snapshot.
+ */
+#ifndef FDEM_STATE_JSON_H
+#define FDEM_STATE_JSON_H
+
+#include <jansson.h>
+#include "snapshot.h"
+
+json_t *state_to_json(const snapshot *s);
+
+#endif
