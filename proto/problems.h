@@ -5,12 +5,16 @@
  * Contract: problems_add() never fails visibly (on allocation failure the
  * problem is dropped and `dropped` counts it); pointers are RFC 6901 strings
  * ("" is the whole document); `status` is 400 for malformed JSON and 422 for
- * a well-formed but invalid case.
+ * a well-formed but invalid case. At most PROBLEMS_MAX problems are kept;
+ * later ones only increase `dropped` (a broken document must not produce a
+ * response larger than itself).
  */
 #ifndef FDEM_PROBLEMS_H
 #define FDEM_PROBLEMS_H
 
 #include <stddef.h>
+
+#define PROBLEMS_MAX 100
 
 typedef struct problem {
     char pointer[256];

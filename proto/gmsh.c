@@ -1,0 +1,562 @@
+/*
+ * gmsh.c - reads the 3-node triangles of an ASCII gmsh mesh (formats 2.2 and
+ * 4.1) into an engine mesh.
+ *
+ * The text arrives inside a JSON string from an untrusted upload, so the
+ * reader works on a (pointer, length) buffer that need not be NUL-terminated,
+ * never trusts a declared count more than the bytes left can hold, and
+ * reports the section and line of the first thing it does not understand.
+ * It reads line by line: gmsh writes one node or element per line, and a
+ * line number is what a user needs to find the fault in the file.
+ *
+ * Nodes are kept in file order with their tags; triangles are kept as tags
+ * and resolved once every section has been read (via a tag-sorted index),
+ * because tags may be non-contiguous and sections may come in any order.
+ */
+#include "gmsh.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GMSH_MAX_TOKENS 64 /* more than any element line we care about */
+#define GMSH_TOKEN_CHARS 64
+
+typedef struct gmsh_line {
+    const char *tokens[GMSH_MAX_TOKENS];
+    size_t lengths[GMSH_MAX_TOKENS];
+    int count; /* tokens found (capped at GMSH_MAX_TOKENS) */
+} gmsh_line;
+
+typedef struct gmsh_node {
+    long long tag;
+    double x, y;
+} gmsh_node;
+
+typedef struct gmsh_triangle {
+    long long tags[3];
+    int line;
+} gmsh_triangle;
+
+typedef struct gmsh_reader {
+    const char *p, *end;
+    int line;              /* number of the line last read, 1-based */
+    const char *section;   /* "$Nodes", ... for messages */
+    int version;           /* 22 or 41 once $MeshFormat was read, else 0 */
+    int seen_nodes, seen_elements;
+    gmsh_node *nodes;
+    long node_count, node_capacity;
+    gmsh_triangle *triangles;
+    long triangle_count, triangle_capacity;
+    char *message;
+    size_t message_size;
+    int failed;
+} gmsh_reader;
+
+__attribute__((format(printf, 2, 3)))
+static int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
+{
+    if (r->failed) return -1;
+    r->failed = 1;
+    char what[400];
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(what, sizeof what, fmt, args);
+    va_end(args);
+    char where[64] = "gmsh";
+    if (r->section && r->line > 0)
+        snprintf(where, sizeof where, "gmsh %s, line %d", r->section, r->line);
+    else if (r->section)
+        snprintf(where, sizeof where, "gmsh %s", r->section);
+    else if (r->line > 0)
+        snprintf(where, sizeof where, "gmsh line %d", r->line);
+    snprintf(r->message, r->message_size, "%s: %s", where, what);
+    return -1;
+}
+
+/* ------------------------------------------------------------------ lines */
+
+/* Reads the next line into `out` (tokens point into the buffer). Returns 0,
+ * or -1 at the end of the buffer. */
+static int gmsh_next_line(gmsh_reader *r, gmsh_line *out)
+{
+    if (r->p >= r->end) return -1;
+    const char *start = r->p;
+    const char *nl = memchr(start, '\n', (size_t)(r->end - start));
+    const char *stop = nl ? nl : r->end;
+    r->p = nl ? nl + 1 : r->end;
+    r->line++;
+    out->count = 0;
+    const char *c = start;
+    while (c < stop) {
+        while (c < stop && (*c == ' ' || *c == '\t' || *c == '\r')) c++;
+        if (c >= stop) break;
+        const char *t = c;
+        while (c < stop && *c != ' ' && *c != '\t' && *c != '\r') c++;
+        if (out->count < GMSH_MAX_TOKENS) {
+            out->tokens[out->count] = t;
+            out->lengths[out->count] = (size_t)(c - t);
+        }
+        out->count++;
+    }
+    if (out->count > GMSH_MAX_TOKENS) out->count = GMSH_MAX_TOKENS;
+    return 0;
+}
+
+/* The next line, which must exist: a missing one means a truncated file. */
+static int gmsh_need_line(gmsh_reader *r, gmsh_line *out, const char *what)
+{
+    if (gmsh_next_line(r, out) == 0) return 0;
+    return gmsh_fail(r, "the file ends where %s was expected (truncated?)", what);
+}
+
+static int gmsh_token_is(const gmsh_line *l, int i, const char *word)
+{
+    return i < l->count && l->lengths[i] == strlen(word) &&
+           memcmp(l->tokens[i], word, l->lengths[i]) == 0;
+}
+
+/* Copies token i into a NUL-terminated buffer for strtod/strtoll. */
+static int gmsh_token_copy(const gmsh_line *l, int i, char *buf)
+{
+    if (i >= l->count || l->lengths[i] >= GMSH_TOKEN_CHARS) return -1;
+    memcpy(buf, l->tokens[i], l->lengths[i]);
+    buf[l->lengths[i]] = '\0';
+    return 0;
+}
+
+static int gmsh_token_long(const gmsh_line *l, int i, long long *out)
+{
+    char buf[GMSH_TOKEN_CHARS];
+    if (gmsh_token_copy(l, i, buf) < 0) return -1;
+    char *stop;
+    errno = 0;
+    long long v = strtoll(buf, &stop, 10);
+    if (errno || stop == buf || *stop) return -1;
+    *out = v;
+    return 0;
+}
+
+static int gmsh_token_double(const gmsh_line *l, int i, double *out)
+{
+    char buf[GMSH_TOKEN_CHARS];
+    if (gmsh_token_copy(l, i, buf) < 0) return -1;
+    char *stop;
+    double v = strtod(buf, &stop);
+    if (stop == buf || *stop || !isfinite(v)) return -1;
+    *out = v;
+    return 0;
+}
+
+/* Reads `n` integers from the start of a line; names them in the message. */
+static int gmsh_line_longs(gmsh_reader *r, const gmsh_line *l, long long *out, int n,
+                           const char *what)
+{
+    if (l->count < n) return gmsh_fail(r, "expected %s, found %d value(s)", what, l->count);
+    for (int i = 0; i < n; i++)
+        if (gmsh_token_long(l, i, &out[i]) < 0)
+            return gmsh_fail(r, "expected %s, value %d is not an integer", what, i + 1);
+    return 0;
+}
+
+/* A declared count must be non-negative and fit in the rest of the buffer
+ * (every item takes at least `min_bytes`), so a hostile header cannot make
+ * us allocate more than the upload's size. */
+static int gmsh_check_count(gmsh_reader *r, long long count, long min_bytes, const char *what)
+{
+    if (count < 0) return gmsh_fail(r, "negative number of %s (%lld)", what, count);
+    long long room = (long long)(r->end - r->p) / min_bytes + 1;
+    if (count > room)
+        return gmsh_fail(r, "declares %lld %s but the rest of the file is too short for that "
+                            "(truncated?)", count, what);
+    return 0;
+}
+
+/* --------------------------------------------------------------- storage */
+
+static int gmsh_grow(void **items, long *capacity, long need, size_t item_size)
+{
+    if (need <= *capacity) return 0;
+    long capacity_new = *capacity ? *capacity : 64;
+    while (capacity_new < need) capacity_new *= 2;
+    void *grown = realloc(*items, (size_t)capacity_new * item_size);
+    if (!grown) return -1;
+    *items = grown;
+    *capacity = capacity_new;
+    return 0;
+}
+
+static int gmsh_push_node(gmsh_reader *r, long long tag, double x, double y)
+{
+    if (tag <= 0) return gmsh_fail(r, "node tag %lld is not positive", tag);
+    if (gmsh_grow((void **)&r->nodes, &r->node_capacity, r->node_count + 1, sizeof *r->nodes))
+        return gmsh_fail(r, "out of memory");
+    r->nodes[r->node_count++] = (gmsh_node){tag, x, y};
+    return 0;
+}
+
+static int gmsh_push_triangle(gmsh_reader *r, const long long tags[3])
+{
+    if (gmsh_grow((void **)&r->triangles, &r->triangle_capacity, r->triangle_count + 1,
+                  sizeof *r->triangles))
+        return gmsh_fail(r, "out of memory");
+    gmsh_triangle *t = &r->triangles[r->triangle_count++];
+    memcpy(t->tags, tags, sizeof t->tags);
+    t->line = r->line;
+    return 0;
+}
+
+/* Reads "x y [z ...]" from token `first` on. */
+static int gmsh_line_xy(gmsh_reader *r, const gmsh_line *l, int first, double *x, double *y)
+{
+    if (l->count < first + 2) return gmsh_fail(r, "expected node coordinates x y z");
+    if (gmsh_token_double(l, first, x) < 0 || gmsh_token_double(l, first + 1, y) < 0)
+        return gmsh_fail(r, "node coordinates must be finite numbers");
+    return 0;
+}
+
+/* The three node tags of a triangle from token `first` on. */
+static int gmsh_line_triangle(gmsh_reader *r, const gmsh_line *l, int first)
+{
+    long long tags[3];
+    if (l->count < first + 3) return gmsh_fail(r, "a triangle needs 3 node tags");
+    for (int k = 0; k < 3; k++)
+        if (gmsh_token_long(l, first + k, &tags[k]) < 0)
+            return gmsh_fail(r, "triangle node tag %d is not an integer", k + 1);
+    return gmsh_push_triangle(r, tags);
+}
+
+/* --------------------------------------------------------------- sections */
+
+static int gmsh_read_format(gmsh_reader *r)
+{
+    gmsh_line l;
+    if (gmsh_need_line(r, &l, "the version line") < 0) return -1;
+    long long file_type = 0;
+    if (l.count < 3 || gmsh_token_long(&l, 1, &file_type) < 0)
+        return gmsh_fail(r, "expected \"version file-type data-size\"");
+    if (file_type != 0)
+        return gmsh_fail(r, "binary .msh files are not supported; save the mesh as ASCII "
+                            "(gmsh -format msh22 or msh41, without -bin)");
+    if (gmsh_token_is(&l, 0, "2.2"))
+        r->version = 22;
+    else if (gmsh_token_is(&l, 0, "4.1"))
+        r->version = 41;
+    else
+        return gmsh_fail(r, "format version %.*s is not supported; use 2.2 or 4.1 "
+                            "(gmsh -format msh22 or msh41)",
+                         (int)(l.lengths[0] < 16 ? l.lengths[0] : 16), l.tokens[0]);
+    return 0;
+}
+
+static int gmsh_read_nodes22(gmsh_reader *r)
+{
+    gmsh_line l;
+    long long count;
+    if (gmsh_need_line(r, &l, "the number of nodes") < 0) return -1;
+    if (gmsh_line_longs(r, &l, &count, 1, "the number of nodes") < 0) return -1;
+    if (gmsh_check_count(r, count, 8, "nodes") < 0) return -1;
+    for (long long i = 0; i < count; i++) {
+        long long tag;
+        double x, y;
+        if (gmsh_need_line(r, &l, "a node") < 0) return -1;
+        if (gmsh_line_longs(r, &l, &tag, 1, "a node number") < 0) return -1;
+        if (gmsh_line_xy(r, &l, 1, &x, &y) < 0) return -1;
+        if (gmsh_push_node(r, tag, x, y) < 0) return -1;
+    }
+    return 0;
+}
+
+/* 4.1: one block per entity, the block's tags first, then its coordinates
+ * (followed by parametric coordinates, which we ignore). */
+static int gmsh_read_node_block41(gmsh_reader *r, long long *total)
+{
+    gmsh_line l;
+    long long head[4];
+    if (gmsh_need_line(r, &l, "a node block header") < 0) return -1;
+    if (gmsh_line_longs(r, &l, head, 4, "\"entityDim entityTag parametric numNodes\"") < 0)
+        return -1;
+    long long n = head[3];
+    if (gmsh_check_count(r, n, 8, "nodes in the block") < 0) return -1;
+    long first = r->node_count;
+    for (long long i = 0; i < n; i++) {
+        long long tag;
+        if (gmsh_need_line(r, &l, "a node tag") < 0) return -1;
+        if (gmsh_line_longs(r, &l, &tag, 1, "a node tag") < 0) return -1;
+        if (gmsh_push_node(r, tag, 0, 0) < 0) return -1;
+    }
+    for (long long i = 0; i < n; i++) {
+        if (gmsh_need_line(r, &l, "node coordinates") < 0) return -1;
+        gmsh_node *node = &r->nodes[first + i];
+        if (gmsh_line_xy(r, &l, 0, &node->x, &node->y) < 0) return -1;
+    }
+    *total += n;
+    return 0;
+}
+
+static int gmsh_read_nodes41(gmsh_reader *r)
+{
+    gmsh_line l;
+    long long head[4];
+    if (gmsh_need_line(r, &l, "the $Nodes header") < 0) return -1;
+    if (gmsh_line_longs(r, &l, head, 4,
+                        "\"numEntityBlocks numNodes minNodeTag maxNodeTag\"") < 0)
+        return -1;
+    if (gmsh_check_count(r, head[0], 8, "node blocks") < 0) return -1;
+    if (gmsh_check_count(r, head[1], 8, "nodes") < 0) return -1;
+    long long total = 0;
+    for (long long b = 0; b < head[0]; b++)
+        if (gmsh_read_node_block41(r, &total) < 0) return -1;
+    if (total != head[1])
+        return gmsh_fail(r, "the header declares %lld nodes but the blocks hold %lld",
+                         head[1], total);
+    return 0;
+}
+
+static int gmsh_read_elements22(gmsh_reader *r)
+{
+    gmsh_line l;
+    long long count;
+    if (gmsh_need_line(r, &l, "the number of elements") < 0) return -1;
+    if (gmsh_line_longs(r, &l, &count, 1, "the number of elements") < 0) return -1;
+    if (gmsh_check_count(r, count, 8, "elements") < 0) return -1;
+    for (long long i = 0; i < count; i++) {
+        long long head[3]; /* number, type, number of tags */
+        if (gmsh_need_line(r, &l, "an element") < 0) return -1;
+        if (gmsh_line_longs(r, &l, head, 3, "\"number type number-of-tags ...\"") < 0)
+            return -1;
+        if (head[1] != 2) continue;
+        if (head[2] < 0 || head[2] > GMSH_MAX_TOKENS)
+            return gmsh_fail(r, "bad number of element tags (%lld)", head[2]);
+        if (gmsh_line_triangle(r, &l, 3 + (int)head[2]) < 0) return -1;
+    }
+    return 0;
+}
+
+static int gmsh_read_element_block41(gmsh_reader *r, long long *total)
+{
+    gmsh_line l;
+    long long head[4];
+    if (gmsh_need_line(r, &l, "an element block header") < 0) return -1;
+    if (gmsh_line_longs(r, &l, head, 4, "\"entityDim entityTag elementType numElements\"") < 0)
+        return -1;
+    long long n = head[3];
+    if (gmsh_check_count(r, n, 4, "elements in the block") < 0) return -1;
+    for (long long i = 0; i < n; i++) {
+        if (gmsh_need_line(r, &l, "an element") < 0) return -1;
+        if (head[2] == 2 && gmsh_line_triangle(r, &l, 1) < 0) return -1;
+    }
+    *total += n;
+    return 0;
+}
+
+static int gmsh_read_elements41(gmsh_reader *r)
+{
+    gmsh_line l;
+    long long head[4];
+    if (gmsh_need_line(r, &l, "the $Elements header") < 0) return -1;
+    if (gmsh_line_longs(r, &l, head, 4,
+                        "\"numEntityBlocks numElements minElementTag maxElementTag\"") < 0)
+        return -1;
+    if (gmsh_check_count(r, head[0], 8, "element blocks") < 0) return -1;
+    if (gmsh_check_count(r, head[1], 4, "elements") < 0) return -1;
+    long long total = 0;
+    for (long long b = 0; b < head[0]; b++)
+        if (gmsh_read_element_block41(r, &total) < 0) return -1;
+    if (total != head[1])
+        return gmsh_fail(r, "the header declares %lld elements but the blocks hold %lld",
+                         head[1], total);
+    return 0;
+}
+
+/* After a section's content: the matching "$EndName" line. */
+static int gmsh_expect_end(gmsh_reader *r, const char *end_word)
+{
+    gmsh_line l;
+    if (gmsh_need_line(r, &l, end_word) < 0) return -1;
+    if (l.count != 1 || !gmsh_token_is(&l, 0, end_word))
+        return gmsh_fail(r, "expected %s (more entries than the declared count?)", end_word);
+    return 0;
+}
+
+/* Sections we do not need ($Entities, $PhysicalNames, ...) are skipped. */
+static int gmsh_skip_section(gmsh_reader *r, const gmsh_line *start)
+{
+    char end_word[GMSH_TOKEN_CHARS + 4];
+    snprintf(end_word, sizeof end_word, "$End%.*s", (int)(start->lengths[0] - 1),
+             start->tokens[0] + 1);
+    gmsh_line l;
+    while (gmsh_next_line(r, &l) == 0)
+        if (l.count == 1 && gmsh_token_is(&l, 0, end_word)) return 0;
+    return gmsh_fail(r, "the file ends before %s (truncated?)", end_word);
+}
+
+static int gmsh_read_section(gmsh_reader *r, const gmsh_line *l)
+{
+    if (gmsh_token_is(l, 0, "$MeshFormat")) {
+        if (r->version) return gmsh_fail(r, "a second $MeshFormat section");
+        r->section = "$MeshFormat";
+        if (gmsh_read_format(r) < 0) return -1;
+        return gmsh_expect_end(r, "$EndMeshFormat");
+    }
+    if (!r->version)
+        return gmsh_fail(r, "not a gmsh mesh: the file must start with $MeshFormat");
+    if (gmsh_token_is(l, 0, "$Nodes")) {
+        if (r->seen_nodes++) return gmsh_fail(r, "a second $Nodes section");
+        r->section = "$Nodes";
+        if ((r->version == 22 ? gmsh_read_nodes22(r) : gmsh_read_nodes41(r)) < 0) return -1;
+        return gmsh_expect_end(r, "$EndNodes");
+    }
+    if (gmsh_token_is(l, 0, "$Elements")) {
+        if (r->seen_elements++) return gmsh_fail(r, "a second $Elements section");
+        r->section = "$Elements";
+        if ((r->version == 22 ? gmsh_read_elements22(r) : gmsh_read_elements41(r)) < 0)
+            return -1;
+        return gmsh_expect_end(r, "$EndElements");
+    }
+    r->section = NULL;
+    return gmsh_skip_section(r, l);
+}
+
+static int gmsh_read_sections(gmsh_reader *r)
+{
+    gmsh_line l;
+    while (gmsh_next_line(r, &l) == 0) {
+        r->section = NULL;
+        if (l.count == 0) continue;
+        if (l.lengths[0] < 2 || l.tokens[0][0] != '$' || l.count != 1) {
+            if (!r->version)
+                return gmsh_fail(r, "not a gmsh mesh: the file must start with $MeshFormat");
+            return gmsh_fail(r, "expected a section such as $Nodes, found \"%.*s\"",
+                             (int)(l.lengths[0] < 32 ? l.lengths[0] : 32), l.tokens[0]);
+        }
+        if (gmsh_read_section(r, &l) < 0) return -1;
+    }
+    r->section = NULL;
+    if (!r->version) return gmsh_fail(r, "not a gmsh mesh: no $MeshFormat section");
+    if (!r->seen_nodes) return gmsh_fail(r, "no $Nodes section");
+    if (!r->seen_elements) return gmsh_fail(r, "no $Elements section");
+    if (r->triangle_count == 0)
+        return gmsh_fail(r, "no 3-node triangles (element type 2) in $Elements; "
+                            "mesh the surfaces in 2D (gmsh -2)");
+    return 0;
+}
+
+/* --------------------------------------------------------------- resolve */
+
+/* Sorts node indices by tag. qsort_r is a GNU extension and qsort would need
+ * the nodes in a global, so a small merge sort it is. */
+static void gmsh_sort_by_tag(long *idx, long *tmp, long n, const gmsh_node *nodes)
+{
+    if (n < 2) return;
+    long half = n / 2;
+    gmsh_sort_by_tag(idx, tmp, half, nodes);
+    gmsh_sort_by_tag(idx + half, tmp, n - half, nodes);
+    long i = 0, j = half, k = 0;
+    while (i < half && j < n)
+        tmp[k++] = nodes[idx[j]].tag < nodes[idx[i]].tag ? idx[j++] : idx[i++];
+    while (i < half) tmp[k++] = idx[i++];
+    while (j < n) tmp[k++] = idx[j++];
+    memcpy(idx, tmp, (size_t)n * sizeof *idx);
+}
+
+static long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, long long tag)
+{
+    long lo = 0, hi = n - 1;
+    while (lo <= hi) {
+        long mid = lo + (hi - lo) / 2;
+        long long t = nodes[sorted[mid]].tag;
+        if (t == tag) return sorted[mid];
+        if (t < tag) lo = mid + 1; else hi = mid - 1;
+    }
+    return -1;
+}
+
+/* Keeps only the nodes some triangle uses, renumbered in file order. */
+static int gmsh_resolve(gmsh_reader *r, fdem_mesh *out)
+{
+    long n = r->node_count, m = r->triangle_count;
+    if (n > INT32_MAX || m > INT32_MAX / 3) return gmsh_fail(r, "the mesh is too large");
+    long *sorted = malloc((size_t)(n ? n : 1) * sizeof *sorted);
+    long *tmp = malloc((size_t)(n ? n : 1) * sizeof *tmp);
+    long *file_index = malloc((size_t)m * 3 * sizeof *file_index);
+    int32_t *renumber = malloc((size_t)(n ? n : 1) * sizeof *renumber);
+    int rc = -1;
+    if (!sorted || !tmp || !file_index || !renumber) {
+        gmsh_fail(r, "out of memory");
+        goto done;
+    }
+    for (long i = 0; i < n; i++) sorted[i] = i;
+    gmsh_sort_by_tag(sorted, tmp, n, r->nodes);
+    for (long i = 1; i < n; i++)
+        if (r->nodes[sorted[i]].tag == r->nodes[sorted[i - 1]].tag) {
+            r->section = "$Nodes";
+            r->line = 0;
+            gmsh_fail(r, "node tag %lld is defined twice", r->nodes[sorted[i]].tag);
+            goto done;
+        }
+    for (long i = 0; i < n; i++) renumber[i] = -1;
+    for (long t = 0; t < m; t++)
+        for (int k = 0; k < 3; k++) {
+            long found = gmsh_find_tag(sorted, n, r->nodes, r->triangles[t].tags[k]);
+            if (found < 0) {
+                r->section = "$Elements";
+                r->line = r->triangles[t].line;
+                gmsh_fail(r, "the triangle refers to node %lld, which is not in $Nodes",
+                          r->triangles[t].tags[k]);
+                goto done;
+            }
+            file_index[3 * t + k] = found;
+            renumber[found] = 0;
+        }
+    int used = 0;
+    for (long i = 0; i < n; i++)
+        if (renumber[i] == 0) renumber[i] = used++;
+    out->xy = malloc((size_t)used * 2 * sizeof *out->xy);
+    out->tri = malloc((size_t)m * 3 * sizeof *out->tri);
+    if (!out->xy || !out->tri) {
+        free(out->xy);
+        free(out->tri);
+        memset(out, 0, sizeof *out);
+        gmsh_fail(r, "out of memory");
+        goto done;
+    }
+    for (long i = 0; i < n; i++)
+        if (renumber[i] >= 0) {
+            out->xy[2 * renumber[i]] = r->nodes[i].x;
+            out->xy[2 * renumber[i] + 1] = r->nodes[i].y;
+        }
+    for (long t = 0; t < 3 * m; t++) out->tri[t] = renumber[file_index[t]];
+    out->node_count = used;
+    out->triangle_count = (int)m;
+    rc = 0;
+done:
+    free(sorted);
+    free(tmp);
+    free(file_index);
+    free(renumber);
+    return rc;
+}
+
+int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
+              size_t message_size)
+{
+    char scratch[8];
+    memset(out, 0, sizeof *out);
+    gmsh_reader r = {0};
+    if (!text) text = "", length = 0;
+    r.p = text;
+    r.end = text + length;
+    r.message = message && message_size ? message : scratch;
+    r.message_size = message && message_size ? message_size : sizeof scratch;
+    r.message[0] = '\0';
+    int rc = gmsh_read_sections(&r);
+    if (rc == 0) rc = gmsh_resolve(&r, out);
+    free(r.nodes);
+    free(r.triangles);
+    return rc;
+}

@@ -1,0 +1,245 @@
+/*
+ * test_gmsh.c - the gmsh reader on files written by the installed gmsh
+ * (the .msh files in tests/data, from the .geo files next to them) and on broken input:
+ * every malformed file must fail with a message naming section and line,
+ * never crash or read past the buffer (the ASan build checks the latter).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "gmsh.h"
+
+/* Reads a whole file; NULL (and a failed check) if it is missing. */
+static char *read_file(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL, "cannot open %s (run from the repository root)", path);
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = malloc((size_t)n);
+    *length = fread(text, 1, (size_t)n, f);
+    fclose(f);
+    return text;
+}
+
+static double mesh_area(const fdem_mesh *m)
+{
+    double area = 0;
+    for (int t = 0; t < m->triangle_count; t++) {
+        const double *a = &m->xy[2 * m->tri[3 * t]], *b = &m->xy[2 * m->tri[3 * t + 1]],
+                     *c = &m->xy[2 * m->tri[3 * t + 2]];
+        area += fabs((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])) / 2;
+    }
+    return area;
+}
+
+/* Every index in range and every node used by some triangle. */
+static int mesh_is_compact(const fdem_mesh *m)
+{
+    char *used = calloc((size_t)m->node_count + 1, 1);
+    int ok = 1;
+    for (int i = 0; i < 3 * m->triangle_count; i++) {
+        if (m->tri[i] < 0 || m->tri[i] >= m->node_count) ok = 0;
+        else used[m->tri[i]] = 1;
+    }
+    for (int i = 0; i < m->node_count; i++)
+        if (!used[i]) ok = 0;
+    free(used);
+    return ok;
+}
+
+/* Reads a file (copied into a buffer of exactly its size, so ASan catches
+ * any read past the end) and checks its node/triangle counts and area. */
+static void check_file(const char *path, int nodes, int triangles, double area)
+{
+    size_t length = 0;
+    char *text = read_file(path, &length);
+    if (!text) return;
+    fdem_mesh m;
+    char message[256];
+    int rc = gmsh_read(text, length, &m, message, sizeof message);
+    CHECK(rc == 0, "%s: %s", path, message);
+    if (rc == 0) {
+        CHECK(m.node_count == nodes, "%s: %d nodes, want %d", path, m.node_count, nodes);
+        CHECK(m.triangle_count == triangles, "%s: %d triangles, want %d", path,
+              m.triangle_count, triangles);
+        CHECK_NEAR(mesh_area(&m), area, 1e-12);
+        CHECK(mesh_is_compact(&m), "%s: index out of range or unused node", path);
+        fdem_mesh_free(&m);
+    }
+    free(text);
+}
+
+/* Expected figures computed independently (Python) from the same files. */
+static void square_v22(void) { check_file("tests/data/square_v22.msh", 12, 14, 1.0); }
+static void square_v41(void) { check_file("tests/data/square_v41.msh", 12, 14, 1.0); }
+/* The disc's centre point is a geometry node no triangle uses: dropped. */
+static void disc_hole_v22(void)
+{
+    check_file("tests/data/disc_hole_v22.msh", 42, 58, 2.625632949971628);
+}
+static void disc_hole_v41(void)
+{
+    check_file("tests/data/disc_hole_v41.msh", 42, 58, 2.625632949971628);
+}
+
+/* Parses `text` expecting failure with `needle` (and "line" when asked) in
+ * the message. */
+static void check_fails(const char *text, const char *needle, int with_line)
+{
+    size_t length = strlen(text);
+    char *copy = malloc(length ? length : 1); /* no NUL: the reader must not need one */
+    memcpy(copy, text, length);
+    fdem_mesh m;
+    char message[256] = "";
+    int rc = gmsh_read(copy, length, &m, message, sizeof message);
+    CHECK(rc == -1, "accepted: %.60s", text);
+    CHECK(strstr(message, needle) != NULL, "message \"%s\" lacks \"%s\"", message, needle);
+    if (with_line) CHECK(strstr(message, "line") != NULL, "no line in \"%s\"", message);
+    if (rc == 0) fdem_mesh_free(&m);
+    free(copy);
+}
+
+#define V22 "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
+#define V41 "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n"
+
+/* Non-contiguous tags, an unused node, CRLF line ends, a point element and a
+ * skipped section: nodes renumbered in file order. */
+static void tags_and_renumbering_v22(void)
+{
+    const char *text = V22 "$PhysicalNames\r\n1\r\n2 1 \"x\"\r\n$EndPhysicalNames\r\n"
+                           "$Nodes\r\n4\r\n10 0 0 0\r\n7 5 5 0\r\n30 1 0 0\r\n20 0 1 0\r\n"
+                           "$EndNodes\r\n$Elements\r\n2\r\n1 15 2 0 1 7\r\n"
+                           "2 2 2 0 1 10 30 20\r\n$EndElements\r\n";
+    fdem_mesh m;
+    char message[256];
+    int rc = gmsh_read(text, strlen(text), &m, message, sizeof message);
+    CHECK(rc == 0, "%s", message);
+    if (rc) return;
+    CHECK(m.node_count == 3 && m.triangle_count == 1, "%d nodes, %d triangles", m.node_count,
+          m.triangle_count);
+    CHECK(m.tri[0] == 0 && m.tri[1] == 1 && m.tri[2] == 2, "tri %d %d %d", m.tri[0], m.tri[1],
+          m.tri[2]);
+    CHECK_NEAR(m.xy[2], 1.0, 0); /* tag 30 -> index 1 */
+    CHECK_NEAR(m.xy[5], 1.0, 0); /* tag 20 -> index 2 */
+    fdem_mesh_free(&m);
+}
+
+/* 4.1 with a parametric block (extra coordinates ignored) and a block of
+ * lines that is skipped. */
+static void blocks_v41(void)
+{
+    const char *text = V41 "$Nodes\n2 4 1 9\n1 1 1 1\n9\n0.5 0 0 0.5\n2 1 0 3\n1\n2\n3\n"
+                           "0 0 0\n1 0 0\n0 1 0\n$EndNodes\n$Elements\n2 3 1 3\n"
+                           "1 1 1 1\n1 1 9\n2 1 2 2\n2 1 2 3\n3 9 3 2\n$EndElements\n";
+    fdem_mesh m;
+    char message[256];
+    int rc = gmsh_read(text, strlen(text), &m, message, sizeof message);
+    CHECK(rc == 0, "%s", message);
+    if (rc) return;
+    CHECK(m.node_count == 4 && m.triangle_count == 2, "%d nodes, %d triangles", m.node_count,
+          m.triangle_count);
+    CHECK(m.tri[3] == 0 && m.tri[4] == 3 && m.tri[5] == 2, "second tri %d %d %d", m.tri[3],
+          m.tri[4], m.tri[5]);
+    CHECK_NEAR(mesh_area(&m), 0.5 + 0.25, 1e-15);
+    fdem_mesh_free(&m);
+}
+
+static void rejects_binary(void)
+{
+    check_fails("$MeshFormat\n4.1 1 8\n\x01\x00\x00\x00\n$EndMeshFormat\n", "binary", 1);
+}
+
+static void rejects_other_versions(void)
+{
+    check_fails("$MeshFormat\n3.0 0 8\n$EndMeshFormat\n", "version 3.0", 1);
+    check_fails("$MeshFormat\n4 0 8\n$EndMeshFormat\n", "2.2 or 4.1", 1);
+}
+
+static void rejects_garbage(void)
+{
+    check_fails("", "no $MeshFormat", 0);
+    check_fails("hello world\n", "not a gmsh mesh", 1);
+    check_fails("{\"nodes\": []}", "not a gmsh mesh", 1);
+    check_fails("$Nodes\n1\n1 0 0 0\n$EndNodes\n", "must start with $MeshFormat", 1);
+    check_fails(V22 "$Nodes\n1\n1 zero 0 0\n$EndNodes\n", "finite", 1);
+    check_fails(V22 "$Nodes\n1\n1 nan 0 0\n$EndNodes\n", "finite", 1);
+    check_fails(V22 "$Nodes\n1\n1 1e999 0 0\n$EndNodes\n", "finite", 1);
+    check_fails(V22 "$Nodes\n-1\n$EndNodes\n", "negative", 1);
+    check_fails(V22 "$Nodes\n1\n0 0 0 0\n$EndNodes\n", "not positive", 1);
+    check_fails(V22 "stray\n", "expected a section", 1);
+}
+
+static void rejects_truncated(void)
+{
+    check_fails(V22 "$Nodes\n3\n1 0 0 0\n", "truncated", 1);
+    check_fails(V22 "$Nodes\n999999999999\n1 0 0 0\n$EndNodes\n", "too short", 1);
+    check_fails(V22 "$Nodes\n1\n1 0 0 0\n", "$EndNodes", 1);
+    check_fails(V22 "$Entities\n1 2 3\n", "$EndEntities", 0);
+    check_fails("$MeshFormat\n2.2 0 8", "$EndMeshFormat", 1);
+    check_fails(V41 "$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0\n", "truncated", 1);
+    check_fails(V41 "$Nodes\n1 2 1 3\n2 1 0 3\n1\n2\n3\n0 0 0\n1 0 0\n0 1 0\n$EndNodes\n",
+                "declares 2 nodes", 1);
+    check_fails(V22 "$Nodes\n2\n1 0 0 0\n2 1 0 0\n3 1 1 0\n$EndNodes\n", "$EndNodes", 1);
+}
+
+static void rejects_bad_references(void)
+{
+    check_fails(V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                    "$Elements\n1\n1 2 2 0 1 1 2 4\n$EndElements\n",
+                "node 4", 1);
+    check_fails(V22 "$Nodes\n3\n1 0 0 0\n1 1 0 0\n3 0 1 0\n$EndNodes\n"
+                    "$Elements\n1\n1 2 2 0 1 1 3 3\n$EndElements\n",
+                "defined twice", 0);
+    check_fails(V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                    "$Elements\n1\n1 2 2 0 1 1 2\n$EndElements\n",
+                "3 node tags", 1);
+}
+
+static void rejects_missing_sections(void)
+{
+    check_fails(V22 "$Nodes\n1\n1 0 0 0\n$EndNodes\n", "no $Elements", 0);
+    check_fails(V22 "$Elements\n0\n$EndElements\n", "no $Nodes", 0);
+    check_fails(V22 "$Nodes\n2\n1 0 0 0\n2 1 0 0\n$EndNodes\n"
+                    "$Elements\n1\n1 1 2 0 1 1 2\n$EndElements\n",
+                "no 3-node triangles", 0);
+    check_fails(V22 V22, "second $MeshFormat", 1);
+}
+
+/* Every prefix of a real file must fail cleanly (or, for the full length,
+ * succeed): exercises every truncation point under ASan. */
+static void every_prefix_of_a_real_file(void)
+{
+    size_t length = 0;
+    char *text = read_file("tests/data/square_v41.msh", &length);
+    if (!text) return;
+    int accepted = 0, unexplained = 0;
+    for (size_t n = 0; n <= length; n++) {
+        char *copy = malloc(n ? n : 1);
+        memcpy(copy, text, n);
+        fdem_mesh m;
+        char message[256] = "";
+        if (gmsh_read(copy, n, &m, message, sizeof message) == 0) {
+            accepted++;
+            fdem_mesh_free(&m);
+        } else if (strncmp(message, "gmsh", 4) != 0) {
+            unexplained++;
+        }
+        free(copy);
+    }
+    /* Only the whole file and the file without its final newline parse. */
+    CHECK(accepted == 2, "%d prefixes accepted", accepted);
+    CHECK(unexplained == 0, "%d failures without a message", unexplained);
+    free(text);
+}
+
+CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
+           T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
+           T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
+           T(rejects_bad_references), T(rejects_missing_sections),
+           T(every_prefix_of_a_real_file))
