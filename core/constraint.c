@@ -1,0 +1,162 @@
+/*
+ * constraint.c - boundary conditions: node selection by part or box, fixed
+ * and prescribed-velocity components, forces shared over a node set, and the
+ * total reaction of each constraint after every step.
+ *
+ * A degree of freedom belongs to the last constraint (in case order) that
+ * prescribes it, so overlapping selections are well defined and each
+ * reaction is counted once. Prescribed dofs are integrated here, after the
+ * free dofs: the reaction is what the support had to add to the step's
+ * force to impose the prescribed velocity, m (v_prescribed - v_free) / h.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+static int constraint_selects(const fdem_model *m, const constraint *c, int node)
+{
+    if (c->def.select == FDEM_SELECT_PART) return m->node_part[node] == c->def.part;
+    const double *b = c->def.box;
+    double x = m->pos0[2 * node], y = m->pos0[2 * node + 1];
+    return x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3];
+}
+
+static unsigned constraint_dofs(const constraint *c)
+{
+    switch (c->def.kind) {
+    case FDEM_CONSTRAINT_FIX: return (c->def.fix_x ? 1u : 0u) | (c->def.fix_y ? 2u : 0u);
+    case FDEM_CONSTRAINT_VELOCITY: return (c->def.free_x ? 0u : 1u) | (c->def.free_y ? 0u : 2u);
+    default: return 0;
+    }
+}
+
+int constraint_select(fdem_model *m, fdem_error *err)
+{
+    int total = 0;
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (c->def.select == FDEM_SELECT_PART && (c->def.part < 0 || c->def.part >= m->part_count)) {
+            model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d selects part %d, which does not exist",
+                        k, c->def.part);
+            return -1;
+        }
+        int n = 0;
+        for (int i = 0; i < m->node_count; i++) n += constraint_selects(m, c, i);
+        if (n == 0) {
+            model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                        "constraint %d selects no node (check the box against the initial positions)", k);
+            return -1;
+        }
+        c->entry_begin = total;
+        c->entry_count = n;
+        total += n;
+    }
+    m->cnode = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
+    m->cdof = malloc((size_t)(total ? total : 1));
+    m->dof_owned = calloc((size_t)m->node_count, 1);
+    m->constraint_force_out = calloc(2 * (size_t)(m->constraint_count ? m->constraint_count : 1),
+                                     sizeof(double));
+    int32_t *owner = malloc(sizeof(int32_t) * 2 * (size_t)m->node_count);
+    if (!m->cnode || !m->cdof || !m->dof_owned || !m->constraint_force_out || !owner) {
+        free(owner);
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for constraints");
+        return -1;
+    }
+    m->cnode_count = total;
+    for (int i = 0; i < 2 * m->node_count; i++) owner[i] = -1;
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        unsigned dofs = constraint_dofs(c);
+        int at = c->entry_begin;
+        for (int i = 0; i < m->node_count; i++) {
+            if (!constraint_selects(m, c, i)) continue;
+            m->cnode[at++] = i;
+            if (dofs & 1u) owner[2 * i] = k;
+            if (dofs & 2u) owner[2 * i + 1] = k;
+        }
+    }
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            m->cdof[e] = (uint8_t)((owner[2 * i] == k ? 1u : 0u) | (owner[2 * i + 1] == k ? 2u : 0u));
+            m->dof_owned[i] |= m->cdof[e];
+        }
+    }
+    free(owner);
+    /* Prescribed velocities hold from t = 0 on. */
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        if (c->def.kind == FDEM_CONSTRAINT_FORCE) continue;
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            for (int d = 0; d < 2; d++)
+                if (m->cdof[e] & (1u << d))
+                    m->vel[2 * i + d] = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
+        }
+    }
+    return 0;
+}
+
+void constraint_apply_forces(fdem_model *m)
+{
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (c->def.kind != FDEM_CONSTRAINT_FORCE) continue;
+        double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            m->force[2 * i] += fx;
+            m->force[2 * i + 1] += fy;
+        }
+        c->force[0] = c->def.value[0];
+        c->force[1] = c->def.value[1];
+    }
+}
+
+/* Integrates the prescribed dofs (skipped by the free update) and the work
+ * of every constraint during this step. total_force(i, d) is the step's
+ * force on dof d of node i from every source except the support. */
+void constraint_enforce(fdem_model *m, double h, double havg)
+{
+    const double *fc = m->contact.enabled ? m->contact.force : NULL;
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (c->def.kind == FDEM_CONSTRAINT_FORCE) {
+            double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
+            for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+                int i = m->cnode[e];
+                m->external_work += (fx * m->vel[2 * i] + fy * m->vel[2 * i + 1]) * h;
+            }
+            continue;
+        }
+        c->force[0] = c->force[1] = 0;
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            for (int d = 0; d < 2; d++) {
+                if (!(m->cdof[e] & (1u << d))) continue;
+                double mass = m->mass[i];
+                double f = m->force[2 * i + d] + (fc ? fc[2 * i + d] : 0) + mass * m->gravity[d];
+                double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
+                double v_free = m->vel[2 * i + d] + f / mass * havg;
+                double reaction = mass * (prescribed - v_free) / havg;
+                c->force[d] += reaction;
+                m->vel[2 * i + d] = prescribed;
+                double dx = prescribed * h;
+                m->pos[2 * i + d] += dx;
+                m->external_work += reaction * dx;
+                if (fc) m->contact_work += fc[2 * i + d] * dx;
+            }
+            if (fc) {
+                double ux = m->pos[2 * i] - m->contact.pos_detect[2 * i];
+                double uy = m->pos[2 * i + 1] - m->contact.pos_detect[2 * i + 1];
+                m->contact.max_disp2 = fmax(m->contact.max_disp2, ux * ux + uy * uy);
+            }
+        }
+    }
+}

@@ -1,0 +1,305 @@
+/*
+ * contact.c - contact between finite elements of different bodies: when to
+ * run detection, and the distributed potential contact force of Munjiza &
+ * Andrews (2000) with Coulomb friction.
+ *
+ * Detection (nbs.c) runs on bounding circles inflated by a buffer, and only
+ * again once some node has moved more than half the buffer since the last
+ * run: until then every pair that can overlap is already a candidate.
+ *
+ * Force. Each triangle carries the potential phi = 3 min_k lambda_k (lambda
+ * the area coordinates): 1 at the centroid, 0 on the boundary. The force on
+ * a contactor c from a target t is -p * integral over the overlap of
+ * grad phi_t, which the divergence theorem turns into an integral along the
+ * contactor's edges inside t:  F = -p * integral (phi_t n_c) ds. phi_t is
+ * piecewise linear along an edge (it changes branch where two area
+ * coordinates cross), so the integral and its first moment are exact sums.
+ * The resultant acts at the potential's centroid s* along the edge: it is
+ * shared by the edge's two nodes by lever rule, and the equal and opposite
+ * force goes to the target's nodes by the area coordinates of that same
+ * point. Action equals reaction at one point, so both linear and angular
+ * momentum are conserved to round-off. Then the roles swap.
+ *
+ * Friction is Coulomb, |Ft| <= mu |Fn|, opposing the relative tangential
+ * velocity at the point of action. Below the Coulomb bound it is the force
+ * that would stop the relative sliding within one step (halved, so several
+ * contacts on one node cannot overshoot); this holds a body at rest on a
+ * slope without a stored tangential spring per pair.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* The current geometry of one triangle, gathered once per pair. */
+typedef struct tri_now {
+    int node[3];
+    double x[3], y[3];
+    double area2;       /* twice the signed area (> 0 unless inverted) */
+    double penalty, friction;
+} tri_now;
+
+static void tri_gather(const fdem_model *m, int e, tri_now *t)
+{
+    const element_hot *el = &m->elem[e];
+    const material *mat = &m->materials[el->material];
+    for (int c = 0; c < 3; c++) {
+        t->node[c] = el->node[c];
+        t->x[c] = m->pos[2 * el->node[c]];
+        t->y[c] = m->pos[2 * el->node[c] + 1];
+    }
+    t->area2 = (t->x[1] - t->x[0]) * (t->y[2] - t->y[0]) - (t->y[1] - t->y[0]) * (t->x[2] - t->x[0]);
+    t->penalty = mat->penalty;
+    t->friction = mat->def.friction;
+}
+
+/* Area coordinates of (px, py) in t: lambda_k belongs to node k. */
+static inline void area_coordinates(const tri_now *t, double px, double py, double l[3])
+{
+    double inv = 1.0 / t->area2;
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        l[k] = ((t->x[i] - px) * (t->y[j] - py) - (t->y[i] - py) * (t->x[j] - px)) * inv;
+    }
+}
+
+static inline double min3(double a, double b, double c) { return fmin(a, fmin(b, c)); }
+
+/* Integral over s in [0,1] of phi(s) = 3 min_k lambda_k(s), clipped to where
+ * all lambda_k >= 0, and its first moment. Returns 0 when the edge misses. */
+static int edge_potential_integral(const double la[3], const double lb[3], double *i0, double *i1)
+{
+    double smin = 0, smax = 1;
+    for (int k = 0; k < 3; k++) {
+        if (la[k] < 0 && lb[k] < 0) return 0;
+        if (la[k] < 0) smin = fmax(smin, la[k] / (la[k] - lb[k]));
+        else if (lb[k] < 0) smax = fmin(smax, la[k] / (la[k] - lb[k]));
+    }
+    if (!(smax > smin)) return 0;
+
+    double s[5];
+    int n = 0;
+    s[n++] = smin;
+    for (int k = 0; k < 3; k++) { /* where two coordinates cross, phi changes branch */
+        int j = (k + 1) % 3;
+        double denom = (lb[k] - la[k]) - (lb[j] - la[j]);
+        if (fabs(denom) < 1e-300) continue;
+        double sc = (la[j] - la[k]) / denom;
+        if (sc > smin && sc < smax) s[n++] = sc;
+    }
+    s[n++] = smax;
+    for (int a = 1; a < n; a++) /* insertion sort of at most 5 */
+        for (int b = a; b > 0 && s[b] < s[b - 1]; b--) {
+            double tmp = s[b]; s[b] = s[b - 1]; s[b - 1] = tmp;
+        }
+    double sum0 = 0, sum1 = 0, prev_s = s[0];
+    double prev_phi = 3 * fmax(0, min3(la[0] + prev_s * (lb[0] - la[0]), la[1] + prev_s * (lb[1] - la[1]),
+                                       la[2] + prev_s * (lb[2] - la[2])));
+    for (int a = 1; a < n; a++) {
+        double sa = s[a];
+        double phi = 3 * fmax(0, min3(la[0] + sa * (lb[0] - la[0]), la[1] + sa * (lb[1] - la[1]),
+                                      la[2] + sa * (lb[2] - la[2])));
+        double ds = sa - prev_s;
+        sum0 += 0.5 * ds * (prev_phi + phi);
+        sum1 += ds / 6.0 * (prev_phi * (2 * prev_s + sa) + phi * (prev_s + 2 * sa));
+        prev_s = sa;
+        prev_phi = phi;
+    }
+    *i0 = sum0;
+    *i1 = sum1;
+    return sum0 > 0;
+}
+
+/* Forces of target t's potential on contactor c's edges, and their
+ * reactions on t. Returns 1 if any force acted. */
+static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_now *t,
+                                    double penalty, double friction, double havg)
+{
+    double lam[3][3];
+    for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
+    const double *v = m->vel, *inv_mass = m->inv_mass;
+    double *f = m->contact.force;
+    double inv_m_target = fmax(inv_mass[t->node[0]], fmax(inv_mass[t->node[1]], inv_mass[t->node[2]]));
+    int acted = 0;
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3;
+        double i0, i1;
+        if (!edge_potential_integral(lam[i], lam[j], &i0, &i1)) continue;
+        acted = 1;
+        double ex = c->x[j] - c->x[i], ey = c->y[j] - c->y[i];
+        double len = hypot(ex, ey);
+        double sbar = i1 / i0;
+        /* normal: -p * i0 * (length-scaled outward normal) */
+        double fx = -penalty * i0 * ey, fy = penalty * i0 * ex;
+        double lbar[3];
+        for (int k = 0; k < 3; k++) lbar[k] = lam[i][k] + sbar * (lam[j][k] - lam[i][k]);
+        int na = c->node[i], nb = c->node[j];
+        if (friction > 0 && len > 0) {
+            double tx = ex / len, ty = ey / len;
+            double vcx = (1 - sbar) * v[2 * na] + sbar * v[2 * nb];
+            double vcy = (1 - sbar) * v[2 * na + 1] + sbar * v[2 * nb + 1];
+            double vtx = 0, vty = 0;
+            for (int k = 0; k < 3; k++) {
+                vtx += lbar[k] * v[2 * t->node[k]];
+                vty += lbar[k] * v[2 * t->node[k] + 1];
+            }
+            double slip = (vcx - vtx) * tx + (vcy - vty) * ty;
+            double inv_m = fmax(inv_mass[na], inv_mass[nb]) + inv_m_target;
+            double stop = 0.5 * fabs(slip) / (inv_m * havg);
+            double ft = fmin(friction * penalty * i0 * len, stop);
+            if (slip > 0) ft = -ft;
+            fx += ft * tx;
+            fy += ft * ty;
+        }
+        f[2 * na] += (1 - sbar) * fx;
+        f[2 * na + 1] += (1 - sbar) * fy;
+        f[2 * nb] += sbar * fx;
+        f[2 * nb + 1] += sbar * fy;
+        for (int k = 0; k < 3; k++) {
+            f[2 * t->node[k]] -= lbar[k] * fx;
+            f[2 * t->node[k] + 1] -= lbar[k] * fy;
+        }
+    }
+    return acted;
+}
+
+static int boxes_overlap(const tri_now *a, const tri_now *b)
+{
+    double ax0 = min3(a->x[0], a->x[1], a->x[2]), ax1 = fmax(a->x[0], fmax(a->x[1], a->x[2]));
+    double bx0 = min3(b->x[0], b->x[1], b->x[2]), bx1 = fmax(b->x[0], fmax(b->x[1], b->x[2]));
+    if (ax1 < bx0 || bx1 < ax0) return 0;
+    double ay0 = min3(a->y[0], a->y[1], a->y[2]), ay1 = fmax(a->y[0], fmax(a->y[1], a->y[2]));
+    double by0 = min3(b->y[0], b->y[1], b->y[2]), by1 = fmax(b->y[0], fmax(b->y[1], b->y[2]));
+    return !(ay1 < by0 || by1 < ay0);
+}
+
+/* Force between two elements, both roles. Returns 1 if they touched. */
+int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
+{
+    tri_now a, b;
+    tri_gather(m, e1, &a);
+    tri_gather(m, e2, &b);
+    if (!boxes_overlap(&a, &b)) return 0;
+    if (!(a.area2 > 0) || !(b.area2 > 0)) return 0; /* inverted: no potential defined */
+    /* The softer surface sets the penalty; friction is the larger of the two,
+     * so giving it on one material is enough. */
+    double penalty = fmin(a.penalty, b.penalty);
+    double friction = fmax(a.friction, b.friction);
+    int touched = contactor_against_target(m, &a, &b, penalty, friction, havg);
+    touched |= contactor_against_target(m, &b, &a, penalty, friction, havg);
+    return touched;
+}
+
+static void element_circle(const fdem_model *m, int e, double *cx, double *cy, double *r)
+{
+    const element_hot *el = &m->elem[e];
+    const double *p = m->pos;
+    double x = 0, y = 0;
+    for (int c = 0; c < 3; c++) {
+        x += p[2 * el->node[c]];
+        y += p[2 * el->node[c] + 1];
+    }
+    x /= 3;
+    y /= 3;
+    double r2 = 0;
+    for (int c = 0; c < 3; c++) {
+        double dx = p[2 * el->node[c]] - x, dy = p[2 * el->node[c] + 1] - y;
+        r2 = fmax(r2, dx * dx + dy * dy);
+    }
+    *cx = x;
+    *cy = y;
+    *r = sqrt(r2);
+}
+
+static int contact_detect(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    for (int e = 0; e < m->elem_count; e++) {
+        element_circle(m, e, &cs->cx[e], &cs->cy[e], &cs->r[e]);
+        cs->r[e] += 0.5 * cs->buffer;
+    }
+    if (nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs))
+        return -1;
+    memcpy(cs->pos_detect, m->pos, sizeof(double) * 2 * (size_t)m->node_count);
+    cs->max_disp2 = 0;
+    cs->need_detect = 0;
+    cs->detections++;
+    return 0;
+}
+
+int contact_init(fdem_model *m, fdem_error *err)
+{
+    contact_state *cs = &m->contact;
+    int fracture = 0;
+    for (int k = 0; k < m->part_count; k++) fracture |= m->parts[k].fracture;
+    cs->enabled = m->part_count > 1 || fracture;
+    if (!cs->enabled) return 0;
+    size_t E = (size_t)m->elem_count, N = (size_t)m->node_count;
+    cs->cx = malloc(sizeof(double) * E);
+    cs->cy = malloc(sizeof(double) * E);
+    cs->r = malloc(sizeof(double) * E);
+    cs->body = malloc(sizeof(int32_t) * E);
+    cs->pos_detect = malloc(sizeof(double) * 2 * N);
+    cs->force = calloc(2 * N, sizeof(double));
+    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->pos_detect || !cs->force) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
+        return -1;
+    }
+    /* Triangles of one unbroken part never touch each other; those of a
+     * fracturing part each count as a body of their own. */
+    for (int e = 0; e < m->elem_count; e++) {
+        int p = m->elem_part[e];
+        cs->body[e] = m->parts[p].fracture ? m->part_count + e : p;
+    }
+    double rmax = 0;
+    for (int e = 0; e < m->elem_count; e++) {
+        double x, y, r;
+        element_circle(m, e, &x, &y, &r);
+        rmax = fmax(rmax, r);
+    }
+    cs->buffer = 0.4 * rmax;
+    cs->need_detect = 1;
+    return 0;
+}
+
+void contact_free(contact_state *cs)
+{
+    free(cs->cx); free(cs->cy); free(cs->r); free(cs->body);
+    free(cs->pos_detect); free(cs->force);
+    nbs_grid_free(&cs->grid);
+    nbs_pairs_free(&cs->pairs);
+    memset(cs, 0, sizeof *cs);
+}
+
+double contact_stable_dt(const fdem_model *m)
+{
+    if (!m->contact.enabled) return INFINITY;
+    /* A penalty p on an edge of an element of size h acts like a spring of
+     * about 9p/(rho h^2) per unit mass on each side; 0.45 h sqrt(rho/p)
+     * keeps both sides of the contact inside the central-difference limit. */
+    double dt = INFINITY;
+    for (int e = 0; e < m->elem_count; e++) {
+        const material *mat = &m->materials[m->elem[e].material];
+        dt = fmin(dt, 0.45 * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
+    }
+    return dt;
+}
+
+int contact_forces(fdem_model *m, double havg)
+{
+    contact_state *cs = &m->contact;
+    if (!cs->enabled) return 0;
+    double half = 0.5 * cs->buffer;
+    if (cs->need_detect || cs->max_disp2 > half * half)
+        if (contact_detect(m)) return -1;
+    memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    int touching = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++)
+        touching += contact_potential_force(m, cs->pairs.a[k], cs->pairs.b[k], havg);
+    cs->touching = touching;
+    return 0;
+}

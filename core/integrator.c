@@ -1,0 +1,104 @@
+/*
+ * integrator.c - the central difference scheme of seed eqs 5.9-5.11 and the
+ * order of one step: forces (elements, contact, gravity, applied), then the
+ * explicit update of every free degree of freedom, then the prescribed ones.
+ *
+ *   v_next = v_current + a_current (h_current + h_next) / 2
+ *   x_next = x_current + v_next h_next,        a = f / m
+ *
+ * Velocities live at half steps. h_current is the previous step size (0
+ * before the first step, which makes the first update the usual half-step
+ * start), so the step size may change from one step to the next.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "model.h"
+
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Updates every dof no constraint owns. Returns a sum of the new positions
+ * and velocities: non-finite if and only if some value is (cheaper than a
+ * test per value in the hot loop). */
+int central_difference_step(fdem_model *m, double h, double havg)
+{
+    const double gx = m->gravity[0], gy = m->gravity[1];
+    double *x = m->pos, *v = m->vel;
+    const double *f = m->force, *inv_mass = m->inv_mass;
+    const uint8_t *owned = m->dof_owned;
+    const double *fc = m->contact.enabled ? m->contact.force : NULL;
+    const double *xd = m->contact.enabled ? m->contact.pos_detect : NULL;
+    double check = 0, max_disp2 = m->contact.max_disp2, contact_work = 0;
+    for (int i = 0; i < m->node_count; i++) {
+        double fx = f[2 * i], fy = f[2 * i + 1];
+        if (fc) {
+            fx += fc[2 * i];
+            fy += fc[2 * i + 1];
+        }
+        unsigned own = owned[i];
+        if (!(own & 1u)) {
+            v[2 * i] += (fx * inv_mass[i] + gx) * havg;
+            x[2 * i] += v[2 * i] * h;
+        }
+        if (!(own & 2u)) {
+            v[2 * i + 1] += (fy * inv_mass[i] + gy) * havg;
+            x[2 * i + 1] += v[2 * i + 1] * h;
+        }
+        check += x[2 * i] + x[2 * i + 1] + v[2 * i] + v[2 * i + 1];
+        if (fc) {
+            contact_work += ((own & 1u) ? 0 : fc[2 * i] * v[2 * i] * h) +
+                            ((own & 2u) ? 0 : fc[2 * i + 1] * v[2 * i + 1] * h);
+            double ux = x[2 * i] - xd[2 * i], uy = x[2 * i + 1] - xd[2 * i + 1];
+            double d2 = ux * ux + uy * uy;
+            if (d2 > max_disp2) max_disp2 = d2;
+        }
+    }
+    m->contact.max_disp2 = max_disp2;
+    m->contact_work += contact_work;
+    return isfinite(check) ? 0 : -1;
+}
+
+/* Names the first node whose state is not finite and an element that uses it. */
+static void report_non_finite(fdem_model *m, double h, fdem_error *err)
+{
+    int node = -1;
+    for (int i = 0; i < m->node_count && node < 0; i++)
+        if (!isfinite(m->pos[2 * i]) || !isfinite(m->pos[2 * i + 1]) || !isfinite(m->vel[2 * i]) ||
+            !isfinite(m->vel[2 * i + 1]))
+            node = i;
+    int elem = node >= 0 ? element_of_node(m, node) : -1;
+    model_error(err, FDEM_ITEM_ELEMENT, elem,
+                "the solution became non-finite at step %lld (t = %.6g s) in element %d (node %d) "
+                "with dt = %.6g s; the stable step is %.6g s: reduce time.safety or check the "
+                "material stiffness, penalty and applied loads",
+                (long long)m->step + 1, m->time + h, elem, node, h, m->stable_dt);
+}
+
+int fdem_step(fdem_model *m, fdem_error *err)
+{
+    if (!m->finalized) {
+        model_error(err, FDEM_ITEM_NONE, -1, "the model is not finalized");
+        return -1;
+    }
+    double h = m->dt, havg = 0.5 * (m->dt_prev + h);
+    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    element_forces(m, h);
+    if (contact_forces(m, havg)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory in contact detection at step %lld",
+                    (long long)m->step + 1);
+        return -1;
+    }
+    constraint_apply_forces(m);
+    int bad = central_difference_step(m, h, havg);
+    constraint_enforce(m, h, havg);
+    if (bad || !isfinite(m->elastic_energy)) {
+        report_non_finite(m, h, err);
+        return -1;
+    }
+    m->dt_prev = h;
+    m->time += h;
+    m->step++;
+    return 0;
+}

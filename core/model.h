@@ -1,0 +1,136 @@
+/*
+ * model.h - the engine's one model struct and the internal contract between
+ * its stages (mesh, element, contact, constraint, integrator, checkpoint).
+ *
+ * Layout follows the hot/cold split: what the per-step loops read and write
+ * (positions, velocities, forces, inverse masses, the 64-byte element record)
+ * sits in contiguous arrays of plain numbers; what only set-up, output and
+ * checkpoints touch (initial positions, masses, part ids) lives beside them.
+ * Nothing in a step allocates.
+ */
+#ifndef FDEM_MODEL_H
+#define FDEM_MODEL_H
+
+#include <stdint.h>
+
+#include "fdem.h"
+#include "nbs.h"
+
+typedef struct material {
+    fdem_material_def def;
+    double lambda, mu;   /* Lame constants (plane strain uses the 3D ones) */
+    double penalty;      /* resolved: def.penalty or 10 * young */
+} material;
+
+/* Hot per-element record: exactly one cache line. */
+typedef struct element_hot {
+    int32_t node[3];     /* counter-clockwise */
+    int32_t material;
+    double xinv[4];      /* inverse of the initial edge matrix [X1-X0, X2-X0], row-major */
+    double area0;        /* initial area */
+    double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
+} element_hot;
+
+typedef struct part {
+    int material;
+    int fracture;
+    int node_begin, node_count;
+    int elem_begin, elem_count;
+} part;
+
+/* One constraint after node selection. Its nodes are entries
+ * [entry_begin, entry_begin + entry_count) of model.cnode / model.cdof. */
+typedef struct constraint {
+    fdem_constraint_def def;
+    int entry_begin, entry_count;
+    double force[2];     /* reaction (fix, velocity) or applied (force) of the last step */
+} constraint;
+
+typedef struct contact_state {
+    int enabled;             /* some pair of elements can ever touch */
+    double buffer;           /* added to circle diameters; re-detect after buffer/2 */
+    double max_disp2;        /* largest squared node displacement since detection */
+    int need_detect;
+    long detections;
+    int touching;            /* pairs with non-zero force in the last step */
+    double *cx, *cy, *r;     /* bounding circles, one per element */
+    double *pos_detect;      /* node positions at the last detection */
+    double *force;           /* contact force per node (kept apart for its work) */
+    int32_t *body;           /* body id per element: pairs of one body never touch */
+    nbs_grid grid;
+    nbs_pairs pairs;
+} contact_state;
+
+struct fdem_model {
+    int finalized;
+
+    /* nodes: hot */
+    int node_count, node_capacity;
+    double *pos, *vel, *force, *inv_mass;
+    /* nodes: cold */
+    double *pos0, *mass;
+    int32_t *node_part;
+    uint8_t *dof_owned;      /* bit 0: x, bit 1: y prescribed by some constraint */
+
+    /* elements */
+    int elem_count, elem_capacity;
+    element_hot *elem;
+    int32_t *elem_part;
+    int32_t *tri;            /* 3 nodes per element, packed (cold copy for output) */
+    double *elem_h;          /* smallest altitude of the initial triangle */
+
+    int material_count, material_capacity;
+    material *materials;
+    int part_count, part_capacity;
+    part *parts;
+    double *part_velocity;   /* 2 per part, applied at finalize */
+
+    int constraint_count, constraint_capacity;
+    constraint *constraints;
+    int cnode_count;
+    int32_t *cnode;          /* node of each constraint entry */
+    uint8_t *cdof;           /* dofs this entry owns (bit 0 x, bit 1 y) */
+    double *constraint_force_out; /* 2 per constraint, for fdem_constraint_forces */
+
+    /* joints (fracture); joint_count == 0 when no part fractures */
+    int joint_count;
+    int32_t *joint_node;     /* 4 per joint */
+    double *joint_damage;
+
+    double gravity[2];
+    double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
+    int64_t step;
+    double time;
+    double stable_dt;
+
+    /* energy accumulators (see fdem_energy) */
+    double elastic_energy;   /* of the last force evaluation */
+    double contact_work;     /* work done by contact forces (negative when storing) */
+    double damping_work;     /* energy dissipated by viscous damping */
+    double external_work;
+
+    contact_state contact;
+};
+
+/* element.c */
+void element_prepare(fdem_model *m, int e);
+double element_stable_dt(const fdem_model *m, int e);
+void element_forces(fdem_model *m, double dt);
+void element_stress_one(const fdem_model *m, int e, double out[3]);
+int element_of_node(const fdem_model *m, int node);
+
+/* contact.c */
+int contact_init(fdem_model *m, fdem_error *err);
+void contact_free(contact_state *c);
+double contact_stable_dt(const fdem_model *m);
+int contact_forces(fdem_model *m, double havg);
+
+/* constraint.c */
+int constraint_select(fdem_model *m, fdem_error *err);
+void constraint_apply_forces(fdem_model *m);
+void constraint_enforce(fdem_model *m, double h, double havg);
+
+/* integrator.c */
+int central_difference_step(fdem_model *m, double h, double havg);
+
+#endif
