@@ -1,0 +1,157 @@
+/*
+ * http.c - the one place fdemctl touches libcurl: a request returning
+ * status + body, and a download streaming into a FILE.
+ *
+ * Each call builds and frees its own easy handle: fdemctl makes a handful of
+ * requests per run, so connection reuse is not worth shared mutable state.
+ */
+#include <stdlib.h>
+#include <string.h>
+#include <curl/curl.h>
+#include "fdemctl.h"
+
+typedef struct body_buffer {
+    char *data;
+    size_t length, capacity;
+    int out_of_memory;
+} body_buffer;
+
+static size_t http_collect(char *chunk, size_t size, size_t count, void *user)
+{
+    body_buffer *b = user;
+    size_t n = size * count;
+    if (b->length + n + 1 > b->capacity) {
+        size_t capacity = b->capacity ? b->capacity : 4096;
+        while (capacity < b->length + n + 1) capacity *= 2;
+        char *grown = realloc(b->data, capacity);
+        if (!grown) { b->out_of_memory = 1; return 0; }
+        b->data = grown;
+        b->capacity = capacity;
+    }
+    memcpy(b->data + b->length, chunk, n);
+    b->length += n;
+    b->data[b->length] = '\0';
+    return n;
+}
+
+static size_t http_to_file(char *chunk, size_t size, size_t count, void *user)
+{
+    return fwrite(chunk, size, count, (FILE *)user) * size;
+}
+
+static struct curl_slist *http_headers(const ctl_options *o, int has_json_body)
+{
+    struct curl_slist *h = NULL;
+    h = curl_slist_append(h, "Accept: application/json, application/problem+json, */*");
+    if (has_json_body) h = curl_slist_append(h, "Content-Type: application/json");
+    if (o->token && o->token[0]) {
+        char line[1024];
+        snprintf(line, sizeof line, "Authorization: Bearer %s", o->token);
+        h = curl_slist_append(h, line);
+    }
+    return h;
+}
+
+/* Common set-up of a handle; the caller adds the method and body. */
+static CURL *http_open(const ctl_options *o, const char *path, char *errbuf)
+{
+    CURL *c = curl_easy_init();
+    if (!c) return NULL;
+    size_t n = strlen(o->server) + strlen(path) + 1;
+    char *url = malloc(n);
+    if (!url) { curl_easy_cleanup(c); return NULL; }
+    snprintf(url, n, "%s%s", o->server, path);
+    curl_easy_setopt(c, CURLOPT_URL, url);
+    free(url);  /* libcurl copies the URL string */
+    curl_easy_setopt(c, CURLOPT_NOSIGNAL, 1L);
+    curl_easy_setopt(c, CURLOPT_CONNECTTIMEOUT, 10L);
+    curl_easy_setopt(c, CURLOPT_ERRORBUFFER, errbuf);
+    curl_easy_setopt(c, CURLOPT_USERAGENT, "fdemctl/1");
+    errbuf[0] = '\0';
+    return c;
+}
+
+/* Runs the transfer and fills status or the transport error. */
+static int http_perform(CURL *c, const char *errbuf, http_response *out)
+{
+    CURLcode rc = curl_easy_perform(c);
+    if (rc != CURLE_OK) {
+        snprintf(out->error, sizeof out->error, "%s",
+                 errbuf[0] ? errbuf : curl_easy_strerror(rc));
+        out->status = 0;
+        return -1;
+    }
+    curl_easy_getinfo(c, CURLINFO_RESPONSE_CODE, &out->status);
+    return 0;
+}
+
+int http_request(const ctl_options *o, const char *method, const char *path,
+                 const char *body, size_t body_length, http_response *out)
+{
+    char errbuf[CURL_ERROR_SIZE];
+    body_buffer b = {0};
+    memset(out, 0, sizeof *out);
+    CURL *c = http_open(o, path, errbuf);
+    if (!c) { snprintf(out->error, sizeof out->error, "out of memory"); return -1; }
+
+    int is_post = strcmp(method, "POST") == 0;
+    struct curl_slist *h = http_headers(o, is_post && body);
+    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
+    if (is_post) {
+        /* An empty POST still sends Content-Length: 0 (the server answers
+         * 411 to a body without a length). */
+        curl_easy_setopt(c, CURLOPT_POSTFIELDSIZE_LARGE, (curl_off_t)(body ? body_length : 0));
+        curl_easy_setopt(c, CURLOPT_POSTFIELDS, body ? body : "");
+    } else if (strcmp(method, "GET") != 0) {
+        curl_easy_setopt(c, CURLOPT_CUSTOMREQUEST, method);
+    }
+    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, http_collect);
+    curl_easy_setopt(c, CURLOPT_WRITEDATA, &b);
+
+    int rc = http_perform(c, errbuf, out);
+    if (b.out_of_memory) {
+        snprintf(out->error, sizeof out->error, "out of memory reading the answer");
+        out->status = 0;
+        rc = -1;
+    }
+    curl_slist_free_all(h);
+    curl_easy_cleanup(c);
+    if (rc != 0) { free(b.data); return -1; }
+    out->body = b.data ? b.data : calloc(1, 1);
+    out->length = b.length;
+    if (!out->body) { snprintf(out->error, sizeof out->error, "out of memory"); return -1; }
+    return 0;
+}
+
+int http_download(const ctl_options *o, const char *path, FILE *sink, http_response *out)
+{
+    char errbuf[CURL_ERROR_SIZE];
+    memset(out, 0, sizeof *out);
+    CURL *c = http_open(o, path, errbuf);
+    if (!c) { snprintf(out->error, sizeof out->error, "out of memory"); return -1; }
+    struct curl_slist *h = http_headers(o, 0);
+    curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
+    curl_easy_setopt(c, CURLOPT_WRITEFUNCTION, http_to_file);
+    curl_easy_setopt(c, CURLOPT_WRITEDATA, sink);
+    int rc = http_perform(c, errbuf, out);
+    curl_slist_free_all(h);
+    curl_easy_cleanup(c);
+    return rc;
+}
+
+void http_response_free(http_response *r)
+{
+    free(r->body);
+    r->body = NULL;
+    r->length = 0;
+}
+
+int http_case_path(char *out, size_t size, const char *id, const char *suffix)
+{
+    /* Escaped so an id typed by a user can never change the path. */
+    char *escaped = curl_easy_escape(NULL, id, 0);
+    if (!escaped) return -1;
+    int n = snprintf(out, size, "/cases/%s%s", escaped, suffix ? suffix : "");
+    curl_free(escaped);
+    return (n < 0 || (size_t)n >= size) ? -1 : 0;
+}
