@@ -37,6 +37,8 @@ result_file *result_reopen(const char *path, const fdem_model *model,
 int result_append(result_file *f, const snapshot *s, char *err, size_t errlen);
 int result_copy(result_file *f, const char *dst_path, char *err, size_t errlen);
 int result_snapshot_count(const result_file *f);
+/* Simulated time of complete snapshot `index` (NAN when out of range). */
+double result_snapshot_time(const result_file *f, int index);
 int result_close(result_file *f);
 
 /* h5_name is the .h5 file name as the .xdmf refers to it (same folder). */

@@ -1,0 +1,197 @@
+/*
+ * result_xdmf.c - the result.xdmf sidecar that lets ParaView open result.h5
+ * as a time series (XDMF2, read by ParaView's "XDMF Reader").
+ *
+ * Layout: a Temporal collection with one Uniform grid per complete snapshot.
+ * Every grid shares /mesh/triangles as its Triangle topology; its XY
+ * geometry and node/cell attributes are HyperSlab DataItems that pick row s
+ * out of the (S, ...) datasets, so the sidecar holds no numbers of its own
+ * and stays small.
+ *
+ * Choices ParaView dictates:
+ *  - velocity is a Node "Vector" with 2 components; VTK's XDMF2 reader pads
+ *    2-component vectors with z = 0, so glyphs work.
+ *  - stress is written as three Cell scalars stress_xx, stress_yy, stress_xy
+ *    (hyperslabs picking one component each) rather than a fake 3-vector
+ *    whose magnitude would mean nothing.
+ *  - damage lives on joints, which are not cells of the triangle mesh, so it
+ *    is left out of the sidecar (it is in result.h5).
+ *  - node_part and element_part are static attributes from /mesh, handy for
+ *    colouring bodies.
+ *
+ * The file is rewritten whole into path.tmp, synced, then renamed, so a
+ * reader never sees a half-written sidecar.
+ */
+#include "result.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+typedef struct xdmf_ctx {
+    FILE *out;
+    char h5[1024]; /* XML-escaped file name the DataItems refer to */
+    long nodes, elements;
+    int snapshots;
+    unsigned fields;
+} xdmf_ctx;
+
+static void xml_escape(char *out, size_t size, const char *in)
+{
+    size_t n = 0;
+    for (; *in && n + 7 < size; in++) {
+        const char *rep = NULL;
+        switch (*in) {
+        case '&': rep = "&amp;"; break;
+        case '<': rep = "&lt;"; break;
+        case '>': rep = "&gt;"; break;
+        case '"': rep = "&quot;"; break;
+        }
+        if (rep) {
+            size_t len = strlen(rep);
+            memcpy(out + n, rep, len);
+            n += len;
+        } else {
+            out[n++] = *in;
+        }
+    }
+    out[n] = '\0';
+}
+
+/* A whole /mesh dataset. */
+static void xdmf_mesh_item(const xdmf_ctx *x, const char *dims, const char *number_type,
+                           int precision, const char *dataset)
+{
+    fprintf(x->out,
+            "        <DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
+            "Format=\"HDF\">%s:/mesh/%s</DataItem>\n",
+            dims, number_type, precision, x->h5, dataset);
+}
+
+/* Row `s` (and, when width_pick >= 0, only that component) of a
+ * (S, rows, width) /snapshots dataset. */
+static void xdmf_row_item(const xdmf_ctx *x, int s, long rows, int width, int width_pick,
+                          const char *dataset)
+{
+    int pick = width_pick >= 0;
+    if (pick)
+        fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld\" "
+                "Type=\"HyperSlab\">\n", rows);
+    else
+        fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld %d\" "
+                "Type=\"HyperSlab\">\n", rows, width);
+    fprintf(x->out,
+            "          <DataItem Dimensions=\"3 3\" NumberType=\"Int\" Format=\"XML\">"
+            "%d 0 %d  1 1 1  1 %ld %d</DataItem>\n",
+            s, pick ? width_pick : 0, rows, pick ? 1 : width);
+    fprintf(x->out,
+            "          <DataItem Dimensions=\"%d %ld %d\" NumberType=\"Float\" Precision=\"8\" "
+            "Format=\"HDF\">%s:/snapshots/%s</DataItem>\n",
+            x->snapshots, rows, width, x->h5, dataset);
+    fprintf(x->out, "        </DataItem>\n");
+}
+
+static void xdmf_grid(const xdmf_ctx *x, int s, double time)
+{
+    char dims[64];
+    fprintf(x->out, "    <Grid Name=\"snapshot %d\" GridType=\"Uniform\">\n", s);
+    fprintf(x->out, "      <Time Value=\"%.17g\"/>\n", time);
+
+    fprintf(x->out, "      <Topology TopologyType=\"Triangle\" NumberOfElements=\"%ld\">\n",
+            x->elements);
+    snprintf(dims, sizeof dims, "%ld 3", x->elements);
+    xdmf_mesh_item(x, dims, "Int", 4, "triangles");
+    fprintf(x->out, "      </Topology>\n");
+
+    fprintf(x->out, "      <Geometry GeometryType=\"XY\">\n");
+    if (x->fields & CASE_FIELD_POSITION) {
+        xdmf_row_item(x, s, x->nodes, 2, -1, "position");
+    } else {
+        snprintf(dims, sizeof dims, "%ld 2", x->nodes);
+        xdmf_mesh_item(x, dims, "Float", 8, "position0");
+    }
+    fprintf(x->out, "      </Geometry>\n");
+
+    if (x->fields & CASE_FIELD_VELOCITY) {
+        fprintf(x->out, "      <Attribute Name=\"velocity\" AttributeType=\"Vector\" "
+                "Center=\"Node\">\n");
+        xdmf_row_item(x, s, x->nodes, 2, -1, "velocity");
+        fprintf(x->out, "      </Attribute>\n");
+    }
+    if (x->fields & CASE_FIELD_STRESS) {
+        static const char *const names[3] = {"stress_xx", "stress_yy", "stress_xy"};
+        for (int k = 0; k < 3; k++) {
+            fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
+                    "Center=\"Cell\">\n", names[k]);
+            xdmf_row_item(x, s, x->elements, 3, k, "stress");
+            fprintf(x->out, "      </Attribute>\n");
+        }
+    }
+    fprintf(x->out, "      <Attribute Name=\"node_part\" AttributeType=\"Scalar\" "
+            "Center=\"Node\">\n");
+    snprintf(dims, sizeof dims, "%ld", x->nodes);
+    xdmf_mesh_item(x, dims, "Int", 4, "node_part");
+    fprintf(x->out, "      </Attribute>\n");
+    fprintf(x->out, "      <Attribute Name=\"element_part\" AttributeType=\"Scalar\" "
+            "Center=\"Cell\">\n");
+    snprintf(dims, sizeof dims, "%ld", x->elements);
+    xdmf_mesh_item(x, dims, "Int", 4, "element_part");
+    fprintf(x->out, "      </Attribute>\n");
+    fprintf(x->out, "    </Grid>\n");
+}
+
+static void xdmf_document(const xdmf_ctx *x, const result_file *f, const char *name)
+{
+    fprintf(x->out, "<?xml version=\"1.0\" ?>\n");
+    fprintf(x->out, "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n");
+    fprintf(x->out, "<Xdmf Version=\"2.0\">\n");
+    fprintf(x->out, "  <Domain>\n");
+    fprintf(x->out, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+            name);
+    for (int s = 0; s < x->snapshots; s++) xdmf_grid(x, s, result_snapshot_time(f, s));
+    fprintf(x->out, "  </Grid>\n");
+    fprintf(x->out, "  </Domain>\n");
+    fprintf(x->out, "</Xdmf>\n");
+}
+
+int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *model,
+               const case_info *info, const result_file *f, char *err, size_t errlen)
+{
+    if (!xdmf_path || !h5_name || !model || !info || !f) {
+        snprintf(err, errlen, "xdmf_write: missing path, file name, model, case info or file");
+        return -1;
+    }
+    fdem_counts counts = fdem_get_counts(model);
+    xdmf_ctx x = {.nodes = counts.nodes, .elements = counts.elements,
+                  .snapshots = result_snapshot_count(f), .fields = info->fields};
+    xml_escape(x.h5, sizeof x.h5, h5_name);
+    char name[512];
+    xml_escape(name, sizeof name, info->name[0] ? info->name : "fdem");
+
+    char tmp[4096];
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", xdmf_path) >= sizeof tmp) {
+        snprintf(err, errlen, "XDMF path too long: %s", xdmf_path);
+        return -1;
+    }
+    x.out = fopen(tmp, "w");
+    if (!x.out) {
+        snprintf(err, errlen, "cannot create %s: %s", tmp, strerror(errno));
+        return -1;
+    }
+    xdmf_document(&x, f, name);
+    int failed = ferror(x.out) || fflush(x.out) != 0 || fsync(fileno(x.out)) != 0;
+    int saved = errno;
+    if (fclose(x.out) != 0) failed = 1;
+    if (failed) {
+        snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(saved));
+        unlink(tmp);
+        return -1;
+    }
+    if (rename(tmp, xdmf_path) != 0) {
+        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, xdmf_path, strerror(errno));
+        unlink(tmp);
+        return -1;
+    }
+    return 0;
+}

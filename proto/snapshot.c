@@ -1,0 +1,97 @@
+/*
+ * snapshot.c - copies a model's state at one step boundary into plain
+ * buffers the caller owns.
+ *
+ * Why a copy: the worker thread keeps stepping while the I/O thread writes
+ * the copy to HDF5 or an HTTP thread turns it into JSON, and the engine's
+ * accessors only stay valid until the next fdem_step().
+ *
+ * Damage is copied whenever the model has joints, requested or not, because
+ * the result file stores it for every fracturing model (contract section 4);
+ * the CASE_FIELD_DAMAGE bit in `fields` says whether the caller asked for it
+ * (state_to_json shows only what was asked for).
+ */
+#include "snapshot.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "case.h"
+
+/* malloc + memcpy of `count` doubles; a zero count gives NULL, not an error. */
+static double *copy_doubles(const double *src, size_t count, int *failed)
+{
+    if (count == 0 || !src) return NULL;
+    double *dst = malloc(count * sizeof *dst);
+    if (!dst) {
+        *failed = 1;
+        return NULL;
+    }
+    memcpy(dst, src, count * sizeof *dst);
+    return dst;
+}
+
+static double *copy_stress(const fdem_model *model, size_t elements, int *failed)
+{
+    if (elements == 0) return NULL;
+    double *dst = malloc(3 * elements * sizeof *dst);
+    if (!dst) {
+        *failed = 1;
+        return NULL;
+    }
+    fdem_element_stress(model, dst);
+    return dst;
+}
+
+snapshot *snapshot_take(const fdem_model *model, unsigned fields)
+{
+    if (!model) return NULL;
+    snapshot *s = calloc(1, sizeof *s);
+    if (!s) return NULL;
+
+    fdem_counts counts = fdem_get_counts(model);
+    s->step = fdem_get_step(model);
+    s->time = fdem_get_time(model);
+    s->nodes = counts.nodes;
+    s->elements = counts.elements;
+    s->joints = counts.joints;
+    s->constraints = counts.constraints;
+    s->energy = fdem_get_energy(model);
+
+    int failed = 0;
+    size_t nodes = (size_t)counts.nodes, elements = (size_t)counts.elements;
+    if (fields & CASE_FIELD_POSITION) {
+        s->position = copy_doubles(fdem_positions(model), 2 * nodes, &failed);
+        if (s->position) s->fields |= CASE_FIELD_POSITION;
+    }
+    if (fields & CASE_FIELD_VELOCITY) {
+        s->velocity = copy_doubles(fdem_velocities(model), 2 * nodes, &failed);
+        if (s->velocity) s->fields |= CASE_FIELD_VELOCITY;
+    }
+    if (fields & CASE_FIELD_STRESS) {
+        s->stress = copy_stress(model, elements, &failed);
+        if (s->stress) s->fields |= CASE_FIELD_STRESS;
+    }
+    if (counts.joints > 0) {
+        s->damage = copy_doubles(fdem_joint_damage(model), (size_t)counts.joints, &failed);
+        if (s->damage && (fields & CASE_FIELD_DAMAGE)) s->fields |= CASE_FIELD_DAMAGE;
+    }
+    s->constraint_force = copy_doubles(fdem_constraint_forces(model),
+                                       2 * (size_t)counts.constraints, &failed);
+    if (failed) {
+        snapshot_free(s);
+        return NULL;
+    }
+    return s;
+}
+
+void snapshot_free(snapshot *s)
+{
+    if (!s) return;
+    free(s->position);
+    free(s->velocity);
+    free(s->stress);
+    free(s->damage);
+    free(s->constraint_force);
+    free(s);
+}
