@@ -1,0 +1,292 @@
+"""fdemd_client - a Python client for the fdemd simulation daemon.
+
+Standard library only (urllib.request, json), so it runs wherever Python 3
+does. It speaks the HTTP API of CONTRACT.md section 2::
+
+    from fdemd_client import Client, FdemdError
+
+    c = Client()                       # FDEMD_URL / FDEMD_TOKEN, else localhost:8080
+    case_id = c.submit("examples/collision.json", start=True)
+    final = c.wait(case_id, callback=lambda s: print(s["progress"]))
+    h5, xdmf = c.fetch(case_id, "collision.h5")
+
+Every refusal of the server raises FdemdError carrying the problem details
+(status, title, detail and the list of {"pointer", "message"} errors), so a
+script can show the user exactly where their case document is wrong.
+"""
+
+import json
+import os
+import re
+import time
+import urllib.error
+import urllib.parse
+import urllib.request
+
+__all__ = ["Client", "FdemdError", "FdemdConnectionError", "DEFAULT_URL"]
+
+DEFAULT_URL = "http://127.0.0.1:8080"
+TERMINAL_STATES = ("finished", "failed", "stopped")
+
+# The server's result.xdmf names its data "result.h5:/path"; a saved copy
+# must name the .h5 file it was saved beside (see Client.fetch).
+_XDMF_H5_REFERENCE = re.compile(r"""[^\s<>"']*result\.h5(?=:)""")
+
+
+class FdemdError(Exception):
+    """A request the server refused (or a case that ended badly).
+
+    Attributes:
+        status: the HTTP status (0 when the server could not be reached,
+            None for a case that failed or was stopped, see Client.wait).
+        title, detail: the problem details' title and detail.
+        errors: list of {"pointer": JSON Pointer, "message": str}.
+        case_status: for a failed/stopped case, its final status object.
+    """
+
+    def __init__(self, status, title, detail="", errors=None, case_status=None):
+        self.status = status
+        self.title = title
+        self.detail = detail or ""
+        self.errors = list(errors or [])
+        self.case_status = case_status
+        super().__init__(str(self))
+
+    def __str__(self):
+        head = self.title if self.status is None else "%s (HTTP %s)" % (self.title, self.status)
+        lines = [head]
+        if self.detail:
+            lines.append("  " + self.detail)
+        for e in self.errors:
+            lines.append("  %s: %s" % (e.get("pointer") or "(document)", e.get("message", "")))
+        return "\n".join(lines)
+
+
+class FdemdConnectionError(FdemdError, ConnectionError):
+    """The server could not be reached at all (status 0)."""
+
+
+class Client:
+    """A connection to one fdemd server.
+
+    Args:
+        url: base URL; default the FDEMD_URL environment variable, else
+            http://127.0.0.1:8080.
+        token: bearer token; default FDEMD_TOKEN (needed when the daemon was
+            started with --token).
+        timeout: seconds to wait for any single request.
+    """
+
+    def __init__(self, url=None, token=None, timeout=60.0):
+        self.url = (url or os.environ.get("FDEMD_URL") or DEFAULT_URL).rstrip("/")
+        self.token = token if token is not None else (os.environ.get("FDEMD_TOKEN") or None)
+        self.timeout = timeout
+
+    # ----------------------------------------------------------- transport
+
+    def _open(self, method, path, body=None):
+        """Sends one request; returns the open response or raises FdemdError."""
+        headers = {"Accept": "application/json, application/problem+json, */*"}
+        if body is not None:
+            headers["Content-Type"] = "application/json"
+        if self.token:
+            headers["Authorization"] = "Bearer " + self.token
+        if method == "POST" and body is None:
+            body = b""  # an explicit Content-Length: 0 (the server wants a length)
+        request = urllib.request.Request(self.url + path, data=body, method=method,
+                                         headers=headers)
+        try:
+            return urllib.request.urlopen(request, timeout=self.timeout)
+        except urllib.error.HTTPError as e:
+            raise _problem_from(e.code, e.read()) from None
+        except (urllib.error.URLError, OSError) as e:
+            reason = getattr(e, "reason", e)
+            raise FdemdConnectionError(
+                0, "Cannot reach fdemd",
+                "could not reach the fdemd server at %s%s (%s); is it running?"
+                % (self.url, path, reason)) from None
+
+    def _json(self, method, path, body=None):
+        """Request whose answer is JSON (None for 204)."""
+        with self._open(method, path, body) as response:
+            data = response.read()
+            if response.status == 204 or not data:
+                return None
+            return json.loads(data)
+
+    @staticmethod
+    def _case_path(case_id, suffix=""):
+        return "/cases/" + urllib.parse.quote(str(case_id), safe="") + suffix
+
+    # ------------------------------------------------------------- the API
+
+    def health(self):
+        """GET /health: {"status": "ok", "version", "cases", "running"}."""
+        return self._json("GET", "/health")
+
+    def submit(self, case, start=False):
+        """Uploads a case and returns its id.
+
+        Args:
+            case: a dict (the case document), bytes (its JSON text), or the
+                path of a JSON file.
+            start: also start it (POST /cases?start=true).
+        Raises:
+            FdemdError: 422 with one error per problem for an invalid case,
+                400 for malformed JSON.
+        """
+        if isinstance(case, dict):
+            body = json.dumps(case).encode("utf-8")
+        elif isinstance(case, (bytes, bytearray)):
+            body = bytes(case)
+        else:
+            with open(case, "rb") as f:
+                body = f.read()
+        path = "/cases?start=true" if start else "/cases"
+        return self._json("POST", path, body)["id"]
+
+    def list(self):
+        """All cases' status objects, oldest first."""
+        return self._json("GET", "/cases")["cases"]
+
+    def status(self, case_id):
+        """The status object of one case (state, step, time, progress, ...)."""
+        return self._json("GET", self._case_path(case_id))
+
+    def start(self, case_id):
+        """created or paused -> running; returns the status."""
+        return self._json("POST", self._case_path(case_id, "/start"))
+
+    def pause(self, case_id):
+        """running -> paused at the next step boundary; returns the status."""
+        return self._json("POST", self._case_path(case_id, "/pause"))
+
+    def stop(self, case_id):
+        """Any non-terminal state -> stopped (results kept); returns the status."""
+        return self._json("POST", self._case_path(case_id, "/stop"))
+
+    def delete(self, case_id):
+        """Stops the case if needed and removes it and its files."""
+        self._json("DELETE", self._case_path(case_id))
+
+    def case(self, case_id):
+        """The case document as uploaded, parsed."""
+        return self._json("GET", self._case_path(case_id, "/case"))
+
+    def state(self, case_id, fields=None):
+        """The current state, taken at one step boundary.
+
+        Args:
+            fields: names among "position", "velocity", "stress", "damage"
+                (a list or a comma-separated string); None = server default.
+        Returns:
+            {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
+            per node, stress [[sxx, syy, sxy], ...] per element, damage per
+            joint.
+        """
+        suffix = "/state"
+        if fields:
+            if not isinstance(fields, str):
+                fields = ",".join(fields)
+            suffix += "?fields=" + urllib.parse.quote(fields, safe=",")
+        return self._json("GET", self._case_path(case_id, suffix))
+
+    def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
+        """Polls until the case is finished, failed or stopped.
+
+        Args:
+            callback: called with every status object polled (the last one
+                included), e.g. to draw progress.
+            interval: seconds between polls.
+            raise_on_failure: raise FdemdError (status None, the case's
+                error as detail, case_status set) when the case ends failed
+                or stopped instead of returning its status.
+            timeout: give up after this many seconds (raises TimeoutError).
+        Returns:
+            the final status object.
+        """
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while True:
+            s = self.status(case_id)
+            if callback is not None:
+                callback(s)
+            if s.get("state") in TERMINAL_STATES:
+                break
+            if deadline is not None and time.monotonic() > deadline:
+                raise TimeoutError("case %s still %s after %g s" % (case_id, s.get("state"), timeout))
+            time.sleep(interval)
+        if raise_on_failure and s["state"] != "finished":
+            detail = s.get("error") or "stopped at step %s, t = %s s" % (s.get("step"), s.get("time"))
+            raise FdemdError(None, "Case %s %s" % (case_id, s["state"]), detail, case_status=s)
+        return s
+
+    def fetch(self, case_id, path=None):
+        """Downloads result.h5 to `path` and the XDMF sidecar beside it.
+
+        The XDMF gets the same stem (``run.h5`` -> ``run.xdmf``) and its
+        references to "result.h5" are rewritten to the saved file's name, so
+        ParaView opens the .xdmf directly. Files are written to "<path>.part"
+        first and renamed, so an interrupted download leaves no truncated
+        result. Works while the case runs (every snapshot written so far).
+
+        Args:
+            path: where to save the .h5 (default "<name>.h5", else "<id>.h5").
+        Returns:
+            (h5_path, xdmf_path)
+        """
+        if path is None:
+            name = self.status(case_id).get("name") or str(case_id)
+            path = re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".") + ".h5"
+        path = os.fspath(path)
+        stem = re.sub(r"\.(h5|hdf5|hdf)$", "", path)
+        xdmf_path = stem + ".xdmf"
+
+        with self._open("GET", self._case_path(case_id, "/result.h5")) as response:
+            _save_stream(response, path)
+        with self._open("GET", self._case_path(case_id, "/result.xdmf")) as response:
+            text = response.read().decode("utf-8")
+        name = _xml_escape(os.path.basename(path))
+        text = _XDMF_H5_REFERENCE.sub(lambda m: name, text)
+        _save_bytes(text.encode("utf-8"), xdmf_path)
+        return path, xdmf_path
+
+
+# ---------------------------------------------------------------- helpers
+
+def _problem_from(status, body):
+    """FdemdError from an error answer (problem details, or anything else)."""
+    try:
+        doc = json.loads(body)
+    except ValueError:
+        doc = None
+    if isinstance(doc, dict) and ("title" in doc or "detail" in doc):
+        return FdemdError(status, doc.get("title") or "Request refused",
+                          doc.get("detail") or "", doc.get("errors") or [])
+    text = body.decode("utf-8", "replace")[:300] if body else ""
+    return FdemdError(status, "Request refused", text)
+
+
+def _save_stream(response, path):
+    part = path + ".part"
+    try:
+        with open(part, "wb") as f:
+            while True:
+                chunk = response.read(1 << 20)
+                if not chunk:
+                    break
+                f.write(chunk)
+        os.replace(part, path)
+    finally:
+        if os.path.exists(part):
+            os.remove(part)
+
+
+def _save_bytes(data, path):
+    part = path + ".part"
+    with open(part, "wb") as f:
+        f.write(data)
+    os.replace(part, path)
+
+
+def _xml_escape(text):
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
