@@ -1,0 +1,144 @@
+#!/usr/bin/python3
+"""generate.py - writes the example case documents of this folder.
+
+    /usr/bin/python3 examples/generate.py
+
+The JSON files are committed, so this is only needed to change them: it keeps
+the layouts that are tedious by hand (the 30 discs of disc-pile.json) and the
+gmsh mesh of gmsh-plate.json (made from gmsh-plate.geo with the installed
+`gmsh -2 -format msh22`) reproducible. Numbers are written the way a person
+would type them (3e10, not 30000000000.0).
+"""
+import json
+import math
+import os
+import subprocess
+import tempfile
+
+OUT = os.path.dirname(os.path.abspath(__file__))
+
+
+def gmsh_text(geo):
+    """The ASCII msh 2.2 text gmsh makes from a .geo file."""
+    with tempfile.TemporaryDirectory() as tmp:
+        msh = os.path.join(tmp, "mesh.msh")
+        subprocess.run(["gmsh", "-2", "-format", "msh22", geo, "-o", msh],
+                       check=True, stdout=subprocess.DEVNULL)
+        with open(msh) as f:
+            return f.read()
+
+def number(v):
+    if isinstance(v, bool) or v is None:
+        return json.dumps(v)
+    if isinstance(v, float) and v != 0 and (abs(v) >= 1e5 or abs(v) < 1e-3):
+        return ("%g" % v).replace("e+", "e").replace("e0", "e").replace("e-0", "e-")
+    return json.dumps(v)
+def fmt(v, ind=0):
+    pad = "  " * (ind + 1)
+    if isinstance(v, dict):
+        items = [pad + json.dumps(k) + ": " + fmt(x, ind + 1) for k, x in v.items()]
+        return "{\n" + ",\n".join(items) + "\n" + "  " * ind + "}"
+    if isinstance(v, list):
+        if all(not isinstance(x, (dict, list)) for x in v) or all(
+                isinstance(x, list) and not any(isinstance(y, (dict, list)) for y in x) for x in v) and len(v) < 8:
+            return "[" + ", ".join(fmt(x, ind) for x in v) + "]"
+        return "[\n" + ",\n".join(pad + fmt(x, ind + 1) for x in v) + "\n" + "  " * ind + "]"
+    if isinstance(v, str):
+        return json.dumps(v)
+    return number(v)
+def dump(name, doc):
+    with open(os.path.join(OUT, name + ".json"), "w") as f:
+        f.write(fmt(doc) + "\n")
+soft = {"density": 2000, "young": 1e8, "poisson": 0.25}
+dump("freefall", {
+    "name": "freefall",
+    "materials": {"rock": dict(soft)},
+    "parts": [{"name": "block", "material": "rock",
+               "rectangle": {"origin": [0, 0], "size": [0.1, 0.1], "divisions": [4, 4]}}],
+    "gravity": [0, -9.81],
+    "time": {"end": 0.5, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
+dump("bar-wave", {
+    "name": "bar-wave",
+    "materials": {"elastic": {"density": 1000, "young": 1e9, "poisson": 0.0}},
+    "parts": [{"name": "bar", "material": "elastic",
+               "rectangle": {"origin": [0, 0], "size": [1.0, 0.05], "divisions": [40, 2]},
+               "velocity": [1.0, 0]}],
+    "constraints": [{"box": [-0.001, -0.001, 0.001, 0.051], "fix": ["x", "y"]}],
+    "time": {"end": 0.008, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 5e-5, "fields": ["position", "velocity", "stress"]}})
+dump("collision", {
+    "name": "collision",
+    "materials": {"rock": dict(soft, friction=0.0)},
+    "parts": [{"name": "left", "material": "rock",
+               "rectangle": {"origin": [-0.105, 0], "size": [0.1, 0.1], "divisions": [5, 5]},
+               "velocity": [2.0, 0]},
+              {"name": "right", "material": "rock",
+               "rectangle": {"origin": [0.005, 0], "size": [0.1, 0.1], "divisions": [5, 5]}}],
+    "time": {"end": 0.015, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 2e-4, "fields": ["position", "velocity", "stress"]}})
+theta = math.radians(30)
+dump("incline", {
+    "name": "incline",
+    "materials": {"rock": dict(soft, friction=0.3)},
+    "parts": [{"name": "slab", "material": "rock",
+               "rectangle": {"origin": [-0.2, -0.1], "size": [1.2, 0.1], "divisions": [24, 2]}},
+              {"name": "block", "material": "rock",
+               "rectangle": {"origin": [0, 0], "size": [0.1, 0.1], "divisions": [4, 4]}}],
+    "constraints": [{"part": "slab", "fix": ["x", "y"]}],
+    "gravity": [round(9.81 * math.sin(theta), 6), round(-9.81 * math.cos(theta), 6)],
+    "time": {"end": 0.5, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity", "stress"]}})
+parts = [
+    {"name": "floor", "material": "wall",
+     "rectangle": {"origin": [-0.5, -0.05], "size": [1.0, 0.05], "divisions": [20, 1]}},
+    {"name": "left-wall", "material": "wall",
+     "rectangle": {"origin": [-0.55, -0.05], "size": [0.05, 0.8], "divisions": [1, 16]}},
+    {"name": "right-wall", "material": "wall",
+     "rectangle": {"origin": [0.5, -0.05], "size": [0.05, 0.8], "divisions": [1, 16]}}]
+k = 0
+for row in range(5):
+    for col in range(6):
+        x = -0.3 + 0.12 * col + (0.02 if row % 2 else -0.02)
+        y = 0.1 + 0.12 * row
+        parts.append({"name": "disc-%d" % k, "material": "grain",
+                      "disc": {"center": [round(x, 4), round(y, 4)], "radius": 0.04, "divisions": 12}})
+        k += 1
+dump("disc-pile", {
+    "name": "disc-pile",
+    "materials": {"grain": {"density": 2000, "young": 5e7, "poisson": 0.25, "damping": 0.2,
+                            "friction": 0.4},
+                  "wall": {"density": 2000, "young": 5e7, "poisson": 0.25, "friction": 0.4}},
+    "parts": parts,
+    "constraints": [{"part": p, "fix": ["x", "y"]} for p in ("floor", "left-wall", "right-wall")],
+    "gravity": [0, -9.81],
+    "time": {"end": 0.8, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
+dump("brazilian-disc", {
+    "name": "brazilian-disc",
+    "materials": {
+        "rock": {"density": 2700, "young": 3e10, "poisson": 0.3, "damping": 0.6,
+                 "friction": 0.3,
+                 "fracture": {"tensile_strength": 1e6, "cohesion": 3e6,
+                              "friction_angle": round(math.degrees(math.atan(0.3)), 2),
+                              "energy_I": 10, "energy_II": 50}},
+        "steel": {"density": 7800, "young": 2e11, "poisson": 0.3, "friction": 0.3}},
+    "parts": [
+        {"name": "disc", "material": "rock", "fracture": True,
+         "disc": {"center": [0, 0], "radius": 0.025, "divisions": 48}},
+        {"name": "top", "material": "steel",
+         "rectangle": {"origin": [-0.01, 0.025], "size": [0.02, 0.005], "divisions": [4, 1]}},
+        {"name": "bottom", "material": "steel",
+         "rectangle": {"origin": [-0.01, -0.03], "size": [0.02, 0.005], "divisions": [4, 1]}}],
+    "constraints": [{"part": "top", "velocity": [0, -0.05]},
+                    {"part": "bottom", "velocity": [0, 0.05]}],
+    "time": {"end": 0.0003, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
+dump("gmsh-plate", {
+    "name": "gmsh-plate",
+    "materials": {"polymer": {"density": 2000, "young": 1e9, "poisson": 0.25, "damping": 0.3}},
+    "parts": [{"name": "plate", "material": "polymer", "gmsh": gmsh_text(os.path.join(OUT, "gmsh-plate.geo"))}],
+    "constraints": [{"box": [-1e-6, -1e-6, 1e-6, 0.100001], "fix": ["x", "y"]},
+                    {"box": [0.199999, -1e-6, 0.200001, 0.100001], "velocity": [0.01, None]}],
+    "time": {"end": 0.003, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 5e-5, "fields": ["position", "velocity", "stress"]}})
