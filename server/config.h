@@ -1,0 +1,21 @@
+/*
+ * config.h - the daemon's command-line settings, filled once by main() and
+ * read-only afterwards (so every thread may read them without locking).
+ */
+#ifndef FDEMD_CONFIG_H
+#define FDEMD_CONFIG_H
+
+#include <stddef.h>
+
+typedef struct fdemd_config {
+    char listen_host[64];     /* dotted IPv4 */
+    int listen_port;          /* 0 = pick a free port */
+    char data_dir[1024];
+    const char *token;        /* NULL = no authentication */
+    size_t max_upload;        /* bytes of a request body */
+    int max_running;          /* cases stepping at once; more are queued */
+    int threads;              /* OpenMP threads per running case */
+    size_t max_case_memory;   /* memory_limit handed to case_build */
+} fdemd_config;
+
+#endif

@@ -1,0 +1,343 @@
+/*
+ * http.c - libmicrohttpd setup and the per-request life cycle.
+ *
+ * libmicrohttpd calls http_access() several times per request: first with
+ * only the headers (where we decide 401/404/405/411/413 without touching
+ * the body, so a 100 MB upload is refused before it is sent), then once per
+ * body chunk, then once more to answer. A small thread pool serves
+ * connections so that one request waiting for the I/O thread (a result
+ * download) or for a step boundary does not hold up the others.
+ */
+#include "http.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include "routes.h"
+
+#define HTTP_THREADS 4
+#define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity */
+#define HTTP_CONNECTION_LIMIT 512
+#define HTTP_PER_IP_LIMIT 128
+#define HTTP_CONNECTION_MEMORY (64 * 1024) /* request line and headers */
+
+typedef struct http_request {
+    route_match route;
+    int answered;     /* a response was queued before the body */
+    int too_large;
+    char *body;
+    size_t size, capacity, limit;
+} http_request;
+
+static struct MHD_Daemon *http_daemon;
+static const fdemd_config *http_cfg;
+
+/* ------------------------------------------------------------ responses */
+
+static enum MHD_Result http_queue(struct MHD_Connection *conn, unsigned status,
+                                  struct MHD_Response *resp)
+{
+    if (!resp)
+        return MHD_NO;
+    enum MHD_Result rc = MHD_queue_response(conn, status, resp);
+    MHD_destroy_response(resp);
+    return rc;
+}
+
+static struct MHD_Response *http_text_response(char *text, const char *content_type)
+{
+    struct MHD_Response *resp =
+        MHD_create_response_from_buffer(strlen(text), text, MHD_RESPMEM_MUST_FREE);
+    if (!resp) {
+        free(text);
+        return NULL;
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    return resp;
+}
+
+enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, json_t *body,
+                                const char *location)
+{
+    char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
+    json_decref(body);
+    if (!text)
+        return http_reply_problem(conn, 500, "Internal error", "the response could not be encoded", NULL);
+    struct MHD_Response *resp = http_text_response(text, "application/json");
+    if (resp && location)
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_LOCATION, location);
+    return http_queue(conn, status, resp);
+}
+
+static json_t *http_problem_json(unsigned status, const char *title, const char *detail,
+                                 const problems *p)
+{
+    json_t *errors = json_array();
+    for (int i = 0; p && i < p->count; i++)
+        json_array_append_new(errors, json_pack("{s:s, s:s}", "pointer", p->items[i].pointer,
+                                                "message", p->items[i].message));
+    return json_pack("{s:s, s:s, s:i, s:s, s:o}", "type", "about:blank", "title", title,
+                     "status", (int)status, "detail", detail, "errors", errors);
+}
+
+static struct MHD_Response *http_problem_response(unsigned status, const char *title,
+                                                  const char *detail, const problems *p)
+{
+    json_t *o = http_problem_json(status, title, detail, p);
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    json_decref(o);
+    if (!text)
+        return NULL;
+    return http_text_response(text, "application/problem+json");
+}
+
+enum MHD_Result http_reply_problem(struct MHD_Connection *conn, unsigned status, const char *title,
+                                   const char *detail, const problems *p)
+{
+    return http_queue(conn, status, http_problem_response(status, title, detail, p));
+}
+
+enum MHD_Result http_reply_not_allowed(struct MHD_Connection *conn, const char *allow)
+{
+    char detail[128];
+    snprintf(detail, sizeof detail, "this path allows %s", allow);
+    struct MHD_Response *resp = http_problem_response(405, "Method not allowed", detail, NULL);
+    if (resp)
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_ALLOW, allow);
+    return http_queue(conn, 405, resp);
+}
+
+enum MHD_Result http_reply_empty(struct MHD_Connection *conn, unsigned status)
+{
+    struct MHD_Response *resp = MHD_create_response_from_buffer(0, "", MHD_RESPMEM_PERSISTENT);
+    return http_queue(conn, status, resp);
+}
+
+enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
+                              const char *content_type, const char *filename)
+{
+    struct MHD_Response *resp = MHD_create_response_from_fd(size, fd);
+    if (!resp) {
+        close(fd);
+        return http_reply_problem(conn, 500, "Internal error", "the file could not be served", NULL);
+    }
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    if (filename) {
+        char disposition[128];
+        snprintf(disposition, sizeof disposition, "attachment; filename=\"%s\"", filename);
+        MHD_add_response_header(resp, "Content-Disposition", disposition);
+    }
+    return http_queue(conn, 200, resp);
+}
+
+/* ------------------------------------------------------ authentication */
+
+/* Compares in time that depends only on the expected token's length, so
+ * the answer time leaks neither how much of a guess matched nor its length. */
+static int http_token_equal(const char *given, size_t given_len, const char *want)
+{
+    size_t want_len = strlen(want);
+    unsigned char diff = given_len != want_len;
+    for (size_t i = 0; i < want_len; i++) {
+        unsigned char g = i < given_len ? (unsigned char)given[i] : 0;
+        diff |= g ^ (unsigned char)want[i];
+    }
+    return diff == 0;
+}
+
+static int http_authorized(struct MHD_Connection *conn)
+{
+    if (!http_cfg->token)
+        return 1;
+    const char *h = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_AUTHORIZATION);
+    if (!h || strncasecmp(h, "Bearer ", 7) != 0)
+        return 0;
+    h += 7;
+    while (*h == ' ')
+        h++;
+    return http_token_equal(h, strlen(h), http_cfg->token);
+}
+
+static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn)
+{
+    struct MHD_Response *resp = http_problem_response(
+        401, "Unauthorized", "this daemon needs an Authorization: Bearer <token> header", NULL);
+    if (resp)
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"fdemd\"");
+    return http_queue(conn, 401, resp);
+}
+
+/* ------------------------------------------------------ request phases */
+
+/* Everything that can be decided from the request line and headers.
+ * Returns 1 when a response was queued. */
+static int http_check_headers(struct MHD_Connection *conn, const char *method, http_request *r,
+                              enum MHD_Result *rc)
+{
+    if (r->route.kind != ROUTE_HEALTH && !http_authorized(conn)) {
+        *rc = http_reply_unauthorized(conn);
+        return 1;
+    }
+    if (r->route.kind == ROUTE_NONE) {
+        *rc = http_reply_problem(conn, 404, "Not found", "no such path", NULL);
+        return 1;
+    }
+    if (!routes_method_allowed(r->route.kind, method)) {
+        *rc = http_reply_not_allowed(conn, routes_allowed(r->route.kind));
+        return 1;
+    }
+    const char *te = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_TRANSFER_ENCODING);
+    const char *cl = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (te && strcasecmp(te, "identity") != 0) {
+        *rc = http_reply_problem(conn, 411, "Length required",
+                                 "send the body with a Content-Length header (chunked uploads are not accepted)", NULL);
+        return 1;
+    }
+    if (!cl) {
+        if (routes_takes_body(r->route.kind, method)) {
+            *rc = http_reply_problem(conn, 411, "Length required",
+                                     "POST /cases needs a Content-Length header", NULL);
+            return 1;
+        }
+        return 0;
+    }
+    errno = 0;
+    char *end = NULL;
+    unsigned long long length = strtoull(cl, &end, 10);
+    if (errno || end == cl || *end != '\0' || length > http_cfg->max_upload) {
+        char detail[160];
+        snprintf(detail, sizeof detail, "the body is %s bytes; this daemon accepts at most %zu (--max-upload)",
+                 cl, http_cfg->max_upload);
+        *rc = http_reply_problem(conn, 413, "Payload too large", detail, NULL);
+        return 1;
+    }
+    r->limit = (size_t)length;
+    return 0;
+}
+
+static int http_collect(http_request *r, const char *data, size_t size)
+{
+    if (r->size + size > r->limit || r->size + size > http_cfg->max_upload) {
+        r->too_large = 1;
+        return 0;
+    }
+    if (r->size + size + 1 > r->capacity) {
+        size_t cap = r->capacity ? r->capacity : 4096;
+        while (cap < r->size + size + 1)
+            cap *= 2;
+        if (cap > r->limit + 1)
+            cap = r->limit + 1;
+        char *grown = realloc(r->body, cap);
+        if (!grown)
+            return -1;
+        r->body = grown;
+        r->capacity = cap;
+    }
+    memcpy(r->body + r->size, data, size);
+    r->size += size;
+    r->body[r->size] = '\0';
+    return 0;
+}
+
+static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const char *url,
+                                   const char *method, const char *version, const char *upload_data,
+                                   size_t *upload_data_size, void **req_cls)
+{
+    (void)cls;
+    (void)version;
+    http_request *r = *req_cls;
+    if (!r) {
+        r = calloc(1, sizeof *r);
+        if (!r)
+            return MHD_NO;
+        *req_cls = r;
+        routes_match(url, &r->route);
+        enum MHD_Result rc = MHD_YES;
+        if (http_check_headers(conn, method, r, &rc)) {
+            r->answered = 1;
+            return rc;
+        }
+        return MHD_YES;
+    }
+    if (r->answered) {
+        *upload_data_size = 0;
+        return MHD_YES;
+    }
+    if (*upload_data_size > 0) {
+        if (!r->too_large && http_collect(r, upload_data, *upload_data_size) != 0)
+            return MHD_NO;
+        *upload_data_size = 0;
+        return MHD_YES;
+    }
+    r->answered = 1;
+    if (r->too_large)
+        return http_reply_problem(conn, 413, "Payload too large",
+                                  "the body is longer than its Content-Length or --max-upload", NULL);
+    return routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+}
+
+static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cls,
+                           enum MHD_RequestTerminationCode toe)
+{
+    (void)cls;
+    (void)conn;
+    (void)toe;
+    http_request *r = *req_cls;
+    if (r) {
+        free(r->body);
+        free(r);
+        *req_cls = NULL;
+    }
+}
+
+/* ---------------------------------------------------------------- start */
+
+int http_start(const fdemd_config *cfg)
+{
+    http_cfg = cfg;
+    struct sockaddr_in addr;
+    memset(&addr, 0, sizeof addr);
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons((uint16_t)cfg->listen_port);
+    if (inet_pton(AF_INET, cfg->listen_host, &addr.sin_addr) != 1) {
+        fprintf(stderr, "fdemd: --listen: \"%s\" is not an IPv4 address\n", cfg->listen_host);
+        return -1;
+    }
+    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
+    flags |= MHD_is_feature_supported(MHD_FEATURE_EPOLL) == MHD_YES ? MHD_USE_EPOLL : MHD_USE_POLL;
+    http_daemon = MHD_start_daemon(
+        flags, 0, NULL, NULL, http_access, NULL,
+        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
+        MHD_OPTION_THREAD_POOL_SIZE, (unsigned)HTTP_THREADS,
+        MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)HTTP_CONNECTION_TIMEOUT,
+        MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_CONNECTION_LIMIT,
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)HTTP_PER_IP_LIMIT,
+        MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)HTTP_CONNECTION_MEMORY,
+        MHD_OPTION_NOTIFY_COMPLETED, http_completed, NULL,
+        MHD_OPTION_END);
+    if (!http_daemon) {
+        fprintf(stderr, "fdemd: cannot listen on %s:%d (in use, or not an address of this machine)\n",
+                cfg->listen_host, cfg->listen_port);
+        return -1;
+    }
+    const union MHD_DaemonInfo *info = MHD_get_daemon_info(http_daemon, MHD_DAEMON_INFO_BIND_PORT);
+    int port = info && info->port ? (int)info->port : cfg->listen_port;
+    return port;
+}
+
+void http_stop(void)
+{
+    if (http_daemon) {
+        MHD_stop_daemon(http_daemon);
+        http_daemon = NULL;
+    }
+}

@@ -1,0 +1,38 @@
+/*
+ * http.h - the libmicrohttpd daemon: connection handling, request bodies,
+ * authentication, and the response helpers the routes use.
+ *
+ * Contract:
+ *  - http_start() binds cfg->listen_host:listen_port and returns the port
+ *    actually bound (useful for port 0), or -1 with a message on stderr.
+ *  - Requests are checked before their body is read: 401 (token), 404/405
+ *    (route), 411 (POST /cases without Content-Length, or any chunked
+ *    body), 413 (Content-Length above --max-upload). Only then is the body
+ *    collected and the route called.
+ *  - Every error body is RFC 9457 problem+json with an "errors" list.
+ */
+#ifndef FDEMD_HTTP_H
+#define FDEMD_HTTP_H
+
+#include <stddef.h>
+#include <jansson.h>
+#include <microhttpd.h>
+
+#include "config.h"
+#include "problems.h"
+
+int http_start(const fdemd_config *cfg);
+void http_stop(void);
+
+/* The json is consumed. */
+enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, json_t *body,
+                                const char *location);
+enum MHD_Result http_reply_problem(struct MHD_Connection *conn, unsigned status, const char *title,
+                                   const char *detail, const problems *p);
+enum MHD_Result http_reply_not_allowed(struct MHD_Connection *conn, const char *allow);
+enum MHD_Result http_reply_empty(struct MHD_Connection *conn, unsigned status);
+/* Serves `size` bytes of an open descriptor (closed by libmicrohttpd). */
+enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
+                              const char *content_type, const char *filename);
+
+#endif

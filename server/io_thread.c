@@ -1,0 +1,388 @@
+/*
+ * io_thread.c - the one thread that writes result.h5, result.xdmf and the
+ * checkpoints.
+ *
+ * HDF5 (high-level and our proto writer) is used from this thread only, so
+ * workers never block on disk and HTTP handlers never touch an open HDF5
+ * handle. Workers hand over snapshots (copies) and checkpoint buffers; the
+ * queue is FIFO over all cases, which gives the ordering guarantees in the
+ * header for free.
+ */
+#include "io_thread.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "persist.h"
+
+typedef enum io_job_kind {
+    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_QUIT,
+} io_job_kind;
+
+typedef struct io_job {
+    io_job_kind kind;
+    server_case *c;
+    snapshot *snap;
+    void *ckpt;
+    size_t ckpt_size;
+    int64_t keep_until_step;
+    int close_after;
+    /* completion, for jobs someone waits on */
+    int waited, done, rc, fd;
+    size_t size;
+    char err[256];
+    struct io_job *next;
+} io_job;
+
+static pthread_mutex_t io_lock = PTHREAD_MUTEX_INITIALIZER;
+static pthread_cond_t io_wake = PTHREAD_COND_INITIALIZER;
+static pthread_cond_t io_done = PTHREAD_COND_INITIALIZER;
+static io_job *io_head, *io_tail;
+static pthread_t io_thread;
+static int io_running;
+static unsigned long io_download_counter;
+
+/* Rewriting the XDMF costs O(snapshots); past a few hundred snapshots we
+ * only refresh it twice a second (and always on close). */
+#define IO_XDMF_EAGER_SNAPSHOTS 200
+#define IO_XDMF_MIN_INTERVAL 0.5
+
+static double io_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void io_log(const server_case *c, const char *what, const char *err)
+{
+    fprintf(stderr, "fdemd: case %s: %s: %s\n", c->id, what, err);
+}
+
+static void io_write_xdmf(server_case *c, int force)
+{
+    if (!c->result || !c->model)
+        return;
+    int count = result_snapshot_count(c->result);
+    double now = io_now();
+    if (!force && count > IO_XDMF_EAGER_SNAPSHOTS &&
+        now - c->xdmf_written_at < IO_XDMF_MIN_INTERVAL) {
+        c->xdmf_dirty = 1;
+        return;
+    }
+    char path[1200], err[256] = "";
+    snprintf(path, sizeof path, "%s/result.xdmf", c->dir);
+    if (xdmf_write(path, "result.h5", c->model, &c->info, c->result, err, sizeof err) != 0)
+        io_log(c, "writing result.xdmf failed", err);
+    c->xdmf_written_at = now;
+    c->xdmf_dirty = 0;
+}
+
+static void io_write_checkpoint(server_case *c, const void *ckpt, size_t size)
+{
+    if (c->deleted)
+        return;
+    if (persist_write_atomic(c->dir, "checkpoint.bin", ckpt, size) != 0)
+        io_log(c, "writing checkpoint.bin failed", strerror(errno));
+}
+
+static void io_do_create(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    c->result = result_create(path, c->model, &c->info, j->err, sizeof j->err);
+    if (!c->result) {
+        j->rc = -1;
+        return;
+    }
+    if (j->snap && result_append(c->result, j->snap, j->err, sizeof j->err) != 0) {
+        j->rc = -1;
+        return;
+    }
+    case_set_snapshots(c, result_snapshot_count(c->result));
+    io_write_xdmf(c, 1);
+    if (j->ckpt && persist_write_atomic(c->dir, "checkpoint.bin", j->ckpt, j->ckpt_size) != 0) {
+        snprintf(j->err, sizeof j->err, "writing checkpoint.bin: %s", strerror(errno));
+        j->rc = -1;
+    }
+}
+
+static void io_do_reopen(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    c->result = result_reopen(path, c->model, &c->info, j->keep_until_step, j->err, sizeof j->err);
+    if (!c->result) {
+        j->rc = -1;
+        return;
+    }
+    case_set_snapshots(c, result_snapshot_count(c->result));
+    io_write_xdmf(c, 1);
+    if (j->close_after) {
+        result_close(c->result);
+        c->result = NULL;
+    }
+}
+
+static void io_do_append(io_job *j)
+{
+    server_case *c = j->c;
+    if (j->snap && c->result && !c->deleted) {
+        char err[256] = "";
+        if (result_append(c->result, j->snap, err, sizeof err) != 0)
+            io_log(c, "appending a snapshot failed", err);
+        else
+            case_set_snapshots(c, result_snapshot_count(c->result));
+        io_write_xdmf(c, 0);
+    }
+    if (j->ckpt) {
+        io_write_checkpoint(c, j->ckpt, j->ckpt_size);
+        case_persist_status(c);
+    }
+    pthread_mutex_lock(&c->lock);
+    c->io_pending--;
+    pthread_cond_broadcast(&c->cv);
+    pthread_mutex_unlock(&c->lock);
+}
+
+static void io_do_close(io_job *j)
+{
+    server_case *c = j->c;
+    if (!c->result)
+        return;
+    if (c->xdmf_dirty && !c->deleted)
+        io_write_xdmf(c, 1);
+    result_close(c->result);
+    c->result = NULL;
+}
+
+/* While the file is open for SWMR writing we hand out a closed copy taken
+ * after the last completed append; a closed file is served as it is. The
+ * copy is unlinked right after opening, so nothing is left behind even if
+ * the client disconnects. */
+static void io_do_fetch(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    int temporary = 0;
+    if (c->result) {
+        snprintf(path, sizeof path, "%s/.download-%lu.h5", c->dir, ++io_download_counter);
+        if (result_copy(c->result, path, j->err, sizeof j->err) != 0) {
+            unlink(path);
+            j->rc = -1;
+            return;
+        }
+        temporary = 1;
+    } else {
+        snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    }
+    j->fd = open(path, O_RDONLY | O_CLOEXEC);
+    if (temporary)
+        unlink(path);
+    struct stat st;
+    if (j->fd < 0 || fstat(j->fd, &st) != 0) {
+        snprintf(j->err, sizeof j->err, "opening the result file: %s", strerror(errno));
+        if (j->fd >= 0)
+            close(j->fd);
+        j->fd = -1;
+        j->rc = -1;
+        return;
+    }
+    j->size = (size_t)st.st_size;
+}
+
+static void io_run_job(io_job *j)
+{
+    switch (j->kind) {
+    case IO_CREATE: io_do_create(j); break;
+    case IO_REOPEN: io_do_reopen(j); break;
+    case IO_APPEND: io_do_append(j); break;
+    case IO_CLOSE: io_do_close(j); break;
+    case IO_FETCH: io_do_fetch(j); break;
+    case IO_QUIT: break;
+    }
+}
+
+static void io_job_free(io_job *j)
+{
+    if (j->snap)
+        snapshot_free(j->snap);
+    free(j->ckpt);
+    if (j->c)
+        case_release(j->c);
+    free(j);
+}
+
+static void *io_main(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        pthread_mutex_lock(&io_lock);
+        while (!io_head)
+            pthread_cond_wait(&io_wake, &io_lock);
+        io_job *j = io_head;
+        io_head = j->next;
+        if (!io_head)
+            io_tail = NULL;
+        pthread_mutex_unlock(&io_lock);
+
+        io_run_job(j);
+        int quit = j->kind == IO_QUIT;
+        if (j->waited) {
+            pthread_mutex_lock(&io_lock);
+            j->done = 1;
+            pthread_cond_broadcast(&io_done);
+            pthread_mutex_unlock(&io_lock);
+        } else {
+            io_job_free(j);
+        }
+        if (quit)
+            return NULL;
+    }
+}
+
+static io_job *io_job_new(io_job_kind kind, server_case *c)
+{
+    io_job *j = calloc(1, sizeof *j);
+    if (!j)
+        return NULL;
+    j->kind = kind;
+    j->fd = -1;
+    if (c) {
+        case_retain(c);
+        j->c = c;
+    }
+    return j;
+}
+
+static void io_enqueue(io_job *j)
+{
+    pthread_mutex_lock(&io_lock);
+    if (io_tail)
+        io_tail->next = j;
+    else
+        io_head = j;
+    io_tail = j;
+    pthread_cond_signal(&io_wake);
+    pthread_mutex_unlock(&io_lock);
+}
+
+/* Queues `j` and waits for it; returns its rc. The caller frees j. */
+static int io_run_and_wait(io_job *j)
+{
+    j->waited = 1;
+    io_enqueue(j);
+    pthread_mutex_lock(&io_lock);
+    while (!j->done)
+        pthread_cond_wait(&io_done, &io_lock);
+    pthread_mutex_unlock(&io_lock);
+    return j->rc;
+}
+
+int io_start(void)
+{
+    if (pthread_create(&io_thread, NULL, io_main, NULL) != 0)
+        return -1;
+    io_running = 1;
+    return 0;
+}
+
+void io_stop(void)
+{
+    if (!io_running)
+        return;
+    io_job *j = io_job_new(IO_QUIT, NULL);
+    if (j) {
+        io_enqueue(j);
+        pthread_join(io_thread, NULL);
+        free(j);
+    }
+    io_running = 0;
+}
+
+int io_create(server_case *c, snapshot *first, void *ckpt, size_t ckpt_size,
+              char *err, size_t errlen)
+{
+    io_job *j = io_job_new(IO_CREATE, c);
+    if (!j) {
+        snapshot_free(first);
+        free(ckpt);
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    j->snap = first;
+    j->ckpt = ckpt;
+    j->ckpt_size = ckpt_size;
+    int rc = io_run_and_wait(j);
+    if (rc != 0)
+        snprintf(err, errlen, "%s", j->err);
+    io_job_free(j);
+    return rc;
+}
+
+int io_reopen(server_case *c, int64_t keep_until_step, int close_after, char *err, size_t errlen)
+{
+    io_job *j = io_job_new(IO_REOPEN, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    j->keep_until_step = keep_until_step;
+    j->close_after = close_after;
+    int rc = io_run_and_wait(j);
+    if (rc != 0)
+        snprintf(err, errlen, "%s", j->err);
+    io_job_free(j);
+    return rc;
+}
+
+void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size)
+{
+    io_job *j = io_job_new(IO_APPEND, c);
+    if (!j) {
+        snapshot_free(s);
+        free(ckpt);
+        return;
+    }
+    pthread_mutex_lock(&c->lock);
+    c->io_pending++;
+    pthread_mutex_unlock(&c->lock);
+    j->snap = s;
+    j->ckpt = ckpt;
+    j->ckpt_size = ckpt_size;
+    io_enqueue(j);
+}
+
+void io_close(server_case *c)
+{
+    io_job *j = io_job_new(IO_CLOSE, c);
+    if (!j)
+        return;
+    io_run_and_wait(j);
+    io_job_free(j);
+}
+
+int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t errlen)
+{
+    io_job *j = io_job_new(IO_FETCH, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    int rc = io_run_and_wait(j);
+    *fd = j->fd;
+    *size = j->size;
+    if (rc != 0)
+        snprintf(err, errlen, "%s", j->err);
+    io_job_free(j);
+    return rc;
+}

@@ -1,0 +1,37 @@
+/*
+ * io_thread.h - the single thread that calls HDF5 (proto/result.h).
+ *
+ * Contract:
+ *  - Jobs run strictly in the order they were queued, so a close queued
+ *    after a case's last append sees every snapshot written, and a
+ *    checkpoint queued with a snapshot lands on disk only after that
+ *    snapshot is appended (checkpoint step <= last snapshot in result.h5,
+ *    which is what result_reopen(keep_until_step) after a crash relies on).
+ *  - io_append() and io_checkpoint() take ownership of what they are given
+ *    and return at once; the other calls wait for their job (they wait on
+ *    file I/O, never on a simulation step).
+ *  - Each job holds a reference on its case.
+ */
+#ifndef FDEMD_IO_THREAD_H
+#define FDEMD_IO_THREAD_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include "registry.h"
+
+int io_start(void);
+void io_stop(void);
+
+/* result_create + first snapshot + xdmf + checkpoint. */
+int io_create(server_case *c, snapshot *first, void *ckpt, size_t ckpt_size,
+              char *err, size_t errlen);
+/* result_reopen keeping steps <= keep_until_step, then xdmf. */
+int io_reopen(server_case *c, int64_t keep_until_step, int close_after,
+              char *err, size_t errlen);
+/* Appends `s` (may be NULL) then writes `ckpt` (may be NULL) as checkpoint.bin. */
+void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size);
+void io_close(server_case *c);
+/* An open, already unlinked-if-temporary descriptor of a consistent result.h5. */
+int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,824 @@
+/*
+ * registry.c - the cases the daemon holds, their state machine, their
+ * status object and its persistence, and loading the data directory.
+ *
+ * The registry lock guards the list (kept oldest first), the running count
+ * and the queue; each case's own lock guards its state and figures. HTTP
+ * commands on one case are serialized by its ctl_lock, which is also what
+ * lets a pause or stop wait for the worker to leave without another command
+ * slipping in between.
+ */
+#include "registry.h"
+
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/random.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "io_thread.h"
+#include "persist.h"
+#include "worker.h"
+
+static const fdemd_config *reg_cfg;
+static pthread_mutex_t reg_lock = PTHREAD_MUTEX_INITIALIZER;
+static server_case **reg_cases;
+static int reg_count, reg_capacity;
+static uint64_t reg_next_seq, reg_next_queue_seq;
+static int reg_running;
+static int reg_shutting_down;
+
+static const char *const state_names[] = {
+    "created", "queued", "running", "paused", "finished", "stopped", "failed",
+};
+
+const char *case_state_name(case_state s)
+{
+    return (unsigned)s < sizeof state_names / sizeof *state_names ? state_names[s] : "failed";
+}
+
+static int case_state_parse(const char *name, case_state *out)
+{
+    for (unsigned i = 0; i < sizeof state_names / sizeof *state_names; i++)
+        if (name && strcmp(name, state_names[i]) == 0) {
+            *out = (case_state)i;
+            return 0;
+        }
+    return -1;
+}
+
+static int case_state_is_terminal(case_state s)
+{
+    return s == CASE_FINISHED || s == CASE_STOPPED || s == CASE_FAILED;
+}
+
+const fdemd_config *registry_config(void)
+{
+    return reg_cfg;
+}
+
+int id_is_valid(const char *s)
+{
+    if (!s)
+        return 0;
+    for (int i = 0; i < CASE_ID_LEN; i++)
+        if (!((s[i] >= '0' && s[i] <= '9') || (s[i] >= 'a' && s[i] <= 'f')))
+            return 0;
+    return s[CASE_ID_LEN] == '\0';
+}
+
+static int id_generate(char out[CASE_ID_LEN + 1])
+{
+    unsigned char raw[CASE_ID_LEN / 2];
+    size_t got = 0;
+    while (got < sizeof raw) {
+        ssize_t n = getrandom(raw + got, sizeof raw - got, 0);
+        if (n < 0) {
+            if (errno == EINTR)
+                continue;
+            return -1;
+        }
+        got += (size_t)n;
+    }
+    for (size_t i = 0; i < sizeof raw; i++)
+        snprintf(out + 2 * i, 3, "%02x", raw[i]);
+    return 0;
+}
+
+static void iso_time_now(char *out, size_t size)
+{
+    struct timespec ts;
+    struct tm tm;
+    clock_gettime(CLOCK_REALTIME, &ts);
+    gmtime_r(&ts.tv_sec, &tm);
+    char base[24];
+    strftime(base, sizeof base, "%Y-%m-%dT%H:%M:%S", &tm);
+    snprintf(out, size, "%.19s.%03dZ", base, (int)(ts.tv_nsec / 1000000L));
+}
+
+/* ------------------------------------------------------------ lifetime */
+
+static server_case *case_new(void)
+{
+    server_case *c = calloc(1, sizeof *c);
+    if (!c)
+        return NULL;
+    atomic_init(&c->refs, 1);
+    atomic_init(&c->command, WORKER_GO);
+    atomic_init(&c->state_waiters, 0);
+    atomic_init(&c->deleted, 0);
+    pthread_mutex_init(&c->lock, NULL);
+    pthread_cond_init(&c->cv, NULL);
+    pthread_mutex_init(&c->ctl_lock, NULL);
+    pthread_mutex_init(&c->model_lock, NULL);
+    pthread_mutex_init(&c->yield_lock, NULL);
+    pthread_cond_init(&c->yield_cv, NULL);
+    pthread_mutex_init(&c->persist_lock, NULL);
+    c->last_snapshot_step = -1;
+    c->last_checkpoint_step = -1;
+    return c;
+}
+
+static void case_free(server_case *c)
+{
+    if (c->model)
+        fdem_model_destroy(c->model);
+    pthread_mutex_destroy(&c->lock);
+    pthread_cond_destroy(&c->cv);
+    pthread_mutex_destroy(&c->ctl_lock);
+    pthread_mutex_destroy(&c->model_lock);
+    pthread_mutex_destroy(&c->yield_lock);
+    pthread_cond_destroy(&c->yield_cv);
+    pthread_mutex_destroy(&c->persist_lock);
+    free(c);
+}
+
+void case_retain(server_case *c)
+{
+    atomic_fetch_add(&c->refs, 1);
+}
+
+void case_release(server_case *c)
+{
+    if (c && atomic_fetch_sub(&c->refs, 1) == 1)
+        case_free(c);
+}
+
+void *case_checkpoint_take(const fdem_model *m, size_t *size)
+{
+    *size = fdem_checkpoint_size(m);
+    void *buf = malloc(*size ? *size : 1);
+    if (buf && fdem_checkpoint_write(m, buf, *size) != 0) {
+        free(buf);
+        buf = NULL;
+    }
+    return buf;
+}
+
+/* ------------------------------------------------------------- figures */
+
+void case_publish(server_case *c, const case_figures *fig)
+{
+    pthread_mutex_lock(&c->lock);
+    int snapshots = c->fig.snapshots;
+    c->fig = *fig;
+    if (fig->snapshots < 0)
+        c->fig.snapshots = snapshots;
+    pthread_mutex_unlock(&c->lock);
+}
+
+void case_set_snapshots(server_case *c, int snapshots)
+{
+    pthread_mutex_lock(&c->lock);
+    c->fig.snapshots = snapshots;
+    pthread_mutex_unlock(&c->lock);
+}
+
+/* Figures straight from the model, for cases no worker is stepping. */
+static void case_publish_from_model(server_case *c)
+{
+    if (!c->model)
+        return;
+    case_figures fig;
+    memset(&fig, 0, sizeof fig);
+    fig.step = fdem_get_step(c->model);
+    fig.time = fdem_get_time(c->model);
+    fig.dt = fdem_get_dt(c->model);
+    fig.counts = fdem_get_counts(c->model);
+    fig.energy = fdem_get_energy(c->model);
+    fig.snapshots = -1;
+    case_publish(c, &fig);
+}
+
+/* JSON has no NaN or infinity; a failed case may hold them. */
+static json_t *json_number_or_null(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+json_t *case_status_json(server_case *c)
+{
+    pthread_mutex_lock(&c->lock);
+    case_state state = c->state;
+    case_figures f = c->fig;
+    char error[sizeof c->error];
+    memcpy(error, c->error, sizeof error);
+    pthread_mutex_unlock(&c->lock);
+
+    double end = c->info.end_time;
+    double progress = end > 0 ? f.time / end : 0.0;
+    if (!(progress >= 0))
+        progress = 0;
+    if (progress > 1)
+        progress = 1;
+    if (state == CASE_FINISHED)
+        progress = 1;
+    json_t *energy = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}",
+                               "kinetic", json_number_or_null(f.energy.kinetic),
+                               "elastic", json_number_or_null(f.energy.elastic),
+                               "contact", json_number_or_null(f.energy.contact),
+                               "gravity_work", json_number_or_null(f.energy.gravity_work),
+                               "damping", json_number_or_null(f.energy.damping),
+                               "external_work", json_number_or_null(f.energy.external_work));
+    json_t *o = json_object();
+    json_object_set_new(o, "id", json_string(c->id));
+    json_object_set_new(o, "name", json_string(c->info.name));
+    json_object_set_new(o, "state", json_string(case_state_name(state)));
+    json_object_set_new(o, "step", json_integer((json_int_t)f.step));
+    json_object_set_new(o, "time", json_number_or_null(f.time));
+    json_object_set_new(o, "end_time", json_number_or_null(end));
+    json_object_set_new(o, "progress", json_number_or_null(progress));
+    json_object_set_new(o, "dt", json_number_or_null(f.dt));
+    json_object_set_new(o, "nodes", json_integer(f.counts.nodes));
+    json_object_set_new(o, "elements", json_integer(f.counts.elements));
+    json_object_set_new(o, "joints", json_integer(f.counts.joints));
+    json_object_set_new(o, "broken_joints", json_integer(f.counts.broken_joints));
+    json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
+    json_object_set_new(o, "snapshots", json_integer(f.snapshots));
+    json_object_set_new(o, "energy", energy ? energy : json_null());
+    json_object_set_new(o, "steps_per_second", json_number_or_null(f.steps_per_second));
+    json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
+    json_object_set_new(o, "created", json_string(c->created));
+    return o;
+}
+
+void case_persist_status(server_case *c)
+{
+    if (atomic_load(&c->deleted))
+        return;
+    pthread_mutex_lock(&c->persist_lock);
+    json_t *o = case_status_json(c);
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    if (!text || persist_write_atomic(c->dir, "status.json", text, strlen(text)) != 0)
+        fprintf(stderr, "fdemd: case %s: writing status.json failed: %s\n", c->id,
+                text ? strerror(errno) : "out of memory");
+    free(text);
+    json_decref(o);
+    pthread_mutex_unlock(&c->persist_lock);
+}
+
+/* ------------------------------------------------------------- listing */
+
+static int registry_append_locked(server_case *c)
+{
+    if (reg_count == reg_capacity) {
+        int cap = reg_capacity ? 2 * reg_capacity : 16;
+        server_case **grown = realloc(reg_cases, (size_t)cap * sizeof *grown);
+        if (!grown)
+            return -1;
+        reg_cases = grown;
+        reg_capacity = cap;
+    }
+    c->seq = reg_next_seq++;
+    reg_cases[reg_count++] = c;
+    return 0;
+}
+
+server_case *registry_find(const char *id)
+{
+    if (!id_is_valid(id))
+        return NULL;
+    server_case *found = NULL;
+    pthread_mutex_lock(&reg_lock);
+    for (int i = 0; i < reg_count; i++)
+        if (strcmp(reg_cases[i]->id, id) == 0) {
+            found = reg_cases[i];
+            case_retain(found);
+            break;
+        }
+    pthread_mutex_unlock(&reg_lock);
+    return found;
+}
+
+server_case **registry_list(int *count)
+{
+    pthread_mutex_lock(&reg_lock);
+    server_case **out = malloc((size_t)(reg_count ? reg_count : 1) * sizeof *out);
+    *count = 0;
+    if (out) {
+        for (int i = 0; i < reg_count; i++) {
+            case_retain(reg_cases[i]);
+            out[i] = reg_cases[i];
+        }
+        *count = reg_count;
+    }
+    pthread_mutex_unlock(&reg_lock);
+    return out;
+}
+
+void registry_list_free(server_case **cases, int count)
+{
+    for (int i = 0; i < count; i++)
+        case_release(cases[i]);
+    free(cases);
+}
+
+void registry_counts(int *cases, int *running)
+{
+    pthread_mutex_lock(&reg_lock);
+    *cases = reg_count;
+    *running = reg_running;
+    pthread_mutex_unlock(&reg_lock);
+}
+
+/* ------------------------------------------------------- state machine */
+
+/* With the registry lock and the case lock held. */
+static int case_start_locked(server_case *c)
+{
+    if (reg_running < reg_cfg->max_running) {
+        if (worker_spawn(c) != 0)
+            return -1;
+        reg_running++;
+        c->state = CASE_RUNNING;
+    } else {
+        c->state = CASE_QUEUED;
+        c->queue_seq = ++reg_next_queue_seq;
+    }
+    return 0;
+}
+
+/* Starts queued cases, first queued first, while slots are free. Returns a
+ * reference to a case whose status must be persisted, or NULL. */
+static server_case *registry_dispatch_one_locked(void)
+{
+    if (reg_shutting_down || reg_running >= reg_cfg->max_running)
+        return NULL;
+    server_case *next = NULL;
+    for (int i = 0; i < reg_count; i++) {
+        server_case *c = reg_cases[i];
+        pthread_mutex_lock(&c->lock);
+        if (c->state == CASE_QUEUED && (!next || c->queue_seq < next->queue_seq))
+            next = c;
+        pthread_mutex_unlock(&c->lock);
+    }
+    if (!next)
+        return NULL;
+    pthread_mutex_lock(&next->lock);
+    int ok = next->state == CASE_QUEUED && !next->worker_active && case_start_locked(next) == 0;
+    if (!ok && next->state == CASE_QUEUED) {
+        next->state = CASE_FAILED;
+        snprintf(next->error, sizeof next->error, "the daemon could not start a thread for this case");
+    }
+    pthread_mutex_unlock(&next->lock);
+    case_retain(next);
+    return next;
+}
+
+static void registry_dispatch(void)
+{
+    for (;;) {
+        pthread_mutex_lock(&reg_lock);
+        server_case *started = registry_dispatch_one_locked();
+        pthread_mutex_unlock(&reg_lock);
+        if (!started)
+            return;
+        case_persist_status(started);
+        case_release(started);
+    }
+}
+
+void registry_worker_exited(server_case *c)
+{
+    (void)c;
+    pthread_mutex_lock(&reg_lock);
+    reg_running--;
+    pthread_mutex_unlock(&reg_lock);
+    registry_dispatch();
+}
+
+/* Waits (case lock held) for the worker to leave, at most one step plus
+ * its final checkpoint. */
+static void case_wait_worker_locked(server_case *c)
+{
+    while (c->worker_active)
+        pthread_cond_wait(&c->cv, &c->lock);
+}
+
+int registry_start(server_case *c, char *msg, size_t msglen)
+{
+    int status = 0;
+    pthread_mutex_lock(&c->ctl_lock);
+    pthread_mutex_lock(&reg_lock);
+    pthread_mutex_lock(&c->lock);
+    if (atomic_load(&c->deleted)) {
+        status = 404;
+    } else if (reg_shutting_down) {
+        snprintf(msg, msglen, "the daemon is shutting down");
+        status = 409;
+    } else if (c->state != CASE_CREATED && c->state != CASE_PAUSED) {
+        snprintf(msg, msglen, "the case is %s; start is allowed only when it is created or paused",
+                 case_state_name(c->state));
+        status = 409;
+    } else if (!c->model) {
+        snprintf(msg, msglen, "the case is %s but its model could not be rebuilt, so it cannot run",
+                 case_state_name(c->state));
+        status = 409;
+    } else if (c->worker_active) {
+        snprintf(msg, msglen, "the case is still winding down its last step; try again");
+        status = 409;
+    } else {
+        if (case_start_locked(c) != 0) {
+            snprintf(msg, msglen, "the daemon could not start a thread for this case");
+            status = 503;
+        }
+    }
+    pthread_mutex_unlock(&c->lock);
+    pthread_mutex_unlock(&reg_lock);
+    if (status == 0)
+        case_persist_status(c);
+    pthread_mutex_unlock(&c->ctl_lock);
+    return status;
+}
+
+/* Asks the worker to leave with `cmd` and waits; returns the state it left in. */
+static case_state case_command_worker_locked(server_case *c, worker_command cmd)
+{
+    atomic_store(&c->command, cmd);
+    case_wait_worker_locked(c);
+    return c->state;
+}
+
+int registry_pause(server_case *c, char *msg, size_t msglen)
+{
+    int status = 0;
+    pthread_mutex_lock(&c->ctl_lock);
+    pthread_mutex_lock(&c->lock);
+    if (atomic_load(&c->deleted)) {
+        status = 404;
+    } else if (c->state == CASE_RUNNING) {
+        case_state now = case_command_worker_locked(c, WORKER_PAUSE);
+        if (now != CASE_PAUSED) {
+            snprintf(msg, msglen, "the case became %s before it could be paused", case_state_name(now));
+            status = 409;
+        }
+    } else if (c->state == CASE_QUEUED) {
+        c->state = CASE_PAUSED;
+    } else {
+        snprintf(msg, msglen, "the case is %s; pause is allowed only when it is running or queued",
+                 case_state_name(c->state));
+        status = 409;
+    }
+    pthread_mutex_unlock(&c->lock);
+    if (status == 0)
+        case_persist_status(c);
+    pthread_mutex_unlock(&c->ctl_lock);
+    return status;
+}
+
+int registry_stop(server_case *c, char *msg, size_t msglen)
+{
+    int status = 0, close_result = 0;
+    pthread_mutex_lock(&c->ctl_lock);
+    pthread_mutex_lock(&c->lock);
+    if (atomic_load(&c->deleted)) {
+        status = 404;
+    } else if (c->state == CASE_RUNNING) {
+        case_state now = case_command_worker_locked(c, WORKER_STOP);
+        if (now != CASE_STOPPED) {
+            snprintf(msg, msglen, "the case became %s before it could be stopped", case_state_name(now));
+            status = 409;
+        }
+    } else if (!case_state_is_terminal(c->state)) {
+        c->state = CASE_STOPPED;
+        close_result = 1;
+    } else {
+        snprintf(msg, msglen,
+                 "the case is %s; stop is allowed only when it is created, queued, running or paused",
+                 case_state_name(c->state));
+        status = 409;
+    }
+    pthread_mutex_unlock(&c->lock);
+    if (close_result)
+        io_close(c);
+    if (status == 0)
+        case_persist_status(c);
+    pthread_mutex_unlock(&c->ctl_lock);
+    return status;
+}
+
+int registry_delete(server_case *c)
+{
+    pthread_mutex_lock(&c->ctl_lock);
+    if (atomic_load(&c->deleted)) {
+        pthread_mutex_unlock(&c->ctl_lock);
+        return 404;
+    }
+    int listed = 0;
+    pthread_mutex_lock(&reg_lock);
+    for (int i = 0; i < reg_count; i++)
+        if (reg_cases[i] == c) {
+            memmove(reg_cases + i, reg_cases + i + 1, (size_t)(reg_count - i - 1) * sizeof *reg_cases);
+            reg_count--;
+            listed = 1;
+            break;
+        }
+    pthread_mutex_unlock(&reg_lock);
+
+    pthread_mutex_lock(&c->lock);
+    if (c->worker_active)
+        case_command_worker_locked(c, WORKER_ABANDON);
+    c->state = CASE_STOPPED;
+    atomic_store(&c->deleted, 1);
+    pthread_mutex_unlock(&c->lock);
+
+    io_close(c); /* FIFO: every earlier job of this case is done after it */
+    if (persist_remove_dir(c->dir) != 0)
+        fprintf(stderr, "fdemd: case %s: removing %s failed: %s\n", c->id, c->dir, strerror(errno));
+    else
+        persist_fsync_dir(reg_cfg->data_dir);
+    pthread_mutex_unlock(&c->ctl_lock);
+    if (listed)
+        case_release(c); /* the registry's reference */
+    return 0;
+}
+
+snapshot *case_take_state(server_case *c, unsigned fields)
+{
+    if (!c->model)
+        return NULL;
+    atomic_fetch_add(&c->state_waiters, 1);
+    pthread_mutex_lock(&c->model_lock);
+    snapshot *s = snapshot_take(c->model, fields);
+    pthread_mutex_unlock(&c->model_lock);
+    pthread_mutex_lock(&c->yield_lock);
+    atomic_fetch_sub(&c->state_waiters, 1);
+    pthread_cond_broadcast(&c->yield_cv);
+    pthread_mutex_unlock(&c->yield_lock);
+    return s;
+}
+
+/* ------------------------------------------------------------- creating */
+
+static int case_make_dir(server_case *c)
+{
+    for (int attempt = 0; attempt < 16; attempt++) {
+        if (id_generate(c->id) != 0)
+            return -1;
+        snprintf(c->dir, sizeof c->dir, "%s/%s", reg_cfg->data_dir, c->id);
+        if (mkdir(c->dir, 0755) == 0)
+            return 0;
+        if (errno != EEXIST)
+            return -1;
+    }
+    errno = EEXIST;
+    return -1;
+}
+
+server_case *registry_create(const char *body, size_t size, int start,
+                             problems *p, int *http_status, char *err, size_t errlen)
+{
+    case_info info;
+    memset(&info, 0, sizeof info);
+    fdem_model *model = case_build(body, size, reg_cfg->max_case_memory, &info, p);
+    if (!model) {
+        *http_status = p->status ? p->status : 422;
+        if (p->count == 0)
+            problems_add(p, 422, "", "the case could not be built");
+        return NULL;
+    }
+    server_case *c = case_new();
+    if (!c) {
+        fdem_model_destroy(model);
+        *http_status = 500;
+        snprintf(err, errlen, "out of memory");
+        return NULL;
+    }
+    c->model = model;
+    c->info = info;
+    c->state = CASE_CREATED;
+    iso_time_now(c->created, sizeof c->created);
+    *http_status = 500;
+    if (case_make_dir(c) != 0) {
+        snprintf(err, errlen, "cannot create the case directory: %s", strerror(errno));
+        case_release(c);
+        return NULL;
+    }
+    if (persist_write_atomic(c->dir, "case.json", body, size) != 0) {
+        snprintf(err, errlen, "cannot store case.json: %s", strerror(errno));
+        goto fail;
+    }
+    size_t ckpt_size = 0;
+    void *ckpt = case_checkpoint_take(model, &ckpt_size);
+    snapshot *first = snapshot_take(model, info.fields);
+    c->last_snapshot_step = c->last_checkpoint_step = fdem_get_step(model);
+    if (io_create(c, first, ckpt, ckpt_size, err, errlen) != 0)
+        goto fail;
+    case_publish_from_model(c);
+    pthread_mutex_lock(&reg_lock);
+    int appended = registry_append_locked(c) == 0;
+    if (appended && start && !reg_shutting_down) {
+        pthread_mutex_lock(&c->lock);
+        case_start_locked(c);
+        pthread_mutex_unlock(&c->lock);
+    }
+    pthread_mutex_unlock(&reg_lock);
+    if (!appended) {
+        snprintf(err, errlen, "out of memory");
+        goto fail;
+    }
+    /* The status is durable before the 201 goes out (a running case that
+     * is acknowledged comes back after a crash). */
+    case_persist_status(c);
+    *http_status = 201;
+    case_retain(c);
+    return c;
+fail:
+    io_close(c);
+    atomic_store(&c->deleted, 1);
+    persist_remove_dir(c->dir);
+    case_release(c);
+    return NULL;
+}
+
+/* ------------------------------------------------------------- loading */
+
+static void case_fail_loading(server_case *c, const char *fmt, const char *detail)
+{
+    c->state = CASE_FAILED;
+    snprintf(c->error, sizeof c->error, fmt, detail);
+    fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
+}
+
+static void case_load_status(server_case *c, const char *path, json_t **status_out)
+{
+    json_error_t jerr;
+    json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
+    const char *state = st ? json_string_value(json_object_get(st, "state")) : NULL;
+    const char *created = st ? json_string_value(json_object_get(st, "created")) : NULL;
+    const char *error = st ? json_string_value(json_object_get(st, "error")) : NULL;
+    if (!st || case_state_parse(state, &c->state) != 0) {
+        case_fail_loading(c, "status.json could not be read (%s)", st ? "no valid state" : jerr.text);
+    } else if (error) {
+        snprintf(c->error, sizeof c->error, "%s", error);
+    }
+    if (created)
+        snprintf(c->created, sizeof c->created, "%s", created);
+    *status_out = st;
+}
+
+/* Rebuilds the model from case.json and restores checkpoint.bin. */
+static void case_load_model(server_case *c)
+{
+    char path[1200], *doc = NULL, *ckpt = NULL;
+    size_t doc_size = 0, ckpt_size = 0;
+    snprintf(path, sizeof path, "%s/case.json", c->dir);
+    if (persist_read_file(path, &doc, &doc_size, (size_t)1 << 34) != 0) {
+        case_fail_loading(c, "case.json could not be read: %s", strerror(errno));
+        return;
+    }
+    problems p;
+    problems_init(&p);
+    c->model = case_build(doc, doc_size, reg_cfg->max_case_memory, &c->info, &p);
+    free(doc);
+    if (!c->model) {
+        case_fail_loading(c, "the stored case could not be rebuilt: %s",
+                          p.count ? p.items[0].message : "unknown problem");
+        problems_free(&p);
+        return;
+    }
+    problems_free(&p);
+    snprintf(path, sizeof path, "%s/checkpoint.bin", c->dir);
+    if (persist_read_file(path, &ckpt, &ckpt_size, (size_t)1 << 40) != 0) {
+        if (c->state != CASE_CREATED)
+            fprintf(stderr, "fdemd: case %s: no checkpoint (%s), resuming from t = 0\n", c->id,
+                    strerror(errno));
+        return;
+    }
+    fdem_error err;
+    memset(&err, 0, sizeof err);
+    if (fdem_checkpoint_read(c->model, ckpt, ckpt_size, &err) != 0) {
+        fdem_model_destroy(c->model);
+        c->model = NULL;
+        case_fail_loading(c, "checkpoint.bin could not be restored: %s", err.message);
+    }
+    free(ckpt);
+}
+
+/* Reopens result.h5 at the checkpoint (the writes after it are replayed). */
+static void case_load_result(server_case *c)
+{
+    if (!c->model)
+        return;
+    char err[256] = "";
+    int terminal = case_state_is_terminal(c->state);
+    int64_t keep = terminal ? INT64_MAX : fdem_get_step(c->model);
+    if (io_reopen(c, keep, terminal, err, sizeof err) == 0)
+        return;
+    fprintf(stderr, "fdemd: case %s: result.h5 could not be reopened (%s)%s\n", c->id, err,
+            terminal ? "" : "; starting a new one from the checkpoint");
+    if (terminal)
+        return;
+    snapshot *s = snapshot_take(c->model, c->info.fields);
+    if (io_create(c, s, NULL, 0, err, sizeof err) != 0)
+        case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+}
+
+static server_case *case_load(const char *id)
+{
+    server_case *c = case_new();
+    if (!c)
+        return NULL;
+    snprintf(c->id, sizeof c->id, "%s", id);
+    snprintf(c->dir, sizeof c->dir, "%s/%s", reg_cfg->data_dir, id);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/case.json", c->dir);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        /* Never acknowledged (the 201 follows case.json and status.json). */
+        fprintf(stderr, "fdemd: skipping %s: no case.json\n", c->dir);
+        case_release(c);
+        return NULL;
+    }
+    json_t *status = NULL;
+    snprintf(path, sizeof path, "%s/status.json", c->dir);
+    case_load_status(c, path, &status);
+    if (!c->created[0])
+        iso_time_now(c->created, sizeof c->created);
+    if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
+        c->state = CASE_PAUSED;
+    case_load_model(c);
+    if (!c->model && status) {
+        /* Keep what the user saw, so the case is still recognisable. */
+        snprintf(c->info.name, sizeof c->info.name, "%s",
+                 json_string_value(json_object_get(status, "name")) ? json_string_value(json_object_get(status, "name")) : "");
+        c->info.end_time = json_number_value(json_object_get(status, "end_time"));
+    }
+    json_decref(status);
+    case_publish_from_model(c);
+    case_load_result(c);
+    c->last_snapshot_step = c->last_checkpoint_step = c->model ? fdem_get_step(c->model) : -1;
+    case_persist_status(c);
+    return c;
+}
+
+static int case_order(const void *a, const void *b)
+{
+    const server_case *x = *(server_case *const *)a, *y = *(server_case *const *)b;
+    int d = strcmp(x->created, y->created);
+    return d ? d : strcmp(x->id, y->id);
+}
+
+int registry_init(const fdemd_config *cfg)
+{
+    reg_cfg = cfg;
+    if (persist_mkdir(cfg->data_dir) != 0) {
+        fprintf(stderr, "fdemd: cannot create the data directory %s: %s\n", cfg->data_dir,
+                strerror(errno));
+        return -1;
+    }
+    DIR *d = opendir(cfg->data_dir);
+    if (!d) {
+        fprintf(stderr, "fdemd: cannot read the data directory %s: %s\n", cfg->data_dir,
+                strerror(errno));
+        return -1;
+    }
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        if (!id_is_valid(e->d_name))
+            continue;
+        server_case *c = case_load(e->d_name);
+        if (c && registry_append_locked(c) != 0)
+            case_release(c);
+    }
+    closedir(d);
+    qsort(reg_cases, (size_t)reg_count, sizeof *reg_cases, case_order);
+    for (int i = 0; i < reg_count; i++)
+        reg_cases[i]->seq = (uint64_t)i;
+    return 0;
+}
+
+void registry_shutdown(void)
+{
+    pthread_mutex_lock(&reg_lock);
+    reg_shutting_down = 1;
+    pthread_mutex_unlock(&reg_lock);
+    int count = 0;
+    server_case **cases = registry_list(&count);
+    for (int i = 0; i < count; i++) {
+        server_case *c = cases[i];
+        pthread_mutex_lock(&c->ctl_lock);
+        pthread_mutex_lock(&c->lock);
+        if (c->state == CASE_RUNNING)
+            case_command_worker_locked(c, WORKER_PAUSE);
+        else if (c->state == CASE_QUEUED)
+            c->state = CASE_PAUSED;
+        pthread_mutex_unlock(&c->lock);
+        case_persist_status(c);
+        io_close(c);
+        pthread_mutex_unlock(&c->ctl_lock);
+    }
+    registry_list_free(cases, count);
+
+    pthread_mutex_lock(&reg_lock);
+    for (int i = 0; i < reg_count; i++)
+        case_release(reg_cases[i]);
+    free(reg_cases);
+    reg_cases = NULL;
+    reg_count = reg_capacity = 0;
+    pthread_mutex_unlock(&reg_lock);
+}

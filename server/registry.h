@@ -1,0 +1,136 @@
+/*
+ * registry.h - the set of cases the daemon holds and their state machine.
+ *
+ * Contract:
+ *  - A case is reference counted: registry_find() and registry_list() hand
+ *    out references that the caller returns with case_release(); a deleted
+ *    case is freed when its last reference goes.
+ *  - States: created -> running <-> paused -> finished | stopped | failed,
+ *    plus "queued": a start while --max-running cases run puts the case in
+ *    "queued"; queued cases start automatically in the order they were
+ *    queued as soon as a slot frees; pause (-> paused) and stop (-> stopped)
+ *    work on them. (We chose a queued state over 429 so a script can submit
+ *    a whole batch and let the daemon pace it.)
+ *  - Lock order: registry lock -> case lock. The worker holds model_lock
+ *    only while it steps; GET /state takes it between two steps (see
+ *    case_take_state), so a request never waits longer than one step.
+ *  - Every state change is written to DIR/ID/status.json before the request
+ *    that caused it is answered.
+ */
+#ifndef FDEMD_REGISTRY_H
+#define FDEMD_REGISTRY_H
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdint.h>
+#include <jansson.h>
+
+#include "case.h"
+#include "config.h"
+#include "fdem.h"
+#include "problems.h"
+#include "result.h"
+#include "snapshot.h"
+
+typedef enum case_state {
+    CASE_CREATED, CASE_QUEUED, CASE_RUNNING, CASE_PAUSED,
+    CASE_FINISHED, CASE_STOPPED, CASE_FAILED,
+} case_state;
+
+/* What the HTTP side asks a worker to do at its next step boundary. */
+typedef enum worker_command {
+    WORKER_GO = 0, WORKER_PAUSE, WORKER_STOP, WORKER_ABANDON, /* abandon: case is being deleted */
+} worker_command;
+
+/* Figures of the last published step (status object). */
+typedef struct case_figures {
+    int64_t step;
+    double time, dt;
+    fdem_counts counts;
+    fdem_energy energy;
+    double steps_per_second;
+    int snapshots;
+} case_figures;
+
+#define CASE_ID_LEN 16
+
+typedef struct server_case {
+    char id[CASE_ID_LEN + 1];
+    char dir[1100];
+    char created[40];          /* ISO 8601 UTC, sorts like time */
+    uint64_t seq;              /* creation order (oldest first listings) */
+    atomic_int refs;
+
+    fdem_model *model;         /* NULL when the case could not be rebuilt */
+    case_info info;
+
+    pthread_mutex_t lock;      /* guards the fields down to `io_pending` */
+    pthread_cond_t cv;         /* worker exit, I/O backlog drained */
+    case_state state;
+    char error[768];           /* "" = no error */
+    case_figures fig;
+    int worker_active;
+    _Atomic int deleted;
+    uint64_t queue_seq;
+    int io_pending;            /* snapshot jobs not yet written */
+    _Atomic int command;       /* worker_command */
+
+    pthread_mutex_t ctl_lock;  /* serializes commands (start/pause/stop/delete) */
+
+    pthread_mutex_t model_lock; /* the worker holds it while stepping */
+    atomic_int state_waiters;   /* requesters that want model_lock */
+    pthread_mutex_t yield_lock;
+    pthread_cond_t yield_cv;
+
+    pthread_mutex_t persist_lock; /* one status.json writer at a time */
+
+    /* touched by the I/O thread only */
+    result_file *result;
+    int xdmf_dirty;
+    double xdmf_written_at;    /* monotonic seconds */
+
+    /* worker-private */
+    double next_output;
+    int64_t last_snapshot_step, last_checkpoint_step;
+} server_case;
+
+int registry_init(const fdemd_config *cfg);
+const fdemd_config *registry_config(void);
+void registry_shutdown(void);  /* pauses running cases, closes results */
+
+server_case *registry_find(const char *id);
+void case_retain(server_case *c);
+void case_release(server_case *c);
+/* References to every case, oldest first; free the array with registry_list_free. */
+server_case **registry_list(int *count);
+void registry_list_free(server_case **cases, int count);
+void registry_counts(int *cases, int *running);
+
+/* Validates and stores a case. Returns the new case (a reference), or NULL
+ * with `p` filled (400/422), or NULL with *http_status = 500 and `err`. */
+server_case *registry_create(const char *body, size_t size, int start,
+                             problems *p, int *http_status, char *err, size_t errlen);
+
+/* start/pause/stop: 0, or 409 with a sentence in msg. */
+int registry_start(server_case *c, char *msg, size_t msglen);
+int registry_pause(server_case *c, char *msg, size_t msglen);
+int registry_stop(server_case *c, char *msg, size_t msglen);
+int registry_delete(server_case *c);
+
+/* The model's state at one step boundary; NULL when no model is held. */
+snapshot *case_take_state(server_case *c, unsigned fields);
+
+json_t *case_status_json(server_case *c);
+const char *case_state_name(case_state s);
+void case_persist_status(server_case *c);
+
+/* Called by the worker and the I/O thread. */
+void case_publish(server_case *c, const case_figures *fig);
+void case_set_snapshots(server_case *c, int snapshots);
+void registry_worker_exited(server_case *c);
+int id_is_valid(const char *s);
+
+/* fdem_checkpoint_write into a malloc'd buffer (NULL on failure). */
+void *case_checkpoint_take(const fdem_model *m, size_t *size);
+
+#endif

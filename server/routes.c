@@ -1,0 +1,289 @@
+/*
+ * routes.c - one function per API route (contract section 2).
+ *
+ * Routes translate between HTTP and the registry: they parse query
+ * arguments, call one registry or I/O function and turn its answer into a
+ * status code. Nothing here touches a model or an HDF5 handle directly.
+ */
+#include "routes.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "http.h"
+#include "io_thread.h"
+#include "state_json.h"
+
+/* ------------------------------------------------------------- matching */
+
+#define ROUTE_MAX_SEGMENTS 4
+
+/* Splits "/a/b/c" into at most ROUTE_MAX_SEGMENTS segments; one trailing
+ * slash is forgiven. Returns the count, or -1 for empty or excess segments. */
+static int routes_split(const char *url, char seg[ROUTE_MAX_SEGMENTS][32])
+{
+    if (!url || url[0] != '/')
+        return -1;
+    const char *p = url + 1;
+    int n = 0;
+    while (*p) {
+        const char *slash = strchr(p, '/');
+        size_t len = slash ? (size_t)(slash - p) : strlen(p);
+        if (len == 0 || len >= 32 || n == ROUTE_MAX_SEGMENTS)
+            return -1;
+        memcpy(seg[n], p, len);
+        seg[n][len] = '\0';
+        n++;
+        if (!slash)
+            break;
+        p = slash + 1;
+    }
+    return n;
+}
+
+void routes_match(const char *url, route_match *out)
+{
+    static const struct { const char *name; route_kind kind; } sub[] = {
+        {"start", ROUTE_CASE_START}, {"pause", ROUTE_CASE_PAUSE}, {"stop", ROUTE_CASE_STOP},
+        {"case", ROUTE_CASE_DOCUMENT}, {"state", ROUTE_CASE_STATE},
+        {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
+    };
+    char seg[ROUTE_MAX_SEGMENTS][32];
+    memset(out, 0, sizeof *out);
+    int n = routes_split(url, seg);
+    if (n == 1 && strcmp(seg[0], "health") == 0)
+        out->kind = ROUTE_HEALTH;
+    if (n < 1 || strcmp(seg[0], "cases") != 0)
+        return;
+    if (n == 1) {
+        out->kind = ROUTE_CASES;
+        return;
+    }
+    if (!id_is_valid(seg[1]) || n > 3)
+        return;
+    if (n == 2) {
+        out->kind = ROUTE_CASE;
+    } else {
+        for (size_t i = 0; i < sizeof sub / sizeof *sub; i++)
+            if (strcmp(seg[2], sub[i].name) == 0)
+                out->kind = sub[i].kind;
+        if (out->kind == ROUTE_NONE)
+            return;
+    }
+    memcpy(out->id, seg[1], CASE_ID_LEN + 1);
+}
+
+const char *routes_allowed(route_kind kind)
+{
+    switch (kind) {
+    case ROUTE_CASES: return "GET, HEAD, POST";
+    case ROUTE_CASE: return "GET, HEAD, DELETE";
+    case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP: return "POST";
+    default: return "GET, HEAD";
+    }
+}
+
+int routes_method_allowed(route_kind kind, const char *method)
+{
+    const char *allowed = routes_allowed(kind);
+    size_t len = strlen(method);
+    for (const char *p = allowed; (p = strstr(p, method)) != NULL; p += len)
+        if ((p == allowed || p[-1] == ' ') && (p[len] == ',' || p[len] == '\0'))
+            return 1;
+    return 0;
+}
+
+int routes_takes_body(route_kind kind, const char *method)
+{
+    return kind == ROUTE_CASES && strcmp(method, "POST") == 0;
+}
+
+/* ---------------------------------------------------------------- helpers */
+
+static enum MHD_Result routes_no_case(struct MHD_Connection *conn, const char *id)
+{
+    char detail[64];
+    snprintf(detail, sizeof detail, "no case with id %s", id);
+    return http_reply_problem(conn, 404, "Not found", detail, NULL);
+}
+
+static enum MHD_Result routes_serve_file(struct MHD_Connection *conn, server_case *c,
+                                         const char *name, const char *content_type)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", c->dir, name);
+    int fd = open(path, O_RDONLY | O_CLOEXEC);
+    struct stat st;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        if (fd >= 0)
+            close(fd);
+        char detail[128];
+        snprintf(detail, sizeof detail, "the case has no %s (yet)", name);
+        return http_reply_problem(conn, 404, "Not found", detail, NULL);
+    }
+    return http_reply_fd(conn, fd, (size_t)st.st_size, content_type, NULL);
+}
+
+/* "true"/"1"/"yes" -> 1, "false"/"0"/"no"/absent -> 0, else -1. */
+static int routes_flag(struct MHD_Connection *conn, const char *name)
+{
+    const char *v = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, name);
+    if (!v)
+        return 0;
+    if (!strcmp(v, "true") || !strcmp(v, "1") || !strcmp(v, "yes") || !*v)
+        return 1;
+    if (!strcmp(v, "false") || !strcmp(v, "0") || !strcmp(v, "no"))
+        return 0;
+    return -1;
+}
+
+/* ----------------------------------------------------------------- routes */
+
+static enum MHD_Result route_health(struct MHD_Connection *conn)
+{
+    int cases = 0, running = 0;
+    registry_counts(&cases, &running);
+    return http_reply_json(conn, 200,
+                           json_pack("{s:s, s:s, s:i, s:i}", "status", "ok", "version", FDEM_VERSION,
+                                     "cases", cases, "running", running), NULL);
+}
+
+static enum MHD_Result route_list_cases(struct MHD_Connection *conn)
+{
+    int count = 0;
+    server_case **cases = registry_list(&count);
+    json_t *arr = json_array();
+    for (int i = 0; i < count; i++)
+        json_array_append_new(arr, case_status_json(cases[i]));
+    registry_list_free(cases, count);
+    return http_reply_json(conn, 200, json_pack("{s:o}", "cases", arr), NULL);
+}
+
+static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char *body, size_t size)
+{
+    int start = routes_flag(conn, "start");
+    if (start < 0)
+        return http_reply_problem(conn, 400, "Bad request", "?start= takes true or false", NULL);
+    problems p;
+    problems_init(&p);
+    int status = 0;
+    char err[300] = "";
+    server_case *c = registry_create(body, size, start, &p, &status, err, sizeof err);
+    enum MHD_Result rc;
+    if (c) {
+        char location[64];
+        snprintf(location, sizeof location, "/cases/%s", c->id);
+        rc = http_reply_json(conn, 201, case_status_json(c), location);
+        case_release(c);
+    } else if (status == 400 || status == 422) {
+        char detail[640];
+        if (status == 400)
+            snprintf(detail, sizeof detail, "%s", p.count ? p.items[0].message : "the body is not valid JSON");
+        else
+            snprintf(detail, sizeof detail, "%d problem%s in the case", p.count + p.dropped,
+                     p.count + p.dropped == 1 ? "" : "s");
+        const char *title = p.title[0] ? p.title : status == 400 ? "Malformed JSON" : "Invalid case";
+        rc = http_reply_problem(conn, (unsigned)status, title, detail, &p);
+    } else {
+        fprintf(stderr, "fdemd: storing a new case failed: %s\n", err);
+        rc = http_reply_problem(conn, 500, "Internal error", err, NULL);
+    }
+    problems_free(&p);
+    return rc;
+}
+
+static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c, route_kind kind)
+{
+    char msg[256] = "";
+    int status = kind == ROUTE_CASE_START ? registry_start(c, msg, sizeof msg)
+               : kind == ROUTE_CASE_PAUSE ? registry_pause(c, msg, sizeof msg)
+                                          : registry_stop(c, msg, sizeof msg);
+    if (status == 0)
+        return http_reply_json(conn, 200, case_status_json(c), NULL);
+    if (status == 404)
+        return routes_no_case(conn, c->id);
+    return http_reply_problem(conn, (unsigned)status, status == 409 ? "Conflict" : "Unavailable", msg, NULL);
+}
+
+static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
+{
+    const char *csv = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "fields");
+    unsigned fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY;
+    if (csv && *csv) {
+        problems p;
+        problems_init(&p);
+        fields = case_parse_fields(csv, &p);
+        if (p.count) {
+            enum MHD_Result rc = http_reply_problem(conn, 400, "Bad request",
+                                                    "unknown field in ?fields=", &p);
+            problems_free(&p);
+            return rc;
+        }
+        problems_free(&p);
+    }
+    snapshot *s = case_take_state(c, fields);
+    if (!s)
+        return http_reply_problem(conn, 409, "Conflict",
+                                  "this case holds no model (it could not be rebuilt)", NULL);
+    json_t *o = state_to_json(s);
+    snapshot_free(s);
+    if (!o)
+        return http_reply_problem(conn, 409, "Conflict",
+                                  "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
+    return http_reply_json(conn, 200, o, NULL);
+}
+
+static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case *c)
+{
+    int fd = -1;
+    size_t size = 0;
+    char err[256] = "";
+    if (io_fetch_result(c, &fd, &size, err, sizeof err) != 0) {
+        fprintf(stderr, "fdemd: case %s: serving result.h5 failed: %s\n", c->id, err);
+        return http_reply_problem(conn, 404, "Not found", "the result file is not available", NULL);
+    }
+    return http_reply_fd(conn, fd, size, "application/x-hdf5", "result.h5");
+}
+
+static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, route_kind kind,
+                                  const char *method)
+{
+    switch (kind) {
+    case ROUTE_CASE:
+        if (strcmp(method, "DELETE") == 0)
+            return registry_delete(c) == 0 ? http_reply_empty(conn, 204) : routes_no_case(conn, c->id);
+        return http_reply_json(conn, 200, case_status_json(c), NULL);
+    case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
+        return route_command(conn, c, kind);
+    case ROUTE_CASE_DOCUMENT:
+        return routes_serve_file(conn, c, "case.json", "application/json");
+    case ROUTE_CASE_STATE:
+        return route_state(conn, c);
+    case ROUTE_CASE_RESULT_H5:
+        return route_result_h5(conn, c);
+    case ROUTE_CASE_RESULT_XDMF:
+        return routes_serve_file(conn, c, "result.xdmf", "application/xml");
+    default:
+        return http_reply_problem(conn, 404, "Not found", "no such path", NULL);
+    }
+}
+
+enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
+                              const char *method, const char *body, size_t body_size)
+{
+    if (m->kind == ROUTE_HEALTH)
+        return route_health(conn);
+    if (m->kind == ROUTE_CASES)
+        return strcmp(method, "POST") == 0 ? route_create_case(conn, body, body_size)
+                                           : route_list_cases(conn);
+    server_case *c = registry_find(m->id);
+    if (!c)
+        return routes_no_case(conn, m->id);
+    enum MHD_Result rc = route_case(conn, c, m->kind, method);
+    case_release(c);
+    return rc;
+}

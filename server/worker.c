@@ -1,0 +1,258 @@
+/*
+ * worker.c - the step loop of one running case.
+ *
+ * The loop holds model_lock only around fdem_step() and the copies taken
+ * right after it (snapshot, checkpoint buffer, published figures), and
+ * steps aside whenever a GET /state is waiting (state_waiters), so such a
+ * request waits at most one step. Disk work happens on the I/O thread; the
+ * worker only blocks when that thread falls far behind (backpressure) or
+ * when it pauses/stops and wants its last checkpoint durable before the
+ * command is acknowledged.
+ */
+#include "worker.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "io_thread.h"
+
+#define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
+#define WORKER_CHECKPOINT_INTERVAL 0.5 /* s of wall time between checkpoints */
+#define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
+
+typedef enum worker_exit {
+    EXIT_PAUSE, EXIT_STOP, EXIT_ABANDON, EXIT_FINISHED, EXIT_FAILED,
+} worker_exit;
+
+typedef struct worker_clock {
+    double last_publish, last_checkpoint;
+    int64_t steps_at_publish;
+    double steps_per_second;
+} worker_clock;
+
+static double worker_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static double worker_output_interval(const server_case *c)
+{
+    double interval = c->info.output_interval;
+    if (!(interval > 0))
+        interval = c->info.end_time / 100.0;
+    return interval > 0 ? interval : 1.0;
+}
+
+/* The first output time strictly after `t` on the grid k * interval. */
+static double worker_next_output(const server_case *c, double t)
+{
+    double interval = worker_output_interval(c);
+    double k = floor(t / interval * (1.0 + 1e-12) + 1e-9);
+    return (k + 1.0) * interval;
+}
+
+/* Called with model_lock held (the figures must belong to one step). */
+static void worker_publish(server_case *c, worker_clock *clk, double now, int running)
+{
+    const fdem_model *m = c->model;
+    case_figures fig;
+    memset(&fig, 0, sizeof fig);
+    fig.step = fdem_get_step(m);
+    fig.time = fdem_get_time(m);
+    fig.dt = fdem_get_dt(m);
+    fig.counts = fdem_get_counts(m);
+    fig.energy = fdem_get_energy(m);
+    double wall = now - clk->last_publish;
+    if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_publish > 100))
+        clk->steps_per_second = (double)(fig.step - clk->steps_at_publish) / wall;
+    if (wall > 0.2 || fig.step - clk->steps_at_publish > 100) {
+        clk->last_publish = now;
+        clk->steps_at_publish = fig.step;
+    }
+    fig.steps_per_second = running ? clk->steps_per_second : 0.0;
+    fig.snapshots = -1; /* owned by the I/O thread */
+    case_publish(c, &fig);
+}
+
+/* Lets pending GET /state requests take model_lock before the next step. */
+static void worker_yield_to_requesters(server_case *c)
+{
+    if (atomic_load(&c->state_waiters) == 0)
+        return;
+    pthread_mutex_lock(&c->yield_lock);
+    while (atomic_load(&c->state_waiters) > 0)
+        pthread_cond_wait(&c->yield_cv, &c->yield_lock);
+    pthread_mutex_unlock(&c->yield_lock);
+}
+
+static void worker_wait_io(server_case *c, int max_pending)
+{
+    pthread_mutex_lock(&c->lock);
+    while (c->io_pending > max_pending)
+        pthread_cond_wait(&c->cv, &c->lock);
+    pthread_mutex_unlock(&c->lock);
+}
+
+static void worker_describe_failure(server_case *c, const fdem_error *err, double dt)
+{
+    char where[64] = "";
+    if (err->kind == FDEM_ITEM_ELEMENT && err->item >= 0)
+        snprintf(where, sizeof where, " in element %d", err->item);
+    else if (err->kind == FDEM_ITEM_NODE && err->item >= 0)
+        snprintf(where, sizeof where, " at node %d", err->item);
+    pthread_mutex_lock(&c->lock);
+    snprintf(c->error, sizeof c->error,
+             "the solution became non-finite at step %lld (t = %.6g s)%s with dt = %.3g s; "
+             "reduce time.safety or check the material stiffness and penalty%s%s",
+             (long long)fdem_get_step(c->model), fdem_get_time(c->model), where, dt,
+             err->message[0] ? " (engine: " : "", err->message[0] ? err->message : "");
+    if (err->message[0] && strlen(c->error) + 2 < sizeof c->error)
+        strcat(c->error, ")");
+    pthread_mutex_unlock(&c->lock);
+}
+
+/* Runs steps until a command, the end time or a failure. */
+static worker_exit worker_loop(server_case *c, worker_clock *clk)
+{
+    fdem_model *m = c->model;
+    const double end = c->info.end_time;
+    for (;;) {
+        int cmd = atomic_load(&c->command);
+        if (cmd == WORKER_PAUSE)
+            return EXIT_PAUSE;
+        if (cmd == WORKER_STOP)
+            return EXIT_STOP;
+        if (cmd == WORKER_ABANDON)
+            return EXIT_ABANDON;
+        worker_yield_to_requesters(c);
+
+        pthread_mutex_lock(&c->model_lock);
+        double dt = fdem_get_dt(m);
+        fdem_error err;
+        memset(&err, 0, sizeof err);
+        if (fdem_step(m, &err) != 0) {
+            worker_describe_failure(c, &err, dt);
+            pthread_mutex_unlock(&c->model_lock);
+            return EXIT_FAILED;
+        }
+        double t = fdem_get_time(m), now = worker_now();
+        int done = t >= end - 1e-6 * dt;
+        snapshot *snap = NULL;
+        void *ckpt = NULL;
+        size_t ckpt_size = 0;
+        if (done || t >= c->next_output - 1e-6 * dt) {
+            snap = snapshot_take(m, c->info.fields);
+            c->last_snapshot_step = fdem_get_step(m);
+            c->next_output = worker_next_output(c, t);
+            if (done || now - clk->last_checkpoint >= WORKER_CHECKPOINT_INTERVAL) {
+                ckpt = case_checkpoint_take(m, &ckpt_size);
+                c->last_checkpoint_step = fdem_get_step(m);
+                clk->last_checkpoint = now;
+            }
+        }
+        if (snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL)
+            worker_publish(c, clk, now, 1);
+        pthread_mutex_unlock(&c->model_lock);
+
+        if (snap || ckpt) {
+            io_append(c, snap, ckpt, ckpt_size);
+            worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
+        }
+        if (done)
+            return EXIT_FINISHED;
+    }
+}
+
+/* Final snapshot/checkpoint for the way the loop ended; waits until they are
+ * on disk so the command's answer never runs ahead of the files. */
+static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
+{
+    if (why == EXIT_ABANDON)
+        return;
+    snapshot *snap = NULL;
+    void *ckpt = NULL;
+    size_t ckpt_size = 0;
+    pthread_mutex_lock(&c->model_lock);
+    int64_t step = fdem_get_step(c->model);
+    if (why == EXIT_STOP && step != c->last_snapshot_step) {
+        snap = snapshot_take(c->model, c->info.fields);
+        c->last_snapshot_step = step;
+    }
+    if ((why == EXIT_PAUSE || why == EXIT_STOP) && step != c->last_checkpoint_step) {
+        ckpt = case_checkpoint_take(c->model, &ckpt_size);
+        c->last_checkpoint_step = step;
+    }
+    worker_publish(c, clk, worker_now(), 0);
+    pthread_mutex_unlock(&c->model_lock);
+    if (snap || ckpt)
+        io_append(c, snap, ckpt, ckpt_size);
+    worker_wait_io(c, 0);
+    if (why != EXIT_PAUSE)
+        io_close(c);
+}
+
+static case_state worker_final_state(worker_exit why)
+{
+    switch (why) {
+    case EXIT_PAUSE: return CASE_PAUSED;
+    case EXIT_STOP: case EXIT_ABANDON: return CASE_STOPPED;
+    case EXIT_FINISHED: return CASE_FINISHED;
+    case EXIT_FAILED: return CASE_FAILED;
+    }
+    return CASE_FAILED;
+}
+
+static void *worker_main(void *arg)
+{
+    server_case *c = arg;
+    const fdemd_config *cfg = registry_config();
+    if (cfg->threads > 0)
+        omp_set_num_threads(cfg->threads);
+
+    worker_clock clk = {worker_now(), worker_now(), fdem_get_step(c->model), 0.0};
+    c->next_output = worker_next_output(c, fdem_get_time(c->model));
+    worker_exit why = worker_loop(c, &clk);
+    worker_wind_down(c, why, &clk);
+
+    pthread_mutex_lock(&c->lock);
+    c->state = worker_final_state(why);
+    atomic_store(&c->command, WORKER_GO);
+    pthread_mutex_unlock(&c->lock);
+    if (why != EXIT_ABANDON)
+        case_persist_status(c);
+
+    /* Free the slot (and start a queued case) before the pauser is woken,
+     * so the running count never exceeds --max-running. */
+    registry_worker_exited(c);
+    pthread_mutex_lock(&c->lock);
+    c->worker_active = 0;
+    pthread_cond_broadcast(&c->cv);
+    pthread_mutex_unlock(&c->lock);
+    case_release(c);
+    return NULL;
+}
+
+int worker_spawn(server_case *c)
+{
+    pthread_attr_t attr;
+    pthread_attr_init(&attr);
+    pthread_attr_setdetachstate(&attr, PTHREAD_CREATE_DETACHED);
+    case_retain(c);
+    c->worker_active = 1;
+    atomic_store(&c->command, WORKER_GO);
+    pthread_t t;
+    int rc = pthread_create(&t, &attr, worker_main, c);
+    pthread_attr_destroy(&attr);
+    if (rc != 0) {
+        c->worker_active = 0;
+        case_release(c);
+        return -1;
+    }
+    return 0;
+}
