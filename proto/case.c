@@ -1,0 +1,309 @@
+/*
+ * case.c - case_build(): a case document (contract section 3) in, a
+ * finalized engine model (or the full list of problems) out.
+ *
+ * This file owns the order of things: parse, read every section (pass 1,
+ * case_materials.c, case_parts.c, case_constraints.c and the small sections
+ * here), estimate memory (pass 2, case_memory.c), build and finalize the
+ * model (pass 3), then choose the time step. It also maps engine errors to
+ * JSON Pointers, because only the case knows which document item became
+ * which engine index.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "case_internal.h"
+
+#define CASE_MAX_SNAPSHOTS 1e6
+#define CASE_DEFAULT_SNAPSHOTS 100
+#define CASE_DEFAULT_SAFETY 0.5
+
+static const char *const top_keys[] = {
+    "name", "materials", "parts", "constraints", "gravity", "time", "output", NULL,
+};
+static const char *const time_keys[] = {"end", "dt", "safety", NULL};
+static const char *const output_keys[] = {"interval", "fields", NULL};
+static const char *const field_names[] = {"position", "velocity", "stress", "damage"};
+
+/* ------------------------------------------------------- small sections */
+
+static void case_read_name(case_doc *doc, const json_t *root)
+{
+    json_t *name = json_object_get(root, "name");
+    snprintf(doc->name, sizeof doc->name, "unnamed");
+    if (!name) return;
+    if (!json_is_string(name))
+        case_problem(doc, "/name", "expected a string, got %s", case_type_word(name));
+    else if (json_string_length(name) >= CASE_NAME ||
+             strlen(json_string_value(name)) != json_string_length(name))
+        case_problem(doc, "/name", "the name must be at most %d bytes, without NUL characters",
+                     CASE_NAME - 1);
+    else if (json_string_length(name) > 0)
+        snprintf(doc->name, sizeof doc->name, "%s", json_string_value(name));
+}
+
+static void case_read_dt(case_doc *doc, const json_t *dt)
+{
+    doc->dt_auto = 1;
+    if (!dt || (json_is_string(dt) && strcmp(json_string_value(dt), "auto") == 0)) return;
+    if (json_is_string(dt)) {
+        case_problem(doc, "/time/dt", "expected a number or \"auto\", got \"%.32s\"",
+                     json_string_value(dt));
+        return;
+    }
+    if (!json_is_number(dt)) {
+        case_problem(doc, "/time/dt", "expected a number or \"auto\", got %s",
+                     case_type_word(dt));
+        return;
+    }
+    doc->dt_auto = 0;
+    if (case_read_number(doc, dt, "/time/dt", &doc->dt) && !(doc->dt > 0))
+        case_problem(doc, "/time/dt", "dt must be > 0, got %g", doc->dt);
+}
+
+static void case_read_time(case_doc *doc, const json_t *time)
+{
+    doc->safety = CASE_DEFAULT_SAFETY;
+    doc->dt_auto = 1;
+    if (!time) {
+        case_problem(doc, "", "missing required \"time\" {\"end\": seconds}");
+        return;
+    }
+    if (!case_expect_object(doc, time, "/time")) return;
+    case_check_keys(doc, time, "/time", time_keys, "\"time\"");
+    if (case_number_member(doc, time, "/time", "end", 1, &doc->end_time) &&
+        !(doc->end_time > 0))
+        case_problem(doc, "/time/end", "end must be > 0, got %g", doc->end_time);
+    case_read_dt(doc, json_object_get(time, "dt"));
+    if (case_number_member(doc, time, "/time", "safety", 0, &doc->safety) &&
+        !(doc->safety > 0 && doc->safety <= 1))
+        case_problem(doc, "/time/safety", "safety must be in (0, 1], got %g", doc->safety);
+}
+
+static void case_read_fields(case_doc *doc, const json_t *fields)
+{
+    if (!case_expect_array(doc, fields, "/output/fields")) return;
+    doc->fields = 0;
+    size_t i;
+    json_t *f;
+    json_array_foreach(fields, i, f) {
+        char at[CASE_POINTER];
+        pointer_join_index(at, sizeof at, "/output/fields", (long)i);
+        if (!json_is_string(f)) {
+            case_problem(doc, at, "expected a field name, got %s", case_type_word(f));
+            continue;
+        }
+        unsigned bit = 0;
+        for (int k = 0; k < 4; k++)
+            if (strcmp(json_string_value(f), field_names[k]) == 0) bit = 1u << k;
+        char hint[96];
+        if (!bit)
+            case_problem(doc, at, "unknown field \"%.64s\"%s (fields are position, velocity, "
+                                  "stress, damage)", json_string_value(f),
+                         case_did_you_mean(hint, sizeof hint, json_string_value(f),
+                                           field_names, 4));
+        doc->fields |= bit;
+    }
+}
+
+/* Needs time.end, so it runs after case_read_time(). */
+static void case_read_output(case_doc *doc, const json_t *output)
+{
+    doc->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY;
+    doc->interval = doc->end_time / CASE_DEFAULT_SNAPSHOTS;
+    if (!output) return;
+    if (!case_expect_object(doc, output, "/output")) return;
+    case_check_keys(doc, output, "/output", output_keys, "\"output\"");
+    if (json_object_get(output, "interval") &&
+        case_number_member(doc, output, "/output", "interval", 0, &doc->interval)) {
+        if (!(doc->interval > 0))
+            case_problem(doc, "/output/interval", "interval must be > 0, got %g", doc->interval);
+        else if (doc->end_time > 0 && doc->end_time / doc->interval > CASE_MAX_SNAPSHOTS)
+            case_problem(doc, "/output/interval",
+                         "an interval of %g s over %g s would write %.3g snapshots; the limit "
+                         "is %.0f", doc->interval, doc->end_time,
+                         doc->end_time / doc->interval, CASE_MAX_SNAPSHOTS);
+    }
+    json_t *fields = json_object_get(output, "fields");
+    if (fields) case_read_fields(doc, fields);
+}
+
+static void case_read_gravity(case_doc *doc, const json_t *gravity)
+{
+    if (gravity) case_read_vec2(doc, gravity, "/gravity", doc->gravity);
+}
+
+/* Pass 1 over the whole document. */
+static void case_read(case_doc *doc, const json_t *root)
+{
+    if (!json_is_object(root)) {
+        case_problem(doc, "", "a case is a JSON object, got %s", case_type_word(root));
+        return;
+    }
+    case_check_keys(doc, root, "", top_keys, "the case");
+    case_read_name(doc, root);
+    json_t *materials = json_object_get(root, "materials");
+    if (materials) case_read_materials(doc, materials);
+    else case_problem(doc, "", "missing required \"materials\" {name: {...}}");
+    json_t *parts = json_object_get(root, "parts");
+    if (parts) case_read_parts(doc, parts);
+    else case_problem(doc, "", "missing required \"parts\" [...]");
+    json_t *constraints = json_object_get(root, "constraints");
+    if (constraints) case_read_constraints(doc, constraints);
+    case_read_gravity(doc, json_object_get(root, "gravity"));
+    case_read_time(doc, json_object_get(root, "time"));
+    case_read_output(doc, json_object_get(root, "output"));
+}
+
+/* ---------------------------------------------------------------- pass 3 */
+
+void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback)
+{
+    char ptr[CASE_POINTER];
+    snprintf(ptr, sizeof ptr, "%s", fallback);
+    if (err->kind == FDEM_ITEM_MATERIAL && err->item >= 0 && err->item < doc->material_count)
+        pointer_join(ptr, sizeof ptr, "/materials", doc->materials[err->item].name);
+    else if (err->kind == FDEM_ITEM_PART && err->item >= 0 && err->item < doc->part_count)
+        pointer_join_index(ptr, sizeof ptr, "/parts", err->item);
+    else if (err->kind == FDEM_ITEM_CONSTRAINT && err->item >= 0 &&
+             err->item < doc->constraint_count)
+        pointer_join_index(ptr, sizeof ptr, "/constraints", err->item);
+    case_problem(doc, ptr, "%s", err->message[0] ? err->message : "the engine refused the case");
+}
+
+/* Belt and braces: a constraint that selected nothing is a user error even
+ * if the engine accepted it. */
+static int case_check_selections(case_doc *doc, const fdem_model *model)
+{
+    int ok = 1;
+    for (int i = 0; i < doc->constraint_count; i++)
+        if (fdem_constraint_node_count(model, i) <= 0) {
+            char ptr[CASE_POINTER];
+            pointer_join_index(ptr, sizeof ptr, "/constraints", i);
+            case_problem(doc, ptr, "the constraint selects no node");
+            ok = 0;
+        }
+    return ok;
+}
+
+/* "auto" is safety x the stable step; a given dt must not exceed it. */
+static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
+{
+    double stable = fdem_stable_dt(model);
+    if (!(stable > 0) || !isfinite(stable)) {
+        case_problem(doc, "", "the model has no finite stable time step (%g s)", stable);
+        return -1;
+    }
+    if (!doc->dt_auto && doc->dt > stable) {
+        case_problem(doc, "/time/dt", "dt = %g s is above the stable time step of this model, "
+                                      "%.4g s; use at most that, or \"auto\" (%.4g s with "
+                                      "safety %g)", doc->dt, stable, doc->safety * stable,
+                     doc->safety);
+        return -1;
+    }
+    double dt = doc->dt_auto ? doc->safety * stable : doc->dt;
+    fdem_set_dt(model, dt);
+    info->dt = dt;
+    info->stable_dt = stable;
+    return 0;
+}
+
+static fdem_model *case_build_model(case_doc *doc, case_info *info)
+{
+    fdem_model *model = fdem_model_create();
+    if (!model) {
+        case_problem(doc, "", "out of memory");
+        return NULL;
+    }
+    fdem_error err = {0};
+    int ok = case_add_materials(doc, model) == 0 && case_add_parts(doc, model) == 0 &&
+             case_add_constraints(doc, model) == 0;
+    if (ok) {
+        fdem_set_gravity(model, doc->gravity[0], doc->gravity[1]);
+        ok = fdem_model_finalize(model, &err) == 0;
+        if (!ok) case_engine_problem(doc, &err, "");
+    }
+    ok = ok && case_check_selections(doc, model) && case_choose_dt(doc, model, info) == 0;
+    if (!ok) {
+        fdem_model_destroy(model);
+        return NULL;
+    }
+    return model;
+}
+
+static void case_fill_info(const case_doc *doc, case_info *info)
+{
+    snprintf(info->name, sizeof info->name, "%s", doc->name);
+    info->end_time = doc->end_time;
+    info->safety = doc->safety;
+    info->output_interval = doc->interval;
+    info->fields = doc->fields;
+    info->part_count = doc->part_count;
+    info->constraint_count = doc->constraint_count;
+    info->fracture = 0;
+    for (int i = 0; i < doc->part_count; i++) info->fracture |= doc->parts[i].fracture;
+}
+
+void case_doc_free(case_doc *doc)
+{
+    for (int i = 0; i < doc->part_count; i++) fdem_mesh_free(&doc->parts[i].mesh);
+    free(doc->parts);
+    free(doc->materials);
+    free(doc->constraints);
+}
+
+static json_t *case_parse(const char *text, size_t length, problems *out)
+{
+    json_error_t error;
+    json_t *root = json_loadb(text ? text : "", text ? length : 0, JSON_REJECT_DUPLICATES, &error);
+    if (root) return root;
+    if (!out->title[0]) snprintf(out->title, sizeof out->title, "Malformed JSON");
+    problems_add(out, 400, "", "line %d, column %d: %s", error.line, error.column, error.text);
+    return NULL;
+}
+
+fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
+                       case_info *info, problems *out)
+{
+    case_info scratch;
+    if (!info) info = &scratch;
+    memset(info, 0, sizeof *info);
+    json_t *root = case_parse(text, length, out);
+    if (!root) return NULL;
+    case_doc doc = {0};
+    doc.out = out;
+    int before = out->count + out->dropped;
+    case_read(&doc, root);
+    if (out->count + out->dropped == before) case_check_memory(&doc, memory_limit);
+    fdem_model *model = NULL;
+    if (out->count + out->dropped == before) model = case_build_model(&doc, info);
+    if (model) case_fill_info(&doc, info);
+    case_doc_free(&doc);
+    json_decref(root);
+    return model;
+}
+
+unsigned case_parse_fields(const char *csv, problems *out)
+{
+    unsigned fields = 0;
+    const char *p = csv ? csv : "";
+    while (*p) {
+        const char *comma = strchr(p, ',');
+        size_t n = comma ? (size_t)(comma - p) : strlen(p);
+        unsigned bit = 0;
+        for (int k = 0; k < 4; k++)
+            if (strlen(field_names[k]) == n && strncmp(p, field_names[k], n) == 0)
+                bit = 1u << k;
+        if (!bit && n > 0) {
+            if (!out->title[0]) snprintf(out->title, sizeof out->title, "Unknown field");
+            problems_add(out, 400, "", "unknown field \"%.*s\"; fields are position, velocity, "
+                                       "stress, damage", (int)(n < 64 ? n : 64), p);
+        }
+        fields |= bit;
+        p += n;
+        if (*p == ',') p++;
+    }
+    return fields;
+}

@@ -1,0 +1,134 @@
+/*
+ * case_internal.h - what the case_*.c files share while turning a case
+ * document into an engine model. Not part of any public contract.
+ *
+ * case_build() works in three passes so that a user sees every problem at
+ * once and nothing large is allocated for an invalid case:
+ *   1. read: every section is checked and copied into a case_doc (explicit
+ *      and gmsh meshes are parsed here; their size is bounded by the upload);
+ *   2. estimate: node/element/joint counts from the shapes, checked against
+ *      the memory limit before any generator runs;
+ *   3. build: engine calls in contract order; an engine error is mapped back
+ *      to the JSON Pointer of the thing it names.
+ */
+#ifndef FDEM_CASE_INTERNAL_H
+#define FDEM_CASE_INTERNAL_H
+
+#include <jansson.h>
+
+#include "case.h"
+#include "fdem.h"
+#include "problems.h"
+
+#define CASE_POINTER 256 /* = sizeof problem.pointer */
+#define CASE_NAME 128
+
+typedef struct case_material {
+    const char *name; /* key in "materials" (owned by the JSON tree) */
+    fdem_material_def def;
+} case_material;
+
+typedef enum case_shape {
+    CASE_SHAPE_NONE,
+    CASE_SHAPE_RECTANGLE,
+    CASE_SHAPE_DISC,
+    CASE_SHAPE_MESH,
+    CASE_SHAPE_GMSH,
+} case_shape;
+
+typedef struct case_part {
+    char name[CASE_NAME];
+    int material;            /* index into case_doc.materials, -1 if unknown */
+    int fracture;
+    int has_velocity;
+    double velocity[2];
+    case_shape shape;
+    double at[2];            /* rectangle origin or disc centre */
+    double size[2];          /* rectangle width, height */
+    double radius;           /* disc */
+    long divisions[2];       /* rectangle nx, ny; disc rim divisions in [0] */
+    fdem_mesh mesh;          /* MESH, GMSH: read in pass 1; others: pass 3 */
+    double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
+} case_part;
+
+typedef struct case_constraint {
+    fdem_constraint_def def;
+} case_constraint;
+
+typedef struct case_doc {
+    problems *out;
+    char name[CASE_NAME];
+    case_material *materials;
+    int material_count;
+    case_part *parts;
+    int part_count;
+    case_constraint *constraints;
+    int constraint_count;
+    double gravity[2];
+    double end_time, dt, safety, interval;
+    int dt_auto;
+    unsigned fields;
+} case_doc;
+
+/* ------------------------------------------------- case_read.c: JSON values */
+
+/* "a string", "an array", ... for "expected X, got Y" messages. */
+const char *case_type_word(const json_t *value);
+
+void case_problem(case_doc *doc, const char *pointer, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/* The member `key` of `object` (NULL if absent) with its pointer in `ptr`. */
+json_t *case_member(const json_t *object, const char *base, const char *key, char *ptr);
+
+/* Each returns 1 when the value is acceptable, 0 after adding a problem. */
+int case_expect_object(case_doc *doc, const json_t *value, const char *ptr);
+int case_expect_array(case_doc *doc, const json_t *value, const char *ptr);
+int case_read_number(case_doc *doc, const json_t *value, const char *ptr, double *out);
+int case_read_vec2(case_doc *doc, const json_t *value, const char *ptr, double out[2]);
+/* An integer-valued number (2 or 2.0 or 1e3) in [lo, hi]. */
+int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long lo, long hi,
+                      long *out);
+int case_read_bool(case_doc *doc, const json_t *value, const char *ptr, int *out);
+
+/* Optional number member: 1 read (or absent, leaving *out), 0 on a problem.
+ * With `required`, absence is a problem naming the key. */
+int case_number_member(case_doc *doc, const json_t *object, const char *base,
+                       const char *key, int required, double *out);
+
+/* Every key of `object` must be in the NULL-terminated `allowed` list; an
+ * unknown one is reported with the closest allowed name, if any. `what`
+ * names the object in the message ("material \"rock\""). */
+int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
+                    const char *const *allowed, const char *what);
+
+/* The candidate closest to `word` if it is a plausible typo, else NULL. */
+const char *case_closest(const char *word, const char *const *candidates, int count);
+
+/* ", did you mean \"x\"?" or "" (static buffer per call site is not needed:
+ * writes into `buf`). */
+const char *case_did_you_mean(char *buf, size_t size, const char *word,
+                              const char *const *candidates, int count);
+
+/* -------------------------------------------------- the sections, pass 1 */
+void case_read_materials(case_doc *doc, const json_t *materials);
+int case_material_index(const case_doc *doc, const char *name);
+void case_read_parts(case_doc *doc, const json_t *parts);
+void case_read_constraints(case_doc *doc, const json_t *constraints);
+
+/* ----------------------------------------------------- pass 2 and pass 3 */
+void case_check_memory(case_doc *doc, size_t memory_limit);
+int case_add_materials(case_doc *doc, fdem_model *model);
+int case_add_parts(case_doc *doc, fdem_model *model);
+int case_add_constraints(case_doc *doc, fdem_model *model);
+
+/* Turns an engine error into a problem at the pointer of the item it names;
+ * `fallback` is used when the error names nothing more precise. */
+void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback);
+
+/* The pointer of part i's mesh source ("/parts/3/mesh" or "/parts/3/gmsh"). */
+void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr);
+
+void case_doc_free(case_doc *doc);
+
+#endif

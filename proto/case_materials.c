@@ -1,0 +1,145 @@
+/*
+ * case_materials.c - the "materials" object of a case: read and range-check
+ * every material (pass 1), then hand them to the engine in document order
+ * (pass 3), so a material's engine index is its position in the object.
+ *
+ * The ranges are the ones the explicit solver can run: positive density and
+ * stiffness, a Poisson ratio strictly inside (-1, 0.5) (0.5 would make the
+ * bulk modulus, and so the stable step, degenerate), non-negative damping
+ * and friction, and positive fracture strengths and energies.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "case_internal.h"
+
+static const char *const material_keys[] = {
+    "density", "young", "poisson", "damping", "penalty", "friction", "fracture", NULL,
+};
+static const char *const fracture_keys[] = {
+    "tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", NULL,
+};
+
+/* Adds a problem at base/key when `ok` is false. */
+static void material_require(case_doc *doc, int ok, const char *base, const char *key,
+                             const char *rule, double value)
+{
+    if (ok) return;
+    char ptr[CASE_POINTER];
+    pointer_join(ptr, sizeof ptr, base, key);
+    case_problem(doc, ptr, "%s %s, got %g", key, rule, value);
+}
+
+static void material_read_poisson(case_doc *doc, const json_t *object, const char *base,
+                                  double *poisson)
+{
+    if (!case_number_member(doc, object, base, "poisson", 1, poisson)) return;
+    char ptr[CASE_POINTER];
+    pointer_join(ptr, sizeof ptr, base, "poisson");
+    if (*poisson == 0.5)
+        case_problem(doc, ptr, "poisson must be below 0.5: an incompressible material "
+                               "(0.5) is not supported by the explicit solver");
+    else if (!(*poisson > -1 && *poisson < 0.5))
+        case_problem(doc, ptr, "poisson must be in (-1, 0.5), got %g", *poisson);
+}
+
+static void material_read_fracture(case_doc *doc, const json_t *value, const char *ptr,
+                                   const char *what, fdem_fracture_params *f)
+{
+    if (!case_expect_object(doc, value, ptr)) return;
+    case_check_keys(doc, value, ptr, fracture_keys, what);
+    if (case_number_member(doc, value, ptr, "tensile_strength", 1, &f->tensile_strength))
+        material_require(doc, f->tensile_strength > 0, ptr, "tensile_strength", "must be > 0",
+                         f->tensile_strength);
+    if (case_number_member(doc, value, ptr, "cohesion", 1, &f->cohesion))
+        material_require(doc, f->cohesion > 0, ptr, "cohesion", "must be > 0", f->cohesion);
+    if (case_number_member(doc, value, ptr, "friction_angle", 1, &f->friction_angle))
+        material_require(doc, f->friction_angle >= 0 && f->friction_angle < 90, ptr,
+                         "friction_angle", "must be in [0, 90) degrees", f->friction_angle);
+    if (case_number_member(doc, value, ptr, "energy_I", 1, &f->energy_I))
+        material_require(doc, f->energy_I > 0, ptr, "energy_I", "must be > 0", f->energy_I);
+    if (case_number_member(doc, value, ptr, "energy_II", 1, &f->energy_II))
+        material_require(doc, f->energy_II > 0, ptr, "energy_II", "must be > 0", f->energy_II);
+}
+
+static void material_read(case_doc *doc, const char *name, const json_t *value,
+                          const char *ptr, fdem_material_def *def)
+{
+    char what[96];
+    snprintf(what, sizeof what, "material \"%.64s\"", name);
+    if (!case_expect_object(doc, value, ptr)) return;
+    case_check_keys(doc, value, ptr, material_keys, what);
+    if (case_number_member(doc, value, ptr, "density", 1, &def->density))
+        material_require(doc, def->density > 0, ptr, "density", "must be > 0", def->density);
+    if (case_number_member(doc, value, ptr, "young", 1, &def->young)) {
+        material_require(doc, def->young > 0, ptr, "young", "must be > 0", def->young);
+        /* the default penalty is 10 x young and must stay finite */
+        material_require(doc, isfinite(10 * def->young), ptr, "young", "is too large",
+                         def->young);
+    }
+    material_read_poisson(doc, value, ptr, &def->poisson);
+    if (case_number_member(doc, value, ptr, "damping", 0, &def->damping))
+        material_require(doc, def->damping >= 0, ptr, "damping", "must be >= 0", def->damping);
+    def->penalty = 0; /* the engine's default, 10 x young */
+    if (json_object_get(value, "penalty") &&
+        case_number_member(doc, value, ptr, "penalty", 0, &def->penalty))
+        material_require(doc, def->penalty > 0, ptr, "penalty", "must be > 0", def->penalty);
+    if (case_number_member(doc, value, ptr, "friction", 0, &def->friction))
+        material_require(doc, def->friction >= 0, ptr, "friction", "must be >= 0",
+                         def->friction);
+    char fracture_ptr[CASE_POINTER];
+    json_t *fracture = case_member(value, ptr, "fracture", fracture_ptr);
+    if (fracture) {
+        char fracture_what[128];
+        snprintf(fracture_what, sizeof fracture_what, "the fracture block of %s", what);
+        def->has_fracture = 1;
+        material_read_fracture(doc, fracture, fracture_ptr, fracture_what, &def->fracture);
+    }
+}
+
+void case_read_materials(case_doc *doc, const json_t *materials)
+{
+    if (!case_expect_object(doc, materials, "/materials")) return;
+    size_t count = json_object_size(materials);
+    if (count == 0) {
+        case_problem(doc, "/materials", "a case needs at least one material");
+        return;
+    }
+    doc->materials = calloc(count, sizeof *doc->materials);
+    if (!doc->materials) {
+        case_problem(doc, "/materials", "out of memory");
+        return;
+    }
+    const char *name;
+    json_t *value;
+    json_object_foreach((json_t *)materials, name, value) {
+        case_material *m = &doc->materials[doc->material_count++];
+        char ptr[CASE_POINTER];
+        pointer_join(ptr, sizeof ptr, "/materials", name);
+        m->name = name;
+        material_read(doc, name, value, ptr, &m->def);
+    }
+}
+
+int case_material_index(const case_doc *doc, const char *name)
+{
+    for (int i = 0; i < doc->material_count; i++)
+        if (strcmp(doc->materials[i].name, name) == 0) return i;
+    return -1;
+}
+
+int case_add_materials(case_doc *doc, fdem_model *model)
+{
+    for (int i = 0; i < doc->material_count; i++) {
+        fdem_error err = {0};
+        if (fdem_add_material(model, &doc->materials[i].def, &err) != i) {
+            char ptr[CASE_POINTER];
+            pointer_join(ptr, sizeof ptr, "/materials", doc->materials[i].name);
+            case_engine_problem(doc, &err, ptr);
+            return -1;
+        }
+    }
+    return 0;
+}

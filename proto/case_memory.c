@@ -1,0 +1,104 @@
+/*
+ * case_memory.c - pass 2 of the case builder: how big would the model be?
+ *
+ * Counts are estimated from the shapes alone (in doubles, so absurd
+ * divisions cannot overflow) and priced with fdem_memory_estimate() before
+ * any generator runs: an oversized case costs the daemon nothing but this
+ * arithmetic, and the user learns how large the model would have been.
+ */
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+
+#include "case_internal.h"
+
+/* Beyond this many items fdem_memory_estimate() is asked about a scaled-down
+ * model and the answer scaled back up: its size_t arithmetic stays exact and
+ * the estimate is linear in the counts anyway. */
+#define MEMORY_EXACT_COUNT 1e12
+
+/* A disc with d rim nodes has about d/(2 pi) rings (equilateral triangles);
+ * ring k holds about d k / rings nodes; a triangulation of n nodes has about
+ * 2 n triangles. Rounded up so the estimate errs on the large side. */
+static void memory_disc_counts(double divisions, double *nodes, double *elements)
+{
+    double rings = ceil(divisions / (2 * M_PI));
+    if (rings < 1) rings = 1;
+    *nodes = 1 + divisions * (rings + 1) / 2 + rings;
+    *elements = 2 * *nodes;
+}
+
+static void memory_part_counts(case_part *part)
+{
+    double nx = (double)part->divisions[0], ny = (double)part->divisions[1];
+    switch (part->shape) {
+    case CASE_SHAPE_RECTANGLE:
+        part->nodes = (nx + 1) * (ny + 1);
+        part->elements = 2 * nx * ny;
+        break;
+    case CASE_SHAPE_DISC:
+        memory_disc_counts(nx, &part->nodes, &part->elements);
+        break;
+    case CASE_SHAPE_MESH:
+    case CASE_SHAPE_GMSH:
+        part->nodes = part->mesh.node_count;
+        part->elements = part->mesh.triangle_count;
+        break;
+    case CASE_SHAPE_NONE:
+        break;
+    }
+    part->joints = 0;
+    if (part->fracture) {
+        /* every triangle gets its own 3 nodes; one joint per interior edge */
+        part->nodes = 3 * part->elements;
+        part->joints = 1.5 * part->elements;
+    }
+}
+
+static double memory_bytes(double nodes, double elements, double joints)
+{
+    double largest = fmax(nodes, fmax(elements, joints));
+    double scale = largest > MEMORY_EXACT_COUNT ? largest / MEMORY_EXACT_COUNT : 1;
+    size_t bytes = fdem_memory_estimate((long)(nodes / scale), (long)(elements / scale),
+                                        (long)(joints / scale));
+    return (double)bytes * scale;
+}
+
+/* "12.3 GiB" */
+static void memory_format(double bytes, char *out, size_t size)
+{
+    static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+    int unit = 0;
+    while (bytes >= 1024 && unit < 6) {
+        bytes /= 1024;
+        unit++;
+    }
+    if (unit == 0)
+        snprintf(out, size, "%.0f bytes", bytes);
+    else
+        snprintf(out, size, "%.3g %s", bytes, units[unit]);
+}
+
+void case_check_memory(case_doc *doc, size_t memory_limit)
+{
+    double nodes = 0, elements = 0, joints = 0;
+    for (int i = 0; i < doc->part_count; i++) {
+        memory_part_counts(&doc->parts[i]);
+        nodes += doc->parts[i].nodes;
+        elements += doc->parts[i].elements;
+        joints += doc->parts[i].joints;
+    }
+    double bytes = memory_bytes(nodes, elements, joints);
+    char need[32], limit[32];
+    memory_format(bytes, need, sizeof need);
+    if (bytes > (double)memory_limit) {
+        memory_format((double)memory_limit, limit, sizeof limit);
+        case_problem(doc, "/parts", "the model would need %s (about %.3g nodes, %.3g elements, "
+                                    "%.3g joints), more than this daemon's limit of %s",
+                     need, nodes, elements, joints, limit);
+    } else if (nodes > INT_MAX || elements > INT_MAX || joints > INT_MAX) {
+        case_problem(doc, "/parts", "the model would have about %.3g nodes, %.3g elements and "
+                                    "%.3g joints (%s); the engine's limit is %d of each",
+                     nodes, elements, joints, need, INT_MAX);
+    }
+}

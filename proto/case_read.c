@@ -1,0 +1,224 @@
+/*
+ * case_read.c - typed reads of JSON values for the case builder, each of
+ * which either accepts the value or records one problem at its pointer.
+ *
+ * Users write cases by hand and from scripts, so the messages say what was
+ * expected and what was found ("expected a number, got a string"), and a
+ * misspelt key is never ignored: it is reported with the closest valid name.
+ */
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "case_internal.h"
+
+const char *case_type_word(const json_t *value)
+{
+    switch (json_typeof(value)) {
+    case JSON_OBJECT: return "an object";
+    case JSON_ARRAY: return "an array";
+    case JSON_STRING: return "a string";
+    case JSON_INTEGER:
+    case JSON_REAL: return "a number";
+    case JSON_TRUE:
+    case JSON_FALSE: return "a boolean";
+    case JSON_NULL: return "null";
+    }
+    return "an unknown value";
+}
+
+void case_problem(case_doc *doc, const char *pointer, const char *fmt, ...)
+{
+    char message[sizeof ((problem *)0)->message];
+    va_list args;
+    va_start(args, fmt);
+    vsnprintf(message, sizeof message, fmt, args);
+    va_end(args);
+    problems_add(doc->out, 422, pointer, "%s", message);
+}
+
+json_t *case_member(const json_t *object, const char *base, const char *key, char *ptr)
+{
+    pointer_join(ptr, CASE_POINTER, base, key);
+    return json_object_get(object, key);
+}
+
+int case_expect_object(case_doc *doc, const json_t *value, const char *ptr)
+{
+    if (json_is_object(value)) return 1;
+    case_problem(doc, ptr, "expected an object, got %s", case_type_word(value));
+    return 0;
+}
+
+int case_expect_array(case_doc *doc, const json_t *value, const char *ptr)
+{
+    if (json_is_array(value)) return 1;
+    case_problem(doc, ptr, "expected an array, got %s", case_type_word(value));
+    return 0;
+}
+
+int case_read_number(case_doc *doc, const json_t *value, const char *ptr, double *out)
+{
+    if (!json_is_number(value)) {
+        case_problem(doc, ptr, "expected a number, got %s", case_type_word(value));
+        return 0;
+    }
+    double v = json_number_value(value);
+    if (!isfinite(v)) {
+        case_problem(doc, ptr, "expected a finite number");
+        return 0;
+    }
+    *out = v;
+    return 1;
+}
+
+int case_read_vec2(case_doc *doc, const json_t *value, const char *ptr, double out[2])
+{
+    if (!json_is_array(value) || json_array_size(value) != 2) {
+        case_problem(doc, ptr, "expected an array of two numbers, got %s%s",
+                     case_type_word(value), json_is_array(value) ? " of another length" : "");
+        return 0;
+    }
+    int ok = 1;
+    for (int k = 0; k < 2; k++) {
+        char item[CASE_POINTER];
+        pointer_join_index(item, sizeof item, ptr, k);
+        ok &= case_read_number(doc, json_array_get(value, (size_t)k), item, &out[k]);
+    }
+    return ok;
+}
+
+int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long lo, long hi,
+                      long *out)
+{
+    const long exact = 1L << 53; /* beyond this a double is not a whole count */
+    double v;
+    if (!case_read_number(doc, value, ptr, &v)) return 0;
+    if (v != floor(v)) {
+        case_problem(doc, ptr, "expected a whole number, got %g", v);
+        return 0;
+    }
+    long top = hi < exact ? hi : exact;
+    if (v < (double)lo) {
+        case_problem(doc, ptr, "must be at least %ld, got %.17g", lo, v);
+        return 0;
+    }
+    if (v > (double)top) {
+        if (hi >= exact) case_problem(doc, ptr, "%.17g is too large", v);
+        else case_problem(doc, ptr, "must be at most %ld, got %.17g", hi, v);
+        return 0;
+    }
+    *out = (long)v; /* in range, so the conversion is defined */
+    return 1;
+}
+
+int case_read_bool(case_doc *doc, const json_t *value, const char *ptr, int *out)
+{
+    if (!json_is_boolean(value)) {
+        case_problem(doc, ptr, "expected true or false, got %s", case_type_word(value));
+        return 0;
+    }
+    *out = json_is_true(value);
+    return 1;
+}
+
+int case_number_member(case_doc *doc, const json_t *object, const char *base,
+                       const char *key, int required, double *out)
+{
+    char ptr[CASE_POINTER];
+    json_t *value = case_member(object, base, key, ptr);
+    if (!value) {
+        if (!required) return 1;
+        case_problem(doc, base, "missing required \"%s\"", key);
+        return 0;
+    }
+    return case_read_number(doc, value, ptr, out);
+}
+
+/* --------------------------------------------------------------- typos */
+
+#define CASE_TYPO_MAX 64 /* longer words get no suggestion */
+
+static size_t case_min3(size_t a, size_t b, size_t c)
+{
+    size_t m = a < b ? a : b;
+    return m < c ? m : c;
+}
+
+/* Edit distance counting an adjacent transposition as one edit ("tpo" is
+ * one edit from "top"): optimal string alignment, three rows of state. */
+static size_t case_edit_distance(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    size_t rows[3][CASE_TYPO_MAX + 1];
+    size_t *before = rows[0], *prev = rows[1], *row = rows[2];
+    for (size_t j = 0; j <= lb; j++) prev[j] = j;
+    for (size_t i = 1; i <= la; i++) {
+        row[0] = i;
+        for (size_t j = 1; j <= lb; j++) {
+            size_t cost = a[i - 1] != b[j - 1];
+            row[j] = case_min3(prev[j] + 1, row[j - 1] + 1, prev[j - 1] + cost);
+            if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] &&
+                before[j - 2] + 1 < row[j])
+                row[j] = before[j - 2] + 1;
+        }
+        size_t *oldest = before;
+        before = prev;
+        prev = row;
+        row = oldest;
+    }
+    return prev[lb];
+}
+
+const char *case_closest(const char *word, const char *const *candidates, int count)
+{
+    size_t lw = strlen(word);
+    if (lw == 0 || lw > CASE_TYPO_MAX) return NULL;
+    const char *best = NULL;
+    size_t best_distance = (size_t)-1;
+    for (int i = 0; i < count; i++) {
+        size_t lc = strlen(candidates[i]);
+        if (lc > CASE_TYPO_MAX) continue;
+        size_t d = case_edit_distance(word, candidates[i]);
+        size_t longer = lw > lc ? lw : lc;
+        /* a plausible typo: at most a third of the longer word changed */
+        if (d > 0 && 3 * d <= longer && d < best_distance) {
+            best = candidates[i];
+            best_distance = d;
+        }
+    }
+    return best;
+}
+
+const char *case_did_you_mean(char *buf, size_t size, const char *word,
+                              const char *const *candidates, int count)
+{
+    const char *close = case_closest(word, candidates, count);
+    if (close)
+        snprintf(buf, size, "; did you mean \"%.64s\"?", close);
+    else if (size)
+        buf[0] = '\0';
+    return buf;
+}
+
+int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
+                    const char *const *allowed, const char *what)
+{
+    int count = 0, ok = 1;
+    while (allowed[count]) count++;
+    const char *key;
+    json_t *value;
+    json_object_foreach((json_t *)object, key, value) {
+        int known = 0;
+        for (int i = 0; i < count && !known; i++) known = strcmp(key, allowed[i]) == 0;
+        if (known) continue;
+        char at[CASE_POINTER], hint[96];
+        pointer_join(at, sizeof at, ptr, key);
+        case_problem(doc, at, "unknown key \"%.64s\" in %s%s", key, what,
+                     case_did_you_mean(hint, sizeof hint, key, allowed, count));
+        ok = 0;
+    }
+    return ok;
+}
