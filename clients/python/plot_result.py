@@ -138,11 +138,15 @@ def plot(args):
         tri = Triangulation(xy[:, 0], xy[:, 1], triangles)
         field = args.field or ("stress" if "/snapshots/stress" in f else "velocity")
 
-        fig, ax = plt.subplots(figsize=(8, 6), dpi=args.dpi)
+        width = np.ptp(xy[:, 0]) or 1.0
+        height = np.ptp(xy[:, 1]) or 1.0
+        wide = width > 2.0 * height    # e.g. a bar: colourbar below, not beside
+        fig, ax = plt.subplots(figsize=(10, 5) if wide else (8, 6.5), dpi=args.dpi)
         art, label = DRAW[field](ax, f, tri, s, args)
         if field != "damage" and triangles.shape[0] <= 20000:
             ax.triplot(tri, color="k", linewidth=0.1, alpha=0.4)
-        fig.colorbar(art, ax=ax, label=label, shrink=0.85)
+        fig.colorbar(art, ax=ax, label=label, fraction=0.046, pad=0.18 if wide else 0.04,
+                     orientation="horizontal" if wide else "vertical")
         name = attr_text(f, "name", args.result)
         t = float(f["/snapshots/time"][s])
         ax.set_title("%s   t = %.4g s   (snapshot %d of %d, %s)" % (name, t, s + 1, count, where))
