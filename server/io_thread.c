@@ -302,9 +302,8 @@ void io_stop(void)
         return;
     io_job *j = io_job_new(IO_QUIT, NULL);
     if (j) {
-        io_enqueue(j);
+        io_enqueue(j); /* freed by the I/O thread on its way out */
         pthread_join(io_thread, NULL);
-        free(j);
     }
     io_running = 0;
 }

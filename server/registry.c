@@ -786,7 +786,8 @@ int registry_init(const fdemd_config *cfg)
             case_release(c);
     }
     closedir(d);
-    qsort(reg_cases, (size_t)reg_count, sizeof *reg_cases, case_order);
+    if (reg_count > 1)
+        qsort(reg_cases, (size_t)reg_count, sizeof *reg_cases, case_order);
     for (int i = 0; i < reg_count; i++)
         reg_cases[i]->seq = (uint64_t)i;
     return 0;
