@@ -131,7 +131,11 @@ void constraint_enforce(fdem_model *m, double h, double havg)
             double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
             for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
                 int i = m->cnode[e];
-                m->external_work += (fx * m->vel[2 * i] + fy * m->vel[2 * i + 1]) * h;
+                /* velocities were already advanced: v_old = v_new - a havg */
+                double ax = (m->force[2 * i] + (fc ? fc[2 * i] : 0)) / m->mass[i] + m->gravity[0];
+                double ay = (m->force[2 * i + 1] + (fc ? fc[2 * i + 1] : 0)) / m->mass[i] + m->gravity[1];
+                double vx = m->vel[2 * i] - 0.5 * ax * havg, vy = m->vel[2 * i + 1] - 0.5 * ay * havg;
+                m->external_work += (fx * vx + fy * vy) * havg;
             }
             continue;
         }
@@ -143,14 +147,15 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 double mass = m->mass[i];
                 double f = m->force[2 * i + d] + (fc ? fc[2 * i + d] : 0) + mass * m->gravity[d];
                 double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
-                double v_free = m->vel[2 * i + d] + f / mass * havg;
+                double v_old = m->vel[2 * i + d];
+                double v_free = v_old + f / mass * havg;
                 double reaction = mass * (prescribed - v_free) / havg;
                 c->force[d] += reaction;
                 m->vel[2 * i + d] = prescribed;
-                double dx = prescribed * h;
-                m->pos[2 * i + d] += dx;
-                m->external_work += reaction * dx;
-                if (fc) m->contact_work += fc[2 * i + d] * dx;
+                m->pos[2 * i + d] += prescribed * h;
+                double v_mid = 0.5 * (v_old + prescribed) * havg;
+                m->external_work += reaction * v_mid;
+                if (fc) m->contact_work += fc[2 * i + d] * v_mid;
             }
             if (fc) {
                 double ux = m->pos[2 * i] - m->contact.pos_detect[2 * i];

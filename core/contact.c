@@ -43,15 +43,26 @@ typedef struct tri_now {
     double penalty, friction;
 } tri_now;
 
-static void tri_gather(const fdem_model *m, int e, tri_now *t)
+/* libm's fmin/fmax are calls unless NaN semantics are relaxed; these are not. */
+static inline double min2(double a, double b) { return a < b ? a : b; }
+static inline double max2(double a, double b) { return a > b ? a : b; }
+static inline double min3(double a, double b, double c) { return min2(a, min2(b, c)); }
+static inline double max3(double a, double b, double c) { return max2(a, max2(b, c)); }
+
+static inline void tri_gather(const fdem_model *m, int e, tri_now *t)
 {
     const element_hot *el = &m->elem[e];
-    const material *mat = &m->materials[el->material];
     for (int c = 0; c < 3; c++) {
         t->node[c] = el->node[c];
         t->x[c] = m->pos[2 * el->node[c]];
         t->y[c] = m->pos[2 * el->node[c] + 1];
     }
+}
+
+/* The rest of the record, needed only for pairs whose boxes overlap. */
+static inline void tri_complete(const fdem_model *m, int e, tri_now *t)
+{
+    const material *mat = &m->materials[m->elem[e].material];
     t->area2 = (t->x[1] - t->x[0]) * (t->y[2] - t->y[0]) - (t->y[1] - t->y[0]) * (t->x[2] - t->x[0]);
     t->penalty = mat->penalty;
     t->friction = mat->def.friction;
@@ -67,8 +78,6 @@ static inline void area_coordinates(const tri_now *t, double px, double py, doub
     }
 }
 
-static inline double min3(double a, double b, double c) { return fmin(a, fmin(b, c)); }
-
 /* Integral over s in [0,1] of phi(s) = 3 min_k lambda_k(s), clipped to where
  * all lambda_k >= 0, and its first moment. Returns 0 when the edge misses. */
 static int edge_potential_integral(const double la[3], const double lb[3], double *i0, double *i1)
@@ -76,8 +85,8 @@ static int edge_potential_integral(const double la[3], const double lb[3], doubl
     double smin = 0, smax = 1;
     for (int k = 0; k < 3; k++) {
         if (la[k] < 0 && lb[k] < 0) return 0;
-        if (la[k] < 0) smin = fmax(smin, la[k] / (la[k] - lb[k]));
-        else if (lb[k] < 0) smax = fmin(smax, la[k] / (la[k] - lb[k]));
+        if (la[k] < 0) smin = max2(smin, la[k] / (la[k] - lb[k]));
+        else if (lb[k] < 0) smax = min2(smax, la[k] / (la[k] - lb[k]));
     }
     if (!(smax > smin)) return 0;
 
@@ -97,11 +106,11 @@ static int edge_potential_integral(const double la[3], const double lb[3], doubl
             double tmp = s[b]; s[b] = s[b - 1]; s[b - 1] = tmp;
         }
     double sum0 = 0, sum1 = 0, prev_s = s[0];
-    double prev_phi = 3 * fmax(0, min3(la[0] + prev_s * (lb[0] - la[0]), la[1] + prev_s * (lb[1] - la[1]),
+    double prev_phi = 3 * max2(0, min3(la[0] + prev_s * (lb[0] - la[0]), la[1] + prev_s * (lb[1] - la[1]),
                                        la[2] + prev_s * (lb[2] - la[2])));
     for (int a = 1; a < n; a++) {
         double sa = s[a];
-        double phi = 3 * fmax(0, min3(la[0] + sa * (lb[0] - la[0]), la[1] + sa * (lb[1] - la[1]),
+        double phi = 3 * max2(0, min3(la[0] + sa * (lb[0] - la[0]), la[1] + sa * (lb[1] - la[1]),
                                       la[2] + sa * (lb[2] - la[2])));
         double ds = sa - prev_s;
         sum0 += 0.5 * ds * (prev_phi + phi);
@@ -123,7 +132,7 @@ static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_n
     for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
     const double *v = m->vel, *inv_mass = m->inv_mass;
     double *f = m->contact.force;
-    double inv_m_target = fmax(inv_mass[t->node[0]], fmax(inv_mass[t->node[1]], inv_mass[t->node[2]]));
+    double inv_m_target = max3(inv_mass[t->node[0]], inv_mass[t->node[1]], inv_mass[t->node[2]]);
     int acted = 0;
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3;
@@ -148,9 +157,9 @@ static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_n
                 vty += lbar[k] * v[2 * t->node[k] + 1];
             }
             double slip = (vcx - vtx) * tx + (vcy - vty) * ty;
-            double inv_m = fmax(inv_mass[na], inv_mass[nb]) + inv_m_target;
+            double inv_m = max2(inv_mass[na], inv_mass[nb]) + inv_m_target;
             double stop = 0.5 * fabs(slip) / (inv_m * havg);
-            double ft = fmin(friction * penalty * i0 * len, stop);
+            double ft = min2(friction * penalty * i0 * len, stop);
             if (slip > 0) ft = -ft;
             fx += ft * tx;
             fy += ft * ty;
@@ -169,11 +178,11 @@ static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_n
 
 static int boxes_overlap(const tri_now *a, const tri_now *b)
 {
-    double ax0 = min3(a->x[0], a->x[1], a->x[2]), ax1 = fmax(a->x[0], fmax(a->x[1], a->x[2]));
-    double bx0 = min3(b->x[0], b->x[1], b->x[2]), bx1 = fmax(b->x[0], fmax(b->x[1], b->x[2]));
+    double ax0 = min3(a->x[0], a->x[1], a->x[2]), ax1 = max3(a->x[0], a->x[1], a->x[2]);
+    double bx0 = min3(b->x[0], b->x[1], b->x[2]), bx1 = max3(b->x[0], b->x[1], b->x[2]);
     if (ax1 < bx0 || bx1 < ax0) return 0;
-    double ay0 = min3(a->y[0], a->y[1], a->y[2]), ay1 = fmax(a->y[0], fmax(a->y[1], a->y[2]));
-    double by0 = min3(b->y[0], b->y[1], b->y[2]), by1 = fmax(b->y[0], fmax(b->y[1], b->y[2]));
+    double ay0 = min3(a->y[0], a->y[1], a->y[2]), ay1 = max3(a->y[0], a->y[1], a->y[2]);
+    double by0 = min3(b->y[0], b->y[1], b->y[2]), by1 = max3(b->y[0], b->y[1], b->y[2]);
     return !(ay1 < by0 || by1 < ay0);
 }
 
@@ -184,11 +193,13 @@ int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
     tri_gather(m, e1, &a);
     tri_gather(m, e2, &b);
     if (!boxes_overlap(&a, &b)) return 0;
+    tri_complete(m, e1, &a);
+    tri_complete(m, e2, &b);
     if (!(a.area2 > 0) || !(b.area2 > 0)) return 0; /* inverted: no potential defined */
     /* The softer surface sets the penalty; friction is the larger of the two,
      * so giving it on one material is enough. */
-    double penalty = fmin(a.penalty, b.penalty);
-    double friction = fmax(a.friction, b.friction);
+    double penalty = min2(a.penalty, b.penalty);
+    double friction = max2(a.friction, b.friction);
     int touched = contactor_against_target(m, &a, &b, penalty, friction, havg);
     touched |= contactor_against_target(m, &b, &a, penalty, friction, havg);
     return touched;

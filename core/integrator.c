@@ -33,6 +33,7 @@ int central_difference_step(fdem_model *m, double h, double havg)
     double check = 0, max_disp2 = m->contact.max_disp2, contact_work = 0;
     for (int i = 0; i < m->node_count; i++) {
         double fx = f[2 * i], fy = f[2 * i + 1];
+        double vx_old = v[2 * i], vy_old = v[2 * i + 1];
         if (fc) {
             fx += fc[2 * i];
             fy += fc[2 * i + 1];
@@ -48,13 +49,16 @@ int central_difference_step(fdem_model *m, double h, double havg)
         }
         check += x[2 * i] + x[2 * i + 1] + v[2 * i] + v[2 * i + 1];
         if (fc) {
-            contact_work += ((own & 1u) ? 0 : fc[2 * i] * v[2 * i] * h) +
-                            ((own & 2u) ? 0 : fc[2 * i + 1] * v[2 * i + 1] * h);
+            /* f . (v_old + v_new)/2 * havg is exactly what the force adds to
+             * the half-step kinetic energy, so the balance closes. */
+            contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + v[2 * i])) +
+                            ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + v[2 * i + 1]));
             double ux = x[2 * i] - xd[2 * i], uy = x[2 * i + 1] - xd[2 * i + 1];
             double d2 = ux * ux + uy * uy;
             if (d2 > max_disp2) max_disp2 = d2;
         }
     }
+    contact_work *= 0.5 * havg;
     m->contact.max_disp2 = max_disp2;
     m->contact_work += contact_work;
     return isfinite(check) ? 0 : -1;

@@ -1,0 +1,190 @@
+/*
+ * test_contact.c - the distributed potential contact force against physics:
+ * one overlapping pair (equal and opposite, no net moment, pushing apart),
+ * a head-on collision (momentum to 1e-12, energy within 5%), a block sliding
+ * on a 30 degree incline with Coulomb friction (1/2 g (sin - mu cos) t^2
+ * within 5%), a block resting on a slope steeper than friction allows not,
+ * and a 100-disc pile in a box settling with no disc through another.
+ */
+#include "build_model.h"
+#include "check.h"
+#include "model.h"
+
+int contact_potential_force(fdem_model *m, int e1, int e2, double havg);
+
+static void overlapping_pair_forces_balance(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e9, 0.25, 0, 0);
+    double xy1[] = {0, 0, 1, 0, 0.3, 1}, xy2[] = {0.2, 0.8, 1.2, 0.7, 0.9, 1.9};
+    int32_t tri[] = {0, 1, 2};
+    fdem_mesh a = {3, 1, xy1, tri}, b = {3, 1, xy2, tri};
+    fdem_error err;
+    fdem_add_part(m, &a, mat, 0, &err);
+    fdem_add_part(m, &b, mat, 0, &err);
+    build_finalize(m, 0.5);
+    memset(m->contact.force, 0, sizeof(double) * 12);
+    CHECK(contact_potential_force(m, 0, 1, 1e-6) == 1, "no contact found");
+    const double *f = m->contact.force;
+    double fx = 0, fy = 0, moment = 0, scale = 0;
+    for (int i = 0; i < 6; i++) {
+        fx += f[2 * i];
+        fy += f[2 * i + 1];
+        moment += m->pos[2 * i] * f[2 * i + 1] - m->pos[2 * i + 1] * f[2 * i];
+        scale = fmax(scale, hypot(f[2 * i], f[2 * i + 1]));
+    }
+    CHECK(scale > 0, "no force");
+    CHECK(fabs(fx) < 1e-12 * scale && fabs(fy) < 1e-12 * scale, "net force %g %g", fx, fy);
+    CHECK(fabs(moment) < 1e-12 * scale, "net moment %g", moment);
+    /* the upper triangle is pushed up, the lower one down */
+    CHECK(f[7] + f[9] + f[11] > 0, "upper triangle pushed %g", f[7] + f[9] + f[11]);
+    fdem_model_destroy(m);
+}
+
+static void separated_pair_has_no_force(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e9, 0.25, 0, 0);
+    double xy1[] = {0, 0, 1, 0, 0, 1}, xy2[] = {0.6, 0.6, 1.6, 0.6, 0.6, 1.6};
+    int32_t tri[] = {0, 1, 2};
+    fdem_mesh a = {3, 1, xy1, tri}, b = {3, 1, xy2, tri};
+    fdem_error err;
+    fdem_add_part(m, &a, mat, 0, &err);
+    fdem_add_part(m, &b, mat, 0, &err);
+    build_finalize(m, 0.5);
+    memset(m->contact.force, 0, sizeof(double) * 12);
+    CHECK(contact_potential_force(m, 0, 1, 1e-6) == 0, "touching although apart");
+    fdem_model_destroy(m);
+}
+
+static void momentum(const fdem_model *m, double p[2], double *scale)
+{
+    const double *v = fdem_velocities(m), *ms = fdem_node_masses(m);
+    p[0] = p[1] = 0;
+    *scale = 0;
+    for (int i = 0; i < fdem_get_counts(m).nodes; i++) {
+        p[0] += ms[i] * v[2 * i];
+        p[1] += ms[i] * v[2 * i + 1];
+        *scale += ms[i] * hypot(v[2 * i], v[2 * i + 1]);
+    }
+}
+
+static void collision_conserves_momentum_and_energy(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0);
+    int a = build_rectangle(m, mat, 0, 0, 0.1, 0.05, 8, 4);
+    int b = build_rectangle(m, mat, 0.1002, 0.01, 0.06, 0.05, 5, 4);
+    fdem_set_part_velocity(m, a, 2.0, 0.1, NULL);
+    fdem_set_part_velocity(m, b, -3.0, 0, NULL);
+    build_finalize(m, 0.5);
+    double p0[2], s0, p[2], s;
+    momentum(m, p0, &s0);
+    double e0 = fdem_get_energy(m).kinetic;
+    fdem_error err;
+    double va[2] = {0, 0}, vb[2] = {0, 0}, c[2];
+    int touched = 0;
+    for (long k = 0; k < 200000 && fdem_get_time(m) < 0.01; k++) {
+        CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+        if (fdem_get_counts(m).contacts) touched = 1;
+        part_centre(m, a, c, va);
+        part_centre(m, b, c, vb);
+        if (touched && !fdem_get_counts(m).contacts && vb[0] > va[0]) break;
+    }
+    CHECK(touched, "the blocks never touched");
+    momentum(m, p, &s);
+    CHECK(fabs(p[0] - p0[0]) <= 1e-12 * s0, "x momentum %.17g -> %.17g", p0[0], p[0]);
+    CHECK(fabs(p[1] - p0[1]) <= 1e-12 * s0, "y momentum %.17g -> %.17g", p0[1], p[1]);
+    CHECK(vb[0] > va[0], "still approaching: %g %g", va[0], vb[0]);
+    fdem_energy en = fdem_get_energy(m);
+    CHECK_REL(en.kinetic + en.elastic + en.contact, e0, 0.05);
+    CHECK_REL(en.kinetic + en.elastic, e0, 0.05);
+    fdem_model_destroy(m);
+}
+
+/* Gravity tilted by theta on a horizontal fixed slab: the block's slide is
+ * 1/2 g (sin theta - mu cos theta) t^2. */
+static double incline_slide(double theta_deg, double mu, double t_end, double *expected)
+{
+    double th = theta_deg * M_PI / 180, g = 9.81;
+    fdem_model *m = fdem_model_create();
+    int slab_mat = build_material(m, 1000, 1e8, 0.25, 0.0, mu);
+    int block_mat = build_material(m, 1000, 1e8, 0.25, 0.2, mu);
+    int slab = build_rectangle(m, slab_mat, 0, -0.05, 0.6, 0.05, 24, 2);
+    int block = build_rectangle(m, block_mat, 0.05, 0, 0.1, 0.05, 6, 3);
+    build_fix_part(m, slab);
+    fdem_set_gravity(m, g * sin(th), -g * cos(th));
+    build_finalize(m, 0.5);
+    double c0[2], c[2];
+    part_centre(m, block, c0, NULL);
+    run_until(m, t_end);
+    part_centre(m, block, c, NULL);
+    double t = fdem_get_time(m);
+    *expected = fmax(0, 0.5 * g * (sin(th) - mu * cos(th)) * t * t);
+    fdem_model_destroy(m);
+    return c[0] - c0[0];
+}
+
+static void block_slides_down_incline_with_friction(void)
+{
+    double want, got = incline_slide(30, 0.3, 0.15, &want);
+    CHECK_REL(got, want, 0.05);
+    fprintf(stderr, "  incline 30 deg, mu 0.3: slide %.6g m, expected %.6g m (%.2f%%)\n", got, want,
+            100 * (got - want) / want);
+}
+
+static void block_sticks_below_friction_angle(void)
+{
+    double want, got = incline_slide(20, 0.5, 0.1, &want); /* tan 20 = 0.36 < 0.5 */
+    CHECK(want == 0, "expected %g", want);
+    CHECK(fabs(got) < 1e-4, "crept %g m in 0.1 s", got);
+}
+
+static void disc_pile_settles_without_interpenetration(void)
+{
+    fdem_model *m = fdem_model_create();
+    int wall = build_material(m, 1000, 1e6, 0.25, 0.1, 0.3);
+    int disc = build_material(m, 1000, 1e6, 0.25, 0.3, 0.3);
+    double r = 0.01, W = 0.22;
+    int floor_p = build_rectangle(m, wall, -0.02, -0.02, W + 0.04, 0.02, 24, 2);
+    int left = build_rectangle(m, wall, -0.02, 0, 0.02, 0.3, 2, 24);
+    int right = build_rectangle(m, wall, W, 0, 0.02, 0.3, 2, 24);
+    build_fix_part(m, floor_p);
+    build_fix_part(m, left);
+    build_fix_part(m, right);
+    int first = -1, count = 0;
+    for (int row = 0; row < 10; row++)
+        for (int col = 0; col < 10; col++) {
+            double x = 0.012 + col * 0.0215 + (row % 2) * 0.003, y = 0.0105 + row * 0.0205;
+            int p = build_disc(m, disc, x, y, r * (0.9 + 0.1 * ((row * 7 + col * 3) % 5) / 4.0), 12);
+            if (first < 0) first = p;
+            count++;
+        }
+    fdem_set_gravity(m, 0, -9.81);
+    build_finalize(m, 0.5);
+    run_until(m, 0.25);
+    fdem_energy en = fdem_get_energy(m);
+    CHECK(en.kinetic < 0.02 * en.gravity_work, "still moving: kinetic %g of gravity work %g",
+          en.kinetic, en.gravity_work);
+    double centre[100][2];
+    for (int k = 0; k < count; k++) part_centre(m, first + k, centre[k], NULL);
+    double worst = 1;
+    for (int i = 0; i < count; i++)
+        for (int j = i + 1; j < count; j++) {
+            double d = hypot(centre[i][0] - centre[j][0], centre[i][1] - centre[j][1]);
+            worst = fmin(worst, d / (2 * r));
+        }
+    /* radii are 0.9r..r, so touching discs sit at >= 1.8 r; anything well
+     * below means one disc went into another */
+    CHECK(worst > 0.85, "two discs' centres only %.3f diameters apart", worst);
+    for (int i = 0; i < count; i++)
+        CHECK(centre[i][1] > 0 && centre[i][0] > 0 && centre[i][0] < W, "disc %d left the box: %g %g",
+              i, centre[i][0], centre[i][1]);
+    fprintf(stderr, "  pile: closest centres %.3f diameters, kinetic/gravity work %.2g, %ld detections\n",
+            worst, en.kinetic / en.gravity_work, fdem_get_counts(m).detections);
+    fdem_model_destroy(m);
+}
+
+CHECK_MAIN(T(overlapping_pair_forces_balance), T(separated_pair_has_no_force),
+           T(collision_conserves_momentum_and_energy), T(block_slides_down_incline_with_friction),
+           T(block_sticks_below_friction_angle), T(disc_pile_settles_without_interpenetration))

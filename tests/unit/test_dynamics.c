@@ -1,0 +1,157 @@
+/*
+ * test_dynamics.c - the central difference scheme against closed forms:
+ * free fall (exact for constant acceleration, also with a changing step),
+ * the first longitudinal period of a fixed-free bar (4L/c), constraint
+ * reactions in equilibrium, and a checkpoint round trip.
+ */
+#include "build_model.h"
+#include "check.h"
+
+static void free_fall_matches_half_g_t_squared(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2700, 3e10, 0.25, 0, 0);
+    int p = build_rectangle(m, mat, 0, 0, 0.1, 0.1, 4, 4);
+    fdem_set_gravity(m, 0, -9.81);
+    build_finalize(m, 0.5);
+    double c0[2], c[2], v[2];
+    part_centre(m, p, c0, NULL);
+    run_until(m, 0.01);
+    double t = fdem_get_time(m);
+    part_centre(m, p, c, v);
+    CHECK_REL(c0[1] - c[1], 0.5 * 9.81 * t * t, 1e-9);
+    CHECK_NEAR(c[0], c0[0], 1e-12);
+    fdem_energy en = fdem_get_energy(m);
+    CHECK_REL(en.gravity_work, 2700 * 0.01 * 9.81 * (c0[1] - c[1]), 1e-9);
+    fdem_model_destroy(m);
+}
+
+static void free_fall_with_changing_step(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e9, 0.2, 0, 0);
+    int p = build_rectangle(m, mat, 0, 0, 1, 1, 2, 2);
+    fdem_set_gravity(m, 0, -10);
+    build_finalize(m, 0.5);
+    double h = fdem_get_dt(m), c0[2], c[2];
+    part_centre(m, p, c0, NULL);
+    fdem_error err;
+    for (int k = 0; k < 300; k++) {
+        fdem_set_dt(m, h * (k % 3 == 0 ? 1.0 : k % 3 == 1 ? 0.5 : 0.8));
+        CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+    }
+    double t = fdem_get_time(m);
+    part_centre(m, p, c, NULL);
+    /* eq 5.9 with h_current != h_next keeps constant acceleration exact */
+    CHECK_REL(c0[1] - c[1], 0.5 * 10 * t * t, 1e-9);
+    fdem_model_destroy(m);
+}
+
+/* Fixed at x = 0, free at x = L, every node but the fixed ones moving at v0
+ * at t = 0: the tip displacement is a triangle wave of period 4L/c. */
+static void bar_period_is_4L_over_c(void)
+{
+    double L = 1.0, H = 0.05, E = 1e9, rho = 1000, v0 = 0.01;
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, rho, E, 0.0, 0, 0);
+    int p = build_rectangle(m, mat, 0, 0, L, H, 80, 4);
+    fdem_set_part_velocity(m, p, v0, 0, NULL);
+    fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1e-9, -1, 1e-9, 1},
+                               .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 0};
+    fdem_error err;
+    CHECK(fdem_add_constraint(m, &fix, &err) == 0, "%s", err.message);
+    build_finalize(m, 0.5);
+    double c = sqrt(E / rho), period = 4 * L / c;
+    /* tip = mean x-displacement of the nodes at x = L */
+    const double *x = fdem_positions(m), *x0 = fdem_initial_positions(m);
+    int n = fdem_get_counts(m).nodes;
+    double prev = 0, crossings[4];
+    int found = 0;
+    while (fdem_get_time(m) < 2.2 * period && found < 3) {
+        double t_before = fdem_get_time(m);
+        CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+        double tip = 0;
+        int k = 0;
+        for (int i = 0; i < n; i++)
+            if (x0[2 * i] > L - 1e-9) { tip += x[2 * i] - x0[2 * i]; k++; }
+        tip /= k;
+        if (t_before > 0 && prev > 0 && tip <= 0) { /* downward zero crossing */
+            double t_cross = t_before + fdem_get_dt(m) * prev / (prev - tip);
+            crossings[found++] = t_cross;
+        }
+        prev = tip;
+    }
+    CHECK(found >= 2, "found %d crossings", found);
+    if (found >= 2) {
+        CHECK_REL(crossings[1] - crossings[0], period, 0.02);
+        CHECK_REL(crossings[0], period / 2, 0.02);
+    }
+    fdem_model_destroy(m);
+}
+
+static void hanging_block_reaction_equals_weight(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2000, 1e8, 0.3, 0.5, 0);
+    build_rectangle(m, mat, 0, 0, 0.2, 0.4, 4, 8);
+    fdem_constraint_def top = {.select = FDEM_SELECT_BOX, .box = {-1, 0.4 - 1e-9, 1, 1},
+                               .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1};
+    fdem_error err;
+    fdem_add_constraint(m, &top, &err);
+    fdem_set_gravity(m, 0, -9.81);
+    build_finalize(m, 0.5);
+    /* Damping is a fraction of the stiffest mode's, so the slow first mode
+     * rings for long: compare the reaction averaged over ~10 of its periods. */
+    run_until(m, 0.04);
+    double rx = 0, ry = 0, t0 = fdem_get_time(m);
+    fdem_error e2;
+    while (fdem_get_time(m) < 0.1) {
+        if (fdem_step(m, &e2)) build_die("step", &e2);
+        const double *r = fdem_constraint_forces(m);
+        rx += r[0] * fdem_get_dt(m);
+        ry += r[1] * fdem_get_dt(m);
+    }
+    rx /= fdem_get_time(m) - t0;
+    ry /= fdem_get_time(m) - t0;
+    CHECK_REL(ry, 2000 * 0.2 * 0.4 * 9.81, 0.01);
+    CHECK_NEAR(rx, 0, 1e-3 * ry);
+    /* energy balance: kinetic + elastic + damping = gravity work + external work */
+    fdem_energy en = fdem_get_energy(m);
+    double lhs = en.kinetic + en.elastic + en.damping, rhs = en.gravity_work + en.external_work;
+    CHECK_REL(lhs, rhs, 0.02);
+    fdem_model_destroy(m);
+}
+
+static void checkpoint_round_trip_continues_identically(void)
+{
+    fdem_model *a = fdem_model_create(), *b = fdem_model_create();
+    fdem_model *ms[2] = {a, b};
+    for (int k = 0; k < 2; k++) {
+        int mat = build_material(ms[k], 1000, 1e8, 0.3, 0, 0.2);
+        build_rectangle(ms[k], mat, 0, 0, 0.1, 0.1, 3, 3);
+        int q = build_rectangle(ms[k], mat, 0.0, 0.1005, 0.1, 0.05, 3, 2);
+        fdem_set_part_velocity(ms[k], q, 0.1, -1, NULL);
+        fdem_set_gravity(ms[k], 0, -9.81);
+        build_finalize(ms[k], 0.5);
+    }
+    fdem_error err;
+    for (int s = 0; s < 500; s++) fdem_step(a, &err);
+    size_t size = fdem_checkpoint_size(a);
+    void *buf = malloc(size);
+    CHECK(fdem_checkpoint_write(a, buf, size) == 0, "write");
+    CHECK(fdem_checkpoint_read(b, buf, size, &err) == 0, "%s", err.message);
+    CHECK(fdem_checkpoint_read(b, buf, size - 8, &err) < 0, "truncated checkpoint accepted");
+    for (int s = 0; s < 500; s++) { fdem_step(a, &err); fdem_step(b, &err); }
+    int n = fdem_get_counts(a).nodes;
+    double diff = 0;
+    for (int i = 0; i < 2 * n; i++) diff = fmax(diff, fabs(fdem_positions(a)[i] - fdem_positions(b)[i]));
+    CHECK(diff == 0.0, "positions differ by %g after restore", diff);
+    CHECK(fdem_get_step(b) == 1000, "step %lld", (long long)fdem_get_step(b));
+    free(buf);
+    fdem_model_destroy(a);
+    fdem_model_destroy(b);
+}
+
+CHECK_MAIN(T(free_fall_matches_half_g_t_squared), T(free_fall_with_changing_step),
+           T(bar_period_is_4L_over_c), T(hanging_block_reaction_equals_weight),
+           T(checkpoint_round_trip_continues_identically))
