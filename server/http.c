@@ -299,6 +299,27 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
     }
 }
 
+/* Percent-decodes in place like libmicrohttpd's default, except that
+ * "%00" stays as it is: a decoded NUL would silently cut the path short
+ * ("/cases/ID%00/x" would become "/cases/ID"). */
+static size_t http_unescape(void *cls, struct MHD_Connection *conn, char *s)
+{
+    (void)cls;
+    (void)conn;
+    char *out = s;
+    for (const char *in = s; *in; ) {
+        unsigned hi, lo;
+        if (in[0] == '%' && sscanf(in + 1, "%1x%1x", &hi, &lo) == 2 && (hi | lo) != 0) {
+            *out++ = (char)(hi << 4 | lo);
+            in += 3;
+        } else {
+            *out++ = *in++;
+        }
+    }
+    *out = '\0';
+    return (size_t)(out - s);
+}
+
 /* ---------------------------------------------------------------- start */
 
 int http_start(const fdemd_config *cfg)
@@ -323,6 +344,7 @@ int http_start(const fdemd_config *cfg)
         MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)HTTP_PER_IP_LIMIT,
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)HTTP_CONNECTION_MEMORY,
         MHD_OPTION_NOTIFY_COMPLETED, http_completed, NULL,
+        MHD_OPTION_UNESCAPE_CALLBACK, http_unescape, NULL,
         MHD_OPTION_END);
     if (!http_daemon) {
         fprintf(stderr, "fdemd: cannot listen on %s:%d (in use, or not an address of this machine)\n",

@@ -1,0 +1,201 @@
+"""Bad requests are each answered with a clear 4xx (problem+json naming
+what and where) and change nothing: the case already stored before them
+is untouched and no case is added."""
+import copy
+import json
+import socket
+import unittest
+
+from fdemd_harness import Daemon, tiny_case
+
+
+def degenerate_mesh_case():
+    case = tiny_case("degenerate")
+    case["parts"].append({"name": "flat", "material": "rock",
+                          "mesh": {"nodes": [[1, 1], [2, 2], [3, 3]], "triangles": [[0, 1, 2]]}})
+    return case
+
+
+def out_of_range_mesh_case():
+    case = tiny_case("range")
+    case["parts"].append({"name": "bad", "material": "rock",
+                          "mesh": {"nodes": [[1, 1], [2, 1], [1, 2]], "triangles": [[0, 1, 3]]}})
+    return case
+
+
+def edit(path, value, name="bad"):
+    """tiny_case() with the value at a JSON path (list of keys) replaced."""
+    case = tiny_case(name)
+    target = case
+    for key in path[:-1]:
+        target = target[key]
+    target[path[-1]] = value
+    return case
+
+
+class BadInputTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon(args=["--max-upload", "1M"]).start()
+        cls.kept = cls.d.create(tiny_case("keep-me", end=0.0003), start=True)
+        cls.d.wait_state(cls.kept["id"], "finished")
+        cls.kept = cls.d.status(cls.kept["id"])
+
+    @classmethod
+    def tearDownClass(cls):
+        code, _ = cls.d.stop()
+        cls.d.close()
+        assert code == 0, "fdemd exited with %s" % code
+
+    def tearDown(self):
+        # Nothing bad got in and the stored case is as it was.
+        status, body = self.d.json("GET", "/cases")
+        self.assertEqual(status, 200)
+        self.assertEqual(body["cases"], [self.kept])
+
+    def assertProblem(self, status, headers, data, expected, pointer=None, words=()):
+        self.assertEqual(status, expected, data[:300])
+        self.assertEqual(headers.get("content-type"), "application/problem+json")
+        problem = json.loads(data)
+        self.assertEqual(problem["type"], "about:blank")
+        self.assertEqual(problem["status"], expected)
+        self.assertTrue(problem["title"])
+        self.assertTrue(problem["detail"])
+        self.assertIsInstance(problem["errors"], list)
+        text = json.dumps(problem).lower()
+        for word in words:
+            self.assertIn(word.lower(), text)
+        if pointer is not None:
+            pointers = [e["pointer"] for e in problem["errors"]]
+            self.assertTrue(any(p.startswith(pointer) for p in pointers), (pointer, pointers))
+            for e in problem["errors"]:
+                self.assertTrue(e["message"])
+        return problem
+
+    def post(self, body, expected, pointer=None, words=()):
+        status, headers, data = self.d.request("POST", "/cases", body,
+                                               {"Content-Type": "application/json"})
+        return self.assertProblem(status, headers, data, expected, pointer, words)
+
+    # ------------------------------------------------------------ 400
+    def test_malformed_json(self):
+        self.post(b'{"name": "x", ', 400)
+        self.post(b"", 400)
+        self.post(b"\xff\xfe garbage", 400)
+
+    def test_deeply_nested_json(self):
+        self.post(b"[" * 100000, 400)
+        self.post(b'{"a":' * 50000 + b"1" + b"}" * 50000, 400)
+
+    def test_nan_literal(self):
+        text = json.dumps(tiny_case("nan")).replace('"density": 2700', '"density": NaN')
+        self.assertIn("NaN", text)
+        self.post(text.encode(), 400)
+        text = json.dumps(tiny_case("inf")).replace('"density": 2700', '"density": Infinity')
+        self.post(text.encode(), 400)
+
+    def test_not_an_object(self):
+        self.post(b"[]", 422)
+        self.post(b'"case"', 400)  # not a JSON document for the parser
+
+    # ------------------------------------------------------------ 422
+    def test_negative_and_zero_sizes(self):
+        self.post(edit(["parts", 0, "rectangle", "size"], [-0.1, 0.1]), 422, "/parts/0/rectangle/size")
+        self.post(edit(["parts", 0, "rectangle", "size"], [0.1, 0]), 422, "/parts/0/rectangle/size")
+        self.post(edit(["parts", 0, "rectangle", "divisions"], [0, 4]), 422, "/parts/0/rectangle/divisions")
+        self.post(edit(["time", "end"], -1), 422, "/time/end")
+        self.post(edit(["materials", "rock", "density"], 0), 422, "/materials/rock/density")
+
+    def test_poisson_half(self):
+        self.post(edit(["materials", "rock", "poisson"], 0.5), 422, "/materials/rock/poisson")
+
+    def test_degenerate_and_out_of_range_triangles(self):
+        self.post(degenerate_mesh_case(), 422, "/parts/1")
+        self.post(out_of_range_mesh_case(), 422, "/parts/1")
+
+    def test_two_shapes_in_one_part(self):
+        case = tiny_case("two")
+        case["parts"][0]["disc"] = {"center": [0, 0], "radius": 0.05, "divisions": 16}
+        self.post(case, 422, "/parts/0")
+
+    def test_strings_for_numbers(self):
+        self.post(edit(["materials", "rock", "young"], "3e10"), 422, "/materials/rock/young")
+        self.post(edit(["time", "end"], "soon"), 422, "/time/end")
+
+    def test_several_problems_reported_together(self):
+        case = tiny_case("many")
+        case["materials"]["rock"]["poisson"] = 0.7
+        case["parts"][0]["material"] = "granit"
+        problem = self.post(case, 422)
+        self.assertGreaterEqual(len(problem["errors"]), 2)
+
+    def test_garbage_gmsh(self):
+        case = tiny_case("gmsh")
+        del case["parts"][0]["rectangle"]
+        case["parts"][0]["gmsh"] = "$MeshFormat\nthis is not a mesh\n$EndMeshFormat\n\x01\x02"
+        self.post(case, 422, "/parts/0")
+
+    def test_dt_above_stable(self):
+        problem = self.post(edit(["time", "dt"], 1.0), 422, "/time/dt")
+        self.assertIn("stable", json.dumps(problem).lower())
+
+    # ------------------------------------------------- 413, 411, paths
+    def test_100mb_body_refused_before_sending(self):
+        conn = self.d.connection(timeout=10)
+        conn.putrequest("POST", "/cases")
+        conn.putheader("Content-Type", "application/json")
+        conn.putheader("Content-Length", "100000000")
+        conn.endheaders()  # headers only: the body is never sent
+        resp = conn.getresponse()
+        data = resp.read()
+        conn.close()
+        headers = {k.lower(): v for k, v in resp.getheaders()}
+        self.assertProblem(resp.status, headers, data, 413, words=["max-upload"])
+
+    def test_body_over_limit_while_sending(self):
+        body = b'{"name": "' + b"x" * (2 << 20) + b'"}'
+        try:
+            status, headers, data = self.d.request("POST", "/cases", body)
+        except (BrokenPipeError, ConnectionResetError):
+            return  # refused before we finished sending: also fine
+        self.assertProblem(status, headers, data, 413)
+
+    def test_chunked_body_needs_length(self):
+        conn = self.d.connection(timeout=10)
+        conn.putrequest("POST", "/cases")
+        conn.putheader("Transfer-Encoding", "chunked")
+        conn.endheaders()
+        conn.send(b"2\r\n{}\r\n0\r\n\r\n")
+        resp = conn.getresponse()
+        data = resp.read()
+        conn.close()
+        self.assertProblem(resp.status, {k.lower(): v for k, v in resp.getheaders()}, data, 411)
+
+    def test_missing_content_length(self):
+        with socket.create_connection(("127.0.0.1", self.d.port), timeout=10) as s:
+            s.sendall(b"POST /cases HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n")
+            reply = b""
+            while True:
+                chunk = s.recv(65536)
+                if not chunk:
+                    break
+                reply += chunk
+        self.assertTrue(reply.startswith(b"HTTP/1.1 411"), reply[:100])
+        self.assertIn(b"application/problem+json", reply)
+
+    def test_path_traversal(self):
+        for path in ("/cases/..%2F..%2Fetc", "/cases/../x", "/cases/..", "/cases/%2e%2e/case",
+                     "/cases/../../etc/passwd", "/cases/..%2F" + self.kept["id"] + "/case",
+                     "/cases/" + self.kept["id"] + "/..%2Fcase.json", "/cases/" + self.kept["id"] + "/../../x",
+                     "//cases", "/cases//" + self.kept["id"], "/cases/" + self.kept["id"] + "%00"):
+            status, headers, data = self.d.request("GET", path)
+            self.assertEqual(status, 404, path)
+            self.assertEqual(json.loads(data)["status"], 404)
+
+    def test_bad_query(self):
+        status, headers, data = self.d.request("POST", "/cases?start=maybe", tiny_case("q"))
+        self.assertProblem(status, headers, data, 400, words=["start"])
+
+
+if __name__ == "__main__":
+    unittest.main()
