@@ -20,10 +20,12 @@
  *    flushed, and only this thread writes) with the copy's status flags
  *    cleared, so a plain h5py.File(copy) opens it.
  *
- * Chunks: per-snapshot rows of at least 64 KiB get one snapshot per chunk,
+ * Chunks: per-snapshot rows of at least 8 KiB get one snapshot per chunk,
  * split into ~1 MiB pieces along the node/element axis for huge models;
- * smaller rows are grouped up to 64 KiB (at most 1024 snapshots) per chunk
- * so time series of small models do not become thousands of tiny chunks.
+ * smaller rows (energies, time, small models) are grouped up to 8 KiB (at
+ * most 1024 snapshots) per chunk so they do not become thousands of tiny
+ * chunks. The group stays small because every flush rewrites the partly
+ * filled chunk whole.
  *
  * A model without constraints still gets /snapshots/constraint_force with
  * shape (S, 0, 2) (axis 1 declared unlimited, since a chunk cannot be wider
@@ -47,7 +49,7 @@
 #include <unistd.h>
 
 #define RESULT_FORMAT "fdem-result/1"
-#define CHUNK_SMALL_BYTES (64u * 1024u)
+#define CHUNK_SMALL_BYTES (8u * 1024u)
 #define CHUNK_MAX_BYTES (1024u * 1024u)
 #define CHUNK_MAX_SNAPSHOTS 1024u
 

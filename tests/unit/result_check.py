@@ -8,6 +8,8 @@ doubles printed with 17 digits so they compare exactly) and runs:
   result_check.py FILE EXPECTED plain  [--count K]   h5py.File(FILE, 'r')
   result_check.py FILE EXPECTED swmr   [--count K]   SWMR reader while the writer runs
   result_check.py FILE EXPECTED follow               SWMR reader racing the writer
+  result_check.py FILE EXPECTED frozen               SWMR reader, writer stopped mid-append
+                                                     (one check per line on stdin)
   result_check.py FILE EXPECTED xdmf XDMF            the sidecar against the file
   result_check.py FILE - openfails                   plain open must be refused
 
@@ -74,14 +76,17 @@ def want_series(exp, name, snaps):
     return np.array([s[name] for s in snaps], dtype="f8")
 
 
-def check_snapshots(f, exp, count, refresh=False):
+def check_snapshots(f, exp, count, refresh=False, growing=False):
+    """The first `count` rows of every dataset equal the expected ones; unless
+    the writer may still be appending (`growing`), time has exactly `count`."""
     snaps = exp["snapshots"][:count]
     need(len(snaps) == count, f"EXPECTED has only {len(exp['snapshots'])} snapshots")
     group = f["snapshots"]
     t = group["time"]
     if refresh:
         t.refresh()
-    need(t.shape == (count,), f"/snapshots/time has shape {t.shape}, want ({count},)")
+    need(t.shape == (count,) or (growing and t.shape[0] >= count),
+         f"/snapshots/time has shape {t.shape}, want ({count},)")
     for name in SERIES:
         present = name in exp["series"]
         need((name in group) == present,
@@ -127,10 +132,29 @@ def follow(path, exp):
         if n == seen:
             time.sleep(0.0005)
             continue
-        check_snapshots(f, exp, n, refresh=True)
+        check_snapshots(f, exp, n, refresh=True, growing=True)
         seen, checks = n, checks + 1
     f.close()
     return f"followed {total} snapshots in {checks} distinct states"
+
+
+def frozen(path, exp):
+    """One check per line on stdin, each while the test holds the writer
+    stopped (SIGSTOP) at an arbitrary point, perhaps in the middle of an
+    append: whatever time admits must be complete in every dataset."""
+    failures, counts = 0, []
+    for _ in sys.stdin:
+        try:
+            with h5py.File(path, "r", libver="latest", swmr=True) as f:
+                n = f["snapshots/time"].shape[0]
+                check_file(f, exp, n, refresh=True)
+            counts.append(n)
+            print("checked", n, flush=True)
+        except Mismatch as e:
+            failures += 1
+            print("mismatch:", e, flush=True)
+    need(failures == 0, f"{failures} of {failures + len(counts)} frozen states inconsistent")
+    return f"{len(counts)} frozen states consistent, {counts[0]}..{counts[-1]} snapshots"
 
 
 def dataitem_dims(item):
@@ -221,6 +245,8 @@ def main(argv):
         with h5py.File(path, "r", libver="latest", swmr=True) as f:
             check_file(f, exp, count, refresh=True)
         return f"swmr: {count} snapshots match"
+    if mode == "frozen":
+        return frozen(path, exp)
     if mode == "follow":
         return follow(path, exp)
     if mode == "xdmf":

@@ -1,0 +1,87 @@
+/*
+ * result_fixture.h - a small real model for the snapshot and result tests:
+ * a fixed 4x2 rock block under gravity and, optionally, a fracturing 2x1
+ * slab above it (so the model has joints) pushed by a force constraint.
+ * Small on purpose: the tests compare every number, and must stay fast.
+ */
+#ifndef RESULT_FIXTURE_H
+#define RESULT_FIXTURE_H
+
+#include <stdio.h>
+#include <string.h>
+
+#include "case.h"
+#include "fdem.h"
+
+static int fixture_add_block(fdem_model *m, double ox, double oy, double w, double h, int nx,
+                             int ny, int material, int fracture, fdem_error *err)
+{
+    fdem_mesh mesh = {0};
+    if (fdem_mesh_rectangle(ox, oy, w, h, nx, ny, &mesh, err) < 0) return -1;
+    int part = fdem_add_part(m, &mesh, material, fracture, err);
+    fdem_mesh_free(&mesh);
+    return part;
+}
+
+/* Returns a finalized model with dt = 0.5 x stable, or NULL (printing why).
+ * `fracturing` adds the breakable slab, `constraints` the two constraints. */
+static fdem_model *fixture_model(int fracturing, int constraints, case_info *info)
+{
+    fdem_error err = {0};
+    fdem_model *m = fdem_model_create();
+    fdem_material_def rock = {.density = 2700, .young = 3e10, .poisson = 0.25,
+                              .damping = 0.0, .penalty = 3e11, .friction = 0.5,
+                              .has_fracture = 1,
+                              .fracture = {.tensile_strength = 5e6, .cohesion = 2e7,
+                                           .friction_angle = 30, .energy_I = 20,
+                                           .energy_II = 100}};
+    int mat = m ? fdem_add_material(m, &rock, &err) : -1;
+    int ok = mat >= 0 && fixture_add_block(m, 0, 0, 0.4, 0.2, 4, 2, mat, 0, &err) >= 0;
+    if (ok && fracturing) ok = fixture_add_block(m, 0, 0.21, 0.4, 0.1, 2, 1, mat, 1, &err) >= 0;
+    if (ok && constraints) {
+        fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1, -0.001, 1, 0.001},
+                                   .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1};
+        fdem_constraint_def push = {.select = FDEM_SELECT_PART, .part = 0,
+                                    .kind = FDEM_CONSTRAINT_FORCE, .value = {1e5, -2e5}};
+        ok = fdem_add_constraint(m, &fix, &err) >= 0 && fdem_add_constraint(m, &push, &err) >= 0;
+    }
+    if (ok) {
+        fdem_set_gravity(m, 0, -9.81);
+        ok = fdem_model_finalize(m, &err) >= 0;
+    }
+    if (!ok) {
+        fprintf(stderr, "  fixture model: %s\n", err.message);
+        fdem_model_destroy(m);
+        return NULL;
+    }
+    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
+    if (info) {
+        memset(info, 0, sizeof *info);
+        snprintf(info->name, sizeof info->name, "fixture \"block\" & <slab>");
+        info->dt = fdem_get_dt(m);
+        info->stable_dt = fdem_stable_dt(m);
+        info->end_time = 1000 * info->dt;
+        info->safety = 0.5;
+        info->output_interval = 5 * info->dt;
+        info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS |
+                       CASE_FIELD_DAMAGE;
+        info->part_count = fracturing ? 2 : 1;
+        info->constraint_count = constraints ? 2 : 0;
+        info->fracture = fracturing;
+    }
+    return m;
+}
+
+/* Steps n times; returns 0 or -1 (printing the engine's error). */
+static int fixture_step(fdem_model *m, int n)
+{
+    fdem_error err = {0};
+    for (int i = 0; i < n; i++)
+        if (fdem_step(m, &err) < 0) {
+            fprintf(stderr, "  fixture step: %s\n", err.message);
+            return -1;
+        }
+    return 0;
+}
+
+#endif

@@ -1,0 +1,573 @@
+/*
+ * test_result.c - result.h5 and result.xdmf checked by an independent
+ * reader: tests/unit/result_check.py (h5py) compares the file with what the
+ * engine reported, which this test writes as JSON (17-digit doubles, so the
+ * comparison is exact). It reads while the writer still has the file open
+ * (SWMR), races the writer, reads a crashed file's successor and a download
+ * copy with a plain h5py.File(path, 'r').
+ */
+#include <hdf5.h>
+#include <jansson.h>
+#include <signal.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "result.h"
+#include "result_fixture.h"
+#include "state_json.h"
+
+#define STEPS_BETWEEN 5
+
+static char tmpdir[256];
+
+/* ------------------------------------------------------------- test paths */
+
+static void tmp_path(char *out, size_t size, const char *name)
+{
+    snprintf(out, size, "%s/%s", tmpdir, name);
+}
+
+/* result_check.py sits next to this file; tests run from the repo root. */
+static const char *checker_path(void)
+{
+    static char path[512];
+    const char *here = __FILE__;
+    const char *slash = strrchr(here, '/');
+    int dir = slash ? (int)(slash - here) : 0;
+    snprintf(path, sizeof path, "%.*s%sresult_check.py", dir, here, slash ? "/" : "");
+    return path;
+}
+
+/* ------------------------------------------------- the expected document */
+
+static json_t *doubles_rows(const double *v, int rows, int width)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < rows; i++) {
+        if (width == 0) {
+            json_array_append_new(a, json_real(v[i]));
+            continue;
+        }
+        json_t *row = json_array();
+        for (int k = 0; k < width; k++) json_array_append_new(row, json_real(v[i * width + k]));
+        json_array_append_new(a, row);
+    }
+    return a;
+}
+
+static json_t *ints_rows(const int32_t *v, int rows, int width)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < rows; i++) {
+        if (width == 0) {
+            json_array_append_new(a, json_integer(v[i]));
+            continue;
+        }
+        json_t *row = json_array();
+        for (int k = 0; k < width; k++) json_array_append_new(row, json_integer(v[i * width + k]));
+        json_array_append_new(a, row);
+    }
+    return a;
+}
+
+/* What result_check.py expects: root attributes, mesh, dataset list. */
+static json_t *expect_new(const fdem_model *m, const case_info *info)
+{
+    fdem_counts c = fdem_get_counts(m);
+    json_t *mesh = json_object();
+    json_object_set_new(mesh, "position0", doubles_rows(fdem_initial_positions(m), c.nodes, 2));
+    json_object_set_new(mesh, "triangles", ints_rows(fdem_triangles(m), c.elements, 3));
+    json_object_set_new(mesh, "node_mass", doubles_rows(fdem_node_masses(m), c.nodes, 0));
+    json_object_set_new(mesh, "node_part", ints_rows(fdem_node_parts(m), c.nodes, 0));
+    json_object_set_new(mesh, "element_part", ints_rows(fdem_element_parts(m), c.elements, 0));
+    if (c.joints > 0) json_object_set_new(mesh, "joints", ints_rows(fdem_joints(m), c.joints, 4));
+
+    json_t *series = json_pack("[sssss]", "step", "time", "kinetic_energy", "elastic_energy",
+                               "constraint_force");
+    if (info->fields & CASE_FIELD_POSITION) json_array_append_new(series, json_string("position"));
+    if (info->fields & CASE_FIELD_VELOCITY) json_array_append_new(series, json_string("velocity"));
+    if (info->fields & CASE_FIELD_STRESS) json_array_append_new(series, json_string("stress"));
+    if (c.joints > 0) json_array_append_new(series, json_string("damage"));
+
+    return json_pack("{s:s, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name, "dt",
+                     fdem_get_dt(m), "constraints", c.constraints, "h5_name", "result.h5",
+                     "series", series, "mesh", mesh, "snapshots");
+}
+
+/* One snapshot as the file must hold it: the state JSON (which the daemon
+ * serves) plus what only the file stores. */
+static void expect_snapshot(json_t *doc, const snapshot *s)
+{
+    snapshot all = *s;
+    all.fields |= s->damage ? CASE_FIELD_DAMAGE : 0;
+    json_t *j = state_to_json(&all);
+    json_object_set_new(j, "constraint_force", doubles_rows(s->constraint_force, s->constraints, 2));
+    json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
+    json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
+    json_array_append_new(json_object_get(doc, "snapshots"), j);
+}
+
+static void expect_save(json_t *doc, const char *name)
+{
+    char path[512];
+    tmp_path(path, sizeof path, name);
+    CHECK(json_dump_file(doc, path, JSON_COMPACT) == 0, "cannot write %s", path);
+}
+
+/* ------------------------------------------------------- running checks */
+
+/* Runs result_check.py; its report goes to stderr. Returns its exit code. */
+static int run_checker(const char *h5_name, const char *expected, const char *mode,
+                       const char *extra)
+{
+    char cmd[2048], h5[512], exp[512];
+    tmp_path(h5, sizeof h5, h5_name);
+    tmp_path(exp, sizeof exp, expected);
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s' '%s' %s %s 2>&1", checker_path(), h5,
+             exp, mode, extra ? extra : "");
+    FILE *p = popen(cmd, "r");
+    if (!p) return -1;
+    char line[1024];
+    while (fgets(line, sizeof line, p)) fprintf(stderr, "    checker %s: %s", mode, line);
+    int status = pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* -------------------------------------------------------------- fixtures */
+
+typedef struct run {
+    fdem_model *model;
+    case_info info;
+    json_t *expect;
+    result_file *file;
+    char err[512];
+} run;
+
+static int run_start(run *r, int fracturing, int constraints, unsigned fields, const char *name)
+{
+    memset(r, 0, sizeof *r);
+    r->model = fixture_model(fracturing, constraints, &r->info);
+    if (!r->model) return -1;
+    if (fields) r->info.fields = fields;
+    r->expect = expect_new(r->model, &r->info);
+    char path[512];
+    tmp_path(path, sizeof path, name);
+    r->file = result_create(path, r->model, &r->info, r->err, sizeof r->err);
+    CHECK(r->file != NULL, "result_create: %s", r->err);
+    return r->file ? 0 : -1;
+}
+
+/* Takes a snapshot now, appends it and records it as expected; then steps. */
+static int run_append(run *r)
+{
+    snapshot *s = snapshot_take(r->model, r->info.fields);
+    int rc = s ? result_append(r->file, s, r->err, sizeof r->err) : -1;
+    CHECK(rc == 0, "result_append: %s", r->err);
+    if (rc == 0) expect_snapshot(r->expect, s);
+    snapshot_free(s);
+    return rc == 0 ? fixture_step(r->model, STEPS_BETWEEN) : -1;
+}
+
+static void run_end(run *r)
+{
+    if (r->file) CHECK(result_close(r->file) == 0, "result_close");
+    json_decref(r->expect);
+    fdem_model_destroy(r->model);
+}
+
+/* ----------------------------------------------------------------- tests */
+
+static void test_result_layout_and_swmr_reads(void)
+{
+    run r;
+    if (run_start(&r, 1, 1, 0, "layout.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        expect_save(r.expect, "layout.json");
+        /* Still open for SWMR writing. */
+        CHECK(run_checker("layout.h5", "layout.json", "swmr", NULL) == 0, "3 snapshots, swmr");
+        run_append(&r);
+        run_append(&r);
+        expect_save(r.expect, "layout.json");
+        CHECK(run_checker("layout.h5", "layout.json", "swmr", NULL) == 0, "5 snapshots, swmr");
+        CHECK(result_snapshot_count(r.file) == 5, "count %d", result_snapshot_count(r.file));
+        CHECK(result_snapshot_time(r.file, 0) == 0.0, "first snapshot at t = 0");
+        CHECK_NEAR(result_snapshot_time(r.file, 4), 4 * STEPS_BETWEEN * r.info.dt,
+                   1e-9 * r.info.dt);
+        CHECK(isnan(result_snapshot_time(r.file, 5)), "time past the end is NaN");
+        CHECK(result_close(r.file) == 0, "result_close");
+        r.file = NULL;
+        CHECK(run_checker("layout.h5", "layout.json", "plain", NULL) == 0, "closed file");
+    }
+    run_end(&r);
+}
+
+static void test_result_reader_follows_writer(void)
+{
+    enum { SNAPSHOTS = 40 };
+    run r;
+    if (run_start(&r, 1, 1, 0, "follow.h5") != 0) {
+        run_end(&r);
+        return;
+    }
+    /* The follower needs every expected snapshot up front. */
+    snapshot *snaps[SNAPSHOTS] = {0};
+    for (int i = 0; i < SNAPSHOTS; i++) {
+        snaps[i] = snapshot_take(r.model, r.info.fields);
+        expect_snapshot(r.expect, snaps[i]);
+        fixture_step(r.model, 1);
+    }
+    expect_save(r.expect, "follow.json");
+    CHECK(result_append(r.file, snaps[0], r.err, sizeof r.err) == 0, "%s", r.err);
+
+    char cmd[2048], h5[512], exp[512];
+    tmp_path(h5, sizeof h5, "follow.h5");
+    tmp_path(exp, sizeof exp, "follow.json");
+    snprintf(cmd, sizeof cmd, "/usr/bin/python3 %s '%s' '%s' follow 2>&1", checker_path(), h5,
+             exp);
+    FILE *p = popen(cmd, "r");
+    char line[1024] = "";
+    CHECK(p && fgets(line, sizeof line, p) && strncmp(line, "ready", 5) == 0,
+          "follower did not start: %s", line);
+    for (int i = 1; i < SNAPSHOTS; i++) {
+        CHECK(result_append(r.file, snaps[i], r.err, sizeof r.err) == 0, "%s", r.err);
+        usleep(1000);
+    }
+    int seen_ok = 0;
+    while (p && fgets(line, sizeof line, p)) {
+        fprintf(stderr, "    checker follow: %s", line);
+        seen_ok |= strncmp(line, "ok", 2) == 0;
+    }
+    int status = p ? pclose(p) : -1;
+    CHECK(seen_ok && WIFEXITED(status) && WEXITSTATUS(status) == 0, "follower failed");
+    for (int i = 0; i < SNAPSHOTS; i++) snapshot_free(snaps[i]);
+    run_end(&r);
+}
+
+/* A child process that creates `name`, appends snaps[0], reports ready on
+ * a pipe, then appends the rest flat out. Returns its pid once ready, or -1. */
+static pid_t spawn_writer(run *r, const char *name, snapshot **snaps, int count)
+{
+    char path[512];
+    tmp_path(path, sizeof path, name);
+    int ready[2];
+    if (pipe(ready) != 0) return -1;
+    fflush(NULL);
+    pid_t child = fork();
+    if (child == 0) {
+        char e[512];
+        result_file *f = result_create(path, r->model, &r->info, e, sizeof e);
+        if (!f || result_append(f, snaps[0], e, sizeof e) < 0) _exit(1);
+        if (write(ready[1], "1", 1) != 1) _exit(1);
+        for (int i = 1; i < count; i++) {
+            if (result_append(f, snaps[i], e, sizeof e) < 0) _exit(1);
+            usleep(20);
+        }
+        _exit(result_close(f) == 0 ? 0 : 1);
+    }
+    close(ready[1]);
+    char byte = 0;
+    int started = child > 0 && read(ready[0], &byte, 1) == 1;
+    close(ready[0]);
+    return started ? child : -1;
+}
+
+/* result_check.py in a mode that answers one line per line it is sent. */
+static pid_t spawn_checker(const char *h5_name, const char *expected, const char *mode,
+                           FILE **ask, FILE **answer)
+{
+    int to[2], from[2];
+    if (pipe(to) != 0 || pipe(from) != 0) return -1;
+    char h5[512], exp[512];
+    tmp_path(h5, sizeof h5, h5_name);
+    tmp_path(exp, sizeof exp, expected);
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(to[0], 0);
+        dup2(from[1], 1);
+        dup2(from[1], 2);
+        close(to[1]);
+        close(from[0]);
+        execl("/usr/bin/python3", "python3", checker_path(), h5, exp, mode, (char *)NULL);
+        _exit(127);
+    }
+    close(to[0]);
+    close(from[1]);
+    *ask = fdopen(to[1], "w");
+    *answer = fdopen(from[0], "r");
+    return pid;
+}
+
+/* A writer process appending flat out is frozen with SIGSTOP at arbitrary
+ * moments, usually in the middle of an append, and a SWMR reader checks
+ * that every snapshot /snapshots/time admits is complete in every dataset.
+ * This is the test that fails if time is not written last (checked by
+ * moving the time write first: 3 to 15 of the 40 states were torn). */
+static void test_result_writer_stopped_mid_append(void)
+{
+    enum { SNAPSHOTS = 800, FREEZES = 40 };
+    run r;
+    memset(&r, 0, sizeof r);
+    r.model = fixture_model(1, 1, &r.info);
+    CHECK(r.model != NULL, "fixture model");
+    if (!r.model) return;
+    r.expect = expect_new(r.model, &r.info);
+    snapshot *snaps[SNAPSHOTS];
+    for (int i = 0; i < SNAPSHOTS; i++) {
+        snaps[i] = snapshot_take(r.model, r.info.fields);
+        expect_snapshot(r.expect, snaps[i]);
+        fixture_step(r.model, 1);
+    }
+    expect_save(r.expect, "frozen.json");
+
+    pid_t writer = spawn_writer(&r, "frozen.h5", snaps, SNAPSHOTS);
+    CHECK(writer > 0, "the writer process failed to start");
+    FILE *ask = NULL, *answer = NULL;
+    pid_t checker = writer > 0 ? spawn_checker("frozen.h5", "frozen.json", "frozen", &ask,
+                                               &answer) : -1;
+    char line[1024];
+    int consistent = 0;
+    for (int round = 0; round < FREEZES && checker > 0; round++) {
+        usleep(200 + (unsigned)(rand() % 2000));
+        int status;
+        kill(writer, SIGSTOP);
+        waitpid(writer, &status, WUNTRACED);
+        fputs("check\n", ask);
+        fflush(ask);
+        if (fgets(line, sizeof line, answer)) {
+            int ok = strncmp(line, "checked", 7) == 0;
+            consistent += ok;
+            if (!ok) fprintf(stderr, "    checker frozen: %s", line);
+        }
+        kill(writer, SIGCONT);
+    }
+    int checker_status = -1, writer_status = -1;
+    if (checker > 0) {
+        fclose(ask);
+        while (fgets(line, sizeof line, answer)) fprintf(stderr, "    checker frozen: %s", line);
+        fclose(answer);
+        waitpid(checker, &checker_status, 0);
+    }
+    CHECK(consistent == FREEZES && WIFEXITED(checker_status) &&
+              WEXITSTATUS(checker_status) == 0,
+          "%d of %d frozen states consistent", consistent, FREEZES);
+    if (writer > 0) waitpid(writer, &writer_status, 0);
+    CHECK(WIFEXITED(writer_status) && WEXITSTATUS(writer_status) == 0, "writer process failed");
+    CHECK(run_checker("frozen.h5", "frozen.json", "plain", NULL) == 0, "all snapshots");
+    for (int i = 0; i < SNAPSHOTS; i++) snapshot_free(snaps[i]);
+    run_end(&r);
+}
+
+static void test_result_reopen_after_crash(void)
+{
+    run r;
+    memset(&r, 0, sizeof r);
+    r.model = fixture_model(1, 1, &r.info);
+    CHECK(r.model != NULL, "fixture model");
+    if (!r.model) return;
+    snapshot *snaps[5];
+    for (int i = 0; i < 5; i++) {
+        snaps[i] = snapshot_take(r.model, r.info.fields);
+        fixture_step(r.model, STEPS_BETWEEN);
+    }
+    char path[512];
+    tmp_path(path, sizeof path, "crash.h5");
+
+    /* A writer that dies without closing the file. */
+    fflush(NULL);
+    pid_t child = fork();
+    if (child == 0) {
+        char e[512];
+        result_file *f = result_create(path, r.model, &r.info, e, sizeof e);
+        for (int i = 0; f && i < 3; i++) result_append(f, snaps[i], e, sizeof e);
+        _exit(f ? 0 : 1);
+    }
+    int status = -1;
+    waitpid(child, &status, 0);
+    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0, "crashing writer failed early");
+    CHECK(run_checker("crash.h5", "-", "openfails", NULL) == 0,
+          "a crashed SWMR file should refuse a plain open (else this test proves nothing)");
+
+    r.file = result_reopen(path, r.model, &r.info, snaps[1]->step, r.err, sizeof r.err);
+    CHECK(r.file != NULL, "result_reopen: %s", r.err);
+    if (r.file) {
+        CHECK(result_snapshot_count(r.file) == 2, "kept %d snapshots, want 2",
+              result_snapshot_count(r.file));
+        CHECK(result_snapshot_time(r.file, 1) == snaps[1]->time, "time of the kept snapshot");
+        for (int i = 3; i < 5; i++)
+            CHECK(result_append(r.file, snaps[i], r.err, sizeof r.err) == 0, "%s", r.err);
+        CHECK(result_snapshot_count(r.file) == 4, "count %d", result_snapshot_count(r.file));
+        CHECK(result_close(r.file) == 0, "result_close");
+        r.file = NULL;
+    }
+    r.expect = expect_new(r.model, &r.info);
+    int kept[4] = {0, 1, 3, 4};
+    for (int i = 0; i < 4; i++) expect_snapshot(r.expect, snaps[kept[i]]);
+    expect_save(r.expect, "crash.json");
+    CHECK(run_checker("crash.h5", "crash.json", "plain", NULL) == 0, "reopened file");
+    for (int i = 0; i < 5; i++) snapshot_free(snaps[i]);
+    run_end(&r);
+}
+
+static void test_result_reopen_clean_file_keeps_all(void)
+{
+    run r;
+    if (run_start(&r, 0, 1, 0, "clean.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        CHECK(result_close(r.file) == 0, "result_close");
+        char path[512];
+        tmp_path(path, sizeof path, "clean.h5");
+        r.file = result_reopen(path, r.model, &r.info, INT64_MAX, r.err, sizeof r.err);
+        CHECK(r.file != NULL, "result_reopen: %s", r.err);
+        if (r.file) {
+            CHECK(result_snapshot_count(r.file) == 3, "count %d", result_snapshot_count(r.file));
+            run_append(&r);
+            expect_save(r.expect, "clean.json");
+            CHECK(run_checker("clean.h5", "clean.json", "swmr", NULL) == 0, "reopened, swmr");
+        }
+    }
+    run_end(&r);
+}
+
+static void test_result_copy_opens_plainly(void)
+{
+    run r;
+    if (run_start(&r, 1, 1, 0, "live.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        expect_save(r.expect, "live.json");
+        char copy[512];
+        tmp_path(copy, sizeof copy, "copy.h5");
+        CHECK(result_copy(r.file, copy, r.err, sizeof r.err) == 0, "result_copy: %s", r.err);
+        CHECK(run_checker("copy.h5", "live.json", "plain", NULL) == 0, "copy, plain open");
+        /* The copy is a snapshot of the file, not a view of it. */
+        run_append(&r);
+        expect_save(r.expect, "live.json");
+        CHECK(run_checker("copy.h5", "live.json", "plain", "--count 3") == 0, "copy unchanged");
+        CHECK(result_copy(r.file, copy, r.err, sizeof r.err) == 0, "result_copy: %s", r.err);
+        CHECK(run_checker("copy.h5", "live.json", "plain", NULL) == 0, "second copy");
+        CHECK(access(strcat(copy, ".tmp"), F_OK) != 0, "temporary copy left behind");
+    }
+    run_end(&r);
+}
+
+static void test_result_minimal_fields_without_constraints(void)
+{
+    run r;
+    /* No constraints: /snapshots/constraint_force is (S, 0, 2). */
+    if (run_start(&r, 0, 0, CASE_FIELD_VELOCITY, "minimal.h5") == 0) {
+        for (int i = 0; i < 2; i++) run_append(&r);
+        expect_save(r.expect, "minimal.json");
+        CHECK(run_checker("minimal.h5", "minimal.json", "swmr", NULL) == 0, "minimal layout");
+        char xdmf[512];
+        tmp_path(xdmf, sizeof xdmf, "minimal.xdmf");
+        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
+              "xdmf_write: %s", r.err);
+    }
+    run_end(&r);
+}
+
+static void test_xdmf_matches_file(void)
+{
+    run r;
+    if (run_start(&r, 1, 1, 0, "result.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        expect_save(r.expect, "result.json");
+        char xdmf[512], extra[600];
+        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
+        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
+              "xdmf_write: %s", r.err);
+        snprintf(extra, sizeof extra, "'%s'", xdmf);
+        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf with stress");
+    }
+    run_end(&r);
+    /* Without position the geometry is the initial mesh. */
+    if (run_start(&r, 0, 0, CASE_FIELD_VELOCITY, "result.h5") == 0) {
+        for (int i = 0; i < 2; i++) run_append(&r);
+        expect_save(r.expect, "result.json");
+        char xdmf[512], extra[600];
+        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
+        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
+              "xdmf_write: %s", r.err);
+        snprintf(extra, sizeof extra, "'%s'", xdmf);
+        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf, position0");
+    }
+    run_end(&r);
+}
+
+static void test_result_bad_input_is_an_error(void)
+{
+    char err[512] = "";
+    run r;
+    if (run_start(&r, 1, 1, 0, "errors.h5") != 0) {
+        run_end(&r);
+        return;
+    }
+    CHECK(result_create("/nonexistent-dir/x.h5", r.model, &r.info, err, sizeof err) == NULL &&
+              strstr(err, "/nonexistent-dir/x.h5"), "create in a missing folder: %s", err);
+
+    /* A snapshot of another model, and one missing a stored field. */
+    fdem_model *other = fixture_model(0, 1, NULL);
+    snapshot *wrong = other ? snapshot_take(other, r.info.fields) : NULL;
+    CHECK(wrong && result_append(r.file, wrong, err, sizeof err) < 0 && strstr(err, "nodes"),
+          "snapshot of another model: %s", err);
+    snapshot *partial = snapshot_take(r.model, CASE_FIELD_POSITION);
+    CHECK(partial && result_append(r.file, partial, err, sizeof err) < 0 &&
+              strstr(err, "velocity"), "snapshot without velocity: %s", err);
+    CHECK(result_snapshot_count(r.file) == 0, "a rejected snapshot was counted");
+    run_append(&r); /* the file is still usable */
+    expect_save(r.expect, "errors.json");
+    CHECK(run_checker("errors.h5", "errors.json", "swmr", NULL) == 0, "after rejections");
+
+    char path[512];
+    tmp_path(path, sizeof path, "missing.h5");
+    CHECK(result_reopen(path, r.model, &r.info, 0, err, sizeof err) == NULL &&
+              strstr(err, "missing.h5"), "reopen a missing file: %s", err);
+    tmp_path(path, sizeof path, "foreign.h5");
+    hid_t foreign = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+    H5Fclose(foreign);
+    CHECK(result_reopen(path, r.model, &r.info, 0, err, sizeof err) == NULL &&
+              strstr(err, "not an fdem result"), "reopen a foreign file: %s", err);
+    CHECK(result_close(r.file) == 0, "close");
+    r.file = NULL;
+    tmp_path(path, sizeof path, "errors.h5");
+    CHECK(other && result_reopen(path, other, &r.info, 0, err, sizeof err) == NULL &&
+              strstr(err, "does not match"), "reopen with another model: %s", err);
+    snapshot_free(wrong);
+    snapshot_free(partial);
+    fdem_model_destroy(other);
+    run_end(&r);
+}
+
+static void setup(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/fdem-test-result-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        perror("mkdtemp");
+        exit(2);
+    }
+}
+
+static void teardown(void)
+{
+    char cmd[400];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", tmpdir);
+    if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", tmpdir);
+}
+
+/* CHECK_MAIN plus a scratch folder for the files, removed afterwards. */
+int main(int argc, char **argv)
+{
+    static const check_test tests[] = {
+        T(test_result_layout_and_swmr_reads), T(test_result_reader_follows_writer),
+        T(test_result_writer_stopped_mid_append), T(test_result_reopen_after_crash), T(test_result_reopen_clean_file_keeps_all),
+        T(test_result_copy_opens_plainly), T(test_result_minimal_fields_without_constraints),
+        T(test_xdmf_matches_file), T(test_result_bad_input_is_an_error),
+    };
+    setup();
+    int rc = check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
+    teardown();
+    return rc;
+}

@@ -1,0 +1,136 @@
+/*
+ * test_snapshot.c - snapshot_take() copies exactly what the engine reports
+ * at that step, only the requested fields, and never aliases engine memory.
+ */
+#include <stdlib.h>
+
+#include "check.h"
+#include "result_fixture.h"
+#include "snapshot.h"
+
+static int equal_doubles(const double *a, const double *b, size_t n)
+{
+    return a && b && memcmp(a, b, n * sizeof *a) == 0;
+}
+
+static void test_snapshot_copies_requested_fields(void)
+{
+    fdem_model *m = fixture_model(1, 1, NULL);
+    CHECK(m != NULL, "fixture model");
+    if (!m) return;
+    CHECK(fixture_step(m, 10) == 0, "stepping");
+    snapshot *s = snapshot_take(m, CASE_FIELD_POSITION | CASE_FIELD_VELOCITY);
+    CHECK(s != NULL, "snapshot_take");
+    if (s) {
+        fdem_counts c = fdem_get_counts(m);
+        CHECK(s->step == 10 && s->step == fdem_get_step(m), "step %lld", (long long)s->step);
+        CHECK(s->time == fdem_get_time(m), "time %g vs %g", s->time, fdem_get_time(m));
+        CHECK(s->nodes == c.nodes && s->elements == c.elements && s->joints == c.joints &&
+              s->constraints == 2, "counts");
+        CHECK(s->fields == (CASE_FIELD_POSITION | CASE_FIELD_VELOCITY), "fields %#x", s->fields);
+        CHECK(equal_doubles(s->position, fdem_positions(m), 2 * (size_t)c.nodes), "position");
+        CHECK(equal_doubles(s->velocity, fdem_velocities(m), 2 * (size_t)c.nodes), "velocity");
+        CHECK(s->stress == NULL, "stress was not requested");
+        CHECK(equal_doubles(s->constraint_force, fdem_constraint_forces(m), 4),
+              "constraint forces");
+        fdem_energy e = fdem_get_energy(m);
+        CHECK(s->energy.kinetic == e.kinetic && s->energy.elastic == e.elastic, "energies");
+        CHECK(s->energy.kinetic > 0, "gravity made the model move: kinetic %g", s->energy.kinetic);
+    }
+    snapshot_free(s);
+    fdem_model_destroy(m);
+}
+
+static void test_snapshot_is_a_copy(void)
+{
+    fdem_model *m = fixture_model(0, 0, NULL);
+    CHECK(m != NULL, "fixture model");
+    if (!m) return;
+    CHECK(fixture_step(m, 3) == 0, "stepping");
+    snapshot *s = snapshot_take(m, CASE_FIELD_POSITION);
+    CHECK(s != NULL, "snapshot_take");
+    if (s) {
+        size_t n = 2 * (size_t)s->nodes;
+        double *saved = malloc(n * sizeof *saved);
+        memcpy(saved, s->position, n * sizeof *saved);
+        CHECK(s->position != fdem_positions(m), "position aliases engine memory");
+        CHECK(fixture_step(m, 50) == 0, "stepping on");
+        /* The free-falling block has moved, the snapshot has not. */
+        CHECK(!equal_doubles(s->position, fdem_positions(m), n), "the model did not move");
+        CHECK(equal_doubles(s->position, saved, n), "the snapshot changed with the model");
+        free(saved);
+    }
+    snapshot_free(s);
+    fdem_model_destroy(m);
+}
+
+static void test_snapshot_stress_matches_engine(void)
+{
+    fdem_model *m = fixture_model(1, 1, NULL);
+    CHECK(m != NULL, "fixture model");
+    if (!m) return;
+    CHECK(fixture_step(m, 20) == 0, "stepping");
+    snapshot *s = snapshot_take(m, CASE_FIELD_STRESS | CASE_FIELD_DAMAGE);
+    CHECK(s != NULL, "snapshot_take");
+    if (s) {
+        size_t n = 3 * (size_t)s->elements;
+        double *want = malloc(n * sizeof *want);
+        fdem_element_stress(m, want);
+        CHECK(equal_doubles(s->stress, want, n), "stress differs from fdem_element_stress");
+        double largest = 0;
+        for (size_t i = 0; i < n; i++) largest = fmax(largest, fabs(want[i]));
+        CHECK(largest > 0, "the fixed block under gravity and load carries stress");
+        CHECK(s->position == NULL && s->velocity == NULL, "position/velocity not requested");
+        free(want);
+    }
+    snapshot_free(s);
+    fdem_model_destroy(m);
+}
+
+static void test_snapshot_damage_of_fracturing_model(void)
+{
+    fdem_model *m = fixture_model(1, 1, NULL);
+    CHECK(m != NULL, "fixture model");
+    if (!m) return;
+    fdem_counts c = fdem_get_counts(m);
+    CHECK(c.joints > 0, "a fracturing part must have joints, the model has %d", c.joints);
+    /* The result file needs damage of every fracturing model, so it is
+     * copied even when not requested; only the field bit says "asked for". */
+    snapshot *plain = snapshot_take(m, CASE_FIELD_POSITION);
+    snapshot *asked = snapshot_take(m, CASE_FIELD_DAMAGE);
+    CHECK(plain && asked, "snapshot_take");
+    if (plain && asked && c.joints > 0) {
+        CHECK(equal_doubles(plain->damage, fdem_joint_damage(m), (size_t)c.joints),
+              "damage copied though not requested");
+        CHECK(!(plain->fields & CASE_FIELD_DAMAGE), "damage bit set though not requested");
+        CHECK(equal_doubles(asked->damage, fdem_joint_damage(m), (size_t)c.joints), "damage");
+        CHECK(asked->fields == CASE_FIELD_DAMAGE, "fields %#x", asked->fields);
+        CHECK(asked->joints == c.joints, "joints %d", asked->joints);
+    }
+    snapshot_free(plain);
+    snapshot_free(asked);
+    fdem_model_destroy(m);
+}
+
+static void test_snapshot_without_joints_has_no_damage(void)
+{
+    fdem_model *m = fixture_model(0, 0, NULL);
+    CHECK(m != NULL, "fixture model");
+    if (!m) return;
+    snapshot *s = snapshot_take(m, CASE_FIELD_POSITION | CASE_FIELD_DAMAGE);
+    CHECK(s != NULL, "snapshot_take");
+    if (s) {
+        CHECK(s->joints == 0 && s->damage == NULL, "damage without joints");
+        CHECK(s->fields == CASE_FIELD_POSITION, "fields %#x claims damage", s->fields);
+        CHECK(s->constraints == 0 && s->constraint_force == NULL, "no constraints");
+        CHECK(s->step == 0 && s->time == 0, "first snapshot at t = 0");
+    }
+    snapshot_free(s);
+    CHECK(snapshot_take(NULL, CASE_FIELD_POSITION) == NULL, "NULL model");
+    snapshot_free(NULL);
+    fdem_model_destroy(m);
+}
+
+CHECK_MAIN(T(test_snapshot_copies_requested_fields), T(test_snapshot_is_a_copy),
+           T(test_snapshot_stress_matches_engine), T(test_snapshot_damage_of_fracturing_model),
+           T(test_snapshot_without_joints_has_no_damage))
