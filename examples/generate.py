@@ -127,12 +127,12 @@ dump("brazilian-disc", {
         {"name": "disc", "material": "rock", "fracture": True,
          "disc": {"center": [0, 0], "radius": 0.025, "divisions": 48}},
         {"name": "top", "material": "steel",
-         "rectangle": {"origin": [-0.01, 0.025], "size": [0.02, 0.005], "divisions": [4, 1]}},
+         "rectangle": {"origin": [-0.01, 0.02495], "size": [0.02, 0.005], "divisions": [4, 1]}},
         {"name": "bottom", "material": "steel",
-         "rectangle": {"origin": [-0.01, -0.03], "size": [0.02, 0.005], "divisions": [4, 1]}}],
+         "rectangle": {"origin": [-0.01, -0.02995], "size": [0.02, 0.005], "divisions": [4, 1]}}],
     "constraints": [{"part": "top", "velocity": [0, -0.05]},
                     {"part": "bottom", "velocity": [0, 0.05]}],
-    "time": {"end": 0.0003, "dt": "auto", "safety": 0.5},
+    "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
     "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
 dump("gmsh-plate", {
     "name": "gmsh-plate",
