@@ -24,15 +24,14 @@ sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import h5py  # noqa: E402
 from fdemd_client import Client, FdemdConnectionError, FdemdError  # noqa: E402
 
-FDEMD = os.path.join(ROOT, os.environ.get("FDEMD_BIN", "bin/fdemd"))
-FDEMCTL = os.path.join(ROOT, os.environ.get("FDEMCTL_BIN", "bin/fdemctl"))
+import fdemd_harness  # noqa: E402  (starts bin/fdemd on port 0, temp data dir)
+
+FDEMCTL = os.environ.get("FDEMCTL_BIN", "bin/fdemctl")
+if not os.path.isabs(FDEMCTL):
+    FDEMCTL = os.path.join(ROOT, FDEMCTL)
 PLOT = os.path.join(ROOT, "clients", "python", "plot_result.py")
 PYTHON = "/usr/bin/python3"
-
-try:
-    import fdemd_harness  # written with the server: starts bin/fdemd on port 0
-except ImportError:
-    fdemd_harness = None
+SLOW = fdemd_harness.SLOW     # sanitizer builds: every time limit scales
 
 MATERIAL = {"density": 2000, "young": 1e8, "poisson": 0.25}
 
@@ -56,7 +55,7 @@ def long_case(name="long"):
 
 
 def wait_for(predicate, timeout=10.0, interval=0.05):
-    deadline = time.monotonic() + timeout
+    deadline = time.monotonic() + timeout * SLOW
     while time.monotonic() < deadline:
         value = predicate()
         if value:
@@ -65,67 +64,33 @@ def wait_for(predicate, timeout=10.0, interval=0.05):
     return predicate()
 
 
-class Daemon:
-    """bin/fdemd on 127.0.0.1:0 with a temporary --data (harness if present)."""
-
-    def __init__(self, *extra):
-        self.tmp = tempfile.TemporaryDirectory(prefix="fdemd-clients-")
-        if fdemd_harness is not None:
-            self._h = fdemd_harness.Daemon(extra_args=list(extra), data_dir=self.tmp.name)
-            self.url = self._h.url
-            return
-        self._h = None
-        self.proc = subprocess.Popen(
-            [FDEMD, "--listen", "127.0.0.1:0", "--data", os.path.join(self.tmp.name, "data")]
-            + list(extra),
-            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-        line = self.proc.stdout.readline().strip()
-        if not line.startswith("listening on "):
-            self.proc.kill()
-            raise RuntimeError("fdemd did not say where it listens: %r" % line)
-        self.url = "http://" + line[len("listening on "):]
-
-    def close(self):
-        if self._h is not None:
-            self._h.stop()
-        else:
-            self.proc.terminate()
-            try:
-                self.proc.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-            self.proc.stdout.close()
-        self.tmp.cleanup()
-
-
 class ClientTestCase(unittest.TestCase):
     """One daemon per test class; helpers to run fdemctl against it."""
 
-    daemon_args = ()
-    token = None
+    token = None     # the daemon's --token, and what the clients send
 
     @classmethod
     def setUpClass(cls):
-        cls.daemon = Daemon(*cls.daemon_args)
-        cls.client = Client(cls.daemon.url, token=cls.token)
+        cls.daemon = fdemd_harness.Daemon(token=cls.token).start()
+        cls.url = "http://127.0.0.1:%d" % cls.daemon.port
+        cls.client = Client(cls.url, token=cls.token)
         cls.work = tempfile.TemporaryDirectory(prefix="fdemctl-work-")
 
     @classmethod
     def tearDownClass(cls):
+        cls.daemon.stop()
         cls.daemon.close()
         cls.work.cleanup()
 
     def ctl(self, *args, stdin=None, token=None, server=None, timeout=30):
         env = dict(os.environ)
-        env.pop("FDEMD_URL", None)
         env.pop("FDEMD_TOKEN", None)
-        env["FDEMD_URL"] = server or self.daemon.url
+        env["FDEMD_URL"] = server or self.url
         token = token if token is not None else self.token
         if token:
             env["FDEMD_TOKEN"] = token
         return subprocess.run([FDEMCTL] + list(args), input=stdin, capture_output=True,
-                              text=True, env=env, cwd=self.work.name, timeout=timeout)
+                              text=True, env=env, cwd=self.work.name, timeout=timeout * SLOW)
 
     def write_case(self, doc, name="case.json"):
         path = os.path.join(self.work.name, name)
@@ -285,7 +250,7 @@ class FdemctlTests(ClientTestCase):
         self.assertEqual(r.returncode, 2)
 
     def test_server_option_overrides_environment(self):
-        r = self.ctl("--server", self.daemon.url, "list", server="http://127.0.0.1:9")
+        r = self.ctl("--server", self.url, "list", server="http://127.0.0.1:9")
         self.assertEqual(r.returncode, 0, r.stderr)
 
     def test_state_prints_the_fields(self):
@@ -327,7 +292,6 @@ class FdemctlTests(ClientTestCase):
 
 
 class TokenTests(ClientTestCase):
-    daemon_args = ("--token", "s3cret")
     token = "s3cret"
 
     def test_fdemctl_sends_the_token(self):
@@ -342,12 +306,12 @@ class TokenTests(ClientTestCase):
             self.assertIn("401", r.stderr)
 
     def test_health_needs_no_token(self):
-        self.assertEqual(Client(self.daemon.url, token="").health()["status"], "ok")
+        self.assertEqual(Client(self.url, token="").health()["status"], "ok")
 
     def test_python_client_token(self):
         self.assertIsInstance(self.client.list(), list)
         with self.assertRaises(FdemdError) as e:
-            Client(self.daemon.url, token="wrong").list()
+            Client(self.url, token="wrong").list()
         self.assertEqual(e.exception.status, 401)
 
 
@@ -358,7 +322,7 @@ class PythonClientTests(ClientTestCase):
         self.assertEqual(self.client.status(case_id)["state"], "created")
         self.assertEqual(self.client.start(case_id)["state"], "running")
         seen = []
-        final = self.client.wait(case_id, callback=seen.append, interval=0.05)
+        final = self.client.wait(case_id, callback=seen.append, interval=0.05, timeout=30 * SLOW)
         self.assertEqual(final["state"], "finished")
         self.assertGreaterEqual(len(seen), 1)
         self.assertIs(seen[-1], final)
@@ -372,7 +336,7 @@ class PythonClientTests(ClientTestCase):
 
     def test_submit_from_path_with_start(self):
         case_id = self.client.submit(self.write_case(quick_case("py-path"), "p.json"), start=True)
-        self.assertEqual(self.client.wait(case_id, interval=0.05)["state"], "finished")
+        self.assertEqual(self.client.wait(case_id, interval=0.05, timeout=30 * SLOW)["state"], "finished")
         ids = [c["id"] for c in self.client.list()]
         self.assertIn(case_id, ids)
         self.assertEqual(self.client.case(case_id)["name"], "py-path")
@@ -390,9 +354,9 @@ class PythonClientTests(ClientTestCase):
     def test_wait_raises_on_a_stopped_case_when_asked(self):
         case_id = self.client.submit(long_case("py-stop"), start=True)
         self.assertEqual(self.client.stop(case_id)["state"], "stopped")
-        self.assertEqual(self.client.wait(case_id)["state"], "stopped")
+        self.assertEqual(self.client.wait(case_id, timeout=30 * SLOW)["state"], "stopped")
         with self.assertRaises(FdemdError) as e:
-            self.client.wait(case_id, raise_on_failure=True)
+            self.client.wait(case_id, raise_on_failure=True, timeout=30 * SLOW)
         self.assertEqual(e.exception.case_status["state"], "stopped")
         self.client.delete(case_id)
         with self.assertRaises(FdemdError) as e:
@@ -401,7 +365,7 @@ class PythonClientTests(ClientTestCase):
 
     def test_state_fields(self):
         case_id = self.client.submit(quick_case("py-state"), start=True)
-        self.client.wait(case_id, interval=0.05)
+        self.client.wait(case_id, interval=0.05, timeout=30 * SLOW)
         state = self.client.state(case_id, ["position", "stress"])
         self.assertEqual(len(state["position"]), 9)
         self.assertEqual(len(state["stress"]), 8)
@@ -419,13 +383,13 @@ class PlotTests(ClientTestCase):
     def setUp(self):
         if not hasattr(PlotTests, "h5"):
             case_id = self.client.submit(quick_case("plotted"), start=True)
-            self.client.wait(case_id, interval=0.05)
+            self.client.wait(case_id, interval=0.05, timeout=30 * SLOW)
             PlotTests.h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "plot.h5"))
 
     def plot(self, *args):
         png = os.path.join(self.work.name, "out-%d.png" % len(os.listdir(self.work.name)))
         r = subprocess.run([PYTHON, PLOT, self.h5, "-o", png] + list(args),
-                           capture_output=True, text=True, timeout=60)
+                           capture_output=True, text=True, timeout=60 * SLOW)
         return r, png
 
     def assert_png(self, r, png):
