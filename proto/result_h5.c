@@ -755,7 +755,7 @@ static int copy_bytes(const char *src, int out, char *err, size_t errlen)
         snprintf(err, errlen, "cannot read %s: %s", src, strerror(errno));
         return -1;
     }
-    static char buffer[1 << 16]; /* one I/O thread: a static buffer is safe */
+    char buffer[1 << 16];
     int rc = 0;
     for (;;) {
         ssize_t n = read(in, buffer, sizeof buffer);
