@@ -81,6 +81,23 @@ static char *read_all(const char *path, size_t *length)
     return data;
 }
 
+/* GETs /cases/ID<suffix> (JSON) and copies it to stdout byte for byte. */
+static int print_case_json(const ctl_options *o, const char *id, const char *suffix)
+{
+    char path[1024];
+    if (http_case_path(path, sizeof path, id, suffix) != 0) {
+        fprintf(stderr, "fdemctl: case id or field list too long\n");
+        return CTL_USAGE;
+    }
+    http_response r;
+    int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
+    if (code) return code;
+    fwrite(r.body, 1, r.length, stdout);
+    if (r.length == 0 || r.body[r.length - 1] != '\n') fputc('\n', stdout);
+    http_response_free(&r);
+    return CTL_OK;
+}
+
 /* ----------------------------------------------------------------- health */
 
 static const char USAGE_HEALTH[] =
@@ -188,7 +205,7 @@ int cmd_list(const ctl_options *o, int argc, char **argv)
 static const char USAGE_STATUS[] =
     "usage: fdemctl status ID [--json]\n"
     "  Shows the progress and figures of one case.\n"
-    "  --json    print the server's status object as is\n";
+    "  --json    print the server's status object exactly as it was sent\n";
 
 static void status_print_energy(json_t *energy)
 {
@@ -255,15 +272,11 @@ int cmd_status(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--json", NULL, NULL, &raw}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_STATUS, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    if (raw) return print_case_json(o, id[0], NULL);
     int code;
     json_t *s = ctl_get_status(o, id[0], &code);
     if (!s) return code;
-    if (raw) {
-        json_dumpf(s, stdout, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(17));
-        printf("\n");
-    } else {
-        status_print_table(s);
-    }
+    status_print_table(s);
     json_decref(s);
     return CTL_OK;
 }
@@ -326,23 +339,6 @@ int cmd_delete(const ctl_options *o, int argc, char **argv)
 
 /* -------------------------------------------------------- case and state */
 
-/* GETs a JSON document under /cases/ID and copies it to stdout unchanged. */
-static int print_case_document(const ctl_options *o, const char *id, const char *suffix)
-{
-    char path[1024];
-    if (http_case_path(path, sizeof path, id, suffix) != 0) {
-        fprintf(stderr, "fdemctl: case id or field list too long\n");
-        return CTL_USAGE;
-    }
-    http_response r;
-    int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
-    if (code) return code;
-    fwrite(r.body, 1, r.length, stdout);
-    if (r.length == 0 || r.body[r.length - 1] != '\n') fputc('\n', stdout);
-    http_response_free(&r);
-    return CTL_OK;
-}
-
 static const char USAGE_CASE[] =
     "usage: fdemctl case ID\n"
     "  Prints the case document exactly as it was uploaded.\n";
@@ -353,7 +349,7 @@ int cmd_case(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_CASE, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
-    return print_case_document(o, id[0], "/case");
+    return print_case_json(o, id[0], "/case");
 }
 
 static const char USAGE_STATE[] =
@@ -379,5 +375,5 @@ int cmd_state(const ctl_options *o, int argc, char **argv)
         }
         snprintf(suffix, sizeof suffix, "/state?fields=%.400s", fields);
     }
-    return print_case_document(o, id[0], suffix);
+    return print_case_json(o, id[0], suffix);
 }
