@@ -405,6 +405,21 @@ class PlotTests(ClientTestCase):
     def test_velocity_plot_of_the_first_snapshot(self):
         self.assert_png(*self.plot("--field", "velocity", "--snapshot", "0"))
 
+    def test_plot_reads_a_file_the_daemon_is_still_writing(self):
+        doc = long_case("live")
+        doc["output"]["interval"] = 0.005
+        case_id = self.client.submit(doc, start=True)
+        try:
+            self.assertTrue(wait_for(lambda: self.client.status(case_id)["snapshots"] >= 3))
+            live = os.path.join(self.daemon.data_dir, case_id, "result.h5")
+            self.assertTrue(os.path.exists(live), live)
+            png = os.path.join(self.work.name, "live.png")
+            r = subprocess.run([PYTHON, PLOT, live, "-o", png, "--field", "velocity"],
+                               capture_output=True, text=True, timeout=60 * SLOW)
+            self.assert_png(r, png)
+        finally:
+            self.client.delete(case_id)
+
     def test_damage_without_joints_is_a_clear_error(self):
         r, png = self.plot("--field", "damage")
         self.assertNotEqual(r.returncode, 0)
