@@ -103,9 +103,15 @@ static int fetch_save(const char *path, const char *data, size_t length)
     char part[4096];
     snprintf(part, sizeof part, "%s.part", path);
     FILE *f = fopen(part, "wb");
-    if (!f || fwrite(data, 1, length, f) != length || fclose(f) != 0 || rename(part, path) != 0) {
+    if (!f) {
+        fprintf(stderr, "fdemctl: cannot write %s: %s\n", part, strerror(errno));
+        return CTL_FAIL;
+    }
+    int failed = fwrite(data, 1, length, f) != length;
+    failed |= fclose(f) != 0;
+    if (failed || rename(part, path) != 0) {
         fprintf(stderr, "fdemctl: cannot write %s: %s\n", path, strerror(errno));
-        if (f) remove(part);
+        remove(part);
         return CTL_FAIL;
     }
     return CTL_OK;
