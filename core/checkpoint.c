@@ -88,6 +88,9 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     m->damping_work = h.damping_work;
     m->external_work = h.external_work;
     m->contact.need_detect = 1;
+    m->broken_joints = 0;
+    for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
+    if (m->joint_count) m->fragments = joint_fragment_count(m);
     /* Forces and elastic energy are those of the restored positions. */
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     element_forces(m, 0);

@@ -235,6 +235,16 @@ static int contact_detect(fdem_model *m)
     }
     if (nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs))
         return -1;
+    if (m->joint_count) { /* triangles held by an intact joint never contact */
+        size_t kept = 0;
+        for (size_t k = 0; k < cs->pairs.count; k++) {
+            if (joint_holds(m, cs->pairs.a[k], cs->pairs.b[k])) continue;
+            cs->pairs.a[kept] = cs->pairs.a[k];
+            cs->pairs.b[kept] = cs->pairs.b[k];
+            kept++;
+        }
+        cs->pairs.count = kept;
+    }
     memcpy(cs->pos_detect, m->pos, sizeof(double) * 2 * (size_t)m->node_count);
     cs->max_disp2 = 0;
     cs->need_detect = 0;
@@ -305,8 +315,13 @@ int contact_forces(fdem_model *m, double havg)
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
     double half = 0.5 * cs->buffer;
-    if (cs->need_detect || cs->max_disp2 > half * half)
+    if (cs->need_detect || cs->max_disp2 > half * half) {
+        double t0 = stage_clock();
         if (contact_detect(m)) return -1;
+        double spent = stage_clock() - t0;
+        m->times.detection += spent;
+        m->times.contact -= spent; /* the caller books the whole call as contact */
+    }
     memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     int touching = 0;
     for (size_t k = 0; k < cs->pairs.count; k++)

@@ -178,6 +178,7 @@ typedef struct fdem_energy {
 typedef struct fdem_counts {
     int nodes, elements, parts, materials, constraints;
     int joints, broken_joints;
+    int fragments;     /* connected pieces through intact joints (parts count as one each) */
     int contacts;      /* candidate pairs currently in contact (non-zero force) */
     int contact_pairs; /* candidate pairs from the last detection */
     long detections;   /* how many times detection ran */
@@ -224,6 +225,17 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 /* Fails (with a message) if the buffer does not belong to a model of the
  * same shape (node/element/joint counts). */
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
+
+/* Seconds spent in each stage of fdem_step() since the model was built
+ * (wall clock, for benchmarks and the status' figures). */
+typedef struct fdem_stage_times {
+    double elements;    /* internal forces, stress, damping */
+    double detection;   /* NBS runs */
+    double contact;     /* pair forces */
+    double integration; /* central difference update and constraints */
+} fdem_stage_times;
+
+fdem_stage_times fdem_get_stage_times(const fdem_model *model);
 
 /* Bytes the engine holds for this model (for memory limits and bench). */
 size_t fdem_memory_bytes(const fdem_model *model);

@@ -13,6 +13,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 #include "model.h"
 
@@ -64,6 +65,15 @@ int central_difference_step(fdem_model *m, double h, double havg)
     return isfinite(check) ? 0 : -1;
 }
 
+double stage_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+fdem_stage_times fdem_get_stage_times(const fdem_model *m) { return m->times; }
+
 /* Names the first node whose state is not finite and an element that uses it. */
 static void report_non_finite(fdem_model *m, double h, fdem_error *err)
 {
@@ -87,16 +97,30 @@ int fdem_step(fdem_model *m, fdem_error *err)
         return -1;
     }
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
+    double t0 = stage_clock();
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     element_forces(m, h);
+    if (m->joint_count) {
+        int broke = joint_forces(m);
+        if (broke) {
+            m->broken_joints += broke;
+            m->fragments = joint_fragment_count(m);
+            m->contact.need_detect = 1; /* the freed faces must meet through contact */
+        }
+    }
+    double t1 = stage_clock();
+    m->times.elements += t1 - t0;
     if (contact_forces(m, havg)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory in contact detection at step %lld",
                     (long long)m->step + 1);
         return -1;
     }
+    double t2 = stage_clock();
     constraint_apply_forces(m);
     int bad = central_difference_step(m, h, havg);
     constraint_enforce(m, h, havg);
+    m->times.integration += stage_clock() - t2;
+    m->times.contact += t2 - t1; /* detection time is moved out in contact_forces */
     if (bad || !isfinite(m->elastic_energy)) {
         report_non_finite(m, h, err);
         return -1;

@@ -57,7 +57,8 @@ void fdem_model_destroy(fdem_model *m)
     free(m->elem); free(m->elem_part); free(m->tri); free(m->elem_h);
     free(m->materials); free(m->parts); free(m->part_velocity);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
-    free(m->joint_node); free(m->joint_damage);
+    free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
+    free(m->elem_joint);
     contact_free(&m->contact);
     free(m);
 }
@@ -226,8 +227,9 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
     m->node_count += add_nodes;
     m->elem_count += copy.triangle_count;
     m->part_count++;
+    int failed = fracture && joint_build_part(m, k, copy.tri, copy.triangle_count, err);
     fdem_mesh_free(&copy);
-    return k;
+    return failed ? -1 : k;
 }
 
 int fdem_set_part_velocity(fdem_model *m, int part_index, double vx, double vy, fdem_error *err)
@@ -325,6 +327,8 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     }
     for (int e = 0; e < m->elem_count; e++) element_prepare(m, e);
     lump_masses(m);
+    if (joint_prepare(m, err)) return -1;
+    m->fragments = joint_fragment_count(m);
     if (constraint_select(m, err)) return -1;
     if (contact_init(m, err)) return -1;
 
@@ -333,8 +337,8 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         double de = element_stable_dt(m, e);
         if (de < dt) dt = de;
     }
-    double dc = contact_stable_dt(m);
-    m->stable_dt = dc < dt ? dc : dt;
+    dt = fmin(dt, contact_stable_dt(m));
+    m->stable_dt = fmin(dt, joint_stable_dt(m));
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;
@@ -358,7 +362,8 @@ fdem_counts fdem_get_counts(const fdem_model *m)
     c.materials = m->material_count;
     c.constraints = m->constraint_count;
     c.joints = m->joint_count;
-    for (int j = 0; j < m->joint_count; j++) c.broken_joints += m->joint_damage[j] >= 1.0;
+    c.broken_joints = m->broken_joints;
+    c.fragments = m->fragments;
     c.contacts = m->contact.touching;
     c.contact_pairs = (int)m->contact.pairs.count;
     c.detections = m->contact.detections;
@@ -436,7 +441,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     if (m->contact.enabled)
         b += (size_t)m->elem_count * (3 * sizeof(double) + sizeof(int32_t)) +
              nbs_memory_bytes(&m->contact.grid, &m->contact.pairs);
-    b += (size_t)m->joint_count * (4 * sizeof(int32_t) + sizeof(double));
+    b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
+    if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
     return b;
 }

@@ -94,8 +94,13 @@ struct fdem_model {
 
     /* joints (fracture); joint_count == 0 when no part fractures */
     int joint_count;
-    int32_t *joint_node;     /* 4 per joint */
-    double *joint_damage;
+    int32_t *joint_node;     /* 4 per joint: a0, a1 (face A), b0, b1 (their copies in B) */
+    int32_t *joint_elem;     /* 2 per joint: elements A and B */
+    double *joint_h;         /* smaller size of the two elements: sets the stiffness */
+    double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
+    int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */
+    int broken_joints;
+    int fragments;
 
     double gravity[2];
     double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
@@ -110,7 +115,10 @@ struct fdem_model {
     double external_work;
 
     contact_state contact;
+    fdem_stage_times times;
 };
+
+double stage_clock(void);
 
 /* element.c */
 void element_prepare(fdem_model *m, int e);
@@ -129,6 +137,16 @@ int contact_forces(fdem_model *m, double havg);
 int constraint_select(fdem_model *m, fdem_error *err);
 void constraint_apply_forces(fdem_model *m);
 void constraint_enforce(fdem_model *m, double h, double havg);
+
+/* joint.c */
+double joint_softening(double D);
+int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
+                     fdem_error *err);
+int joint_prepare(fdem_model *m, fdem_error *err);
+double joint_stable_dt(const fdem_model *m);
+int joint_holds(const fdem_model *m, int a, int b);
+int joint_forces(fdem_model *m);
+int joint_fragment_count(const fdem_model *m);
 
 /* integrator.c */
 int central_difference_step(fdem_model *m, double h, double havg);

@@ -1,0 +1,302 @@
+/*
+ * joint.c - the transition from continuum to discontinuum: four-noded joint
+ * (cohesive) elements on every interior edge of a fracturing part, their
+ * traction-separation law, breakage, and fragment counting.
+ *
+ * Kinematics. A joint joins face A (nodes a0 -> a1, in A's counter-clockwise
+ * order) to face B (b0, b1: the copies of a0, a1 in the neighbour). At two
+ * Gauss points along the edge, the relative displacement of B against A
+ * gives the opening delta (along n, A's outward normal) and the sliding s
+ * (along the edge), both in the current configuration.
+ *
+ * Law (Munjiza 2004 ch. 7, as in Y-Geo). Penalty-elastic up to the
+ * strength: sigma = p delta / h, tau = p s / h (h the smaller adjacent
+ * element size, p the material penalty), up to the tensile strength f_t and
+ * the shear strength f_s = cohesion + sigma_c tan(phi) (sigma_c the
+ * compressive normal stress). Past the elastic limits delta_p, s_p the
+ * traction softens as f z(D), Munjiza's curve with a = 0.63, b = 1.8,
+ * c = 6, where D = sqrt(Dn^2 + Ds^2) combines the opening and sliding
+ * beyond their limits over the softening spans delta_c - delta_p, with
+ * delta_c = 3 G_I / f_t (and s_c = 3 G_II / f_s): the mixed-mode criterion
+ * (delta/delta_c)^2 + (s/s_c)^2 >= 1 is D >= 1. D never decreases (damage
+ * is irreversible); at D = 1 the joint is broken, exerts nothing, and its
+ * two triangles meet through contact from then on. Compression is resisted
+ * by the joint's penalty while it holds.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+#define Z_A 0.63
+#define Z_B 1.8
+#define Z_C 6.0
+
+double joint_softening(double D)
+{
+    if (D <= 0) return 1.0;
+    if (D >= 1) return 0.0;
+    double ab = Z_A + Z_B;
+    double e = exp(D * (Z_A + Z_C * Z_B) / (ab * (1 - ab)));
+    return (1 - (ab - 1) / ab * e) * (Z_A * (1 - D) + Z_B * pow(1 - D, Z_C));
+}
+
+/* ------------------------------------------------------------ building */
+
+typedef struct edge_ref {
+    int32_t lo, hi;   /* original node ids, lo < hi */
+    int32_t tri;      /* triangle within the part */
+    int32_t corner;   /* the edge runs from corner to corner+1 (ccw) */
+} edge_ref;
+
+static int edge_compare(const void *pa, const void *pb)
+{
+    const edge_ref *a = pa, *b = pb;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    if (a->hi != b->hi) return a->hi < b->hi ? -1 : 1;
+    return a->tri < b->tri ? -1 : a->tri > b->tri;
+}
+
+/* Adds a joint on every edge shared by two triangles of the fracturing part
+ * whose elements start at elem_begin; tri holds the part's original
+ * (validated, counter-clockwise) connectivity. */
+int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
+                     fdem_error *err)
+{
+    size_t ne = 3 * (size_t)triangle_count;
+    edge_ref *edges = malloc(sizeof *edges * ne);
+    if (!edges) {
+        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+        return -1;
+    }
+    for (int t = 0; t < triangle_count; t++)
+        for (int c = 0; c < 3; c++) {
+            int32_t p = tri[3 * t + c], q = tri[3 * t + (c + 1) % 3];
+            edge_ref *e = &edges[3 * (size_t)t + c];
+            e->lo = p < q ? p : q;
+            e->hi = p < q ? q : p;
+            e->tri = t;
+            e->corner = c;
+        }
+    qsort(edges, ne, sizeof *edges, edge_compare);
+    int shared = 0;
+    for (size_t k = 0; k + 1 < ne; k++)
+        if (edges[k].lo == edges[k + 1].lo && edges[k].hi == edges[k + 1].hi) shared++;
+
+    int J0 = m->joint_count, J = J0 + shared;
+    int32_t *jn = realloc(m->joint_node, sizeof(int32_t) * 4 * (size_t)(J ? J : 1));
+    if (jn) m->joint_node = jn;
+    int32_t *je = realloc(m->joint_elem, sizeof(int32_t) * 2 * (size_t)(J ? J : 1));
+    if (je) m->joint_elem = je;
+    if (!jn || !je) {
+        free(edges);
+        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+        return -1;
+    }
+    const part *p = &m->parts[part_index];
+    int j = J0;
+    for (size_t k = 0; k + 1 < ne; k++) {
+        const edge_ref *a = &edges[k], *b = &edges[k + 1];
+        if (a->lo != b->lo || a->hi != b->hi) continue;
+        if (k + 2 < ne && edges[k + 2].lo == a->lo && edges[k + 2].hi == a->hi) {
+            int lo = a->lo, hi = a->hi;
+            free(edges);
+            model_error(err, FDEM_ITEM_PART, part_index,
+                        "edge %d-%d of part %d is shared by more than two triangles", lo, hi,
+                        part_index);
+            return -1;
+        }
+        int ea = p->elem_begin + a->tri, eb = p->elem_begin + b->tri;
+        /* face A runs a0 -> a1 counter-clockwise in A; b0, b1 are the
+         * neighbour's copies of the same two original nodes */
+        int32_t a0 = m->elem[ea].node[a->corner], a1 = m->elem[ea].node[(a->corner + 1) % 3];
+        int32_t orig_a0 = tri[3 * a->tri + a->corner];
+        int32_t b_first = m->elem[eb].node[b->corner], b_second = m->elem[eb].node[(b->corner + 1) % 3];
+        int32_t orig_b_first = tri[3 * b->tri + b->corner];
+        int32_t b0 = orig_b_first == orig_a0 ? b_first : b_second;
+        int32_t b1 = orig_b_first == orig_a0 ? b_second : b_first;
+        m->joint_node[4 * j] = a0;
+        m->joint_node[4 * j + 1] = a1;
+        m->joint_node[4 * j + 2] = b0;
+        m->joint_node[4 * j + 3] = b1;
+        m->joint_elem[2 * j] = ea;
+        m->joint_elem[2 * j + 1] = eb;
+        j++;
+        k++;
+    }
+    m->joint_count = J;
+    free(edges);
+    return 0;
+}
+
+/* Per-joint data derived at finalize: stiffness length, element map. */
+int joint_prepare(fdem_model *m, fdem_error *err)
+{
+    if (!m->joint_count) return 0;
+    size_t J = (size_t)m->joint_count;
+    m->joint_damage = calloc(J, sizeof(double));
+    m->joint_h = malloc(sizeof(double) * J);
+    m->elem_joint = malloc(sizeof(int32_t) * 3 * (size_t)m->elem_count);
+    if (!m->joint_damage || !m->joint_h || !m->elem_joint) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
+        return -1;
+    }
+    for (int k = 0; k < 3 * m->elem_count; k++) m->elem_joint[k] = -1;
+    for (int j = 0; j < m->joint_count; j++) {
+        int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
+        m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
+        for (int s = 0; s < 2; s++) {
+            int e = m->joint_elem[2 * j + s];
+            for (int c = 0; c < 3; c++)
+                if (m->elem_joint[3 * e + c] < 0) {
+                    m->elem_joint[3 * e + c] = j;
+                    break;
+                }
+        }
+    }
+    return 0;
+}
+
+/* Joint springs in series with the element: each face node feels about
+ * p L / (2h) from one joint and sits on two joints, against its own mass. */
+double joint_stable_dt(const fdem_model *m)
+{
+    double dt = INFINITY;
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *n = m->joint_node + 4 * j;
+        double mass = fmin(fmin(m->mass[n[0]], m->mass[n[1]]), fmin(m->mass[n[2]], m->mass[n[3]]));
+        const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
+        double L = hypot(m->pos0[2 * n[1]] - m->pos0[2 * n[0]], m->pos0[2 * n[1] + 1] - m->pos0[2 * n[0] + 1]);
+        double k = 2 * mat->penalty * L / m->joint_h[j]; /* two joints, both faces */
+        dt = fmin(dt, 0.9 * 2 * sqrt(mass / (2 * k)));
+    }
+    return dt;
+}
+
+/* True while an intact joint holds elements a and b together. */
+int joint_holds(const fdem_model *m, int a, int b)
+{
+    if (!m->joint_count) return 0;
+    for (int c = 0; c < 3; c++) {
+        int j = m->elem_joint[3 * a + c];
+        if (j < 0) continue;
+        int other = m->joint_elem[2 * j] == a ? m->joint_elem[2 * j + 1] : m->joint_elem[2 * j];
+        if (other == b && m->joint_damage[j] < 1.0) return 1;
+    }
+    return 0;
+}
+
+/* --------------------------------------------------------------- forces */
+
+typedef struct joint_law {
+    double penalty_over_h;   /* p / h */
+    double ft, cohesion, tan_phi, gI, gII;
+} joint_law;
+
+/* Tractions at one Gauss point from opening and sliding; updates the
+ * joint's damage (never downwards). */
+static void joint_traction(const joint_law *law, double delta, double slide, double *damage,
+                           double *sigma, double *tau)
+{
+    double k = law->penalty_over_h;
+    double sigma_elastic = k * delta;
+    double compression = delta < 0 ? -sigma_elastic : 0;
+    double fs = law->cohesion + compression * law->tan_phi;
+    double dp = law->ft / k, sp = fs / k;
+    double dc = fmax(3 * law->gI / law->ft, 2 * dp), sc = fmax(3 * law->gII / fs, 2 * sp);
+    double dn = delta > dp ? (delta - dp) / (dc - dp) : 0;
+    double ds = fabs(slide) > sp ? (fabs(slide) - sp) / (sc - sp) : 0;
+    double D = sqrt(dn * dn + ds * ds);
+    if (D > *damage) *damage = D > 1 ? 1 : D;
+    double z = joint_softening(*damage);
+    if (delta < 0) *sigma = sigma_elastic; /* compression: the joint's penalty */
+    else *sigma = law->ft * fmin(delta / dp, 1.0) * z;
+    double r = slide / sp;
+    *tau = fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
+}
+
+/* Adds the forces of every intact joint to m->force. Returns the number of
+ * joints that broke in this call. */
+int joint_forces(fdem_model *m)
+{
+    static const double gauss[2] = {0.21132486540518713, 0.78867513459481287};
+    const double *x = m->pos;
+    double *f = m->force;
+    int broke = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        if (m->joint_damage[j] >= 1.0) continue;
+        const int32_t *n = m->joint_node + 4 * j;
+        const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
+        const fdem_fracture_params *fp = &mat->def.fracture;
+        joint_law law = {mat->penalty / m->joint_h[j], fp->tensile_strength, fp->cohesion,
+                         tan(fp->friction_angle * M_PI / 180), fp->energy_I, fp->energy_II};
+        double ax0 = x[2 * n[0]], ay0 = x[2 * n[0] + 1], ax1 = x[2 * n[1]], ay1 = x[2 * n[1] + 1];
+        double bx0 = x[2 * n[2]], by0 = x[2 * n[2] + 1], bx1 = x[2 * n[3]], by1 = x[2 * n[3] + 1];
+        double tx = 0.5 * ((ax1 - ax0) + (bx1 - bx0)), ty = 0.5 * ((ay1 - ay0) + (by1 - by0));
+        double L = hypot(tx, ty);
+        if (!(L > 0)) continue;
+        tx /= L;
+        ty /= L;
+        double nx = ty, ny = -tx; /* A's outward normal */
+        double damage = m->joint_damage[j];
+        double fa0x = 0, fa0y = 0, fa1x = 0, fa1y = 0;
+        for (int g = 0; g < 2; g++) {
+            double xi = gauss[g];
+            double dx = ((1 - xi) * bx0 + xi * bx1) - ((1 - xi) * ax0 + xi * ax1);
+            double dy = ((1 - xi) * by0 + xi * by1) - ((1 - xi) * ay0 + xi * ay1);
+            double sigma, tau;
+            joint_traction(&law, dx * nx + dy * ny, dx * tx + dy * ty, &damage, &sigma, &tau);
+            double w = 0.5 * L;
+            double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
+            fa0x += (1 - xi) * Tx; fa0y += (1 - xi) * Ty;
+            fa1x += xi * Tx;       fa1y += xi * Ty;
+        }
+        if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
+            m->joint_damage[j] = 1.0;
+            broke++;
+            continue;
+        }
+        m->joint_damage[j] = damage;
+        f[2 * n[0]] += fa0x; f[2 * n[0] + 1] += fa0y;
+        f[2 * n[1]] += fa1x; f[2 * n[1] + 1] += fa1y;
+        f[2 * n[2]] -= fa0x; f[2 * n[2] + 1] -= fa0y;
+        f[2 * n[3]] -= fa1x; f[2 * n[3] + 1] -= fa1y;
+    }
+    return broke;
+}
+
+/* ------------------------------------------------------------ fragments */
+
+static int uf_find(int32_t *parent, int i)
+{
+    while (parent[i] != i) {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    return i;
+}
+
+/* Connected pieces: elements joined by intact joints (a part that does not
+ * fracture is one piece). Returns -1 on allocation failure. */
+int joint_fragment_count(const fdem_model *m)
+{
+    int32_t *parent = malloc(sizeof(int32_t) * (size_t)(m->elem_count ? m->elem_count : 1));
+    if (!parent) return -1;
+    for (int e = 0; e < m->elem_count; e++) {
+        int p = m->elem_part[e];
+        parent[e] = m->parts[p].fracture ? e : m->parts[p].elem_begin;
+    }
+    for (int j = 0; j < m->joint_count; j++) {
+        if (m->joint_damage[j] >= 1.0) continue;
+        int a = uf_find(parent, m->joint_elem[2 * j]), b = uf_find(parent, m->joint_elem[2 * j + 1]);
+        if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+    }
+    int count = 0;
+    for (int e = 0; e < m->elem_count; e++) count += uf_find(parent, e) == e;
+    free(parent);
+    return count;
+}

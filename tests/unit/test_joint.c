@@ -1,0 +1,229 @@
+/*
+ * test_joint.c - joint (cohesive) elements against the numbers their law
+ * implies: the energy one joint absorbs when pulled apart in pure mode I or
+ * sheared in pure mode II (strength x softening span x integral of z(D)),
+ * breakage and fragment counting, no contact across an intact joint, and an
+ * intact fracturing bar vibrating like a continuous one (period 4L/c).
+ */
+#include "build_model.h"
+#include "check.h"
+#include "model.h"
+
+static int fracture_material(fdem_model *m, double penalty_factor)
+{
+    fdem_material_def d = {0};
+    d.density = 2700;
+    d.young = 3e10;
+    d.poisson = 0.0;
+    d.penalty = penalty_factor * d.young;
+    d.has_fracture = 1;
+    d.fracture = (fdem_fracture_params){1e6, 3e6, 30, 10, 50};
+    fdem_error err;
+    int k = fdem_add_material(m, &d, &err);
+    if (k < 0) build_die("material", &err);
+    return k;
+}
+
+/* A unit square split along its diagonal: two triangles, one joint. */
+static fdem_model *one_joint(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = fracture_material(m, 10);
+    fdem_mesh mesh;
+    fdem_error err;
+    fdem_mesh_rectangle(0, 0, 0.01, 0.01, 1, 1, &mesh, &err);
+    if (fdem_add_part(m, &mesh, mat, 1, &err) < 0) build_die("part", &err);
+    fdem_mesh_free(&mesh);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+static double simpson_z(void)
+{
+    int n = 20000;
+    double s = joint_softening(0) + joint_softening(1);
+    for (int i = 1; i < n; i++) s += (i % 2 ? 4 : 2) * joint_softening((double)i / n);
+    return s / (3.0 * n);
+}
+
+/* Moves face B rigidly by (dn along n, ds along t) from the initial state,
+ * in small increments, and integrates the work the joint's resisting force
+ * absorbs. Returns the work; *broken tells whether the joint broke. */
+static double pull_joint(fdem_model *m, double dn_total, double ds_total, int steps, int *broken)
+{
+    const int32_t *n = m->joint_node;
+    const double *x0 = m->pos0;
+    double tx = x0[2 * n[1]] - x0[2 * n[0]], ty = x0[2 * n[1] + 1] - x0[2 * n[0] + 1];
+    double L = hypot(tx, ty);
+    tx /= L; ty /= L;
+    double nx = ty, ny = -tx;
+    double work = 0, prev_force = 0;
+    for (int k = 1; k <= steps; k++) {
+        double f = (double)k / steps;
+        for (int i = 0; i < m->node_count; i++) {
+            m->pos[2 * i] = x0[2 * i];
+            m->pos[2 * i + 1] = x0[2 * i + 1];
+        }
+        for (int c = 2; c < 4; c++) {
+            m->pos[2 * n[c]] += f * (dn_total * nx + ds_total * tx);
+            m->pos[2 * n[c] + 1] += f * (dn_total * ny + ds_total * ty);
+        }
+        memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+        joint_forces(m);
+        /* resisting force on face B along the imposed motion */
+        double dirx = dn_total * nx + ds_total * tx, diry = dn_total * ny + ds_total * ty;
+        double len = hypot(dirx, diry);
+        double force = -((m->force[2 * n[2]] + m->force[2 * n[3]]) * dirx +
+                         (m->force[2 * n[2] + 1] + m->force[2 * n[3] + 1]) * diry) / len;
+        work += 0.5 * (force + prev_force) * len / steps;
+        prev_force = force;
+    }
+    *broken = m->joint_damage[0] >= 1.0;
+    return work;
+}
+
+static void mode_I_energy_matches_softening_curve(void)
+{
+    fdem_model *m = one_joint();
+    CHECK(m->joint_count == 1, "joints %d", m->joint_count);
+    double ft = 1e6, GI = 10, L = hypot(0.01, 0.01);
+    double dp = ft / (m->materials[0].penalty / m->joint_h[0]), dc = 3 * GI / ft;
+    int broken;
+    double work = pull_joint(m, 1.3 * dc, 0, 40000, &broken) / L; /* per unit joint length */
+    double want = ft * (dc - dp) * simpson_z() + 0.5 * ft * dp;
+    CHECK(broken, "joint still holds at 1.3 critical openings");
+    CHECK_REL(work, want, 0.02);
+    CHECK_REL(work, 1.16 * GI, 0.03);
+    fprintf(stderr, "  mode I: %.4f J/m^2 absorbed, curve implies %.4f (%.2f G_I), integral z = %.4f\n",
+            work, want, want / GI, simpson_z());
+    CHECK(fdem_get_counts(m).broken_joints == 0, "counted before a step");
+    fdem_model_destroy(m);
+}
+
+static void mode_II_energy_matches_softening_curve(void)
+{
+    fdem_model *m = one_joint();
+    double c = 3e6, GII = 50, L = hypot(0.01, 0.01);
+    double sp = c / (m->materials[0].penalty / m->joint_h[0]), sc = 3 * GII / c;
+    int broken;
+    double work = pull_joint(m, 0, 1.3 * sc, 40000, &broken) / L;
+    double want = c * (sc - sp) * simpson_z() + 0.5 * c * sp;
+    CHECK(broken, "joint still holds at 1.3 critical slides");
+    CHECK_REL(work, want, 0.02);
+    fprintf(stderr, "  mode II: %.3f J/m^2 absorbed, curve implies %.3f\n", work, want);
+    fdem_model_destroy(m);
+}
+
+static void softening_curve_ends(void)
+{
+    CHECK_NEAR(joint_softening(0), 1.0, 1e-12);
+    CHECK_NEAR(joint_softening(1), 0.0, 1e-12);
+    CHECK(joint_softening(0.5) > 0 && joint_softening(0.5) < 1, "z(0.5) = %g", joint_softening(0.5));
+    CHECK_REL(simpson_z(), 0.387, 0.01);
+}
+
+static void block_of_fracturing_triangles_is_built_right(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = fracture_material(m, 10);
+    fdem_mesh mesh;
+    fdem_error err;
+    fdem_mesh_rectangle(0, 0, 1, 1, 4, 3, &mesh, &err);
+    fdem_add_part(m, &mesh, mat, 1, &err);
+    fdem_mesh_free(&mesh);
+    build_finalize(m, 0.5);
+    fdem_counts c = fdem_get_counts(m);
+    /* 24 triangles: 3 private nodes each; interior edges: E = (3T - boundary)/2 */
+    CHECK(c.nodes == 72, "nodes %d", c.nodes);
+    int boundary = 2 * (4 + 3);
+    CHECK(c.joints == (3 * 24 - boundary) / 2, "joints %d", c.joints);
+    CHECK(c.fragments == 1, "fragments %d", c.fragments);
+    /* every joint's faces coincide at the start: a0 on b0, a1 on b1 */
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *n = m->joint_node + 4 * j;
+        CHECK(m->pos0[2 * n[0]] == m->pos0[2 * n[2]] && m->pos0[2 * n[1] + 1] == m->pos0[2 * n[3] + 1],
+              "joint %d faces do not coincide", j);
+    }
+    /* no contact pair across an intact joint */
+    fdem_set_gravity(m, 0, -9.81);
+    fdem_step(m, &err);
+    for (size_t k = 0; k < m->contact.pairs.count; k++)
+        CHECK(!joint_holds(m, m->contact.pairs.a[k], m->contact.pairs.b[k]), "pair %zu held", k);
+    CHECK(fdem_get_counts(m).contact_pairs > 0, "corner neighbours should be candidates");
+    fdem_model_destroy(m);
+}
+
+static void broken_joints_make_fragments(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = fracture_material(m, 10);
+    int p;
+    fdem_mesh mesh;
+    fdem_error err;
+    fdem_mesh_rectangle(0, 0, 0.02, 0.01, 2, 1, &mesh, &err);
+    p = fdem_add_part(m, &mesh, mat, 1, &err);
+    fdem_mesh_free(&mesh);
+    (void)p;
+    build_finalize(m, 0.5);
+    /* pull the two halves (x < 0.01 and x > 0.01 by triangle centroid) apart fast */
+    for (int e = 0; e < m->elem_count; e++) {
+        double cx = 0;
+        for (int c = 0; c < 3; c++) cx += m->pos0[2 * m->elem[e].node[c]] / 3;
+        for (int c = 0; c < 3; c++) m->vel[2 * m->elem[e].node[c]] = cx < 0.01 ? -5 : 5;
+    }
+    run_until(m, 2e-5);
+    fdem_counts c = fdem_get_counts(m);
+    CHECK(c.broken_joints >= 1, "broken %d", c.broken_joints);
+    CHECK(c.fragments >= 2, "fragments %d", c.fragments);
+    fdem_model_destroy(m);
+}
+
+/* Tip period of a fixed-free bar with nu = 0: fracturing (every triangle on
+ * its own nodes, joints everywhere) against the same bar without fracture. */
+static double bar_period(int fracture, double penalty_factor)
+{
+    double L = 0.5, H = 0.025;
+    fdem_model *m = fdem_model_create();
+    int mat = fracture_material(m, penalty_factor);
+    fdem_mesh mesh;
+    fdem_error err;
+    fdem_mesh_rectangle(0, 0, L, H, 40, 2, &mesh, &err);
+    int p = fdem_add_part(m, &mesh, mat, fracture, &err);
+    fdem_mesh_free(&mesh);
+    fdem_set_part_velocity(m, p, 0.001, 0, NULL);
+    fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1e-9, -1, 1e-9, 1},
+                               .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 0};
+    fdem_add_constraint(m, &fix, &err);
+    build_finalize(m, 0.5);
+    const double *x = fdem_positions(m), *x0 = fdem_initial_positions(m);
+    double period = 4 * L / sqrt(3e10 / 2700), prev = 0, cross[3];
+    int found = 0;
+    while (fdem_get_time(m) < 2.2 * period && found < 2) {
+        double t = fdem_get_time(m);
+        if (fdem_step(m, &err)) build_die("step", &err);
+        double tip = 0;
+        int k = 0;
+        for (int i = 0; i < m->node_count; i++)
+            if (x0[2 * i] > L - 1e-9) { tip += x[2 * i] - x0[2 * i]; k++; }
+        tip /= k;
+        if (t > 0 && prev > 0 && tip <= 0) cross[found++] = t + fdem_get_dt(m) * prev / (prev - tip);
+        prev = tip;
+    }
+    CHECK(fdem_get_counts(m).broken_joints == 0, "joints broke in a small-strain vibration");
+    fdem_model_destroy(m);
+    return found == 2 ? cross[1] - cross[0] : NAN;
+}
+
+static void intact_fracturing_bar_vibrates_like_continuum(void)
+{
+    double continuous = bar_period(0, 100), fracturing = bar_period(1, 100);
+    double exact = 4 * 0.5 / sqrt(3e10 / 2700);
+    CHECK_REL(continuous, exact, 0.02);
+    CHECK_REL(fracturing, continuous, 0.03);
+    fprintf(stderr, "  bar period: exact %.4g s, continuous %.4g s, fracturing %.4g s (%+.2f%%)\n",
+            exact, continuous, fracturing, 100 * (fracturing / continuous - 1));
+}
+
+CHECK_MAIN(T(softening_curve_ends), T(mode_I_energy_matches_softening_curve),
+           T(mode_II_energy_matches_softening_curve), T(block_of_fracturing_triangles_is_built_right),
+           T(broken_joints_make_fragments), T(intact_fracturing_bar_vibrates_like_continuum))
