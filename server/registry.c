@@ -382,12 +382,18 @@ static void registry_dispatch(void)
     }
 }
 
-void registry_worker_exited(server_case *c)
+void registry_worker_exited(server_case *c, case_state final_state)
 {
-    (void)c;
+    /* State and running count change together, so /health and the status
+     * never disagree about whether the case runs. */
     pthread_mutex_lock(&reg_lock);
+    pthread_mutex_lock(&c->lock);
+    c->state = final_state;
+    atomic_store(&c->command, WORKER_GO);
+    pthread_mutex_unlock(&c->lock);
     reg_running--;
     pthread_mutex_unlock(&reg_lock);
+    case_persist_status(c);
     registry_dispatch();
 }
 

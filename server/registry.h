@@ -127,7 +127,9 @@ void case_persist_status(server_case *c);
 /* Called by the worker and the I/O thread. */
 void case_publish(server_case *c, const case_figures *fig);
 void case_set_snapshots(server_case *c, int snapshots);
-void registry_worker_exited(server_case *c);
+/* The worker's last words: sets the final state, frees its slot, persists
+ * the status and starts queued cases (the worker then clears worker_active). */
+void registry_worker_exited(server_case *c, case_state final_state);
 int id_is_valid(const char *s);
 
 /* fdem_checkpoint_write into a malloc'd buffer (NULL on failure). */

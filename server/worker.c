@@ -99,6 +99,8 @@ static void worker_wait_io(server_case *c, int max_pending)
     pthread_mutex_unlock(&c->lock);
 }
 
+/* The engine's message already names the step, element and dt (fdem.h);
+ * we compose our own sentence only if it left the message empty. */
 static void worker_describe_failure(server_case *c, const fdem_error *err, double dt)
 {
     char where[64] = "";
@@ -107,13 +109,13 @@ static void worker_describe_failure(server_case *c, const fdem_error *err, doubl
     else if (err->kind == FDEM_ITEM_NODE && err->item >= 0)
         snprintf(where, sizeof where, " at node %d", err->item);
     pthread_mutex_lock(&c->lock);
-    snprintf(c->error, sizeof c->error,
-             "the solution became non-finite at step %lld (t = %.6g s)%s with dt = %.3g s; "
-             "reduce time.safety or check the material stiffness and penalty%s%s",
-             (long long)fdem_get_step(c->model), fdem_get_time(c->model), where, dt,
-             err->message[0] ? " (engine: " : "", err->message[0] ? err->message : "");
-    if (err->message[0] && strlen(c->error) + 2 < sizeof c->error)
-        strcat(c->error, ")");
+    if (err->message[0])
+        snprintf(c->error, sizeof c->error, "%s", err->message);
+    else
+        snprintf(c->error, sizeof c->error,
+                 "the solution became non-finite in the step after step %lld (t = %.6g s)%s "
+                 "with dt = %.3g s; reduce time.safety or check the material stiffness and penalty",
+                 (long long)fdem_get_step(c->model), fdem_get_time(c->model), where, dt);
     pthread_mutex_unlock(&c->lock);
 }
 
@@ -220,16 +222,9 @@ static void *worker_main(void *arg)
     worker_exit why = worker_loop(c, &clk);
     worker_wind_down(c, why, &clk);
 
-    pthread_mutex_lock(&c->lock);
-    c->state = worker_final_state(why);
-    atomic_store(&c->command, WORKER_GO);
-    pthread_mutex_unlock(&c->lock);
-    if (why != EXIT_ABANDON)
-        case_persist_status(c);
-
-    /* Free the slot (and start a queued case) before the pauser is woken,
-     * so the running count never exceeds --max-running. */
-    registry_worker_exited(c);
+    if (why == EXIT_ABANDON)
+        atomic_store(&c->deleted, 1); /* nothing more to persist */
+    registry_worker_exited(c, worker_final_state(why));
     pthread_mutex_lock(&c->lock);
     c->worker_active = 0;
     pthread_cond_broadcast(&c->cv);

@@ -133,6 +133,21 @@ class ApiTest(unittest.TestCase):
         status, st = self.d.json("POST", "/cases/%s/stop" % other)
         self.assertEqual((status, st["state"]), (200, "stopped"))
 
+    def test_failed_case_says_where_and_why(self):
+        case = tiny_case("boom", end=0.01, divisions=(4, 4))
+        case["constraints"].append({"box": [0.09, 0.09, 0.2, 0.2], "force": [1e300, 1e300]})
+        case_id = self.d.create(case, start=True)["id"]
+        st = self.d.wait_state(case_id, "failed")
+        self.assertRegex(st["error"], r"non-finite at step \d+")
+        self.assertRegex(st["error"], r"element \d+")
+        self.assertIn("dt = ", st["error"])
+        self.assertIn("reduce time.safety", st["error"])
+        status, problem = self.d.json("POST", "/cases/%s/start" % case_id)
+        self.assertEqual(status, 409)
+        self.assertIn("failed", problem["detail"])
+        self.assertEqual(self.d.request("GET", "/cases/%s/result.h5" % case_id)[0], 200)
+        self.assertEqual(self.d.json("GET", "/health")[1]["running"], 0)
+
     def test_state_is_consistent(self):
         case_id = self.d.create(tiny_case("state", end=LONG), start=True)["id"]
         self.d.wait(case_id, lambda s: s["step"] > 10, what="steps")
