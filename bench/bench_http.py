@@ -1,0 +1,93 @@
+#!/usr/bin/env python3
+"""HTTP load figure for `make bench`: latency (p50, p99) and requests/s of
+GET /cases/ID against bin/fdemd on loopback while four cases step.
+
+Uses wrk when installed (2 threads, 8 connections, 5 s), else a bounded
+Python client (4 threads x 500 requests). Never part of the tests.
+
+    FDEMD_BIN=bin/fdemd /usr/bin/python3 bench/bench_http.py
+"""
+import http.client
+import os
+import re
+import shutil
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tests", "integration"))
+from fdemd_harness import Daemon, tiny_case  # noqa: E402
+
+WRK_SECONDS = 5
+PY_THREADS, PY_REQUESTS = 4, 500
+
+
+def wrk_figures(url):
+    out = subprocess.run(["wrk", "-t2", "-c8", "-d%ds" % WRK_SECONDS, "--latency", url],
+                         capture_output=True, text=True, timeout=WRK_SECONDS + 30).stdout
+    unit = {"us": 1e-3, "ms": 1.0, "s": 1e3}
+
+    def pct(p):
+        m = re.search(r"^\s*%d%%\s+([\d.]+)(us|ms|s)\s*$" % p, out, re.M)
+        return float(m.group(1)) * unit[m.group(2)] if m else float("nan")
+
+    rate = re.search(r"Requests/sec:\s+([\d.]+)", out)
+    errors = re.search(r"Non-2xx or 3xx responses: (\d+)", out)
+    return pct(50), pct(99), float(rate.group(1)) if rate else float("nan"), \
+        int(errors.group(1)) if errors else 0, "wrk -t2 -c8 -d%ds" % WRK_SECONDS
+
+
+def python_figures(port, ids):
+    latencies, bad = [], [0]
+    lock = threading.Lock()
+
+    def client(k):
+        conn = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+        mine = []
+        for i in range(PY_REQUESTS):
+            t0 = time.perf_counter()
+            conn.request("GET", "/cases/" + ids[(k + i) % len(ids)])
+            resp = conn.getresponse()
+            resp.read()
+            mine.append(time.perf_counter() - t0)
+            if resp.status != 200:
+                bad[0] += 1
+        conn.close()
+        with lock:
+            latencies.extend(mine)
+
+    threads = [threading.Thread(target=client, args=(k,)) for k in range(PY_THREADS)]
+    t0 = time.perf_counter()
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    elapsed = time.perf_counter() - t0
+    latencies.sort()
+    return (1e3 * latencies[len(latencies) // 2], 1e3 * latencies[int(0.99 * len(latencies)) - 1],
+            len(latencies) / elapsed, bad[0], "python %dx%d" % (PY_THREADS, PY_REQUESTS))
+
+
+def main():
+    d = Daemon(args=["--max-running", "4"]).start()
+    try:
+        ids = [d.create(tiny_case("bench%d" % i, end=100.0, interval=1e-3), start=True)["id"]
+               for i in range(4)]
+        url = "http://127.0.0.1:%d/cases/%s" % (d.port, ids[0])
+        if shutil.which("wrk"):
+            p50, p99, rate, bad, how = wrk_figures(url)
+        else:
+            p50, p99, rate, bad, how = python_figures(d.port, ids)
+        steps = sum(d.status(i)["steps_per_second"] for i in ids)
+        print("http GET /cases/ID (4 cases running, %s): p50 %.3f ms, p99 %.3f ms, %.0f requests/s, "
+              "%d non-200; cases stepped %.3g steps/s in total meanwhile" % (how, p50, p99, rate, bad, steps))
+        d.stop()
+    finally:
+        d.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
