@@ -132,7 +132,7 @@ dump("brazilian-disc", {
          "rectangle": {"origin": [-0.01, -0.02995], "size": [0.02, 0.005], "divisions": [4, 1]}}],
     "constraints": [{"part": "top", "velocity": [0, -0.05]},
                     {"part": "bottom", "velocity": [0, 0.05]}],
-    "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
+    "time": {"end": 0.0006, "dt": "auto", "safety": 0.5},
     "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
 dump("gmsh-plate", {
     "name": "gmsh-plate",
