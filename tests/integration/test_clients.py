@@ -432,6 +432,35 @@ class PlotTests(ClientTestCase):
         self.assertIn("out of range", r.stderr)
 
 
+class ExampleTests(ClientTestCase):
+    """The bundled examples stay valid case documents as the daemon evolves."""
+
+    EXAMPLES = os.path.join(ROOT, "examples")
+
+    def test_every_example_is_accepted(self):
+        names = sorted(n for n in os.listdir(self.EXAMPLES) if n.endswith(".json"))
+        self.assertGreaterEqual(len(names), 7)
+        for name in names:
+            with self.subTest(example=name):
+                case_id = self.client.submit(os.path.join(self.EXAMPLES, name))
+                s = self.client.status(case_id)
+                self.assertEqual(s["name"], name[:-len(".json")])
+                self.assertGreater(s["elements"], 0)
+                self.client.delete(case_id)
+
+    def test_freefall_drops_half_g_t_squared(self):
+        case_id = self.client.submit(os.path.join(self.EXAMPLES, "freefall.json"), start=True)
+        final = self.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
+        self.assertEqual(final["state"], "finished")
+        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "freefall.h5"))
+        with h5py.File(h5, "r") as f:
+            t = f["/snapshots/time"][-1]
+            drop = f["/mesh/position0"][:, 1] - f["/snapshots/position"][-1][:, 1]
+        # Central difference integrates constant acceleration exactly.
+        for d in drop:
+            self.assertAlmostEqual(d, 0.5 * 9.81 * t * t, delta=1e-9)
+
+
 class VonMisesTests(unittest.TestCase):
     """The plane-strain von Mises formula of plot_result.py on known states."""
 
