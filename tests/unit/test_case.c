@@ -304,6 +304,9 @@ static void malformed_json_is_400(void)
     problems_free(&p);
     expect_text("", 0, 400, "", "line");
     expect_text("{\"a\": 1} trailing", 17, 400, "", "line 1");
+    /* NUL inside strings would cut names short in C: jansson refuses it */
+    const char *nul = "{\"name\": \"a\\u0000b\"}";
+    expect_text(nul, strlen(nul), 400, "", "line 1");
     /* the length bounds the text: a valid prefix of a longer buffer */
     expect_text("{\"a\": 1}", 5, 400, "", "line 1");
 }
