@@ -20,7 +20,7 @@ LOG=$OUT/demo-fdemd.log
 say() { printf '\n== %s\n' "$*"; }
 die() { printf 'demo: %s\n' "$*" >&2; exit 1; }
 
-[ -x "$BIN/fdemd" ] && [ -x "$BIN/fdemctl" ] || die "build first: make"
+if [ ! -x "$BIN/fdemd" ] || [ ! -x "$BIN/fdemctl" ]; then die "build first: make"; fi
 [ -f "$EXAMPLE" ] || die "no such example: $EXAMPLE"
 
 rm -rf "$DATA"
