@@ -5,9 +5,11 @@
  * Contract: worker_spawn() is called with the registry lock and the case
  * lock held, with the case in state running; it sets worker_active and the
  * thread takes its own reference. The worker acts on c->command at the next
- * step boundary, sets the final state (paused, stopped, finished, failed),
- * persists the status, clears worker_active, broadcasts c->cv and tells the
- * registry a slot is free.
+ * step boundary, waits until its last snapshot and checkpoint are on disk,
+ * hands the final state (paused, stopped, finished, failed) to
+ * registry_worker_exited() (slot freed, status persisted, queued cases
+ * started), and only then clears worker_active and broadcasts c->cv, so a
+ * pause or stop is answered after everything it implies is durable.
  */
 #ifndef FDEMD_WORKER_H
 #define FDEMD_WORKER_H
