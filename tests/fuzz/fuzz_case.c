@@ -4,12 +4,18 @@
  * allocation beyond the memory limit (ASan enforces -rss_limit_mb and
  * -malloc_limit_mb; the limit below keeps accepted models small so the
  * fuzzer spends its time on the parser, not on meshing).
+ *
+ * The same bytes also go to gmsh_read() directly: inside a case, gmsh text
+ * sits in an escaped JSON string that mutations rarely keep valid, so the
+ * reader gets its own raw-text coverage from the same run (the corpus holds
+ * the .msh files of tests/data as they are).
  */
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
 #include "case.h"
+#include "gmsh.h"
 
 #define FUZZ_MEMORY_LIMIT ((size_t)64 << 20)
 
@@ -27,5 +33,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         __builtin_trap(); /* a refusal must say why */
     }
     problems_free(&out);
+
+    fdem_mesh mesh;
+    char message[256];
+    if (gmsh_read((const char *)data, size, &mesh, message, sizeof message) == 0) {
+        if (mesh.node_count < 3 || mesh.triangle_count < 1) __builtin_trap();
+        for (int i = 0; i < 3 * mesh.triangle_count; i++)
+            if (mesh.tri[i] < 0 || mesh.tri[i] >= mesh.node_count) __builtin_trap();
+        fdem_mesh_free(&mesh);
+    } else if (strncmp(message, "gmsh", 4) != 0) {
+        __builtin_trap(); /* every failure names where it happened */
+    }
     return 0;
 }

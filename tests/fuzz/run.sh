@@ -25,6 +25,7 @@ clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*.c $pkg -lm 
 for f in examples/*.json; do [ -e "$f" ] && cp "$f" "$corpus/"; done
 for f in tests/data/*.msh; do
   [ -e "$f" ] || continue
+  cp "$f" "$corpus/"
   /usr/bin/python3 - "$f" "$corpus/$(basename "$f").json" <<'PY'
 import json, sys
 text = open(sys.argv[1]).read()
@@ -51,7 +52,7 @@ printf '{"time": {"end": 1e999}}' > "$corpus/inline-overflow.json"
 printf '[[[[[[[[[[' > "$corpus/inline-deep.json"
 
 status=0
-"$out/fuzz_case" "$corpus" -max_total_time="$seconds" -max_len=65536 -timeout=10 \
+"$out/fuzz_case" "$corpus" -dict=tests/fuzz/case.dict -max_total_time="$seconds" -max_len=65536 -timeout=10 \
     -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 \
     -artifact_prefix="$out/" 2>&1 | tail -n 25 || status=$?
 if [ "$status" -ne 0 ]; then

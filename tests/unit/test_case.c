@@ -166,6 +166,28 @@ static int count_part_nodes(const fdem_model *m, int part)
     return n;
 }
 
+static int compare_edge(const void *a, const void *b)
+{
+    const long long *x = a, *y = b;
+    return (*x > *y) - (*x < *y);
+}
+
+/* Edges shared by two triangles: where a fracturing part gets its joints. */
+static int count_interior_edges(const fdem_mesh *m)
+{
+    long long *edges = malloc(sizeof *edges * 3 * (size_t)m->triangle_count);
+    for (int t = 0; t < m->triangle_count; t++)
+        for (int k = 0; k < 3; k++) {
+            long long a = m->tri[3 * t + k], b = m->tri[3 * t + (k + 1) % 3];
+            edges[3 * t + k] = a < b ? a * m->node_count + b : b * m->node_count + a;
+        }
+    qsort(edges, 3 * (size_t)m->triangle_count, sizeof *edges, compare_edge);
+    int shared = 0;
+    for (int i = 1; i < 3 * m->triangle_count; i++) shared += edges[i] == edges[i - 1];
+    free(edges);
+    return shared;
+}
+
 static void valid_document_builds(void)
 {
     /* the disc as the engine's own generator meshes it, independently */
@@ -173,6 +195,7 @@ static void valid_document_builds(void)
     fdem_error err;
     CHECK(fdem_mesh_disc(0, 0, 0.025, 24, &disc, &err) == 0, "%s", err.message);
     int disc_elements = disc.triangle_count;
+    int disc_joints = count_interior_edges(&disc);
     fdem_mesh_free(&disc);
 
     json_t *doc = load(base_text);
@@ -191,6 +214,8 @@ static void valid_document_builds(void)
      * 2 x 4 x 1 triangles; explicit mesh 4 nodes, 2 triangles */
     CHECK(c.nodes == 3 * disc_elements + 10 + 4, "nodes %d", c.nodes);
     CHECK(c.elements == disc_elements + 8 + 2, "elements %d", c.elements);
+    CHECK(c.joints == disc_joints, "joints %d, want %d (interior edges of the disc)", c.joints,
+          disc_joints);
     CHECK(c.parts == 3 && c.materials == 2 && c.constraints == 3, "parts %d materials %d "
           "constraints %d", c.parts, c.materials, c.constraints);
     CHECK(count_part_nodes(m, 1) == 10, "part 1 has %d nodes", count_part_nodes(m, 1));
