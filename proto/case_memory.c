@@ -79,6 +79,15 @@ static void memory_format(double bytes, char *out, size_t size)
         snprintf(out, size, "%.3g %s", bytes, units[unit]);
 }
 
+/* "about 9e+08 nodes, 1.8e+09 elements" (and joints when there are any) */
+static void memory_describe(double nodes, double elements, double joints, char *out,
+                            size_t size)
+{
+    int n = snprintf(out, size, "about %.3g nodes, %.3g elements", nodes, elements);
+    if (joints > 0 && n > 0 && (size_t)n < size)
+        snprintf(out + n, size - (size_t)n, ", %.3g joints", joints);
+}
+
 void case_check_memory(case_doc *doc, size_t memory_limit)
 {
     double nodes = 0, elements = 0, joints = 0;
@@ -89,16 +98,15 @@ void case_check_memory(case_doc *doc, size_t memory_limit)
         joints += doc->parts[i].joints;
     }
     double bytes = memory_bytes(nodes, elements, joints);
-    char need[32], limit[32];
+    char need[32], limit[32], counts[96];
     memory_format(bytes, need, sizeof need);
+    memory_describe(nodes, elements, joints, counts, sizeof counts);
     if (bytes > (double)memory_limit) {
         memory_format((double)memory_limit, limit, sizeof limit);
-        case_problem(doc, "/parts", "the model would need %s (about %.3g nodes, %.3g elements, "
-                                    "%.3g joints), more than this daemon's limit of %s",
-                     need, nodes, elements, joints, limit);
+        case_problem(doc, "/parts", "the model would need %s (%s), more than this daemon's "
+                                    "limit of %s", need, counts, limit);
     } else if (nodes > INT_MAX || elements > INT_MAX || joints > INT_MAX) {
-        case_problem(doc, "/parts", "the model would have about %.3g nodes, %.3g elements and "
-                                    "%.3g joints (%s); the engine's limit is %d of each",
-                     nodes, elements, joints, need, INT_MAX);
+        case_problem(doc, "/parts", "the model would have %s (%s); the engine's limit is %d "
+                                    "of each", counts, need, INT_MAX);
     }
 }
