@@ -1,0 +1,340 @@
+/*
+ * bench_nbs.c - Munjiza-NBS contact detection speed and memory, printed by
+ * `make bench`. Figures, not pass/fail: nothing here is a test.
+ *
+ * For N = 1e3 .. 1e6 circles on a jittered square lattice at packing
+ * densities 1, 1/10, 1/100 and 1/1e4 circles per cell (cell = the largest
+ * diameter), in lattice (spatial) and shuffled order, it times one detection
+ * and sets it beside two baselines measured in the same run:
+ *  - a counting-sort uniform grid (bin every circle into a dense nx*ny grid,
+ *    gather the circles into cell order, test the same half mask) - the
+ *    usual fast alternative, which pays O(nx*ny) and is skipped when the
+ *    grid would exceed GRID_MAX_CELLS;
+ *  - the all-pairs check (N <= 1e4 only).
+ * Every method's pair count is compared; a mismatch is printed loudly.
+ * The issue's goals: <= 20 ns/element in spatial order at every N, flat
+ * within 20 % across densities, and <= 1.5x the counting-sort grid.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "nbs.h"
+#include "stream.h"
+
+#define GRID_MAX_CELLS ((int64_t)1 << 26) /* 256 MB of int32 counts */
+#define BRUTE_MAX_N 10000
+#define TARGET_SECONDS 0.04 /* per timed batch */
+#define BATCHES 5
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------------ inputs */
+
+typedef struct circles {
+    size_t n;
+    double *x, *y, *r;
+} circles;
+
+static uint64_t rng_state = 12345;
+
+static double rng_uniform(void)
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-53;
+}
+
+/* Row-major square lattice, spacing 1/sqrt(density) cells, jittered by
+ * +-10 % of the spacing, radii 0.4 .. 0.5 (so the cell is 1): at density 1
+ * neighbours overlap now and then, as loosely packed elements do. */
+static circles circles_lattice(size_t n, double density)
+{
+    circles c = {n, malloc(n * sizeof(double)), malloc(n * sizeof(double)),
+                 malloc(n * sizeof(double))};
+    size_t cols = (size_t)ceil(sqrt((double)n));
+    double s = 1.0 / sqrt(density);
+    for (size_t i = 0; i < n; i++) {
+        c.x[i] = s * ((double)(i % cols) + 0.2 * (rng_uniform() - 0.5));
+        c.y[i] = s * ((double)(i / cols) + 0.2 * (rng_uniform() - 0.5));
+        c.r[i] = 0.4 + 0.1 * rng_uniform();
+    }
+    c.r[0] = 0.5;
+    return c;
+}
+
+static void circles_shuffle(circles *c)
+{
+    for (size_t i = c->n; i > 1; i--) {
+        size_t j = (size_t)(rng_uniform() * (double)i) % i;
+        double t;
+        t = c->x[i - 1]; c->x[i - 1] = c->x[j]; c->x[j] = t;
+        t = c->y[i - 1]; c->y[i - 1] = c->y[j]; c->y[j] = t;
+        t = c->r[i - 1]; c->r[i - 1] = c->r[j]; c->r[j] = t;
+    }
+}
+
+static void circles_free(circles *c)
+{
+    free(c->x);
+    free(c->y);
+    free(c->r);
+}
+
+/* ------------------------------------------ counting-sort uniform grid */
+
+typedef struct grid_ws {
+    int32_t *start;            /* cells + 1 prefix sums */
+    int32_t *cell, *order;     /* per circle: cell index, circles in cell order */
+    double *sx, *sy, *sr;      /* circles gathered into cell order */
+    int64_t cells_capacity;
+    size_t n_capacity;
+} grid_ws;
+
+static void grid_ws_free(grid_ws *w)
+{
+    free(w->start), free(w->cell), free(w->order);
+    free(w->sx), free(w->sy), free(w->sr);
+    memset(w, 0, sizeof *w);
+}
+
+static size_t grid_ws_bytes(const grid_ws *w)
+{
+    return (size_t)(w->cells_capacity + 1) * 4 + w->n_capacity * (4 + 4 + 24);
+}
+
+static int push(nbs_pairs *p, int32_t a, int32_t b)
+{
+    if (p->count == p->capacity) {
+        size_t cap = p->capacity ? 2 * p->capacity : 1024;
+        int32_t *na = realloc(p->a, cap * sizeof *na), *nb;
+        if (!na) return -1;
+        p->a = na;
+        if (!(nb = realloc(p->b, cap * sizeof *nb))) return -1;
+        p->b = nb;
+        p->capacity = cap;
+    }
+    p->a[p->count] = a;
+    p->b[p->count] = b;
+    p->count++;
+    return 0;
+}
+
+/* The same circle test as nbs.c (split statements: no FMA contraction). */
+static inline int touch(double xi, double yi, double ri, double xj, double yj, double rj)
+{
+    double dx = xi - xj, dy = yi - yj, reach = ri + rj;
+    double dx2 = dx * dx;
+    double dy2 = dy * dy;
+    double dist2 = dx2 + dy2;
+    double reach2 = reach * reach;
+    return dist2 <= reach2;
+}
+
+/* Returns 0, 1 when the dense grid would be too large, -1 on allocation
+ * failure. Cell size is padded like nbs.c's so the two agree exactly. */
+static int grid_detect(grid_ws *w, const circles *c, nbs_pairs *pairs)
+{
+    size_t n = c->n;
+    pairs->count = 0;
+    double xmin = 1e300, xmax = -1e300, ymin = 1e300, ymax = -1e300, rmax = 0;
+    for (size_t i = 0; i < n; i++) {
+        xmin = fmin(xmin, c->x[i]), xmax = fmax(xmax, c->x[i]);
+        ymin = fmin(ymin, c->y[i]), ymax = fmax(ymax, c->y[i]);
+        rmax = fmax(rmax, c->r[i]);
+    }
+    double span = fmax(xmax - xmin, ymax - ymin);
+    double cell = 2 * rmax * (1 + 1e-9) + 32 * 2.220446049250313e-16 * span;
+    double inv = 1.0 / cell;
+    int64_t nx = (int64_t)((xmax - xmin) * inv) + 1, ny = (int64_t)((ymax - ymin) * inv) + 1;
+    int64_t cells = nx * ny;
+    if (cells > GRID_MAX_CELLS) return 1;
+    if (cells > w->cells_capacity) {
+        free(w->start);
+        if (!(w->start = malloc((size_t)(cells + 1) * sizeof *w->start))) return -1;
+        w->cells_capacity = cells;
+    }
+    if (n > w->n_capacity) {
+        w->cell = realloc(w->cell, n * sizeof *w->cell);
+        w->order = realloc(w->order, n * sizeof *w->order);
+        w->sx = realloc(w->sx, n * sizeof *w->sx);
+        w->sy = realloc(w->sy, n * sizeof *w->sy);
+        w->sr = realloc(w->sr, n * sizeof *w->sr);
+        if (!w->cell || !w->order || !w->sx || !w->sy || !w->sr) return -1;
+        w->n_capacity = n;
+    }
+    int32_t *start = w->start;
+    memset(start, 0, (size_t)(cells + 1) * sizeof *start);
+    for (size_t i = 0; i < n; i++) {
+        int64_t ix = (int64_t)((c->x[i] - xmin) * inv), iy = (int64_t)((c->y[i] - ymin) * inv);
+        w->cell[i] = (int32_t)(iy * nx + ix);
+        start[w->cell[i] + 1]++;
+    }
+    for (int64_t k = 0; k < cells; k++) start[k + 1] += start[k];
+    /* scatter; start[k] ends as the start of cell k + 1, shifted back below */
+    for (size_t i = 0; i < n; i++) {
+        int32_t k = start[w->cell[i]]++;
+        w->order[k] = (int32_t)i;
+        w->sx[k] = c->x[i], w->sy[k] = c->y[i], w->sr[k] = c->r[i];
+    }
+    for (int64_t k = cells; k > 0; k--) start[k] = start[k - 1];
+    start[0] = 0;
+    /* half mask: earlier circles of this cell and the left cell (one
+     * contiguous range), then the three cells of the row below (another) */
+    for (int32_t k = 0; k < (int32_t)n; k++) {
+        int32_t cc = w->cell[w->order[k]];
+        int64_t ix = cc % nx, iy = cc / nx;
+        double xk = w->sx[k], yk = w->sy[k], rk = w->sr[k];
+        int32_t lo = start[ix > 0 ? cc - 1 : cc];
+        for (int32_t j = lo; j < k; j++)
+            if (touch(xk, yk, rk, w->sx[j], w->sy[j], w->sr[j]) && push(pairs, w->order[k], w->order[j]))
+                return -1;
+        if (iy == 0) continue;
+        int64_t below = cc - nx;
+        int32_t b0 = start[ix > 0 ? below - 1 : below], b1 = start[ix + 1 < nx ? below + 2 : below + 1];
+        for (int32_t j = b0; j < b1; j++)
+            if (touch(xk, yk, rk, w->sx[j], w->sy[j], w->sr[j]) && push(pairs, w->order[k], w->order[j]))
+                return -1;
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------- timing */
+
+typedef enum method { M_NBS, M_GRID, M_BRUTE } method;
+
+typedef struct runner {
+    const circles *c;
+    nbs_grid nbs;
+    grid_ws grid;
+    nbs_pairs pairs;
+} runner;
+
+static int run_once(runner *u, method m)
+{
+    const circles *c = u->c;
+    switch (m) {
+    case M_NBS: return nbs_detect(&u->nbs, c->n, c->x, c->y, c->r, NULL, &u->pairs);
+    case M_GRID: return grid_detect(&u->grid, c, &u->pairs);
+    case M_BRUTE: return nbs_detect_brute(c->n, c->x, c->y, c->r, NULL, &u->pairs);
+    }
+    return -1;
+}
+
+/* Best ns per element over BATCHES batches of detections sized to
+ * TARGET_SECONDS; -1 if the method cannot run. *pairs gets the count. */
+static double time_method(runner *u, method m, size_t *pairs)
+{
+    if (run_once(u, m) != 0) return -1; /* warm-up: reach the high-water mark */
+    *pairs = u->pairs.count;
+    double t0 = now();
+    run_once(u, m);
+    double once = now() - t0;
+    int reps = once > 0 ? (int)(TARGET_SECONDS / once) : 1000;
+    if (reps < 1) reps = 1;
+    int batches = m == M_BRUTE ? 1 : BATCHES;
+    double best = 1e30;
+    for (int b = 0; b < batches; b++) {
+        t0 = now();
+        for (int k = 0; k < reps; k++) run_once(u, m);
+        double t = (now() - t0) / reps;
+        if (t < best) best = t;
+    }
+    return best * 1e9 / (double)u->c->n;
+}
+
+/* ------------------------------------------------------------------ main */
+
+typedef struct summary {
+    double worst_ns, worst_ratio, worst_spread;
+    int mismatches;
+} summary;
+
+static void print_cell(double v, const char *fmt)
+{
+    if (v < 0) printf(" %8s", "-");
+    else printf(fmt, v);
+}
+
+int main(void)
+{
+    static const size_t sizes[] = {1000, 10000, 100000, 1000000};
+    static const double densities[] = {1.0, 0.1, 0.01, 1e-4};
+    static const char *density_names[] = {"1", "1/10", "1/100", "1/1e4"};
+
+    double copy = stream_copy_gbs(), triad = stream_bandwidth_gbs();
+    printf("# Munjiza-NBS contact detection (single core)\n");
+    printf("single-core bandwidth: copy %.1f GB/s, triad %.1f GB/s\n", copy, triad);
+    printf("ns/el: one detection divided by N (best of %d batches); B/el: detector memory / N\n"
+           "(NBS: lists + pairs; grid: counts + sort + gathered copy; inputs not counted); grid: counting-sort dense grid baseline\n"
+           "(n/a above %lld cells); brute: all pairs (N <= %d)\n\n",
+           BATCHES, (long long)GRID_MAX_CELLS, BRUTE_MAX_N);
+    printf("%8s %-8s %-6s %8s %8s %8s %8s %8s %8s %8s %9s\n", "N", "order", "dens", "pairs/el",
+           "NBS ns", "NBS B", "grid ns", "grid B", "NBS/grid", "brute ns", "brute/NBS");
+
+    summary s = {0, 0, 0, 0};
+    for (size_t si = 0; si < sizeof sizes / sizeof sizes[0]; si++) {
+        double spatial_ns[4];
+        for (int order = 0; order < 2; order++) {
+            for (size_t di = 0; di < 4; di++) {
+                size_t n = sizes[si];
+                circles c = circles_lattice(n, densities[di]);
+                if (order) circles_shuffle(&c);
+                runner u = {.c = &c};
+                nbs_grid_init(&u.nbs);
+                nbs_pairs_init(&u.pairs);
+                size_t p_nbs = 0, p_grid = 0, p_brute = 0;
+                double nbs_ns = time_method(&u, M_NBS, &p_nbs);
+                double bytes = (double)nbs_memory_bytes(&u.nbs, &u.pairs) / (double)n;
+                double grid_ns = time_method(&u, M_GRID, &p_grid);
+                double brute_ns = n <= BRUTE_MAX_N ? time_method(&u, M_BRUTE, &p_brute) : -1;
+                int bad = (grid_ns >= 0 && p_grid != p_nbs) || (brute_ns >= 0 && p_brute != p_nbs);
+                s.mismatches += bad;
+
+                printf("%8zu %-8s %-6s %8.2f", n, order ? "shuffled" : "lattice",
+                       density_names[di], (double)p_nbs / (double)n);
+                print_cell(nbs_ns, " %8.1f");
+                print_cell(bytes, " %8.1f");
+                print_cell(grid_ns, " %8.1f");
+                print_cell(grid_ns >= 0 ? (double)grid_ws_bytes(&u.grid) / (double)n : -1, " %8.0f");
+                print_cell(grid_ns > 0 ? nbs_ns / grid_ns : -1, " %8.2f");
+                print_cell(brute_ns, " %8.1f");
+                print_cell(brute_ns > 0 ? brute_ns / nbs_ns : -1, " %9.1f");
+                printf("%s\n", bad ? "  PAIR COUNT MISMATCH" : "");
+                fflush(stdout);
+
+                if (!order) {
+                    spatial_ns[di] = nbs_ns;
+                    if (nbs_ns > s.worst_ns) s.worst_ns = nbs_ns;
+                    if (grid_ns > 0 && nbs_ns / grid_ns > s.worst_ratio) s.worst_ratio = nbs_ns / grid_ns;
+                }
+                nbs_grid_free(&u.nbs);
+                nbs_pairs_free(&u.pairs);
+                grid_ws_free(&u.grid);
+                circles_free(&c);
+            }
+            if (!order) {
+                double lo = spatial_ns[0], hi = spatial_ns[0];
+                for (int k = 1; k < 4; k++) lo = fmin(lo, spatial_ns[k]), hi = fmax(hi, spatial_ns[k]);
+                if (hi / lo - 1 > s.worst_spread) s.worst_spread = hi / lo - 1;
+            }
+        }
+    }
+    printf("\ngoals (lattice order): worst %.1f ns/el (goal <= 20): %s; "
+           "spread across densities %.0f %% (goal <= 20 %%): %s; "
+           "worst NBS/grid %.2f (goal <= 1.5): %s; pair count mismatches: %d\n",
+           s.worst_ns, s.worst_ns <= 20 ? "met" : "MISSED", 100 * s.worst_spread,
+           s.worst_spread <= 0.2 ? "met" : "MISSED", s.worst_ratio,
+           s.worst_ratio <= 1.5 ? "met" : "MISSED", s.mismatches);
+    return s.mismatches ? 1 : 0;
+}
