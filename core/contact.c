@@ -235,10 +235,12 @@ static int contact_detect(fdem_model *m)
     }
     if (nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs))
         return -1;
-    if (m->joint_count) { /* triangles held by an intact joint never contact */
+    if (m->joint_count) { /* triangles glued by intact joints never contact */
+        joint_mark_broken_vertices(m);
         size_t kept = 0;
         for (size_t k = 0; k < cs->pairs.count; k++) {
-            if (joint_holds(m, cs->pairs.a[k], cs->pairs.b[k])) continue;
+            int a = cs->pairs.a[k], b = cs->pairs.b[k];
+            if (m->elem_part[a] == m->elem_part[b] && joint_fan_holds(m, a, b)) continue;
             cs->pairs.a[kept] = cs->pairs.a[k];
             cs->pairs.b[kept] = cs->pairs.b[k];
             kept++;

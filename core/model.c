@@ -53,12 +53,12 @@ void fdem_model_destroy(fdem_model *m)
 {
     if (!m) return;
     free(m->pos); free(m->vel); free(m->force); free(m->inv_mass);
-    free(m->pos0); free(m->mass); free(m->node_part); free(m->dof_owned);
+    free(m->pos0); free(m->mass); free(m->node_part); free(m->node_origin); free(m->dof_owned);
     free(m->elem); free(m->elem_part); free(m->tri); free(m->elem_h);
     free(m->materials); free(m->parts); free(m->part_velocity);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
-    free(m->elem_joint);
+    free(m->elem_joint); free(m->vertex_broken);
     contact_free(&m->contact);
     free(m);
 }
@@ -117,9 +117,12 @@ static int reserve_nodes(fdem_model *m, int need)
         if (!p) return -1;
         *d1[i] = p;
     }
-    void *p = realloc(m->node_part, sizeof(int32_t) * (size_t)newcap);
-    if (!p) return -1;
-    m->node_part = p;
+    int32_t **i1[] = {&m->node_part, &m->node_origin};
+    for (size_t i = 0; i < sizeof i1 / sizeof i1[0]; i++) {
+        void *p = realloc(*i1[i], sizeof(int32_t) * (size_t)newcap);
+        if (!p) return -1;
+        *i1[i] = p;
+    }
     m->node_capacity = newcap;
     return 0;
 }
@@ -214,6 +217,7 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
             int dst = fracture ? m->node_count + 3 * t + c : m->node_count + src;
             e->node[c] = dst;
             m->tri[3 * (m->elem_count + t) + c] = dst;
+            m->node_origin[dst] = m->node_count + src;
             if (fracture) {
                 m->pos0[2 * dst] = copy.xy[2 * src];
                 m->pos0[2 * dst + 1] = copy.xy[2 * src + 1];
@@ -224,6 +228,8 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
     if (!fracture)
         memcpy(m->pos0 + 2 * m->node_count, copy.xy, sizeof(double) * 2 * (size_t)copy.node_count);
     for (int i = 0; i < add_nodes; i++) m->node_part[m->node_count + i] = k;
+    if (!fracture)
+        for (int i = 0; i < add_nodes; i++) m->node_origin[m->node_count + i] = m->node_count + i;
     m->node_count += add_nodes;
     m->elem_count += copy.triangle_count;
     m->part_count++;

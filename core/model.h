@@ -70,6 +70,8 @@ struct fdem_model {
     /* nodes: cold */
     double *pos0, *mass;
     int32_t *node_part;
+    int32_t *node_origin;    /* the mesh vertex a node stands for: copies in a fracturing
+                                part share it; otherwise the node itself */
     uint8_t *dof_owned;      /* bit 0: x, bit 1: y prescribed by some constraint */
 
     /* elements */
@@ -99,6 +101,8 @@ struct fdem_model {
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */
+    uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
+                                refreshed at each contact detection */
     int broken_joints;
     int fragments;
 
@@ -145,6 +149,8 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
 int joint_prepare(fdem_model *m, fdem_error *err);
 double joint_stable_dt(const fdem_model *m);
 int joint_holds(const fdem_model *m, int a, int b);
+void joint_mark_broken_vertices(fdem_model *m);
+int joint_fan_holds(const fdem_model *m, int a, int b);
 int joint_forces(fdem_model *m);
 int joint_fragment_count(const fdem_model *m);
 

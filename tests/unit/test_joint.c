@@ -122,6 +122,15 @@ static void softening_curve_ends(void)
     CHECK_REL(simpson_z(), 0.387, 0.01);
 }
 
+static int shared_vertices(const fdem_model *m, int a, int b)
+{
+    int n = 0;
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++)
+            n += m->node_origin[m->elem[a].node[i]] == m->node_origin[m->elem[b].node[k]];
+    return n;
+}
+
 static void block_of_fracturing_triangles_is_built_right(void)
 {
     fdem_model *m = fdem_model_create();
@@ -144,12 +153,27 @@ static void block_of_fracturing_triangles_is_built_right(void)
         CHECK(m->pos0[2 * n[0]] == m->pos0[2 * n[2]] && m->pos0[2 * n[1] + 1] == m->pos0[2 * n[3] + 1],
               "joint %d faces do not coincide", j);
     }
-    /* no contact pair across an intact joint */
+    /* while every joint holds, no contact pair shares a mesh vertex */
     fdem_set_gravity(m, 0, -9.81);
     fdem_step(m, &err);
     for (size_t k = 0; k < m->contact.pairs.count; k++)
-        CHECK(!joint_holds(m, m->contact.pairs.a[k], m->contact.pairs.b[k]), "pair %zu held", k);
-    CHECK(fdem_get_counts(m).contact_pairs > 0, "corner neighbours should be candidates");
+        CHECK(shared_vertices(m, m->contact.pairs.a[k], m->contact.pairs.b[k]) == 0,
+              "pair %zu is glued by intact joints", k);
+    /* break one joint: its two triangles, and every pair around its two
+     * vertices, become contact candidates */
+    int j = m->joint_count / 2;
+    int a = m->joint_elem[2 * j], b = m->joint_elem[2 * j + 1];
+    m->joint_damage[j] = 1.0;
+    m->contact.need_detect = 1;
+    fdem_step(m, &err);
+    int across = 0, around = 0;
+    for (size_t k = 0; k < m->contact.pairs.count; k++) {
+        int pa = m->contact.pairs.a[k], pb = m->contact.pairs.b[k];
+        across += (pa == a && pb == b) || (pa == b && pb == a);
+        around += shared_vertices(m, pa, pb) > 0;
+    }
+    CHECK(across == 1, "the pair across the broken joint appears %d times", across);
+    CHECK(around >= 3, "only %d pairs around the broken joint's vertices", around);
     fdem_model_destroy(m);
 }
 
