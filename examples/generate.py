@@ -114,25 +114,41 @@ dump("disc-pile", {
     "gravity": [0, -9.81],
     "time": {"end": 0.8, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
+# OpenFDEM's Brazilian set in this format's names: "friction" 0.3 is the
+# contact's Coulomb coefficient; the joints' friction angle is not part of
+# the set, so it takes a common value for rock, 30 degrees.
+rock = {"density": 2700, "young": 3e10, "poisson": 0.3, "damping": 0.6, "friction": 0.3,
+        "fracture": {"tensile_strength": 1e6, "cohesion": 3e6,
+                     "friction_angle": 30,
+                     "energy_I": 10, "energy_II": 50}}
+steel = {"density": 7800, "young": 2e11, "poisson": 0.3, "friction": 0.3}
 dump("brazilian-disc", {
     "name": "brazilian-disc",
-    "materials": {
-        "rock": {"density": 2700, "young": 3e10, "poisson": 0.3, "damping": 0.6,
-                 "friction": 0.3,
-                 "fracture": {"tensile_strength": 1e6, "cohesion": 3e6,
-                              "friction_angle": round(math.degrees(math.atan(0.3)), 2),
-                              "energy_I": 10, "energy_II": 50}},
-        "steel": {"density": 7800, "young": 2e11, "poisson": 0.3, "friction": 0.3}},
+    "materials": {"rock": rock, "steel": steel},
     "parts": [
         {"name": "disc", "material": "rock", "fracture": True,
-         "disc": {"center": [0, 0], "radius": 0.025, "divisions": 48}},
+         "gmsh": gmsh_text(os.path.join(OUT, "brazilian-disc.geo"))},
         {"name": "top", "material": "steel",
-         "rectangle": {"origin": [-0.01, 0.02495], "size": [0.02, 0.005], "divisions": [4, 1]}},
+         "rectangle": {"origin": [-0.01, 0.025], "size": [0.02, 0.004], "divisions": [8, 2]}},
         {"name": "bottom", "material": "steel",
-         "rectangle": {"origin": [-0.01, -0.02995], "size": [0.02, 0.005], "divisions": [4, 1]}}],
+         "rectangle": {"origin": [-0.01, -0.029], "size": [0.02, 0.004], "divisions": [8, 2]}}],
+    "constraints": [{"part": "top", "velocity": [0, -0.025]},
+                    {"part": "bottom", "velocity": [0, 0.025]}],
+    "time": {"end": 0.0008, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 1e-5, "fields": ["position", "velocity", "stress", "damage"]}})
+dump("uniaxial-compression", {
+    "name": "uniaxial-compression",
+    "materials": {"rock": rock, "steel": steel},
+    "parts": [
+        {"name": "specimen", "material": "rock", "fracture": True,
+         "gmsh": gmsh_text(os.path.join(OUT, "uniaxial-compression.geo"))},
+        {"name": "top", "material": "steel",
+         "rectangle": {"origin": [-0.0175, 0.025], "size": [0.035, 0.004], "divisions": [10, 2]}},
+        {"name": "bottom", "material": "steel",
+         "rectangle": {"origin": [-0.0175, -0.029], "size": [0.035, 0.004], "divisions": [10, 2]}}],
     "constraints": [{"part": "top", "velocity": [0, -0.05]},
                     {"part": "bottom", "velocity": [0, 0.05]}],
-    "time": {"end": 0.0006, "dt": "auto", "safety": 0.5},
+    "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
     "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
 dump("gmsh-plate", {
     "name": "gmsh-plate",
