@@ -69,7 +69,7 @@ trap - EXIT
 cat <<TXT
 
 Done. Files:
-  $OUT/$name.h5     the result (HDF5, layout in the contract, section 4)
+  $OUT/$name.h5     the result (HDF5, layout in docs/results.md)
   $OUT/$name.xdmf   open this one in ParaView: File > Open, Apply, then play the time series
   $OUT/$name.png    the last snapshot, drawn by clients/python/plot_result.py
 
