@@ -11,7 +11,8 @@
  *
  * Nodal forces come from edge tractions: the force on node a is
  * 1/2 sigma m_a, m_a the outward normal (scaled by length) of the edge
- * opposite a. This needs no division and sums to zero exactly.
+ * opposite a. This needs no division; node 0 takes minus the sum of the
+ * other two, so the forces sum to zero exactly.
  *
  * An element squashed to (or through) zero area would make ln J undefined;
  * below J_MIN the law continues along its tangent in J so the force stays
@@ -61,33 +62,70 @@ double element_stable_dt(const fdem_model *m, int e)
     return m->elem_h[e] / c * (sqrt(1 + xi * xi) - xi);
 }
 
-/* Stress of a deformation gradient (a b; c d), returns J; *w gets the
- * strain energy density per unit initial area. */
-static inline double neo_hookean(double a, double b, double c, double d, double lambda,
-                                 double mu, double s[3], double *w)
+/* ln J for the J of a stressed solid, which is almost always within a few
+ * per mille of 1. libm's log() is a call of ~20 ns-worth of work per element
+ * per step (half the element kernel), so near 1 the Taylor series of
+ * ln(1 + x) is used instead:
+ *   ln(1 + x) = x + x^2 q(x),  q(x) = sum_{k=2..9} (-1)^(k+1) x^(k-2) / k,
+ * for |x| <= 2^-6. x = J - 1 is exact there (Sterbenz), the truncation error
+ * is below |x|^10 / 10, i.e. < 1e-17 of the result, and x^2 q is at most
+ * 1/128 of x, so its rounding hardly reaches the sum: the result is within
+ * an ulp or two of log(J) (tested against log() in test_element.c). q is
+ * evaluated in Estrin's form: a short dependency chain that overlaps with
+ * the division 1/J. Everything else goes to log(). */
+#define LOG_SERIES_RANGE 0x1p-6
+static inline double log_near1(double J)
+{
+    double x = J - 1.0;
+    double x2 = x * x;
+    if (fabs(x) <= 0x1p-10) {
+        double q = (-1.0 / 2 + x * (1.0 / 3)) + x2 * (-1.0 / 4 + x * (1.0 / 5));
+        return x + x2 * q;
+    }
+    if (!(fabs(x) <= LOG_SERIES_RANGE)) return log(J);
+    double x4 = x2 * x2;
+    double p01 = -1.0 / 2 + x * (1.0 / 3), p23 = -1.0 / 4 + x * (1.0 / 5);
+    double p45 = -1.0 / 6 + x * (1.0 / 7), p67 = -1.0 / 8 + x * (1.0 / 9);
+    double q = (p01 + x2 * p23) + x4 * (p45 + x2 * p67);
+    return x + x2 * q;
+}
+
+/* The same function, for the test that holds it to log(). */
+double element_log_near1(double J);
+double element_log_near1(double J) { return log_near1(J); }
+
+/* Half the stress of a deformation gradient (a b; c d) for Lame constants
+ * 2 hlambda, 2 hmu; returns J. *w gets the strain energy density per unit
+ * initial area. Half, because nodal forces are 1/2 sigma m_a: scaling by a
+ * power of two is exact, so this is bit for bit half of sigma and the 0.5
+ * costs no multiplications per component. lambda ln J is shared by the
+ * stress and the energy. */
+static inline double neo_hookean_half(double a, double b, double c, double d, double hlambda,
+                                      double hmu, double hs[3], double *w)
 {
     double J = a * d - b * c;
     double lnJ, invJ;
     if (J >= J_MIN) {
-        lnJ = log(J);
+        lnJ = log_near1(J);
         invJ = 1.0 / J;
     } else {
         lnJ = log(J_MIN) + (J - J_MIN) / J_MIN;
         invJ = 1.0 / J_MIN;
     }
     double B11 = a * a + b * b, B22 = c * c + d * d, B12 = a * c + b * d;
-    double muJ = mu * invJ, vol = lambda * lnJ * invJ;
-    s[0] = muJ * (B11 - 1) + vol;
-    s[1] = muJ * (B22 - 1) + vol;
-    s[2] = muJ * B12;
-    *w = 0.5 * mu * (B11 + B22 - 2 - 2 * lnJ) + 0.5 * lambda * lnJ * lnJ;
+    double hmuJ = hmu * invJ, hl_lnJ = hlambda * lnJ, hvol = hl_lnJ * invJ;
+    hs[0] = hmuJ * (B11 - 1) + hvol;
+    hs[1] = hmuJ * (B22 - 1) + hvol;
+    hs[2] = hmuJ * B12;
+    *w = hmu * (B11 + B22 - 2 - 2 * lnJ) + hl_lnJ * lnJ;
     return J;
 }
 
-/* Adds 2 eta D to s, returns the dissipated power per unit current area
- * (sigma_v : D). */
-static inline double viscous_stress(const double *v, int n0, int n1, int n2, double x1, double y1,
-                                    double x2, double y2, double eta, double s[3])
+/* Adds eta D (half of 2 eta D) to the half stress hs, returns the
+ * dissipated power per unit current area (sigma_v : D). The division is
+ * paid only by damped elements. */
+static inline double viscous_half(const double *v, int n0, int n1, int n2, double x1, double y1,
+                                  double x2, double y2, double eta, double hs[3])
 {
     double u1 = v[2 * n1] - v[2 * n0], w1 = v[2 * n1 + 1] - v[2 * n0 + 1];
     double u2 = v[2 * n2] - v[2 * n0], w2 = v[2 * n2 + 1] - v[2 * n0 + 1];
@@ -98,44 +136,61 @@ static inline double viscous_stress(const double *v, int n0, int n1, int n2, dou
     double L11 = (u1 * y2 - u2 * y1) * inv, L12 = (-u1 * x2 + u2 * x1) * inv;
     double L21 = (w1 * y2 - w2 * y1) * inv, L22 = (-w1 * x2 + w2 * x1) * inv;
     double D12 = 0.5 * (L12 + L21);
-    s[0] += 2 * eta * L11;
-    s[1] += 2 * eta * L22;
-    s[2] += 2 * eta * D12;
+    hs[0] += eta * L11;
+    hs[1] += eta * L22;
+    hs[2] += eta * D12;
     return 2 * eta * (L11 * L11 + L22 * L22 + 2 * D12 * D12);
 }
 
+/* The hot loop: one pass over the element records, gathering three nodes
+ * and scattering three forces each. Per element it is ~80 floating-point
+ * operations and one division, so it is bound by the FP ports rather than
+ * memory; the shape below is chosen to keep that count low:
+ *  - half stress (above), so the 1/2 of 1/2 sigma m_a is free;
+ *  - the edge normals opposite nodes 1 and 2 are (-y2, x2) and (y1, -x1),
+ *    read straight off the edge vectors; node 0 takes minus the sum of the
+ *    other two, which is 1/2 sigma m_0 since m_0 + m_1 + m_2 = 0, and makes
+ *    each element's forces sum to exactly zero in floating point;
+ *  - the material's constants are reloaded only when the material changes
+ *    (elements of a part are contiguous). */
 void element_forces(fdem_model *m, double dt)
 {
     const double *pos = m->pos, *vel = m->vel;
     double *f = m->force;
     const material *mats = m->materials;
     double energy = 0, dissipated = 0;
-    for (int e = 0; e < m->elem_count; e++) {
-        const element_hot *el = &m->elem[e];
+    int32_t cur_mat = -1;
+    double hlambda = 0, hmu = 0;
+    const element_hot *el = m->elem, *end = m->elem + m->elem_count;
+    for (; el < end; el++) {
         int n0 = el->node[0], n1 = el->node[1], n2 = el->node[2];
-        double x0 = pos[2 * n0], y0 = pos[2 * n0 + 1];
-        double x1 = pos[2 * n1] - x0, y1 = pos[2 * n1 + 1] - y0;
-        double x2 = pos[2 * n2] - x0, y2 = pos[2 * n2 + 1] - y0;
+        const double *p0 = pos + 2 * (size_t)n0, *p1 = pos + 2 * (size_t)n1,
+                     *p2 = pos + 2 * (size_t)n2;
+        double x1 = p1[0] - p0[0], y1 = p1[1] - p0[1];
+        double x2 = p2[0] - p0[0], y2 = p2[1] - p0[1];
         const double *Xi = el->xinv;
         double a = x1 * Xi[0] + x2 * Xi[2], b = x1 * Xi[1] + x2 * Xi[3];
         double c = y1 * Xi[0] + y2 * Xi[2], d = y1 * Xi[1] + y2 * Xi[3];
-        const material *mat = &mats[el->material];
-        double s[3], w;
-        double J = neo_hookean(a, b, c, d, mat->lambda, mat->mu, s, &w);
+        if (el->material != cur_mat) {
+            cur_mat = el->material;
+            hlambda = 0.5 * mats[cur_mat].lambda;
+            hmu = 0.5 * mats[cur_mat].mu;
+        }
+        double hs[3], w;
+        double J = neo_hookean_half(a, b, c, d, hlambda, hmu, hs, &w);
         energy += w * el->area0;
         if (el->eta > 0)
-            dissipated += viscous_stress(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, s) *
+            dissipated += viscous_half(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, hs) *
                           fabs(J) * el->area0;
-        /* edge normals (outward, length-scaled) opposite nodes 0, 1, 2 */
-        double m0x = y2 - y1, m0y = -(x2 - x1);
-        double m1x = -y2, m1y = x2;
-        double m2x = y1, m2y = -x1;
-        f[2 * n0] += 0.5 * (s[0] * m0x + s[2] * m0y);
-        f[2 * n0 + 1] += 0.5 * (s[2] * m0x + s[1] * m0y);
-        f[2 * n1] += 0.5 * (s[0] * m1x + s[2] * m1y);
-        f[2 * n1 + 1] += 0.5 * (s[2] * m1x + s[1] * m1y);
-        f[2 * n2] += 0.5 * (s[0] * m2x + s[2] * m2y);
-        f[2 * n2 + 1] += 0.5 * (s[2] * m2x + s[1] * m2y);
+        double f1x = hs[2] * x2 - hs[0] * y2, f1y = hs[1] * x2 - hs[2] * y2;
+        double f2x = hs[0] * y1 - hs[2] * x1, f2y = hs[2] * y1 - hs[1] * x1;
+        double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
+        g1[0] += f1x;
+        g1[1] += f1y;
+        g2[0] += f2x;
+        g2[1] += f2y;
+        g0[0] -= f1x + f2x;
+        g0[1] -= f1y + f2y;
     }
     m->elastic_energy = energy;
     m->damping_work += dissipated * dt;
@@ -154,8 +209,9 @@ void element_stress_one(const fdem_model *m, int e, double out[3])
     double c = y1 * Xi[0] + y2 * Xi[2], d = y1 * Xi[1] + y2 * Xi[3];
     const material *mat = &m->materials[el->material];
     double w;
-    neo_hookean(a, b, c, d, mat->lambda, mat->mu, out, &w);
-    if (el->eta > 0) viscous_stress(m->vel, n0, n1, n2, x1, y1, x2, y2, el->eta, out);
+    neo_hookean_half(a, b, c, d, 0.5 * mat->lambda, 0.5 * mat->mu, out, &w);
+    if (el->eta > 0) viscous_half(m->vel, n0, n1, n2, x1, y1, x2, y2, el->eta, out);
+    for (int k = 0; k < 3; k++) out[k] *= 2; /* exact */
 }
 
 int element_of_node(const fdem_model *m, int node)

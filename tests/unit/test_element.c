@@ -121,6 +121,63 @@ static void inverted_element_stays_finite(void)
     fdem_model_destroy(m);
 }
 
+/* element.c's ln J: series near 1, log() elsewhere (not in model.h: it is
+ * the kernel's private approximation, exported for this test only). */
+double element_log_near1(double J);
+
+/* The series must stay within a few ulps of log() over both of its ranges
+ * (|J - 1| <= 2^-10 and <= 2^-6), at their edges, and be exact elsewhere. */
+static void log_series_matches_log(void)
+{
+    double worst = 0;
+    int n = 200000;
+    for (int k = -n; k <= n; k++) {
+        double x = 0x1p-6 * (double)k / n * 1.001; /* a little past the edge */
+        for (int s = 0; s < 2; s++) {
+            double J = 1.0 + (s ? x * 0x1p-4 : x); /* also sweep |x| <= 2^-10 finely */
+            double want = log(J), got = element_log_near1(J);
+            double err = want == 0 ? fabs(got) : fabs(got - want) / fabs(want);
+            if (err > worst) worst = err;
+        }
+    }
+    CHECK(worst < 1e-15, "series ln J: worst relative error %.3g", worst);
+    double edges[] = {1 + 0x1p-10, 1 - 0x1p-10, 1 + 0x1p-6, 1 - 0x1p-6, 1 + 1e-300, 1, 0.5, 2, 0.05, 7};
+    for (int k = 0; k < (int)(sizeof edges / sizeof edges[0]); k++) {
+        double J = edges[k], want = log(J), got = element_log_near1(J);
+        CHECK(want == 0 ? got == 0 : fabs(got - want) <= 1e-15 * fabs(want), "ln %.17g: %.17g vs %.17g",
+              J, got, want);
+    }
+    CHECK(element_log_near1(1.5) == log(1.5) && element_log_near1(0.9) == log(0.9),
+          "outside the series' range ln J must be log()");
+}
+
+/* Node 0 of each element takes exactly minus the (rounded) sum of the other
+ * two forces, so (f1 + f2) + f0 == 0 in floating point, under any
+ * deformation. */
+static void element_forces_sum_to_zero_exactly(void)
+{
+    fdem_model *m = unit_block(3e10, 0.25);
+    deform(m, 1.003, 0.02, -0.01, 0.995, 0.3, 0.1);
+    element_hot *all = m->elem;
+    int count = m->elem_count;
+    for (int e = 0; e < count; e++) {
+        memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+        m->elem = all + e; /* this element on its own */
+        m->elem_count = 1;
+        element_forces(m, 0);
+        const int32_t *nd = all[e].node;
+        for (int d = 0; d < 2; d++) {
+            double f0 = m->force[2 * nd[0] + d], f1 = m->force[2 * nd[1] + d];
+            double f2 = m->force[2 * nd[2] + d];
+            CHECK((f1 + f2) + f0 == 0 && f0 != 0, "element %d dof %d: %g %g %g", e, d, f0, f1, f2);
+        }
+    }
+    m->elem = all;
+    m->elem_count = count;
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(rigid_rotation_gives_zero_stress), T(small_strain_is_linear_plane_strain),
            T(forces_balance_and_energy_matches), T(stretched_block_pulls_nodes_inward),
-           T(inverted_element_stays_finite))
+           T(inverted_element_stays_finite), T(log_series_matches_log),
+           T(element_forces_sum_to_zero_exactly))
