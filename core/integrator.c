@@ -20,45 +20,68 @@
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
-/* Updates every dof no constraint owns. Returns a sum of the new positions
- * and velocities: non-finite if and only if some value is (cheaper than a
- * test per value in the hot loop). */
-int central_difference_step(fdem_model *m, double h, double havg)
+/* One pass over the nodes: the central difference update of every dof no
+ * constraint owns. Returns a sum of the new positions and velocities:
+ * non-finite if and only if some value is (cheaper than a test per value in
+ * the hot loop); the sum is accumulated as one add per node, so that its
+ * dependency chain does not pace the loop. with_contact is a constant at
+ * each call below, so the compiler emits the contact-free loop without the
+ * contact terms' loads and branches. */
+static inline double central_difference_pass(fdem_model *m, double h, double havg,
+                                             int with_contact, double *contact_work_out,
+                                             double *max_disp2_io)
 {
     const double gx = m->gravity[0], gy = m->gravity[1];
     double *x = m->pos, *v = m->vel;
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
-    const double *fc = m->contact.enabled ? m->contact.force : NULL;
-    const double *xd = m->contact.enabled ? m->contact.pos_detect : NULL;
-    double check = 0, max_disp2 = m->contact.max_disp2, contact_work = 0;
+    const double *fc = m->contact.force;
+    const double *xd = m->contact.pos_detect;
+    double check = 0, max_disp2 = *max_disp2_io, contact_work = 0;
     for (int i = 0; i < m->node_count; i++) {
         double fx = f[2 * i], fy = f[2 * i + 1];
         double vx_old = v[2 * i], vy_old = v[2 * i + 1];
-        if (fc) {
+        if (with_contact) {
             fx += fc[2 * i];
             fy += fc[2 * i + 1];
         }
         unsigned own = owned[i];
+        double vx = vx_old, vy = vy_old, px = x[2 * i], py = x[2 * i + 1];
         if (!(own & 1u)) {
-            v[2 * i] += (fx * inv_mass[i] + gx) * havg;
-            x[2 * i] += v[2 * i] * h;
+            vx += (fx * inv_mass[i] + gx) * havg;
+            px += vx * h;
+            v[2 * i] = vx;
+            x[2 * i] = px;
         }
         if (!(own & 2u)) {
-            v[2 * i + 1] += (fy * inv_mass[i] + gy) * havg;
-            x[2 * i + 1] += v[2 * i + 1] * h;
+            vy += (fy * inv_mass[i] + gy) * havg;
+            py += vy * h;
+            v[2 * i + 1] = vy;
+            x[2 * i + 1] = py;
         }
-        check += x[2 * i] + x[2 * i + 1] + v[2 * i] + v[2 * i + 1];
-        if (fc) {
+        check += (px + py) + (vx + vy);
+        if (with_contact) {
             /* f . (v_old + v_new)/2 * havg is exactly what the force adds to
              * the half-step kinetic energy, so the balance closes. */
-            contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + v[2 * i])) +
-                            ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + v[2 * i + 1]));
-            double ux = x[2 * i] - xd[2 * i], uy = x[2 * i + 1] - xd[2 * i + 1];
+            contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + vx)) +
+                            ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + vy));
+            double ux = px - xd[2 * i], uy = py - xd[2 * i + 1];
             double d2 = ux * ux + uy * uy;
             if (d2 > max_disp2) max_disp2 = d2;
         }
     }
+    *contact_work_out = contact_work;
+    *max_disp2_io = max_disp2;
+    return check;
+}
+
+int central_difference_step(fdem_model *m, double h, double havg)
+{
+    double contact_work = 0, max_disp2 = m->contact.max_disp2, check;
+    if (m->contact.enabled)
+        check = central_difference_pass(m, h, havg, 1, &contact_work, &max_disp2);
+    else
+        check = central_difference_pass(m, h, havg, 0, &contact_work, &max_disp2);
     contact_work *= 0.5 * havg;
     m->contact.max_disp2 = max_disp2;
     m->contact_work += contact_work;
