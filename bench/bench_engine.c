@@ -5,7 +5,11 @@
  *     element-step must move (measured with the STREAM-like triad here);
  *  2. a dense pile of discs in a box with contact: ns per element-step and
  *     the split over element forces, detection, contact and integration,
- *     and NBS against the all-pairs check on the same circles.
+ *     and NBS against the all-pairs check on the same circles;
+ *  3. a fracturing block (every triangle on its own nodes, a joint on every
+ *     interior edge) vibrating at small strain: ns per element-step with
+ *     the joints, beside the same block without fracture and the bandwidth
+ *     bound of a private-node mesh.
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -73,8 +77,14 @@ static fdem_model *disc_pile(int columns, int rows)
     build_fix_part(m, ri);
     for (int row = 0; row < rows; row++)
         for (int col = 0; col < columns; col++)
-            build_disc(m, disc, 0.0115 + col * 0.021 + (row % 2) * 0.002, 0.0105 + row * 0.0205,
-                       r * (0.92 + 0.08 * ((row * 7 + col * 3) % 5) / 4.0), 16);
+        {
+            int p = build_disc(m, disc, 0.0115 + col * 0.021 + (row % 2) * 0.002,
+                               0.0105 + row * 0.0205,
+                               r * (0.92 + 0.08 * ((row * 7 + col * 3) % 5) / 4.0), 16);
+            /* thrown down at 1 m/s so the pile is packed and touching within
+             * the settling steps, instead of still falling when timed */
+            fdem_set_part_velocity(m, p, 0, -1.0, NULL);
+        }
     fdem_set_gravity(m, 0, -9.81);
     build_finalize(m, 0.5);
     return m;
@@ -129,11 +139,96 @@ static void bench_disc_pile(void)
     }
 }
 
-int main(void)
+/* A block vibrating at small strain (no joint breaks), fracturing or not. */
+/* A bench that broke joints would time the wrong thing: say so loudly. */
+#define CHECK_BROKEN(n) \
+    do { \
+        if (n) printf("           (!) %d joints broke: the figure above is not an intact block\n", n); \
+    } while (0)
+
+static fdem_model *vibrating_block(int n, int fracture)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_material_def def = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = 0.1,
+                             .friction = 0.3, .has_fracture = 1,
+                             .fracture = {1e6, 3e6, 30, 10, 50}};
+    fdem_error err;
+    int mat = fdem_add_material(m, &def, &err);
+    fdem_mesh mesh;
+    if (fdem_mesh_rectangle(0, 0, 1, 1, n, n, &mesh, &err)) build_die("rectangle", &err);
+    int p = fdem_add_part(m, &mesh, mat, fracture, &err);
+    fdem_mesh_free(&mesh);
+    if (p < 0) build_die("block", &err);
+    /* a 0.1 mm/s shear of the initial velocity field: strains stay ~1e-9 */
+    build_finalize(m, 0.5);
+    for (int i = 0; i < m->node_count; i++) m->vel[2 * i] = 1e-4 * m->pos0[2 * i + 1];
+    return m;
+}
+
+static void bench_fracturing_block(double bandwidth_gbs)
+{
+    printf("\n## Fracturing block: private nodes per triangle, a joint on every interior edge\n");
+    printf("%10s %8s %8s %14s %13s %9s %9s %9s %12s %10s %14s\n", "elements", "joints", "steps",
+           "ns/elem-step", "no-fracture", "forces%", "contact%", "integr%", "bytes/elem",
+           "bound ns", "pairs/el");
+    int sizes[] = {70, 224, 707}; /* 2 n^2 triangles: 1e4, 1e5, 1e6 */
+    for (int k = 0; k < 3; k++) {
+        double ns[2] = {0, 0};
+        int steps = 0;
+        fdem_stage_times before = {0};
+        fdem_model *keep = NULL;
+        for (int fracture = 0; fracture < 2; fracture++) {
+            fdem_model *m = vibrating_block(sizes[k], fracture);
+            fdem_error err;
+            for (int s = 0; s < 3; s++) fdem_step(m, &err);
+            if (fracture) before = fdem_get_stage_times(m);
+            steps = (int)(2e7 / m->elem_count);
+            if (steps < 10) steps = 10;
+            double t0 = now();
+            for (int s = 0; s < steps; s++) fdem_step(m, &err);
+            ns[fracture] = (now() - t0) * 1e9 / ((double)steps * m->elem_count);
+            if (fracture) keep = m;
+            else fdem_model_destroy(m);
+        }
+        fdem_model *m = keep;
+        fdem_stage_times t = fdem_get_stage_times(m);
+        t.elements -= before.elements;
+        t.detection -= before.detection;
+        t.contact -= before.contact;
+        t.integration -= before.integration;
+        double sum = t.elements + t.detection + t.contact + t.integration;
+        fdem_counts c = fdem_get_counts(m);
+        /* per element-step once the mesh is larger than cache: the element
+         * record (64), three private nodes' position, velocity and force
+         * (3 x 64, force written twice: elements, joints), inverse mass and
+         * dof flag (3 x 9), and 1.5 joints of 4 node ids + damage + size (40) */
+        double bytes = 64 + 3 * (64 + 9) + 1.5 * 40;
+        printf("%10d %8d %8d %14.1f %13.1f %9.1f %9.1f %9.1f %12.0f %10.1f %14.2f\n", c.elements,
+               c.joints, steps, ns[1], ns[0], 100 * t.elements / sum,
+               100 * (t.contact + t.detection) / sum, 100 * t.integration / sum,
+               (double)fdem_memory_bytes(m) / c.elements, bytes / bandwidth_gbs,
+               (double)c.contact_pairs / c.elements);
+        CHECK_BROKEN(c.broken_joints);
+        fdem_model_destroy(m);
+    }
+}
+
+/* With no argument every section runs; otherwise only those named
+ * (block, pile, fracture), to iterate on one kernel. */
+static int wanted(int argc, char **argv, const char *name)
+{
+    if (argc < 2) return 1;
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], name) == 0) return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
 {
     double bw = stream_bandwidth_gbs();
     printf("# fdemd engine bench (single core)\nsingle-core triad bandwidth: %.1f GB/s\n", bw);
-    bench_elastic_block(bw);
-    bench_disc_pile();
+    if (wanted(argc, argv, "block")) bench_elastic_block(bw);
+    if (wanted(argc, argv, "pile")) bench_disc_pile();
+    if (wanted(argc, argv, "fracture")) bench_fracturing_block(bw);
     return 0;
 }

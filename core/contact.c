@@ -237,10 +237,12 @@ static int contact_detect(fdem_model *m)
         return -1;
     if (m->joint_count) { /* triangles glued by intact joints never contact */
         joint_mark_broken_vertices(m);
+        joint_fragment_labels(m, cs->piece);
         size_t kept = 0;
         for (size_t k = 0; k < cs->pairs.count; k++) {
             int a = cs->pairs.a[k], b = cs->pairs.b[k];
-            if (m->elem_part[a] == m->elem_part[b] && joint_fan_holds(m, a, b)) continue;
+            if (m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, cs->piece, a, b))
+                continue;
             cs->pairs.a[kept] = cs->pairs.a[k];
             cs->pairs.b[kept] = cs->pairs.b[k];
             kept++;
@@ -266,9 +268,10 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->cy = malloc(sizeof(double) * E);
     cs->r = malloc(sizeof(double) * E);
     cs->body = malloc(sizeof(int32_t) * E);
+    cs->piece = malloc(sizeof(int32_t) * E);
     cs->pos_detect = malloc(sizeof(double) * 2 * N);
     cs->force = calloc(2 * N, sizeof(double));
-    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->pos_detect || !cs->force) {
+    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->piece || !cs->pos_detect || !cs->force) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -291,7 +294,7 @@ int contact_init(fdem_model *m, fdem_error *err)
 
 void contact_free(contact_state *cs)
 {
-    free(cs->cx); free(cs->cy); free(cs->r); free(cs->body);
+    free(cs->cx); free(cs->cy); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
     nbs_grid_free(&cs->grid);
     nbs_pairs_free(&cs->pairs);

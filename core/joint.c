@@ -140,9 +140,12 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     size_t J = (size_t)m->joint_count;
     m->joint_damage = calloc(J, sizeof(double));
     m->joint_h = malloc(sizeof(double) * J);
+    m->joint_k = malloc(sizeof(double) * J);
+    m->joint_material = malloc(sizeof(int32_t) * J);
     m->elem_joint = malloc(sizeof(int32_t) * 3 * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
-    if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken) {
+    if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k ||
+        !m->joint_material) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
     }
@@ -150,6 +153,8 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     for (int j = 0; j < m->joint_count; j++) {
         int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
         m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
+        m->joint_material[j] = m->elem[ea].material;
+        m->joint_k[j] = m->materials[m->elem[ea].material].penalty / m->joint_h[j];
         for (int s = 0; s < 2; s++) {
             int e = m->joint_elem[2 * j + s];
             for (int c = 0; c < 3; c++)
@@ -211,6 +216,27 @@ void joint_mark_broken_vertices(fdem_model *m)
  * Leaving these pairs out of contact keeps an intact fracturing block as
  * cheap as its joints instead of paying for about a dozen touching-at-a-
  * point pairs per triangle. Valid after joint_mark_broken_vertices. */
+static int element_on_crack(const fdem_model *m, int e)
+{
+    const int32_t *n = m->elem[e].node;
+    return m->vertex_broken[m->node_origin[n[0]]] | m->vertex_broken[m->node_origin[n[1]]] |
+           m->vertex_broken[m->node_origin[n[2]]];
+}
+
+/* True when contact between a and b (of one fracturing part) can be left
+ * out: they are glued (joint_fan_holds), or they belong to one piece
+ * (piece[], from joint_fragment_labels) and neither has a vertex on a broken
+ * joint. The faces a crack exposes all have such a vertex, so every pair
+ * that can meet across a crack stays; two elements inside one intact piece
+ * could only meet if the piece folded onto itself, which no joint in a
+ * brittle solid survives. This makes an intact fracturing block cost its
+ * joints and no contact at all. */
+int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int b)
+{
+    if (joint_fan_holds(m, a, b)) return 1;
+    return piece[a] == piece[b] && !element_on_crack(m, a) && !element_on_crack(m, b);
+}
+
 int joint_fan_holds(const fdem_model *m, int a, int b)
 {
     if (joint_holds(m, a, b)) return 1;
@@ -226,29 +252,33 @@ int joint_fan_holds(const fdem_model *m, int a, int b)
 
 /* --------------------------------------------------------------- forces */
 
-typedef struct joint_law {
-    double penalty_over_h;   /* p / h */
-    double ft, cohesion, tan_phi, gI, gII;
-} joint_law;
-
-/* Tractions at one Gauss point from opening and sliding; updates the
- * joint's damage (never downwards). */
-static void joint_traction(const joint_law *law, double delta, double slide, double *damage,
-                           double *sigma, double *tau)
+/* Tractions at one Gauss point from opening delta and sliding s; updates
+ * the joint's damage (never downwards). k is the joint's stiffness p / h.
+ *
+ * The elastic test compares tractions, not displacements (k delta <= f_t
+ * rather than delta <= f_t / k), so an intact joint, which is nearly every
+ * joint in nearly every step, costs no division and no softening curve. */
+static inline void joint_traction(const material *mat, double k, double delta, double slide,
+                                  double *damage, double *sigma, double *tau)
 {
-    double k = law->penalty_over_h;
-    double sigma_elastic = k * delta;
-    double compression = delta < 0 ? -sigma_elastic : 0;
-    double fs = law->cohesion + compression * law->tan_phi;
-    double dp = law->ft / k, sp = fs / k;
-    double dc = fmax(3 * law->gI / law->ft, 2 * dp), sc = fmax(3 * law->gII / fs, 2 * sp);
+    const fdem_fracture_params *fp = &mat->def.fracture;
+    double sigma_e = k * delta, tau_e = k * slide;
+    double fs = fp->cohesion + (delta < 0 ? -sigma_e * mat->tan_phi : 0);
+    if (*damage == 0 && sigma_e <= fp->tensile_strength && fabs(tau_e) <= fs) {
+        *sigma = sigma_e;
+        *tau = tau_e;
+        return;
+    }
+    double ft = fp->tensile_strength;
+    double dp = ft / k, sp = fs / k;
+    double dc = fmax(3 * fp->energy_I / ft, 2 * dp), sc = fmax(3 * fp->energy_II / fs, 2 * sp);
     double dn = delta > dp ? (delta - dp) / (dc - dp) : 0;
     double ds = fabs(slide) > sp ? (fabs(slide) - sp) / (sc - sp) : 0;
     double D = sqrt(dn * dn + ds * ds);
     if (D > *damage) *damage = D > 1 ? 1 : D;
     double z = joint_softening(*damage);
-    if (delta < 0) *sigma = sigma_elastic; /* compression: the joint's penalty */
-    else *sigma = law->ft * fmin(delta / dp, 1.0) * z;
+    if (delta < 0) *sigma = sigma_e; /* compression: the joint's penalty */
+    else *sigma = ft * fmin(delta / dp, 1.0) * z;
     double r = slide / sp;
     *tau = fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
 }
@@ -260,30 +290,30 @@ int joint_forces(fdem_model *m)
     static const double gauss[2] = {0.21132486540518713, 0.78867513459481287};
     const double *x = m->pos;
     double *f = m->force;
+    const material *mats = m->materials;
     int broke = 0;
     for (int j = 0; j < m->joint_count; j++) {
-        if (m->joint_damage[j] >= 1.0) continue;
+        double damage = m->joint_damage[j];
+        if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 4 * j;
-        const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
-        const fdem_fracture_params *fp = &mat->def.fracture;
-        joint_law law = {mat->penalty / m->joint_h[j], fp->tensile_strength, fp->cohesion,
-                         tan(fp->friction_angle * M_PI / 180), fp->energy_I, fp->energy_II};
+        const material *mat = &mats[m->joint_material[j]];
+        double k = m->joint_k[j];
         double ax0 = x[2 * n[0]], ay0 = x[2 * n[0] + 1], ax1 = x[2 * n[1]], ay1 = x[2 * n[1] + 1];
         double bx0 = x[2 * n[2]], by0 = x[2 * n[2] + 1], bx1 = x[2 * n[3]], by1 = x[2 * n[3] + 1];
         double tx = 0.5 * ((ax1 - ax0) + (bx1 - bx0)), ty = 0.5 * ((ay1 - ay0) + (by1 - by0));
-        double L = hypot(tx, ty);
-        if (!(L > 0)) continue;
-        tx /= L;
-        ty /= L;
+        double L2 = tx * tx + ty * ty;
+        if (!(L2 > 0)) continue;
+        double L = sqrt(L2), inv_L = 1.0 / L;
+        tx *= inv_L;
+        ty *= inv_L;
         double nx = ty, ny = -tx; /* A's outward normal */
-        double damage = m->joint_damage[j];
         double fa0x = 0, fa0y = 0, fa1x = 0, fa1y = 0;
         for (int g = 0; g < 2; g++) {
             double xi = gauss[g];
             double dx = ((1 - xi) * bx0 + xi * bx1) - ((1 - xi) * ax0 + xi * ax1);
             double dy = ((1 - xi) * by0 + xi * by1) - ((1 - xi) * ay0 + xi * ay1);
             double sigma, tau;
-            joint_traction(&law, dx * nx + dy * ny, dx * tx + dy * ty, &damage, &sigma, &tau);
+            joint_traction(mat, k, dx * nx + dy * ny, dx * tx + dy * ty, &damage, &sigma, &tau);
             double w = 0.5 * L;
             double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
             fa0x += (1 - xi) * Tx; fa0y += (1 - xi) * Ty;
@@ -314,23 +344,34 @@ static int uf_find(int32_t *parent, int i)
     return i;
 }
 
-/* Connected pieces: elements joined by intact joints (a part that does not
- * fracture is one piece). Returns -1 on allocation failure. */
-int joint_fragment_count(const fdem_model *m)
+/* Labels every element with its piece (elements joined by intact joints;
+ * a part that does not fracture is one piece): label[e] is the smallest
+ * element of e's piece. Returns the number of pieces. */
+int joint_fragment_labels(const fdem_model *m, int32_t *label)
 {
-    int32_t *parent = malloc(sizeof(int32_t) * (size_t)(m->elem_count ? m->elem_count : 1));
-    if (!parent) return -1;
     for (int e = 0; e < m->elem_count; e++) {
         int p = m->elem_part[e];
-        parent[e] = m->parts[p].fracture ? e : m->parts[p].elem_begin;
+        label[e] = m->parts[p].fracture ? e : m->parts[p].elem_begin;
     }
     for (int j = 0; j < m->joint_count; j++) {
         if (m->joint_damage[j] >= 1.0) continue;
-        int a = uf_find(parent, m->joint_elem[2 * j]), b = uf_find(parent, m->joint_elem[2 * j + 1]);
-        if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+        int a = uf_find(label, m->joint_elem[2 * j]), b = uf_find(label, m->joint_elem[2 * j + 1]);
+        if (a != b) label[a < b ? b : a] = a < b ? a : b;
     }
     int count = 0;
-    for (int e = 0; e < m->elem_count; e++) count += uf_find(parent, e) == e;
-    free(parent);
+    for (int e = 0; e < m->elem_count; e++) {
+        label[e] = uf_find(label, e);
+        count += label[e] == e;
+    }
+    return count;
+}
+
+/* The number of pieces, or -1 on allocation failure. */
+int joint_fragment_count(const fdem_model *m)
+{
+    int32_t *label = malloc(sizeof(int32_t) * (size_t)(m->elem_count ? m->elem_count : 1));
+    if (!label) return -1;
+    int count = joint_fragment_labels(m, label);
+    free(label);
     return count;
 }

@@ -58,6 +58,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->materials); free(m->parts); free(m->part_velocity);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
+    free(m->joint_k); free(m->joint_material);
     free(m->elem_joint); free(m->vertex_broken);
     contact_free(&m->contact);
     free(m);
@@ -95,6 +96,7 @@ int fdem_add_material(fdem_model *m, const fdem_material_def *def, fdem_error *e
     mat->mu = E / (2 * (1 + nu));
     mat->lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
     mat->penalty = def->penalty > 0 ? def->penalty : 10 * E;
+    mat->tan_phi = def->has_fracture ? tan(def->fracture.friction_angle * M_PI / 180) : 0;
     m->material_count++;
     return k;
 }

@@ -20,6 +20,7 @@ typedef struct material {
     fdem_material_def def;
     double lambda, mu;   /* Lame constants (plane strain uses the 3D ones) */
     double penalty;      /* resolved: def.penalty or 10 * young */
+    double tan_phi;      /* joints: tan(fracture.friction_angle) */
 } material;
 
 /* Hot per-element record: exactly one cache line. */
@@ -57,6 +58,7 @@ typedef struct contact_state {
     double *pos_detect;      /* node positions at the last detection */
     double *force;           /* contact force per node (kept apart for its work) */
     int32_t *body;           /* body id per element: pairs of one body never touch */
+    int32_t *piece;          /* scratch: piece label per element (fracturing models) */
     nbs_grid grid;
     nbs_pairs pairs;
 } contact_state;
@@ -99,6 +101,8 @@ struct fdem_model {
     int32_t *joint_node;     /* 4 per joint: a0, a1 (face A), b0, b1 (their copies in B) */
     int32_t *joint_elem;     /* 2 per joint: elements A and B */
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
+    double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
+    int32_t *joint_material; /* element A's material */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
@@ -151,6 +155,8 @@ double joint_stable_dt(const fdem_model *m);
 int joint_holds(const fdem_model *m, int a, int b);
 void joint_mark_broken_vertices(fdem_model *m);
 int joint_fan_holds(const fdem_model *m, int a, int b);
+int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int b);
+int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 int joint_fragment_count(const fdem_model *m);
 
