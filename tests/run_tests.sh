@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every unit-test binary, then (unless UNIT_ONLY=1) the integration
 # tests against the real daemon, and closes with "N passed, N failed".
-# Each test prints "PASS name" or "FAIL name"; this script only counts them.
+# Each test prints "PASS name" or "FAIL name" (or "SKIP name (why)", which
+# is reported but never counted as passed); this script only counts them.
 set -u
 BUILD=${BUILD:-build}
 BIN=${BIN:-bin}
@@ -26,9 +27,11 @@ fi
 
 passed=$(grep -c '^PASS ' "$log" || true)
 failed=$(grep -c '^FAIL ' "$log" || true)
+skipped=$(grep -c '^SKIP ' "$log" || true)
 rm -f "$log"
 [ "$failed" -ne 0 ] && status=1
 [ "$passed" -eq 0 ] && status=1
 echo
+if [ "$skipped" -ne 0 ]; then echo "($skipped skipped: see the SKIP lines above)"; fi
 echo "$passed passed, $failed failed"
 exit $status

@@ -14,8 +14,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 
 
 class LineResult(unittest.TestResult):
-    """Prints a PASS/FAIL line as each test ends (skips count as PASS with a
-    note, since a skipped test states why it could not run)."""
+    """Prints a PASS/FAIL line as each test ends; a skipped test prints SKIP
+    with its reason and is not counted as passed."""
 
     def __init__(self):
         super().__init__()
@@ -47,7 +47,7 @@ class LineResult(unittest.TestResult):
 
     def addSkip(self, test, reason):
         super().addSkip(test, reason)
-        print("PASS %s (skipped: %s)" % (test.id(), reason), flush=True)
+        print("SKIP %s (%s)" % (test.id(), reason), flush=True)
 
     def addUnexpectedSuccess(self, test):
         super().addUnexpectedSuccess(test)
