@@ -25,7 +25,20 @@
  *    branches on the edges: unfolded guards stay empty, folded guards mirror
  *    the opposite edge for the duration of one row.
  *  - "Old" rows keep their list (it is still needed as the row below another
- *    row): a row head h >= 0 is new; an old one is stored as -2 - h.
+ *    row): a row head h >= 0 is new; an old one is stored as -2 - h. A row
+ *    head is emptied as soon as no row can need it any more (the row and the
+ *    row above it are both done), so no pass is needed to clear the rows.
+ *  - Speed (the cost is per-element instructions, not memory, even at 1e6):
+ *    integerising and the row lists are one pass; the bounds use plain
+ *    compares (the values are already known to be finite, so fmin/fmax and
+ *    their NaN handling are not needed); a new row's list is walked once, to
+ *    map it into its cell table and to gather its circles into the order
+ *    buffer, so that testing and unmapping read contiguous indices instead
+ *    of chasing the list again; when the next new row is the one just above
+ *    (the usual case in spatial order), the row just done is already mapped
+ *    and is kept as the row below, so each circle is mapped and unmapped
+ *    once instead of twice. The two rows in the tables are gathered at the
+ *    two ends of one buffer of n (they are disjoint, so they never meet).
  *  - The cell size is padded by a few ulps of the extent so that rounding
  *    in (x - xmin) / d can never put two touching circles two cells apart;
  *    the circle test is the same expression as the brute-force reference,
@@ -94,7 +107,7 @@ static int nbs_pairs_grow(nbs_pairs *pairs, size_t want)
 
 static inline int nbs_pairs_push(nbs_pairs *pairs, int32_t i, int32_t j)
 {
-    if (pairs->count == pairs->capacity &&
+    if (__builtin_expect(pairs->count == pairs->capacity, 0) &&
         nbs_pairs_grow(pairs, pairs->count + 1) != 0)
         return -1;
     pairs->a[pairs->count] = i;
@@ -138,6 +151,7 @@ void nbs_grid_free(nbs_grid *grid)
     free(grid->cell_next);
     free(grid->ix);
     free(grid->iy);
+    free(grid->order);
     nbs_grid_init(grid);
 }
 
@@ -158,7 +172,7 @@ static size_t nbs_cell_slots(size_t table) { return 2 * (table + 2); }
 
 size_t nbs_memory_bytes(const nbs_grid *grid, const nbs_pairs *pairs)
 {
-    size_t ints = 4 * grid->n_capacity + grid->ny_capacity;
+    size_t ints = 5 * grid->n_capacity + grid->ny_capacity;
     if (grid->nx_capacity) ints += nbs_cell_slots(grid->nx_capacity);
     size_t bytes = ints * sizeof(int32_t);
     if (pairs) bytes += 2 * pairs->capacity * sizeof(int32_t);
@@ -173,7 +187,8 @@ static int nbs_grid_reserve(nbs_grid *grid, size_t n, size_t table)
     if (n > grid->n_capacity) {
         size_t cap = n > 2 * grid->n_capacity ? n : 2 * grid->n_capacity;
         if (nbs_grow_array(&grid->row_next, cap) || nbs_grow_array(&grid->cell_next, cap) ||
-            nbs_grow_array(&grid->ix, cap) || nbs_grow_array(&grid->iy, cap))
+            nbs_grow_array(&grid->ix, cap) || nbs_grow_array(&grid->iy, cap) ||
+            nbs_grow_array(&grid->order, cap))
             return -1;
         grid->n_capacity = cap;
     }
@@ -210,19 +225,70 @@ typedef struct nbs_layout {
     int fold_x, fold_y;  /* 1 when the real extent is folded onto the table */
 } nbs_layout;
 
-static nbs_bounds nbs_bounds_of(size_t n, const double *cx, const double *cy, const double *r)
+/* The careful bounds: invalid circles (including NaN) are skipped. Plain
+ * compares, not fmin/fmax: the values are finite here, so the NaN rules of
+ * fmin/fmax buy nothing, and they are calls at -O2. */
+static nbs_bounds nbs_bounds_checked(size_t n, const double *cx, const double *cy,
+                                     const double *r)
 {
-    nbs_bounds b = {DBL_MAX, -DBL_MAX, DBL_MAX, -DBL_MAX, 0.0, 0};
+    double xmin = DBL_MAX, xmax = -DBL_MAX, ymin = DBL_MAX, ymax = -DBL_MAX, rmax = 0.0;
+    size_t valid = 0;
     for (size_t i = 0; i < n; i++) {
-        if (!nbs_circle_valid(cx[i], cy[i], r[i])) continue;
-        b.xmin = fmin(b.xmin, cx[i]);
-        b.xmax = fmax(b.xmax, cx[i]);
-        b.ymin = fmin(b.ymin, cy[i]);
-        b.ymax = fmax(b.ymax, cy[i]);
-        b.rmax = fmax(b.rmax, r[i]);
-        b.valid++;
+        double x = cx[i], y = cy[i], ri = r[i];
+        if (!nbs_circle_valid(x, y, ri)) continue;
+        xmin = x < xmin ? x : xmin;
+        xmax = x > xmax ? x : xmax;
+        ymin = y < ymin ? y : ymin;
+        ymax = y > ymax ? y : ymax;
+        rmax = ri > rmax ? ri : rmax;
+        valid++;
     }
-    return b;
+    nbs_bounds bo = {xmin, xmax, ymin, ymax, rmax, valid};
+    return bo;
+}
+
+/* The usual case is that every circle is valid, and that can be decided
+ * from the bounds alone: a sum of every value is finite only if no value
+ * is NaN or infinite, and then the extremes say whether all are within the
+ * limits and no radius is negative. This loop has no per-circle test, two
+ * circles per iteration so that each min/max chain has half the latency;
+ * *all_valid = 0 sends the caller to the careful loop. */
+static nbs_bounds nbs_bounds_of(size_t n, const double *cx, const double *cy, const double *r,
+                                int *all_valid)
+{
+    double xmin[2] = {DBL_MAX, DBL_MAX}, xmax[2] = {-DBL_MAX, -DBL_MAX};
+    double ymin[2] = {DBL_MAX, DBL_MAX}, ymax[2] = {-DBL_MAX, -DBL_MAX};
+    double rmin[2] = {DBL_MAX, DBL_MAX}, rmax[2] = {0.0, 0.0}, sum[2] = {0.0, 0.0};
+    size_t i = 0;
+    for (; i + 2 <= n; i += 2) {
+        for (int k = 0; k < 2; k++) {
+            double x = cx[i + k], y = cy[i + k], ri = r[i + k];
+            xmin[k] = x < xmin[k] ? x : xmin[k];
+            xmax[k] = x > xmax[k] ? x : xmax[k];
+            ymin[k] = y < ymin[k] ? y : ymin[k];
+            ymax[k] = y > ymax[k] ? y : ymax[k];
+            rmin[k] = ri < rmin[k] ? ri : rmin[k];
+            rmax[k] = ri > rmax[k] ? ri : rmax[k];
+            sum[k] += (x + y) + ri;
+        }
+    }
+    for (; i < n; i++) {
+        double x = cx[i], y = cy[i], ri = r[i];
+        xmin[0] = x < xmin[0] ? x : xmin[0];
+        xmax[0] = x > xmax[0] ? x : xmax[0];
+        ymin[0] = y < ymin[0] ? y : ymin[0];
+        ymax[0] = y > ymax[0] ? y : ymax[0];
+        rmin[0] = ri < rmin[0] ? ri : rmin[0];
+        rmax[0] = ri > rmax[0] ? ri : rmax[0];
+        sum[0] += (x + y) + ri;
+    }
+    nbs_bounds bo = {fmin(xmin[0], xmin[1]), fmax(xmax[0], xmax[1]), fmin(ymin[0], ymin[1]),
+                     fmax(ymax[0], ymax[1]), fmax(rmax[0], rmax[1]), n};
+    double rlo = fmin(rmin[0], rmin[1]);
+    *all_valid = isfinite(sum[0] + sum[1]) && n > 0 && nbs_circle_valid(bo.xmin, bo.ymin, rlo) &&
+                 nbs_circle_valid(bo.xmax, bo.ymax, bo.rmax);
+    if (!*all_valid) return nbs_bounds_checked(n, cx, cy, r);
+    return bo;
 }
 
 /* Cell size d = largest diameter, padded so that (1) rounding of
@@ -258,49 +324,36 @@ static nbs_layout nbs_layout_plan(const nbs_bounds *b, size_t table)
     return L;
 }
 
-/* First pass: integerised, folded coordinates, stored so that later passes
- * read two int arrays instead of recomputing from doubles. iy = -1 marks a
- * circle that takes no part. Tables are powers of two, so folding is a mask;
- * unfolded axes use an all-ones mask (their coordinates are already < size). */
-static void nbs_integerise(nbs_grid *grid, const nbs_layout *L, size_t n,
-                           const double *cx, const double *cy, const double *r)
+/* Stage 1 of the book, in the same pass as integerising: integer (folded)
+ * coordinates are stored so that later stages read two int arrays instead
+ * of recomputing from doubles, and every circle goes onto the singly
+ * connected list of its row. iy = -1 marks a circle that takes no part.
+ * Tables are powers of two, so folding is a mask; unfolded axes use an
+ * all-ones mask (their coordinates are already < size). */
+static inline void nbs_rows_build(nbs_grid *grid, const nbs_layout *L, size_t n,
+                                  const double *cx, const double *cy, const double *r,
+                                  int all_valid)
 {
     int64_t mask_x = L->fold_x ? (int64_t)L->nx - 1 : INT64_MAX;
     int64_t mask_y = L->fold_y ? (int64_t)L->ny - 1 : INT64_MAX;
+    const double xmin = L->xmin, ymin = L->ymin, inv = L->inv_cell;
     int32_t *ix = grid->ix, *iy = grid->iy;
-    for (size_t i = 0; i < n; i++) {
-        if (!nbs_circle_valid(cx[i], cy[i], r[i])) {
+    int32_t *head = grid->row_head, *next = grid->row_next;
+    for (size_t i = n; i-- > 0;) {
+        double x = cx[i], y = cy[i];
+        if (!all_valid && !nbs_circle_valid(x, y, r[i])) {
             ix[i] = 0;
             iy[i] = -1;
             continue;
         }
         /* x >= xmin, so truncation is floor */
-        int64_t tx = (int64_t)((cx[i] - L->xmin) * L->inv_cell);
-        int64_t ty = (int64_t)((cy[i] - L->ymin) * L->inv_cell);
-        ix[i] = (int32_t)(tx & mask_x);
-        iy[i] = (int32_t)(ty & mask_y);
+        int32_t tx = (int32_t)((int64_t)((x - xmin) * inv) & mask_x);
+        int32_t ty = (int32_t)((int64_t)((y - ymin) * inv) & mask_y);
+        ix[i] = tx;
+        iy[i] = ty;
+        next[i] = head[ty];
+        head[ty] = (int32_t)i;
     }
-}
-
-/* Stage 1 of the book: every circle onto the singly connected list of its row. */
-static void nbs_rows_build(nbs_grid *grid, size_t n)
-{
-    const int32_t *iy = grid->iy;
-    int32_t *head = grid->row_head, *next = grid->row_next;
-    for (size_t i = 0; i < n; i++) {
-        int32_t y = iy[i];
-        if (y < 0) continue;
-        next[i] = head[y];
-        head[y] = (int32_t)i;
-    }
-}
-
-static void nbs_rows_clear(nbs_grid *grid, size_t n)
-{
-    const int32_t *iy = grid->iy;
-    int32_t *head = grid->row_head;
-    for (size_t i = 0; i < n; i++)
-        if (iy[i] >= 0) head[iy[i]] = NBS_EMPTY;
 }
 
 /* A row's list whether it is still new (h >= 0), old (-2 - h) or empty. */
@@ -311,74 +364,122 @@ static inline int32_t nbs_row_list(int32_t mark)
 
 /* ------------------------------------------------------------- row detection */
 
-/* What one row's detection reads: the inputs, the lists and both cell
- * tables (each offset by one so that slot -1 and slot nx are the guards). */
+/* What the row detection reads: the inputs, the lists, the order buffer and
+ * both cell tables (each offset by one so that slot -1 and slot nx are the
+ * guards). Side 0 of the order buffer grows up from order[0], side 1 down
+ * from order[n]; cell table k holds the row gathered on side k. */
 typedef struct nbs_scan {
     const double *cx, *cy, *r;
     const int32_t *body;
     const int32_t *ix, *row_next;
     int32_t *cell_next;
-    int32_t *cur, *below;
+    int32_t *order;
+    int32_t *table[2];
+    size_t n;
     int32_t nx;
     int fold_x;
 } nbs_scan;
 
-static inline void nbs_cells_map(const nbs_scan *s, int32_t *table, int32_t list)
+/* A row gathered on one side: its circles are seg[0 .. count). */
+typedef struct nbs_held {
+    int32_t *seg;
+    int32_t count;
+} nbs_held;
+
+/* Walks a row's list once: maps each circle into the cell table of `side`
+ * (head insertion, so a circle's X link leads to the circles mapped before
+ * it) and gathers it into that side of the order buffer. */
+static inline nbs_held nbs_row_gather(const nbs_scan *s, int side, int32_t list)
 {
-    for (int32_t j = list; j >= 0; j = s->row_next[j]) {
-        int32_t x = s->ix[j];
-        s->cell_next[j] = table[x];
-        table[x] = j;
+    int32_t *table = s->table[side];
+    const int32_t *ix = s->ix, *row_next = s->row_next;
+    int32_t *cell_next = s->cell_next;
+    nbs_held h;
+    int32_t k = 0;
+    if (side == 0) {
+        int32_t *o = s->order;
+        for (int32_t j = list; j >= 0; j = row_next[j]) {
+            int32_t x = ix[j];
+            o[k++] = j;
+            cell_next[j] = table[x];
+            table[x] = j;
+        }
+        h.seg = o;
+    } else {
+        int32_t *o = s->order + s->n;
+        for (int32_t j = list; j >= 0; j = row_next[j]) {
+            int32_t x = ix[j];
+            *--o = j;
+            k++;
+            cell_next[j] = table[x];
+            table[x] = j;
+        }
+        h.seg = o;
     }
+    h.count = k;
+    return h;
 }
 
-static inline void nbs_cells_unmap(const nbs_scan *s, int32_t *table, int32_t list)
+/* Empties the cells of a gathered row and the guards of its table. */
+static inline void nbs_row_unmap(const nbs_scan *s, int side, nbs_held h)
 {
-    for (int32_t j = list; j >= 0; j = s->row_next[j]) table[s->ix[j]] = NBS_EMPTY;
+    int32_t *table = s->table[side];
+    for (int32_t k = 0; k < h.count; k++) table[s->ix[h.seg[k]]] = NBS_EMPTY;
     table[-1] = NBS_EMPTY;
     table[s->nx] = NBS_EMPTY;
 }
 
-/* Tests circle e against one cell's list. */
-static inline int nbs_chain_test(const nbs_scan *s, int32_t e, int32_t list, nbs_pairs *pairs)
+/* Tests circle e (centre xe, ye, radius re) against one cell's list. The
+ * pair is always written and the count advanced by the test's outcome: at
+ * packing densities near 1 about one test in ten finds a pair, at random,
+ * and a branch on it would be mispredicted that often. */
+static inline int nbs_chain_test(const nbs_scan *s, int use_body, int32_t e, double xe,
+                                 double ye, double re, int32_t list, nbs_pairs *pairs)
 {
-    double xe = s->cx[e], ye = s->cy[e], re = s->r[e];
+    const double *cx = s->cx, *cy = s->cy, *r = s->r;
+    size_t count = pairs->count;
     for (int32_t j = list; j >= 0; j = s->cell_next[j]) {
-        if (!nbs_circles_touch(xe, ye, re, s->cx[j], s->cy[j], s->r[j])) continue;
-        if (nbs_same_body(s->body, e, j)) continue;
-        if (nbs_pairs_push(pairs, e, j) != 0) return -1;
+        int hit = nbs_circles_touch(xe, ye, re, cx[j], cy[j], r[j]);
+        if (use_body) hit &= !nbs_same_body(s->body, e, j);
+        if (__builtin_expect(count == pairs->capacity, 0)) {
+            pairs->count = count;
+            if (nbs_pairs_grow(pairs, count + 1) != 0) return -1;
+        }
+        pairs->a[count] = e;
+        pairs->b[count] = j;
+        count += (size_t)hit;
     }
+    pairs->count = count;
     return 0;
 }
 
-/* Maps one new row and the row below it to cells, applies the half mask to
- * every circle of the row, then empties both cell tables. */
-static int nbs_row_detect(const nbs_scan *s, int32_t row, int32_t below, nbs_pairs *pairs)
+/* Applies the half mask to every circle of the row gathered in cur: later
+ * circles of its own cell, the cell to the left, and the three cells below.
+ * use_body is a constant at each call, so the body test costs nothing when
+ * there are no bodies. */
+static inline int nbs_row_test(const nbs_scan *s, int use_body, const int32_t *cur,
+                               const int32_t *low, int low_empty, nbs_held row,
+                               nbs_pairs *pairs)
 {
-    int32_t *cur = s->cur, *low = s->below;
-    nbs_cells_map(s, cur, row);
-    nbs_cells_map(s, low, below);
-    if (s->fold_x) {
-        cur[-1] = cur[s->nx - 1];
-        low[-1] = low[s->nx - 1];
-        low[s->nx] = low[0];
-    }
+    const int32_t *ix = s->ix;
     int status = 0;
-    for (int32_t e = row; e >= 0 && status == 0; e = s->row_next[e]) {
-        int32_t x = s->ix[e];
-        status |= nbs_chain_test(s, e, s->cell_next[e], pairs); /* later in own cell */
-        status |= nbs_chain_test(s, e, cur[x - 1], pairs);
-        status |= nbs_chain_test(s, e, low[x - 1], pairs);
-        status |= nbs_chain_test(s, e, low[x], pairs);
-        status |= nbs_chain_test(s, e, low[x + 1], pairs);
+    for (int32_t k = 0; k < row.count && status == 0; k++) {
+        int32_t e = row.seg[k], x = ix[e];
+        double xe = s->cx[e], ye = s->cy[e], re = s->r[e];
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, s->cell_next[e], pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, cur[x - 1], pairs);
+        if (low_empty) continue;
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x - 1], pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x], pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x + 1], pairs);
     }
-    nbs_cells_unmap(s, cur, row);
-    nbs_cells_unmap(s, low, below);
     return status;
 }
 
 /* Stage 2 of the book: loop over circles, not rows; a row seen for the first
- * time is marked old and detected against the row below it. */
+ * time is marked old, mapped with the row below it and tested. The row just
+ * done stays mapped ("held"): if the next new row is the one above it, it
+ * is already the row below; otherwise it is unmapped then. */
 static int nbs_rows_detect(nbs_grid *grid, const nbs_layout *L, size_t n,
                            const double *cx, const double *cy, const double *r,
                            const int32_t *body, nbs_pairs *pairs)
@@ -386,22 +487,57 @@ static int nbs_rows_detect(nbs_grid *grid, const nbs_layout *L, size_t n,
     nbs_scan s = {
         .cx = cx, .cy = cy, .r = r, .body = body,
         .ix = grid->ix, .row_next = grid->row_next, .cell_next = grid->cell_next,
-        .cur = grid->cell_head + 1,
-        .below = grid->cell_head + 1 + (L->nx + 2),
-        .nx = L->nx, .fold_x = L->fold_x,
+        .order = grid->order,
+        .table = {grid->cell_head + 1, grid->cell_head + 1 + (L->nx + 2)},
+        .n = n, .nx = L->nx, .fold_x = L->fold_x,
     };
     int32_t *row_head = grid->row_head;
     const int32_t *iy = grid->iy;
+    const int32_t ny = L->ny, nx = L->nx;
+    int32_t held_row = -1;
+    int held_side = 0;
+    nbs_held held = {NULL, 0};
     for (size_t i = 0; i < n; i++) {
         int32_t y = iy[i];
         if (y < 0) continue;
         int32_t head = row_head[y];
-        if (head < 0) continue; /* old */
+        if (head < 0) continue; /* old, or done and emptied */
         row_head[y] = -2 - head;
-        int32_t y_below = y > 0 ? y - 1 : (L->fold_y ? L->ny - 1 : -1);
-        int32_t below = y_below >= 0 ? nbs_row_list(row_head[y_below]) : NBS_EMPTY;
-        if (nbs_row_detect(&s, head, below, pairs) != 0) return -1;
+        int32_t y_below = y > 0 ? y - 1 : (L->fold_y ? ny - 1 : -1);
+        int32_t y_above = y < ny - 1 ? y + 1 : (L->fold_y ? 0 : -1);
+
+        nbs_held low;
+        int side;
+        if (held_row >= 0 && held_row == y_below) {
+            side = 1 - held_side; /* the row below is mapped already */
+            low = held;
+        } else {
+            if (held_row >= 0) nbs_row_unmap(&s, held_side, held);
+            side = 0;
+            int32_t below = y_below >= 0 ? nbs_row_list(row_head[y_below]) : NBS_EMPTY;
+            low = nbs_row_gather(&s, 1, below);
+        }
+        nbs_held row = nbs_row_gather(&s, side, head);
+        int32_t *cur = s.table[side], *lo = s.table[1 - side];
+        if (s.fold_x) {
+            cur[-1] = cur[nx - 1];
+            lo[-1] = lo[nx - 1];
+            lo[nx] = lo[0];
+        }
+        int status = body ? nbs_row_test(&s, 1, cur, lo, low.count == 0, row, pairs)
+                          : nbs_row_test(&s, 0, cur, lo, low.count == 0, row, pairs);
+        if (status != 0) return -1;
+        nbs_row_unmap(&s, 1 - side, low);
+        held_row = y;
+        held_side = side;
+        held = row;
+
+        /* The row below has now served both its uses if it is old; this
+         * row has if the row above is done or has no circles. */
+        if (y_below >= 0 && row_head[y_below] < NBS_EMPTY) row_head[y_below] = NBS_EMPTY;
+        if (y_above < 0 || row_head[y_above] < 0) row_head[y] = NBS_EMPTY;
     }
+    if (held_row >= 0) nbs_row_unmap(&s, held_side, held);
     return 0;
 }
 
@@ -417,21 +553,22 @@ int nbs_detect(nbs_grid *grid, size_t n, const double *cx, const double *cy,
     if (nbs_pairs_grow(pairs, n) != 0) return -1;
     if (n < 2) return 0;
 
-    nbs_bounds b = nbs_bounds_of(n, cx, cy, r);
+    int all_valid;
+    nbs_bounds b = nbs_bounds_of(n, cx, cy, r, &all_valid);
     if (b.valid < 2) return 0;
     nbs_layout L = nbs_layout_plan(&b, table);
     grid->nx = L.nx;
     grid->ny = L.ny;
     grid->cell = L.cell;
 
-    nbs_integerise(grid, &L, n, cx, cy, r);
-    nbs_rows_build(grid, n);
-    int status = nbs_rows_detect(grid, &L, n, cx, cy, r, body, pairs);
-    if (status != 0) {
+    if (all_valid) /* constant flag: the loop without the per-circle test */
+        nbs_rows_build(grid, &L, n, cx, cy, r, 1);
+    else
+        nbs_rows_build(grid, &L, n, cx, cy, r, 0);
+    if (nbs_rows_detect(grid, &L, n, cx, cy, r, body, pairs) != 0) {
         nbs_grid_reset_heads(grid);
         return -1;
     }
-    nbs_rows_clear(grid, n);
     return 0;
 }
 

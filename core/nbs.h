@@ -38,6 +38,7 @@ typedef struct nbs_grid {
     int32_t *row_head, *row_next;
     int32_t *cell_head, *cell_next;
     int32_t *ix, *iy;          /* integerised (folded) coordinates per circle */
+    int32_t *order;            /* the circles of the rows in the cell tables, gathered */
     size_t n_capacity;         /* capacity of per-circle arrays */
     size_t nx_capacity, ny_capacity;
     int32_t nx, ny;            /* folded table sizes of the last detection */
