@@ -476,10 +476,15 @@ static inline int nbs_row_test(const nbs_scan *s, int use_body, const int32_t *c
     return status;
 }
 
-/* Stage 2 of the book: loop over circles, not rows; a row seen for the first
- * time is marked old, mapped with the row below it and tested. The row just
- * done stays mapped ("held"): if the next new row is the one above it, it
- * is already the row below; otherwise it is unmapped then. */
+/* Stage 2 of the book: loop over circles, not rows, to find the rows not yet
+ * done. A row seen for the first time starts a run: down to the lowest of
+ * the consecutive new rows under it, then up row by row while the row above
+ * is new (each step is one row head, so the walk costs no more than the
+ * rows it then processes). Each row of the run is marked old, mapped with
+ * the row below it and tested. The row just done stays mapped ("held") and
+ * is the row below of the next one in the run, so a run maps and unmaps
+ * each circle once; held is unmapped when the run ends. Runs matter for
+ * sparse packings, where the new rows met in circle order are scattered. */
 static int nbs_rows_detect(nbs_grid *grid, const nbs_layout *L, size_t n,
                            const double *cx, const double *cy, const double *r,
                            const int32_t *body, nbs_pairs *pairs)
@@ -494,50 +499,56 @@ static int nbs_rows_detect(nbs_grid *grid, const nbs_layout *L, size_t n,
     int32_t *row_head = grid->row_head;
     const int32_t *iy = grid->iy;
     const int32_t ny = L->ny, nx = L->nx;
-    int32_t held_row = -1;
-    int held_side = 0;
-    nbs_held held = {NULL, 0};
+    const int fold_y = L->fold_y;
     for (size_t i = 0; i < n; i++) {
         int32_t y = iy[i];
-        if (y < 0) continue;
-        int32_t head = row_head[y];
-        if (head < 0) continue; /* old, or done and emptied */
-        row_head[y] = -2 - head;
-        int32_t y_below = y > 0 ? y - 1 : (L->fold_y ? ny - 1 : -1);
-        int32_t y_above = y < ny - 1 ? y + 1 : (L->fold_y ? 0 : -1);
-
-        nbs_held low;
-        int side;
-        if (held_row >= 0 && held_row == y_below) {
-            side = 1 - held_side; /* the row below is mapped already */
-            low = held;
-        } else {
-            if (held_row >= 0) nbs_row_unmap(&s, held_side, held);
-            side = 0;
-            int32_t below = y_below >= 0 ? nbs_row_list(row_head[y_below]) : NBS_EMPTY;
-            low = nbs_row_gather(&s, 1, below);
+        if (y < 0 || row_head[y] < 0) continue; /* old, or done and emptied */
+        /* folded, every row may be new: at most ny - 1 steps down */
+        for (int32_t steps = 1; steps < ny; steps++) {
+            int32_t yb = y > 0 ? y - 1 : (fold_y ? ny - 1 : -1);
+            if (yb < 0 || row_head[yb] < 0) break;
+            y = yb;
         }
-        nbs_held row = nbs_row_gather(&s, side, head);
-        int32_t *cur = s.table[side], *lo = s.table[1 - side];
-        if (s.fold_x) {
-            cur[-1] = cur[nx - 1];
-            lo[-1] = lo[nx - 1];
-            lo[nx] = lo[0];
-        }
-        int status = body ? nbs_row_test(&s, 1, cur, lo, low.count == 0, row, pairs)
-                          : nbs_row_test(&s, 0, cur, lo, low.count == 0, row, pairs);
-        if (status != 0) return -1;
-        nbs_row_unmap(&s, 1 - side, low);
-        held_row = y;
-        held_side = side;
-        held = row;
+        int held_side = 1; /* the first row's below is gathered on side 1 */
+        nbs_held held = {NULL, 0};
+        int first = 1;
+        for (;;) {
+            int32_t head = row_head[y];
+            row_head[y] = -2 - head;
+            int32_t y_below = y > 0 ? y - 1 : (fold_y ? ny - 1 : -1);
+            int32_t y_above = y < ny - 1 ? y + 1 : (fold_y ? 0 : -1);
+            if (first) {
+                int32_t below = y_below >= 0 ? nbs_row_list(row_head[y_below]) : NBS_EMPTY;
+                held = nbs_row_gather(&s, 1, below);
+                first = 0;
+            }
+            nbs_held low = held;
+            int side = 1 - held_side;
+            nbs_held row = nbs_row_gather(&s, side, head);
+            int32_t *cur = s.table[side], *lo = s.table[held_side];
+            if (s.fold_x) {
+                cur[-1] = cur[nx - 1];
+                lo[-1] = lo[nx - 1];
+                lo[nx] = lo[0];
+            }
+            int status = body ? nbs_row_test(&s, 1, cur, lo, low.count == 0, row, pairs)
+                              : nbs_row_test(&s, 0, cur, lo, low.count == 0, row, pairs);
+            if (status != 0) return -1;
+            nbs_row_unmap(&s, held_side, low);
+            held_side = side;
+            held = row;
 
-        /* The row below has now served both its uses if it is old; this
-         * row has if the row above is done or has no circles. */
-        if (y_below >= 0 && row_head[y_below] < NBS_EMPTY) row_head[y_below] = NBS_EMPTY;
-        if (y_above < 0 || row_head[y_above] < 0) row_head[y] = NBS_EMPTY;
+            /* The row below has now served both its uses if it is old; this
+             * row has if the row above is done or has no circles. */
+            if (y_below >= 0 && row_head[y_below] < NBS_EMPTY) row_head[y_below] = NBS_EMPTY;
+            if (y_above < 0 || row_head[y_above] < 0) {
+                row_head[y] = NBS_EMPTY;
+                break; /* the run ends */
+            }
+            y = y_above;
+        }
+        nbs_row_unmap(&s, held_side, held);
     }
-    if (held_row >= 0) nbs_row_unmap(&s, held_side, held);
     return 0;
 }
 
