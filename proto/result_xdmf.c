@@ -14,8 +14,11 @@
  *  - stress is written as three Cell scalars stress_xx, stress_yy, stress_xy
  *    (hyperslabs picking one component each) rather than a fake 3-vector
  *    whose magnitude would mean nothing.
- *  - damage lives on joints, which are not cells of the triangle mesh, so it
- *    is left out of the sidecar (it is in result.h5).
+ *  - damage lives on joints, which are not cells of the triangle mesh: a
+ *    second Temporal collection ("joints", present when the model has
+ *    joints) draws each joint as a line along its face A (columns a0, a1 of
+ *    /mesh/joints) on the same moving nodes, with damage as its cell value.
+ *    ParaView's reader turns the two collections into two blocks.
  *  - node_part and element_part are static attributes from /mesh, handy for
  *    colouring bodies.
  *
@@ -32,7 +35,7 @@
 typedef struct xdmf_ctx {
     FILE *out;
     char h5[1024]; /* XML-escaped file name the DataItems refer to */
-    long nodes, elements;
+    long nodes, elements, joints;
     int snapshots;
     unsigned fields;
 } xdmf_ctx;
@@ -92,6 +95,49 @@ static void xdmf_row_item(const xdmf_ctx *x, int s, long rows, int width, int wi
     fprintf(x->out, "        </DataItem>\n");
 }
 
+/* The nodes of snapshot s (or the initial ones when positions are not
+ * stored), shared by the triangle and joint grids. */
+static void xdmf_geometry(const xdmf_ctx *x, int s)
+{
+    char dims[64];
+    fprintf(x->out, "      <Geometry GeometryType=\"XY\">\n");
+    if (x->fields & CASE_FIELD_POSITION) {
+        xdmf_row_item(x, s, x->nodes, 2, -1, "position");
+    } else {
+        snprintf(dims, sizeof dims, "%ld 2", x->nodes);
+        xdmf_mesh_item(x, dims, "Float", 8, "position0");
+    }
+    fprintf(x->out, "      </Geometry>\n");
+}
+
+static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
+{
+    long J = x->joints;
+    fprintf(x->out, "    <Grid Name=\"joints %d\" GridType=\"Uniform\">\n", s);
+    fprintf(x->out, "      <Time Value=\"%.17g\"/>\n", time);
+    fprintf(x->out, "      <Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" "
+            "NumberOfElements=\"%ld\">\n", J);
+    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld 2\" "
+            "Type=\"HyperSlab\">\n", J);
+    fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
+            "0 0  1 1  %ld 2</DataItem>\n", J);
+    fprintf(x->out, "          <DataItem Dimensions=\"%ld 4\" NumberType=\"Int\" Precision=\"4\" "
+            "Format=\"HDF\">%s:/mesh/joints</DataItem>\n", J, x->h5);
+    fprintf(x->out, "        </DataItem>\n");
+    fprintf(x->out, "      </Topology>\n");
+    xdmf_geometry(x, s);
+    fprintf(x->out, "      <Attribute Name=\"damage\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld\" "
+            "Type=\"HyperSlab\">\n", J);
+    fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
+            "%d 0  1 1  1 %ld</DataItem>\n", s, J);
+    fprintf(x->out, "          <DataItem Dimensions=\"%d %ld\" NumberType=\"Float\" Precision=\"8\" "
+            "Format=\"HDF\">%s:/snapshots/damage</DataItem>\n", x->snapshots, J, x->h5);
+    fprintf(x->out, "        </DataItem>\n");
+    fprintf(x->out, "      </Attribute>\n");
+    fprintf(x->out, "    </Grid>\n");
+}
+
 static void xdmf_grid(const xdmf_ctx *x, int s, double time)
 {
     char dims[64];
@@ -104,14 +150,7 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     xdmf_mesh_item(x, dims, "Int", 4, "triangles");
     fprintf(x->out, "      </Topology>\n");
 
-    fprintf(x->out, "      <Geometry GeometryType=\"XY\">\n");
-    if (x->fields & CASE_FIELD_POSITION) {
-        xdmf_row_item(x, s, x->nodes, 2, -1, "position");
-    } else {
-        snprintf(dims, sizeof dims, "%ld 2", x->nodes);
-        xdmf_mesh_item(x, dims, "Float", 8, "position0");
-    }
-    fprintf(x->out, "      </Geometry>\n");
+    xdmf_geometry(x, s);
 
     if (x->fields & CASE_FIELD_VELOCITY) {
         fprintf(x->out, "      <Attribute Name=\"velocity\" AttributeType=\"Vector\" "
@@ -151,6 +190,12 @@ static void xdmf_document(const xdmf_ctx *x, const result_file *f, const char *n
             name);
     for (int s = 0; s < x->snapshots; s++) xdmf_grid(x, s, result_snapshot_time(f, s));
     fprintf(x->out, "  </Grid>\n");
+    if (x->joints > 0) {
+        fprintf(x->out, "  <Grid Name=\"joints\" GridType=\"Collection\" "
+                "CollectionType=\"Temporal\">\n");
+        for (int s = 0; s < x->snapshots; s++) xdmf_joint_grid(x, s, result_snapshot_time(f, s));
+        fprintf(x->out, "  </Grid>\n");
+    }
     fprintf(x->out, "  </Domain>\n");
     fprintf(x->out, "</Xdmf>\n");
 }
@@ -163,7 +208,7 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
         return -1;
     }
     fdem_counts counts = fdem_get_counts(model);
-    xdmf_ctx x = {.nodes = counts.nodes, .elements = counts.elements,
+    xdmf_ctx x = {.nodes = counts.nodes, .elements = counts.elements, .joints = counts.joints,
                   .snapshots = result_snapshot_count(f), .fields = info->fields};
     xml_escape(x.h5, sizeof x.h5, h5_name);
     char name[512];

@@ -237,6 +237,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "elements", json_integer(f.counts.elements));
     json_object_set_new(o, "joints", json_integer(f.counts.joints));
     json_object_set_new(o, "broken_joints", json_integer(f.counts.broken_joints));
+    json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
     json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
     json_object_set_new(o, "snapshots", json_integer(f.snapshots));
     json_object_set_new(o, "energy", energy ? energy : json_null());
