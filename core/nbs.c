@@ -54,6 +54,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#if defined(__GNUC__)
+#define NBS_UNLIKELY(c) __builtin_expect(!!(c), 0)
+#define NBS_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define NBS_UNLIKELY(c) (c)
+#define NBS_ALWAYS_INLINE inline
+#endif
+
 #define NBS_EMPTY (-1)
 #define NBS_VALUE_LIMIT 1e150
 #define NBS_MIN_TABLE 4
@@ -107,7 +115,7 @@ static int nbs_pairs_grow(nbs_pairs *pairs, size_t want)
 
 static inline int nbs_pairs_push(nbs_pairs *pairs, int32_t i, int32_t j)
 {
-    if (__builtin_expect(pairs->count == pairs->capacity, 0) &&
+    if (NBS_UNLIKELY(pairs->count == pairs->capacity) &&
         nbs_pairs_grow(pairs, pairs->count + 1) != 0)
         return -1;
     pairs->a[pairs->count] = i;
@@ -429,27 +437,37 @@ static inline void nbs_row_unmap(const nbs_scan *s, int side, nbs_held h)
     table[s->nx] = NBS_EMPTY;
 }
 
+/* The pair list while a row is tested, in locals the compiler can keep in
+ * registers (stores through a and b cannot then force reloads). */
+typedef struct nbs_out {
+    int32_t *a, *b;
+    size_t count, capacity;
+} nbs_out;
+
 /* Tests circle e (centre xe, ye, radius re) against one cell's list. The
  * pair is always written and the count advanced by the test's outcome: at
  * packing densities near 1 about one test in ten finds a pair, at random,
  * and a branch on it would be mispredicted that often. */
-static inline int nbs_chain_test(const nbs_scan *s, int use_body, int32_t e, double xe,
-                                 double ye, double re, int32_t list, nbs_pairs *pairs)
+static NBS_ALWAYS_INLINE int nbs_chain_test(const nbs_scan *s, int use_body, int32_t e,
+                                            double xe, double ye, double re, int32_t list,
+                                            nbs_out *o, nbs_pairs *pairs)
 {
     const double *cx = s->cx, *cy = s->cy, *r = s->r;
-    size_t count = pairs->count;
-    for (int32_t j = list; j >= 0; j = s->cell_next[j]) {
+    const int32_t *cell_next = s->cell_next;
+    for (int32_t j = list; j >= 0; j = cell_next[j]) {
         int hit = nbs_circles_touch(xe, ye, re, cx[j], cy[j], r[j]);
         if (use_body) hit &= !nbs_same_body(s->body, e, j);
-        if (__builtin_expect(count == pairs->capacity, 0)) {
-            pairs->count = count;
-            if (nbs_pairs_grow(pairs, count + 1) != 0) return -1;
+        if (NBS_UNLIKELY(o->count == o->capacity)) {
+            pairs->count = o->count;
+            if (nbs_pairs_grow(pairs, o->count + 1) != 0) return -1;
+            o->a = pairs->a;
+            o->b = pairs->b;
+            o->capacity = pairs->capacity;
         }
-        pairs->a[count] = e;
-        pairs->b[count] = j;
-        count += (size_t)hit;
+        o->a[o->count] = e;
+        o->b[o->count] = j;
+        o->count += (size_t)hit;
     }
-    pairs->count = count;
     return 0;
 }
 
@@ -457,23 +475,38 @@ static inline int nbs_chain_test(const nbs_scan *s, int use_body, int32_t e, dou
  * circles of its own cell, the cell to the left, and the three cells below.
  * use_body is a constant at each call, so the body test costs nothing when
  * there are no bodies. */
-static inline int nbs_row_test(const nbs_scan *s, int use_body, const int32_t *cur,
-                               const int32_t *low, int low_empty, nbs_held row,
-                               nbs_pairs *pairs)
+static NBS_ALWAYS_INLINE int nbs_row_test(const nbs_scan *s, int use_body, const int32_t *cur,
+                                          const int32_t *low, int low_empty, nbs_held row,
+                                          nbs_pairs *pairs)
 {
-    const int32_t *ix = s->ix;
+    const int32_t *ix = s->ix, *cell_next = s->cell_next;
+    const double *cx = s->cx, *cy = s->cy, *r = s->r;
+    nbs_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity};
     int status = 0;
     for (int32_t k = 0; k < row.count && status == 0; k++) {
         int32_t e = row.seg[k], x = ix[e];
-        double xe = s->cx[e], ye = s->cy[e], re = s->r[e];
-        status |= nbs_chain_test(s, use_body, e, xe, ye, re, s->cell_next[e], pairs);
-        status |= nbs_chain_test(s, use_body, e, xe, ye, re, cur[x - 1], pairs);
+        double xe = cx[e], ye = cy[e], re = r[e];
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, cell_next[e], &o, pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, cur[x - 1], &o, pairs);
         if (low_empty) continue;
-        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x - 1], pairs);
-        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x], pairs);
-        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x + 1], pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x - 1], &o, pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x], &o, pairs);
+        status |= nbs_chain_test(s, use_body, e, xe, ye, re, low[x + 1], &o, pairs);
     }
+    pairs->count = o.count;
     return status;
+}
+
+static int nbs_row_test_all(const nbs_scan *s, const int32_t *cur, const int32_t *low,
+                            int low_empty, nbs_held row, nbs_pairs *pairs)
+{
+    return nbs_row_test(s, 0, cur, low, low_empty, row, pairs);
+}
+
+static int nbs_row_test_body(const nbs_scan *s, const int32_t *cur, const int32_t *low,
+                             int low_empty, nbs_held row, nbs_pairs *pairs)
+{
+    return nbs_row_test(s, 1, cur, low, low_empty, row, pairs);
 }
 
 /* Stage 2 of the book: loop over circles, not rows, to find the rows not yet
@@ -531,8 +564,8 @@ static int nbs_rows_detect(nbs_grid *grid, const nbs_layout *L, size_t n,
                 lo[-1] = lo[nx - 1];
                 lo[nx] = lo[0];
             }
-            int status = body ? nbs_row_test(&s, 1, cur, lo, low.count == 0, row, pairs)
-                              : nbs_row_test(&s, 0, cur, lo, low.count == 0, row, pairs);
+            int status = body ? nbs_row_test_body(&s, cur, lo, low.count == 0, row, pairs)
+                              : nbs_row_test_all(&s, cur, lo, low.count == 0, row, pairs);
             if (status != 0) return -1;
             nbs_row_unmap(&s, held_side, low);
             held_side = side;
