@@ -136,10 +136,21 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
 
         pthread_mutex_lock(&c->model_lock);
         double dt = fdem_get_dt(m);
+        /* A step that would pass the next output time or the end is cut to
+         * land on it, so snapshots sit exactly on the k * interval grid and
+         * the last one at time.end (a shorter step is always stable, and
+         * central difference takes a changing step). */
+        double t0 = fdem_get_time(m), target = fmin(end, c->next_output);
+        int cut = t0 + dt > target + 1e-6 * dt && target - t0 > 1e-6 * dt;
+        if (cut)
+            fdem_set_dt(m, target - t0);
         fdem_error err;
         memset(&err, 0, sizeof err);
-        if (fdem_step(m, &err) != 0) {
-            worker_describe_failure(c, &err, dt);
+        int failed = fdem_step(m, &err) != 0;
+        if (cut)
+            fdem_set_dt(m, dt);
+        if (failed) {
+            worker_describe_failure(c, &err, cut ? target - t0 : dt);
             pthread_mutex_unlock(&c->model_lock);
             return EXIT_FAILED;
         }
