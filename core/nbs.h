@@ -14,7 +14,8 @@
  *    (heads B[ny], next Y[n]); only non-empty rows are visited, by looping
  *    over elements; each new row's elements go into cell lists (heads A[nx],
  *    next X[n]) and are tested against the neighbouring cells of the contact
- *    mask; the lists are then cleared by looping over the same elements.
+ *    mask; the lists are then cleared by looping over the same elements
+ *    (row heads as soon as no row can need them any more).
  *  - RAM is O(n + nx + ny) and never O(nx * ny); nx and ny are folded
  *    (integer coordinate modulo a table size of O(n)) so that two bodies a
  *    kilometre apart cost no more memory than two touching. Folding only

@@ -539,6 +539,58 @@ static void test_nbs_large_against_sweep(void)
     circles_free(&c);
 }
 
+/* Rows are done in runs of consecutive new rows, found by walking down from
+ * the first circle's row and then up. Folded, every row of the table can be
+ * occupied, so the walk must stop after one lap; rows met top-down, bottom-up,
+ * interleaved or shuffled must all give the all-pairs set. */
+static void test_nbs_row_runs(void)
+{
+    rng_seed(13);
+    for (int trial = 0; trial < 200; trial++) {
+        int rows = 3 + trial % 40, cols = 1 + trial % 7;
+        size_t n = (size_t)rows * (size_t)cols;
+        circles c = circles_new(n);
+        /* unit cells; a row pitch of 1 or of 1 + a fold-sized gap (16 cells
+         * for tables of <= 16 slots) puts every folded row in use */
+        double pitch = trial % 3 == 0 ? 1.0 : trial % 3 == 1 ? 17.0 : 1e4 + 1.0;
+        for (int row = 0; row < rows; row++)
+            for (int col = 0; col < cols; col++) {
+                size_t i = (size_t)row * (size_t)cols + (size_t)col;
+                int ry = trial % 4 == 0 ? rows - 1 - row : trial % 4 == 1 ? row : (row * 7) % rows;
+                c.x[i] = col + rng_range(-0.2, 0.2);
+                c.y[i] = ry * pitch + rng_range(0.05, 0.95);
+                c.r[i] = rng_range(0.3, 0.5);
+                c.body[i] = -1;
+            }
+        if (trial % 5 == 4) shuffle(&c);
+        char what[64];
+        snprintf(what, sizeof what, "row runs trial %d n=%zu", trial, n);
+        check_against_brute(what, &c, 0);
+        circles_free(&c);
+    }
+}
+
+/* One invalid circle sends the bounds to the careful loop; the valid ones
+ * must still all be found, and the invalid one never. */
+static void test_nbs_one_invalid_circle(void)
+{
+    rng_seed(14);
+    size_t n = 500;
+    double bad[] = {NAN, INFINITY, -INFINITY, 1e200, -1.0};
+    for (int k = 0; k < 5; k++) {
+        circles c = circles_new(n);
+        fill_uniform(&c, 0, n, 0, 0, 20, 20, 0.2, 0.6);
+        size_t victim = (size_t)(rng_uniform() * (double)n) % n;
+        if (k == 4) c.r[victim] = bad[k];
+        else if (k % 2) c.x[victim] = bad[k];
+        else c.y[victim] = bad[k];
+        char what[64];
+        snprintf(what, sizeof what, "one invalid circle (%g)", bad[k]);
+        check_against_brute(what, &c, 0);
+        circles_free(&c);
+    }
+}
+
 /* Two small clusters touching and 1 km apart must cost the same memory. */
 static void test_nbs_memory_independent_of_distance(void)
 {
@@ -630,4 +682,4 @@ CHECK_MAIN(T(test_nbs_tiny_inputs), T(test_nbs_random_matches_brute),
            T(test_nbs_bodies_km_apart), T(test_nbs_folding_stress),
            T(test_nbs_body_filter), T(test_nbs_degenerate),
            T(test_nbs_large_against_sweep), T(test_nbs_memory_independent_of_distance),
-           T(test_nbs_reuse))
+           T(test_nbs_reuse), T(test_nbs_row_runs), T(test_nbs_one_invalid_circle))
