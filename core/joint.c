@@ -324,7 +324,7 @@ int joint_forces(fdem_model *m)
             broke++;
             continue;
         }
-        m->joint_damage[j] = damage;
+        if (damage != m->joint_damage[j]) m->joint_damage[j] = damage; /* no write-back when intact */
         f[2 * n[0]] += fa0x; f[2 * n[0] + 1] += fa0y;
         f[2 * n[1]] += fa1x; f[2 * n[1] + 1] += fa1y;
         f[2 * n[2]] -= fa0x; f[2 * n[2] + 1] -= fa0y;
