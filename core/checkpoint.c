@@ -11,9 +11,6 @@
 
 #include "model.h"
 
-void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
 
 typedef struct checkpoint_header {

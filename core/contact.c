@@ -32,9 +32,6 @@
 
 #include "model.h"
 
-void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
 /* The current geometry of one triangle, gathered once per pair. */
 typedef struct tri_now {
     int node[3];

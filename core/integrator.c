@@ -17,9 +17,6 @@
 
 #include "model.h"
 
-void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
 /* One pass over the nodes: the central difference update of every dof no
  * constraint owns. Returns a sum of the new positions and velocities:
  * non-finite if and only if some value is (cheaper than a test per value in

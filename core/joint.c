@@ -29,9 +29,6 @@
 
 #include "model.h"
 
-void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
 #define Z_A 0.63
 #define Z_B 1.8
 #define Z_C 6.0

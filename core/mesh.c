@@ -12,22 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "fdem.h"
-
-static void mesh_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-#include <stdarg.h>
-static void mesh_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-{
-    if (!err) return;
-    err->kind = kind;
-    err->item = item;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err->message, sizeof err->message, fmt, ap);
-    va_end(ap);
-}
+#include "model.h"
 
 void fdem_mesh_free(fdem_mesh *mesh)
 {
@@ -43,7 +28,7 @@ static int mesh_alloc(fdem_mesh *out, long nodes, long triangles, fdem_error *er
 {
     memset(out, 0, sizeof *out);
     if (nodes <= 0 || triangles <= 0 || nodes > INT32_MAX / 2 || triangles > INT32_MAX / 3) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "a mesh of %ld nodes and %ld triangles is out of range",
+        model_error(err, FDEM_ITEM_NONE, -1, "a mesh of %ld nodes and %ld triangles is out of range",
                    nodes, triangles);
         return -1;
     }
@@ -51,7 +36,7 @@ static int mesh_alloc(fdem_mesh *out, long nodes, long triangles, fdem_error *er
     out->tri = malloc(sizeof(int32_t) * 3 * (size_t)triangles);
     if (!out->xy || !out->tri) {
         fdem_mesh_free(out);
-        mesh_error(err, FDEM_ITEM_NONE, -1, "out of memory for a mesh of %ld nodes", nodes);
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for a mesh of %ld nodes", nodes);
         return -1;
     }
     out->node_count = (int)nodes;
@@ -64,11 +49,11 @@ int fdem_mesh_rectangle(double ox, double oy, double width, double height, int n
 {
     if (!(width > 0) || !(height > 0) || !isfinite(width) || !isfinite(height) ||
         !isfinite(ox) || !isfinite(oy)) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "rectangle size must be positive and finite");
+        model_error(err, FDEM_ITEM_NONE, -1, "rectangle size must be positive and finite");
         return -1;
     }
     if (nx < 1 || ny < 1) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "rectangle divisions must be at least 1");
+        model_error(err, FDEM_ITEM_NONE, -1, "rectangle divisions must be at least 1");
         return -1;
     }
     long nodes = (long)(nx + 1) * (ny + 1);
@@ -128,11 +113,11 @@ int fdem_mesh_disc(double cx, double cy, double radius, int divisions, fdem_mesh
                    fdem_error *err)
 {
     if (!(radius > 0) || !isfinite(radius) || !isfinite(cx) || !isfinite(cy)) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "disc radius must be positive and finite");
+        model_error(err, FDEM_ITEM_NONE, -1, "disc radius must be positive and finite");
         return -1;
     }
     if (divisions < 6) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "a disc needs at least 6 divisions around the rim");
+        model_error(err, FDEM_ITEM_NONE, -1, "a disc needs at least 6 divisions around the rim");
         return -1;
     }
     int rings = (int)lround(divisions / (2 * M_PI));
@@ -184,25 +169,25 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err)
 {
     if (reoriented) *reoriented = 0;
     if (mesh->node_count < 3 || mesh->triangle_count < 1) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "a mesh needs at least 3 nodes and 1 triangle");
+        model_error(err, FDEM_ITEM_NONE, -1, "a mesh needs at least 3 nodes and 1 triangle");
         return -1;
     }
     for (int i = 0; i < 2 * mesh->node_count; i++)
         if (!isfinite(mesh->xy[i])) {
-            mesh_error(err, FDEM_ITEM_NODE, i / 2, "node %d has a non-finite coordinate", i / 2);
+            model_error(err, FDEM_ITEM_NODE, i / 2, "node %d has a non-finite coordinate", i / 2);
             return -1;
         }
     for (int k = 0; k < mesh->triangle_count; k++) {
         int32_t *t = mesh->tri + 3 * k;
         for (int c = 0; c < 3; c++)
             if (t[c] < 0 || t[c] >= mesh->node_count) {
-                mesh_error(err, FDEM_ITEM_TRIANGLE, k,
+                model_error(err, FDEM_ITEM_TRIANGLE, k,
                            "triangle %d refers to node %d, but nodes are numbered 0 to %d", k,
                            (int)t[c], mesh->node_count - 1);
                 return -1;
             }
         if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-            mesh_error(err, FDEM_ITEM_TRIANGLE, k, "triangle %d uses node %d twice", k,
+            model_error(err, FDEM_ITEM_TRIANGLE, k, "triangle %d uses node %d twice", k,
                        (int)(t[0] == t[1] || t[0] == t[2] ? t[0] : t[1]));
             return -1;
         }
@@ -213,7 +198,7 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err)
                     fabs(mesh->xy[2 * t[2] + 1] - mesh->xy[2 * t[0] + 1]);
         double scale = (ex + ey) * (ex + ey);
         if (!(fabs(a2) > 1e-12 * scale)) {
-            mesh_error(err, FDEM_ITEM_TRIANGLE, k,
+            model_error(err, FDEM_ITEM_TRIANGLE, k,
                        "triangle %d has zero area (nodes %d, %d, %d are collinear or coincide)",
                        k, (int)t[0], (int)t[1], (int)t[2]);
             return -1;
@@ -228,7 +213,7 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err)
     /* A node no triangle uses would have no mass and could never move. */
     unsigned char *used = calloc((size_t)mesh->node_count, 1);
     if (!used) {
-        mesh_error(err, FDEM_ITEM_NONE, -1, "out of memory validating a mesh");
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory validating a mesh");
         return -1;
     }
     for (int k = 0; k < 3 * mesh->triangle_count; k++) used[mesh->tri[k]] = 1;
@@ -237,7 +222,7 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err)
         if (!used[i]) unused = i;
     free(used);
     if (unused >= 0) {
-        mesh_error(err, FDEM_ITEM_NODE, unused, "node %d is not used by any triangle", unused);
+        model_error(err, FDEM_ITEM_NODE, unused, "node %d is not used by any triangle", unused);
         return -1;
     }
     return 0;

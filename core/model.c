@@ -15,8 +15,6 @@
 #include "model.h"
 
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
 {
     if (!err) return;
     err->kind = kind;

@@ -128,6 +128,10 @@ struct fdem_model {
 
 double stage_clock(void);
 
+/* model.c: fills *err (when not NULL) with a kind, an item and a message */
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
 /* element.c */
 void element_prepare(fdem_model *m, int e);
 double element_stable_dt(const fdem_model *m, int e);

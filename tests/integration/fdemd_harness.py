@@ -17,6 +17,7 @@ import signal
 import subprocess
 import tempfile
 import time
+import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FDEMD_BIN = os.environ.get("FDEMD_BIN", os.path.join(ROOT, "bin", "fdemd"))
@@ -206,3 +207,21 @@ class Daemon:
         """tiny_case() whose run takes about `seconds` of wall time here."""
         rate, dt = self.steps_per_second()
         return tiny_case(name, end=rate * seconds * dt, **kw)
+
+
+class DaemonTestCase(unittest.TestCase):
+    """One daemon and one scratch directory shared by a class's tests; the
+    daemon must exit 0 on SIGTERM when the class is done."""
+    PREFIX = "fdemd-test-"
+
+    @classmethod
+    def setUpClass(cls):
+        cls.d = Daemon().start()
+        cls.tmp = tempfile.mkdtemp(prefix=cls.PREFIX)
+
+    @classmethod
+    def tearDownClass(cls):
+        code, _ = cls.d.stop()
+        cls.d.close()
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+        assert code == 0, "fdemd exited %s on SIGTERM" % code

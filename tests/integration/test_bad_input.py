@@ -1,7 +1,6 @@
 """Bad requests are each answered with a clear 4xx (problem+json naming
 what and where) and change nothing: the case already stored before them
 is untouched and no case is added."""
-import copy
 import json
 import socket
 import unittest

@@ -9,23 +9,23 @@ test tests/unit/test_fracture.c; the snapshots here are one sample every
 import json
 import math
 import os
-import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, Daemon
+from fdemd_harness import ROOT, DaemonTestCase
 
 EXAMPLE = os.path.join(ROOT, "examples", "brazilian-disc.json")
 
 
-class BrazilianThroughDaemon(unittest.TestCase):
+class BrazilianThroughDaemon(DaemonTestCase):
+    PREFIX = "fdemd-fracture-"
+
     @classmethod
     def setUpClass(cls):
-        cls.d = Daemon().start()
-        cls.tmp = tempfile.mkdtemp(prefix="fdemd-fracture-")
+        super().setUpClass()
         with open(EXAMPLE) as f:
             case = json.load(f)
         st = cls.d.create(case, start=True)
@@ -37,15 +37,6 @@ class BrazilianThroughDaemon(unittest.TestCase):
             f.write(data)
         status, _, cls.xdmf = cls.d.request("GET", "/cases/%s/result.xdmf" % st["id"])
         assert status == 200, status
-
-    @classmethod
-    def tearDownClass(cls):
-        code, _ = cls.d.stop()
-        cls.d.close()
-        for name in os.listdir(cls.tmp):
-            os.unlink(os.path.join(cls.tmp, name))
-        os.rmdir(cls.tmp)
-        assert code == 0
 
     def test_status_counts_the_split(self):
         st = self.final

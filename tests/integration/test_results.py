@@ -3,30 +3,17 @@ xml.etree: valid while the case runs (a consistent copy with every
 snapshot written before the request), complete once it finished, and an
 XDMF whose every HDF5 reference exists in the file."""
 import os
-import tempfile
 import unittest
 import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
 
-from fdemd_harness import Daemon, tiny_case
+from fdemd_harness import DaemonTestCase, tiny_case
 
 
-class ResultTest(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon().start()
-        cls.tmp = tempfile.mkdtemp(prefix="fdemd-results-")
-
-    @classmethod
-    def tearDownClass(cls):
-        code, _ = cls.d.stop()
-        cls.d.close()
-        for name in os.listdir(cls.tmp):
-            os.unlink(os.path.join(cls.tmp, name))
-        os.rmdir(cls.tmp)
-        assert code == 0
+class ResultTest(DaemonTestCase):
+    PREFIX = "fdemd-results-"
 
     def download(self, case_id, name):
         status, headers, data = self.d.request("GET", "/cases/%s/%s" % (case_id, name))
