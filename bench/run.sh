@@ -6,9 +6,10 @@ set -u
 BUILD=${BUILD:-build}
 BIN=${BIN:-bin}
 PYTHON=${PYTHON:-/usr/bin/python3}
+cores=$(nproc --all)
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 cd "$(dirname "$0")/.."
-echo "# fdemd bench on $(uname -m), $(nproc) cores, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')"
+echo "# fdemd bench on $(uname -m), $cores cores, $(date -u +%Y-%m-%dT%H:%MZ), commit $(git rev-parse --short HEAD 2>/dev/null || echo '?')"
 for b in "$BUILD"/bench/*; do
   [ -x "$b" ] && [ -f "$b" ] || continue
   echo
