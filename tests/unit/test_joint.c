@@ -114,6 +114,81 @@ static void mode_II_energy_matches_softening_curve(void)
     fdem_model_destroy(m);
 }
 
+/* Turns the one-joint model rigidly by `angle` about the origin, then moves
+ * face B by (dn0, ds0) at b0 and (dn1, ds1) at b1 in the turned face's
+ * normal/tangent frame, and returns the joint forces on a0, a1, b0, b1. */
+static void turned_joint_forces(fdem_model *m, double angle, double dn0, double ds0, double dn1,
+                                double ds1, double out[8])
+{
+    const int32_t *n = m->joint_node;
+    const double *x0 = m->pos0;
+    double c = cos(angle), s = sin(angle);
+    for (int i = 0; i < m->node_count; i++) {
+        m->pos[2 * i] = c * x0[2 * i] - s * x0[2 * i + 1];
+        m->pos[2 * i + 1] = s * x0[2 * i] + c * x0[2 * i + 1];
+    }
+    double tx = m->pos[2 * n[1]] - m->pos[2 * n[0]], ty = m->pos[2 * n[1] + 1] - m->pos[2 * n[0] + 1];
+    double L = hypot(tx, ty);
+    tx /= L; ty /= L;
+    double nx = ty, ny = -tx;
+    m->pos[2 * n[2]] += dn0 * nx + ds0 * tx;
+    m->pos[2 * n[2] + 1] += dn0 * ny + ds0 * ty;
+    m->pos[2 * n[3]] += dn1 * nx + ds1 * tx;
+    m->pos[2 * n[3] + 1] += dn1 * ny + ds1 * ty;
+    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    joint_forces(m);
+    for (int c4 = 0; c4 < 4; c4++) {
+        out[2 * c4] = m->force[2 * n[c4]];
+        out[2 * c4 + 1] = m->force[2 * n[c4] + 1];
+    }
+}
+
+/* An undamaged joint below its strengths is a penalty spring on the whole
+ * relative displacement: face B feels -k times the integral of the gap d
+ * along the edge (resultant -k L (d0 + d1) / 2, moment about b0
+ * -k L^2 (d0 + 2 d1) / 6 x t), the same after any rigid rotation, with no
+ * damage. Just past the tensile strength the joint starts to soften. */
+static void elastic_joint_is_a_penalty_spring_in_any_orientation(void)
+{
+    fdem_model *m = one_joint();
+    double k = m->joint_k[0], L = hypot(0.01, 0.01), ft = 1e6;
+    double dp = ft / k; /* opening at the tensile strength */
+    /* opening 0.3 dp at b0, 0.6 dp at b1, sliding 0.2 dp and -0.1 dp */
+    double dn0 = 0.3 * dp, dn1 = 0.6 * dp, ds0 = 0.2 * dp, ds1 = -0.1 * dp;
+    double flat[8], turned[8];
+    turned_joint_forces(m, 0, dn0, ds0, dn1, ds1, flat);
+    CHECK(m->joint_damage[0] == 0, "damage %g below the strengths", m->joint_damage[0]);
+    double angle = 37 * M_PI / 180, c = cos(angle), s = sin(angle);
+    turned_joint_forces(m, angle, dn0, ds0, dn1, ds1, turned);
+    double scale = k * L * dp;
+    for (int i = 0; i < 4; i++) {
+        double rx = c * flat[2 * i] - s * flat[2 * i + 1], ry = s * flat[2 * i] + c * flat[2 * i + 1];
+        CHECK_NEAR(turned[2 * i], rx, 1e-9 * scale);
+        CHECK_NEAR(turned[2 * i + 1], ry, 1e-9 * scale);
+    }
+    /* resultant on B, in the face frame of the unturned joint; the engine
+     * weighs by the current mean face length, which the sliding changes by
+     * (ds1 - ds0) / 2, a few 1e-7 of L here: hence 1e-6 */
+    const double *x0 = m->pos0;
+    const int32_t *n = m->joint_node;
+    double tx = (x0[2 * n[1]] - x0[2 * n[0]]) / L, ty = (x0[2 * n[1] + 1] - x0[2 * n[0] + 1]) / L;
+    double nx = ty, ny = -tx;
+    double Bx = flat[4] + flat[6], By = flat[5] + flat[7];
+    CHECK_REL(Bx * nx + By * ny, -k * L * (dn0 + dn1) / 2, 1e-6);
+    CHECK_REL(Bx * tx + By * ty, -k * L * (ds0 + ds1) / 2, 1e-6);
+    /* share of b1 = the moment about b0 over L */
+    CHECK_REL(flat[6] * nx + flat[7] * ny, -k * L * (dn0 + 2 * dn1) / 6, 1e-6);
+    for (int i = 0; i < 2; i++) { /* action equals reaction */
+        CHECK_NEAR(flat[i] + flat[4 + i], 0, 1e-12 * scale);
+        CHECK_NEAR(flat[2 + i] + flat[6 + i], 0, 1e-12 * scale);
+    }
+    /* just past the strength at the Gauss point nearer b1: softening starts */
+    turned_joint_forces(m, angle, 1.05 * dp, 0, 1.05 * dp, 0, turned);
+    CHECK(m->joint_damage[0] > 0 && m->joint_damage[0] < 1, "damage %g past the tensile strength",
+          m->joint_damage[0]);
+    fdem_model_destroy(m);
+}
+
 static void softening_curve_ends(void)
 {
     CHECK_NEAR(joint_softening(0), 1.0, 1e-12);
@@ -249,5 +324,6 @@ static void intact_fracturing_bar_vibrates_like_continuum(void)
 }
 
 CHECK_MAIN(T(softening_curve_ends), T(mode_I_energy_matches_softening_curve),
-           T(mode_II_energy_matches_softening_curve), T(block_of_fracturing_triangles_is_built_right),
+           T(mode_II_energy_matches_softening_curve),
+           T(elastic_joint_is_a_penalty_spring_in_any_orientation), T(block_of_fracturing_triangles_is_built_right),
            T(broken_joints_make_fragments), T(intact_fracturing_bar_vibrates_like_continuum))
