@@ -9,7 +9,9 @@
  *  3. a fracturing block (every triangle on its own nodes, a joint on every
  *     interior edge) vibrating at small strain: ns per element-step with
  *     the joints, beside the same block without fracture and the bandwidth
- *     bound of a private-node mesh.
+ *     bound of a private-node mesh;
+ *  4. the elastic and fracturing blocks on 1 thread and on every core
+ *     (fdem_set_threads): ns per element-step and the speed-up.
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -17,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "../tests/unit/build_model.h"
 #include "model.h"
@@ -214,8 +217,58 @@ static void bench_fracturing_block(double bandwidth_gbs)
     }
 }
 
+/* ns per element-step on `threads` threads: the best of three runs of
+ * `steps` steps (a shared machine's neighbours only ever slow a run). */
+static double time_steps(fdem_model *m, int threads, int steps)
+{
+    fdem_error err;
+    fdem_set_threads(m, threads);
+    for (int s = 0; s < 3; s++) fdem_step(m, &err);
+    double best = INFINITY;
+    for (int rep = 0; rep < 3; rep++) {
+        double t0 = now();
+        for (int s = 0; s < steps; s++) fdem_step(m, &err);
+        best = fmin(best, now() - t0);
+    }
+    return best * 1e9 / ((double)steps * m->elem_count);
+}
+
+static void bench_threads(void)
+{
+    int cores = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 2) cores = 2;
+    printf("\n## Threads: the same models on 1 and %d threads (results are bit-identical)\n", cores);
+    printf("%-28s %10s %8s %12s %12s %9s\n", "model", "elements", "colours", "1 thread ns",
+           "threads ns", "speed-up");
+    for (int fracture = 0; fracture < 2; fracture++)
+        for (int k = 0; k < 2; k++) {
+            int n = k ? 707 : 224;
+            fdem_model *m = vibrating_block(n, fracture);
+            int steps = (int)(1e7 / m->elem_count);
+            if (steps < 10) steps = 10;
+            double one = time_steps(m, 1, steps), many = time_steps(m, cores, steps);
+            printf("%-28s %10d %8d %12.1f %12.1f %9.2f\n",
+                   fracture ? "fracturing block (joints)" : "elastic block (shared nodes)",
+                   m->elem_count, fracture ? m->joint_plan.color_count : m->elem_plan.color_count,
+                   one, many, one / many);
+            fdem_model_destroy(m);
+        }
+    int dims[][2] = {{20, 20}, {60, 60}};
+    for (int k = 0; k < 2; k++) {
+        fdem_model *m = disc_pile(dims[k][0], dims[k][1]);
+        fdem_error err;
+        for (int s = 0; s < 300; s++) fdem_step(m, &err); /* into contact, as above */
+        int steps = (int)(5e6 / m->elem_count);
+        if (steps < 25) steps = 25;
+        double one = time_steps(m, 1, steps), many = time_steps(m, cores, steps);
+        printf("%-28s %10d %8d %12.1f %12.1f %9.2f\n", "disc pile (contact)", m->elem_count,
+               m->elem_plan.color_count, one, many, one / many);
+        fdem_model_destroy(m);
+    }
+}
+
 /* With no argument every section runs; otherwise only those named
- * (block, pile, fracture), to iterate on one kernel. */
+ * (block, pile, fracture, threads), to iterate on one kernel. */
 static int wanted(int argc, char **argv, const char *name)
 {
     if (argc < 2) return 1;
@@ -231,5 +284,6 @@ int main(int argc, char **argv)
     if (wanted(argc, argv, "block")) bench_elastic_block(bw);
     if (wanted(argc, argv, "pile")) bench_disc_pile();
     if (wanted(argc, argv, "fracture")) bench_fracturing_block(bw);
+    if (wanted(argc, argv, "threads")) bench_threads();
     return 0;
 }

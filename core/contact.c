@@ -29,8 +29,26 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "model.h"
+
+/* Fewer candidate pairs than this are evaluated on one thread: below it the
+ * threads' start-up costs more than they share. */
+#define CONTACT_THREADED_PAIRS 2048
+
+/* A thread's pairs that touched, in pair order, with their forces. */
+typedef struct contact_touch {
+    long pair;
+    double force[12];
+} contact_touch;
+
+typedef struct contact_touches {
+    contact_touch *item;
+    size_t count, capacity;
+} contact_touches;
 
 /* The current geometry of one triangle, gathered once per pair. */
 typedef struct tri_now {
@@ -120,15 +138,17 @@ static int edge_potential_integral(const double la[3], const double lb[3], doubl
     return sum0 > 0;
 }
 
-/* Forces of target t's potential on contactor c's edges, and their
- * reactions on t. Returns 1 if any force acted. */
-static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_now *t,
-                                    double penalty, double friction, double havg)
+/* Forces of target t's potential on contactor c's edges, added to fc (two
+ * per corner of c), and their reactions on t, added to ft. Returns 1 if any
+ * force acted. Reads the model, writes nothing in it: pairs can be
+ * evaluated side by side. */
+static int contactor_against_target(const fdem_model *m, const tri_now *c, const tri_now *t,
+                                    double penalty, double friction, double havg, double fc[6],
+                                    double ft[6])
 {
     double lam[3][3];
     for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
     const double *v = m->vel, *inv_mass = m->inv_mass;
-    double *f = m->contact.force;
     double inv_m_target = max3(inv_mass[t->node[0]], inv_mass[t->node[1]], inv_mass[t->node[2]]);
     int acted = 0;
     for (int i = 0; i < 3; i++) {
@@ -156,18 +176,18 @@ static int contactor_against_target(fdem_model *m, const tri_now *c, const tri_n
             double slip = (vcx - vtx) * tx + (vcy - vty) * ty;
             double inv_m = max2(inv_mass[na], inv_mass[nb]) + inv_m_target;
             double stop = 0.5 * fabs(slip) / (inv_m * havg);
-            double ft = min2(friction * penalty * i0 * len, stop);
-            if (slip > 0) ft = -ft;
-            fx += ft * tx;
-            fy += ft * ty;
+            double f_slip = min2(friction * penalty * i0 * len, stop);
+            if (slip > 0) f_slip = -f_slip;
+            fx += f_slip * tx;
+            fy += f_slip * ty;
         }
-        f[2 * na] += (1 - sbar) * fx;
-        f[2 * na + 1] += (1 - sbar) * fy;
-        f[2 * nb] += sbar * fx;
-        f[2 * nb + 1] += sbar * fy;
+        fc[2 * i] += (1 - sbar) * fx;
+        fc[2 * i + 1] += (1 - sbar) * fy;
+        fc[2 * j] += sbar * fx;
+        fc[2 * j + 1] += sbar * fy;
         for (int k = 0; k < 3; k++) {
-            f[2 * t->node[k]] -= lbar[k] * fx;
-            f[2 * t->node[k] + 1] -= lbar[k] * fy;
+            ft[2 * k] -= lbar[k] * fx;
+            ft[2 * k + 1] -= lbar[k] * fy;
         }
     }
     return acted;
@@ -183,8 +203,10 @@ static int boxes_overlap(const tri_now *a, const tri_now *b)
     return !(ay1 < by0 || by1 < ay0);
 }
 
-/* Force between two elements, both roles. Returns 1 if they touched. */
-int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
+/* Force between two elements, both roles, into out: two per corner of e1,
+ * then two per corner of e2. Returns 1 if they touched (out is then
+ * filled; otherwise it may be left as it was). Writes nothing in m. */
+static int contact_pair_force(const fdem_model *m, int e1, int e2, double havg, double out[12])
 {
     tri_now a, b;
     tri_gather(m, e1, &a);
@@ -197,9 +219,35 @@ int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
      * so giving it on one material is enough. */
     double penalty = min2(a.penalty, b.penalty);
     double friction = max2(a.friction, b.friction);
-    int touched = contactor_against_target(m, &a, &b, penalty, friction, havg);
-    touched |= contactor_against_target(m, &b, &a, penalty, friction, havg);
+    for (int k = 0; k < 12; k++) out[k] = 0;
+    int touched = contactor_against_target(m, &a, &b, penalty, friction, havg, out, out + 6);
+    touched |= contactor_against_target(m, &b, &a, penalty, friction, havg, out + 6, out);
     return touched;
+}
+
+/* Adds a pair's forces (contact_pair_force) to the contact force array. */
+static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out[12])
+{
+    double *f = m->contact.force;
+    const int32_t *n1 = m->elem[e1].node, *n2 = m->elem[e2].node;
+    for (int c = 0; c < 3; c++) {
+        f[2 * n1[c]] += out[2 * c];
+        f[2 * n1[c] + 1] += out[2 * c + 1];
+    }
+    for (int c = 0; c < 3; c++) {
+        f[2 * n2[c]] += out[6 + 2 * c];
+        f[2 * n2[c] + 1] += out[6 + 2 * c + 1];
+    }
+}
+
+/* Force between two elements, both roles, added to the contact force
+ * array. Returns 1 if they touched. */
+int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
+{
+    double out[12];
+    if (!contact_pair_force(m, e1, e2, havg, out)) return 0;
+    contact_pair_scatter(m, e1, e2, out);
+    return 1;
 }
 
 static void element_circle(const fdem_model *m, int e, double *cx, double *cy, double *r)
@@ -268,6 +316,7 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->piece = malloc(sizeof(int32_t) * E);
     cs->pos_detect = malloc(sizeof(double) * 2 * N);
     cs->force = calloc(2 * N, sizeof(double));
+    cs->force_is_zero = 1;
     if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->piece || !cs->pos_detect || !cs->force) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
@@ -293,6 +342,8 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
+    for (int t = 0; t < cs->touch_lists; t++) free(cs->touches[t].item);
+    free(cs->touches);
     nbs_grid_free(&cs->grid);
     nbs_pairs_free(&cs->pairs);
     memset(cs, 0, sizeof *cs);
@@ -312,6 +363,108 @@ double contact_stable_dt(const fdem_model *m)
     return dt;
 }
 
+size_t contact_memory_bytes(const contact_state *cs)
+{
+    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    for (int t = 0; t < cs->touch_lists; t++) b += cs->touches[t].capacity * sizeof(contact_touch);
+    return b;
+}
+
+static int contact_touch_push(contact_touches *list, long pair, const double force[12])
+{
+    if (list->count == list->capacity) {
+        size_t cap = list->capacity ? 2 * list->capacity : 1024;
+        contact_touch *p = realloc(list->item, cap * sizeof *p);
+        if (!p) return -1;
+        list->item = p;
+        list->capacity = cap;
+    }
+    contact_touch *t = &list->item[list->count++];
+    t->pair = pair;
+    memcpy(t->force, force, sizeof t->force);
+    return 0;
+}
+
+/* One list per thread; 0, or -1 if they cannot be had. */
+static int contact_touch_lists(contact_state *cs, int threads)
+{
+    if (threads <= cs->touch_lists) return 0;
+    contact_touches *t = realloc(cs->touches, sizeof *t * (size_t)threads);
+    if (!t) return -1;
+    memset(t + cs->touch_lists, 0, sizeof *t * (size_t)(threads - cs->touch_lists));
+    cs->touches = t;
+    cs->touch_lists = threads;
+    return 0;
+}
+
+/* Every candidate pair's force, added to the contact force array in pair
+ * order, one pair at a time. Returns the number of pairs that touched. */
+static int contact_pairs_forces_serial(fdem_model *m, double havg)
+{
+    const contact_state *cs = &m->contact;
+    int touching = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++)
+        touching += contact_potential_force(m, cs->pairs.a[k], cs->pairs.b[k], havg);
+    return touching;
+}
+
+/* The same on several threads: each takes a contiguous share of the pairs
+ * and lists the ones that touched with their forces; the lists are then
+ * added in thread order, which is pair order. Every node's sum is formed in
+ * the order the serial loop forms it: the same bits on any thread count.
+ * Returns the number of pairs that touched, or -1 if a list could not grow
+ * (nothing has been added then). */
+static int contact_pairs_forces_threaded(fdem_model *m, double havg)
+{
+    contact_state *cs = &m->contact;
+    long n = (long)cs->pairs.count;
+    const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b;
+    int touching = 0, failed = 0, used = 1;
+    contact_touches *lists = cs->touches;
+#pragma omp parallel num_threads(m->threads) reduction(+ : touching)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        if (t == 0) used = nt;
+        contact_touches *list = &lists[t];
+        list->count = 0;
+        long begin = n * t / nt, end = n * (t + 1) / nt;
+        for (long k = begin; k < end; k++) {
+            double force[12];
+            if (!contact_pair_force(m, pa[k], pb[k], havg, force)) continue;
+            touching++;
+            if (contact_touch_push(list, k, force)) {
+#pragma omp atomic write
+                failed = 1;
+                break;
+            }
+        }
+    }
+    if (failed) return -1;
+    for (int t = 0; t < used; t++)
+        for (size_t i = 0; i < lists[t].count; i++) {
+            const contact_touch *c = &lists[t].item[i];
+            contact_pair_scatter(m, pa[c->pair], pb[c->pair], c->force);
+        }
+    return touching;
+}
+
+/* Threads only pay off with enough pairs; without room for their lists the
+ * step stays on one thread. */
+static int contact_pairs_forces(fdem_model *m, double havg)
+{
+    contact_state *cs = &m->contact;
+    if (m->threads > 1 && cs->pairs.count >= CONTACT_THREADED_PAIRS &&
+        contact_touch_lists(cs, m->threads) == 0) {
+        int touching = contact_pairs_forces_threaded(m, havg);
+        if (touching >= 0) return touching;
+    }
+    return contact_pairs_forces_serial(m, havg);
+}
+
 int contact_forces(fdem_model *m, double havg)
 {
     contact_state *cs = &m->contact;
@@ -324,10 +477,10 @@ int contact_forces(fdem_model *m, double havg)
         m->times.detection += spent;
         m->times.contact -= spent; /* the caller books the whole call as contact */
     }
-    memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    int touching = 0;
-    for (size_t k = 0; k < cs->pairs.count; k++)
-        touching += contact_potential_force(m, cs->pairs.a[k], cs->pairs.b[k], havg);
-    cs->touching = touching;
+    /* With no candidate pair (bodies apart, an intact fracturing block) the
+     * force array stays zero, and the integrator skips reading it. */
+    if (!cs->force_is_zero) memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    cs->force_is_zero = cs->pairs.count == 0;
+    cs->touching = contact_pairs_forces(m, havg);
     return 0;
 }

@@ -17,28 +17,31 @@
 
 #include "model.h"
 
-/* One pass over the nodes: the central difference update of every dof no
- * constraint owns. Returns a sum of the new positions and velocities:
+/* The central difference update of nodes [begin, end), for every dof no
+ * constraint owns. sums[0] gets a sum of the new positions and velocities:
  * non-finite if and only if some value is (cheaper than a test per value in
- * the hot loop); the sum is accumulated as one add per node, so that its
- * dependency chain does not pace the loop. with_contact is a constant at
- * each call below, so the compiler emits the contact-free loop without the
- * contact terms' loads and branches. */
-static inline double central_difference_pass(fdem_model *m, double h, double havg,
-                                             int with_contact, double *contact_work_out,
-                                             double *max_disp2_io)
+ * the hot loop); it is accumulated as one add per node, so that its
+ * dependency chain does not pace the loop. sums[1] gets the work of the
+ * contact forces (times 2 / havg) and sums[2] the largest squared
+ * displacement since the last detection. with_contact (contact is on: track
+ * displacements) and with_force (some contact force may be non-zero) are
+ * constants at each call below, so the compiler emits each loop without the
+ * loads and branches it does not need. */
+static inline void central_difference_pass(fdem_model *m, int begin, int end, int with_contact,
+                                           int with_force, double sums[SCATTER_SUMS])
 {
+    const double h = m->dt, havg = 0.5 * (m->dt_prev + m->dt);
     const double gx = m->gravity[0], gy = m->gravity[1];
     double *x = m->pos, *v = m->vel;
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
     const double *fc = m->contact.force;
     const double *xd = m->contact.pos_detect;
-    double check = 0, max_disp2 = *max_disp2_io, contact_work = 0;
-    for (int i = 0; i < m->node_count; i++) {
+    double check = 0, max_disp2 = 0, contact_work = 0;
+    for (int i = begin; i < end; i++) {
         double fx = f[2 * i], fy = f[2 * i + 1];
         double vx_old = v[2 * i], vy_old = v[2 * i + 1];
-        if (with_contact) {
+        if (with_force) {
             fx += fc[2 * i];
             fy += fc[2 * i + 1];
         }
@@ -60,29 +63,49 @@ static inline double central_difference_pass(fdem_model *m, double h, double hav
         if (with_contact) {
             /* f . (v_old + v_new)/2 * havg is exactly what the force adds to
              * the half-step kinetic energy, so the balance closes. */
-            contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + vx)) +
-                            ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + vy));
+            if (with_force)
+                contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + vx)) +
+                                ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + vy));
             double ux = px - xd[2 * i], uy = py - xd[2 * i + 1];
             double d2 = ux * ux + uy * uy;
             if (d2 > max_disp2) max_disp2 = d2;
         }
     }
-    *contact_work_out = contact_work;
-    *max_disp2_io = max_disp2;
-    return check;
+    sums[0] += check;
+    sums[1] += contact_work;
+    if (max_disp2 > sums[2]) sums[2] = max_disp2;
 }
 
-int central_difference_step(fdem_model *m, double h, double havg)
+static void central_difference_nodes(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    double contact_work = 0, max_disp2 = m->contact.max_disp2, check;
-    if (m->contact.enabled)
-        check = central_difference_pass(m, h, havg, 1, &contact_work, &max_disp2);
-    else
-        check = central_difference_pass(m, h, havg, 0, &contact_work, &max_disp2);
-    contact_work *= 0.5 * havg;
-    m->contact.max_disp2 = max_disp2;
-    m->contact_work += contact_work;
-    return isfinite(check) ? 0 : -1;
+    central_difference_pass(m, begin, end, 0, 0, sums);
+}
+
+static void central_difference_nodes_tracked(fdem_model *m, int begin, int end,
+                                             double sums[SCATTER_SUMS])
+{
+    central_difference_pass(m, begin, end, 1, 0, sums);
+}
+
+static void central_difference_nodes_contact(fdem_model *m, int begin, int end,
+                                             double sums[SCATTER_SUMS])
+{
+    central_difference_pass(m, begin, end, 1, 1, sums);
+}
+
+/* Advances every free dof by m->dt (h_next) after a step of m->dt_prev
+ * (h_current). Returns -1 if some new value is not finite. */
+int central_difference_step(fdem_model *m)
+{
+    double havg = 0.5 * (m->dt_prev + m->dt);
+    double sums[SCATTER_SUMS] = {0, 0, m->contact.max_disp2};
+    scatter_block_fn pass = !m->contact.enabled      ? central_difference_nodes
+                            : m->contact.force_is_zero ? central_difference_nodes_tracked
+                                                       : central_difference_nodes_contact;
+    scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
+    m->contact.max_disp2 = sums[2];
+    m->contact_work += sums[1] * 0.5 * havg;
+    return isfinite(sums[0]) ? 0 : -1;
 }
 
 double stage_clock(void)
@@ -137,7 +160,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double t2 = stage_clock();
     constraint_apply_forces(m);
-    int bad = central_difference_step(m, h, havg);
+    int bad = central_difference_step(m);
     constraint_enforce(m, h, havg);
     m->times.integration += stage_clock() - t2;
     m->times.contact += t2 - t1; /* detection time is moved out in contact_forces */

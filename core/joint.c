@@ -318,8 +318,8 @@ static void joint_forces_general(const material *mat, double k, const double d0[
     }
 }
 
-/* Adds the forces of every intact joint to m->force. Returns the number of
- * joints that broke in this call.
+/* Adds the forces of intact joints [begin, end) to m->force and counts in
+ * sums[0] those that broke in this call.
  *
  * Nearly every joint in nearly every step is undamaged and elastic at both
  * Gauss points. There the traction is k (delta n + s t) = k d: the penalty
@@ -328,13 +328,13 @@ static void joint_forces_general(const material *mat, double k, const double d0[
  *   f_a0 = L k (2 d0 + d1) / 6,   f_a1 = L k (d0 + 2 d1) / 6,
  * the same forces as the Gauss-point sum, without unit vectors, tractions or
  * the damage bookkeeping. Only the elastic test needs the projections. */
-int joint_forces(fdem_model *m)
+static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
     const double *x = m->pos;
     double *f = m->force;
     const material *mats = m->materials;
     int broke = 0;
-    for (int j = 0; j < m->joint_count; j++) {
+    for (int j = begin; j < end; j++) {
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 4 * j;
@@ -383,7 +383,19 @@ int joint_forces(fdem_model *m)
         gb0[0] -= fa0[0]; gb0[1] -= fa0[1];
         gb1[0] -= fa1[0]; gb1[1] -= fa1[1];
     }
-    return broke;
+    sums[0] += broke;
+}
+
+/* Adds the forces of every intact joint to m->force. Returns the number of
+ * joints that broke in this call. */
+int joint_forces(fdem_model *m)
+{
+    double sums[SCATTER_SUMS] = {0, 0, 0};
+    if (m->joint_plan.color_count)
+        scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
+    else
+        joint_forces_range(m, 0, m->joint_count, sums);
+    return (int)sums[0];
 }
 
 /* ------------------------------------------------------------ fragments */

@@ -59,6 +59,9 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_k); free(m->joint_material);
     free(m->elem_joint); free(m->vertex_broken);
     contact_free(&m->contact);
+    scatter_plan_free(&m->elem_plan);
+    scatter_plan_free(&m->joint_plan);
+    scatter_plan_free(&m->node_plan);
     free(m);
 }
 
@@ -310,9 +313,29 @@ static void lump_masses(fdem_model *m)
     for (int i = 0; i < m->node_count; i++) m->inv_mass[i] = 1.0 / m->mass[i];
 }
 
+/* Element nodes sit at the start of each 64-byte record, 16 int32 apart. */
+static int build_scatter_plans(fdem_model *m)
+{
+    _Static_assert(sizeof(element_hot) % sizeof(int32_t) == 0, "element records in int32 words");
+    if (m->elem_count &&
+        scatter_plan_build(&m->elem_plan, m->elem_count,
+                           scatter_block_size(m->elem_count, SCATTER_BLOCK_ELEMENTS),
+                           m->elem[0].node, sizeof(element_hot) / sizeof(int32_t), 3,
+                           m->node_count))
+        return -1;
+    if (m->joint_count &&
+        scatter_plan_build(&m->joint_plan, m->joint_count,
+                           scatter_block_size(m->joint_count, SCATTER_BLOCK_JOINTS),
+                           m->joint_node, 4, 4, m->node_count))
+        return -1;
+    return scatter_plan_build_disjoint(&m->node_plan, m->node_count,
+                                       scatter_block_size(m->node_count, SCATTER_BLOCK_NODES));
+}
+
 int fdem_model_finalize(fdem_model *m, fdem_error *err)
 {
     if (m->finalized) return 0;
+    if (m->threads < 1) m->threads = 1;
     if (m->part_count == 0) {
         model_error(err, FDEM_ITEM_NONE, -1, "the model has no parts");
         return -1;
@@ -337,6 +360,10 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     m->fragments = joint_fragment_count(m);
     if (constraint_select(m, err)) return -1;
     if (contact_init(m, err)) return -1;
+    if (build_scatter_plans(m)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
+        return -1;
+    }
 
     double dt = INFINITY;
     for (int e = 0; e < m->elem_count; e++) {
@@ -356,6 +383,8 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
 double fdem_stable_dt(const fdem_model *m) { return m->stable_dt; }
 void fdem_set_dt(fdem_model *m, double dt) { if (dt > 0 && isfinite(dt)) m->dt = dt; }
 double fdem_get_dt(const fdem_model *m) { return m->dt; }
+void fdem_set_threads(fdem_model *m, int threads) { m->threads = threads > 1 ? threads : 1; }
+int fdem_get_threads(const fdem_model *m) { return m->threads > 1 ? m->threads : 1; }
 int64_t fdem_get_step(const fdem_model *m) { return m->step; }
 double fdem_get_time(const fdem_model *m) { return m->time; }
 
@@ -450,5 +479,6 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
     if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
+    b += contact_memory_bytes(&m->contact);
     return b;
 }

@@ -6,7 +6,8 @@
  * (positions, velocities, forces, inverse masses, the 64-byte element record)
  * sits in contiguous arrays of plain numbers; what only set-up, output and
  * checkpoints touch (initial positions, masses, part ids) lives beside them.
- * Nothing in a step allocates.
+ * A step allocates only to grow the contact pair lists to a new high-water
+ * mark.
  */
 #ifndef FDEM_MODEL_H
 #define FDEM_MODEL_H
@@ -47,6 +48,17 @@ typedef struct constraint {
     double force[2];     /* reaction (fix, velocity) or applied (force) of the last step */
 } constraint;
 
+/* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
+ * blocks of one colour share no node, so threads may run them side by side
+ * and add into node arrays without races (scatter_plan.c). */
+typedef struct scatter_plan {
+    int item_count, block_size, block_count;
+    int color_count;         /* 0: no plan, the loop runs serially */
+    int32_t *color_begin;    /* color_count + 1 offsets into block_order */
+    int32_t *block_order;    /* block indices, colour by colour */
+    double *block_sum;       /* SCATTER_SUMS partials per block, totalled in block order */
+} scatter_plan;
+
 typedef struct contact_state {
     int enabled;             /* some pair of elements can ever touch */
     double buffer;           /* added to circle diameters; re-detect after buffer/2 */
@@ -57,8 +69,11 @@ typedef struct contact_state {
     double *cx, *cy, *r;     /* bounding circles, one per element */
     double *pos_detect;      /* node positions at the last detection */
     double *force;           /* contact force per node (kept apart for its work) */
+    int force_is_zero;       /* force holds only zeros: no pair was evaluated */
     int32_t *body;           /* body id per element: pairs of one body never touch */
     int32_t *piece;          /* scratch: piece label per element (fracturing models) */
+    struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
+    int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;
     nbs_pairs pairs;
 } contact_state;
@@ -124,6 +139,11 @@ struct fdem_model {
 
     contact_state contact;
     fdem_stage_times times;
+
+    /* threads for the per-step loops; the plans fix the summation order so
+     * that the result does not depend on the thread count */
+    int threads;
+    scatter_plan elem_plan, joint_plan, node_plan;
 };
 
 double stage_clock(void);
@@ -144,6 +164,7 @@ int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m, double havg);
+size_t contact_memory_bytes(const contact_state *c); /* threaded runs' lists only */
 
 /* constraint.c */
 int constraint_select(fdem_model *m, fdem_error *err);
@@ -164,7 +185,31 @@ int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 int joint_fragment_count(const fdem_model *m);
 
+/* scatter_plan.c: fn runs items [begin, end) of one block and may add into
+ * node arrays. It starts from sums zeroed and leaves its block's partial
+ * results there: sums[0] and sums[1] are added, block by block in block
+ * order, to totals[0] and totals[1]; totals[2] becomes the largest sums[2]
+ * (and what it held before, if larger). */
+#define SCATTER_SUMS 3
+typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+/* Smallest blocks, and the block count aimed at above that: a node on the
+ * border of two colours is loaded once per colour, so large meshes get
+ * blocks many rows deep (few border nodes), while 64 blocks still spread
+ * over any core count this daemon meets. */
+#define SCATTER_BLOCK_ELEMENTS 1024
+#define SCATTER_BLOCK_JOINTS 2048
+#define SCATTER_BLOCK_NODES 4096
+#define SCATTER_TARGET_BLOCKS 64
+int scatter_block_size(int item_count, int smallest);
+int scatter_plan_build(scatter_plan *plan, int item_count, int block_size,
+                       const int32_t *item_nodes, size_t stride, int nodes_per_item,
+                       int node_count);
+int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_size);
+void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_block_fn fn,
+                      double totals[SCATTER_SUMS]);
+void scatter_plan_free(scatter_plan *plan);
+
 /* integrator.c */
-int central_difference_step(fdem_model *m, double h, double havg);
+int central_difference_step(fdem_model *m);
 
 #endif

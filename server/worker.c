@@ -12,7 +12,6 @@
 #include "worker.h"
 
 #include <math.h>
-#include <omp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -225,8 +224,7 @@ static void *worker_main(void *arg)
 {
     server_case *c = arg;
     const fdemd_config *cfg = registry_config();
-    if (cfg->threads > 0)
-        omp_set_num_threads(cfg->threads);
+    fdem_set_threads(c->model, cfg->threads);
 
     worker_clock clk = {worker_now(), worker_now(), fdem_get_step(c->model), 0.0};
     c->next_output = worker_next_output(c, fdem_get_time(c->model));
