@@ -1,11 +1,17 @@
 """The daemon's command line and signals: --help, refused options, a port
-already in use, SIGINT behaving like SIGTERM, and GET /state answering
-quickly while the case steps (it waits for at most one step)."""
+already in use, SIGINT behaving like SIGTERM, GET /state answering
+quickly while the case steps (it waits for at most one step), and
+--threads giving the same result file as one thread."""
+import os
 import signal
 import socket
 import subprocess
+import tempfile
 import time
 import unittest
+
+import h5py
+import numpy as np
 
 from fdemd_harness import FDEMD_BIN, SLOW, Daemon, tiny_case
 
@@ -82,6 +88,59 @@ class StateLatencyTest(unittest.TestCase):
             self.assertEqual(d.stop()[0], 0)
         finally:
             d.close()
+
+
+def colliding_blocks():
+    """Two 30x30 blocks meeting at 5 m/s: 3600 elements, so the element
+    loops are cut into several blocks, and contact from the first steps."""
+    block = {"size": [0.1, 0.1], "divisions": [30, 30]}
+    return {
+        "name": "threads",
+        "materials": {"rock": {"density": 2700, "young": 3e10, "poisson": 0.25,
+                               "damping": 0.05, "friction": 0.3}},
+        "parts": [
+            {"name": "left", "material": "rock", "velocity": [5, 0],
+             "rectangle": dict(block, origin=[-0.1005, 0])},
+            {"name": "right", "material": "rock", "velocity": [-5, 0.5],
+             "rectangle": dict(block, origin=[0.0005, 0.02])},
+        ],
+        "time": {"end": 2e-4},
+        "output": {"interval": 5e-5, "fields": ["position", "velocity", "stress"]},
+    }
+
+
+class ThreadsTest(unittest.TestCase):
+    def run_case(self, threads):
+        d = Daemon(args=["--threads", str(threads)]).start()
+        try:
+            case_id = d.create(colliding_blocks(), start=True)["id"]
+            st = d.wait_state(case_id, ("finished", "failed"), timeout=60)
+            self.assertEqual(st["state"], "finished", st.get("error"))
+            self.assertGreater(st["contacts"] + st["snapshots"], 0)
+            status, _, data = d.request("GET", "/cases/%s/result.h5" % case_id)
+            self.assertEqual(status, 200)
+            path = os.path.join(self.tmp, "threads-%d.h5" % threads)
+            with open(path, "wb") as f:
+                f.write(data)
+            self.assertEqual(d.stop()[0], 0)
+            return st, path
+        finally:
+            d.close()
+
+    def test_two_threads_write_the_bits_of_one(self):
+        with tempfile.TemporaryDirectory(prefix="fdemd-threads-") as self.tmp:
+            one, h1 = self.run_case(1)
+            two, h2 = self.run_case(2)
+            self.assertEqual(one["step"], two["step"])
+            with h5py.File(h1, "r") as f1, h5py.File(h2, "r") as f2:
+                self.assertGreaterEqual(len(f1["/snapshots/time"]), 5)
+                for name in ("position", "velocity", "stress", "kinetic_energy",
+                             "elastic_energy"):
+                    a, b = f1["/snapshots/" + name][...], f2["/snapshots/" + name][...]
+                    np.testing.assert_array_equal(a, b, err_msg=name)
+                # the blocks did meet: the left one was slowed down
+                v = f1["/snapshots/velocity"][-1]
+                self.assertLess(v[: len(v) // 2, 0].mean(), 4.9)
 
 
 if __name__ == "__main__":
