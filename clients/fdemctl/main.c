@@ -1,7 +1,7 @@
 /*
  * main.c - fdemctl, the command-line client of the fdemd daemon.
  *
- *   fdemctl [--server URL] COMMAND [ARGS...]
+ *   fdemctl [--server URL] COMMAND [ARGS...]   (--server may also follow COMMAND)
  *
  * Reads the global options (server URL from --server or FDEMD_URL, token
  * from FDEMD_TOKEN) once into an immutable ctl_options and dispatches to one
@@ -111,6 +111,34 @@ static int ctl_global_options(int argc, char **argv, const char **server)
     return i;
 }
 
+/* --server may also follow the command ("fdemctl list --server URL"), as
+ * every command's own options may: takes it out of the command's arguments
+ * (up to a "--") so the command never sees it. Returns the new count, or -1
+ * when --server has no value. */
+static int ctl_server_after_command(int argc, char **argv, const char **server)
+{
+    int kept = 1, options_done = 0;
+    for (int i = 1; i < argc; i++) {
+        const char *arg = argv[i];
+        if (!options_done && strcmp(arg, "--") == 0) options_done = 1;
+        if (!options_done && strcmp(arg, "--server") == 0) {
+            if (i + 1 == argc) {
+                fprintf(stderr, "fdemctl %s: option needs a value '--server'\n", argv[0]);
+                return -1;
+            }
+            *server = argv[++i];
+            continue;
+        }
+        if (!options_done && strncmp(arg, "--server=", 9) == 0) {
+            *server = arg + 9;
+            continue;
+        }
+        argv[kept++] = argv[i];
+    }
+    argv[kept] = NULL;
+    return kept;
+}
+
 int main(int argc, char **argv)
 {
     const char *server = getenv("FDEMD_URL");
@@ -123,6 +151,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "fdemctl: unknown command '%s' (try fdemctl --help)\n", argv[first]);
         return CTL_USAGE;
     }
+    int command_argc = ctl_server_after_command(argc - first, argv + first, &server);
+    if (command_argc < 0) return CTL_USAGE;
     char *url = ctl_server_url(server);
     if (!url) return CTL_USAGE;
     const char *token = getenv("FDEMD_TOKEN");
@@ -133,7 +163,7 @@ int main(int argc, char **argv)
         free(url);
         return CTL_USAGE;
     }
-    int code = command->run(&options, argc - first, argv + first);
+    int code = command->run(&options, command_argc, argv + first);
     curl_global_cleanup();
     free(url);
     return code;

@@ -128,6 +128,14 @@ class FdemctlTests(ClientTestCase):
         self.assertEqual(self.ctl("status", "a", "b").returncode, 2)
         self.assertEqual(self.ctl("wait", "x", "--interval", "-1").returncode, 2)
 
+    def test_server_option_before_or_after_the_command(self):
+        dead = "http://127.0.0.1:9"  # FDEMD_URL points nowhere: only --server can reach it
+        for args in (("--server", self.url, "list"), ("list", "--server", self.url),
+                     ("list", "--server=" + self.url)):
+            r = self.ctl(*args, server=dead)
+            self.assertEqual(r.returncode, 0, (args, r.stderr))
+        self.assertEqual(self.ctl("list", "--server", server=dead).returncode, 2)
+
     def test_submit_prints_only_the_id(self):
         case_id = self.submit(quick_case("submitted"))
         self.assertRegex(case_id, r"^\S+$")
