@@ -158,11 +158,7 @@ static fdem_model *vibrating_block(int n, int fracture)
                              .fracture = {1e6, 3e6, 30, 10, 50}};
     fdem_error err;
     int mat = fdem_add_material(m, &def, &err);
-    fdem_mesh mesh;
-    if (fdem_mesh_rectangle(0, 0, 1, 1, n, n, &mesh, &err)) build_die("rectangle", &err);
-    int p = fdem_add_part(m, &mesh, mat, fracture, &err);
-    fdem_mesh_free(&mesh);
-    if (p < 0) build_die("block", &err);
+    build_rectangle_part(m, mat, 0, 0, 1, 1, n, n, fracture);
     /* a 0.1 mm/s shear of the initial velocity field: strains stay ~1e-9 */
     build_finalize(m, 0.5);
     for (int i = 0; i < m->node_count; i++) m->vel[2 * i] = 1e-4 * m->pos0[2 * i + 1];

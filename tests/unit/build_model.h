@@ -33,16 +33,24 @@ static inline int build_material(fdem_model *m, double rho, double E, double nu,
     return k;
 }
 
-static inline int build_rectangle(fdem_model *m, int mat, double x, double y, double w, double h,
-                                  int nx, int ny)
+/* A rectangle part; fracture != 0 makes it breakable along its interior
+ * edges (the material needs fracture parameters then). */
+static inline int build_rectangle_part(fdem_model *m, int mat, double x, double y, double w,
+                                       double h, int nx, int ny, int fracture)
 {
     fdem_mesh mesh;
     fdem_error err;
     if (fdem_mesh_rectangle(x, y, w, h, nx, ny, &mesh, &err)) build_die("rectangle", &err);
-    int p = fdem_add_part(m, &mesh, mat, 0, &err);
+    int p = fdem_add_part(m, &mesh, mat, fracture, &err);
     fdem_mesh_free(&mesh);
     if (p < 0) build_die("rectangle part", &err);
     return p;
+}
+
+static inline int build_rectangle(fdem_model *m, int mat, double x, double y, double w, double h,
+                                  int nx, int ny)
+{
+    return build_rectangle_part(m, mat, x, y, w, h, nx, ny, 0);
 }
 
 static inline int build_disc(fdem_model *m, int mat, double x, double y, double r, int divisions)

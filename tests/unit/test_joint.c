@@ -29,11 +29,7 @@ static fdem_model *one_joint(void)
 {
     fdem_model *m = fdem_model_create();
     int mat = fracture_material(m, 10);
-    fdem_mesh mesh;
-    fdem_error err;
-    fdem_mesh_rectangle(0, 0, 0.01, 0.01, 1, 1, &mesh, &err);
-    if (fdem_add_part(m, &mesh, mat, 1, &err) < 0) build_die("part", &err);
-    fdem_mesh_free(&mesh);
+    build_rectangle_part(m, mat, 0, 0, 0.01, 0.01, 1, 1, 1);
     build_finalize(m, 0.5);
     return m;
 }
@@ -210,12 +206,9 @@ static void block_of_fracturing_triangles_is_built_right(void)
 {
     fdem_model *m = fdem_model_create();
     int mat = fracture_material(m, 10);
-    fdem_mesh mesh;
-    fdem_error err;
-    fdem_mesh_rectangle(0, 0, 1, 1, 4, 3, &mesh, &err);
-    fdem_add_part(m, &mesh, mat, 1, &err);
-    fdem_mesh_free(&mesh);
+    build_rectangle_part(m, mat, 0, 0, 1, 1, 4, 3, 1);
     build_finalize(m, 0.5);
+    fdem_error err;
     fdem_counts c = fdem_get_counts(m);
     /* 24 triangles: 3 private nodes each; interior edges: E = (3T - boundary)/2 */
     CHECK(c.nodes == 72, "nodes %d", c.nodes);
@@ -256,13 +249,7 @@ static void broken_joints_make_fragments(void)
 {
     fdem_model *m = fdem_model_create();
     int mat = fracture_material(m, 10);
-    int p;
-    fdem_mesh mesh;
-    fdem_error err;
-    fdem_mesh_rectangle(0, 0, 0.02, 0.01, 2, 1, &mesh, &err);
-    p = fdem_add_part(m, &mesh, mat, 1, &err);
-    fdem_mesh_free(&mesh);
-    (void)p;
+    build_rectangle_part(m, mat, 0, 0, 0.02, 0.01, 2, 1, 1);
     build_finalize(m, 0.5);
     /* pull the two halves (x < 0.01 and x > 0.01 by triangle centroid) apart fast */
     for (int e = 0; e < m->elem_count; e++) {
@@ -284,11 +271,8 @@ static double bar_period(int fracture, double penalty_factor)
     double L = 0.5, H = 0.025;
     fdem_model *m = fdem_model_create();
     int mat = fracture_material(m, penalty_factor);
-    fdem_mesh mesh;
+    int p = build_rectangle_part(m, mat, 0, 0, L, H, 40, 2, fracture);
     fdem_error err;
-    fdem_mesh_rectangle(0, 0, L, H, 40, 2, &mesh, &err);
-    int p = fdem_add_part(m, &mesh, mat, fracture, &err);
-    fdem_mesh_free(&mesh);
     fdem_set_part_velocity(m, p, 0.001, 0, NULL);
     fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1e-9, -1, 1e-9, 1},
                                .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 0};

@@ -98,11 +98,7 @@ static fdem_model *impact_model(int threads, int fracture)
     fdem_error err;
     int mr = fdem_add_material(m, &rock, &err);
     int mw = build_material(m, 7800, 2e11, 0.3, 0, 0.3);
-    fdem_mesh mesh;
-    if (fdem_mesh_rectangle(0, 0, 0.1, 0.1, 60, 60, &mesh, &err)) build_die("rectangle", &err);
-    int block = fdem_add_part(m, &mesh, mr, fracture, &err);
-    fdem_mesh_free(&mesh);
-    if (block < 0) build_die("block", &err);
+    int block = build_rectangle_part(m, mr, 0, 0, 0.1, 0.1, 60, 60, fracture);
     int wall = build_rectangle(m, mw, -0.05, -0.021, 0.2, 0.02, 40, 4);
     build_fix_part(m, wall);
     fdem_set_part_velocity(m, block, 0.5, -40, &err);
