@@ -193,25 +193,61 @@ static int contactor_against_target(const fdem_model *m, const tri_now *c, const
     return acted;
 }
 
-static int boxes_overlap(const tri_now *a, const tri_now *b)
+/* Axis-aligned boxes (xmin, xmax, ymin, ymax) that overlap or touch. */
+static inline int boxes_overlap(const double *a, const double *b)
 {
-    double ax0 = min3(a->x[0], a->x[1], a->x[2]), ax1 = max3(a->x[0], a->x[1], a->x[2]);
-    double bx0 = min3(b->x[0], b->x[1], b->x[2]), bx1 = max3(b->x[0], b->x[1], b->x[2]);
-    if (ax1 < bx0 || bx1 < ax0) return 0;
-    double ay0 = min3(a->y[0], a->y[1], a->y[2]), ay1 = max3(a->y[0], a->y[1], a->y[2]);
-    double by0 = min3(b->y[0], b->y[1], b->y[2]), by1 = max3(b->y[0], b->y[1], b->y[2]);
-    return !(ay1 < by0 || by1 < ay0);
+    return !(a[1] < b[0] || b[1] < a[0] || a[3] < b[2] || b[3] < a[2]);
 }
 
-/* Force between two elements, both roles, into out: two per corner of e1,
- * then two per corner of e2. Returns 1 if they touched (out is then
- * filled; otherwise it may be left as it was). Writes nothing in m. */
+static inline void element_box(const fdem_model *m, int e, double b[4])
+{
+    const double *p = m->pos;
+    const int32_t *n = m->elem[e].node;
+    double x0 = p[2 * n[0]], y0 = p[2 * n[0] + 1], x1 = p[2 * n[1]], y1 = p[2 * n[1] + 1];
+    double x2 = p[2 * n[2]], y2 = p[2 * n[2] + 1];
+    b[0] = min3(x0, x1, x2);
+    b[1] = max3(x0, x1, x2);
+    b[2] = min3(y0, y1, y2);
+    b[3] = max3(y0, y1, y2);
+}
+
+/* The current box of every element in some candidate pair. Most candidate
+ * pairs do not touch (their bounding circles, inflated by the buffer,
+ * overlap; their triangles do not): the box test then reads two 32-byte
+ * boxes instead of two element records and six scattered nodes. */
+static void contact_boxes(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    const int32_t *active = cs->active;
+    double *box = cs->box;
+    int count = cs->active_count;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++) element_box(m, active[k], box + 4 * (size_t)active[k]);
+}
+
+/* The elements of the candidate pairs, once each, for contact_boxes. */
+static void contact_collect_active(contact_state *cs, int elem_count)
+{
+    memset(cs->in_pair, 0, (size_t)elem_count);
+    int count = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+        if (!cs->in_pair[a]) { cs->in_pair[a] = 1; cs->active[count++] = a; }
+        if (!cs->in_pair[b]) { cs->in_pair[b] = 1; cs->active[count++] = b; }
+    }
+    cs->active_count = count;
+}
+
+/* Force between two elements whose boxes overlap, both roles, into out: two
+ * per corner of e1, then two per corner of e2. Returns 1 if they touched
+ * (out is then filled; otherwise it may be left as it was). Writes nothing
+ * in m. */
 static int contact_pair_force(const fdem_model *m, int e1, int e2, double havg, double out[12])
 {
     tri_now a, b;
     tri_gather(m, e1, &a);
     tri_gather(m, e2, &b);
-    if (!boxes_overlap(&a, &b)) return 0;
     tri_complete(m, e1, &a);
     tri_complete(m, e2, &b);
     if (!(a.area2 > 0) || !(b.area2 > 0)) return 0; /* inverted: no potential defined */
@@ -244,8 +280,10 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out
  * array. Returns 1 if they touched. */
 int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
 {
-    double out[12];
-    if (!contact_pair_force(m, e1, e2, havg, out)) return 0;
+    double b1[4], b2[4], out[12];
+    element_box(m, e1, b1);
+    element_box(m, e2, b2);
+    if (!boxes_overlap(b1, b2) || !contact_pair_force(m, e1, e2, havg, out)) return 0;
     contact_pair_scatter(m, e1, e2, out);
     return 1;
 }
@@ -294,6 +332,7 @@ static int contact_detect(fdem_model *m)
         }
         cs->pairs.count = kept;
     }
+    contact_collect_active(cs, m->elem_count);
     memcpy(cs->pos_detect, m->pos, sizeof(double) * 2 * (size_t)m->node_count);
     cs->max_disp2 = 0;
     cs->need_detect = 0;
@@ -317,7 +356,11 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->pos_detect = malloc(sizeof(double) * 2 * N);
     cs->force = calloc(2 * N, sizeof(double));
     cs->force_is_zero = 1;
-    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->piece || !cs->pos_detect || !cs->force) {
+    cs->box = malloc(sizeof(double) * 4 * E);
+    cs->active = malloc(sizeof(int32_t) * E);
+    cs->in_pair = malloc(E);
+    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->piece || !cs->pos_detect || !cs->force ||
+        !cs->box || !cs->active || !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -342,6 +385,7 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
+    free(cs->box); free(cs->active); free(cs->in_pair);
     for (int t = 0; t < cs->touch_lists; t++) free(cs->touches[t].item);
     free(cs->touches);
     nbs_grid_free(&cs->grid);
@@ -403,8 +447,16 @@ static int contact_pairs_forces_serial(fdem_model *m, double havg)
 {
     const contact_state *cs = &m->contact;
     int touching = 0;
-    for (size_t k = 0; k < cs->pairs.count; k++)
-        touching += contact_potential_force(m, cs->pairs.a[k], cs->pairs.b[k], havg);
+    const double *box = cs->box;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+        double out[12];
+        if (!boxes_overlap(box + 4 * (size_t)a, box + 4 * (size_t)b) ||
+            !contact_pair_force(m, a, b, havg, out))
+            continue;
+        contact_pair_scatter(m, a, b, out);
+        touching++;
+    }
     return touching;
 }
 
@@ -432,9 +484,12 @@ static int contact_pairs_forces_threaded(fdem_model *m, double havg)
         contact_touches *list = &lists[t];
         list->count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
+        const double *box = cs->box;
         for (long k = begin; k < end; k++) {
             double force[12];
-            if (!contact_pair_force(m, pa[k], pb[k], havg, force)) continue;
+            if (!boxes_overlap(box + 4 * (size_t)pa[k], box + 4 * (size_t)pb[k]) ||
+                !contact_pair_force(m, pa[k], pb[k], havg, force))
+                continue;
             touching++;
             if (contact_touch_push(list, k, force)) {
 #pragma omp atomic write
@@ -481,6 +536,7 @@ int contact_forces(fdem_model *m, double havg)
      * force array stays zero, and the integrator skips reading it. */
     if (!cs->force_is_zero) memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
+    if (cs->pairs.count) contact_boxes(m);
     cs->touching = contact_pairs_forces(m, havg);
     return 0;
 }

@@ -460,8 +460,8 @@ int fdem_constraint_node_count(const fdem_model *m, int c)
 size_t fdem_memory_estimate(long nodes, long elements, long joints)
 {
     size_t per_node = sizeof(double) * (2 * 5 + 2) + sizeof(int32_t) + 1;
-    size_t per_elem = sizeof(element_hot) + sizeof(int32_t) * 2 + sizeof(double) * 4 +
-                      2 * 2 * sizeof(int32_t) * 4; /* circles, body, NBS lists, ~4 pairs */
+    size_t per_elem = sizeof(element_hot) + sizeof(int32_t) * 3 + sizeof(double) * 8 + 1 +
+                      2 * 2 * sizeof(int32_t) * 4; /* circles, boxes, body, NBS lists, ~4 pairs */
     size_t per_joint = sizeof(int32_t) * 4 + sizeof(double) * 8;
     return (size_t)nodes * per_node + (size_t)elements * per_elem + (size_t)joints * per_joint;
 }
@@ -474,7 +474,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->elem_capacity * (sizeof(element_hot) + 4 * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
     if (m->contact.enabled)
-        b += (size_t)m->elem_count * (3 * sizeof(double) + sizeof(int32_t)) +
+        b += (size_t)m->elem_count * (7 * sizeof(double) + 2 * sizeof(int32_t) + 1) +
              nbs_memory_bytes(&m->contact.grid, &m->contact.pairs);
     b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
     if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);

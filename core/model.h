@@ -72,6 +72,11 @@ typedef struct contact_state {
     int force_is_zero;       /* force holds only zeros: no pair was evaluated */
     int32_t *body;           /* body id per element: pairs of one body never touch */
     int32_t *piece;          /* scratch: piece label per element (fracturing models) */
+    double *box;             /* 4 per element: xmin, xmax, ymin, ymax, each step, of the
+                                elements in some candidate pair */
+    int32_t *active;         /* the elements in some candidate pair, once each */
+    int active_count;
+    uint8_t *in_pair;        /* scratch per element for building active */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;
