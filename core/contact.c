@@ -226,16 +226,18 @@ static void contact_boxes(fdem_model *m)
     for (int k = 0; k < count; k++) element_box(m, active[k], box + 4 * (size_t)active[k]);
 }
 
-/* The elements of the candidate pairs, once each, for contact_boxes. */
+/* The elements of the candidate pairs, once each and in element order (so
+ * that contact_boxes walks the mesh forwards), for contact_boxes. */
 static void contact_collect_active(contact_state *cs, int elem_count)
 {
     memset(cs->in_pair, 0, (size_t)elem_count);
-    int count = 0;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
-        if (!cs->in_pair[a]) { cs->in_pair[a] = 1; cs->active[count++] = a; }
-        if (!cs->in_pair[b]) { cs->in_pair[b] = 1; cs->active[count++] = b; }
+        cs->in_pair[cs->pairs.a[k]] = 1;
+        cs->in_pair[cs->pairs.b[k]] = 1;
     }
+    int count = 0;
+    for (int e = 0; e < elem_count; e++)
+        if (cs->in_pair[e]) cs->active[count++] = e;
     cs->active_count = count;
 }
 
