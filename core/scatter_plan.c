@@ -124,20 +124,31 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
     return 0;
 }
 
+/* Runs block k of the colour-ordered list, leaving its partial sums in
+ * block_sum. */
+static inline void scatter_run_block(scatter_plan *plan, fdem_model *m, scatter_block_fn fn,
+                                     int k)
+{
+    const int bs = plan->block_size, items = plan->item_count;
+    int b = plan->block_order[k];
+    int begin = b * bs, end = items - begin > bs ? begin + bs : items;
+    double *sum = &plan->block_sum[SCATTER_SUMS * (size_t)b];
+    sum[0] = sum[1] = sum[2] = 0;
+    fn(m, begin, end, sum);
+}
+
 void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_block_fn fn,
                       double totals[SCATTER_SUMS])
 {
-    const int bs = plan->block_size, items = plan->item_count;
-#pragma omp parallel num_threads(threads) if (threads > 1 && plan->block_count > 1)
-    for (int c = 0; c < plan->color_count; c++) {
+    if (threads > 1 && plan->block_count > 1) {
+#pragma omp parallel num_threads(threads)
+        for (int c = 0; c < plan->color_count; c++) {
 #pragma omp for schedule(dynamic, 1)
-        for (int k = plan->color_begin[c]; k < plan->color_begin[c + 1]; k++) {
-            int b = plan->block_order[k];
-            int begin = b * bs, end = items - begin > bs ? begin + bs : items;
-            double *sum = &plan->block_sum[SCATTER_SUMS * (size_t)b];
-            sum[0] = sum[1] = sum[2] = 0;
-            fn(m, begin, end, sum);
+            for (int k = plan->color_begin[c]; k < plan->color_begin[c + 1]; k++)
+                scatter_run_block(plan, m, fn, k);
         }
+    } else { /* the same blocks in the same order, without a thread team's start-up */
+        for (int k = 0; k < plan->block_count; k++) scatter_run_block(plan, m, fn, k);
     }
     for (int b = 0; b < plan->block_count; b++) { /* block order: the same bits for any T */
         const double *sum = &plan->block_sum[SCATTER_SUMS * (size_t)b];
