@@ -66,34 +66,6 @@ static void bench_elastic_block(double bandwidth_gbs)
     }
 }
 
-/* Discs of radius r in hexagonal packing at a spacing of 1.97 r: the
- * 16-gon's flats sit at 0.981 r, so neighbours start touching and the pile
- * is loaded by gravity from the first step (timed as a packed pile, not a
- * falling cloud). Walls are meshed as finely as the discs: NBS sizes its
- * cells by the largest element, and coarse walls would crowd many disc
- * elements into each cell. */
-static fdem_model *disc_pile(int columns, int rows)
-{
-    fdem_model *m = fdem_model_create();
-    int wall = build_material(m, 1000, 1e7, 0.25, 0.1, 0.3);
-    int disc = build_material(m, 1000, 1e7, 0.25, 0.2, 0.3);
-    double r = 0.01, d = 1.97 * r, W = columns * d + 0.5 * d + 0.001;
-    double H = rows * d * 0.8660254 + 0.05;
-    int fl = build_rectangle(m, wall, -0.02, -0.02, W + 0.04, 0.02, (int)((W + 0.04) / 0.004), 5);
-    int le = build_rectangle(m, wall, -0.02, 0, 0.02, H, 5, (int)(H / 0.004));
-    int ri = build_rectangle(m, wall, W, 0, 0.02, H, 5, (int)(H / 0.004));
-    build_fix_part(m, fl);
-    build_fix_part(m, le);
-    build_fix_part(m, ri);
-    for (int row = 0; row < rows; row++)
-        for (int col = 0; col < columns; col++)
-            build_disc(m, disc, 0.0005 + r + col * d + (row % 2) * 0.5 * d,
-                       0.981 * r + row * d * 0.8660254, r, 16);
-    fdem_set_gravity(m, 0, -9.81);
-    build_finalize(m, 0.5);
-    return m;
-}
-
 static void bench_disc_pile(void)
 {
     printf("\n## Dense disc pile in a box, with contact (discs of 16 rim nodes)\n");
@@ -101,7 +73,7 @@ static void bench_disc_pile(void)
            "ns/elem-step", "forces%", "detect%", "contact%", "integr%", "pairs/el", "touch/el");
     int dims[][2] = {{20, 20}, {60, 60}};
     for (int k = 0; k < 2; k++) {
-        fdem_model *m = disc_pile(dims[k][0], dims[k][1]);
+        fdem_model *m = build_disc_pile(dims[k][0], dims[k][1]);
         fdem_error err;
         /* let the pile come into contact first: measure a loaded pile */
         int settle = 1000;
@@ -153,11 +125,7 @@ static void bench_disc_pile(void)
 static fdem_model *vibrating_block(int n, int fracture)
 {
     fdem_model *m = fdem_model_create();
-    fdem_material_def def = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = 0.1,
-                             .friction = 0.3, .has_fracture = 1,
-                             .fracture = {1e6, 3e6, 30, 10, 50}};
-    fdem_error err;
-    int mat = fdem_add_material(m, &def, &err);
+    int mat = build_fracturing_rock(m, 0.1);
     build_rectangle_part(m, mat, 0, 0, 1, 1, n, n, fracture);
     /* a 0.1 mm/s shear of the initial velocity field: strains stay ~1e-9 */
     build_finalize(m, 0.5);
@@ -251,7 +219,7 @@ static void bench_threads(void)
         }
     int dims[][2] = {{20, 20}, {60, 60}};
     for (int k = 0; k < 2; k++) {
-        fdem_model *m = disc_pile(dims[k][0], dims[k][1]);
+        fdem_model *m = build_disc_pile(dims[k][0], dims[k][1]);
         fdem_error err;
         for (int s = 0; s < 300; s++) fdem_step(m, &err); /* into contact, as above */
         int steps = (int)(5e6 / m->elem_count);

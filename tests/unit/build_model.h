@@ -33,6 +33,21 @@ static inline int build_material(fdem_model *m, double rho, double E, double nu,
     return k;
 }
 
+/* A rock that can fracture: 2700 kg/m^3, E = 30 GPa, nu = 0.25, friction
+ * 0.3, tensile strength 1 MPa, cohesion 3 MPa, friction angle 30 degrees,
+ * G_I = 10 and G_II = 50 J/m^2 (the strengths and energies of the
+ * Brazilian disc example). */
+static inline int build_fracturing_rock(fdem_model *m, double damping)
+{
+    fdem_material_def d = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = damping,
+                           .friction = 0.3, .has_fracture = 1,
+                           .fracture = {1e6, 3e6, 30, 10, 50}};
+    fdem_error err;
+    int k = fdem_add_material(m, &d, &err);
+    if (k < 0) build_die("material", &err);
+    return k;
+}
+
 /* A rectangle part; fracture != 0 makes it breakable along its interior
  * edges (the material needs fracture parameters then). */
 static inline int build_rectangle_part(fdem_model *m, int mat, double x, double y, double w,
@@ -80,6 +95,34 @@ static inline void build_finalize(fdem_model *m, double safety)
     fdem_error err;
     if (fdem_model_finalize(m, &err)) build_die("finalize", &err);
     fdem_set_dt(m, safety * fdem_stable_dt(m));
+}
+
+/* Discs of radius r in hexagonal packing at a spacing of 1.97 r: the
+ * 16-gon's flats sit at 0.981 r, so neighbours start touching and the pile
+ * is loaded by gravity from the first step (timed as a packed pile, not a
+ * falling cloud). Walls are meshed as finely as the discs: NBS sizes its
+ * cells by the largest element, and coarse walls would crowd many disc
+ * elements into each cell. Used by the bench and the thread tests. */
+static inline fdem_model *build_disc_pile(int columns, int rows)
+{
+    fdem_model *m = fdem_model_create();
+    int wall = build_material(m, 1000, 1e7, 0.25, 0.1, 0.3);
+    int disc = build_material(m, 1000, 1e7, 0.25, 0.2, 0.3);
+    double r = 0.01, d = 1.97 * r, W = columns * d + 0.5 * d + 0.001;
+    double H = rows * d * 0.8660254 + 0.05;
+    int fl = build_rectangle(m, wall, -0.02, -0.02, W + 0.04, 0.02, (int)((W + 0.04) / 0.004), 5);
+    int le = build_rectangle(m, wall, -0.02, 0, 0.02, H, 5, (int)(H / 0.004));
+    int ri = build_rectangle(m, wall, W, 0, 0.02, H, 5, (int)(H / 0.004));
+    build_fix_part(m, fl);
+    build_fix_part(m, le);
+    build_fix_part(m, ri);
+    for (int row = 0; row < rows; row++)
+        for (int col = 0; col < columns; col++)
+            build_disc(m, disc, 0.0005 + r + col * d + (row % 2) * 0.5 * d,
+                       0.981 * r + row * d * 0.8660254, r, 16);
+    fdem_set_gravity(m, 0, -9.81);
+    build_finalize(m, 0.5);
+    return m;
 }
 
 static inline void run_until(fdem_model *m, double t_end)

@@ -92,16 +92,12 @@ static void scattered_items_fall_back_or_stay_valid(void)
 static fdem_model *impact_model(int threads, int fracture)
 {
     fdem_model *m = fdem_model_create();
-    fdem_material_def rock = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = 0.05,
-                              .friction = 0.3, .has_fracture = 1,
-                              .fracture = {1e6, 3e6, 30, 10, 50}};
-    fdem_error err;
-    int mr = fdem_add_material(m, &rock, &err);
+    int mr = build_fracturing_rock(m, 0.05);
     int mw = build_material(m, 7800, 2e11, 0.3, 0, 0.3);
     int block = build_rectangle_part(m, mr, 0, 0, 0.1, 0.1, 60, 60, fracture);
     int wall = build_rectangle(m, mw, -0.05, -0.021, 0.2, 0.02, 40, 4);
     build_fix_part(m, wall);
-    fdem_set_part_velocity(m, block, 0.5, -40, &err);
+    fdem_set_part_velocity(m, block, 0.5, -40, NULL);
     fdem_set_gravity(m, 0, -9.81);
     build_finalize(m, 0.5);
     fdem_set_threads(m, threads);
@@ -154,21 +150,7 @@ static void two_threads_give_the_bits_of_one_with_fracture(void)
  * thousands of candidate pairs, so contact runs threaded too. */
 static fdem_model *packed_discs(int threads)
 {
-    fdem_model *m = fdem_model_create();
-    int wall = build_material(m, 1000, 1e7, 0.25, 0.1, 0.3);
-    int disc = build_material(m, 1000, 1e7, 0.25, 0.2, 0.3);
-    double r = 0.01, d = 1.97 * r;
-    int columns = 12, rows = 10;
-    double W = columns * d + 0.5 * d + 0.001;
-    build_fix_part(m, build_rectangle(m, wall, -0.02, -0.02, W + 0.04, 0.02, 70, 5));
-    build_fix_part(m, build_rectangle(m, wall, -0.02, 0, 0.02, 0.25, 5, 60));
-    build_fix_part(m, build_rectangle(m, wall, W, 0, 0.02, 0.25, 5, 60));
-    for (int row = 0; row < rows; row++)
-        for (int col = 0; col < columns; col++)
-            build_disc(m, disc, 0.0005 + r + col * d + (row % 2) * 0.5 * d,
-                       0.981 * r + row * d * 0.8660254, r, 16);
-    fdem_set_gravity(m, 0, -9.81);
-    build_finalize(m, 0.5);
+    fdem_model *m = build_disc_pile(12, 10);
     fdem_set_threads(m, threads);
     return m;
 }
