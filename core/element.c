@@ -221,14 +221,11 @@ static void element_forces_range(fdem_model *m, int begin, int end_index,
 }
 
 /* Runs the element blocks through the model's scatter plan (threads side
- * by side within a colour), or serially when the mesh has no plan. */
+ * by side within a colour). */
 void element_forces(fdem_model *m, double dt)
 {
     double sums[SCATTER_SUMS] = {0, 0, 0};
-    if (m->elem_plan.color_count)
-        scatter_plan_run(&m->elem_plan, m, m->threads, element_forces_range, sums);
-    else
-        element_forces_range(m, 0, m->elem_count, sums);
+    scatter_plan_run(&m->elem_plan, m, m->threads, element_forces_range, sums);
     m->elastic_energy = sums[0];
     m->damping_work += sums[1] * dt;
 }

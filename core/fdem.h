@@ -159,8 +159,8 @@ double fdem_stable_dt(const fdem_model *model);
 void fdem_set_dt(fdem_model *model, double dt);
 double fdem_get_dt(const fdem_model *model);
 
-/* Threads (OpenMP) for the per-step loops: element and joint forces, the
- * central difference update. Any time, default 1. The result does not
+/* Threads (OpenMP) for the per-step loops: element, joint and contact
+ * forces, the central difference update. Any time, default 1. The result does not
  * depend on it: every node's force is summed in an order fixed when the
  * model is finalized, so one thread and eight give the same bits. */
 void fdem_set_threads(fdem_model *model, int threads);

@@ -391,10 +391,7 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
 int joint_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0, 0, 0};
-    if (m->joint_plan.color_count)
-        scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
-    else
-        joint_forces_range(m, 0, m->joint_count, sums);
+    scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
     return (int)sums[0];
 }
 

@@ -53,7 +53,7 @@ typedef struct constraint {
  * and add into node arrays without races (scatter_plan.c). */
 typedef struct scatter_plan {
     int item_count, block_size, block_count;
-    int color_count;         /* 0: no plan, the loop runs serially */
+    int color_count;         /* 0: no blocks, scatter_plan_run runs the items serially */
     int32_t *color_begin;    /* color_count + 1 offsets into block_order */
     int32_t *block_order;    /* block indices, colour by colour */
     double *block_sum;       /* SCATTER_SUMS partials per block, totalled in block order */

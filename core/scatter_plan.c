@@ -10,7 +10,8 @@
  * colours. Inside a block the items keep their mesh order, so each thread
  * streams through memory as the serial loop does. Meshes in spatial order
  * (the generators, gmsh) need two to four colours; a mesh so scattered that
- * 64 colours do not suffice gets no plan and runs serially.
+ * 64 colours do not suffice gets no blocks (color_count 0), and
+ * scatter_plan_run then runs its items serially.
  *
  * The plan, not the thread count, fixes the order in which each node's sum
  * is formed (colour by colour, each block in item order), and per-block
@@ -99,7 +100,10 @@ int scatter_plan_build(scatter_plan *plan, int item_count, int block_size,
     int colors = scatter_color_blocks(item_count, block_size, item_nodes, stride, nodes_per_item,
                                       node_count, mask, color);
     rc = 0;
-    if (colors == 0) goto done; /* too scattered: no plan, the loop runs serially */
+    if (colors == 0) { /* too scattered: no blocks, scatter_plan_run runs it serially */
+        plan->item_count = item_count;
+        goto done;
+    }
     if ((rc = scatter_plan_alloc(plan, item_count, block_size, colors)) != 0) goto done;
     int32_t fill[64];
     for (int b = 0; b < block_count; b++) plan->color_begin[color[b] + 1]++;
@@ -140,6 +144,14 @@ static inline void scatter_run_block(scatter_plan *plan, fdem_model *m, scatter_
 void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_block_fn fn,
                       double totals[SCATTER_SUMS])
 {
+    if (plan->color_count == 0) { /* unplanned: every item, in order, on this thread */
+        double sum[SCATTER_SUMS] = {0, 0, 0};
+        if (plan->item_count > 0) fn(m, 0, plan->item_count, sum);
+        totals[0] += sum[0];
+        totals[1] += sum[1];
+        if (sum[2] > totals[2]) totals[2] = sum[2];
+        return;
+    }
     if (threads > 1 && plan->block_count > 1) {
 #pragma omp parallel num_threads(threads)
         for (int c = 0; c < plan->color_count; c++) {

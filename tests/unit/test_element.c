@@ -160,8 +160,8 @@ static void element_forces_sum_to_zero_exactly(void)
     deform(m, 1.003, 0.02, -0.01, 0.995, 0.3, 0.1);
     element_hot *all = m->elem;
     int count = m->elem_count;
-    int colors = m->elem_plan.color_count;
-    m->elem_plan.color_count = 0; /* the plan covers the whole mesh: run serially */
+    scatter_plan plan = m->elem_plan; /* covers the whole mesh: run one element instead */
+    m->elem_plan = (scatter_plan){.item_count = 1};
     for (int e = 0; e < count; e++) {
         memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
         m->elem = all + e; /* this element on its own */
@@ -176,7 +176,7 @@ static void element_forces_sum_to_zero_exactly(void)
     }
     m->elem = all;
     m->elem_count = count;
-    m->elem_plan.color_count = colors;
+    m->elem_plan = plan;
     fdem_model_destroy(m);
 }
 
