@@ -90,7 +90,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     if (m->joint_count) m->fragments = joint_fragment_count(m);
     /* Forces and elastic energy are those of the restored positions. */
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    element_forces(m, 0);
+    element_forces(m);
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     return 0;
 }

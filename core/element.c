@@ -139,16 +139,15 @@ static inline double neo_hookean_half(double a, double b, double c, double d, do
     return J;
 }
 
-/* Adds eta D (half of 2 eta D) to the half stress hs, returns the
- * dissipated power per unit current area (sigma_v : D). The division is
- * paid only by damped elements. */
-static inline double viscous_half(const double *v, int n0, int n1, int n2, double x1, double y1,
-                                  double x2, double y2, double eta, double hs[3])
+/* Adds eta D (half of 2 eta D) to the half stress hs. The division is paid
+ * only by damped elements. */
+static inline void viscous_half(const double *v, int n0, int n1, int n2, double x1, double y1,
+                                double x2, double y2, double eta, double hs[3])
 {
     double u1 = v[2 * n1] - v[2 * n0], w1 = v[2 * n1 + 1] - v[2 * n0 + 1];
     double u2 = v[2 * n2] - v[2 * n0], w2 = v[2 * n2 + 1] - v[2 * n0 + 1];
     double det = x1 * y2 - x2 * y1;
-    if (!(fabs(det) > 0)) return 0;
+    if (!(fabs(det) > 0)) return;
     double inv = 1.0 / det;
     /* [x]^-1 = (1/det) (y2 -x2; -y1 x1); L = [v][x]^-1 */
     double L11 = (u1 * y2 - u2 * y1) * inv, L12 = (-u1 * x2 + u2 * x1) * inv;
@@ -157,7 +156,22 @@ static inline double viscous_half(const double *v, int n0, int n1, int n2, doubl
     hs[0] += eta * L11;
     hs[1] += eta * L22;
     hs[2] += eta * D12;
-    return 2 * eta * (L11 * L11 + L22 * L22 + 2 * D12 * D12);
+}
+
+/* Nodal forces 1/2 sigma m_a of a half stress hs on the element with edge
+ * vectors (x1, y1), (x2, y2), added to f (node 0 takes minus the sum). */
+static inline void edge_traction_forces(double *f, int n0, int n1, int n2, double x1, double y1,
+                                        double x2, double y2, const double hs[3])
+{
+    double f1x = hs[2] * x2 - hs[0] * y2, f1y = hs[1] * x2 - hs[2] * y2;
+    double f2x = hs[0] * y1 - hs[2] * x1, f2y = hs[2] * y1 - hs[1] * x1;
+    double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
+    g1[0] += f1x;
+    g1[1] += f1y;
+    g2[0] += f2x;
+    g2[1] += f2y;
+    g0[0] -= f1x + f2x;
+    g0[1] -= f1y + f2y;
 }
 
 /* The hot loop: one pass over the element records, gathering three nodes
@@ -179,9 +193,9 @@ static void element_forces_range(fdem_model *m, int begin, int end_index,
                                  double sums[SCATTER_SUMS])
 {
     const double *pos = m->pos, *vel = m->vel;
-    double *f = m->force;
+    double *f = m->force, *fd = m->damping_force;
     const material *mats = m->materials;
-    double energy = 0, dissipated = 0;
+    double energy = 0;
     int32_t cur_mat = -1;
     double hlambda = 0, hmu = 0;
     const element_hot *el = m->elem + begin, *end = m->elem + end_index;
@@ -201,33 +215,32 @@ static void element_forces_range(fdem_model *m, int begin, int end_index,
             hmu = 0.5 * mats[cur_mat].mu;
         }
         double hs[3], w;
-        double J = neo_hookean_half(a, b, c, d, hlambda, hmu, hs, &w);
+        neo_hookean_half(a, b, c, d, hlambda, hmu, hs, &w);
         energy += w * el->area0;
-        if (el->eta > 0)
-            dissipated += viscous_half(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, hs) *
-                          fabs(J) * el->area0;
-        double f1x = hs[2] * x2 - hs[0] * y2, f1y = hs[1] * x2 - hs[2] * y2;
-        double f2x = hs[0] * y1 - hs[2] * x1, f2y = hs[2] * y1 - hs[1] * x1;
-        double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
-        g1[0] += f1x;
-        g1[1] += f1y;
-        g2[0] += f2x;
-        g2[1] += f2y;
-        g0[0] -= f1x + f2x;
-        g0[1] -= f1y + f2y;
+        if (el->eta > 0) {
+            /* the viscous forces also go to their own array: the integrator
+             * books their work with the step-averaged velocity */
+            double hv[3] = {0, 0, 0};
+            viscous_half(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, hv);
+            edge_traction_forces(fd, n0, n1, n2, x1, y1, x2, y2, hv);
+            hs[0] += hv[0];
+            hs[1] += hv[1];
+            hs[2] += hv[2];
+        }
+        edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
     }
     sums[0] += energy;
-    sums[1] += dissipated;
 }
 
 /* Runs the element blocks through the model's scatter plan (threads side
  * by side within a colour). */
-void element_forces(fdem_model *m, double dt)
+void element_forces(fdem_model *m)
 {
-    double sums[SCATTER_SUMS] = {0, 0, 0};
+    double sums[SCATTER_SUMS] = {0};
+    if (m->damping_force)
+        memset(m->damping_force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     scatter_plan_run(&m->elem_plan, m, m->threads, element_forces_range, sums);
     m->elastic_energy = sums[0];
-    m->damping_work += sums[1] * dt;
 }
 
 void element_stress_one(const fdem_model *m, int e, double out[3])

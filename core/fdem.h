@@ -173,13 +173,27 @@ int fdem_step(fdem_model *model, fdem_error *err);
 
 /* ----------------------------------------------------------------- accessors */
 
+/* The energy accounts, in J per metre of thickness, all since t = 0 and all
+ * at the start of the last step, where the elastic energy is evaluated (see
+ * energy.c for why that instant). residual is their balance:
+ *   kinetic + elastic + joint + contact + friction + fracture + damping
+ *   - gravity_work - external_work - (kinetic + elastic at t = 0),
+ * zero but for the time discretisation of non-linear forces. */
 typedef struct fdem_energy {
-    double kinetic;       /* sum 1/2 m v^2 (half-step velocities) */
+    double kinetic;       /* 1/2 sum m v(t - h/2) . v(t + h/2): the central-difference kinetic
+                             energy, which with the elastic energy the scheme conserves exactly
+                             for a linear solid */
     double elastic;       /* strain energy of all elements */
-    double contact;       /* energy taken by contact forces: minus their work (stored + dissipated) */
-    double damping;       /* energy dissipated by viscous damping (>= 0) */
-    double gravity_work;  /* work done by gravity since t = 0 */
-    double external_work; /* work of applied forces and constraint reactions since t = 0 */
+    double joint;         /* elastic energy stored in intact joints */
+    double contact;       /* minus the work of the contact forces, less what friction
+                             dissipated: what the penalty (normal and stick) springs hold;
+                             negative means the contact discretisation gave energy */
+    double friction;      /* dissipated by Coulomb sliding (>= 0) */
+    double fracture;      /* dissipated by joint softening and breaking (>= 0, never decreases) */
+    double damping;       /* dissipated by viscous damping (>= 0) */
+    double gravity_work;  /* work done by gravity */
+    double external_work; /* work of applied forces and constraint reactions */
+    double residual;      /* the balance above */
 } fdem_energy;
 
 typedef struct fdem_counts {

@@ -16,9 +16,11 @@
  * compressive normal stress). Past the elastic limits delta_p, s_p the
  * traction softens as f z(D), Munjiza's curve with a = 0.63, b = 1.8,
  * c = 6, where D = sqrt(Dn^2 + Ds^2) combines the opening and sliding
- * beyond their limits over the softening spans delta_c - delta_p, with
- * delta_c = 3 G_I / f_t (and s_c = 3 G_II / f_s): the mixed-mode criterion
- * (delta/delta_c)^2 + (s/s_c)^2 >= 1 is D >= 1. D never decreases (damage
+ * beyond their limits over the softening spans delta_c - delta_p, chosen so
+ * that a joint pulled apart in pure mode I absorbs exactly G_I per unit
+ * area (elastic part plus softening: softening_span), and likewise G_II in
+ * pure mode II: the mixed-mode criterion
+ * (dn)^2 + (ds)^2 >= 1 is D >= 1. D never decreases (damage
  * is irreversible); at D = 1 the joint is broken, exerts nothing, and its
  * two triangles meet through contact from then on. Compression is resisted
  * by the joint's penalty while it holds.
@@ -249,41 +251,77 @@ int joint_fan_holds(const fdem_model *m, int a, int b)
 
 /* --------------------------------------------------------------- forces */
 
-/* Tractions at one Gauss point from opening delta and sliding s; updates
- * the joint's damage (never downwards). k is the joint's stiffness p / h.
- *
- * The elastic test compares tractions, not displacements (k delta <= f_t
- * rather than delta <= f_t / k), so an intact joint, which is nearly every
- * joint in nearly every step, costs no division and no softening curve. */
-static inline void joint_traction(const material *mat, double k, double delta, double slide,
-                                  double *damage, double *sigma, double *tau)
+/* The area under Munjiza's curve, integral of z(D) over [0, 1] (held to a
+ * Simpson sum of joint_softening in test_joint.c). */
+#define Z_INTEGRAL 0.38630729474388764
+
+/* The softening spans delta_c - delta_p (or s_c - s_p) for strength f,
+ * elastic limit p = f / k and fracture energy G. A joint pulled apart in
+ * one mode absorbs 1/2 f p while elastic and f span Z_INTEGRAL while it
+ * softens; the span is chosen so that the two add up to G exactly. A joint
+ * too soft for its G (1/2 f p >= G / 2) keeps a span of p, and absorbs more
+ * than G: the fracture account then reports what it really dissipated. */
+static inline double softening_span(double f, double p, double G)
+{
+    double span = (G - 0.5 * f * p) / (f * Z_INTEGRAL);
+    return span > p ? span : p;
+}
+
+/* One Gauss point of a joint leaving its elastic range or already damaged. */
+typedef struct joint_point {
+    double delta, slide;   /* opening and sliding */
+    double fs;             /* shear strength there: cohesion + compression tan(phi) */
+    double D;              /* the damage its opening and sliding ask for */
+} joint_point;
+
+static inline void joint_point_measure(const material *mat, double k, double delta, double slide,
+                                       joint_point *g)
 {
     const fdem_fracture_params *fp = &mat->def.fracture;
-    double sigma_e = k * delta, tau_e = k * slide;
-    double fs = fp->cohesion + (delta < 0 ? -sigma_e * mat->tan_phi : 0);
-    if (*damage == 0 && sigma_e <= fp->tensile_strength && fabs(tau_e) <= fs) {
-        *sigma = sigma_e;
-        *tau = tau_e;
-        return;
-    }
     double ft = fp->tensile_strength;
-    double dp = ft / k, sp = fs / k;
-    double dc = fmax(3 * fp->energy_I / ft, 2 * dp), sc = fmax(3 * fp->energy_II / fs, 2 * sp);
-    double dn = delta > dp ? (delta - dp) / (dc - dp) : 0;
-    double ds = fabs(slide) > sp ? (fabs(slide) - sp) / (sc - sp) : 0;
-    double D = sqrt(dn * dn + ds * ds);
-    if (D > *damage) *damage = D > 1 ? 1 : D;
-    double z = joint_softening(*damage);
-    if (delta < 0) *sigma = sigma_e; /* compression: the joint's penalty */
-    else *sigma = ft * fmin(delta / dp, 1.0) * z;
-    double r = slide / sp;
-    *tau = fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
+    g->delta = delta;
+    g->slide = slide;
+    g->fs = fp->cohesion + (delta < 0 ? -k * delta * mat->tan_phi : 0);
+    double dp = ft / k, sp = g->fs / k;
+    double dn = delta > dp ? (delta - dp) / softening_span(ft, dp, fp->energy_I) : 0;
+    double ds = fabs(slide) > sp ? (fabs(slide) - sp) / softening_span(g->fs, sp, fp->energy_II) : 0;
+    g->D = sqrt(dn * dn + ds * ds);
+}
+
+/* The law derives from a stored energy psi = z(D) phi(delta, s) (plus
+ * 1/2 k delta^2 in compression, which damage leaves alone): phi is the
+ * undamaged joint's energy, 1/2 k x^2 up to the elastic limit and linear at
+ * the strength beyond it, for the opening and the sliding alike. The
+ * tractions are d psi / d delta and d psi / d s: f_t min(delta/delta_p, 1) z
+ * and f_s clamp(s/s_p) z. Damage growing by dD dissipates -z'(D) phi dD,
+ * which joint_forces_general books as (z_old - z_new) phi. */
+static inline double joint_phi(const material *mat, double k, const joint_point *g)
+{
+    double ft = mat->def.fracture.tensile_strength;
+    double dp = ft / k, sp = g->fs / k, phi = 0;
+    if (g->delta > 0)
+        phi += g->delta <= dp ? 0.5 * k * g->delta * g->delta : ft * (g->delta - 0.5 * dp);
+    double s = fabs(g->slide);
+    phi += s <= sp ? 0.5 * k * s * s : g->fs * (s - 0.5 * sp);
+    return phi;
+}
+
+/* Tractions at a Gauss point for damage with softening factor z. */
+static inline void joint_point_traction(const material *mat, double k, const joint_point *g,
+                                        double z, double *sigma, double *tau)
+{
+    double ft = mat->def.fracture.tensile_strength;
+    double dp = ft / k, sp = g->fs / k;
+    if (g->delta < 0) *sigma = k * g->delta; /* compression: the joint's penalty */
+    else *sigma = ft * fmin(g->delta / dp, 1.0) * z;
+    double r = g->slide / sp;
+    *tau = g->fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
 }
 
 /* Two-point Gauss rule along the edge, as fractions from a0 (b0) to a1 (b1). */
 static const double gauss[2] = {0.21132486540518713, 0.78867513459481287};
 
-/* The elastic test of joint_traction at one Gauss point, on unnormalised
+/* The elastic test of joint_point_measure at one Gauss point, on unnormalised
  * projections: on = L delta and sl = L slide (d against the face normal and
  * tangent scaled by the face length L), so it needs neither the unit
  * vectors nor a division. */
@@ -297,29 +335,45 @@ static inline int joint_gauss_elastic(const material *mat, double k, double L, d
 }
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
- * that is damaged or leaving its elastic range; updates *damage. d0 and d1
- * are the displacements of b0 against a0 and b1 against a1; (tx, ty) the
- * unit face tangent and L the face length. */
+ * that is damaged or leaving its elastic range; updates *damage (the
+ * largest either Gauss point asks for, never less than before) and adds the
+ * joint's stored energy to *stored and what the damage growth dissipated to
+ * *dissipated. d0 and d1 are the displacements of b0 against a0 and b1
+ * against a1; (tx, ty) the unit face tangent and L the face length. */
 static void joint_forces_general(const material *mat, double k, const double d0[2],
                                  const double d1[2], double tx, double ty, double L,
-                                 double *damage, double fa0[2], double fa1[2])
+                                 double *damage, double fa0[2], double fa1[2], double *stored,
+                                 double *dissipated)
 {
     double nx = ty, ny = -tx; /* A's outward normal */
-    fa0[0] = fa0[1] = fa1[0] = fa1[1] = 0;
-    for (int g = 0; g < 2; g++) {
-        double xi = gauss[g];
+    joint_point g[2];
+    double D = *damage;
+    for (int i = 0; i < 2; i++) {
+        double xi = gauss[i];
         double dx = (1 - xi) * d0[0] + xi * d1[0], dy = (1 - xi) * d0[1] + xi * d1[1];
-        double sigma, tau;
-        joint_traction(mat, k, dx * nx + dy * ny, dx * tx + dy * ty, damage, &sigma, &tau);
-        double w = 0.5 * L;
+        joint_point_measure(mat, k, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
+        if (g[i].D > D) D = g[i].D;
+    }
+    if (D > 1) D = 1;
+    double z_old = joint_softening(*damage), z = joint_softening(D);
+    *damage = D;
+    double w = 0.5 * L; /* Gauss weight */
+    fa0[0] = fa0[1] = fa1[0] = fa1[1] = 0;
+    for (int i = 0; i < 2; i++) {
+        double xi = gauss[i], sigma, tau;
+        double phi = w * joint_phi(mat, k, &g[i]);
+        *dissipated += (z_old - z) * phi;
+        *stored += z * phi + (g[i].delta < 0 ? 0.5 * w * k * g[i].delta * g[i].delta : 0);
+        joint_point_traction(mat, k, &g[i], z, &sigma, &tau);
         double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
         fa0[0] += (1 - xi) * Tx; fa0[1] += (1 - xi) * Ty;
         fa1[0] += xi * Tx;       fa1[1] += xi * Ty;
     }
 }
 
-/* Adds the forces of intact joints [begin, end) to m->force and counts in
- * sums[0] those that broke in this call.
+/* Adds the forces of intact joints [begin, end) to m->force, counts in
+ * sums[0] those that broke in this call, and adds their stored energy to
+ * sums[1] and what their damage growth dissipated to sums[2].
  *
  * Nearly every joint in nearly every step is undamaged and elastic at both
  * Gauss points. There the traction is k (delta n + s t) = k d: the penalty
@@ -334,6 +388,7 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
     double *f = m->force;
     const material *mats = m->materials;
     int broke = 0;
+    double stored = 0, dissipated = 0;
     for (int j = begin; j < end; j++) {
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
@@ -366,9 +421,12 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             fa0[1] = s * (2 * d0[1] + d1[1]);
             fa1[0] = s * (d0[0] + 2 * d1[0]);
             fa1[1] = s * (d0[1] + 2 * d1[1]);
+            /* 1/2 integral of k |d|^2 along the face, exact for linear d */
+            stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
         } else {
             double inv_L = 1.0 / L;
-            joint_forces_general(mat, k, d0, d1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1);
+            joint_forces_general(mat, k, d0, d1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1,
+                                 &stored, &dissipated);
             if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
                 m->joint_damage[j] = 1.0;
                 broke++;
@@ -384,14 +442,19 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
         gb1[0] -= fa1[0]; gb1[1] -= fa1[1];
     }
     sums[0] += broke;
+    sums[1] += stored;
+    sums[2] += dissipated;
 }
 
-/* Adds the forces of every intact joint to m->force. Returns the number of
- * joints that broke in this call. */
+/* Adds the forces of every intact joint to m->force, sets the joints'
+ * stored energy and adds what they dissipated to the fracture account.
+ * Returns the number of joints that broke in this call. */
 int joint_forces(fdem_model *m)
 {
-    double sums[SCATTER_SUMS] = {0, 0, 0};
+    double sums[SCATTER_SUMS] = {0};
     scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
+    m->joint_energy = sums[1];
+    m->fracture_energy += sums[2];
     return (int)sums[0];
 }
 

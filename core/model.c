@@ -57,7 +57,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
     free(m->joint_k); free(m->joint_material);
-    free(m->elem_joint); free(m->vertex_broken);
+    free(m->elem_joint); free(m->vertex_broken); free(m->damping_force);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     scatter_plan_free(&m->joint_plan);
@@ -354,7 +354,15 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
         return -1;
     }
-    for (int e = 0; e < m->elem_count; e++) element_prepare(m, e);
+    int damped = 0;
+    for (int e = 0; e < m->elem_count; e++) {
+        element_prepare(m, e);
+        damped |= m->elem[e].eta > 0;
+    }
+    if (damped && !(m->damping_force = calloc(2 * (size_t)m->node_count, sizeof(double)))) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
+        return -1;
+    }
     lump_masses(m);
     if (joint_prepare(m, err)) return -1;
     m->fragments = joint_fragment_count(m);
@@ -375,6 +383,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;
+    energy_initial(m);
     return 0;
 }
 
@@ -403,27 +412,6 @@ fdem_counts fdem_get_counts(const fdem_model *m)
     c.contact_pairs = (int)m->contact.pairs.count;
     c.detections = m->contact.detections;
     return c;
-}
-
-fdem_energy fdem_get_energy(const fdem_model *m)
-{
-    fdem_energy en = {0};
-    double mx = 0, my = 0, mx0 = 0, my0 = 0;
-    for (int i = 0; i < m->node_count; i++) {
-        double vx = m->vel[2 * i], vy = m->vel[2 * i + 1];
-        en.kinetic += 0.5 * m->mass[i] * (vx * vx + vy * vy);
-        mx += m->mass[i] * m->pos[2 * i];
-        my += m->mass[i] * m->pos[2 * i + 1];
-        mx0 += m->mass[i] * m->pos0[2 * i];
-        my0 += m->mass[i] * m->pos0[2 * i + 1];
-    }
-    /* Gravity is uniform, so its work is M g . (displacement of the centre of mass). */
-    en.gravity_work = m->gravity[0] * (mx - mx0) + m->gravity[1] * (my - my0);
-    en.elastic = m->elastic_energy;
-    en.contact = -m->contact_work;
-    en.damping = m->damping_work;
-    en.external_work = m->external_work;
-    return en;
 }
 
 const double *fdem_positions(const fdem_model *m) { return m->pos; }

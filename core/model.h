@@ -136,11 +136,22 @@ struct fdem_model {
     double time;
     double stable_dt;
 
-    /* energy accumulators (see fdem_energy) */
+    /* energy accounts (see fdem_energy and energy.c). Work is booked with
+     * the step-averaged velocity (v_old + v_new)/2 * havg, which is exactly
+     * what a force adds to the half-step kinetic energy; fdem_get_energy
+     * turns the sums into values at the start of the last step, where the
+     * elastic and joint energies are evaluated. */
     double elastic_energy;   /* of the last force evaluation */
-    double contact_work;     /* work done by contact forces (negative when storing) */
+    double joint_energy;     /* stored in intact joints, last force evaluation */
+    double contact_work;     /* work of all contact forces (normal and friction) */
+    double friction_energy;  /* dissipated by Coulomb sliding (>= 0) */
+    double fracture_energy;  /* dissipated by joint softening and breaking (>= 0) */
     double damping_work;     /* energy dissipated by viscous damping */
     double external_work;
+    double initial_energy;   /* kinetic + elastic at t = 0 */
+    double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
+    double *damping_force;   /* viscous nodal forces of the last step (also in force);
+                                NULL when no element is damped */
 
     contact_state contact;
     fdem_stage_times times;
@@ -160,7 +171,7 @@ void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt
 /* element.c */
 void element_prepare(fdem_model *m, int e);
 double element_stable_dt(const fdem_model *m, int e);
-void element_forces(fdem_model *m, double dt);
+void element_forces(fdem_model *m);
 void element_stress_one(const fdem_model *m, int e, double out[3]);
 int element_of_node(const fdem_model *m, int node);
 
@@ -192,10 +203,11 @@ int joint_fragment_count(const fdem_model *m);
 
 /* scatter_plan.c: fn runs items [begin, end) of one block and may add into
  * node arrays. It starts from sums zeroed and leaves its block's partial
- * results there: sums[0] and sums[1] are added, block by block in block
- * order, to totals[0] and totals[1]; totals[2] becomes the largest sums[2]
- * (and what it held before, if larger). */
-#define SCATTER_SUMS 3
+ * results there: sums[0 .. SCATTER_MAX - 1] are added, block by block in
+ * block order, to the same totals; totals[SCATTER_MAX] becomes the largest
+ * sums[SCATTER_MAX] (and what it held before, if larger). */
+#define SCATTER_SUMS 4
+#define SCATTER_MAX 3
 typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 /* Smallest blocks, and the block count aimed at above that: a node on the
  * border of two colours is loaded once per colour, so large meshes get
@@ -213,6 +225,9 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
 void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_block_fn fn,
                       double totals[SCATTER_SUMS]);
 void scatter_plan_free(scatter_plan *plan);
+
+/* energy.c */
+void energy_initial(fdem_model *m);
 
 /* integrator.c */
 int central_difference_step(fdem_model *m);

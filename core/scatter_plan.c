@@ -128,6 +128,13 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
     return 0;
 }
 
+/* One block's partial results into the totals (SCATTER_SUMS in model.h). */
+static inline void scatter_add_sums(double totals[SCATTER_SUMS], const double sum[SCATTER_SUMS])
+{
+    for (int i = 0; i < SCATTER_MAX; i++) totals[i] += sum[i];
+    if (sum[SCATTER_MAX] > totals[SCATTER_MAX]) totals[SCATTER_MAX] = sum[SCATTER_MAX];
+}
+
 /* Runs block k of the colour-ordered list, leaving its partial sums in
  * block_sum. */
 static inline void scatter_run_block(scatter_plan *plan, fdem_model *m, scatter_block_fn fn,
@@ -137,7 +144,7 @@ static inline void scatter_run_block(scatter_plan *plan, fdem_model *m, scatter_
     int b = plan->block_order[k];
     int begin = b * bs, end = items - begin > bs ? begin + bs : items;
     double *sum = &plan->block_sum[SCATTER_SUMS * (size_t)b];
-    sum[0] = sum[1] = sum[2] = 0;
+    for (int i = 0; i < SCATTER_SUMS; i++) sum[i] = 0;
     fn(m, begin, end, sum);
 }
 
@@ -145,11 +152,9 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
                       double totals[SCATTER_SUMS])
 {
     if (plan->color_count == 0) { /* unplanned: every item, in order, on this thread */
-        double sum[SCATTER_SUMS] = {0, 0, 0};
+        double sum[SCATTER_SUMS] = {0};
         if (plan->item_count > 0) fn(m, 0, plan->item_count, sum);
-        totals[0] += sum[0];
-        totals[1] += sum[1];
-        if (sum[2] > totals[2]) totals[2] = sum[2];
+        scatter_add_sums(totals, sum);
         return;
     }
     if (threads > 1 && plan->block_count > 1) {
@@ -163,9 +168,6 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
         for (int k = 0; k < plan->block_count; k++) scatter_run_block(plan, m, fn, k);
     }
     for (int b = 0; b < plan->block_count; b++) { /* block order: the same bits for any T */
-        const double *sum = &plan->block_sum[SCATTER_SUMS * (size_t)b];
-        totals[0] += sum[0];
-        totals[1] += sum[1];
-        if (sum[2] > totals[2]) totals[2] = sum[2];
+        scatter_add_sums(totals, &plan->block_sum[SCATTER_SUMS * (size_t)b]);
     }
 }

@@ -63,13 +63,22 @@ enum series_kind {
     SERIES_CONSTRAINT_FORCE,
     SERIES_KINETIC,
     SERIES_ELASTIC,
+    SERIES_CONTACT,
+    SERIES_FRICTION,
+    SERIES_JOINT,
+    SERIES_FRACTURE,
+    SERIES_DAMPING,
+    SERIES_GRAVITY_WORK,
+    SERIES_EXTERNAL_WORK,
     SERIES_TIME,
     SERIES_COUNT
 };
 
 static const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage",
-    "constraint_force", "kinetic_energy", "elastic_energy", "time",
+    "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
+    "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
+    "external_work", "time",
 };
 
 typedef struct series {
@@ -339,6 +348,13 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;
+    case SERIES_CONTACT: return &s->energy.contact;
+    case SERIES_FRICTION: return &s->energy.friction;
+    case SERIES_JOINT: return &s->energy.joint;
+    case SERIES_FRACTURE: return &s->energy.fracture;
+    case SERIES_DAMPING: return &s->energy.damping;
+    case SERIES_GRAVITY_WORK: return &s->energy.gravity_work;
+    case SERIES_EXTERNAL_WORK: return &s->energy.external_work;
     case SERIES_TIME: return &s->time;
     }
     return NULL;

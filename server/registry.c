@@ -217,13 +217,17 @@ json_t *case_status_json(server_case *c)
         progress = 1;
     if (state == CASE_FINISHED)
         progress = 1;
-    json_t *energy = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o}",
+    json_t *energy = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}",
                                "kinetic", json_number_or_null(f.energy.kinetic),
                                "elastic", json_number_or_null(f.energy.elastic),
+                               "joint", json_number_or_null(f.energy.joint),
                                "contact", json_number_or_null(f.energy.contact),
-                               "gravity_work", json_number_or_null(f.energy.gravity_work),
+                               "friction", json_number_or_null(f.energy.friction),
+                               "fracture", json_number_or_null(f.energy.fracture),
                                "damping", json_number_or_null(f.energy.damping),
-                               "external_work", json_number_or_null(f.energy.external_work));
+                               "gravity_work", json_number_or_null(f.energy.gravity_work),
+                               "external_work", json_number_or_null(f.energy.external_work),
+                               "residual", json_number_or_null(f.energy.residual));
     json_t *o = json_object();
     json_object_set_new(o, "id", json_string(c->id));
     json_object_set_new(o, "name", json_string(c->info.name));

@@ -135,30 +135,31 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
 
         pthread_mutex_lock(&c->model_lock);
         double dt = fdem_get_dt(m);
-        /* A step that would pass the next output time or the end is cut to
-         * land on it, so snapshots sit exactly on the k * interval grid and
-         * the last one at time.end (a shorter step is always stable, and
-         * central difference takes a changing step). */
-        double t0 = fdem_get_time(m), target = fmin(end, c->next_output);
-        int cut = t0 + dt > target + 1e-6 * dt && target - t0 > 1e-6 * dt;
+        /* Output never shapes the run: every step has the model's own
+         * size, and a snapshot is taken at the first step boundary at or
+         * after its output time. Only the last step is cut, to end the case
+         * exactly at time.end (a shorter step is always stable, and central
+         * difference takes a changing step). */
+        double t0 = fdem_get_time(m);
+        int cut = t0 + dt >= end - 1e-9 * dt; /* no sliver of a step left over */
         if (cut)
-            fdem_set_dt(m, target - t0);
+            fdem_set_dt(m, end - t0);
         fdem_error err;
         memset(&err, 0, sizeof err);
         int failed = fdem_step(m, &err) != 0;
         if (cut)
             fdem_set_dt(m, dt);
         if (failed) {
-            worker_describe_failure(c, &err, cut ? target - t0 : dt);
+            worker_describe_failure(c, &err, cut ? end - t0 : dt);
             pthread_mutex_unlock(&c->model_lock);
             return EXIT_FAILED;
         }
         double t = fdem_get_time(m), now = worker_now();
-        int done = t >= end - 1e-6 * dt;
+        int done = cut || t >= end;
         snapshot *snap = NULL;
         void *ckpt = NULL;
         size_t ckpt_size = 0;
-        if (done || t >= c->next_output - 1e-6 * dt) {
+        if (done || t >= c->next_output - 1e-9 * dt) {
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);

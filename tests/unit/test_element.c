@@ -78,7 +78,7 @@ static void forces_balance_and_energy_matches(void)
     fdem_model *m = unit_block(E, nu);
     deform(m, 1 + eps, 0, 0, 1 - 0.5 * eps, 0, 0);
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    element_forces(m, 0);
+    element_forces(m);
     double fx = 0, fy = 0, fmax_ = 0;
     for (int i = 0; i < m->node_count; i++) {
         fx += m->force[2 * i];
@@ -99,7 +99,7 @@ static void stretched_block_pulls_nodes_inward(void)
     fdem_model *m = unit_block(1e9, 0.0);
     deform(m, 1.01, 0, 0, 1, 0, 0);
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    element_forces(m, 0);
+    element_forces(m);
     /* right edge nodes (x = 1) must be pulled back in -x */
     int checked = 0;
     for (int i = 0; i < m->node_count; i++)
@@ -116,7 +116,7 @@ static void inverted_element_stays_finite(void)
     fdem_model *m = unit_block(1e9, 0.3);
     deform(m, -0.2, 0, 0, 1, 0, 0); /* turned inside out */
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    element_forces(m, 0);
+    element_forces(m);
     for (int i = 0; i < 2 * m->node_count; i++) CHECK(isfinite(m->force[i]), "force %d", i);
     fdem_model_destroy(m);
 }
@@ -166,7 +166,7 @@ static void element_forces_sum_to_zero_exactly(void)
         memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
         m->elem = all + e; /* this element on its own */
         m->elem_count = 1;
-        element_forces(m, 0);
+        element_forces(m);
         const int32_t *nd = all[e].node;
         for (int d = 0; d < 2; d++) {
             double f0 = m->force[2 * nd[0] + d], f1 = m->force[2 * nd[1] + d];
