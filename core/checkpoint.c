@@ -2,37 +2,81 @@
  * checkpoint.c - the dynamic state of a model as one flat byte buffer.
  *
  * Only what stepping changes is stored (step, time, step sizes, positions,
- * velocities, joint damage, energy accumulators): the static model is
- * rebuilt from the case document, so a checkpoint stays small and a model
- * of another shape is detected by its counts and refused.
+ * velocities, joint damage, the last contact detection, the stick springs,
+ * energy accumulators): the static model is rebuilt from the case document,
+ * so a checkpoint stays small and a model of another shape is detected by
+ * its counts and refused. A model restored from a checkpoint steps on to the
+ * same bits as the one that wrote it.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
+#define CHECKPOINT_VERSION 2
 
-typedef struct checkpoint_header {
+/* Version 1 (fdemd 0.1): the header up to external_work, then positions,
+ * velocities and damage. Read for cases stored by that version; they carry
+ * on without friction history and restart their energy accounts' new terms
+ * from zero. */
+typedef struct checkpoint_header_v1 {
     uint32_t magic, version;
     int32_t nodes, elements, joints, constraints;
     int64_t step;
     double time, dt, dt_prev;
     double contact_work, damping_work, external_work;
+} checkpoint_header_v1;
+
+/* Version 2 adds what makes a restored run continue bit for bit: the last
+ * detection's positions and the largest displacement since (so detection
+ * reruns at the same steps with the same pairs), the stick springs, and
+ * every energy accumulator with the accounts as they stood. */
+typedef struct checkpoint_header {
+    checkpoint_header_v1 v1;
+    double havg_last, friction_energy, fracture_energy;
+    double max_disp2;
+    int64_t detections;
+    int32_t need_detect, has_detection;
+    int64_t spring_records;
+    fdem_energy energy;      /* the accounts at the checkpoint, shown until the next step */
 } checkpoint_header;
+
+static int checkpoint_has_detection(const fdem_model *m) { return m->contact.enabled; }
+
+static size_t checkpoint_body_size(const fdem_model *m, int has_detection, size_t spring_bytes)
+{
+    return sizeof(double) * 4 * (size_t)m->node_count + sizeof(double) * (size_t)m->joint_count +
+           (has_detection ? sizeof(double) * 2 * (size_t)m->node_count : 0) + spring_bytes;
+}
 
 size_t fdem_checkpoint_size(const fdem_model *m)
 {
-    return sizeof(checkpoint_header) + sizeof(double) * 4 * (size_t)m->node_count +
-           sizeof(double) * (size_t)m->joint_count;
+    return sizeof(checkpoint_header) +
+           checkpoint_body_size(m, checkpoint_has_detection(m),
+                                contact_history_checkpoint_size(&m->contact));
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
 {
     if (size < fdem_checkpoint_size(m)) return -1;
-    checkpoint_header h = {CHECKPOINT_MAGIC, 1, m->node_count, m->elem_count, m->joint_count,
-                           m->constraint_count, m->step, m->time, m->dt, m->dt_prev,
-                           m->contact_work, m->damping_work, m->external_work};
+    size_t spring_bytes = contact_history_checkpoint_size(&m->contact);
+    checkpoint_header h;
+    memset(&h, 0, sizeof h);
+    h.v1 = (checkpoint_header_v1){CHECKPOINT_MAGIC, CHECKPOINT_VERSION, m->node_count,
+                                  m->elem_count, m->joint_count, m->constraint_count, m->step,
+                                  m->time, m->dt, m->dt_prev, m->contact_work, m->damping_work,
+                                  m->external_work};
+    h.havg_last = m->havg_last;
+    h.friction_energy = m->friction_energy;
+    h.fracture_energy = m->fracture_energy;
+    h.max_disp2 = m->contact.max_disp2;
+    h.detections = m->contact.detections;
+    h.need_detect = m->contact.need_detect;
+    h.has_detection = checkpoint_has_detection(m);
+    h.spring_records = (int64_t)(spring_bytes / sizeof(contact_record));
+    h.energy = fdem_get_energy(m);
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
     p += sizeof h;
@@ -42,55 +86,125 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     memcpy(p, m->vel, nb);
     p += nb;
     if (m->joint_count) memcpy(p, m->joint_damage, sizeof(double) * (size_t)m->joint_count);
+    p += sizeof(double) * (size_t)m->joint_count;
+    if (h.has_detection) {
+        memcpy(p, m->contact.pos_detect, nb);
+        p += nb;
+    }
+    contact_history_checkpoint_write(&m->contact, p);
+    return 0;
+}
+
+/* The numbers a checkpoint must have to be a state this model can go on
+ * from (a hand-edited or damaged file is refused, not run). */
+static int checkpoint_header_sane(const checkpoint_header_v1 *h, fdem_error *err)
+{
+    if (h->step < 0 || !isfinite(h->time) || h->time < 0 || !(h->dt > 0) || !isfinite(h->dt) ||
+        !(h->dt_prev >= 0) || !isfinite(h->dt_prev)) {
+        model_error(err, FDEM_ITEM_NONE, -1,
+                    "checkpoint holds an impossible state (step %lld, time %g s, dt %g s)",
+                    (long long)h->step, h->time, h->dt);
+        return -1;
+    }
     return 0;
 }
 
 int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error *err)
 {
-    checkpoint_header h;
-    if (size < sizeof h) {
+    checkpoint_header_v1 h1;
+    if (size < sizeof h1) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is truncated (%zu bytes)", size);
         return -1;
     }
-    memcpy(&h, buf, sizeof h);
-    if (h.magic != CHECKPOINT_MAGIC || h.version != 1) {
+    memcpy(&h1, buf, sizeof h1);
+    if (h1.magic != CHECKPOINT_MAGIC || (h1.version != 1 && h1.version != CHECKPOINT_VERSION)) {
         model_error(err, FDEM_ITEM_NONE, -1, "not an fdemd checkpoint (or of another version)");
         return -1;
     }
-    if (h.nodes != m->node_count || h.elements != m->elem_count || h.joints != m->joint_count ||
-        h.constraints != m->constraint_count) {
+    if (h1.nodes != m->node_count || h1.elements != m->elem_count || h1.joints != m->joint_count ||
+        h1.constraints != m->constraint_count) {
         model_error(err, FDEM_ITEM_NONE, -1,
                     "checkpoint is of a model with %d nodes, %d elements, %d joints; this one has "
                     "%d, %d, %d",
-                    h.nodes, h.elements, h.joints, m->node_count, m->elem_count, m->joint_count);
+                    h1.nodes, h1.elements, h1.joints, m->node_count, m->elem_count, m->joint_count);
         return -1;
     }
-    if (size != fdem_checkpoint_size(m)) {
+    if (checkpoint_header_sane(&h1, err)) return -1;
+    checkpoint_header h;
+    memset(&h, 0, sizeof h);
+    h.v1 = h1;
+    size_t header = sizeof h1, expected;
+    if (h1.version == 1) {
+        expected = header + checkpoint_body_size(m, 0, 0);
+    } else {
+        header = sizeof h;
+        if (size < header) {
+            model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is truncated (%zu bytes)", size);
+            return -1;
+        }
+        memcpy(&h, buf, sizeof h);
+        if (h.spring_records < 0 || h.spring_records > (int64_t)(size / sizeof(contact_record)) ||
+            h.has_detection != checkpoint_has_detection(m)) {
+            model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's contact section does not fit");
+            return -1;
+        }
+        expected = header + checkpoint_body_size(m, h.has_detection,
+                                                 (size_t)h.spring_records * sizeof(contact_record));
+    }
+    if (size != expected) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,
-                    fdem_checkpoint_size(m));
+                    expected);
         return -1;
     }
-    const unsigned char *p = (const unsigned char *)buf + sizeof h;
+    const unsigned char *p = (const unsigned char *)buf + header;
+    const unsigned char *springs = p + checkpoint_body_size(m, h.has_detection, 0);
+    if (contact_history_checkpoint_read(&m->contact, springs, (size_t)h.spring_records,
+                                        m->elem_count)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's friction history is damaged");
+        return -1;
+    }
     size_t nb = sizeof(double) * 2 * (size_t)m->node_count;
     memcpy(m->pos, p, nb);
     p += nb;
     memcpy(m->vel, p, nb);
     p += nb;
     if (m->joint_count) memcpy(m->joint_damage, p, sizeof(double) * (size_t)m->joint_count);
-    m->step = h.step;
-    m->time = h.time;
-    m->dt = h.dt;
-    m->dt_prev = h.dt_prev;
-    m->contact_work = h.contact_work;
-    m->damping_work = h.damping_work;
-    m->external_work = h.external_work;
-    m->contact.need_detect = 1;
+    p += sizeof(double) * (size_t)m->joint_count;
+    m->step = h1.step;
+    m->time = h1.time;
+    m->dt = h1.dt;
+    m->dt_prev = h1.dt_prev;
+    m->contact_work = h1.contact_work;
+    m->damping_work = h1.damping_work;
+    m->external_work = h1.external_work;
+    m->havg_last = h.havg_last;
+    m->friction_energy = h.friction_energy;
+    m->fracture_energy = h.fracture_energy;
     m->broken_joints = 0;
     for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
     if (m->joint_count) m->fragments = joint_fragment_count(m);
-    /* Forces and elastic energy are those of the restored positions. */
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    element_forces(m);
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    if (h1.version == 1 || !h.has_detection) {
+        m->contact.need_detect = 1;
+    } else {
+        memcpy(m->contact.pos_detect, p, nb);
+        m->contact.need_detect = h.need_detect;
+        m->contact.detections = h.detections;
+    }
+    if (contact_restore_detection(m)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory restoring contact detection");
+        return -1;
+    }
+    m->contact.max_disp2 = h.max_disp2;
+    if (h1.version == 1) { /* no accounts stored: those of the restored positions */
+        element_forces(m);
+        memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+        m->restored_energy_valid = 0;
+    } else {
+        m->elastic_energy = h.energy.elastic;
+        m->joint_energy = h.energy.joint;
+        m->restored_energy = h.energy;
+        m->restored_energy_valid = 1;
+    }
     return 0;
 }

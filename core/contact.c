@@ -20,11 +20,16 @@
  * point. Action equals reaction at one point, so both linear and angular
  * momentum are conserved to round-off. Then the roles swap.
  *
- * Friction is Coulomb, |Ft| <= mu |Fn|, opposing the relative tangential
- * velocity at the point of action. Below the Coulomb bound it is the force
- * that would stop the relative sliding within one step (halved, so several
- * contacts on one node cannot overshoot); this holds a body at rest on a
- * slope without a stored tangential spring per pair.
+ * Friction is Coulomb with elastic stick (PHYSICS.md, "Friction"): each
+ * contactor edge of a pair carries a tangential spring, loaded by the
+ * relative tangential displacement at the point of action and capped at
+ * mu Fn, beyond which the surfaces slide and the spring stays at the cap.
+ * The spring's stiffness is 2/3 of the normal one, p L / (h/3) for the
+ * length L of the edge inside the target of smallest altitude h, so it adds
+ * nothing to the stable step; its force is kept per pair across steps
+ * (contact_history.c). A block on a slope below its friction angle then
+ * stays put for as long as one runs it, whatever the step; the energy that
+ * sliding dissipates, cap x slip, is booked in the friction account.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -39,10 +44,15 @@
  * threads' start-up costs more than they share. */
 #define CONTACT_THREADED_PAIRS 2048
 
+/* What a pair's evaluation hands back: two forces per corner of e1, then of
+ * e2, then the energy friction dissipated. */
+#define PAIR_OUT 13
+#define PAIR_DISSIPATED 12
+
 /* A thread's pairs that touched, in pair order, with their forces. */
 typedef struct contact_touch {
     long pair;
-    double force[12];
+    double force[PAIR_OUT];
 } contact_touch;
 
 typedef struct contact_touches {
@@ -94,8 +104,10 @@ static inline void area_coordinates(const tri_now *t, double px, double py, doub
 }
 
 /* Integral over s in [0,1] of phi(s) = 3 min_k lambda_k(s), clipped to where
- * all lambda_k >= 0, and its first moment. Returns 0 when the edge misses. */
-static int edge_potential_integral(const double la[3], const double lb[3], double *i0, double *i1)
+ * all lambda_k >= 0, its first moment, and the fraction of the edge inside.
+ * Returns 0 when the edge misses. */
+static int edge_potential_integral(const double la[3], const double lb[3], double *i0, double *i1,
+                                   double *inside)
 {
     double smin = 0, smax = 1;
     for (int k = 0; k < 3; k++) {
@@ -135,26 +147,57 @@ static int edge_potential_integral(const double la[3], const double lb[3], doubl
     }
     *i0 = sum0;
     *i1 = sum1;
+    *inside = smax - smin;
     return sum0 > 0;
 }
 
+/* The friction force on edge (na, nb) of a contactor, acting at sbar along
+ * it and lbar in the target t: the edge's stick spring `spring` is loaded
+ * by the relative tangential displacement of the last step (velocity times
+ * h, the last step's size), capped at mu Fn; *dissipated gets cap x slip. */
+static double friction_force(const fdem_model *m, const tri_now *t, int na, int nb, double sbar,
+                             const double lbar[3], double tx, double ty, double k_t, double cap,
+                             double h, double *spring, double *dissipated)
+{
+    const double *v = m->vel;
+    double vcx = (1 - sbar) * v[2 * na] + sbar * v[2 * nb];
+    double vcy = (1 - sbar) * v[2 * na + 1] + sbar * v[2 * nb + 1];
+    double vtx = 0, vty = 0;
+    for (int k = 0; k < 3; k++) {
+        vtx += lbar[k] * v[2 * t->node[k]];
+        vty += lbar[k] * v[2 * t->node[k] + 1];
+    }
+    double slide = ((vcx - vtx) * tx + (vcy - vty) * ty) * h;
+    double f = *spring - k_t * slide;
+    if (fabs(f) > cap) {
+        *dissipated += cap * (fabs(f) - cap) / k_t;
+        f = f > 0 ? cap : -cap;
+    }
+    *spring = f;
+    return f;
+}
+
 /* Forces of target t's potential on contactor c's edges, added to fc (two
- * per corner of c), and their reactions on t, added to ft. Returns 1 if any
- * force acted. Reads the model, writes nothing in it: pairs can be
- * evaluated side by side. */
+ * per corner of c), and their reactions on t, added to ft; springs holds the
+ * stick springs of c's three edges against t (updated; an edge that does not
+ * touch lets its spring go) and *dissipated gets what friction dissipated.
+ * Returns 1 if any force acted. Reads the model, writes nothing in it:
+ * pairs can be evaluated side by side. */
 static int contactor_against_target(const fdem_model *m, const tri_now *c, const tri_now *t,
-                                    double penalty, double friction, double havg, double fc[6],
-                                    double ft[6])
+                                    double penalty, double friction, double h, double springs[3],
+                                    double fc[6], double ft[6], double *dissipated)
 {
     double lam[3][3];
     for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
-    const double *v = m->vel, *inv_mass = m->inv_mass;
-    double inv_m_target = max3(inv_mass[t->node[0]], inv_mass[t->node[1]], inv_mass[t->node[2]]);
+    double stiffness = 0; /* p / (h_t / 3), h_t the target's smallest altitude */
     int acted = 0;
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3;
-        double i0, i1;
-        if (!edge_potential_integral(lam[i], lam[j], &i0, &i1)) continue;
+        double i0, i1, inside;
+        if (!edge_potential_integral(lam[i], lam[j], &i0, &i1, &inside)) {
+            springs[i] = 0;
+            continue;
+        }
         acted = 1;
         double ex = c->x[j] - c->x[i], ey = c->y[j] - c->y[i];
         double len = hypot(ex, ey);
@@ -165,21 +208,20 @@ static int contactor_against_target(const fdem_model *m, const tri_now *c, const
         for (int k = 0; k < 3; k++) lbar[k] = lam[i][k] + sbar * (lam[j][k] - lam[i][k]);
         int na = c->node[i], nb = c->node[j];
         if (friction > 0 && len > 0) {
-            double tx = ex / len, ty = ey / len;
-            double vcx = (1 - sbar) * v[2 * na] + sbar * v[2 * nb];
-            double vcy = (1 - sbar) * v[2 * na + 1] + sbar * v[2 * nb + 1];
-            double vtx = 0, vty = 0;
-            for (int k = 0; k < 3; k++) {
-                vtx += lbar[k] * v[2 * t->node[k]];
-                vty += lbar[k] * v[2 * t->node[k] + 1];
+            if (stiffness == 0) {
+                double e0 = hypot(t->x[1] - t->x[0], t->y[1] - t->y[0]);
+                double e1 = hypot(t->x[2] - t->x[1], t->y[2] - t->y[1]);
+                double e2 = hypot(t->x[0] - t->x[2], t->y[0] - t->y[2]);
+                stiffness = 3 * penalty * max3(e0, e1, e2) / t->area2;
             }
-            double slip = (vcx - vtx) * tx + (vcy - vty) * ty;
-            double inv_m = max2(inv_mass[na], inv_mass[nb]) + inv_m_target;
-            double stop = 0.5 * fabs(slip) / (inv_m * havg);
-            double f_slip = min2(friction * penalty * i0 * len, stop);
-            if (slip > 0) f_slip = -f_slip;
-            fx += f_slip * tx;
-            fy += f_slip * ty;
+            double tx = ex / len, ty = ey / len;
+            double k_t = (2.0 / 3.0) * stiffness * inside * len;
+            double f_t = friction_force(m, t, na, nb, sbar, lbar, tx, ty, k_t,
+                                        friction * penalty * i0 * len, h, &springs[i], dissipated);
+            fx += f_t * tx;
+            fy += f_t * ty;
+        } else {
+            springs[i] = 0;
         }
         fc[2 * i] += (1 - sbar) * fx;
         fc[2 * i + 1] += (1 - sbar) * fy;
@@ -241,30 +283,39 @@ static void contact_collect_active(contact_state *cs, int elem_count)
     cs->active_count = count;
 }
 
-/* Force between two elements whose boxes overlap, both roles, into out: two
- * per corner of e1, then two per corner of e2. Returns 1 if they touched
- * (out is then filled; otherwise it may be left as it was). Writes nothing
- * in m. */
-static int contact_pair_force(const fdem_model *m, int e1, int e2, double havg, double out[12])
+/* Force between two elements whose boxes overlap, both roles, into out;
+ * springs are the pair's CONTACT_SLOTS stick springs (updated), h the last
+ * step's size. Returns 1 if they touched (out is then filled; otherwise it
+ * may be left as it was). Writes nothing in m. */
+static int contact_pair_force(const fdem_model *m, int e1, int e2, double h,
+                              double springs[CONTACT_SLOTS], double out[PAIR_OUT])
 {
     tri_now a, b;
     tri_gather(m, e1, &a);
     tri_gather(m, e2, &b);
     tri_complete(m, e1, &a);
     tri_complete(m, e2, &b);
-    if (!(a.area2 > 0) || !(b.area2 > 0)) return 0; /* inverted: no potential defined */
+    if (!(a.area2 > 0) || !(b.area2 > 0)) { /* inverted: no potential defined */
+        memset(springs, 0, sizeof(double) * CONTACT_SLOTS);
+        return 0;
+    }
     /* The softer surface sets the penalty; friction is the larger of the two,
      * so giving it on one material is enough. */
     double penalty = min2(a.penalty, b.penalty);
     double friction = max2(a.friction, b.friction);
-    for (int k = 0; k < 12; k++) out[k] = 0;
-    int touched = contactor_against_target(m, &a, &b, penalty, friction, havg, out, out + 6);
-    touched |= contactor_against_target(m, &b, &a, penalty, friction, havg, out + 6, out);
+    for (int k = 0; k < PAIR_OUT; k++) out[k] = 0;
+    double *dissipated = &out[PAIR_DISSIPATED];
+    int touched = contactor_against_target(m, &a, &b, penalty, friction, h, springs, out, out + 6,
+                                           dissipated);
+    touched |= contactor_against_target(m, &b, &a, penalty, friction, h, springs + 3, out + 6,
+                                        out, dissipated);
     return touched;
 }
 
-/* Adds a pair's forces (contact_pair_force) to the contact force array. */
-static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out[12])
+/* Adds a pair's forces (contact_pair_force) to the contact force array and
+ * what its friction dissipated to the friction account; called in pair
+ * order, so every sum is formed in the same order on any thread count. */
+static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out[PAIR_OUT])
 {
     double *f = m->contact.force;
     const int32_t *n1 = m->elem[e1].node, *n2 = m->elem[e2].node;
@@ -276,24 +327,30 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out
         f[2 * n2[c]] += out[6 + 2 * c];
         f[2 * n2[c] + 1] += out[6 + 2 * c + 1];
     }
+    m->friction_energy += out[PAIR_DISSIPATED];
+}
+
+/* A pair whose boxes no longer overlap lets its stick springs go. */
+static inline void pair_springs_release(double springs[CONTACT_SLOTS])
+{
+    for (int k = 0; k < CONTACT_SLOTS; k++) springs[k] = 0;
 }
 
 /* Force between two elements, both roles, added to the contact force
- * array. Returns 1 if they touched. */
-int contact_potential_force(fdem_model *m, int e1, int e2, double havg)
+ * array, with no friction history (for tests). Returns 1 if they touched. */
+int contact_potential_force(fdem_model *m, int e1, int e2, double h)
 {
-    double b1[4], b2[4], out[12];
+    double b1[4], b2[4], out[PAIR_OUT], springs[CONTACT_SLOTS] = {0};
     element_box(m, e1, b1);
     element_box(m, e2, b2);
-    if (!boxes_overlap(b1, b2) || !contact_pair_force(m, e1, e2, havg, out)) return 0;
+    if (!boxes_overlap(b1, b2) || !contact_pair_force(m, e1, e2, h, springs, out)) return 0;
     contact_pair_scatter(m, e1, e2, out);
     return 1;
 }
 
-static void element_circle(const fdem_model *m, int e, double *cx, double *cy, double *r)
+static void element_circle(const double *p, const element_hot *el, double *cx, double *cy,
+                           double *r)
 {
-    const element_hot *el = &m->elem[e];
-    const double *p = m->pos;
     double x = 0, y = 0;
     for (int c = 0; c < 3; c++) {
         x += p[2 * el->node[c]];
@@ -311,11 +368,15 @@ static void element_circle(const fdem_model *m, int e, double *cx, double *cy, d
     *r = sqrt(r2);
 }
 
-static int contact_detect(fdem_model *m)
+/* Candidate pairs from the bounding circles of the elements at `pos` (the
+ * current positions, or a checkpoint's positions at its last detection),
+ * with the stick springs of the pairs that stay. */
+static int contact_detect_at(fdem_model *m, const double *pos)
 {
     contact_state *cs = &m->contact;
+    if (contact_history_set_aside(cs)) return -1;
     for (int e = 0; e < m->elem_count; e++) {
-        element_circle(m, e, &cs->cx[e], &cs->cy[e], &cs->r[e]);
+        element_circle(pos, &m->elem[e], &cs->cx[e], &cs->cy[e], &cs->r[e]);
         cs->r[e] += 0.5 * cs->buffer;
     }
     if (nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs))
@@ -334,11 +395,37 @@ static int contact_detect(fdem_model *m)
         }
         cs->pairs.count = kept;
     }
+    if (contact_history_take_back(cs)) return -1;
     contact_collect_active(cs, m->elem_count);
-    memcpy(cs->pos_detect, m->pos, sizeof(double) * 2 * (size_t)m->node_count);
-    cs->max_disp2 = 0;
+    if (pos != cs->pos_detect)
+        memcpy(cs->pos_detect, pos, sizeof(double) * 2 * (size_t)m->node_count);
     cs->need_detect = 0;
     cs->detections++;
+    return 0;
+}
+
+static int contact_detect(fdem_model *m)
+{
+    if (contact_detect_at(m, m->pos)) return -1;
+    m->contact.max_disp2 = 0;
+    return 0;
+}
+
+/* After a checkpoint restore: the candidate pairs of the last detection
+ * before it (same circles, same joints, so the same list in the same
+ * order: the run goes on bit for bit), with the stick springs the
+ * checkpoint held, waiting in the records. */
+int contact_restore_detection(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (!cs->enabled) return 0;
+    cs->pairs.count = 0;
+    memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    cs->force_is_zero = 1;
+    if (cs->need_detect) return 0; /* the next step detects anyway */
+    long detections = cs->detections;
+    if (contact_detect_at(m, cs->pos_detect)) return -1;
+    cs->detections = detections;
     return 0;
 }
 
@@ -375,7 +462,7 @@ int contact_init(fdem_model *m, fdem_error *err)
     double rmax = 0;
     for (int e = 0; e < m->elem_count; e++) {
         double x, y, r;
-        element_circle(m, e, &x, &y, &r);
+        element_circle(m->pos, &m->elem[e], &x, &y, &r);
         rmax = fmax(rmax, r);
     }
     cs->buffer = 0.4 * rmax;
@@ -390,6 +477,8 @@ void contact_free(contact_state *cs)
     free(cs->box); free(cs->active); free(cs->in_pair);
     for (int t = 0; t < cs->touch_lists; t++) free(cs->touches[t].item);
     free(cs->touches);
+    free(cs->slip);
+    free(cs->records);
     nbs_grid_free(&cs->grid);
     nbs_pairs_free(&cs->pairs);
     memset(cs, 0, sizeof *cs);
@@ -416,7 +505,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     return b;
 }
 
-static int contact_touch_push(contact_touches *list, long pair, const double force[12])
+static int contact_touch_push(contact_touches *list, long pair, const double force[PAIR_OUT])
 {
     if (list->count == list->capacity) {
         size_t cap = list->capacity ? 2 * list->capacity : 1024;
@@ -445,17 +534,19 @@ static int contact_touch_lists(contact_state *cs, int threads)
 
 /* Every candidate pair's force, added to the contact force array in pair
  * order, one pair at a time. Returns the number of pairs that touched. */
-static int contact_pairs_forces_serial(fdem_model *m, double havg)
+static int contact_pairs_forces_serial(fdem_model *m, double h)
 {
     const contact_state *cs = &m->contact;
     int touching = 0;
     const double *box = cs->box;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
-        double out[12];
-        if (!boxes_overlap(box + 4 * (size_t)a, box + 4 * (size_t)b) ||
-            !contact_pair_force(m, a, b, havg, out))
+        double out[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
+        if (!boxes_overlap(box + 4 * (size_t)a, box + 4 * (size_t)b)) {
+            pair_springs_release(springs);
             continue;
+        }
+        if (!contact_pair_force(m, a, b, h, springs, out)) continue;
         contact_pair_scatter(m, a, b, out);
         touching++;
     }
@@ -468,7 +559,7 @@ static int contact_pairs_forces_serial(fdem_model *m, double havg)
  * the order the serial loop forms it: the same bits on any thread count.
  * Returns the number of pairs that touched, or -1 if a list could not grow
  * (nothing has been added then). */
-static int contact_pairs_forces_threaded(fdem_model *m, double havg)
+static int contact_pairs_forces_threaded(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
     long n = (long)cs->pairs.count;
@@ -488,10 +579,12 @@ static int contact_pairs_forces_threaded(fdem_model *m, double havg)
         long begin = n * t / nt, end = n * (t + 1) / nt;
         const double *box = cs->box;
         for (long k = begin; k < end; k++) {
-            double force[12];
-            if (!boxes_overlap(box + 4 * (size_t)pa[k], box + 4 * (size_t)pb[k]) ||
-                !contact_pair_force(m, pa[k], pb[k], havg, force))
+            double force[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
+            if (!boxes_overlap(box + 4 * (size_t)pa[k], box + 4 * (size_t)pb[k])) {
+                pair_springs_release(springs);
                 continue;
+            }
+            if (!contact_pair_force(m, pa[k], pb[k], h, springs, force)) continue;
             touching++;
             if (contact_touch_push(list, k, force)) {
 #pragma omp atomic write
@@ -510,19 +603,24 @@ static int contact_pairs_forces_threaded(fdem_model *m, double havg)
 }
 
 /* Threads only pay off with enough pairs; without room for their lists the
- * step stays on one thread. */
-static int contact_pairs_forces(fdem_model *m, double havg)
+ * step stays on one thread. Returns the number of pairs that touched, or -1
+ * when out of memory. */
+static int contact_pairs_forces(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
     if (m->threads > 1 && cs->pairs.count >= CONTACT_THREADED_PAIRS &&
         contact_touch_lists(cs, m->threads) == 0) {
-        int touching = contact_pairs_forces_threaded(m, havg);
-        if (touching >= 0) return touching;
+        /* a list that cannot grow has already moved some stick springs:
+         * the step fails rather than run the pairs twice */
+        return contact_pairs_forces_threaded(m, h);
     }
-    return contact_pairs_forces_serial(m, havg);
+    return contact_pairs_forces_serial(m, h);
 }
 
-int contact_forces(fdem_model *m, double havg)
+/* Detection when due, then every candidate pair's force. The stick springs
+ * are loaded by the motion of the last step (m->dt_prev). Returns 0, or -1
+ * when out of memory. */
+int contact_forces(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
@@ -539,6 +637,8 @@ int contact_forces(fdem_model *m, double havg)
     if (!cs->force_is_zero) memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (cs->pairs.count) contact_boxes(m);
-    cs->touching = contact_pairs_forces(m, havg);
+    int touching = contact_pairs_forces(m, m->dt_prev);
+    if (touching < 0) return -1;
+    cs->touching = touching;
     return 0;
 }

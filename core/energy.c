@@ -62,6 +62,7 @@ static double constraints_last_half_step(const fdem_model *m)
 
 fdem_energy fdem_get_energy(const fdem_model *m)
 {
+    if (m->restored_energy_valid) return m->restored_energy;
     fdem_energy en = {0};
     const double havg = m->havg_last, h = m->dt_prev;
     const double *fc = m->contact.enabled && !m->contact.force_is_zero ? m->contact.force : NULL;

@@ -161,7 +161,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double t1 = stage_clock();
     m->times.elements += t1 - t0;
-    if (contact_forces(m, havg)) {
+    if (contact_forces(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory in contact detection at step %lld",
                     (long long)m->step + 1);
         return -1;
@@ -178,6 +178,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     m->dt_prev = h;
     m->havg_last = havg;
+    m->restored_energy_valid = 0;
     m->time += h;
     m->step++;
     return 0;

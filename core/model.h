@@ -59,6 +59,14 @@ typedef struct scatter_plan {
     double *block_sum;       /* SCATTER_SUMS partials per block, totalled in block order */
 } scatter_plan;
 
+/* Stick-spring history of one pair of elements lo < hi (contact_history.c):
+ * the tangential force on each edge of lo against hi, then of hi against lo. */
+#define CONTACT_SLOTS 6
+typedef struct contact_record {
+    int32_t lo, hi;
+    double slip[CONTACT_SLOTS];
+} contact_record;
+
 typedef struct contact_state {
     int enabled;             /* some pair of elements can ever touch */
     double buffer;           /* added to circle diameters; re-detect after buffer/2 */
@@ -77,6 +85,10 @@ typedef struct contact_state {
     int32_t *active;         /* the elements in some candidate pair, once each */
     int active_count;
     uint8_t *in_pair;        /* scratch per element for building active */
+    double *slip;            /* CONTACT_SLOTS per candidate pair: the stick springs' force */
+    size_t slip_capacity;
+    contact_record *records; /* history set aside across a detection or a restore */
+    size_t record_count, record_capacity;
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;
@@ -122,6 +134,7 @@ struct fdem_model {
     int32_t *joint_elem;     /* 2 per joint: elements A and B */
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
     double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
+    double *joint_kc;        /* traction per unit closing: that of contact (joint.c) */
     int32_t *joint_material; /* element A's material */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */
@@ -152,6 +165,9 @@ struct fdem_model {
     double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
     double *damping_force;   /* viscous nodal forces of the last step (also in force);
                                 NULL when no element is damped */
+    fdem_energy restored_energy; /* the accounts a checkpoint held, reported until the next
+                                    step (the last step's forces they need are not stored) */
+    int restored_energy_valid;
 
     contact_state contact;
     fdem_stage_times times;
@@ -179,8 +195,18 @@ int element_of_node(const fdem_model *m, int node);
 int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
-int contact_forces(fdem_model *m, double havg);
+int contact_forces(fdem_model *m);
+int contact_restore_detection(fdem_model *m);
 size_t contact_memory_bytes(const contact_state *c); /* threaded runs' lists only */
+
+/* contact_history.c */
+int contact_history_reserve(contact_state *cs, size_t pairs);
+int contact_history_set_aside(contact_state *cs);
+int contact_history_take_back(contact_state *cs);
+size_t contact_history_checkpoint_size(const contact_state *cs);
+void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p);
+int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, size_t count,
+                                    int elements);
 
 /* constraint.c */
 int constraint_select(fdem_model *m, fdem_error *err);
@@ -206,8 +232,8 @@ int joint_fragment_count(const fdem_model *m);
  * results there: sums[0 .. SCATTER_MAX - 1] are added, block by block in
  * block order, to the same totals; totals[SCATTER_MAX] becomes the largest
  * sums[SCATTER_MAX] (and what it held before, if larger). */
-#define SCATTER_SUMS 4
-#define SCATTER_MAX 3
+#define SCATTER_SUMS 5
+#define SCATTER_MAX 4
 typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 /* Smallest blocks, and the block count aimed at above that: a node on the
  * border of two colours is loaded once per colour, so large meshes get

@@ -1,0 +1,165 @@
+/*
+ * contact_history.c - the stick springs of Coulomb friction: one tangential
+ * force per contactor edge of every candidate pair, kept across steps,
+ * detections and checkpoints.
+ *
+ * Friction with elastic stick needs to remember, per touching pair, how far
+ * its surfaces have been sheared against each other (PHYSICS.md,
+ * "Friction"). The history sits beside the candidate pair list (six values
+ * a pair: the three edges of each element as contactor), because that is
+ * where the force loop walks. Detection rebuilds the pair list in an order
+ * of its own, so before it runs the pairs that hold some history are set
+ * aside as records keyed by their two elements, and afterwards every new
+ * pair looks its record up in a small open-addressing table. A checkpoint
+ * stores the same records, and a restore feeds them through the same path.
+ * Nothing depends on the thread count or on the order of the records.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "model.h"
+
+/* Slots of a pair (a, b): the edges of a against b, then those of b against
+ * a. Records store them for (lo, hi) = (min, max) of the two elements; this
+ * turns one order into the other (either way: it swaps the halves or not). */
+static void pair_slots_oriented(const double *slip, int a, int b, double out[CONTACT_SLOTS])
+{
+    int half = CONTACT_SLOTS / 2;
+    for (int k = 0; k < half; k++) {
+        out[k] = slip[a < b ? k : k + half];
+        out[k + half] = slip[a < b ? k + half : k];
+    }
+}
+
+int contact_history_reserve(contact_state *cs, size_t pairs)
+{
+    if (pairs <= cs->slip_capacity) return 0;
+    size_t cap = cs->slip_capacity ? cs->slip_capacity : 1024;
+    while (cap < pairs) cap *= 2;
+    double *s = realloc(cs->slip, sizeof(double) * CONTACT_SLOTS * cap);
+    if (!s) return -1;
+    cs->slip = s;
+    cs->slip_capacity = cap;
+    return 0;
+}
+
+static int records_reserve(contact_state *cs, size_t count)
+{
+    if (count <= cs->record_capacity) return 0;
+    size_t cap = cs->record_capacity ? cs->record_capacity : 256;
+    while (cap < count) cap *= 2;
+    contact_record *r = realloc(cs->records, sizeof *r * cap);
+    if (!r) return -1;
+    cs->records = r;
+    cs->record_capacity = cap;
+    return 0;
+}
+
+static int slots_hold_history(const double *slip)
+{
+    for (int k = 0; k < CONTACT_SLOTS; k++)
+        if (slip[k] != 0) return 1;
+    return 0;
+}
+
+/* Appends the pairs that hold history to the pending records (a restore
+ * may have put some there already). */
+int contact_history_set_aside(contact_state *cs)
+{
+    size_t n = cs->record_count;
+    for (size_t k = 0; k < cs->pairs.count; k++)
+        n += slots_hold_history(cs->slip + CONTACT_SLOTS * k);
+    if (records_reserve(cs, n)) return -1;
+    n = cs->record_count;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        const double *slip = cs->slip + CONTACT_SLOTS * k;
+        if (!slots_hold_history(slip)) continue;
+        int a = cs->pairs.a[k], b = cs->pairs.b[k];
+        contact_record *r = &cs->records[n++];
+        r->lo = a < b ? a : b;
+        r->hi = a < b ? b : a;
+        pair_slots_oriented(slip, a, b, r->slip);
+    }
+    cs->record_count = n;
+    return 0;
+}
+
+static inline uint64_t pair_hash(int32_t lo, int32_t hi)
+{
+    uint64_t key = ((uint64_t)(uint32_t)lo << 32) | (uint32_t)hi;
+    key ^= key >> 33;
+    key *= 0xff51afd7ed558ccdULL;
+    key ^= key >> 33;
+    return key;
+}
+
+/* Gives every pair of the new list its pending record, if it has one, and
+ * empties the records. */
+int contact_history_take_back(contact_state *cs)
+{
+    if (contact_history_reserve(cs, cs->pairs.count)) return -1;
+    memset(cs->slip, 0, sizeof(double) * CONTACT_SLOTS * cs->pairs.count);
+    size_t n = cs->record_count;
+    if (n == 0) return 0;
+    size_t size = 16;
+    while (size < 2 * n) size *= 2;
+    int32_t *table = malloc(sizeof(int32_t) * size);
+    if (!table) return -1;
+    for (size_t i = 0; i < size; i++) table[i] = -1;
+    for (size_t r = 0; r < n; r++) {
+        size_t i = pair_hash(cs->records[r].lo, cs->records[r].hi) & (size - 1);
+        while (table[i] >= 0) i = (i + 1) & (size - 1);
+        table[i] = (int32_t)r;
+    }
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int a = cs->pairs.a[k], b = cs->pairs.b[k];
+        int32_t lo = a < b ? a : b, hi = a < b ? b : a;
+        size_t i = pair_hash(lo, hi) & (size - 1);
+        for (; table[i] >= 0; i = (i + 1) & (size - 1)) {
+            const contact_record *r = &cs->records[table[i]];
+            if (r->lo != lo || r->hi != hi) continue;
+            pair_slots_oriented(r->slip, a, b, cs->slip + CONTACT_SLOTS * k);
+            break;
+        }
+    }
+    free(table);
+    cs->record_count = 0;
+    return 0;
+}
+
+size_t contact_history_checkpoint_size(const contact_state *cs)
+{
+    size_t n = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++)
+        n += slots_hold_history(cs->slip + CONTACT_SLOTS * k);
+    return n * sizeof(contact_record);
+}
+
+void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p)
+{
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        const double *slip = cs->slip + CONTACT_SLOTS * k;
+        if (!slots_hold_history(slip)) continue;
+        int a = cs->pairs.a[k], b = cs->pairs.b[k];
+        contact_record r;
+        memset(&r, 0, sizeof r);
+        r.lo = a < b ? a : b;
+        r.hi = a < b ? b : a;
+        pair_slots_oriented(slip, a, b, r.slip);
+        memcpy(p, &r, sizeof r);
+        p += sizeof r;
+    }
+}
+
+int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, size_t count,
+                                    int elements)
+{
+    if (records_reserve(cs, count)) return -1;
+    for (size_t k = 0; k < count; k++) {
+        contact_record *r = &cs->records[k];
+        memcpy(r, p + k * sizeof *r, sizeof *r);
+        if (r->lo < 0 || r->hi <= r->lo || r->hi >= elements) return -1;
+    }
+    cs->record_count = count;
+    return 0;
+}

@@ -1,0 +1,128 @@
+/*
+ * test_energy.c - the energy accounts close (contract 5.1, PHYSICS.md
+ * "Energy accounting"): on a collision, a damped bar, a fracturing bar
+ * pulled apart and a block sliding with friction, the residual
+ *   kinetic + elastic + joint + contact + friction + fracture + damping
+ *   - gravity_work - external_work - (kinetic + elastic at t = 0)
+ * stays under 1 % of the energy that went through the model at every step,
+ * and each account has the sign and size its physics gives it.
+ *
+ * "Energy that went through the model" is the largest of the initial
+ * energy, the gravity work and the external work seen so far: the scale a
+ * user compares the residual with.
+ */
+#include "build_model.h"
+#include "check.h"
+#include "model.h"
+
+typedef struct balance {
+    double worst;  /* largest |residual| / scale seen */
+    double scale;  /* energy through the model */
+    double at;     /* time of the worst */
+} balance;
+
+static void balance_watch(const fdem_model *m, balance *b)
+{
+    fdem_energy en = fdem_get_energy(m);
+    double through = fmax(m->initial_energy, fmax(fabs(en.gravity_work), fabs(en.external_work)));
+    if (through > b->scale) b->scale = through;
+    if (b->scale > 0 && fabs(en.residual) / b->scale > b->worst) {
+        b->worst = fabs(en.residual) / b->scale;
+        b->at = fdem_get_time(m);
+    }
+}
+
+static void run_watched(fdem_model *m, double t_end, balance *b)
+{
+    fdem_error err;
+    while (fdem_get_time(m) < t_end) {
+        if (fdem_step(m, &err)) build_die("step", &err);
+        balance_watch(m, b);
+    }
+}
+
+static void print_accounts(const char *name, const fdem_model *m, const balance *b)
+{
+    fdem_energy en = fdem_get_energy(m);
+    fprintf(stderr,
+            "  %s: kinetic %.6g elastic %.6g joint %.6g contact %.6g friction %.6g fracture %.6g "
+            "damping %.6g gravity %.6g external %.6g; worst residual %.3g %% of %.6g J/m at "
+            "t = %.3g s\n",
+            name, en.kinetic, en.elastic, en.joint, en.contact, en.friction, en.fracture,
+            en.damping, en.gravity_work, en.external_work, 100 * b->worst, b->scale, b->at);
+}
+
+/* Two undamped, frictionless blocks meet and part: everything kinetic goes
+ * through the contact penalty and back. */
+static void collision_closes_the_balance(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0);
+    int a = build_rectangle(m, mat, 0, 0, 0.1, 0.05, 8, 4);
+    int b = build_rectangle(m, mat, 0.1002, 0.01, 0.06, 0.05, 5, 4);
+    fdem_set_part_velocity(m, a, 2.0, 0.1, NULL);
+    fdem_set_part_velocity(m, b, -3.0, 0, NULL);
+    build_finalize(m, 0.5);
+    balance bal = {0};
+    run_watched(m, 0.004, &bal);
+    print_accounts("collision", m, &bal);
+    CHECK(fdem_get_counts(m).detections > 0, "no detection");
+    CHECK(bal.worst < 0.01, "residual %.3g %% of the energy", 100 * bal.worst);
+    fdem_model_destroy(m);
+}
+
+/* A cantilevered bar swinging with 10 % damping: the damping account takes
+ * what the oscillation loses. */
+static void damped_bar_closes_the_balance(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2000, 1e8, 0.25, 0.1, 0);
+    int bar = build_rectangle(m, mat, 0, 0, 1.0, 0.1, 40, 4);
+    fdem_constraint_def c = {.select = FDEM_SELECT_BOX, .box = {-0.001, -1, 0.001, 1},
+                             .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1};
+    fdem_error err;
+    if (fdem_add_constraint(m, &c, &err) < 0) build_die("constraint", &err);
+    fdem_set_part_velocity(m, bar, 0, 0.5, NULL);
+    build_finalize(m, 0.5);
+    balance bal = {0};
+    run_watched(m, 0.05, &bal);
+    print_accounts("damped bar", m, &bal);
+    fdem_energy en = fdem_get_energy(m);
+    CHECK(en.damping > 0.05 * m->initial_energy, "damping took only %g of %g J/m", en.damping,
+          m->initial_energy);
+    CHECK(bal.worst < 0.01, "residual %.3g %% of the energy", 100 * bal.worst);
+    fdem_model_destroy(m);
+}
+
+/* A fracturing bar whose ends are pulled apart: the work of the supports
+ * goes into the joints, the crack (G_I per unit area at least once across
+ * the bar) and the pieces' motion. */
+static void fracturing_bar_closes_the_balance(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_fracturing_rock(m, 0);
+    const double L = 0.1, H = 0.02;
+    build_rectangle_part(m, mat, 0, 0, L, H, 20, 4, 1);
+    fdem_constraint_def left = {.select = FDEM_SELECT_BOX, .box = {-0.001, -1, 0.0001, 1},
+                                .kind = FDEM_CONSTRAINT_VELOCITY, .value = {-0.2, 0}};
+    fdem_constraint_def right = left;
+    right.box[0] = L - 0.0001;
+    right.box[2] = L + 0.001;
+    right.value[0] = 0.2;
+    fdem_error err;
+    if (fdem_add_constraint(m, &left, &err) < 0 || fdem_add_constraint(m, &right, &err) < 0)
+        build_die("constraint", &err);
+    build_finalize(m, 0.5);
+    balance bal = {0};
+    run_watched(m, 4e-4, &bal);
+    print_accounts("fracturing bar", m, &bal);
+    fdem_energy en = fdem_get_energy(m);
+    CHECK(m->broken_joints > 0, "the bar did not break");
+    CHECK(en.fracture >= 0.98 * 10 * H, "fracture %g J/m, a crack across is %g", en.fracture,
+          10 * H);
+    CHECK(bal.worst < 0.01, "residual %.3g %% of the energy", 100 * bal.worst);
+    fdem_model_destroy(m);
+}
+
+CHECK_MAIN(T(collision_closes_the_balance), T(damped_bar_closes_the_balance),
+           T(fracturing_bar_closes_the_balance))
