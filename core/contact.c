@@ -487,13 +487,18 @@ void contact_free(contact_state *cs)
 double contact_stable_dt(const fdem_model *m)
 {
     if (!m->contact.enabled) return INFINITY;
-    /* A penalty p on an edge of an element of size h acts like a spring of
-     * about 9p/(rho h^2) per unit mass on each side; 0.45 h sqrt(rho/p)
-     * keeps both sides of the contact inside the central-difference limit. */
+    /* A face pressed a depth d into a triangle of altitude h is pushed back
+     * with p 3 d / h from each side, so a corner node of an element of
+     * size h, on two such faces, feels a spring of up to about 16 p / (rho
+     * h^2) per unit mass. 0.25 h sqrt(rho / p) keeps omega dt at 1 at
+     * safety 1: measured on flat impacts of shared-node and fracturing
+     * blocks (test_contact.c), the energy after the impact is within 1 % of
+     * the energy before at every safety up to 1 (0.45, the earlier factor,
+     * gained 20 % at safety 1). */
     double dt = INFINITY;
     for (int e = 0; e < m->elem_count; e++) {
         const material *mat = &m->materials[m->elem[e].material];
-        dt = fmin(dt, 0.45 * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
+        dt = fmin(dt, 0.25 * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
     }
     return dt;
 }

@@ -132,27 +132,6 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
     return 0;
 }
 
-/* A joint pressed shut resists as the contact between its two triangles
- * would once it breaks: the potential contact of a face pushed a depth d
- * into a triangle of altitude h over it pushes back with p 3 d / h, from
- * each side. Were the joint softer in compression than that (the plain
- * p / h), a joint breaking under compression would hand its overlap to a
- * contact six times stiffer, which throws the freed faces apart with
- * energy from nowhere. */
-static double joint_compression_stiffness(const fdem_model *m, int j)
-{
-    const int32_t *n = m->joint_node + 4 * j;
-    double L = hypot(m->pos0[2 * n[1]] - m->pos0[2 * n[0]], m->pos0[2 * n[1] + 1] - m->pos0[2 * n[0] + 1]);
-    double kc = 0, p = INFINITY;
-    for (int s = 0; s < 2; s++) {
-        const element_hot *el = &m->elem[m->joint_elem[2 * j + s]];
-        double altitude = 2 * el->area0 / L;
-        kc += 3 / altitude;
-        p = fmin(p, m->materials[el->material].penalty);
-    }
-    return p * kc;
-}
-
 /* Per-joint data derived at finalize: stiffness length, element map. */
 int joint_prepare(fdem_model *m, fdem_error *err)
 {
@@ -161,11 +140,10 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     m->joint_damage = calloc(J, sizeof(double));
     m->joint_h = malloc(sizeof(double) * J);
     m->joint_k = malloc(sizeof(double) * J);
-    m->joint_kc = malloc(sizeof(double) * J);
     m->joint_material = malloc(sizeof(int32_t) * J);
     m->elem_joint = malloc(sizeof(int32_t) * 3 * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
-    if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k || !m->joint_kc ||
+    if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k ||
         !m->joint_material) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
@@ -176,7 +154,6 @@ int joint_prepare(fdem_model *m, fdem_error *err)
         m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
         m->joint_material[j] = m->elem[ea].material;
         m->joint_k[j] = m->materials[m->elem[ea].material].penalty / m->joint_h[j];
-        m->joint_kc[j] = joint_compression_stiffness(m, j);
         for (int s = 0; s < 2; s++) {
             int e = m->joint_elem[2 * j + s];
             for (int c = 0; c < 3; c++)
@@ -190,8 +167,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
 }
 
 /* Joint springs in series with the element: each face node feels about
- * k L / 2 from one joint (k the stiffer of tension and compression) and
- * sits on two joints, against its own mass. */
+ * p L / (2h) from one joint and sits on two joints, against its own mass. */
 double joint_stable_dt(const fdem_model *m)
 {
     double dt = INFINITY;
@@ -200,7 +176,7 @@ double joint_stable_dt(const fdem_model *m)
         double mass = fmin(fmin(m->mass[n[0]], m->mass[n[1]]), fmin(m->mass[n[2]], m->mass[n[3]]));
         const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
         double L = hypot(m->pos0[2 * n[1]] - m->pos0[2 * n[0]], m->pos0[2 * n[1] + 1] - m->pos0[2 * n[0] + 1]);
-        double k = 2 * fmax(mat->penalty / m->joint_h[j], m->joint_kc[j]) * L; /* two joints, both faces */
+        double k = 2 * mat->penalty * L / m->joint_h[j]; /* two joints, both faces */
         dt = fmin(dt, 0.9 * 2 * sqrt(mass / (2 * k)));
     }
     return dt;
@@ -298,14 +274,14 @@ typedef struct joint_point {
     double D;              /* the damage its opening and sliding ask for */
 } joint_point;
 
-static inline void joint_point_measure(const material *mat, double k, double kc, double delta,
-                                       double slide, joint_point *g)
+static inline void joint_point_measure(const material *mat, double k, double delta, double slide,
+                                       joint_point *g)
 {
     const fdem_fracture_params *fp = &mat->def.fracture;
     double ft = fp->tensile_strength;
     g->delta = delta;
     g->slide = slide;
-    g->fs = fp->cohesion + (delta < 0 ? -kc * delta * mat->tan_phi : 0);
+    g->fs = fp->cohesion + (delta < 0 ? -k * delta * mat->tan_phi : 0);
     double dp = ft / k, sp = g->fs / k;
     double dn = delta > dp ? (delta - dp) / softening_span(ft, dp, fp->energy_I) : 0;
     double ds = fabs(slide) > sp ? (fabs(slide) - sp) / softening_span(g->fs, sp, fp->energy_II) : 0;
@@ -313,7 +289,7 @@ static inline void joint_point_measure(const material *mat, double k, double kc,
 }
 
 /* The law derives from a stored energy psi = z(D) phi(delta, s) (plus
- * 1/2 kc delta^2 in compression, which damage leaves alone): phi is the
+ * 1/2 k delta^2 in compression, which damage leaves alone): phi is the
  * undamaged joint's energy, 1/2 k x^2 up to the elastic limit and linear at
  * the strength beyond it, for the opening and the sliding alike. The
  * tractions are d psi / d delta and d psi / d s: f_t min(delta/delta_p, 1) z
@@ -331,12 +307,12 @@ static inline double joint_phi(const material *mat, double k, const joint_point 
 }
 
 /* Tractions at a Gauss point for damage with softening factor z. */
-static inline void joint_point_traction(const material *mat, double k, double kc,
-                                        const joint_point *g, double z, double *sigma, double *tau)
+static inline void joint_point_traction(const material *mat, double k, const joint_point *g,
+                                        double z, double *sigma, double *tau)
 {
     double ft = mat->def.fracture.tensile_strength;
     double dp = ft / k, sp = g->fs / k;
-    if (g->delta < 0) *sigma = kc * g->delta; /* compression: as contact would push */
+    if (g->delta < 0) *sigma = k * g->delta; /* compression: the joint's penalty */
     else *sigma = ft * fmin(g->delta / dp, 1.0) * z;
     double r = g->slide / sp;
     *tau = g->fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
@@ -349,31 +325,13 @@ static const double gauss[2] = {0.21132486540518713, 0.78867513459481287};
  * projections: on = L delta and sl = L slide (d against the face normal and
  * tangent scaled by the face length L), so it needs neither the unit
  * vectors nor a division. */
-static inline int joint_gauss_elastic(const material *mat, double k, double kc, double L,
-                                      double on, double sl)
+static inline int joint_gauss_elastic(const material *mat, double k, double L, double on,
+                                      double sl)
 {
     const fdem_fracture_params *fp = &mat->def.fracture;
-    double shear_limit = fp->cohesion * L + (on < 0 ? -kc * on * mat->tan_phi : 0);
-    return k * on <= fp->tensile_strength * L && fabs(k * sl) <= shear_limit;
-}
-
-/* An elastic joint pressed shut at a Gauss point (L delta = on < 0) pushes
- * back with kc, not k: adds the difference, (kc - k) delta n with n =
- * (ty, -tx) / L at weight L/2, to the face forces and returns its stored
- * energy, 1/2 (kc - k) delta^2 L/2, per compressed point. */
-static double joint_compression_extra(double k, double kc, double L, double tx, double ty,
-                                      double on0, double on1, double fa0[2], double fa1[2])
-{
-    double s = (kc - k) / (2 * L), stored = 0;
-    const double on[2] = {on0, on1};
-    for (int i = 0; i < 2; i++) {
-        if (!(on[i] < 0)) continue;
-        double Tx = s * on[i] * ty, Ty = -s * on[i] * tx;
-        fa0[0] += (1 - gauss[i]) * Tx; fa0[1] += (1 - gauss[i]) * Ty;
-        fa1[0] += gauss[i] * Tx;       fa1[1] += gauss[i] * Ty;
-        stored += 0.5 * s * on[i] * on[i];
-    }
-    return stored;
+    double ksig = k * on;
+    double shear_limit = fp->cohesion * L + (on < 0 ? -ksig * mat->tan_phi : 0);
+    return ksig <= fp->tensile_strength * L && fabs(k * sl) <= shear_limit;
 }
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
@@ -383,7 +341,7 @@ static double joint_compression_extra(double k, double kc, double L, double tx, 
  * *dissipated; a joint that breaks while pressed shut adds the energy of
  * its compression, which the contact of its faces takes over, to *handed. d0 and d1 are the displacements of b0 against a0 and b1
  * against a1; (tx, ty) the unit face tangent and L the face length. */
-static void joint_forces_general(const material *mat, double k, double kc, const double d0[2],
+static void joint_forces_general(const material *mat, double k, const double d0[2],
                                  const double d1[2], double tx, double ty, double L,
                                  double *damage, double fa0[2], double fa1[2], double *stored,
                                  double *dissipated, double *handed)
@@ -394,7 +352,7 @@ static void joint_forces_general(const material *mat, double k, double kc, const
     for (int i = 0; i < 2; i++) {
         double xi = gauss[i];
         double dx = (1 - xi) * d0[0] + xi * d1[0], dy = (1 - xi) * d0[1] + xi * d1[1];
-        joint_point_measure(mat, k, kc, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
+        joint_point_measure(mat, k, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
         if (g[i].D > D) D = g[i].D;
     }
     if (D > 1) D = 1;
@@ -406,10 +364,10 @@ static void joint_forces_general(const material *mat, double k, double kc, const
         double xi = gauss[i], sigma, tau;
         double phi = w * joint_phi(mat, k, &g[i]);
         *dissipated += (z_old - z) * phi;
-        *stored += z * phi + (g[i].delta < 0 ? 0.5 * w * kc * g[i].delta * g[i].delta : 0);
-        if (D >= 1 && g[i].delta < 0) /* broken shut: its overlap goes on as contact */
-            *handed += 0.5 * w * kc * g[i].delta * g[i].delta;
-        joint_point_traction(mat, k, kc, &g[i], z, &sigma, &tau);
+        double squeezed = g[i].delta < 0 ? 0.5 * w * k * g[i].delta * g[i].delta : 0;
+        *stored += z * phi + squeezed;
+        if (D >= 1) *handed += squeezed; /* broken shut: its overlap goes on as contact */
+        joint_point_traction(mat, k, &g[i], z, &sigma, &tau);
         double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
         fa0[0] += (1 - xi) * Tx; fa0[1] += (1 - xi) * Ty;
         fa1[0] += xi * Tx;       fa1[1] += xi * Ty;
@@ -440,7 +398,7 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 4 * j;
         const material *mat = &mats[m->joint_material[j]];
-        double k = m->joint_k[j], kc = m->joint_kc[j];
+        double k = m->joint_k[j];
         const double *a0 = x + 2 * (size_t)n[0], *a1 = x + 2 * (size_t)n[1];
         const double *b0 = x + 2 * (size_t)n[2], *b1 = x + 2 * (size_t)n[3];
         double d0[2] = {b0[0] - a0[0], b0[1] - a0[1]}, d1[2] = {b1[0] - a1[0], b1[1] - a1[1]};
@@ -452,17 +410,14 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
         double L = sqrt(L2);
         double fa0[2], fa1[2];
         int elastic = 0;
-        double on0 = 0, on1 = 0;
         if (damage == 0) {
             double g0x = (1 - gauss[0]) * d0[0] + gauss[0] * d1[0];
             double g0y = (1 - gauss[0]) * d0[1] + gauss[0] * d1[1];
             double g1x = (1 - gauss[1]) * d0[0] + gauss[1] * d1[0];
             double g1y = (1 - gauss[1]) * d0[1] + gauss[1] * d1[1];
             /* (tx, ty) has length L, normal (ty, -tx): projections are L x */
-            on0 = g0x * ty - g0y * tx;
-            on1 = g1x * ty - g1y * tx;
-            elastic = joint_gauss_elastic(mat, k, kc, L, on0, g0x * tx + g0y * ty) &&
-                      joint_gauss_elastic(mat, k, kc, L, on1, g1x * tx + g1y * ty);
+            elastic = joint_gauss_elastic(mat, k, L, g0x * ty - g0y * tx, g0x * tx + g0y * ty) &&
+                      joint_gauss_elastic(mat, k, L, g1x * ty - g1y * tx, g1x * tx + g1y * ty);
         }
         if (elastic) {
             double s = L * k * (1.0 / 6);
@@ -472,11 +427,9 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             fa1[1] = s * (d0[1] + 2 * d1[1]);
             /* 1/2 integral of k |d|^2 along the face, exact for linear d */
             stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
-            if (on0 < 0 || on1 < 0)
-                stored += joint_compression_extra(k, kc, L, tx, ty, on0, on1, fa0, fa1);
         } else {
             double inv_L = 1.0 / L, joint_stored = 0;
-            joint_forces_general(mat, k, kc, d0, d1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1,
+            joint_forces_general(mat, k, d0, d1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1,
                                  &joint_stored, &dissipated, &handed);
             if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
                 m->joint_damage[j] = 1.0;

@@ -56,7 +56,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->materials); free(m->parts); free(m->part_velocity);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
-    free(m->joint_k); free(m->joint_kc); free(m->joint_material);
+    free(m->joint_k); free(m->joint_material);
     free(m->elem_joint); free(m->vertex_broken); free(m->damping_force);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);

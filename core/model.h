@@ -134,7 +134,6 @@ struct fdem_model {
     int32_t *joint_elem;     /* 2 per joint: elements A and B */
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
     double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
-    double *joint_kc;        /* traction per unit closing: that of contact (joint.c) */
     int32_t *joint_material; /* element A's material */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */

@@ -78,7 +78,9 @@ typedef struct load_history {
     double drop_time;         /* when it first fell below 30% of that peak, or -1 */
     double last;              /* the last complete window's mean */
     double sum, span;         /* the window being filled */
-    double residual, scale;   /* worst |energy residual| / the external work so far */
+    double residual_to_peak;  /* worst |energy residual| while the load rises to its peak */
+    double residual_after;    /* worst |energy residual| after the peak */
+    double peak_work;         /* the supports' work at the peak */
 } load_history;
 
 /* Steps until the case's end, or 0.1 ms after the load has fallen below 30%
@@ -97,9 +99,12 @@ static int run_loaded(fdem_model *m, double end, load_history *h)
             return -1;
         }
         fdem_energy en = fdem_get_energy(m);
-        if (fabs(en.external_work) > h->scale) h->scale = fabs(en.external_work);
-        if (h->scale > 0 && fabs(en.residual) / h->scale > h->residual)
-            h->residual = fabs(en.residual) / h->scale;
+        if (h->peak_time == 0 || fdem_get_time(m) <= h->peak_time + WINDOW) {
+            h->residual_to_peak = fmax(h->residual_to_peak, fabs(en.residual));
+            h->peak_work = en.external_work;
+        } else {
+            h->residual_after = fmax(h->residual_after, fabs(en.residual));
+        }
         const double *f = fdem_constraint_forces(m);
         double P = 0.5 * (fabs(f[1]) + fabs(f[3]));
         double dt = fdem_get_dt(m);
@@ -118,6 +123,24 @@ static int run_loaded(fdem_model *m, double end, load_history *h)
     }
     CHECK(h->drop_time >= 0, "the load never fell below 30%% of its peak %g N/m", h->peak);
     return 0;
+}
+
+/* The energy balance of a loaded specimen: up to the peak load, where the
+ * supports' work goes into elastic, joint and contact energy and the first
+ * cracks, the residual must stay under 1 % of that work. After the peak the
+ * freed pieces ring and rub; what the residual does then is printed (see
+ * docs/physics.md, "Energy accounting", for why it grows there). */
+static void energy_report(const char *name, const fdem_model *m, const load_history *h)
+{
+    fdem_energy en = fdem_get_energy(m);
+    printf("  %s: work in %.4g J/m (%.4g at the peak): elastic %.4g, joint %.4g, fracture %.4g, "
+           "contact %.4g, friction %.4g, damping %.4g, kinetic %.4g; worst residual %.3g %% of the "
+           "work up to the peak, %.3g %% of all the work after it\n",
+           name, en.external_work, h->peak_work, en.elastic, en.joint, en.fracture, en.contact,
+           en.friction, en.damping, en.kinetic, 100 * h->residual_to_peak / h->peak_work,
+           100 * h->residual_after / en.external_work);
+    CHECK(h->residual_to_peak < 0.01 * h->peak_work, "energy residual %.3g %% of the work done",
+          100 * h->residual_to_peak / h->peak_work);
 }
 
 /* A joint's midpoint and direction in the initial configuration. */
@@ -148,12 +171,7 @@ static void brazilian_disc_splits_at_its_tensile_strength(void)
            h.peak, 1e3 * h.peak_time, sigma / 1e6, 100 * (sigma / ft - 1), 1e3 * h.drop_time,
            m->broken_joints, m->joint_count, m->fragments);
     CHECK_REL(sigma, ft, 0.15);
-    fdem_energy en = fdem_get_energy(m);
-    printf("  brazilian: energy in %.4g J/m: elastic %.4g, joint %.4g, fracture %.4g, contact %.4g, "
-           "friction %.4g, kinetic %.4g; worst residual %.3g %% of the work done\n",
-           en.external_work, en.elastic, en.joint, en.fracture, en.contact, en.friction, en.kinetic,
-           100 * h.residual);
-    CHECK(h.residual < 0.01, "energy residual %.3g %% of the work done", 100 * h.residual);
+    energy_report("brazilian", m, &h);
 
     /* the crack: damaged joints within 0.2 R of the loaded (vertical)
      * diameter, counted per tenth of the height */
@@ -220,11 +238,7 @@ static void uniaxial_compression_fails_in_shear(void)
     CHECK(broken >= 10, "only %d joints broke", broken);
     CHECK(inclined >= 0.6 * broken, "only %d of %d broken joints are inclined", inclined, broken);
     CHECK(slid > opened, "faces opened (%g) more than they slid (%g)", opened, slid);
-    /* shear under compression: the joints' friction term (cohesion plus
-     * compression tan phi) is not in the stored-energy law, so what it
-     * dissipates shows in the residual; reported, held to 5 % */
-    printf("  uniaxial: worst energy residual %.3g %% of the work done\n", 100 * h.residual);
-    CHECK(h.residual < 0.05, "energy residual %.3g %% of the work done", 100 * h.residual);
+    energy_report("uniaxial", m, &h);
     fdem_model_destroy(m);
 }
 
