@@ -8,6 +8,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include <stdlib.h>
+
 #include "build_model.h"
 #include "check.h"
 #include "model.h"
@@ -178,6 +180,36 @@ static void contact_on_two_threads_gives_the_bits_of_one(void)
     fdem_model_destroy(two);
 }
 
+/* A pause, a restart or a memory-saving unload goes through a checkpoint:
+ * the packed pile restored at step 300 (between two detections, with
+ * thousands of candidate pairs and stick springs) reaches step 600 in the
+ * bits of the run that never stopped, on two threads. */
+static void restored_pile_gives_the_bits_of_one_run(void)
+{
+    fdem_model *run = packed_discs(2), *restored = packed_discs(2);
+    fdem_error err;
+    for (int s = 0; s < 300; s++)
+        if (fdem_step(run, &err)) build_die("step", &err);
+    size_t size = fdem_checkpoint_size(run);
+    void *buf = malloc(size);
+    CHECK(buf && fdem_checkpoint_write(run, buf, size) == 0, "checkpoint");
+    CHECK(run->contact.max_disp2 > 0, "checkpoint right at a detection: nothing to test");
+    if (buf && fdem_checkpoint_read(restored, buf, size, &err)) build_die("restore", &err);
+    for (int s = 0; s < 300; s++)
+        if (fdem_step(run, &err) || fdem_step(restored, &err)) build_die("step", &err);
+    size_t bytes = sizeof(double) * 2 * (size_t)run->node_count;
+    CHECK(memcmp(run->pos, restored->pos, bytes) == 0, "positions differ");
+    CHECK(memcmp(run->vel, restored->vel, bytes) == 0, "velocities differ");
+    fdem_energy e1 = fdem_get_energy(run), e2 = fdem_get_energy(restored);
+    CHECK(memcmp(&e1, &e2, sizeof e1) == 0, "energies differ");
+    CHECK(run->contact.detections == restored->contact.detections, "detections %ld vs %ld",
+          run->contact.detections, restored->contact.detections);
+    free(buf);
+    fdem_model_destroy(run);
+    fdem_model_destroy(restored);
+}
+
 CHECK_MAIN(T(spatial_mesh_needs_few_colours), T(scattered_items_fall_back_or_stay_valid),
            T(two_threads_give_the_bits_of_one), T(two_threads_give_the_bits_of_one_with_fracture),
-           T(contact_on_two_threads_gives_the_bits_of_one))
+           T(contact_on_two_threads_gives_the_bits_of_one),
+           T(restored_pile_gives_the_bits_of_one_run))
