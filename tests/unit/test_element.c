@@ -180,7 +180,57 @@ static void element_forces_sum_to_zero_exactly(void)
     fdem_model_destroy(m);
 }
 
-CHECK_MAIN(T(rigid_rotation_gives_zero_stress), T(small_strain_is_linear_plane_strain),
+/* The stable step is 2 / omega_max of the element with its lumped masses:
+ * here omega_max comes from the element's own forces (a stiffness matrix by
+ * central differences of element_forces at small strain, then power
+ * iteration on M^-1 K), for one scalene triangle at three Poisson ratios. */
+static void stable_step_is_that_of_the_fastest_element_mode(void)
+{
+    const double nus[3] = {0.0, 0.3, 0.45};
+    for (int t = 0; t < 3; t++) {
+        fdem_model *m = fdem_model_create();
+        int mat = build_material(m, 2000, 1e9, nus[t], 0, 0);
+        fdem_mesh mesh = {3, 1, (double[]){0, 0, 0.1, 0, 0.03, 0.05}, (int32_t[]){0, 1, 2}};
+        fdem_error err;
+        if (fdem_add_part(m, &mesh, mat, 0, &err) < 0) build_die("part", &err);
+        build_finalize(m, 1.0);
+        double K[6][6], h = 1e-9;
+        for (int j = 0; j < 6; j++) {
+            double f[2][6];
+            for (int sgn = 0; sgn < 2; sgn++) {
+                memcpy(m->pos, m->pos0, sizeof(double) * 6);
+                m->pos[j] += sgn ? -h : h;
+                memset(m->force, 0, sizeof(double) * 6);
+                element_forces(m);
+                memcpy(f[sgn], m->force, sizeof(double) * 6);
+            }
+            for (int i = 0; i < 6; i++) K[i][j] = -(f[0][i] - f[1][i]) / (2 * h);
+        }
+        double v[6] = {1, -0.3, 0.2, 0.7, -0.5, 0.1}, lambda = 0;
+        for (int it = 0; it < 2000; it++) {
+            double w[6], norm = 0;
+            for (int i = 0; i < 6; i++) {
+                w[i] = 0;
+                for (int j = 0; j < 6; j++) w[i] += K[i][j] * v[j];
+                w[i] /= m->mass[i / 2];
+                norm += w[i] * w[i];
+            }
+            norm = sqrt(norm);
+            double vn = 0;
+            for (int i = 0; i < 6; i++) vn += v[i] * v[i];
+            lambda = norm / sqrt(vn);
+            for (int i = 0; i < 6; i++) v[i] = w[i] / norm;
+        }
+        double want = 2 / sqrt(lambda);
+        CHECK_REL(fdem_stable_dt(m), want, 1e-4);
+        fprintf(stderr, "  nu %.2f: stable step %.6g s, 2/omega_max %.6g s, h_min/c %.6g s\n",
+                nus[t], fdem_stable_dt(m), want,
+                m->elem_h[0] / sqrt((m->materials[0].lambda + 2 * m->materials[0].mu) / 2000));
+        fdem_model_destroy(m);
+    }
+}
+
+CHECK_MAIN(T(stable_step_is_that_of_the_fastest_element_mode), T(rigid_rotation_gives_zero_stress), T(small_strain_is_linear_plane_strain),
            T(forces_balance_and_energy_matches), T(stretched_block_pulls_nodes_inward),
            T(inverted_element_stays_finite), T(log_series_matches_log),
            T(element_forces_sum_to_zero_exactly))
