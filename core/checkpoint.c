@@ -40,21 +40,26 @@ typedef struct checkpoint_header {
     int64_t detections;
     int32_t need_detect, has_detection;
     int64_t spring_records;
+    int32_t has_viscous, unused;
     fdem_energy energy;      /* the accounts at the checkpoint, shown until the next step */
 } checkpoint_header;
 
 static int checkpoint_has_detection(const fdem_model *m) { return m->contact.enabled; }
 
-static size_t checkpoint_body_size(const fdem_model *m, int has_detection, size_t spring_bytes)
+/* Positions, velocities, damage, [detection positions], [viscous stresses],
+ * stick springs. */
+static size_t checkpoint_body_size(const fdem_model *m, int has_detection, int has_viscous,
+                                   size_t spring_bytes)
 {
     return sizeof(double) * 4 * (size_t)m->node_count + sizeof(double) * (size_t)m->joint_count +
-           (has_detection ? sizeof(double) * 2 * (size_t)m->node_count : 0) + spring_bytes;
+           (has_detection ? sizeof(double) * 2 * (size_t)m->node_count : 0) +
+           (has_viscous ? sizeof(double) * 3 * (size_t)m->elem_count : 0) + spring_bytes;
 }
 
 size_t fdem_checkpoint_size(const fdem_model *m)
 {
     return sizeof(checkpoint_header) +
-           checkpoint_body_size(m, checkpoint_has_detection(m),
+           checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
                                 contact_history_checkpoint_size(&m->contact));
 }
 
@@ -75,6 +80,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.detections = m->contact.detections;
     h.need_detect = m->contact.need_detect;
     h.has_detection = checkpoint_has_detection(m);
+    h.has_viscous = m->elem_viscous != NULL;
     h.spring_records = (int64_t)(spring_bytes / sizeof(contact_record));
     h.energy = fdem_get_energy(m);
     unsigned char *p = buf;
@@ -90,6 +96,10 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     if (h.has_detection) {
         memcpy(p, m->contact.pos_detect, nb);
         p += nb;
+    }
+    if (h.has_viscous) {
+        memcpy(p, m->elem_viscous, sizeof(double) * 3 * (size_t)m->elem_count);
+        p += sizeof(double) * 3 * (size_t)m->elem_count;
     }
     contact_history_checkpoint_write(&m->contact, p);
     return 0;
@@ -135,7 +145,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     h.v1 = h1;
     size_t header = sizeof h1, expected;
     if (h1.version == 1) {
-        expected = header + checkpoint_body_size(m, 0, 0);
+        expected = header + checkpoint_body_size(m, 0, 0, 0);
     } else {
         header = sizeof h;
         if (size < header) {
@@ -144,11 +154,12 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         }
         memcpy(&h, buf, sizeof h);
         if (h.spring_records < 0 || h.spring_records > (int64_t)(size / sizeof(contact_record)) ||
-            h.has_detection != checkpoint_has_detection(m)) {
+            h.has_detection != checkpoint_has_detection(m) ||
+            h.has_viscous != (m->elem_viscous != NULL)) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's contact section does not fit");
             return -1;
         }
-        expected = header + checkpoint_body_size(m, h.has_detection,
+        expected = header + checkpoint_body_size(m, h.has_detection, h.has_viscous,
                                                  (size_t)h.spring_records * sizeof(contact_record));
     }
     if (size != expected) {
@@ -157,7 +168,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         return -1;
     }
     const unsigned char *p = (const unsigned char *)buf + header;
-    const unsigned char *springs = p + checkpoint_body_size(m, h.has_detection, 0);
+    const unsigned char *springs = p + checkpoint_body_size(m, h.has_detection, h.has_viscous, 0);
     if (contact_history_checkpoint_read(&m->contact, springs, (size_t)h.spring_records,
                                         m->elem_count)) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's friction history is damaged");
@@ -188,9 +199,12 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         m->contact.need_detect = 1;
     } else {
         memcpy(m->contact.pos_detect, p, nb);
+        p += nb;
         m->contact.need_detect = h.need_detect;
         m->contact.detections = h.detections;
     }
+    if (h.has_viscous)
+        memcpy(m->elem_viscous, p, sizeof(double) * 3 * (size_t)m->elem_count);
     if (contact_restore_detection(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory restoring contact detection");
         return -1;
@@ -199,6 +213,8 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     if (h1.version == 1) { /* no accounts stored: those of the restored positions */
         element_forces(m);
         memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+        m->damping_work = h1.damping_work; /* that pass was no step */
+        if (m->elem_viscous) memset(m->elem_viscous, 0, sizeof(double) * 3 * (size_t)m->elem_count);
         m->restored_energy_valid = 0;
     } else {
         m->elastic_energy = h.energy.elastic;

@@ -125,7 +125,6 @@ void constraint_apply_forces(fdem_model *m)
 void constraint_enforce(fdem_model *m, double h, double havg)
 {
     const double *fc = m->contact.enabled ? m->contact.force : NULL;
-    const double *fd = m->damping_force;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.kind == FDEM_CONSTRAINT_FORCE) {
@@ -157,7 +156,6 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 double v_mid = 0.5 * (v_old + prescribed) * havg;
                 m->external_work += reaction * v_mid;
                 if (fc) m->contact_work += fc[2 * i + d] * v_mid;
-                if (fd) m->damping_work -= fd[2 * i + d] * v_mid;
             }
             if (fc) {
                 double ux = m->pos[2 * i] - m->contact.pos_detect[2 * i];

@@ -331,9 +331,21 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out
 }
 
 /* A pair whose boxes no longer overlap lets its stick springs go. */
-static inline void pair_springs_release(double springs[CONTACT_SLOTS])
+static inline void pair_springs_release(contact_state *cs, size_t k)
 {
-    for (int k = 0; k < CONTACT_SLOTS; k++) springs[k] = 0;
+    if (!cs->sprung[k]) return;
+    double *springs = cs->slip + CONTACT_SLOTS * k;
+    for (int s = 0; s < CONTACT_SLOTS; s++) springs[s] = 0;
+    cs->sprung[k] = 0;
+}
+
+/* Notes whether pair k's springs hold anything after its evaluation. */
+static inline void pair_springs_mark(contact_state *cs, size_t k)
+{
+    const double *springs = cs->slip + CONTACT_SLOTS * k;
+    int any = 0;
+    for (int s = 0; s < CONTACT_SLOTS; s++) any |= springs[s] != 0;
+    cs->sprung[k] = (uint8_t)any;
 }
 
 /* Force between two elements, both roles, added to the contact force
@@ -478,6 +490,7 @@ void contact_free(contact_state *cs)
     for (int t = 0; t < cs->touch_lists; t++) free(cs->touches[t].item);
     free(cs->touches);
     free(cs->slip);
+    free(cs->sprung);
     free(cs->records);
     nbs_grid_free(&cs->grid);
     nbs_pairs_free(&cs->pairs);
@@ -541,17 +554,19 @@ static int contact_touch_lists(contact_state *cs, int threads)
  * order, one pair at a time. Returns the number of pairs that touched. */
 static int contact_pairs_forces_serial(fdem_model *m, double h)
 {
-    const contact_state *cs = &m->contact;
+    contact_state *cs = &m->contact;
     int touching = 0;
     const double *box = cs->box;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
         double out[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
         if (!boxes_overlap(box + 4 * (size_t)a, box + 4 * (size_t)b)) {
-            pair_springs_release(springs);
+            pair_springs_release(cs, k);
             continue;
         }
-        if (!contact_pair_force(m, a, b, h, springs, out)) continue;
+        int touched = contact_pair_force(m, a, b, h, springs, out);
+        pair_springs_mark(cs, k);
+        if (!touched) continue;
         contact_pair_scatter(m, a, b, out);
         touching++;
     }
@@ -586,10 +601,12 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
         for (long k = begin; k < end; k++) {
             double force[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
             if (!boxes_overlap(box + 4 * (size_t)pa[k], box + 4 * (size_t)pb[k])) {
-                pair_springs_release(springs);
+                pair_springs_release(cs, (size_t)k);
                 continue;
             }
-            if (!contact_pair_force(m, pa[k], pb[k], h, springs, force)) continue;
+            int touched = contact_pair_force(m, pa[k], pb[k], h, springs, force);
+            pair_springs_mark(cs, (size_t)k);
+            if (!touched) continue;
             touching++;
             if (contact_touch_push(list, k, force)) {
 #pragma omp atomic write

@@ -39,6 +39,9 @@ int contact_history_reserve(contact_state *cs, size_t pairs)
     double *s = realloc(cs->slip, sizeof(double) * CONTACT_SLOTS * cap);
     if (!s) return -1;
     cs->slip = s;
+    uint8_t *f = realloc(cs->sprung, cap);
+    if (!f) return -1;
+    cs->sprung = f;
     cs->slip_capacity = cap;
     return 0;
 }
@@ -99,6 +102,7 @@ int contact_history_take_back(contact_state *cs)
 {
     if (contact_history_reserve(cs, cs->pairs.count)) return -1;
     memset(cs->slip, 0, sizeof(double) * CONTACT_SLOTS * cs->pairs.count);
+    memset(cs->sprung, 0, cs->pairs.count);
     size_t n = cs->record_count;
     if (n == 0) return 0;
     size_t size = 16;
@@ -119,6 +123,7 @@ int contact_history_take_back(contact_state *cs)
             const contact_record *r = &cs->records[table[i]];
             if (r->lo != lo || r->hi != hi) continue;
             pair_slots_oriented(r->slip, a, b, cs->slip + CONTACT_SLOTS * k);
+            cs->sprung[k] = 1;
             break;
         }
     }

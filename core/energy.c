@@ -13,7 +13,8 @@
  *    scheme conserves exactly for a linear solid (1/2 v_old M v_new +
  *    1/2 x K x), so a linear elastic model closes to round-off;
  *  - each work sum drops its last half step, 1/2 f . v_new havg, which
- *    turns the sum into the trapezoidal rule along the positions up to x_n;
+ *    turns the sum into the trapezoidal rule along the positions up to x_n
+ *    (damping is booked that way in element.c, element by element);
  *  - gravity's work is exact: M g . (centre of mass at x_n - at x_0).
  * Friction and fracture are booked where they dissipate (contact.c,
  * joint.c), exactly and never negative. What remains in `residual` is the
@@ -36,7 +37,8 @@ void energy_initial(fdem_model *m)
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
     element_forces(m);
     memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    if (m->damping_force) memset(m->damping_force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    if (m->elem_viscous) memset(m->elem_viscous, 0, sizeof(double) * 3 * (size_t)m->elem_count);
+    m->damping_work = 0;
     m->initial_energy = kinetic + m->elastic_energy;
 }
 
@@ -66,8 +68,7 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     fdem_energy en = {0};
     const double havg = m->havg_last, h = m->dt_prev;
     const double *fc = m->contact.enabled && !m->contact.force_is_zero ? m->contact.force : NULL;
-    const double *fd = m->damping_force;
-    double contact_power = 0, damping_power = 0, gravity_work = 0;
+    double contact_power = 0, gravity_work = 0;
     for (int i = 0; i < m->node_count; i++) {
         for (int d = 0; d < 2; d++) {
             size_t k = 2 * (size_t)i + (size_t)d;
@@ -79,7 +80,6 @@ fdem_energy fdem_get_energy(const fdem_model *m)
             en.kinetic += 0.5 * m->mass[i] * v * v_old;
             gravity_work += m->mass[i] * m->gravity[d] * (m->pos[k] - v * h - m->pos0[k]);
             if (fc) contact_power += fc[k] * v;
-            if (fd) damping_power += fd[k] * v;
         }
     }
     en.elastic = m->elastic_energy;
@@ -87,7 +87,7 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     en.friction = m->friction_energy;
     en.fracture = m->fracture_energy;
     en.contact = -(m->contact_work - 0.5 * havg * contact_power) - m->friction_energy;
-    en.damping = m->damping_work + 0.5 * havg * damping_power;
+    en.damping = m->damping_work;
     en.gravity_work = gravity_work;
     en.external_work = m->external_work - constraints_last_half_step(m);
     en.residual = en.kinetic + en.elastic + en.joint + en.contact + en.friction + en.fracture +

@@ -21,25 +21,23 @@
  * constraint owns. sums[0] gets a sum of the new positions and velocities:
  * non-finite if and only if some value is (cheaper than a test per value in
  * the hot loop); it is accumulated as one add per node, so that its
- * dependency chain does not pace the loop. sums[1] and sums[2] get the work
- * of the contact and of the damping forces (times 2 / havg), and
- * sums[SCATTER_MAX] the largest squared displacement since the last
- * detection. with_contact (contact is on: track displacements), with_force
- * (some contact force may be non-zero) and with_damping (some element is
- * damped) are constants at each call below, so the compiler emits each loop
- * without the loads and branches it does not need. */
+ * dependency chain does not pace the loop. sums[1] gets the work of the
+ * contact forces (times 2 / havg) and sums[SCATTER_MAX] the largest squared
+ * displacement since the last detection. with_contact (contact is on: track
+ * displacements) and with_force (some contact force may be non-zero) are
+ * constants at each call below, so the compiler emits each loop without the
+ * loads and branches it does not need. */
 static inline void central_difference_pass(fdem_model *m, int begin, int end, int with_contact,
-                                           int with_force, int with_damping,
-                                           double sums[SCATTER_SUMS])
+                                           int with_force, double sums[SCATTER_SUMS])
 {
     const double h = m->dt, havg = 0.5 * (m->dt_prev + m->dt);
     const double gx = m->gravity[0], gy = m->gravity[1];
     double *x = m->pos, *v = m->vel;
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
-    const double *fc = m->contact.force, *fd = m->damping_force;
+    const double *fc = m->contact.force;
     const double *xd = m->contact.pos_detect;
-    double check = 0, max_disp2 = 0, contact_work = 0, damping_work = 0;
+    double check = 0, max_disp2 = 0, contact_work = 0;
     for (int i = begin; i < end; i++) {
         double fx = f[2 * i], fy = f[2 * i + 1];
         double vx_old = v[2 * i], vy_old = v[2 * i + 1];
@@ -68,9 +66,6 @@ static inline void central_difference_pass(fdem_model *m, int begin, int end, in
         if (with_force)
             contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + vx)) +
                             ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + vy));
-        if (with_damping)
-            damping_work += ((own & 1u) ? 0 : fd[2 * i] * (vx_old + vx)) +
-                            ((own & 2u) ? 0 : fd[2 * i + 1] * (vy_old + vy));
         if (with_contact) {
             double ux = px - xd[2 * i], uy = py - xd[2 * i + 1];
             double d2 = ux * ux + uy * uy;
@@ -79,40 +74,39 @@ static inline void central_difference_pass(fdem_model *m, int begin, int end, in
     }
     sums[0] += check;
     sums[1] += contact_work;
-    sums[2] += damping_work;
     if (max_disp2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = max_disp2;
 }
 
-#define CENTRAL_DIFFERENCE_VARIANT(name, contact, force, damping)                         \
-    static void name(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])          \
-    {                                                                                      \
-        central_difference_pass(m, begin, end, contact, force, damping, sums);             \
-    }
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes, 0, 0, 0)
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes_tracked, 1, 0, 0)
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes_contact, 1, 1, 0)
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes_damped, 0, 0, 1)
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes_tracked_damped, 1, 0, 1)
-CENTRAL_DIFFERENCE_VARIANT(central_difference_nodes_contact_damped, 1, 1, 1)
+static void central_difference_nodes(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    central_difference_pass(m, begin, end, 0, 0, sums);
+}
+
+static void central_difference_nodes_tracked(fdem_model *m, int begin, int end,
+                                             double sums[SCATTER_SUMS])
+{
+    central_difference_pass(m, begin, end, 1, 0, sums);
+}
+
+static void central_difference_nodes_contact(fdem_model *m, int begin, int end,
+                                             double sums[SCATTER_SUMS])
+{
+    central_difference_pass(m, begin, end, 1, 1, sums);
+}
 
 /* Advances every free dof by m->dt (h_next) after a step of m->dt_prev
  * (h_current). Returns -1 if some new value is not finite. */
 int central_difference_step(fdem_model *m)
 {
-    static const scatter_block_fn variants[2][3] = {
-        {central_difference_nodes, central_difference_nodes_tracked,
-         central_difference_nodes_contact},
-        {central_difference_nodes_damped, central_difference_nodes_tracked_damped,
-         central_difference_nodes_contact_damped},
-    };
     double havg = 0.5 * (m->dt_prev + m->dt);
-    double sums[SCATTER_SUMS] = {0, 0, 0, m->contact.max_disp2};
-    int contact = !m->contact.enabled ? 0 : m->contact.force_is_zero ? 1 : 2;
-    scatter_plan_run(&m->node_plan, m, m->threads, variants[m->damping_force != NULL][contact],
-                     sums);
+    double sums[SCATTER_SUMS] = {0};
+    sums[SCATTER_MAX] = m->contact.max_disp2;
+    scatter_block_fn pass = !m->contact.enabled      ? central_difference_nodes
+                            : m->contact.force_is_zero ? central_difference_nodes_tracked
+                                                       : central_difference_nodes_contact;
+    scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
     m->contact.max_disp2 = sums[SCATTER_MAX];
     m->contact_work += sums[1] * 0.5 * havg;
-    m->damping_work -= sums[2] * 0.5 * havg;
     return isfinite(sums[0]) ? 0 : -1;
 }
 

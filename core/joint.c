@@ -428,9 +428,12 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             /* 1/2 integral of k |d|^2 along the face, exact for linear d */
             stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
         } else {
-            double inv_L = 1.0 / L, joint_stored = 0;
+            /* locals, so that the loop's sums stay in registers */
+            double inv_L = 1.0 / L, joint_stored = 0, joint_dissipated = 0, joint_handed = 0;
             joint_forces_general(mat, k, d0, d1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1,
-                                 &joint_stored, &dissipated, &handed);
+                                 &joint_stored, &joint_dissipated, &joint_handed);
+            dissipated += joint_dissipated;
+            handed += joint_handed;
             if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
                 m->joint_damage[j] = 1.0;
                 broke++;

@@ -57,7 +57,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
     free(m->joint_k); free(m->joint_material);
-    free(m->elem_joint); free(m->vertex_broken); free(m->damping_force);
+    free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     scatter_plan_free(&m->joint_plan);
@@ -359,7 +359,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         element_prepare(m, e);
         damped |= m->elem[e].eta > 0;
     }
-    if (damped && !(m->damping_force = calloc(2 * (size_t)m->node_count, sizeof(double)))) {
+    if (damped && !(m->elem_viscous = calloc(3 * (size_t)m->elem_count, sizeof(double)))) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
         return -1;
     }

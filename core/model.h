@@ -86,6 +86,8 @@ typedef struct contact_state {
     int active_count;
     uint8_t *in_pair;        /* scratch per element for building active */
     double *slip;            /* CONTACT_SLOTS per candidate pair: the stick springs' force */
+    uint8_t *sprung;         /* per candidate pair: some spring may be non-zero (so a pair
+                                out of reach reads one byte, not its springs) */
     size_t slip_capacity;
     contact_record *records; /* history set aside across a detection or a restore */
     size_t record_count, record_capacity;
@@ -162,8 +164,9 @@ struct fdem_model {
     double external_work;
     double initial_energy;   /* kinetic + elastic at t = 0 */
     double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
-    double *damping_force;   /* viscous nodal forces of the last step (also in force);
-                                NULL when no element is damped */
+    double *elem_viscous;    /* 3 per element: the viscous half stress of the last step, whose
+                                work with the new velocities the next step books
+                                (element.c); NULL when no element is damped */
     fdem_energy restored_energy; /* the accounts a checkpoint held, reported until the next
                                     step (the last step's forces they need are not stored) */
     int restored_energy_valid;
