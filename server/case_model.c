@@ -46,6 +46,20 @@ int case_model_gate(void *ctx, double estimate)
     return cost <= spare ? 0 : membudget_grow(g->lease, cost - spare);
 }
 
+/* Allocation failures anywhere in the builder and the engine say this. */
+static int case_model_out_of_memory(const char *message)
+{
+    return strstr(message, "out of memory") != NULL;
+}
+
+static int case_model_problems_out_of_memory(const problems *p)
+{
+    for (int i = 0; i < p->count; i++)
+        if (case_model_out_of_memory(p->items[i].message))
+            return 1;
+    return 0;
+}
+
 /* The file and the meshes read from it stay while the model is built. */
 static size_t case_model_document_cost(size_t bytes)
 {
@@ -68,13 +82,15 @@ static case_model_rc case_model_parse(server_case *c, membudget_lease *lease, fd
     problems p;
     problems_init(&p);
     case_model_gate_ctx gate = {lease, case_model_document_cost(size)};
+    /* No --max-case-memory here: the case was admitted when it was stored,
+     * and a lower limit since must not turn it into a broken case. */
     membudget_meter_begin(lease, 0);
-    *model = case_build_gated(doc, size, registry_config()->max_case_memory, case_model_gate,
-                              &gate, info, &p);
+    *model = case_build_gated(doc, size, (size_t)-1, case_model_gate, &gate, info, &p);
     membudget_meter_end();
     free(doc);
     case_model_rc rc = CASE_MODEL_OK;
-    if (!*model && (membudget_meter_refused() || p.status == 503)) {
+    if (!*model && (membudget_meter_refused() || p.status == 503 ||
+                    case_model_problems_out_of_memory(&p))) {
         rc = CASE_MODEL_NO_MEMORY;
     } else if (!*model) {
         snprintf(err, errlen, "the stored case could not be rebuilt: %s",
@@ -103,6 +119,8 @@ static case_model_rc case_model_restore(server_case *c, fdem_model *model, char 
     memset(&e, 0, sizeof e);
     int failed = fdem_checkpoint_read(model, ckpt, size, &e) != 0;
     free(ckpt);
+    if (failed && case_model_out_of_memory(e.message))
+        return CASE_MODEL_NO_MEMORY;
     if (failed) {
         snprintf(err, errlen, "checkpoint.bin could not be restored: %s", e.message);
         return CASE_MODEL_BROKEN;

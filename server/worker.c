@@ -237,8 +237,6 @@ static int worker_take_model(server_case *c, case_state *fallback)
         rc = case_model_build(c, &c->reserve, &model, &info, err, sizeof err);
     if (rc == CASE_MODEL_OK && case_model_attach(c, model, &info, 0, err, sizeof err) == 0)
         return 0;
-    if (rc == CASE_MODEL_OK && !c->model)
-        fdem_model_destroy(model);
     *fallback = rc == CASE_MODEL_NO_MEMORY ? c->queued_from : CASE_FAILED;
     if (rc == CASE_MODEL_NO_MEMORY) {
         fprintf(stderr, "fdemd: case %s: no memory for its model now (--max-memory); it goes "
