@@ -675,16 +675,15 @@ static int case_make_dir(server_case *c)
     return -1;
 }
 
-server_case *registry_create(const char *body, size_t size, int start,
-                             problems *p, int *http_status, char *err, size_t errlen)
+/* registry_create() with the lease that pays for the upload. */
+static server_case *registry_store_upload(const char *body, size_t size, int start,
+                                          membudget_lease *lease, problems *p, int *http_status,
+                                          char *err, size_t errlen)
 {
-    membudget_lease own = {0};
-    membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
     case_info info;
     memset(&info, 0, sizeof info);
     fdem_model *model = case_model_build_upload(body, size, lease, &info, p);
     if (!model) {
-        membudget_release(&own);
         *http_status = p->status ? p->status : 422;
         if (p->count == 0)
             problems_add(p, 422, "", "the case could not be built");
@@ -693,7 +692,6 @@ server_case *registry_create(const char *body, size_t size, int start,
     server_case *c = case_new();
     if (!c) {
         fdem_model_destroy(model);
-        membudget_release(&own);
         *http_status = 500;
         snprintf(err, errlen, "out of memory");
         return NULL;
@@ -705,7 +703,6 @@ server_case *registry_create(const char *body, size_t size, int start,
     *http_status = 500;
     if (case_make_dir(c) != 0) {
         snprintf(err, errlen, "cannot create the case directory: %s", strerror(errno));
-        membudget_release(&own);
         case_release(c);
         return NULL;
     }
@@ -746,7 +743,6 @@ server_case *registry_create(const char *body, size_t size, int start,
     if (unused)
         fdem_model_destroy(unused);
     membudget_release(&unreserve);
-    membudget_release(&own);
     if (!appended) {
         snprintf(err, errlen, "out of memory");
         goto fail;
@@ -758,12 +754,25 @@ server_case *registry_create(const char *body, size_t size, int start,
     case_retain(c);
     return c;
 fail:
-    membudget_release(&own);
     io_close(c);
     atomic_store(&c->deleted, 1);
     persist_remove_dir(c->dir);
     case_release(c);
     return NULL;
+}
+
+server_case *registry_create(const char *body, size_t size, int start,
+                             problems *p, int *http_status, char *err, size_t errlen)
+{
+    membudget_lease own = {0};
+    membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
+    server_case *c = registry_store_upload(body, size, start, lease, p, http_status, err, errlen);
+    /* Only the body is left (until the answer is sent); the tree, the meshes
+     * and the model are gone, so the client's next request already finds the
+     * budget as it will be. */
+    membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);
+    membudget_release(&own);
+    return c;
 }
 
 /* ------------------------------------------------------------- loading */

@@ -16,6 +16,7 @@
 
 #include "http.h"
 #include "io_thread.h"
+#include "memory_budget.h"
 #include "state_json.h"
 
 /* ------------------------------------------------------------- matching */
@@ -238,12 +239,24 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
     if (!s)
         return http_reply_problem(conn, 409, "Conflict",
                                   "the stored case could not be rebuilt to read its state", NULL);
+    /* The JSON tree of a state is ~100 bytes per number: it is charged to
+     * the budget, and its pages go back to the OS once it is sent off. */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
     json_t *o = state_to_json(s);
+    membudget_meter_end();
     snapshot_free(s);
-    if (!o)
-        return http_reply_problem(conn, 409, "Conflict",
-                                  "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
-    return http_reply_json(conn, 200, o, NULL);
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of this state would take the daemon past "
+                                    "its memory budget (--max-memory) now", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 409, "Conflict",
+                                "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
 }
 
 static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case *c)
