@@ -13,6 +13,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -801,24 +802,28 @@ static int status_count(const json_t *o, const char *key)
  * runs again (no model is built to find them). */
 static void case_load_figures(server_case *c, const json_t *st)
 {
+    static const struct { const char *key; size_t offset; } counts[] = {
+        {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
+        {"joints", offsetof(fdem_counts, joints)},
+        {"broken_joints", offsetof(fdem_counts, broken_joints)},
+        {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
+    }, energies[] = {
+        {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
+        {"contact", offsetof(fdem_energy, contact)},
+        {"gravity_work", offsetof(fdem_energy, gravity_work)},
+        {"damping", offsetof(fdem_energy, damping)},
+        {"external_work", offsetof(fdem_energy, external_work)},
+    };
     case_figures *f = &c->fig;
+    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
+        *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
     const json_t *e = json_object_get(st, "energy");
+    for (size_t i = 0; i < sizeof energies / sizeof *energies; i++)
+        *(double *)((char *)&f->energy + energies[i].offset) = status_number(e, energies[i].key);
     f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
     f->time = status_number(st, "time");
     f->dt = status_number(st, "dt");
-    f->counts.nodes = status_count(st, "nodes");
-    f->counts.elements = status_count(st, "elements");
-    f->counts.joints = status_count(st, "joints");
-    f->counts.broken_joints = status_count(st, "broken_joints");
-    f->counts.fragments = status_count(st, "fragments");
-    f->counts.contacts = status_count(st, "contacts");
     f->snapshots = status_count(st, "snapshots");
-    f->energy.kinetic = status_number(e, "kinetic");
-    f->energy.elastic = status_number(e, "elastic");
-    f->energy.contact = status_number(e, "contact");
-    f->energy.gravity_work = status_number(e, "gravity_work");
-    f->energy.damping = status_number(e, "damping");
-    f->energy.external_work = status_number(e, "external_work");
     const char *name = json_string_value(json_object_get(st, "name"));
     snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
     c->info.end_time = status_number(st, "end_time");
