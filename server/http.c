@@ -237,9 +237,15 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
     r->limit = (size_t)length;
     if (routes_takes_body(r->route.kind, method) &&
         membudget_grow(&r->lease, membudget_upload_cost(r->limit)) != 0) {
-        char detail[200];
-        snprintf(detail, sizeof detail, "parsing a body of %s bytes would take this daemon past its "
-                 "memory budget (--max-memory) now; try again later", cl);
+        char detail[240], need[32], limit[32];
+        if (membudget_upload_cost(r->limit) > membudget_limit())
+            snprintf(detail, sizeof detail, "parsing a body of %s bytes takes about %s, more than "
+                     "this daemon's whole memory budget (--max-memory, %s)", cl,
+                     membudget_describe(membudget_upload_cost(r->limit), need, sizeof need),
+                     membudget_describe(membudget_limit(), limit, sizeof limit));
+        else
+            snprintf(detail, sizeof detail, "parsing a body of %s bytes would take this daemon past "
+                     "its memory budget (--max-memory) now; try again later", cl);
         *rc = http_reply_unavailable(conn, detail, NULL);
         return 1;
     }

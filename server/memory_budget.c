@@ -18,6 +18,7 @@
 #include <jansson.h>
 #include <malloc.h>
 #include <pthread.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
 
@@ -105,6 +106,19 @@ size_t membudget_upload_cost(size_t body_bytes)
 {
     return body_bytes > (size_t)-1 / MEMBUDGET_UPLOAD_FACTOR ? (size_t)-1
                                                              : body_bytes * MEMBUDGET_UPLOAD_FACTOR;
+}
+
+const char *membudget_describe(size_t bytes, char *buf, size_t size)
+{
+    static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+    double x = (double)bytes;
+    int unit = 0;
+    while (x >= 1024 && unit < 4) {
+        x /= 1024;
+        unit++;
+    }
+    snprintf(buf, size, unit ? "%.3g %s" : "%.0f %s", x, units[unit]);
+    return buf;
 }
 
 /* ------------------------------------------------------------- the meter */

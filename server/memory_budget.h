@@ -46,6 +46,9 @@ void membudget_move(membudget_lease *from, membudget_lease *to, size_t bytes);
  * from it and a typical JSON tree (a larger tree grows it through the meter). */
 size_t membudget_upload_cost(size_t body_bytes);
 
+/* "12 KiB", "25.6 MiB", "1.5 GiB" into buf; returns buf. */
+const char *membudget_describe(size_t bytes, char *buf, size_t size);
+
 /* `allowance`: bytes of the lease already meant for the tree. */
 void membudget_meter_begin(membudget_lease *lease, size_t allowance);
 void membudget_meter_end(void);

@@ -449,10 +449,19 @@ static int case_prepare_start(server_case *c, int will_run, fdem_model **model, 
                               size_t msglen)
 {
     size_t cost = case_model_cost_of(c);
+    char need[32], limit[32], free_now[32];
+    membudget_describe(cost, need, sizeof need);
+    membudget_describe(membudget_limit(), limit, sizeof limit);
+    if (cost > membudget_limit()) {
+        snprintf(msg, msglen, "the model of this case needs about %s, more than the daemon's "
+                 "whole memory budget (--max-memory, %s)", need, limit);
+        return 503;
+    }
     if (membudget_grow(&c->reserve, cost) != 0) {
-        snprintf(msg, msglen, "the model of this case needs about %zu MiB and the daemon's memory "
-                 "budget (--max-memory) has %zu MiB free now; try again when other cases stop",
-                 cost >> 20, (membudget_limit() - membudget_used()) >> 20);
+        snprintf(msg, msglen, "the model of this case needs about %s and the daemon's memory "
+                 "budget (--max-memory, %s) has %s free now; try again when other cases stop",
+                 need, limit,
+                 membudget_describe(membudget_limit() - membudget_used(), free_now, sizeof free_now));
         return 503;
     }
     if (!will_run)

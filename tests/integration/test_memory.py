@@ -217,6 +217,8 @@ class MemoryTest(unittest.TestCase):
                                  "%s after a restart with %s" % (st["name"], args))
             if "--max-memory" in args:
                 status, headers, body = d.request("POST", "/cases/%s/start" % paused)
+                self.assertUnavailable(status, headers, body, ["whole memory budget"])
+                status, headers, body = d.request("GET", "/cases/%s/state" % paused)
                 self.assertUnavailable(status, headers, body)
                 self.assertEqual(d.status(paused)["state"], "paused")
 
