@@ -264,8 +264,33 @@ static json_t *case_parse(const char *text, size_t length, problems *out)
     return NULL;
 }
 
-fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
-                       case_info *info, problems *out)
+/* Material names are keys of the JSON tree; copies let the tree go before
+ * pass 3. Returns the copies (free with case_free_names), NULL when out of
+ * memory. */
+static char **case_copy_names(case_doc *doc)
+{
+    char **names = calloc((size_t)doc->material_count + 1, sizeof *names);
+    for (int i = 0; names && i < doc->material_count; i++) {
+        names[i] = strdup(doc->materials[i].name);
+        if (!names[i]) {
+            for (int k = 0; k < i; k++) free(names[k]);
+            free(names);
+            return NULL;
+        }
+        doc->materials[i].name = names[i];
+    }
+    return names;
+}
+
+static void case_free_names(char **names)
+{
+    for (int i = 0; names && names[i]; i++) free(names[i]);
+    free(names);
+}
+
+fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limit,
+                             case_memory_gate gate, void *gate_ctx,
+                             case_info *info, problems *out)
 {
     case_info scratch;
     if (!info) info = &scratch;
@@ -276,13 +301,30 @@ fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
     doc.out = out;
     int before = out->count + out->dropped;
     case_read(&doc, root);
-    if (out->count + out->dropped == before) case_check_memory(&doc, memory_limit);
+    double bytes = 0;
+    if (out->count + out->dropped == before) bytes = case_check_memory(&doc, memory_limit);
+    /* The tree of an explicit mesh is ten or more times its text; the model
+     * must not come on top of it. */
+    char **names = case_copy_names(&doc);
+    json_decref(root);
+    if (!names) case_problem(&doc, "", "out of memory");
+    if (out->count + out->dropped == before && gate && gate(gate_ctx, bytes) != 0) {
+        snprintf(out->title, sizeof out->title, "Service unavailable");
+        problems_add(out, 503, "", "the daemon has no memory to spare for this model now "
+                                   "(--max-memory); try again later");
+    }
     fdem_model *model = NULL;
     if (out->count + out->dropped == before) model = case_build_model(&doc, info);
     if (model) case_fill_info(&doc, info);
     case_doc_free(&doc);
-    json_decref(root);
+    case_free_names(names);
     return model;
+}
+
+fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
+                       case_info *info, problems *out)
+{
+    return case_build_gated(text, length, memory_limit, NULL, NULL, info, out);
 }
 
 unsigned case_parse_fields(const char *csv, problems *out)

@@ -44,6 +44,19 @@ typedef struct case_info {
 fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
                        case_info *info, problems *out);
 
+/* Asked, once the document is read and before anything is built, whether
+ * `bytes` (the model's estimated size) may be allocated now; nonzero means
+ * no: case_build_gated() then builds nothing and reports one problem with
+ * status 503 (the daemon is short of memory at the moment, the case itself
+ * is fine). */
+typedef int (*case_memory_gate)(void *ctx, double bytes);
+
+/* case_build() with a gate; the JSON tree is freed before the model is built
+ * (never both at once). */
+fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limit,
+                             case_memory_gate gate, void *gate_ctx,
+                             case_info *info, problems *out);
+
 /* Parses "position,velocity,..." (the ?fields= of GET /state) into
  * CASE_FIELD_* bits; unknown names are added to `out` (400). */
 unsigned case_parse_fields(const char *csv, problems *out);

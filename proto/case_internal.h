@@ -117,7 +117,8 @@ void case_read_parts(case_doc *doc, const json_t *parts);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
 
 /* ----------------------------------------------------- pass 2 and pass 3 */
-void case_check_memory(case_doc *doc, size_t memory_limit);
+/* Adds a problem when the model would pass memory_limit; returns the estimate. */
+double case_check_memory(case_doc *doc, size_t memory_limit);
 int case_add_materials(case_doc *doc, fdem_model *model);
 int case_add_parts(case_doc *doc, fdem_model *model);
 int case_add_constraints(case_doc *doc, fdem_model *model);

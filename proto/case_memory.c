@@ -88,7 +88,7 @@ static void memory_describe(double nodes, double elements, double joints, char *
         snprintf(out + n, size - (size_t)n, ", %.3g joints", joints);
 }
 
-void case_check_memory(case_doc *doc, size_t memory_limit)
+double case_check_memory(case_doc *doc, size_t memory_limit)
 {
     double nodes = 0, elements = 0, joints = 0;
     for (int i = 0; i < doc->part_count; i++) {
@@ -109,4 +109,5 @@ void case_check_memory(case_doc *doc, size_t memory_limit)
         case_problem(doc, "/parts", "the model would have %s (%s); the engine's limit is %d "
                                     "of each", counts, need, INT_MAX);
     }
+    return bytes;
 }

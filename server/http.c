@@ -20,6 +20,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include "memory_budget.h"
 #include "routes.h"
 
 #define HTTP_THREADS 4
@@ -34,6 +35,7 @@ typedef struct http_request {
     int too_large;
     char *body;
     size_t size, capacity, limit;
+    membudget_lease lease; /* the body and what parsing it costs */
 } http_request;
 
 static struct MHD_Daemon *http_daemon;
@@ -103,6 +105,18 @@ enum MHD_Result http_reply_problem(struct MHD_Connection *conn, unsigned status,
                                    const char *detail, const problems *p)
 {
     return http_queue(conn, status, http_problem_response(status, title, detail, p));
+}
+
+enum MHD_Result http_reply_unavailable(struct MHD_Connection *conn, const char *detail,
+                                       const problems *p)
+{
+    struct MHD_Response *resp = http_problem_response(503, "Service unavailable", detail, p);
+    if (resp) {
+        char seconds[16];
+        snprintf(seconds, sizeof seconds, "%d", MEMBUDGET_RETRY_AFTER);
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_RETRY_AFTER, seconds);
+    }
+    return http_queue(conn, 503, resp);
 }
 
 enum MHD_Result http_reply_not_allowed(struct MHD_Connection *conn, const char *allow)
@@ -221,6 +235,20 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         return 1;
     }
     r->limit = (size_t)length;
+    if (routes_takes_body(r->route.kind, method) &&
+        membudget_grow(&r->lease, membudget_upload_cost(r->limit)) != 0) {
+        char detail[240], need[32], limit[32];
+        if (membudget_upload_cost(r->limit) > membudget_limit())
+            snprintf(detail, sizeof detail, "parsing a body of %s bytes takes about %s, more than "
+                     "this daemon's whole memory budget (--max-memory, %s)", cl,
+                     membudget_describe(membudget_upload_cost(r->limit), need, sizeof need),
+                     membudget_describe(membudget_limit(), limit, sizeof limit));
+        else
+            snprintf(detail, sizeof detail, "parsing a body of %s bytes would take this daemon past "
+                     "its memory budget (--max-memory) now; try again later", cl);
+        *rc = http_reply_unavailable(conn, detail, NULL);
+        return 1;
+    }
     return 0;
 }
 
@@ -282,7 +310,10 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     if (r->too_large)
         return http_reply_problem(conn, 413, "Payload too large",
                                   "the body is longer than its Content-Length or --max-upload", NULL);
-    return routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+    membudget_request_enter(&r->lease);
+    enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+    membudget_request_leave();
+    return rc;
 }
 
 static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cls,
@@ -294,6 +325,7 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
     http_request *r = *req_cls;
     if (r) {
         free(r->body);
+        membudget_release(&r->lease);
         free(r);
         *req_cls = NULL;
     }

@@ -29,6 +29,9 @@ enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, js
                                 const char *location);
 enum MHD_Result http_reply_problem(struct MHD_Connection *conn, unsigned status, const char *title,
                                    const char *detail, const problems *p);
+/* 503 with Retry-After: MEMBUDGET_RETRY_AFTER (the daemon is short of memory). */
+enum MHD_Result http_reply_unavailable(struct MHD_Connection *conn, const char *detail,
+                                       const problems *p);
 enum MHD_Result http_reply_not_allowed(struct MHD_Connection *conn, const char *allow);
 enum MHD_Result http_reply_empty(struct MHD_Connection *conn, unsigned status);
 /* Serves `size` bytes of an open descriptor (closed by libmicrohttpd). */

@@ -19,6 +19,7 @@
 #include "fdem.h"
 #include "http.h"
 #include "io_thread.h"
+#include "memory_budget.h"
 #include "registry.h"
 
 static void usage(FILE *out)
@@ -26,7 +27,7 @@ static void usage(FILE *out)
     fprintf(out,
             "usage: fdemd [--listen 127.0.0.1:8080] [--data DIR] [--token TOKEN]\n"
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
-            "             [--max-case-memory BYTES]\n"
+            "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -35,6 +36,7 @@ static void usage(FILE *out)
             "  --max-running N         cases stepping at once; later starts are queued (default: cores)\n"
             "  --threads T             OpenMP threads per running case (default 1)\n"
             "  --max-case-memory BYTES largest model a case may build (default 4G)\n"
+            "  --max-memory BYTES      models and uploads held at once (default: half the RAM)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -89,12 +91,13 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
-    enum { OPT_MAX_CASE_MEMORY = 1000 };
+    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
         {"max-running", required_argument, 0, 'r'}, {"threads", required_argument, 0, 'j'},
         {"max-case-memory", required_argument, 0, OPT_MAX_CASE_MEMORY},
+        {"max-memory", required_argument, 0, OPT_MAX_MEMORY},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -105,6 +108,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->max_running = cores > 0 ? (int)cores : 1;
     cfg->threads = 1;
     cfg->max_case_memory = (size_t)4 << 30;
+    cfg->max_memory = membudget_default_limit();
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
@@ -123,6 +127,9 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case 'j': if (parse_int(optarg, 1, &cfg->threads)) bad = "--threads takes a positive integer"; break;
         case OPT_MAX_CASE_MEMORY:
             if (parse_size(optarg, &cfg->max_case_memory) || !cfg->max_case_memory) bad = "--max-case-memory takes a positive size in bytes";
+            break;
+        case OPT_MAX_MEMORY:
+            if (parse_size(optarg, &cfg->max_memory) || !cfg->max_memory) bad = "--max-memory takes a positive size in bytes";
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;
@@ -155,6 +162,7 @@ int main(int argc, char **argv)
     pthread_sigmask(SIG_BLOCK, &stop_signals, NULL);
     signal(SIGPIPE, SIG_IGN);
 
+    membudget_init(cfg.max_memory);
     if (io_start() != 0) {
         fprintf(stderr, "fdemd: cannot start the I/O thread\n");
         return 1;

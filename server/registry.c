@@ -13,6 +13,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -20,6 +21,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "case_model.h"
 #include "io_thread.h"
 #include "persist.h"
 #include "worker.h"
@@ -127,6 +129,7 @@ static void case_free(server_case *c)
 {
     if (c->model)
         fdem_model_destroy(c->model);
+    membudget_release(&c->reserve);
     pthread_mutex_destroy(&c->lock);
     pthread_cond_destroy(&c->cv);
     pthread_mutex_destroy(&c->ctl_lock);
@@ -368,6 +371,7 @@ static server_case *registry_dispatch_one_locked(void)
     if (!ok && next->state == CASE_QUEUED) {
         next->state = CASE_FAILED;
         snprintf(next->error, sizeof next->error, "the daemon could not start a thread for this case");
+        membudget_release(&next->reserve);
     }
     pthread_mutex_unlock(&next->lock);
     case_retain(next);
@@ -410,40 +414,135 @@ static void case_wait_worker_locked(server_case *c)
         pthread_cond_wait(&c->cv, &c->lock);
 }
 
+/* 0 when `c` may start now, else 404 or 409 with a sentence in msg. With
+ * the registry lock and the case lock held. */
+static int case_startable_locked(server_case *c, char *msg, size_t msglen)
+{
+    if (atomic_load(&c->deleted))
+        return 404;
+    if (reg_shutting_down) {
+        snprintf(msg, msglen, "the daemon is shutting down");
+        return 409;
+    }
+    if (c->state != CASE_CREATED && c->state != CASE_PAUSED) {
+        snprintf(msg, msglen, "the case is %s; start is allowed only when it is created or paused",
+                 case_state_name(c->state));
+        return 409;
+    }
+    if (c->worker_active) {
+        snprintf(msg, msglen, "the case is still winding down its last step; try again");
+        return 409;
+    }
+    return 0;
+}
+
+/* A rebuild showed the stored files cannot give a model: that does not pass. */
+static void case_mark_broken(server_case *c, const char *why)
+{
+    pthread_mutex_lock(&c->lock);
+    c->state = CASE_FAILED;
+    snprintf(c->error, sizeof c->error, "%s", why);
+    pthread_mutex_unlock(&c->lock);
+    fprintf(stderr, "fdemd: case %s: %s\n", c->id, why);
+    case_persist_status(c);
+}
+
+/* Reserves the model's memory and, when it will run at once (not queued),
+ * builds it. 0, or 503/409 with msg; on failure nothing is held. */
+static int case_prepare_start(server_case *c, int will_run, fdem_model **model, char *msg,
+                              size_t msglen)
+{
+    size_t cost = case_model_cost_of(c);
+    char need[32], limit[32], free_now[32];
+    membudget_describe(cost, need, sizeof need);
+    membudget_describe(membudget_limit(), limit, sizeof limit);
+    if (cost > membudget_limit()) {
+        snprintf(msg, msglen, "the model of this case needs about %s, more than the daemon's "
+                 "whole memory budget (--max-memory, %s)", need, limit);
+        return 503;
+    }
+    if (membudget_grow(&c->reserve, cost) != 0) {
+        snprintf(msg, msglen, "the model of this case needs about %s and the daemon's memory "
+                 "budget (--max-memory, %s) has %s free now; try again when other cases stop",
+                 need, limit,
+                 membudget_describe(membudget_limit() - membudget_used(), free_now, sizeof free_now));
+        return 503;
+    }
+    if (!will_run)
+        return 0;
+    case_info info;
+    char err[512] = "";
+    case_model_rc rc = case_model_build(c, &c->reserve, model, &info, err, sizeof err);
+    if (rc == CASE_MODEL_OK) {
+        c->info = info;
+        return 0;
+    }
+    membudget_release(&c->reserve);
+    if (rc == CASE_MODEL_NO_MEMORY) {
+        snprintf(msg, msglen, "rebuilding the model of this case would take the daemon past its "
+                 "memory budget (--max-memory) now; try again when other cases stop");
+        return 503;
+    }
+    case_mark_broken(c, err);
+    snprintf(msg, msglen, "the case cannot run: %s", err);
+    return 409;
+}
+
 int registry_start(server_case *c, char *msg, size_t msglen)
 {
-    int status = 0;
     pthread_mutex_lock(&c->ctl_lock);
     pthread_mutex_lock(&reg_lock);
     pthread_mutex_lock(&c->lock);
-    if (atomic_load(&c->deleted)) {
-        status = 404;
-    } else if (reg_shutting_down) {
-        snprintf(msg, msglen, "the daemon is shutting down");
-        status = 409;
-    } else if (c->state != CASE_CREATED && c->state != CASE_PAUSED) {
-        snprintf(msg, msglen, "the case is %s; start is allowed only when it is created or paused",
-                 case_state_name(c->state));
-        status = 409;
-    } else if (!c->model) {
-        snprintf(msg, msglen, "the case is %s but its model could not be rebuilt, so it cannot run",
-                 case_state_name(c->state));
-        status = 409;
-    } else if (c->worker_active) {
-        snprintf(msg, msglen, "the case is still winding down its last step; try again");
-        status = 409;
-    } else {
-        if (case_start_locked(c) != 0) {
-            snprintf(msg, msglen, "the daemon could not start a thread for this case");
-            status = 503;
-        }
-    }
+    int status = case_startable_locked(c, msg, msglen);
+    int will_run = reg_running < reg_cfg->max_running;
     pthread_mutex_unlock(&c->lock);
     pthread_mutex_unlock(&reg_lock);
+
+    fdem_model *model = NULL;
+    if (status == 0)
+        status = case_prepare_start(c, will_run, &model, msg, msglen);
+    int queued = 0;
+    if (status == 0) {
+        /* model_lock first (the worker's order): no GET /state reads c->model
+         * while it is handed over or taken back. */
+        pthread_mutex_lock(&c->model_lock);
+        pthread_mutex_lock(&reg_lock);
+        pthread_mutex_lock(&c->lock);
+        status = case_startable_locked(c, msg, msglen);
+        if (status == 0) {
+            c->queued_from = c->state;
+            c->model = model;
+            if (case_start_locked(c) != 0) {
+                snprintf(msg, msglen, "the daemon could not start a thread for this case");
+                status = 503;
+            }
+        }
+        queued = status == 0 && c->state == CASE_QUEUED;
+        if (status != 0 || queued)
+            c->model = NULL; /* a queued case is built when its turn comes */
+        else
+            model = NULL;    /* the worker's now */
+        pthread_mutex_unlock(&c->lock);
+        pthread_mutex_unlock(&reg_lock);
+        pthread_mutex_unlock(&c->model_lock);
+        if (model)
+            fdem_model_destroy(model);
+        if (status != 0)
+            membudget_release(&c->reserve);
+    }
     if (status == 0)
         case_persist_status(c);
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
+}
+
+/* A queued case gives its reservation back when it leaves the queue
+ * without running. With the case lock held; release it after unlocking. */
+static membudget_lease case_take_reserve_locked(server_case *c)
+{
+    membudget_lease taken = {0};
+    membudget_move(&c->reserve, &taken, c->reserve.bytes);
+    return taken;
 }
 
 /* Asks the worker to leave with `cmd` and waits; returns the state it left in. */
@@ -457,6 +556,7 @@ static case_state case_command_worker_locked(server_case *c, worker_command cmd)
 int registry_pause(server_case *c, char *msg, size_t msglen)
 {
     int status = 0;
+    membudget_lease unreserve = {0};
     pthread_mutex_lock(&c->ctl_lock);
     pthread_mutex_lock(&c->lock);
     if (atomic_load(&c->deleted)) {
@@ -469,12 +569,14 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
         }
     } else if (c->state == CASE_QUEUED) {
         c->state = CASE_PAUSED;
+        unreserve = case_take_reserve_locked(c);
     } else {
         snprintf(msg, msglen, "the case is %s; pause is allowed only when it is running or queued",
                  case_state_name(c->state));
         status = 409;
     }
     pthread_mutex_unlock(&c->lock);
+    membudget_release(&unreserve);
     if (status == 0)
         case_persist_status(c);
     pthread_mutex_unlock(&c->ctl_lock);
@@ -484,6 +586,7 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
 int registry_stop(server_case *c, char *msg, size_t msglen)
 {
     int status = 0, close_result = 0;
+    membudget_lease unreserve = {0};
     pthread_mutex_lock(&c->ctl_lock);
     pthread_mutex_lock(&c->lock);
     if (atomic_load(&c->deleted)) {
@@ -496,6 +599,7 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
         }
     } else if (!case_state_is_terminal(c->state)) {
         c->state = CASE_STOPPED;
+        unreserve = case_take_reserve_locked(c);
         close_result = 1;
     } else {
         snprintf(msg, msglen,
@@ -504,6 +608,7 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
         status = 409;
     }
     pthread_mutex_unlock(&c->lock);
+    membudget_release(&unreserve);
     if (close_result)
         io_close(c);
     if (status == 0)
@@ -535,7 +640,9 @@ int registry_delete(server_case *c)
         case_command_worker_locked(c, WORKER_ABANDON);
     c->state = CASE_STOPPED;
     atomic_store(&c->deleted, 1);
+    membudget_lease unreserve = case_take_reserve_locked(c);
     pthread_mutex_unlock(&c->lock);
+    membudget_release(&unreserve);
 
     io_close(c); /* FIFO: every earlier job of this case is done after it */
     if (persist_remove_dir(c->dir) != 0)
@@ -548,18 +655,20 @@ int registry_delete(server_case *c)
     return 0;
 }
 
-snapshot *case_take_state(server_case *c, unsigned fields)
+snapshot *case_take_state(server_case *c, unsigned fields, int *status)
 {
-    if (!c->model)
-        return NULL;
     atomic_fetch_add(&c->state_waiters, 1);
     pthread_mutex_lock(&c->model_lock);
-    snapshot *s = snapshot_take(c->model, fields);
+    snapshot *s = c->model ? snapshot_take(c->model, fields) : NULL;
+    int held = c->model != NULL;
     pthread_mutex_unlock(&c->model_lock);
     pthread_mutex_lock(&c->yield_lock);
     atomic_fetch_sub(&c->state_waiters, 1);
     pthread_cond_broadcast(&c->yield_cv);
     pthread_mutex_unlock(&c->yield_lock);
+    *status = 503;
+    if (!held)
+        s = case_model_state_from_disk(c, fields, status);
     return s;
 }
 
@@ -580,12 +689,14 @@ static int case_make_dir(server_case *c)
     return -1;
 }
 
-server_case *registry_create(const char *body, size_t size, int start,
-                             problems *p, int *http_status, char *err, size_t errlen)
+/* registry_create() with the lease that pays for the upload. */
+static server_case *registry_store_upload(const char *body, size_t size, int start,
+                                          membudget_lease *lease, problems *p, int *http_status,
+                                          char *err, size_t errlen)
 {
     case_info info;
     memset(&info, 0, sizeof info);
-    fdem_model *model = case_build(body, size, reg_cfg->max_case_memory, &info, p);
+    fdem_model *model = case_model_build_upload(body, size, lease, &info, p);
     if (!model) {
         *http_status = p->status ? p->status : 422;
         if (p->count == 0)
@@ -619,15 +730,33 @@ server_case *registry_create(const char *body, size_t size, int start,
     c->last_snapshot_step = c->last_checkpoint_step = fdem_get_step(model);
     if (io_create(c, first, ckpt, ckpt_size, err, errlen) != 0)
         goto fail;
+    io_close(c); /* a case that is not running keeps no file open */
     case_publish_from_model(c);
+    fdem_counts n = fdem_get_counts(model);
+    size_t cost = case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
+    fdem_model *unused = NULL;
+    membudget_lease unreserve = {0};
     pthread_mutex_lock(&reg_lock);
     int appended = registry_append_locked(c) == 0;
+    pthread_mutex_lock(&c->lock);
     if (appended && start && !reg_shutting_down) {
-        pthread_mutex_lock(&c->lock);
+        membudget_move(lease, &c->reserve, cost);
+        c->queued_from = CASE_CREATED;
         case_start_locked(c);
-        pthread_mutex_unlock(&c->lock);
     }
+    if (c->state != CASE_RUNNING) {
+        /* No other thread has found the case yet (the registry lock is
+         * still held), so the model can be taken back without model_lock. */
+        unused = c->model;
+        c->model = NULL;
+    }
+    if (c->state == CASE_CREATED)
+        unreserve = case_take_reserve_locked(c);
+    pthread_mutex_unlock(&c->lock);
     pthread_mutex_unlock(&reg_lock);
+    if (unused)
+        fdem_model_destroy(unused);
+    membudget_release(&unreserve);
     if (!appended) {
         snprintf(err, errlen, "out of memory");
         goto fail;
@@ -646,6 +775,20 @@ fail:
     return NULL;
 }
 
+server_case *registry_create(const char *body, size_t size, int start,
+                             problems *p, int *http_status, char *err, size_t errlen)
+{
+    membudget_lease own = {0};
+    membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
+    server_case *c = registry_store_upload(body, size, start, lease, p, http_status, err, errlen);
+    /* Only the body is left (until the answer is sent); the tree, the meshes
+     * and the model are gone, so the client's next request already finds the
+     * budget as it will be. */
+    membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);
+    membudget_release(&own);
+    return c;
+}
+
 /* ------------------------------------------------------------- loading */
 
 static void case_fail_loading(server_case *c, const char *fmt, const char *detail)
@@ -655,7 +798,51 @@ static void case_fail_loading(server_case *c, const char *fmt, const char *detai
     fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
 }
 
-static void case_load_status(server_case *c, const char *path, json_t **status_out)
+/* A number of status.json; null (a non-finite figure) reads as NaN. */
+static double status_number(const json_t *o, const char *key)
+{
+    const json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+static int status_count(const json_t *o, const char *key)
+{
+    json_int_t v = json_integer_value(json_object_get(o, key));
+    return v >= 0 && v <= INT32_MAX ? (int)v : 0;
+}
+
+/* The figures the case last published: what its status shows until it
+ * runs again (no model is built to find them). */
+static void case_load_figures(server_case *c, const json_t *st)
+{
+    static const struct { const char *key; size_t offset; } counts[] = {
+        {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
+        {"joints", offsetof(fdem_counts, joints)},
+        {"broken_joints", offsetof(fdem_counts, broken_joints)},
+        {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
+    }, energies[] = {
+        {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
+        {"contact", offsetof(fdem_energy, contact)},
+        {"gravity_work", offsetof(fdem_energy, gravity_work)},
+        {"damping", offsetof(fdem_energy, damping)},
+        {"external_work", offsetof(fdem_energy, external_work)},
+    };
+    case_figures *f = &c->fig;
+    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
+        *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
+    const json_t *e = json_object_get(st, "energy");
+    for (size_t i = 0; i < sizeof energies / sizeof *energies; i++)
+        *(double *)((char *)&f->energy + energies[i].offset) = status_number(e, energies[i].key);
+    f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
+    f->time = status_number(st, "time");
+    f->dt = status_number(st, "dt");
+    f->snapshots = status_count(st, "snapshots");
+    const char *name = json_string_value(json_object_get(st, "name"));
+    snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
+    c->info.end_time = status_number(st, "end_time");
+}
+
+static void case_load_status(server_case *c, const char *path)
 {
     json_error_t jerr;
     json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
@@ -669,64 +856,39 @@ static void case_load_status(server_case *c, const char *path, json_t **status_o
     }
     if (created)
         snprintf(c->created, sizeof c->created, "%s", created);
-    *status_out = st;
+    if (st)
+        case_load_figures(c, st);
+    json_decref(st);
 }
 
-/* Rebuilds the model from case.json and restores checkpoint.bin. */
-static void case_load_model(server_case *c)
+/* A case that may run again is rebuilt once at start-up, when the budget
+ * allows, to check its stored files and cut result.h5 back to its
+ * checkpoint (a crash leaves later snapshots); the model is freed at once.
+ * Short of memory the check waits for the case's start: it stays as it was
+ * (memory short for a moment never makes a case fail). */
+static void case_check_stored(server_case *c)
 {
-    char path[1200], *doc = NULL, *ckpt = NULL;
-    size_t doc_size = 0, ckpt_size = 0;
-    snprintf(path, sizeof path, "%s/case.json", c->dir);
-    if (persist_read_file(path, &doc, &doc_size, (size_t)1 << 34) != 0) {
-        case_fail_loading(c, "case.json could not be read: %s", strerror(errno));
+    if (case_state_is_terminal(c->state))
         return;
+    membudget_lease lease = {0};
+    fdem_model *model = NULL;
+    case_info info;
+    char err[512] = "";
+    case_model_rc rc = CASE_MODEL_NO_MEMORY;
+    if (membudget_grow(&lease, case_model_cost_of(c)) == 0)
+        rc = case_model_build(c, &lease, &model, &info, err, sizeof err);
+    if (rc == CASE_MODEL_BROKEN) {
+        case_fail_loading(c, "%s", err);
+    } else if (rc == CASE_MODEL_OK) {
+        if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0)
+            case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+        case_publish_from_model(c);
+        case_model_drop(c);
+    } else {
+        fprintf(stderr, "fdemd: case %s: not checked at start-up (--max-memory is short); it "
+                "stays %s and is checked when it starts\n", c->id, case_state_name(c->state));
     }
-    problems p;
-    problems_init(&p);
-    c->model = case_build(doc, doc_size, reg_cfg->max_case_memory, &c->info, &p);
-    free(doc);
-    if (!c->model) {
-        case_fail_loading(c, "the stored case could not be rebuilt: %s",
-                          p.count ? p.items[0].message : "unknown problem");
-        problems_free(&p);
-        return;
-    }
-    problems_free(&p);
-    snprintf(path, sizeof path, "%s/checkpoint.bin", c->dir);
-    if (persist_read_file(path, &ckpt, &ckpt_size, (size_t)1 << 40) != 0) {
-        if (c->state != CASE_CREATED)
-            fprintf(stderr, "fdemd: case %s: no checkpoint (%s), resuming from t = 0\n", c->id,
-                    strerror(errno));
-        return;
-    }
-    fdem_error err;
-    memset(&err, 0, sizeof err);
-    if (fdem_checkpoint_read(c->model, ckpt, ckpt_size, &err) != 0) {
-        fdem_model_destroy(c->model);
-        c->model = NULL;
-        case_fail_loading(c, "checkpoint.bin could not be restored: %s", err.message);
-    }
-    free(ckpt);
-}
-
-/* Reopens result.h5 at the checkpoint (the writes after it are replayed). */
-static void case_load_result(server_case *c)
-{
-    if (!c->model)
-        return;
-    char err[256] = "";
-    int terminal = case_state_is_terminal(c->state);
-    int64_t keep = terminal ? INT64_MAX : fdem_get_step(c->model);
-    if (io_reopen(c, keep, terminal, err, sizeof err) == 0)
-        return;
-    fprintf(stderr, "fdemd: case %s: result.h5 could not be reopened (%s)%s\n", c->id, err,
-            terminal ? "" : "; starting a new one from the checkpoint");
-    if (terminal)
-        return;
-    snapshot *s = snapshot_take(c->model, c->info.fields);
-    if (io_create(c, s, NULL, 0, err, sizeof err) != 0)
-        case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+    membudget_release(&lease);
 }
 
 static server_case *case_load(const char *id)
@@ -745,24 +907,13 @@ static server_case *case_load(const char *id)
         case_release(c);
         return NULL;
     }
-    json_t *status = NULL;
     snprintf(path, sizeof path, "%s/status.json", c->dir);
-    case_load_status(c, path, &status);
+    case_load_status(c, path);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
-    case_load_model(c);
-    if (!c->model && status) {
-        /* Keep what the user saw, so the case is still recognisable. */
-        snprintf(c->info.name, sizeof c->info.name, "%s",
-                 json_string_value(json_object_get(status, "name")) ? json_string_value(json_object_get(status, "name")) : "");
-        c->info.end_time = json_number_value(json_object_get(status, "end_time"));
-    }
-    json_decref(status);
-    case_publish_from_model(c);
-    case_load_result(c);
-    c->last_snapshot_step = c->last_checkpoint_step = c->model ? fdem_get_step(c->model) : -1;
+    case_check_stored(c);
     case_persist_status(c);
     return c;
 }
@@ -819,7 +970,9 @@ void registry_shutdown(void)
             case_command_worker_locked(c, WORKER_PAUSE);
         else if (c->state == CASE_QUEUED)
             c->state = CASE_PAUSED;
+        membudget_lease unreserve = case_take_reserve_locked(c);
         pthread_mutex_unlock(&c->lock);
+        membudget_release(&unreserve);
         case_persist_status(c);
         io_close(c);
         pthread_mutex_unlock(&c->ctl_lock);

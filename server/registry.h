@@ -28,6 +28,7 @@
 #include "case.h"
 #include "config.h"
 #include "fdem.h"
+#include "memory_budget.h"
 #include "problems.h"
 #include "result.h"
 #include "snapshot.h"
@@ -61,8 +62,10 @@ typedef struct server_case {
     uint64_t seq;              /* creation order (oldest first listings) */
     atomic_int refs;
 
-    fdem_model *model;         /* NULL when the case could not be rebuilt */
+    fdem_model *model;         /* only while a worker runs the case (model_lock) */
     case_info info;
+    membudget_lease reserve;   /* the model's share of --max-memory: running or queued */
+    case_state queued_from;    /* where a queued case goes back to if it cannot start */
 
     pthread_mutex_t lock;      /* guards the fields down to `io_pending` */
     pthread_cond_t cv;         /* worker exit, I/O backlog drained */
@@ -111,14 +114,17 @@ void registry_counts(int *cases, int *running);
 server_case *registry_create(const char *body, size_t size, int start,
                              problems *p, int *http_status, char *err, size_t errlen);
 
-/* start/pause/stop: 0, or 409 with a sentence in msg. */
+/* start/pause/stop: 0, or 409 (or 503: no memory for the model now) with a
+ * sentence in msg. */
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);
 int registry_delete(server_case *c);
 
-/* The model's state at one step boundary; NULL when no model is held. */
-snapshot *case_take_state(server_case *c, unsigned fields);
+/* The state at one step boundary: the running model's, else the last
+ * checkpoint's (a temporary rebuild). NULL with *status 503 (memory short
+ * now) or 409 (the stored case cannot be rebuilt). */
+snapshot *case_take_state(server_case *c, unsigned fields, int *status);
 
 json_t *case_status_json(server_case *c);
 const char *case_state_name(case_state s);

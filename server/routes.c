@@ -16,6 +16,7 @@
 
 #include "http.h"
 #include "io_thread.h"
+#include "memory_budget.h"
 #include "state_json.h"
 
 /* ------------------------------------------------------------- matching */
@@ -179,6 +180,8 @@ static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char
         snprintf(location, sizeof location, "/cases/%s", c->id);
         rc = http_reply_json(conn, 201, case_status_json(c), location);
         case_release(c);
+    } else if (status == 503) {
+        rc = http_reply_unavailable(conn, p.count ? p.items[0].message : "short of memory", &p);
     } else if (status == 400 || status == 422) {
         char detail[640];
         if (status == 400)
@@ -206,7 +209,9 @@ static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c
         return http_reply_json(conn, 200, case_status_json(c), NULL);
     if (status == 404)
         return routes_no_case(conn, c->id);
-    return http_reply_problem(conn, (unsigned)status, status == 409 ? "Conflict" : "Unavailable", msg, NULL);
+    if (status == 503)
+        return http_reply_unavailable(conn, msg, NULL);
+    return http_reply_problem(conn, (unsigned)status, "Conflict", msg, NULL);
 }
 
 static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
@@ -225,16 +230,33 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
         }
         problems_free(&p);
     }
-    snapshot *s = case_take_state(c, fields);
+    int status = 0;
+    snapshot *s = case_take_state(c, fields, &status);
+    if (!s && status == 503)
+        return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
+                                      "from its checkpoint, and that would take the daemon past "
+                                      "its memory budget (--max-memory) now", NULL);
     if (!s)
         return http_reply_problem(conn, 409, "Conflict",
-                                  "this case holds no model (it could not be rebuilt)", NULL);
+                                  "the stored case could not be rebuilt to read its state", NULL);
+    /* The JSON tree of a state is ~100 bytes per number: it is charged to
+     * the budget, and its pages go back to the OS once it is sent off. */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
     json_t *o = state_to_json(s);
+    membudget_meter_end();
     snapshot_free(s);
-    if (!o)
-        return http_reply_problem(conn, 409, "Conflict",
-                                  "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
-    return http_reply_json(conn, 200, o, NULL);
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of this state would take the daemon past "
+                                    "its memory budget (--max-memory) now", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 409, "Conflict",
+                                "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
 }
 
 static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case *c)

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "case_model.h"
 #include "io_thread.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
@@ -206,8 +207,7 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
     if (snap || ckpt)
         io_append(c, snap, ckpt, ckpt_size);
     worker_wait_io(c, 0);
-    if (why != EXIT_PAUSE)
-        io_close(c);
+    io_close(c); /* a paused case keeps no file open either (case_model.h) */
 }
 
 static case_state worker_final_state(worker_exit why)
@@ -221,20 +221,54 @@ static case_state worker_final_state(worker_exit why)
     return CASE_FAILED;
 }
 
+/* The model the start built, or (a case that waited in the queue) one
+ * built now from the stored files under the reservation the start made;
+ * then the result file is opened at its step. 0, or -1 with the state the
+ * case goes back to: where it was when memory is short, failed (with an
+ * error) when its files are broken. */
+static int worker_take_model(server_case *c, case_state *fallback)
+{
+    char err[512] = "";
+    pthread_mutex_lock(&c->model_lock);
+    fdem_model *model = c->model;
+    pthread_mutex_unlock(&c->model_lock);
+    case_info info = c->info;
+    case_model_rc rc = CASE_MODEL_OK;
+    if (!model)
+        rc = case_model_build(c, &c->reserve, &model, &info, err, sizeof err);
+    if (rc == CASE_MODEL_OK && case_model_attach(c, model, &info, 0, err, sizeof err) == 0)
+        return 0;
+    *fallback = rc == CASE_MODEL_NO_MEMORY ? c->queued_from : CASE_FAILED;
+    if (rc == CASE_MODEL_NO_MEMORY) {
+        fprintf(stderr, "fdemd: case %s: no memory for its model now (--max-memory); it goes "
+                "back to %s\n", c->id, case_state_name(*fallback));
+    } else {
+        pthread_mutex_lock(&c->lock);
+        snprintf(c->error, sizeof c->error, "%s", err);
+        pthread_mutex_unlock(&c->lock);
+    }
+    return -1;
+}
+
 static void *worker_main(void *arg)
 {
     server_case *c = arg;
     const fdemd_config *cfg = registry_config();
-    fdem_set_threads(c->model, cfg->threads);
-
-    worker_clock clk = {worker_now(), worker_now(), fdem_get_step(c->model), 0.0};
-    c->next_output = worker_next_output(c, fdem_get_time(c->model));
-    worker_exit why = worker_loop(c, &clk);
-    worker_wind_down(c, why, &clk);
+    worker_exit why = EXIT_FAILED;
+    case_state final_state = CASE_FAILED;
+    if (worker_take_model(c, &final_state) == 0) {
+        fdem_set_threads(c->model, cfg->threads);
+        worker_clock clk = {worker_now(), worker_now(), fdem_get_step(c->model), 0.0};
+        c->next_output = worker_next_output(c, fdem_get_time(c->model));
+        why = worker_loop(c, &clk);
+        worker_wind_down(c, why, &clk);
+        final_state = worker_final_state(why);
+    }
+    case_model_drop(c); /* model, result file and reservation go with the worker */
 
     if (why == EXIT_ABANDON)
         atomic_store(&c->deleted, 1); /* nothing more to persist */
-    registry_worker_exited(c, worker_final_state(why));
+    registry_worker_exited(c, final_state);
     pthread_mutex_lock(&c->lock);
     c->worker_active = 0;
     pthread_cond_broadcast(&c->cv);
