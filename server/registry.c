@@ -203,6 +203,19 @@ static json_t *json_number_or_null(double x)
     return isfinite(x) ? json_real(x) : json_null();
 }
 
+/* The status' energy object, member by member (contract 5.1): written by
+ * case_status_json, read back from status.json by case_load_figures. */
+static const struct { const char *key; size_t offset; } energy_accounts[] = {
+    {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
+    {"joint", offsetof(fdem_energy, joint)}, {"contact", offsetof(fdem_energy, contact)},
+    {"friction", offsetof(fdem_energy, friction)}, {"fracture", offsetof(fdem_energy, fracture)},
+    {"damping", offsetof(fdem_energy, damping)},
+    {"gravity_work", offsetof(fdem_energy, gravity_work)},
+    {"external_work", offsetof(fdem_energy, external_work)},
+    {"residual", offsetof(fdem_energy, residual)},
+};
+#define ENERGY_ACCOUNT_COUNT (sizeof energy_accounts / sizeof energy_accounts[0])
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);
@@ -220,17 +233,11 @@ json_t *case_status_json(server_case *c)
         progress = 1;
     if (state == CASE_FINISHED)
         progress = 1;
-    json_t *energy = json_pack("{s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o, s:o}",
-                               "kinetic", json_number_or_null(f.energy.kinetic),
-                               "elastic", json_number_or_null(f.energy.elastic),
-                               "joint", json_number_or_null(f.energy.joint),
-                               "contact", json_number_or_null(f.energy.contact),
-                               "friction", json_number_or_null(f.energy.friction),
-                               "fracture", json_number_or_null(f.energy.fracture),
-                               "damping", json_number_or_null(f.energy.damping),
-                               "gravity_work", json_number_or_null(f.energy.gravity_work),
-                               "external_work", json_number_or_null(f.energy.external_work),
-                               "residual", json_number_or_null(f.energy.residual));
+    json_t *energy = json_object();
+    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
+        json_object_set_new(energy, energy_accounts[i].key,
+                            json_number_or_null(*(const double *)((const char *)&f.energy +
+                                                                  energy_accounts[i].offset)));
     json_t *o = json_object();
     json_object_set_new(o, "id", json_string(c->id));
     json_object_set_new(o, "name", json_string(c->info.name));
@@ -820,19 +827,14 @@ static void case_load_figures(server_case *c, const json_t *st)
         {"joints", offsetof(fdem_counts, joints)},
         {"broken_joints", offsetof(fdem_counts, broken_joints)},
         {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
-    }, energies[] = {
-        {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
-        {"contact", offsetof(fdem_energy, contact)},
-        {"gravity_work", offsetof(fdem_energy, gravity_work)},
-        {"damping", offsetof(fdem_energy, damping)},
-        {"external_work", offsetof(fdem_energy, external_work)},
     };
     case_figures *f = &c->fig;
     for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
         *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
     const json_t *e = json_object_get(st, "energy");
-    for (size_t i = 0; i < sizeof energies / sizeof *energies; i++)
-        *(double *)((char *)&f->energy + energies[i].offset) = status_number(e, energies[i].key);
+    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
+        *(double *)((char *)&f->energy + energy_accounts[i].offset) =
+            status_number(e, energy_accounts[i].key);
     f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
     f->time = status_number(st, "time");
     f->dt = status_number(st, "dt");
