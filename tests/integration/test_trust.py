@@ -12,8 +12,8 @@
 - a time.end below one step, and a density so high that the stable step
   exceeds time.end, end exactly at time.end with a snapshot there.
 """
-import copy
 import os
+import time
 
 import h5py
 import numpy as np
@@ -157,3 +157,41 @@ class TrustworthyNumbers(DaemonTestCase):
         with h5py.File(path, "r") as f:
             self.assertAlmostEqual(f["/snapshots/time"][-1], 1e-3, delta=1e-15)
             self.assertTrue(np.all(np.isfinite(f["/snapshots/position"][...])))
+
+
+class PauseAndRestart(DaemonTestCase):
+    """A pause frees the case's model (--max-memory): the run goes on from
+    the checkpoint, and must reach the bits of a run that never paused."""
+    PREFIX = "fdemd-trust-pause-"
+
+    def final_state(self, case_id):
+        status, body = self.d.json("GET", "/cases/%s/state?fields=position,velocity" % case_id)
+        self.assertEqual(status, 200, body)
+        return body
+
+    def test_pause_and_resume_reach_the_bits_of_an_uninterrupted_run(self):
+        case = self.d.case_lasting(1.5, name="paused")
+        case["materials"]["rock"]["friction"] = 0.4
+        case["parts"][0]["velocity"] = [0.5, -1]
+        straight = self.d.create(case, start=True)
+        straight = self.d.wait_state(straight["id"], "finished", timeout=60)
+        paused = self.d.create(case, start=True)
+        pauses = 0
+        for _ in range(2):
+            time.sleep(0.4)
+            status, body = self.d.json("POST", "/cases/%s/pause" % paused["id"])
+            self.assertEqual(status, 200, body)
+            st = self.d.wait_state(paused["id"], ("paused", "finished"))
+            if st["state"] == "finished":
+                break
+            pauses += 1
+            status, body = self.d.json("POST", "/cases/%s/start" % paused["id"])
+            self.assertEqual(status, 200, body)
+        paused = self.d.wait_state(paused["id"], "finished", timeout=60)
+        self.assertGreaterEqual(pauses, 1, "finished before it could be paused")
+        self.assertEqual(straight["step"], paused["step"])
+        a, b = self.final_state(straight["id"]), self.final_state(paused["id"])
+        self.assertEqual(a["step"], b["step"])
+        self.assertEqual(a["position"], b["position"])
+        self.assertEqual(a["velocity"], b["velocity"])
+        self.assertEqual(straight["energy"], paused["energy"])
