@@ -16,6 +16,7 @@ typedef struct fdemd_config {
     int max_running;          /* cases stepping at once; more are queued */
     int threads;              /* OpenMP threads per running case */
     size_t max_case_memory;   /* memory_limit handed to case_build */
+    double checkpoint_every;  /* s of wall time between checkpoints of a running case */
 } fdemd_config;
 
 #endif

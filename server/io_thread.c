@@ -61,11 +61,6 @@ static double io_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void io_log(const server_case *c, const char *what, const char *err)
-{
-    fprintf(stderr, "fdemd: case %s: %s: %s\n", c->id, what, err);
-}
-
 static void io_write_xdmf(server_case *c, int force)
 {
     if (!c->result || !c->model)
@@ -80,17 +75,30 @@ static void io_write_xdmf(server_case *c, int force)
     char path[1200], err[256] = "";
     snprintf(path, sizeof path, "%s/result.xdmf", c->dir);
     if (xdmf_write(path, "result.h5", c->model, &c->info, c->result, err, sizeof err) != 0)
-        io_log(c, "writing result.xdmf failed", err);
+        case_record_io_failure(c, "result.xdmf", err);
     c->xdmf_written_at = now;
     c->xdmf_dirty = 0;
 }
 
+/* After a failed write no checkpoint may follow: a restart from it would
+ * resume past the snapshot that was lost. */
 static void io_write_checkpoint(server_case *c, const void *ckpt, size_t size)
 {
-    if (c->deleted)
+    if (c->deleted || atomic_load(&c->io_failed))
         return;
     if (persist_write_atomic(c->dir, "checkpoint.bin", ckpt, size) != 0)
-        io_log(c, "writing checkpoint.bin failed", strerror(errno));
+        case_record_io_failure(c, "checkpoint.bin", strerror(errno));
+}
+
+/* Closes result.h5 after a failed write, so that what was committed stays
+ * a readable file (the flags of an open SWMR writer are cleared on close). */
+static void io_close_after_failure(server_case *c)
+{
+    io_write_xdmf(c, 1);
+    if (result_close(c->result) != 0)
+        fprintf(stderr, "fdemd: case %s: closing result.h5 after a failed write also failed\n",
+                c->id);
+    c->result = NULL;
 }
 
 static void io_do_create(io_job *j)
@@ -138,15 +146,18 @@ static void io_do_append(io_job *j)
     server_case *c = j->c;
     if (j->snap && c->result && !c->deleted) {
         char err[256] = "";
-        if (result_append(c->result, j->snap, err, sizeof err) != 0)
-            io_log(c, "appending a snapshot failed", err);
-        else
+        if (result_append(c->result, j->snap, err, sizeof err) != 0) {
+            case_record_io_failure(c, "result.h5", err);
+            io_close_after_failure(c);
+        } else {
             case_set_snapshots(c, result_snapshot_count(c->result));
-        io_write_xdmf(c, 0);
+            io_write_xdmf(c, 0);
+        }
     }
-    if (j->ckpt) {
+    if (j->ckpt && !atomic_load(&c->io_failed)) {
         io_write_checkpoint(c, j->ckpt, j->ckpt_size);
-        case_persist_status(c);
+        if (!atomic_load(&c->io_failed))
+            case_persist_status(c);
     }
     pthread_mutex_lock(&c->lock);
     c->io_pending--;
@@ -161,7 +172,8 @@ static void io_do_close(io_job *j)
         return;
     if (c->xdmf_dirty && !c->deleted)
         io_write_xdmf(c, 1);
-    result_close(c->result);
+    if (result_close(c->result) != 0 && !c->deleted)
+        case_record_io_failure(c, "result.h5", "its final flush failed (disk full or I/O error)");
     c->result = NULL;
 }
 

@@ -26,7 +26,7 @@ static void usage(FILE *out)
     fprintf(out,
             "usage: fdemd [--listen 127.0.0.1:8080] [--data DIR] [--token TOKEN]\n"
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
-            "             [--max-case-memory BYTES]\n"
+            "             [--max-case-memory BYTES] [--checkpoint-every SECONDS]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -35,6 +35,7 @@ static void usage(FILE *out)
             "  --max-running N         cases stepping at once; later starts are queued (default: cores)\n"
             "  --threads T             OpenMP threads per running case (default 1)\n"
             "  --max-case-memory BYTES largest model a case may build (default 4G)\n"
+            "  --checkpoint-every S    checkpoint running cases at least every S s of wall time (default 60)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -71,6 +72,17 @@ static int parse_int(const char *s, int min, int *out)
     return 0;
 }
 
+static int parse_seconds(const char *s, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !(v > 0) || v > 1e9)
+        return -1;
+    *out = v;
+    return 0;
+}
+
 static int parse_listen(const char *s, fdemd_config *cfg)
 {
     const char *colon = strrchr(s, ':');
@@ -89,12 +101,13 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
-    enum { OPT_MAX_CASE_MEMORY = 1000 };
+    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_CHECKPOINT_EVERY };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
         {"max-running", required_argument, 0, 'r'}, {"threads", required_argument, 0, 'j'},
         {"max-case-memory", required_argument, 0, OPT_MAX_CASE_MEMORY},
+        {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -105,6 +118,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->max_running = cores > 0 ? (int)cores : 1;
     cfg->threads = 1;
     cfg->max_case_memory = (size_t)4 << 30;
+    cfg->checkpoint_every = 60.0;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
@@ -123,6 +137,9 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case 'j': if (parse_int(optarg, 1, &cfg->threads)) bad = "--threads takes a positive integer"; break;
         case OPT_MAX_CASE_MEMORY:
             if (parse_size(optarg, &cfg->max_case_memory) || !cfg->max_case_memory) bad = "--max-case-memory takes a positive size in bytes";
+            break;
+        case OPT_CHECKPOINT_EVERY:
+            if (parse_seconds(optarg, &cfg->checkpoint_every)) bad = "--checkpoint-every takes a positive number of seconds";
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

@@ -247,19 +247,85 @@ json_t *case_status_json(server_case *c)
     return o;
 }
 
-void case_persist_status(server_case *c)
+void case_record_io_failure(server_case *c, const char *file, const char *reason)
+{
+    pthread_mutex_lock(&c->lock);
+    if (!c->io_error[0])
+        snprintf(c->io_error, sizeof c->io_error,
+                 "writing %s failed: %s; the results up to the last snapshot reported are kept",
+                 file, reason);
+    pthread_mutex_unlock(&c->lock);
+    atomic_store(&c->io_failed, 1);
+    fprintf(stderr, "fdemd: case %s: writing %s failed: %s\n", c->id, file, reason);
+}
+
+/* Writes `o` (consumed) as status.json; on a full disk the case's reserve
+ * is given up once so that at least this state becomes durable. */
+static int case_write_status_json(server_case *c, json_t *o, char *reason, size_t reason_size)
+{
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    json_decref(o);
+    int rc = -1;
+    if (!text) {
+        snprintf(reason, reason_size, "out of memory");
+        return -1;
+    }
+    rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+    int saved = errno;
+    if (rc != 0 && (saved == ENOSPC || saved == EDQUOT) && persist_release_reserve(c->dir) == 0) {
+        rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+        saved = errno;
+    }
+    if (rc != 0)
+        snprintf(reason, reason_size, "%s", strerror(saved));
+    free(text);
+    return rc;
+}
+
+/* The status object with `state` (and, when failed, `error`) as they are
+ * about to become; used to make a state durable before it is shown. */
+static json_t *case_status_json_as(server_case *c, case_state state, const char *error)
+{
+    json_t *o = case_status_json(c);
+    if (!o)
+        return NULL;
+    json_object_set_new(o, "state", json_string(case_state_name(state)));
+    if (error && error[0])
+        json_object_set_new(o, "error", json_string(error));
+    if (state == CASE_FINISHED)
+        json_object_set_new(o, "progress", json_real(1.0));
+    return o;
+}
+
+/* A status.json that cannot be written is a storage fault like any other:
+ * a case no worker is stepping becomes failed at once (and we try to make
+ * that durable), a running one is ended by its worker. */
+static void case_status_write_failed(server_case *c, const char *reason)
+{
+    case_record_io_failure(c, "status.json", reason);
+    pthread_mutex_lock(&c->lock);
+    int idle = !c->worker_active && !case_state_is_terminal(c->state);
+    if (idle) {
+        c->state = CASE_FAILED;
+        snprintf(c->error, sizeof c->error, "%s", c->io_error);
+    }
+    pthread_mutex_unlock(&c->lock);
+    char again[128];
+    if (idle)
+        case_write_status_json(c, case_status_json(c), again, sizeof again);
+}
+
+int case_persist_status(server_case *c)
 {
     if (atomic_load(&c->deleted))
-        return;
+        return 0;
+    char reason[128] = "";
     pthread_mutex_lock(&c->persist_lock);
-    json_t *o = case_status_json(c);
-    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
-    if (!text || persist_write_atomic(c->dir, "status.json", text, strlen(text)) != 0)
-        fprintf(stderr, "fdemd: case %s: writing status.json failed: %s\n", c->id,
-                text ? strerror(errno) : "out of memory");
-    free(text);
-    json_decref(o);
+    int rc = case_write_status_json(c, case_status_json(c), reason, sizeof reason);
     pthread_mutex_unlock(&c->persist_lock);
+    if (rc != 0)
+        case_status_write_failed(c, reason);
+    return rc;
 }
 
 /* ------------------------------------------------------------- listing */
@@ -383,18 +449,52 @@ static void registry_dispatch(void)
     }
 }
 
+/* The state a worker leaves its case in once the storage has had its say:
+ * failed (with the write error) if any write of the case failed, and a
+ * state is only published after its status.json is durable, so a state a
+ * client has seen never turns back after a crash. */
+static case_state case_settle_final_state(server_case *c, case_state final_state, char *error,
+                                          size_t error_size)
+{
+    pthread_mutex_lock(&c->lock);
+    snprintf(error, error_size, "%s", c->error);
+    if (atomic_load(&c->io_failed) && final_state != CASE_STOPPED) {
+        final_state = CASE_FAILED;
+        snprintf(error, error_size, "%s", c->io_error);
+    }
+    pthread_mutex_unlock(&c->lock);
+    if (atomic_load(&c->deleted))
+        return final_state;
+    char reason[128] = "";
+    pthread_mutex_lock(&c->persist_lock);
+    int rc = case_write_status_json(c, case_status_json_as(c, final_state, error), reason,
+                                    sizeof reason);
+    if (rc != 0) {
+        case_record_io_failure(c, "status.json", reason);
+        final_state = CASE_FAILED;
+        pthread_mutex_lock(&c->lock);
+        snprintf(error, error_size, "%s", c->io_error);
+        pthread_mutex_unlock(&c->lock);
+        case_write_status_json(c, case_status_json_as(c, final_state, error), reason, sizeof reason);
+    }
+    pthread_mutex_unlock(&c->persist_lock);
+    return final_state;
+}
+
 void registry_worker_exited(server_case *c, case_state final_state)
 {
+    char error[sizeof c->error];
+    final_state = case_settle_final_state(c, final_state, error, sizeof error);
     /* State and running count change together, so /health and the status
      * never disagree about whether the case runs. */
     pthread_mutex_lock(&reg_lock);
     pthread_mutex_lock(&c->lock);
     c->state = final_state;
+    snprintf(c->error, sizeof c->error, "%s", error);
     atomic_store(&c->command, WORKER_GO);
     pthread_mutex_unlock(&c->lock);
     reg_running--;
     pthread_mutex_unlock(&reg_lock);
-    case_persist_status(c);
     registry_dispatch();
 }
 
@@ -605,6 +705,7 @@ server_case *registry_create(const char *body, size_t size, int start,
         case_release(c);
         return NULL;
     }
+    persist_reserve(c->dir);
     if (persist_write_atomic(c->dir, "case.json", body, size) != 0) {
         snprintf(err, errlen, "cannot store case.json: %s", strerror(errno));
         goto fail;
