@@ -6,6 +6,7 @@
  * rebuilt from the case document, so a checkpoint stays small and a model
  * of another shape is detected by its counts and refused.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -45,6 +46,24 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     return 0;
 }
 
+/* A damaged or hand-made header must not be restored: a negative step
+ * would, for one, make the daemon drop every stored snapshot. */
+static int checkpoint_header_valid(const checkpoint_header *h, fdem_error *err)
+{
+    const char *bad = NULL;
+    if (h->step < 0) bad = "a negative step";
+    else if (!isfinite(h->time) || h->time < 0) bad = "a time that is negative or not finite";
+    else if (!isfinite(h->dt) || h->dt <= 0) bad = "a time step that is not positive and finite";
+    else if (!isfinite(h->dt_prev) || h->dt_prev < 0) bad = "a previous time step that is negative or not finite";
+    else if (!isfinite(h->contact_work) || !isfinite(h->damping_work) || !isfinite(h->external_work))
+        bad = "energy totals that are not finite";
+    if (!bad) return 0;
+    model_error(err, FDEM_ITEM_NONE, -1,
+                "checkpoint has %s (step %lld, t = %g s, dt = %g s); it is damaged",
+                bad, (long long)h->step, h->time, h->dt);
+    return -1;
+}
+
 int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error *err)
 {
     checkpoint_header h;
@@ -70,6 +89,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
                     fdem_checkpoint_size(m));
         return -1;
     }
+    if (checkpoint_header_valid(&h, err) != 0) return -1;
     const unsigned char *p = (const unsigned char *)buf + sizeof h;
     size_t nb = sizeof(double) * 2 * (size_t)m->node_count;
     memcpy(m->pos, p, nb);

@@ -826,6 +826,19 @@ static void case_load_result(server_case *c)
         case_fail_loading(c, "result.h5 could not be recreated: %s", err);
 }
 
+/* A case whose restored time is already at its end (a status.json that
+ * says running, e.g. edited by hand) is finished: it must never step on. */
+static void case_finish_if_at_end(server_case *c)
+{
+    if (!c->model || case_state_is_terminal(c->state))
+        return;
+    double dt = fdem_get_dt(c->model);
+    if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
+        fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
+        c->state = CASE_FINISHED;
+    }
+}
+
 static server_case *case_load(const char *id)
 {
     server_case *c = case_new();
@@ -855,12 +868,18 @@ static server_case *case_load(const char *id)
         snprintf(c->info.name, sizeof c->info.name, "%s",
                  json_string_value(json_object_get(status, "name")) ? json_string_value(json_object_get(status, "name")) : "");
         c->info.end_time = json_number_value(json_object_get(status, "end_time"));
+        c->fig.snapshots = (int)json_integer_value(json_object_get(status, "snapshots"));
     }
     json_decref(status);
+    case_finish_if_at_end(c);
     case_publish_from_model(c);
     case_load_result(c);
     c->last_snapshot_step = c->last_checkpoint_step = c->model ? fdem_get_step(c->model) : -1;
-    case_persist_status(c);
+    /* A case that could not be loaded keeps its files as they are, so that
+     * once the damage is mended it comes back as it was. */
+    if (c->model)
+        case_persist_status(c);
+    persist_reserve(c->dir);
     return c;
 }
 
@@ -917,7 +936,8 @@ void registry_shutdown(void)
         else if (c->state == CASE_QUEUED)
             c->state = CASE_PAUSED;
         pthread_mutex_unlock(&c->lock);
-        case_persist_status(c);
+        if (c->model) /* one that could not be loaded keeps its files as found */
+            case_persist_status(c);
         io_close(c);
         pthread_mutex_unlock(&c->ctl_lock);
     }

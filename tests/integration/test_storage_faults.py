@@ -81,5 +81,122 @@ class DiskFullTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
+def edit_json(path, **changes):
+    with open(path) as f:
+        doc = json.load(f)
+    doc.update(changes)
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+class StoredFilesTest(unittest.TestCase):
+    """Damage done to the files of a stopped daemon gets a clear answer."""
+
+    def setUp(self):
+        self.d = Daemon()
+        self.addCleanup(self.d.close)
+        self.d.start()
+
+    def finished_case(self, end=0.0004):
+        cid = self.d.create(tiny_case("done", end=end), start=True)["id"]
+        return self.d.wait_state(cid, "finished")
+
+    def test_negative_checkpoint_step_keeps_every_snapshot(self):
+        d = self.d
+        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] >= 4, what="4 snapshots")
+        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
+        self.assertEqual(d.stop()[0], 0)
+        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        with open(path, "r+b") as f:
+            f.seek(24)                      # int64 step after six int32
+            f.write((-5).to_bytes(8, "little", signed=True))
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "failed", st)
+        self.assertIn("negative step", st["error"])
+        self.assertEqual(st["snapshots"], paused["snapshots"])
+        # Nothing was dropped: mend the checkpoint and the case is back.
+        self.assertEqual(d.stop()[0], 0)
+        with open(path, "r+b") as f:
+            f.seek(24)
+            f.write(paused["step"].to_bytes(8, "little", signed=True))
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "paused", st)
+        self.assertEqual(st["snapshots"], paused["snapshots"])
+        self.assertEqual(len(result_snapshots(d, cid)[0]), paused["snapshots"])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_finished_case_edited_to_running_does_not_step_past_its_end(self):
+        d = self.d
+        done = self.finished_case()
+        self.assertEqual(d.stop()[0], 0)
+        edit_json(os.path.join(d.data_dir, done["id"], "status.json"), state="running")
+        d.start()
+        st = d.status(done["id"])
+        self.assertEqual(st["state"], "finished", st)
+        self.assertEqual(st["step"], done["step"])
+        self.assertEqual(d.json("POST", "/cases/%s/start" % done["id"])[0], 409)
+        time.sleep(0.2)
+        self.assertEqual(d.status(done["id"])["step"], done["step"])
+        times, steps = result_snapshots(d, done["id"])
+        self.assertEqual(len(times), done["snapshots"])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_damaged_result_file_is_a_clear_5xx(self):
+        d = self.d
+        truncated = self.finished_case()["id"]
+        directory = self.finished_case()["id"]
+        self.assertEqual(d.stop()[0], 0)
+        path = os.path.join(d.data_dir, truncated, "result.h5")
+        os.truncate(path, os.path.getsize(path) // 2)
+        path = os.path.join(d.data_dir, directory, "result.h5")
+        os.unlink(path)
+        os.mkdir(path)
+        d.start()
+        for cid in (truncated, directory):
+            status, headers, body = d.request("GET", "/cases/%s/result.h5" % cid)
+            self.assertEqual(status, 500, body[:200])
+            self.assertEqual(headers["content-type"], "application/problem+json")
+            problem = json.loads(body)
+            self.assertIn("result.h5", problem["detail"])
+            self.assertIn("damaged", problem["detail"])
+        self.assertEqual(d.request("GET", "/health")[0], 200)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
+class CheckpointEveryTest(unittest.TestCase):
+    def test_progress_between_snapshots_survives_sigkill(self):
+        d = Daemon(args=["--checkpoint-every", "0.5"])
+        self.addCleanup(d.close)
+        d.start()
+        # ~8 s of work with 4 snapshots after t = 0: the 1st comes at ~2 s.
+        case = d.case_lasting(8.0, name="slow")
+        case["output"]["interval"] = case["time"]["end"] / 4
+        cid = d.create(case, start=True)["id"]
+        st = d.wait(cid, lambda s: s["snapshots"] >= 2, timeout=30, what="the first snapshot")
+        time.sleep(1.5)
+        before = d.status(cid)
+        d.kill()
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "paused", st)
+        # Within two checkpoint intervals of the step reached, not back at the last snapshot.
+        self.assertGreater(st["step"], 0)
+        self.assertGreater(st["time"], case["output"]["interval"] * 1.2, (st, before))
+        self.assertEqual(st["snapshots"], 2)
+        self.assertEqual(d.json("POST", "/cases/%s/start" % cid)[0], 200)
+        st = d.wait_state(cid, "finished", timeout=60)
+        times, steps = result_snapshots(d, cid)
+        self.assertEqual(len(times), 5, times)
+        self.assertEqual(st["snapshots"], 5)
+        interval = case["output"]["interval"]
+        for k, t in enumerate(times):
+            self.assertAlmostEqual(t / interval, k, delta=0.01, msg=list(times))
+        self.assertTrue(all(b > a for a, b in zip(steps, steps[1:])), steps)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
