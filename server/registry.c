@@ -608,13 +608,31 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
     return status;
 }
 
-int registry_delete(server_case *c)
+/* Moves the case directory out of sight (DIR/.tmp-ID, which start-up
+ * sweeps) and removes it there; when a file will not go, what is left is
+ * moved back so the case stays whole and listed. */
+static int case_remove_files(server_case *c, char *msg, size_t msglen)
 {
-    pthread_mutex_lock(&c->ctl_lock);
-    if (atomic_load(&c->deleted)) {
-        pthread_mutex_unlock(&c->ctl_lock);
-        return 404;
+    char trash[sizeof c->dir + 8];
+    snprintf(trash, sizeof trash, "%s/.tmp-%s", reg_cfg->data_dir, c->id);
+    if (rename(c->dir, trash) != 0) {
+        snprintf(msg, msglen, "the files of the case could not be removed: renaming %s: %s",
+                 c->dir, strerror(errno));
+        return -1;
     }
+    if (persist_remove_dir(trash) != 0) {
+        int saved = errno;
+        rename(trash, c->dir);
+        snprintf(msg, msglen, "the files of the case could not all be removed from %s: %s",
+                 c->dir, strerror(saved));
+        return -1;
+    }
+    persist_fsync_dir(reg_cfg->data_dir);
+    return 0;
+}
+
+static void registry_unlist(server_case *c)
+{
     int listed = 0;
     pthread_mutex_lock(&reg_lock);
     for (int i = 0; i < reg_count; i++)
@@ -625,8 +643,19 @@ int registry_delete(server_case *c)
             break;
         }
     pthread_mutex_unlock(&reg_lock);
+    if (listed)
+        case_release(c); /* the registry's reference */
+}
 
+int registry_delete(server_case *c, char *msg, size_t msglen)
+{
+    pthread_mutex_lock(&c->ctl_lock);
+    if (atomic_load(&c->deleted)) {
+        pthread_mutex_unlock(&c->ctl_lock);
+        return 404;
+    }
     pthread_mutex_lock(&c->lock);
+    case_state before = c->state;
     if (c->worker_active)
         case_command_worker_locked(c, WORKER_ABANDON);
     c->state = CASE_STOPPED;
@@ -634,14 +663,23 @@ int registry_delete(server_case *c)
     pthread_mutex_unlock(&c->lock);
 
     io_close(c); /* FIFO: every earlier job of this case is done after it */
-    if (persist_remove_dir(c->dir) != 0)
-        fprintf(stderr, "fdemd: case %s: removing %s failed: %s\n", c->id, c->dir, strerror(errno));
-    else
-        persist_fsync_dir(reg_cfg->data_dir);
+    int status = 0;
+    if (case_remove_files(c, msg, msglen) != 0) {
+        /* Still there: the case stays listed as it was (a running or
+         * queued one stopped, as the DELETE began by stopping it). */
+        fprintf(stderr, "fdemd: case %s: %s\n", c->id, msg);
+        pthread_mutex_lock(&c->lock);
+        if (before != CASE_RUNNING && before != CASE_QUEUED)
+            c->state = before;
+        pthread_mutex_unlock(&c->lock);
+        atomic_store(&c->deleted, 0);
+        case_persist_status(c);
+        status = 500;
+    } else {
+        registry_unlist(c);
+    }
     pthread_mutex_unlock(&c->ctl_lock);
-    if (listed)
-        case_release(c); /* the registry's reference */
-    return 0;
+    return status;
 }
 
 snapshot *case_take_state(server_case *c, unsigned fields)
@@ -661,12 +699,18 @@ snapshot *case_take_state(server_case *c, unsigned fields)
 
 /* ------------------------------------------------------------- creating */
 
-static int case_make_dir(server_case *c)
+/* A new case is built in DIR/.tmp-ID and renamed into place once whole,
+ * so a crash while storing it leaves nothing that start-up would list. */
+static int case_make_dir(server_case *c, char *final_dir, size_t final_size)
 {
     for (int attempt = 0; attempt < 16; attempt++) {
         if (id_generate(c->id) != 0)
             return -1;
-        snprintf(c->dir, sizeof c->dir, "%s/%s", reg_cfg->data_dir, c->id);
+        snprintf(final_dir, final_size, "%s/%s", reg_cfg->data_dir, c->id);
+        snprintf(c->dir, sizeof c->dir, "%s/.tmp-%s", reg_cfg->data_dir, c->id);
+        struct stat st;
+        if (stat(final_dir, &st) == 0)
+            continue;
         if (mkdir(c->dir, 0755) == 0)
             return 0;
         if (errno != EEXIST)
@@ -674,6 +718,31 @@ static int case_make_dir(server_case *c)
     }
     errno = EEXIST;
     return -1;
+}
+
+/* Makes the files of the new case durable, then renames its directory
+ * into place (the rename is the moment the case exists). */
+static int case_publish_dir(server_case *c, const char *final_dir, char *err, size_t errlen)
+{
+    static const char *const files[] = {"result.h5", "result.xdmf"};
+    char path[1300];
+    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
+        snprintf(path, sizeof path, "%s/%s", c->dir, files[i]);
+        if (persist_fsync_path(path) != 0 && errno != ENOENT) {
+            snprintf(err, errlen, "cannot sync %s: %s", files[i], strerror(errno));
+            return -1;
+        }
+    }
+    if (persist_fsync_dir(c->dir) != 0 || rename(c->dir, final_dir) != 0) {
+        snprintf(err, errlen, "cannot move the new case into %s: %s", final_dir, strerror(errno));
+        return -1;
+    }
+    snprintf(c->dir, sizeof c->dir, "%s", final_dir);
+    if (persist_fsync_dir(reg_cfg->data_dir) != 0) {
+        snprintf(err, errlen, "cannot sync the data directory: %s", strerror(errno));
+        return -1;
+    }
+    return 0;
 }
 
 server_case *registry_create(const char *body, size_t size, int start,
@@ -700,7 +769,8 @@ server_case *registry_create(const char *body, size_t size, int start,
     c->state = CASE_CREATED;
     iso_time_now(c->created, sizeof c->created);
     *http_status = 500;
-    if (case_make_dir(c) != 0) {
+    char final_dir[sizeof c->dir];
+    if (case_make_dir(c, final_dir, sizeof final_dir) != 0) {
         snprintf(err, errlen, "cannot create the case directory: %s", strerror(errno));
         case_release(c);
         return NULL;
@@ -717,6 +787,12 @@ server_case *registry_create(const char *body, size_t size, int start,
     if (io_create(c, first, ckpt, ckpt_size, err, errlen) != 0)
         goto fail;
     case_publish_from_model(c);
+    if (case_persist_status(c) != 0) {
+        snprintf(err, errlen, "cannot store status.json: %s", c->io_error);
+        goto fail;
+    }
+    if (case_publish_dir(c, final_dir, err, errlen) != 0)
+        goto fail;
     pthread_mutex_lock(&reg_lock);
     int appended = registry_append_locked(c) == 0;
     if (appended && start && !reg_shutting_down) {
@@ -731,7 +807,8 @@ server_case *registry_create(const char *body, size_t size, int start,
     }
     /* The status is durable before the 201 goes out (a running case that
      * is acknowledged comes back after a crash). */
-    case_persist_status(c);
+    if (start)
+        case_persist_status(c);
     *http_status = 201;
     case_retain(c);
     return c;
@@ -857,6 +934,13 @@ static server_case *case_load(const char *id)
     }
     json_t *status = NULL;
     snprintf(path, sizeof path, "%s/status.json", c->dir);
+    if (stat(path, &st) != 0 && errno == ENOENT) {
+        /* Left by a crash during POST /cases of an older fdemd, which
+         * wrote status.json last before its 201: never acknowledged. */
+        fprintf(stderr, "fdemd: skipping %s: no status.json (a case never acknowledged)\n", c->dir);
+        case_release(c);
+        return NULL;
+    }
     case_load_status(c, path, &status);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
@@ -890,12 +974,29 @@ static int case_order(const void *a, const void *b)
     return d ? d : strcmp(x->id, y->id);
 }
 
+/* A case being created or deleted when the daemon stopped: never
+ * acknowledged (or already deleted), so it goes. */
+static void registry_sweep_half_made(const char *name)
+{
+    char path[sizeof reg_cfg->data_dir + 300];
+    snprintf(path, sizeof path, "%s/%s", reg_cfg->data_dir, name);
+    if (persist_remove_dir(path) != 0)
+        fprintf(stderr, "fdemd: cannot remove the half-made case %s: %s\n", path, strerror(errno));
+    else
+        fprintf(stderr, "fdemd: removed the half-made case %s\n", path);
+}
+
 int registry_init(const fdemd_config *cfg)
 {
     reg_cfg = cfg;
     if (persist_mkdir(cfg->data_dir) != 0) {
         fprintf(stderr, "fdemd: cannot create the data directory %s: %s\n", cfg->data_dir,
                 strerror(errno));
+        return -1;
+    }
+    if (persist_check_writable(cfg->data_dir) != 0) {
+        fprintf(stderr, "fdemd: the data directory %s cannot be written (%s); "
+                "give fdemd a writable --data directory\n", cfg->data_dir, strerror(errno));
         return -1;
     }
     DIR *d = opendir(cfg->data_dir);
@@ -906,6 +1007,10 @@ int registry_init(const fdemd_config *cfg)
     }
     struct dirent *e;
     while ((e = readdir(d)) != NULL) {
+        if (strncmp(e->d_name, ".tmp-", 5) == 0) {
+            registry_sweep_half_made(e->d_name);
+            continue;
+        }
         if (!id_is_valid(e->d_name))
             continue;
         server_case *c = case_load(e->d_name);

@@ -121,7 +121,9 @@ server_case *registry_create(const char *body, size_t size, int start,
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);
-int registry_delete(server_case *c);
+/* 0 once the files are gone; 404; or 500 with the reason in msg (the case
+ * stays listed, stopped). */
+int registry_delete(server_case *c, char *msg, size_t msglen);
 
 /* The model's state at one step boundary; NULL when no model is held. */
 snapshot *case_take_state(server_case *c, unsigned fields);

@@ -249,13 +249,24 @@ static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case 
     return http_reply_fd(conn, fd, size, "application/x-hdf5", "result.h5");
 }
 
+static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
+{
+    char msg[1400] = "";
+    int status = registry_delete(c, msg, sizeof msg);
+    if (status == 0)
+        return http_reply_empty(conn, 204);
+    if (status == 404)
+        return routes_no_case(conn, c->id);
+    return http_reply_problem(conn, 500, "Not deleted", msg, NULL);
+}
+
 static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, route_kind kind,
                                   const char *method)
 {
     switch (kind) {
     case ROUTE_CASE:
         if (strcmp(method, "DELETE") == 0)
-            return registry_delete(c) == 0 ? http_reply_empty(conn, 204) : routes_no_case(conn, c->id);
+            return route_delete(conn, c);
         return http_reply_json(conn, 200, case_status_json(c), NULL);
     case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
         return route_command(conn, c, kind);

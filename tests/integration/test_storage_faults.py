@@ -198,5 +198,109 @@ class CheckpointEveryTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
+def run_mount(test, *args):
+    done = subprocess.run(["mount"] + list(args), capture_output=True, text=True)
+    if done.returncode != 0:
+        test.skipTest("mount %s failed: %s" % (" ".join(args), done.stderr.strip()))
+
+
+class ReadOnlyDataTest(unittest.TestCase):
+    def test_read_only_data_directory_stops_startup(self):
+        where = mount_tmpfs(self, "4m")
+        data = os.path.join(where, "data")
+        d = Daemon(data_dir=data)
+        self.addCleanup(d.close)
+        d.start()
+        cid = d.create(tiny_case("paused", end=10.0), start=True)["id"]
+        d.wait(cid, lambda s: s["step"] > 10, what="steps")
+        d.json("POST", "/cases/%s/pause" % cid)
+        self.assertEqual(d.stop()[0], 0)
+        run_mount(self, "-o", "remount,ro", where)
+        done = subprocess.run([FDEMD_BIN, "--listen", "127.0.0.1:0", "--data", data],
+                              capture_output=True, text=True, timeout=10 * SLOW)
+        self.assertEqual(done.returncode, 1, done.stdout + done.stderr)
+        self.assertIn(data, done.stderr)
+        self.assertIn("Read-only file system", done.stderr)
+        self.assertEqual(done.stdout, "")
+
+    def test_delete_answers_204_only_when_the_files_are_gone(self):
+        if os.geteuid() != 0:
+            self.skipTest("a read-only bind mount needs root")
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        cid = d.create(tiny_case("kept", end=0.0002), start=True)["id"]
+        d.wait_state(cid, "finished")
+        case_dir = os.path.join(d.data_dir, cid)
+        run_mount(self, "--bind", case_dir, case_dir)
+        self.addCleanup(subprocess.run, ["umount", "-l", case_dir], capture_output=True)
+        run_mount(self, "-o", "remount,ro,bind", case_dir)
+        status, problem = d.json("DELETE", "/cases/" + cid)
+        self.assertEqual(status, 500, problem)
+        self.assertIn(cid, problem["detail"])
+        self.assertTrue(os.path.exists(os.path.join(case_dir, "result.h5")))
+        listed = [c["id"] for c in d.json("GET", "/cases")[1]["cases"]]
+        self.assertIn(cid, listed)
+        self.assertEqual(d.status(cid)["state"], "finished")
+        subprocess.run(["umount", case_dir], check=True)
+        self.assertEqual(d.request("DELETE", "/cases/" + cid)[0], 204)
+        self.assertFalse(os.path.exists(case_dir))
+        self.assertEqual(d.request("GET", "/cases/" + cid)[0], 404)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
+class WholeOrNothingTest(unittest.TestCase):
+    def test_half_made_cases_are_not_listed_after_restart(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        good = d.create(tiny_case("good"))["id"]
+        self.assertEqual(d.stop()[0], 0)
+        # What a crash inside POST /cases leaves: a temporary directory (this
+        # version) or a case directory without status.json (older versions).
+        for name in (".tmp-0123456789abcdef", "fedcba9876543210"):
+            os.makedirs(os.path.join(d.data_dir, name))
+            shutil.copy(os.path.join(d.data_dir, good, "case.json"), os.path.join(d.data_dir, name))
+        d.start()
+        listed = {c["id"]: c for c in d.json("GET", "/cases")[1]["cases"]}
+        self.assertEqual(list(listed), [good])
+        self.assertFalse(os.path.exists(os.path.join(d.data_dir, ".tmp-0123456789abcdef")))
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_sigkill_during_post_leaves_no_half_made_case(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        # Storing this one takes a while (a 120k-element mesh and result.h5).
+        big = json.dumps(tiny_case("big", divisions=(250, 240))).encode()
+        t0 = time.monotonic()
+        status, _, body = d.request("POST", "/cases", big, {"Content-Type": "application/json"})
+        store_time = time.monotonic() - t0
+        self.assertEqual(status, 201, body[:300])
+        acknowledged = {json.loads(body)["id"]}
+        import threading
+        for k in range(8):
+            def post():
+                try:
+                    st, _, b = d.request("POST", "/cases", big, {"Content-Type": "application/json"})
+                    if st == 201:
+                        acknowledged.add(json.loads(b)["id"])
+                except OSError:
+                    pass
+            t = threading.Thread(target=post)
+            t.start()
+            time.sleep(store_time * (0.1 + 0.8 * k / 7))
+            d.kill()
+            t.join()
+            d.start()
+            cases = d.json("GET", "/cases")[1]["cases"]
+            for c in cases:
+                self.assertNotEqual(c["state"], "failed", (k, c))
+            self.assertLessEqual(acknowledged, {c["id"] for c in cases})
+            leftovers = [n for n in os.listdir(d.data_dir) if n.startswith(".tmp-")]
+            self.assertEqual(leftovers, [])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
