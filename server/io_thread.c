@@ -36,8 +36,9 @@ typedef struct io_job {
     int close_after;
     /* completion, for jobs someone waits on */
     int waited, done, rc, fd;
+    int held, http_status;     /* IO_FETCH: writes held for a copy; 404/500 */
     size_t size;
-    char err[256];
+    char err[600];
     struct io_job *next;
 } io_job;
 
@@ -45,9 +46,11 @@ static pthread_mutex_t io_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t io_wake = PTHREAD_COND_INITIALIZER;
 static pthread_cond_t io_done = PTHREAD_COND_INITIALIZER;
 static io_job *io_head, *io_tail;
+/* Jobs of cases whose result.h5 is being copied for a download; they go
+ * back to the front of the queue, in order, when the copy is done. */
+static io_job *io_deferred_head, *io_deferred_tail;
 static pthread_t io_thread;
 static int io_running;
-static unsigned long io_download_counter;
 
 /* Rewriting the XDMF costs O(snapshots); past a few hundred snapshots we
  * only refresh it twice a second (and always on close). */
@@ -177,39 +180,47 @@ static void io_do_close(io_job *j)
     c->result = NULL;
 }
 
-/* While the file is open for SWMR writing we hand out a closed copy taken
- * after the last completed append; a closed file is served as it is. The
- * copy is unlinked right after opening, so nothing is left behind even if
- * the client disconnects. */
+/* A finished file is served as it is, once HDF5 has opened it (a file
+ * truncated or replaced on disk is refused, not sent). A file still open
+ * for SWMR writing is flushed and this case's writes are held, so that the
+ * caller can copy it off this thread (result_image_copy_step) and then
+ * calls io_release_hold(). Both cost metadata I/O only. */
 static void io_do_fetch(io_job *j)
 {
     server_case *c = j->c;
     char path[1200];
-    int temporary = 0;
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    j->rc = -1;
+    j->http_status = 500;
     if (c->result) {
-        snprintf(path, sizeof path, "%s/.download-%lu.h5", c->dir, ++io_download_counter);
-        if (result_copy(c->result, path, j->err, sizeof j->err) != 0) {
-            unlink(path);
-            j->rc = -1;
+        if (result_flush(c->result, j->err, sizeof j->err) != 0)
             return;
-        }
-        temporary = 1;
-    } else {
-        snprintf(path, sizeof path, "%s/result.h5", c->dir);
+        j->held = 1;
+        atomic_fetch_add(&c->io_hold, 1);
+    } else if (stat(path, &st) != 0 && errno == ENOENT) {
+        snprintf(j->err, sizeof j->err, "the case has no result.h5");
+        j->http_status = 404;
+        return;
+    } else if (result_check_file(path, j->err, sizeof j->err) != 0) {
+        char detail[sizeof j->err];
+        snprintf(detail, sizeof detail, "%s", j->err);
+        snprintf(j->err, sizeof j->err, "result.h5 is damaged: %.560s", detail);
+        return;
     }
     j->fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (temporary)
-        unlink(path);
-    struct stat st;
     if (j->fd < 0 || fstat(j->fd, &st) != 0) {
-        snprintf(j->err, sizeof j->err, "opening the result file: %s", strerror(errno));
+        snprintf(j->err, sizeof j->err, "opening result.h5: %s", strerror(errno));
         if (j->fd >= 0)
             close(j->fd);
         j->fd = -1;
-        j->rc = -1;
+        if (j->held)
+            io_release_hold(c);
+        j->held = 0;
         return;
     }
     j->size = (size_t)st.st_size;
+    j->rc = 0;
 }
 
 static void io_run_job(io_job *j)
@@ -234,17 +245,66 @@ static void io_job_free(io_job *j)
     free(j);
 }
 
-static void *io_main(void *arg)
+static void io_list_append(io_job **head, io_job **tail, io_job *j)
 {
-    (void)arg;
+    j->next = NULL;
+    if (*tail)
+        (*tail)->next = j;
+    else
+        *head = j;
+    *tail = j;
+}
+
+/* The next job to run; a held case's jobs (but for fetches, which write
+ * nothing) are set aside. */
+static io_job *io_next_locked(void)
+{
     for (;;) {
-        pthread_mutex_lock(&io_lock);
         while (!io_head)
             pthread_cond_wait(&io_wake, &io_lock);
         io_job *j = io_head;
         io_head = j->next;
         if (!io_head)
             io_tail = NULL;
+        if (j->c && j->kind != IO_FETCH && atomic_load(&j->c->io_hold) > 0) {
+            io_list_append(&io_deferred_head, &io_deferred_tail, j);
+            continue;
+        }
+        return j;
+    }
+}
+
+void io_release_hold(server_case *c)
+{
+    pthread_mutex_lock(&io_lock);
+    if (atomic_fetch_sub(&c->io_hold, 1) == 1) {
+        io_job *mine = NULL, *mine_tail = NULL, *rest = NULL, *rest_tail = NULL;
+        for (io_job *j = io_deferred_head, *next; j; j = next) {
+            next = j->next;
+            if (j->c == c)
+                io_list_append(&mine, &mine_tail, j);
+            else
+                io_list_append(&rest, &rest_tail, j);
+        }
+        io_deferred_head = rest;
+        io_deferred_tail = rest_tail;
+        if (mine) {
+            mine_tail->next = io_head;
+            io_head = mine;
+            if (!io_tail)
+                io_tail = mine_tail;
+            pthread_cond_signal(&io_wake);
+        }
+    }
+    pthread_mutex_unlock(&io_lock);
+}
+
+static void *io_main(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        pthread_mutex_lock(&io_lock);
+        io_job *j = io_next_locked();
         pthread_mutex_unlock(&io_lock);
 
         io_run_job(j);
@@ -382,8 +442,12 @@ void io_close(server_case *c)
     io_job_free(j);
 }
 
-int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t errlen)
+int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
+                    char *err, size_t errlen)
 {
+    *fd = -1;
+    *held = 0;
+    *http_status = 500;
     io_job *j = io_job_new(IO_FETCH, c);
     if (!j) {
         snprintf(err, errlen, "out of memory");
@@ -392,6 +456,8 @@ int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t err
     int rc = io_run_and_wait(j);
     *fd = j->fd;
     *size = j->size;
+    *held = j->held;
+    *http_status = j->http_status;
     if (rc != 0)
         snprintf(err, errlen, "%s", j->err);
     io_job_free(j);

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "download.h"
 #include "http.h"
 #include "io_thread.h"
 #include "state_json.h"
@@ -237,18 +238,6 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
     return http_reply_json(conn, 200, o, NULL);
 }
 
-static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case *c)
-{
-    int fd = -1;
-    size_t size = 0;
-    char err[256] = "";
-    if (io_fetch_result(c, &fd, &size, err, sizeof err) != 0) {
-        fprintf(stderr, "fdemd: case %s: serving result.h5 failed: %s\n", c->id, err);
-        return http_reply_problem(conn, 404, "Not found", "the result file is not available", NULL);
-    }
-    return http_reply_fd(conn, fd, size, "application/x-hdf5", "result.h5");
-}
-
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
 {
     char msg[1400] = "";
@@ -275,7 +264,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_STATE:
         return route_state(conn, c);
     case ROUTE_CASE_RESULT_H5:
-        return route_result_h5(conn, c);
+        return download_reply(conn, c);
     case ROUTE_CASE_RESULT_XDMF:
         return routes_serve_file(conn, c, "result.xdmf", "application/xml");
     default:

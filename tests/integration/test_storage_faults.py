@@ -12,6 +12,7 @@ import os
 import shutil
 import signal
 import subprocess
+import sys
 import tempfile
 import time
 import unittest
@@ -299,6 +300,110 @@ class WholeOrNothingTest(unittest.TestCase):
             self.assertLessEqual(acknowledged, {c["id"] for c in cases})
             leftovers = [n for n in os.listdir(d.data_dir) if n.startswith(".tmp-")]
             self.assertEqual(leftovers, [])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
+class DownloadTest(unittest.TestCase):
+    """Downloads of a running case take a consistent copy off the I/O
+    thread, so they hold up neither other requests nor other cases."""
+
+    def big_running_case(self, d, megabytes):
+        # 80k elements: ~3.2 MB per snapshot, one snapshot every 2 steps.
+        case = tiny_case("big", end=1.0, divisions=(200, 200))
+        st = d.create(case)
+        case["output"]["interval"] = 2 * st["dt"]
+        case["time"]["end"] = 2 * st["dt"] * 100000
+        d.request("DELETE", "/cases/" + st["id"])
+        cid = d.create(case, start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] * 3.2 >= megabytes, timeout=60, what="a big result")
+        return cid
+
+    def test_concurrent_downloads_do_not_stall_a_tiny_post(self):
+        import threading
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        cid = self.big_running_case(d, 150)
+
+        def tiny_post_latencies(count):
+            out = []
+            for k in range(count):
+                t0 = time.monotonic()
+                status, _, _ = d.request("POST", "/cases", tiny_case("tiny%d" % k))
+                out.append(time.monotonic() - t0)
+                self.assertEqual(status, 201)
+            return out
+        # The running case's own snapshot writes (3.2 MB each) set the floor.
+        baseline = tiny_post_latencies(5)
+        sizes, errors = [], []
+        kept = os.path.join(d.root, "download.h5")
+
+        def download(keep):
+            # Read in pieces and drop them: the client must not be what is slow.
+            try:
+                conn = d.connection()
+                conn.request("GET", "/cases/%s/result.h5" % cid)
+                resp = conn.getresponse()
+                out = open(kept, "wb") if keep else None
+                n = 0
+                while True:
+                    piece = resp.read(1 << 20)
+                    if not piece:
+                        break
+                    n += len(piece)
+                    if out:
+                        out.write(piece)
+                if out:
+                    out.close()
+                conn.close()
+                sizes.append((resp.status, n))
+            except Exception as e:  # pylint: disable=broad-except
+                errors.append(e)
+        threads = [threading.Thread(target=download, args=(k == 0,)) for k in range(6)]
+        for t in threads:
+            t.start()
+        time.sleep(0.05)
+        latencies = tiny_post_latencies(5)
+        for t in threads:
+            t.join()
+        self.assertEqual(errors, [])
+        self.assertTrue(all(s == 200 and n > 100e6 for s, n in sizes) and len(sizes) == 6, sizes)
+        print("  tiny POST: max %.3f s alone, %.3f s during 6 downloads of ~%.0f MB" %
+              (max(baseline), max(latencies), max(n for _, n in sizes) / 1e6), file=sys.stderr)
+        self.assertLess(max(latencies), max(0.5 * SLOW, 2 * max(baseline)), (baseline, latencies))
+        # A download is a plain, valid HDF5 file of whole snapshots.
+        with h5py.File(kept, "r") as f:
+            times = f["/snapshots/time"][...]
+            self.assertEqual(f["/snapshots/position"].shape[0], len(times))
+        self.assertGreater(len(times), 30)
+        self.assertTrue(all(b > a for a, b in zip(times, times[1:])))
+        d.json("POST", "/cases/%s/stop" % cid)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_download_on_a_full_disk_is_a_507(self):
+        data = os.path.join(mount_tmpfs(self, "64m"), "data")
+        d = Daemon(data_dir=data)
+        self.addCleanup(d.close)
+        d.start()
+        case = tiny_case("paused", end=0.5, divisions=(60, 60), interval=1e-6)
+        cid = d.create(case, start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] >= 40, timeout=60, what="snapshots")
+        d.json("POST", "/cases/%s/pause" % cid)
+        # Fill the disk, then ask for the file of the paused (still open) case.
+        filler = os.path.join(data, "filler")
+        with open(filler, "wb") as f:
+            try:
+                while True:
+                    f.write(b"\0" * 65536)
+                    f.flush()
+            except OSError:
+                pass
+        status, headers, body = d.request("GET", "/cases/%s/result.h5" % cid)
+        self.assertIn(status, (500, 507), body[:200])
+        self.assertEqual(headers["content-type"], "application/problem+json")
+        self.assertIn("No space left on device", json.loads(body)["detail"])
+        os.unlink(filler)
+        self.assertEqual(d.request("GET", "/cases/%s/result.h5" % cid)[0], 200)
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
