@@ -34,9 +34,9 @@ static int persist_write_all(int fd, const void *data, size_t size)
     return 0;
 }
 
-int persist_fsync_dir(const char *dir)
+static int persist_fsync_opened(const char *path, int flags)
 {
-    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_CLOEXEC | flags);
     if (fd < 0)
         return -1;
     int rc = fsync(fd);
@@ -44,6 +44,11 @@ int persist_fsync_dir(const char *dir)
     close(fd);
     errno = saved;
     return rc;
+}
+
+int persist_fsync_dir(const char *dir)
+{
+    return persist_fsync_opened(dir, O_DIRECTORY);
 }
 
 int persist_write_atomic(const char *dir, const char *name, const void *data, size_t size)
@@ -145,14 +150,7 @@ int persist_remove_dir(const char *dir)
 
 int persist_fsync_path(const char *path)
 {
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0)
-        return -1;
-    int rc = fsync(fd);
-    int saved = errno;
-    close(fd);
-    errno = saved;
-    return rc;
+    return persist_fsync_opened(path, 0);
 }
 
 #define PERSIST_RESERVE_BYTES (64 * 1024)

@@ -40,6 +40,15 @@ def mount_tmpfs(test, size):
     return where
 
 
+def daemon_on_tmpfs(test, size):
+    """A started daemon whose data directory is on a fresh tmpfs."""
+    where = mount_tmpfs(test, size)
+    d = Daemon(data_dir=os.path.join(where, "data"))
+    test.addCleanup(d.close)
+    d.start()
+    return d, where
+
+
 def result_snapshots(daemon, case_id):
     """Downloads result.h5 and returns its /snapshots/time (must open)."""
     status, headers, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
@@ -56,10 +65,7 @@ def result_snapshots(daemon, case_id):
 
 class DiskFullTest(unittest.TestCase):
     def test_disk_full_fails_the_case_and_keeps_what_was_written(self):
-        data = os.path.join(mount_tmpfs(self, "2m"), "data")
-        d = Daemon(data_dir=data)
-        self.addCleanup(d.close)
-        d.start()
+        d, _ = daemon_on_tmpfs(self, "2m")
         # ~33 KB per snapshot (441 nodes, 800 elements): 1001 of them cannot fit in 2 MiB.
         case = tiny_case("full", end=0.01, divisions=(20, 20), interval=1e-5)
         cid = d.create(case, start=True)["id"]
@@ -207,11 +213,8 @@ def run_mount(test, *args):
 
 class ReadOnlyDataTest(unittest.TestCase):
     def test_read_only_data_directory_stops_startup(self):
-        where = mount_tmpfs(self, "4m")
-        data = os.path.join(where, "data")
-        d = Daemon(data_dir=data)
-        self.addCleanup(d.close)
-        d.start()
+        d, where = daemon_on_tmpfs(self, "4m")
+        data = d.data_dir
         cid = d.create(tiny_case("paused", end=10.0), start=True)["id"]
         d.wait(cid, lambda s: s["step"] > 10, what="steps")
         d.json("POST", "/cases/%s/pause" % cid)
@@ -381,10 +384,8 @@ class DownloadTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
     def test_download_on_a_full_disk_is_a_507(self):
-        data = os.path.join(mount_tmpfs(self, "64m"), "data")
-        d = Daemon(data_dir=data)
-        self.addCleanup(d.close)
-        d.start()
+        d, _ = daemon_on_tmpfs(self, "64m")
+        data = d.data_dir
         case = tiny_case("paused", end=0.5, divisions=(60, 60), interval=1e-6)
         cid = d.create(case, start=True)["id"]
         d.wait(cid, lambda s: s["snapshots"] >= 40, timeout=60, what="snapshots")
