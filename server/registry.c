@@ -916,6 +916,18 @@ static void case_finish_if_at_end(server_case *c)
     }
 }
 
+/* A case that ended after its last checkpoint (failed, e.g. on a full
+ * disk) still shows the step and time it reported, not the checkpoint's. */
+static void case_keep_reported_progress(server_case *c, json_t *status)
+{
+    json_t *step = json_object_get(status, "step"), *time = json_object_get(status, "time");
+    if (!case_state_is_terminal(c->state) || !json_is_integer(step) || !json_is_number(time) ||
+        json_integer_value(step) <= c->fig.step)
+        return;
+    c->fig.step = (int64_t)json_integer_value(step);
+    c->fig.time = json_number_value(time);
+}
+
 static server_case *case_load(const char *id)
 {
     server_case *c = case_new();
@@ -954,9 +966,10 @@ static server_case *case_load(const char *id)
         c->info.end_time = json_number_value(json_object_get(status, "end_time"));
         c->fig.snapshots = (int)json_integer_value(json_object_get(status, "snapshots"));
     }
-    json_decref(status);
     case_finish_if_at_end(c);
     case_publish_from_model(c);
+    case_keep_reported_progress(c, status);
+    json_decref(status);
     case_load_result(c);
     c->last_snapshot_step = c->last_checkpoint_step = c->model ? fdem_get_step(c->model) : -1;
     /* A case that could not be loaded keeps its files as they are, so that

@@ -85,6 +85,7 @@ class DiskFullTest(unittest.TestCase):
         self.assertEqual(again["state"], "failed", again)
         self.assertEqual(again["error"], st["error"])
         self.assertEqual(again["snapshots"], st["snapshots"], d.log_tail())
+        self.assertEqual(again["step"], st["step"])
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
