@@ -105,18 +105,22 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     return 0;
 }
 
-/* The numbers a checkpoint must have to be a state this model can go on
- * from (a hand-edited or damaged file is refused, not run). */
+/* A damaged or hand-made header must not be restored: a negative step
+ * would, for one, make the daemon drop every stored snapshot. */
 static int checkpoint_header_sane(const checkpoint_header_v1 *h, fdem_error *err)
 {
-    if (h->step < 0 || !isfinite(h->time) || h->time < 0 || !(h->dt > 0) || !isfinite(h->dt) ||
-        !(h->dt_prev >= 0) || !isfinite(h->dt_prev)) {
-        model_error(err, FDEM_ITEM_NONE, -1,
-                    "checkpoint holds an impossible state (step %lld, time %g s, dt %g s)",
-                    (long long)h->step, h->time, h->dt);
-        return -1;
-    }
-    return 0;
+    const char *bad = NULL;
+    if (h->step < 0) bad = "a negative step";
+    else if (!isfinite(h->time) || h->time < 0) bad = "a time that is negative or not finite";
+    else if (!isfinite(h->dt) || h->dt <= 0) bad = "a time step that is not positive and finite";
+    else if (!isfinite(h->dt_prev) || h->dt_prev < 0) bad = "a previous time step that is negative or not finite";
+    else if (!isfinite(h->contact_work) || !isfinite(h->damping_work) || !isfinite(h->external_work))
+        bad = "energy totals that are not finite";
+    if (!bad) return 0;
+    model_error(err, FDEM_ITEM_NONE, -1,
+                "checkpoint has %s (step %lld, t = %g s, dt = %g s); it is damaged",
+                bad, (long long)h->step, h->time, h->dt);
+    return -1;
 }
 
 int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error *err)

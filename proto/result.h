@@ -13,8 +13,12 @@
  *  - result_reopen() reopens a file left by a previous run (clearing the
  *    status flags a crash leaves, as `h5clear -s` does), drops snapshots
  *    whose step is after `keep_until_step` and resumes SWMR writing.
- *  - result_copy() writes a consistent, closed copy of the file as it is
- *    after the last completed append (for downloads while running).
+ *  - Downloads while running: result_flush() on the I/O thread, then, with
+ *    no append in between, any thread may copy the bytes with
+ *    result_image_copy_step() (no HDF5 call; it clears the superblock's
+ *    "open for writing" flags in the copy, so it opens as a plain file).
+ *  - result_check_file() opens a closed result file read-only and says
+ *    whether it is whole (a truncated or replaced file is refused).
  *  - xdmf_write() rewrites the XDMF2 sidecar atomically (temp + rename):
  *    a temporal collection with one grid per snapshot, Triangle topology,
  *    XY geometry and attributes as HyperSlabs into the .h5 file.
@@ -23,6 +27,7 @@
 #define FDEM_RESULT_H
 
 #include <stddef.h>
+#include <sys/types.h>
 #include "case.h"
 #include "fdem.h"
 #include "snapshot.h"
@@ -35,7 +40,14 @@ result_file *result_reopen(const char *path, const fdem_model *model,
                            const case_info *info, int64_t keep_until_step,
                            char *err, size_t errlen);
 int result_append(result_file *f, const snapshot *s, char *err, size_t errlen);
-int result_copy(result_file *f, const char *dst_path, char *err, size_t errlen);
+int result_flush(result_file *f, char *err, size_t errlen);
+int result_check_file(const char *path, char *err, size_t errlen);
+/* Copies the next piece of bytes [done, size) of src to the same place in
+ * dst; returns the bytes copied (0 when done == size) or -1 with errno. */
+ssize_t result_image_copy_step(int src, int dst, size_t done, size_t size);
+/* Clears the open-for-writing flags of the superblock in `head` (the first
+ * bytes of a copy) and fixes its checksum; -1 if it is not a v2/v3 one. */
+int result_image_mark_closed(unsigned char *head, size_t len);
 int result_snapshot_count(const result_file *f);
 /* Simulated time of complete snapshot `index` (NAN when out of range). */
 double result_snapshot_time(const result_file *f, int index);

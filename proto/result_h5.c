@@ -17,8 +17,8 @@
  *    (the one `h5clear -s` sets; present in HDF5 1.10 and later), then
  *    trims every dataset to the committed length and to keep_until_step.
  *  - a download copy is a byte copy taken between appends (the writer has
- *    flushed, and only this thread writes) with the copy's status flags
- *    cleared, so a plain h5py.File(copy) opens it.
+ *    flushed, and appends of that case wait) with the copy's status flags
+ *    cleared, so a plain h5py.File(copy) opens it (result_image.c).
  *
  * Chunks: per-snapshot rows of at least 8 KiB get one snapshot per chunk,
  * split into ~1 MiB pieces along the node/element axis for huge models;
@@ -762,104 +762,42 @@ fail:
     return NULL;
 }
 
-/* -------------------------------------------------------------------- copy */
+/* ----------------------------------------------------------- downloads */
 
-static int copy_bytes(const char *src, int out, char *err, size_t errlen)
+int result_flush(result_file *f, char *err, size_t errlen)
 {
-    int in = open(src, O_RDONLY | O_CLOEXEC);
-    if (in < 0) {
-        snprintf(err, errlen, "cannot read %s: %s", src, strerror(errno));
-        return -1;
-    }
-    char buffer[1 << 16];
-    int rc = 0;
-    for (;;) {
-        ssize_t n = read(in, buffer, sizeof buffer);
-        if (n == 0) break;
-        if (n < 0) {
-            if (errno == EINTR) continue;
-            snprintf(err, errlen, "cannot read %s: %s", src, strerror(errno));
-            rc = -1;
-            break;
-        }
-        for (ssize_t done = 0; done < n;) {
-            ssize_t w = write(out, buffer + done, (size_t)(n - done));
-            if (w < 0 && errno == EINTR) continue;
-            if (w < 0) {
-                snprintf(err, errlen, "cannot write the copy of %s: %s", src, strerror(errno));
-                rc = -1;
-                break;
-            }
-            done += w;
-        }
-        if (rc < 0) break;
-    }
-    close(in);
-    return rc;
-}
-
-/* The byte copy still says "open for SWMR writing"; opening it read-write
- * with clear_status_flags and closing it leaves a plain, closed file. */
-static int clear_copy_flags(const char *path, char *err, size_t errlen)
-{
-    hid_t fapl = file_access_latest(1);
-    hid_t file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : H5I_INVALID_HID;
-    if (fapl >= 0) H5Pclose(fapl);
-    if (file < 0 || H5Fclose(file) < 0) {
-        result_fail(err, errlen, "cannot finalise the copy %s", path);
+    h5_quiet();
+    if (!f || H5Fflush(f->file, H5F_SCOPE_LOCAL) < 0) {
+        result_fail(err, errlen, "cannot flush the result file");
         return -1;
     }
     return 0;
 }
 
-static int fsync_path(const char *path)
-{
-    int fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return -1;
-    int rc = fsync(fd);
-    close(fd);
-    return rc;
-}
-
-int result_copy(result_file *f, const char *dst_path, char *err, size_t errlen)
+int result_check_file(const char *path, char *err, size_t errlen)
 {
     h5_quiet();
-    if (!f || !dst_path) {
-        snprintf(err, errlen, "result_copy: no file or no destination");
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        snprintf(err, errlen, "%s: %s", path, strerror(errno));
         return -1;
     }
-    char src[PATH_MAX], tmp[PATH_MAX];
-    if (H5Fget_name(f->file, src, sizeof src) < 0) {
-        result_fail(err, errlen, "cannot get the name of the result file");
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(err, errlen, "%s is not a regular file", path);
         return -1;
     }
-    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", dst_path) >= sizeof tmp) {
-        snprintf(err, errlen, "copy path too long: %s", dst_path);
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (file < 0) {
+        result_fail(err, errlen, "%s does not open as HDF5", path);
         return -1;
     }
-    if (H5Fflush(f->file, H5F_SCOPE_LOCAL) < 0) {
-        result_fail(err, errlen, "cannot flush %s before copying it", src);
+    int ok = has_result_format(file) && H5Lexists(file, "snapshots", H5P_DEFAULT) > 0;
+    H5Fclose(file);
+    H5Eclear2(H5E_DEFAULT);
+    if (!ok) {
+        snprintf(err, errlen, "%s is not an fdem result file (no format \"%s\" or no /snapshots)",
+                 path, RESULT_FORMAT);
         return -1;
     }
-    int out = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (out < 0) {
-        snprintf(err, errlen, "cannot create %s: %s", tmp, strerror(errno));
-        return -1;
-    }
-    int rc = copy_bytes(src, out, err, errlen);
-    if (close(out) < 0 && rc == 0) {
-        snprintf(err, errlen, "cannot write %s: %s", tmp, strerror(errno));
-        rc = -1;
-    }
-    if (rc == 0) rc = clear_copy_flags(tmp, err, errlen);
-    if (rc == 0 && fsync_path(tmp) < 0) {
-        snprintf(err, errlen, "cannot sync %s: %s", tmp, strerror(errno));
-        rc = -1;
-    }
-    if (rc == 0 && rename(tmp, dst_path) < 0) {
-        snprintf(err, errlen, "cannot rename %s to %s: %s", tmp, dst_path, strerror(errno));
-        rc = -1;
-    }
-    if (rc < 0) unlink(tmp);
-    return rc;
+    return 0;
 }

@@ -17,6 +17,7 @@ typedef struct fdemd_config {
     int threads;              /* OpenMP threads per running case */
     size_t max_case_memory;   /* memory_limit handed to case_build */
     size_t max_memory;        /* --max-memory: all models and uploads together */
+    double checkpoint_every;  /* s of wall time between checkpoints of a running case */
 } fdemd_config;
 
 #endif

@@ -36,8 +36,9 @@ typedef struct io_job {
     int close_after;
     /* completion, for jobs someone waits on */
     int waited, done, rc, fd;
+    int held, http_status;     /* IO_FETCH: writes held for a copy; 404/500 */
     size_t size;
-    char err[256];
+    char err[600];
     struct io_job *next;
 } io_job;
 
@@ -45,9 +46,11 @@ static pthread_mutex_t io_lock = PTHREAD_MUTEX_INITIALIZER;
 static pthread_cond_t io_wake = PTHREAD_COND_INITIALIZER;
 static pthread_cond_t io_done = PTHREAD_COND_INITIALIZER;
 static io_job *io_head, *io_tail;
+/* Jobs of cases whose result.h5 is being copied for a download; they go
+ * back to the front of the queue, in order, when the copy is done. */
+static io_job *io_deferred_head, *io_deferred_tail;
 static pthread_t io_thread;
 static int io_running;
-static unsigned long io_download_counter;
 
 /* Rewriting the XDMF costs O(snapshots); past a few hundred snapshots we
  * only refresh it twice a second (and always on close). */
@@ -59,11 +62,6 @@ static double io_now(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static void io_log(const server_case *c, const char *what, const char *err)
-{
-    fprintf(stderr, "fdemd: case %s: %s: %s\n", c->id, what, err);
 }
 
 static void io_write_xdmf(server_case *c, int force)
@@ -80,17 +78,30 @@ static void io_write_xdmf(server_case *c, int force)
     char path[1200], err[256] = "";
     snprintf(path, sizeof path, "%s/result.xdmf", c->dir);
     if (xdmf_write(path, "result.h5", c->model, &c->info, c->result, err, sizeof err) != 0)
-        io_log(c, "writing result.xdmf failed", err);
+        case_record_io_failure(c, "result.xdmf", err);
     c->xdmf_written_at = now;
     c->xdmf_dirty = 0;
 }
 
+/* After a failed write no checkpoint may follow: a restart from it would
+ * resume past the snapshot that was lost. */
 static void io_write_checkpoint(server_case *c, const void *ckpt, size_t size)
 {
-    if (c->deleted)
+    if (c->deleted || atomic_load(&c->io_failed))
         return;
     if (persist_write_atomic(c->dir, "checkpoint.bin", ckpt, size) != 0)
-        io_log(c, "writing checkpoint.bin failed", strerror(errno));
+        case_record_io_failure(c, "checkpoint.bin", strerror(errno));
+}
+
+/* Closes result.h5 after a failed write, so that what was committed stays
+ * a readable file (the flags of an open SWMR writer are cleared on close). */
+static void io_close_after_failure(server_case *c)
+{
+    io_write_xdmf(c, 1);
+    if (result_close(c->result) != 0)
+        fprintf(stderr, "fdemd: case %s: closing result.h5 after a failed write also failed\n",
+                c->id);
+    c->result = NULL;
 }
 
 static void io_do_create(io_job *j)
@@ -138,15 +149,18 @@ static void io_do_append(io_job *j)
     server_case *c = j->c;
     if (j->snap && c->result && !c->deleted) {
         char err[256] = "";
-        if (result_append(c->result, j->snap, err, sizeof err) != 0)
-            io_log(c, "appending a snapshot failed", err);
-        else
+        if (result_append(c->result, j->snap, err, sizeof err) != 0) {
+            case_record_io_failure(c, "result.h5", err);
+            io_close_after_failure(c);
+        } else {
             case_set_snapshots(c, result_snapshot_count(c->result));
-        io_write_xdmf(c, 0);
+            io_write_xdmf(c, 0);
+        }
     }
-    if (j->ckpt) {
+    if (j->ckpt && !atomic_load(&c->io_failed)) {
         io_write_checkpoint(c, j->ckpt, j->ckpt_size);
-        case_persist_status(c);
+        if (!atomic_load(&c->io_failed))
+            case_persist_status(c);
     }
     pthread_mutex_lock(&c->lock);
     c->io_pending--;
@@ -161,43 +175,52 @@ static void io_do_close(io_job *j)
         return;
     if (c->xdmf_dirty && !c->deleted)
         io_write_xdmf(c, 1);
-    result_close(c->result);
+    if (result_close(c->result) != 0 && !c->deleted)
+        case_record_io_failure(c, "result.h5", "its final flush failed (disk full or I/O error)");
     c->result = NULL;
 }
 
-/* While the file is open for SWMR writing we hand out a closed copy taken
- * after the last completed append; a closed file is served as it is. The
- * copy is unlinked right after opening, so nothing is left behind even if
- * the client disconnects. */
+/* A finished file is served as it is, once HDF5 has opened it (a file
+ * truncated or replaced on disk is refused, not sent). A file still open
+ * for SWMR writing is flushed and this case's writes are held, so that the
+ * caller can copy it off this thread (result_image_copy_step) and then
+ * calls io_release_hold(). Both cost metadata I/O only. */
 static void io_do_fetch(io_job *j)
 {
     server_case *c = j->c;
     char path[1200];
-    int temporary = 0;
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    j->rc = -1;
+    j->http_status = 500;
     if (c->result) {
-        snprintf(path, sizeof path, "%s/.download-%lu.h5", c->dir, ++io_download_counter);
-        if (result_copy(c->result, path, j->err, sizeof j->err) != 0) {
-            unlink(path);
-            j->rc = -1;
+        if (result_flush(c->result, j->err, sizeof j->err) != 0)
             return;
-        }
-        temporary = 1;
-    } else {
-        snprintf(path, sizeof path, "%s/result.h5", c->dir);
+        j->held = 1;
+        atomic_fetch_add(&c->io_hold, 1);
+    } else if (stat(path, &st) != 0 && errno == ENOENT) {
+        snprintf(j->err, sizeof j->err, "the case has no result.h5");
+        j->http_status = 404;
+        return;
+    } else if (result_check_file(path, j->err, sizeof j->err) != 0) {
+        char detail[sizeof j->err];
+        snprintf(detail, sizeof detail, "%s", j->err);
+        snprintf(j->err, sizeof j->err, "result.h5 is damaged: %.560s", detail);
+        return;
     }
     j->fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (temporary)
-        unlink(path);
-    struct stat st;
     if (j->fd < 0 || fstat(j->fd, &st) != 0) {
-        snprintf(j->err, sizeof j->err, "opening the result file: %s", strerror(errno));
+        snprintf(j->err, sizeof j->err, "opening result.h5: %s", strerror(errno));
         if (j->fd >= 0)
             close(j->fd);
         j->fd = -1;
-        j->rc = -1;
+        if (j->held)
+            io_release_hold(c);
+        j->held = 0;
         return;
     }
     j->size = (size_t)st.st_size;
+    j->rc = 0;
 }
 
 static void io_run_job(io_job *j)
@@ -222,17 +245,66 @@ static void io_job_free(io_job *j)
     free(j);
 }
 
-static void *io_main(void *arg)
+static void io_list_append(io_job **head, io_job **tail, io_job *j)
 {
-    (void)arg;
+    j->next = NULL;
+    if (*tail)
+        (*tail)->next = j;
+    else
+        *head = j;
+    *tail = j;
+}
+
+/* The next job to run; a held case's jobs (but for fetches, which write
+ * nothing) are set aside. */
+static io_job *io_next_locked(void)
+{
     for (;;) {
-        pthread_mutex_lock(&io_lock);
         while (!io_head)
             pthread_cond_wait(&io_wake, &io_lock);
         io_job *j = io_head;
         io_head = j->next;
         if (!io_head)
             io_tail = NULL;
+        if (j->c && j->kind != IO_FETCH && atomic_load(&j->c->io_hold) > 0) {
+            io_list_append(&io_deferred_head, &io_deferred_tail, j);
+            continue;
+        }
+        return j;
+    }
+}
+
+void io_release_hold(server_case *c)
+{
+    pthread_mutex_lock(&io_lock);
+    if (atomic_fetch_sub(&c->io_hold, 1) == 1) {
+        io_job *mine = NULL, *mine_tail = NULL, *rest = NULL, *rest_tail = NULL;
+        for (io_job *j = io_deferred_head, *next; j; j = next) {
+            next = j->next;
+            if (j->c == c)
+                io_list_append(&mine, &mine_tail, j);
+            else
+                io_list_append(&rest, &rest_tail, j);
+        }
+        io_deferred_head = rest;
+        io_deferred_tail = rest_tail;
+        if (mine) {
+            mine_tail->next = io_head;
+            io_head = mine;
+            if (!io_tail)
+                io_tail = mine_tail;
+            pthread_cond_signal(&io_wake);
+        }
+    }
+    pthread_mutex_unlock(&io_lock);
+}
+
+static void *io_main(void *arg)
+{
+    (void)arg;
+    for (;;) {
+        pthread_mutex_lock(&io_lock);
+        io_job *j = io_next_locked();
         pthread_mutex_unlock(&io_lock);
 
         io_run_job(j);
@@ -370,8 +442,12 @@ void io_close(server_case *c)
     io_job_free(j);
 }
 
-int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t errlen)
+int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
+                    char *err, size_t errlen)
 {
+    *fd = -1;
+    *held = 0;
+    *http_status = 500;
     io_job *j = io_job_new(IO_FETCH, c);
     if (!j) {
         snprintf(err, errlen, "out of memory");
@@ -380,6 +456,8 @@ int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t err
     int rc = io_run_and_wait(j);
     *fd = j->fd;
     *size = j->size;
+    *held = j->held;
+    *http_status = j->http_status;
     if (rc != 0)
         snprintf(err, errlen, "%s", j->err);
     io_job_free(j);

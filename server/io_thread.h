@@ -11,6 +11,8 @@
  *    and return at once; the other calls wait for their job (they wait on
  *    file I/O, never on a simulation step).
  *  - Each job holds a reference on its case.
+ *  - While a download copies a case's result.h5 (io_fetch_result with
+ *    *held), that case's jobs wait aside and the others run on.
  */
 #ifndef FDEMD_IO_THREAD_H
 #define FDEMD_IO_THREAD_H
@@ -31,7 +33,14 @@ int io_reopen(server_case *c, int64_t keep_until_step, int close_after,
 /* Appends `s` (may be NULL) then writes `ckpt` (may be NULL) as checkpoint.bin. */
 void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size);
 void io_close(server_case *c);
-/* An open, already unlinked-if-temporary descriptor of a consistent result.h5. */
-int io_fetch_result(server_case *c, int *fd, size_t *size, char *err, size_t errlen);
+/* An open descriptor of result.h5 and its size. A finished file is checked
+ * and served as it is (*held = 0). A file still being written was flushed
+ * and every later write of the case waits (*held = 1) until the caller has
+ * copied the `size` bytes (result_image_copy_step, any thread) and called
+ * io_release_hold(c). On failure *http_status is 404 (no file) or 500
+ * (damaged or unreadable) with the reason in err. */
+int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
+                    char *err, size_t errlen);
+void io_release_hold(server_case *c);
 
 #endif

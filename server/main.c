@@ -28,6 +28,7 @@ static void usage(FILE *out)
             "usage: fdemd [--listen 127.0.0.1:8080] [--data DIR] [--token TOKEN]\n"
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
             "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
+            "             [--checkpoint-every SECONDS]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -37,6 +38,7 @@ static void usage(FILE *out)
             "  --threads T             OpenMP threads per running case (default 1)\n"
             "  --max-case-memory BYTES largest model a case may build (default 4G)\n"
             "  --max-memory BYTES      models and uploads held at once (default: half the RAM)\n"
+            "  --checkpoint-every S    checkpoint running cases at least every S s of wall time (default 60)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -73,6 +75,17 @@ static int parse_int(const char *s, int min, int *out)
     return 0;
 }
 
+static int parse_seconds(const char *s, double *out)
+{
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (errno || end == s || *end || !(v > 0) || v > 1e9)
+        return -1;
+    *out = v;
+    return 0;
+}
+
 static int parse_listen(const char *s, fdemd_config *cfg)
 {
     const char *colon = strrchr(s, ':');
@@ -91,13 +104,14 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
-    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY };
+    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
         {"max-running", required_argument, 0, 'r'}, {"threads", required_argument, 0, 'j'},
         {"max-case-memory", required_argument, 0, OPT_MAX_CASE_MEMORY},
         {"max-memory", required_argument, 0, OPT_MAX_MEMORY},
+        {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -109,6 +123,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->threads = 1;
     cfg->max_case_memory = (size_t)4 << 30;
     cfg->max_memory = membudget_default_limit();
+    cfg->checkpoint_every = 60.0;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
@@ -130,6 +145,9 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
             break;
         case OPT_MAX_MEMORY:
             if (parse_size(optarg, &cfg->max_memory) || !cfg->max_memory) bad = "--max-memory takes a positive size in bytes";
+            break;
+        case OPT_CHECKPOINT_EVERY:
+            if (parse_seconds(optarg, &cfg->checkpoint_every)) bad = "--checkpoint-every takes a positive number of seconds";
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

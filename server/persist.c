@@ -34,9 +34,9 @@ static int persist_write_all(int fd, const void *data, size_t size)
     return 0;
 }
 
-int persist_fsync_dir(const char *dir)
+static int persist_fsync_opened(const char *path, int flags)
 {
-    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_CLOEXEC | flags);
     if (fd < 0)
         return -1;
     int rc = fsync(fd);
@@ -44,6 +44,11 @@ int persist_fsync_dir(const char *dir)
     close(fd);
     errno = saved;
     return rc;
+}
+
+int persist_fsync_dir(const char *dir)
+{
+    return persist_fsync_opened(dir, O_DIRECTORY);
 }
 
 int persist_write_atomic(const char *dir, const char *name, const void *data, size_t size)
@@ -127,12 +132,85 @@ int persist_remove_dir(const char *dir)
         return errno == ENOENT ? 0 : -1;
     struct dirent *e;
     char path[4096];
+    int first_errno = 0;
     while ((e = readdir(d)) != NULL) {
         if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
             continue;
-        if (snprintf(path, sizeof path, "%s/%s", dir, e->d_name) < (int)sizeof path)
-            unlink(path);
+        if (snprintf(path, sizeof path, "%s/%s", dir, e->d_name) < (int)sizeof path &&
+            unlink(path) != 0 && errno != ENOENT && !first_errno)
+            first_errno = errno;
     }
     closedir(d);
-    return rmdir(dir);
+    if (rmdir(dir) == 0 || errno == ENOENT)
+        return 0;
+    if (first_errno)
+        errno = first_errno;
+    return -1;
+}
+
+int persist_fsync_path(const char *path)
+{
+    return persist_fsync_opened(path, 0);
+}
+
+#define PERSIST_RESERVE_BYTES (64 * 1024)
+
+static int persist_reserve_path(const char *dir, char *path, size_t size)
+{
+    if (snprintf(path, size, "%s/.reserve", dir) >= (int)size) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    return 0;
+}
+
+int persist_reserve(const char *dir)
+{
+    char path[4096];
+    struct stat st;
+    if (persist_reserve_path(dir, path, sizeof path) != 0)
+        return -1;
+    if (stat(path, &st) == 0 && st.st_size >= PERSIST_RESERVE_BYTES)
+        return 0;
+    /* Real bytes, not a hole: a sparse file would free nothing. */
+    static const char zeros[PERSIST_RESERVE_BYTES];
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+        return -1;
+    int rc = persist_write_all(fd, zeros, sizeof zeros);
+    int saved = errno;
+    close(fd);
+    if (rc != 0)
+        unlink(path);
+    errno = saved;
+    return rc;
+}
+
+int persist_release_reserve(const char *dir)
+{
+    char path[4096];
+    if (persist_reserve_path(dir, path, sizeof path) != 0)
+        return -1;
+    return unlink(path);
+}
+
+int persist_check_writable(const char *dir)
+{
+    char path[4096];
+    if (snprintf(path, sizeof path, "%s/.probe-%ld", dir, (long)getpid()) >= (int)sizeof path) {
+        errno = ENAMETOOLONG;
+        return -1;
+    }
+    int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0)
+        return -1;
+    int rc = persist_write_all(fd, "probe\n", 6) != 0 || fsync(fd) != 0 ? -1 : 0;
+    int saved = errno;
+    close(fd);
+    if (unlink(path) != 0 && rc == 0) {
+        saved = errno;
+        rc = -1;
+    }
+    errno = saved;
+    return rc;
 }

@@ -17,7 +17,18 @@ int persist_write_atomic(const char *dir, const char *name, const void *data, si
 int persist_read_file(const char *path, char **data, size_t *size, size_t max_size);
 int persist_mkdir(const char *path);
 int persist_fsync_dir(const char *dir);
-/* Removes a case directory: its plain files, then the directory itself. */
+/* Removes a case directory: its plain files, then the directory itself;
+ * -1 with errno of the first file or the directory that would not go. */
 int persist_remove_dir(const char *dir);
+int persist_fsync_path(const char *path);
+
+/* A few pages kept in DIR/.reserve so that on a full disk the file that
+ * records a failure (status.json) can still be written: release it, then
+ * retry. persist_reserve is best effort. */
+int persist_reserve(const char *dir);
+int persist_release_reserve(const char *dir);
+
+/* Creates, syncs and removes a probe file: 0 when `dir` takes writes. */
+int persist_check_writable(const char *dir);
 
 #endif

@@ -261,19 +261,85 @@ json_t *case_status_json(server_case *c)
     return o;
 }
 
-void case_persist_status(server_case *c)
+void case_record_io_failure(server_case *c, const char *file, const char *reason)
+{
+    pthread_mutex_lock(&c->lock);
+    if (!c->io_error[0])
+        snprintf(c->io_error, sizeof c->io_error,
+                 "writing %s failed: %s; the results up to the last snapshot reported are kept",
+                 file, reason);
+    pthread_mutex_unlock(&c->lock);
+    atomic_store(&c->io_failed, 1);
+    fprintf(stderr, "fdemd: case %s: writing %s failed: %s\n", c->id, file, reason);
+}
+
+/* Writes `o` (consumed) as status.json; on a full disk the case's reserve
+ * is given up once so that at least this state becomes durable. */
+static int case_write_status_json(server_case *c, json_t *o, char *reason, size_t reason_size)
+{
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    json_decref(o);
+    int rc = -1;
+    if (!text) {
+        snprintf(reason, reason_size, "out of memory");
+        return -1;
+    }
+    rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+    int saved = errno;
+    if (rc != 0 && (saved == ENOSPC || saved == EDQUOT) && persist_release_reserve(c->dir) == 0) {
+        rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+        saved = errno;
+    }
+    if (rc != 0)
+        snprintf(reason, reason_size, "%s", strerror(saved));
+    free(text);
+    return rc;
+}
+
+/* The status object with `state` (and, when failed, `error`) as they are
+ * about to become; used to make a state durable before it is shown. */
+static json_t *case_status_json_as(server_case *c, case_state state, const char *error)
+{
+    json_t *o = case_status_json(c);
+    if (!o)
+        return NULL;
+    json_object_set_new(o, "state", json_string(case_state_name(state)));
+    if (error && error[0])
+        json_object_set_new(o, "error", json_string(error));
+    if (state == CASE_FINISHED)
+        json_object_set_new(o, "progress", json_real(1.0));
+    return o;
+}
+
+/* A status.json that cannot be written is a storage fault like any other:
+ * a case no worker is stepping becomes failed at once (and we try to make
+ * that durable), a running one is ended by its worker. */
+static void case_status_write_failed(server_case *c, const char *reason)
+{
+    case_record_io_failure(c, "status.json", reason);
+    pthread_mutex_lock(&c->lock);
+    int idle = !c->worker_active && !case_state_is_terminal(c->state);
+    if (idle) {
+        c->state = CASE_FAILED;
+        snprintf(c->error, sizeof c->error, "%s", c->io_error);
+    }
+    pthread_mutex_unlock(&c->lock);
+    char again[128];
+    if (idle)
+        case_write_status_json(c, case_status_json(c), again, sizeof again);
+}
+
+int case_persist_status(server_case *c)
 {
     if (atomic_load(&c->deleted))
-        return;
+        return 0;
+    char reason[128] = "";
     pthread_mutex_lock(&c->persist_lock);
-    json_t *o = case_status_json(c);
-    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
-    if (!text || persist_write_atomic(c->dir, "status.json", text, strlen(text)) != 0)
-        fprintf(stderr, "fdemd: case %s: writing status.json failed: %s\n", c->id,
-                text ? strerror(errno) : "out of memory");
-    free(text);
-    json_decref(o);
+    int rc = case_write_status_json(c, case_status_json(c), reason, sizeof reason);
     pthread_mutex_unlock(&c->persist_lock);
+    if (rc != 0)
+        case_status_write_failed(c, reason);
+    return rc;
 }
 
 /* ------------------------------------------------------------- listing */
@@ -398,18 +464,52 @@ static void registry_dispatch(void)
     }
 }
 
+/* The state a worker leaves its case in once the storage has had its say:
+ * failed (with the write error) if any write of the case failed, and a
+ * state is only published after its status.json is durable, so a state a
+ * client has seen never turns back after a crash. */
+static case_state case_settle_final_state(server_case *c, case_state final_state, char *error,
+                                          size_t error_size)
+{
+    pthread_mutex_lock(&c->lock);
+    snprintf(error, error_size, "%s", c->error);
+    if (atomic_load(&c->io_failed) && final_state != CASE_STOPPED) {
+        final_state = CASE_FAILED;
+        snprintf(error, error_size, "%s", c->io_error);
+    }
+    pthread_mutex_unlock(&c->lock);
+    if (atomic_load(&c->deleted))
+        return final_state;
+    char reason[128] = "";
+    pthread_mutex_lock(&c->persist_lock);
+    int rc = case_write_status_json(c, case_status_json_as(c, final_state, error), reason,
+                                    sizeof reason);
+    if (rc != 0) {
+        case_record_io_failure(c, "status.json", reason);
+        final_state = CASE_FAILED;
+        pthread_mutex_lock(&c->lock);
+        snprintf(error, error_size, "%s", c->io_error);
+        pthread_mutex_unlock(&c->lock);
+        case_write_status_json(c, case_status_json_as(c, final_state, error), reason, sizeof reason);
+    }
+    pthread_mutex_unlock(&c->persist_lock);
+    return final_state;
+}
+
 void registry_worker_exited(server_case *c, case_state final_state)
 {
+    char error[sizeof c->error];
+    final_state = case_settle_final_state(c, final_state, error, sizeof error);
     /* State and running count change together, so /health and the status
      * never disagree about whether the case runs. */
     pthread_mutex_lock(&reg_lock);
     pthread_mutex_lock(&c->lock);
     c->state = final_state;
+    snprintf(c->error, sizeof c->error, "%s", error);
     atomic_store(&c->command, WORKER_GO);
     pthread_mutex_unlock(&c->lock);
     reg_running--;
     pthread_mutex_unlock(&reg_lock);
-    case_persist_status(c);
     registry_dispatch();
 }
 
@@ -624,13 +724,31 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
     return status;
 }
 
-int registry_delete(server_case *c)
+/* Moves the case directory out of sight (DIR/.tmp-ID, which start-up
+ * sweeps) and removes it there; when a file will not go, what is left is
+ * moved back so the case stays whole and listed. */
+static int case_remove_files(server_case *c, char *msg, size_t msglen)
 {
-    pthread_mutex_lock(&c->ctl_lock);
-    if (atomic_load(&c->deleted)) {
-        pthread_mutex_unlock(&c->ctl_lock);
-        return 404;
+    char trash[sizeof c->dir + 8];
+    snprintf(trash, sizeof trash, "%s/.tmp-%s", reg_cfg->data_dir, c->id);
+    if (rename(c->dir, trash) != 0) {
+        snprintf(msg, msglen, "the files of the case could not be removed: renaming %s: %s",
+                 c->dir, strerror(errno));
+        return -1;
     }
+    if (persist_remove_dir(trash) != 0) {
+        int saved = errno;
+        rename(trash, c->dir);
+        snprintf(msg, msglen, "the files of the case could not all be removed from %s: %s",
+                 c->dir, strerror(saved));
+        return -1;
+    }
+    persist_fsync_dir(reg_cfg->data_dir);
+    return 0;
+}
+
+static void registry_unlist(server_case *c)
+{
     int listed = 0;
     pthread_mutex_lock(&reg_lock);
     for (int i = 0; i < reg_count; i++)
@@ -641,8 +759,19 @@ int registry_delete(server_case *c)
             break;
         }
     pthread_mutex_unlock(&reg_lock);
+    if (listed)
+        case_release(c); /* the registry's reference */
+}
 
+int registry_delete(server_case *c, char *msg, size_t msglen)
+{
+    pthread_mutex_lock(&c->ctl_lock);
+    if (atomic_load(&c->deleted)) {
+        pthread_mutex_unlock(&c->ctl_lock);
+        return 404;
+    }
     pthread_mutex_lock(&c->lock);
+    case_state before = c->state;
     if (c->worker_active)
         case_command_worker_locked(c, WORKER_ABANDON);
     c->state = CASE_STOPPED;
@@ -652,14 +781,23 @@ int registry_delete(server_case *c)
     membudget_release(&unreserve);
 
     io_close(c); /* FIFO: every earlier job of this case is done after it */
-    if (persist_remove_dir(c->dir) != 0)
-        fprintf(stderr, "fdemd: case %s: removing %s failed: %s\n", c->id, c->dir, strerror(errno));
-    else
-        persist_fsync_dir(reg_cfg->data_dir);
+    int status = 0;
+    if (case_remove_files(c, msg, msglen) != 0) {
+        /* Still there: the case stays listed as it was (a running or
+         * queued one stopped, as the DELETE began by stopping it). */
+        fprintf(stderr, "fdemd: case %s: %s\n", c->id, msg);
+        pthread_mutex_lock(&c->lock);
+        if (before != CASE_RUNNING && before != CASE_QUEUED)
+            c->state = before;
+        pthread_mutex_unlock(&c->lock);
+        atomic_store(&c->deleted, 0);
+        case_persist_status(c);
+        status = 500;
+    } else {
+        registry_unlist(c);
+    }
     pthread_mutex_unlock(&c->ctl_lock);
-    if (listed)
-        case_release(c); /* the registry's reference */
-    return 0;
+    return status;
 }
 
 snapshot *case_take_state(server_case *c, unsigned fields, int *status)
@@ -681,12 +819,18 @@ snapshot *case_take_state(server_case *c, unsigned fields, int *status)
 
 /* ------------------------------------------------------------- creating */
 
-static int case_make_dir(server_case *c)
+/* A new case is built in DIR/.tmp-ID and renamed into place once whole,
+ * so a crash while storing it leaves nothing that start-up would list. */
+static int case_make_dir(server_case *c, char *final_dir, size_t final_size)
 {
     for (int attempt = 0; attempt < 16; attempt++) {
         if (id_generate(c->id) != 0)
             return -1;
-        snprintf(c->dir, sizeof c->dir, "%s/%s", reg_cfg->data_dir, c->id);
+        snprintf(final_dir, final_size, "%s/%s", reg_cfg->data_dir, c->id);
+        snprintf(c->dir, sizeof c->dir, "%s/.tmp-%s", reg_cfg->data_dir, c->id);
+        struct stat st;
+        if (stat(final_dir, &st) == 0)
+            continue;
         if (mkdir(c->dir, 0755) == 0)
             return 0;
         if (errno != EEXIST)
@@ -694,6 +838,31 @@ static int case_make_dir(server_case *c)
     }
     errno = EEXIST;
     return -1;
+}
+
+/* Makes the files of the new case durable, then renames its directory
+ * into place (the rename is the moment the case exists). */
+static int case_publish_dir(server_case *c, const char *final_dir, char *err, size_t errlen)
+{
+    static const char *const files[] = {"result.h5", "result.xdmf"};
+    char path[1300];
+    for (size_t i = 0; i < sizeof files / sizeof *files; i++) {
+        snprintf(path, sizeof path, "%s/%s", c->dir, files[i]);
+        if (persist_fsync_path(path) != 0 && errno != ENOENT) {
+            snprintf(err, errlen, "cannot sync %s: %s", files[i], strerror(errno));
+            return -1;
+        }
+    }
+    if (persist_fsync_dir(c->dir) != 0 || rename(c->dir, final_dir) != 0) {
+        snprintf(err, errlen, "cannot move the new case into %s: %s", final_dir, strerror(errno));
+        return -1;
+    }
+    snprintf(c->dir, sizeof c->dir, "%s", final_dir);
+    if (persist_fsync_dir(reg_cfg->data_dir) != 0) {
+        snprintf(err, errlen, "cannot sync the data directory: %s", strerror(errno));
+        return -1;
+    }
+    return 0;
 }
 
 /* registry_create() with the lease that pays for the upload. */
@@ -722,11 +891,13 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     c->state = CASE_CREATED;
     iso_time_now(c->created, sizeof c->created);
     *http_status = 500;
-    if (case_make_dir(c) != 0) {
+    char final_dir[sizeof c->dir];
+    if (case_make_dir(c, final_dir, sizeof final_dir) != 0) {
         snprintf(err, errlen, "cannot create the case directory: %s", strerror(errno));
         case_release(c);
         return NULL;
     }
+    persist_reserve(c->dir);
     if (persist_write_atomic(c->dir, "case.json", body, size) != 0) {
         snprintf(err, errlen, "cannot store case.json: %s", strerror(errno));
         goto fail;
@@ -739,6 +910,12 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         goto fail;
     io_close(c); /* a case that is not running keeps no file open */
     case_publish_from_model(c);
+    if (case_persist_status(c) != 0) {
+        snprintf(err, errlen, "cannot store status.json: %s", c->io_error);
+        goto fail;
+    }
+    if (case_publish_dir(c, final_dir, err, errlen) != 0)
+        goto fail;
     fdem_counts n = fdem_get_counts(model);
     size_t cost = case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
     fdem_model *unused = NULL;
@@ -770,7 +947,8 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     }
     /* The status is durable before the 201 goes out (a running case that
      * is acknowledged comes back after a crash). */
-    case_persist_status(c);
+    if (start)
+        case_persist_status(c);
     *http_status = 201;
     case_retain(c);
     return c;
@@ -863,15 +1041,28 @@ static void case_load_status(server_case *c, const char *path)
     json_decref(st);
 }
 
+/* A case whose restored time is already at its end (a status.json that
+ * says running, e.g. edited by hand) is finished: it must never step on. */
+static void case_finish_if_at_end(server_case *c)
+{
+    if (!c->model || case_state_is_terminal(c->state))
+        return;
+    double dt = fdem_get_dt(c->model);
+    if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
+        fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
+        c->state = CASE_FINISHED;
+    }
+}
+
 /* A case that may run again is rebuilt once at start-up, when the budget
  * allows, to check its stored files and cut result.h5 back to its
  * checkpoint (a crash leaves later snapshots); the model is freed at once.
  * Short of memory the check waits for the case's start: it stays as it was
  * (memory short for a moment never makes a case fail). */
-static void case_check_stored(server_case *c)
+static int case_check_stored(server_case *c)
 {
     if (case_state_is_terminal(c->state))
-        return;
+        return 0;
     membudget_lease lease = {0};
     fdem_model *model = NULL;
     case_info info;
@@ -879,11 +1070,16 @@ static void case_check_stored(server_case *c)
     case_model_rc rc = CASE_MODEL_NO_MEMORY;
     if (membudget_grow(&lease, case_model_cost_of(c)) == 0)
         rc = case_model_build(c, &lease, &model, &info, err, sizeof err);
+    int broken = 0;
     if (rc == CASE_MODEL_BROKEN) {
         case_fail_loading(c, "%s", err);
+        broken = 1;
     } else if (rc == CASE_MODEL_OK) {
-        if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0)
+        if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0) {
             case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+            broken = 1;
+        }
+        case_finish_if_at_end(c);
         case_publish_from_model(c);
         case_model_drop(c);
     } else {
@@ -891,6 +1087,7 @@ static void case_check_stored(server_case *c)
                 "stays %s and is checked when it starts\n", c->id, case_state_name(c->state));
     }
     membudget_release(&lease);
+    return broken ? -1 : 0;
 }
 
 static server_case *case_load(const char *id)
@@ -910,13 +1107,24 @@ static server_case *case_load(const char *id)
         return NULL;
     }
     snprintf(path, sizeof path, "%s/status.json", c->dir);
+    if (stat(path, &st) != 0 && errno == ENOENT) {
+        /* Left by a crash during POST /cases of an older fdemd, which
+         * wrote status.json last before its 201: never acknowledged. */
+        fprintf(stderr, "fdemd: skipping %s: no status.json (a case never acknowledged)\n", c->dir);
+        case_release(c);
+        return NULL;
+    }
     case_load_status(c, path);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
-    case_check_stored(c);
-    case_persist_status(c);
+    /* A case that could not be loaded keeps its files as they are, so that
+     * once the damage is mended it comes back as it was. */
+    c->load_broken = case_check_stored(c) != 0;
+    if (!c->load_broken)
+        case_persist_status(c);
+    persist_reserve(c->dir);
     return c;
 }
 
@@ -927,12 +1135,29 @@ static int case_order(const void *a, const void *b)
     return d ? d : strcmp(x->id, y->id);
 }
 
+/* A case being created or deleted when the daemon stopped: never
+ * acknowledged (or already deleted), so it goes. */
+static void registry_sweep_half_made(const char *name)
+{
+    char path[sizeof reg_cfg->data_dir + 300];
+    snprintf(path, sizeof path, "%s/%s", reg_cfg->data_dir, name);
+    if (persist_remove_dir(path) != 0)
+        fprintf(stderr, "fdemd: cannot remove the half-made case %s: %s\n", path, strerror(errno));
+    else
+        fprintf(stderr, "fdemd: removed the half-made case %s\n", path);
+}
+
 int registry_init(const fdemd_config *cfg)
 {
     reg_cfg = cfg;
     if (persist_mkdir(cfg->data_dir) != 0) {
         fprintf(stderr, "fdemd: cannot create the data directory %s: %s\n", cfg->data_dir,
                 strerror(errno));
+        return -1;
+    }
+    if (persist_check_writable(cfg->data_dir) != 0) {
+        fprintf(stderr, "fdemd: the data directory %s cannot be written (%s); "
+                "give fdemd a writable --data directory\n", cfg->data_dir, strerror(errno));
         return -1;
     }
     DIR *d = opendir(cfg->data_dir);
@@ -943,6 +1168,10 @@ int registry_init(const fdemd_config *cfg)
     }
     struct dirent *e;
     while ((e = readdir(d)) != NULL) {
+        if (strncmp(e->d_name, ".tmp-", 5) == 0) {
+            registry_sweep_half_made(e->d_name);
+            continue;
+        }
         if (!id_is_valid(e->d_name))
             continue;
         server_case *c = case_load(e->d_name);
@@ -975,7 +1204,8 @@ void registry_shutdown(void)
         membudget_lease unreserve = case_take_reserve_locked(c);
         pthread_mutex_unlock(&c->lock);
         membudget_release(&unreserve);
-        case_persist_status(c);
+        if (!c->load_broken) /* one that could not be loaded keeps its files as found */
+            case_persist_status(c);
         io_close(c);
         pthread_mutex_unlock(&c->ctl_lock);
     }

@@ -92,6 +92,15 @@ typedef struct server_case {
     int xdmf_dirty;
     double xdmf_written_at;    /* monotonic seconds */
 
+    /* storage faults (section 5.5): the first failed write of this case,
+     * set by whoever hit it; the worker ends the case failed with it */
+    _Atomic int io_failed;
+    char io_error[512];        /* guarded by `lock` */
+    _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
+
+    int load_broken;           /* its stored files could not be loaded at start-up: they are
+                                  kept as found (so that, mended, the case comes back) */
+
     /* worker-private */
     double next_output;
     int64_t last_snapshot_step, last_checkpoint_step;
@@ -119,7 +128,9 @@ server_case *registry_create(const char *body, size_t size, int start,
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);
-int registry_delete(server_case *c);
+/* 0 once the files are gone; 404; or 500 with the reason in msg (the case
+ * stays listed, stopped). */
+int registry_delete(server_case *c, char *msg, size_t msglen);
 
 /* The state at one step boundary: the running model's, else the last
  * checkpoint's (a temporary rebuild). NULL with *status 503 (memory short
@@ -128,7 +139,12 @@ snapshot *case_take_state(server_case *c, unsigned fields, int *status);
 
 json_t *case_status_json(server_case *c);
 const char *case_state_name(case_state s);
-void case_persist_status(server_case *c);
+/* Writes status.json durably; 0, or -1 after recording the failure with
+ * case_record_io_failure (a case with no worker becomes failed at once). */
+int case_persist_status(server_case *c);
+/* Records that writing `file` of the case failed for `reason` (the first
+ * failure is kept); the running case ends `failed` with this error. */
+void case_record_io_failure(server_case *c, const char *file, const char *reason);
 
 /* Called by the worker and the I/O thread. */
 void case_publish(server_case *c, const case_figures *fig);

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "download.h"
 #include "http.h"
 #include "io_thread.h"
 #include "memory_budget.h"
@@ -259,16 +260,15 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
     return rc;
 }
 
-static enum MHD_Result route_result_h5(struct MHD_Connection *conn, server_case *c)
+static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
 {
-    int fd = -1;
-    size_t size = 0;
-    char err[256] = "";
-    if (io_fetch_result(c, &fd, &size, err, sizeof err) != 0) {
-        fprintf(stderr, "fdemd: case %s: serving result.h5 failed: %s\n", c->id, err);
-        return http_reply_problem(conn, 404, "Not found", "the result file is not available", NULL);
-    }
-    return http_reply_fd(conn, fd, size, "application/x-hdf5", "result.h5");
+    char msg[1400] = "";
+    int status = registry_delete(c, msg, sizeof msg);
+    if (status == 0)
+        return http_reply_empty(conn, 204);
+    if (status == 404)
+        return routes_no_case(conn, c->id);
+    return http_reply_problem(conn, 500, "Not deleted", msg, NULL);
 }
 
 static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, route_kind kind,
@@ -277,7 +277,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     switch (kind) {
     case ROUTE_CASE:
         if (strcmp(method, "DELETE") == 0)
-            return registry_delete(c) == 0 ? http_reply_empty(conn, 204) : routes_no_case(conn, c->id);
+            return route_delete(conn, c);
         return http_reply_json(conn, 200, case_status_json(c), NULL);
     case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
         return route_command(conn, c, kind);
@@ -286,7 +286,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_STATE:
         return route_state(conn, c);
     case ROUTE_CASE_RESULT_H5:
-        return route_result_h5(conn, c);
+        return download_reply(conn, c);
     case ROUTE_CASE_RESULT_XDMF:
         return routes_serve_file(conn, c, "result.xdmf", "application/xml");
     default:

@@ -132,6 +132,8 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             return EXIT_STOP;
         if (cmd == WORKER_ABANDON)
             return EXIT_ABANDON;
+        if (atomic_load(&c->io_failed))
+            return EXIT_FAILED; /* a write failed: stop, results so far are kept */
         worker_yield_to_requesters(c);
 
         pthread_mutex_lock(&c->model_lock);
@@ -169,6 +171,13 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
                 c->last_checkpoint_step = fdem_get_step(m);
                 clk->last_checkpoint = now;
             }
+        }
+        if (!ckpt && now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
+            /* --checkpoint-every: progress between far-apart snapshots
+             * survives a crash; the restart resumes on the output grid. */
+            ckpt = case_checkpoint_take(m, &ckpt_size);
+            c->last_checkpoint_step = fdem_get_step(m);
+            clk->last_checkpoint = now;
         }
         if (snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL)
             worker_publish(c, clk, now, 1);

@@ -181,6 +181,34 @@ static void checkpoint_round_trip_continues_identically(void)
     fdem_model_destroy(b);
 }
 
+/* A checkpoint whose header was damaged (negative step, NaN time) is
+ * refused and leaves the model as it was. */
+static void checkpoint_with_a_bad_header_is_refused(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
+    build_rectangle(m, mat, 0, 0, 0.1, 0.1, 3, 3);
+    build_finalize(m, 0.5);
+    fdem_error err;
+    for (int s = 0; s < 10; s++) fdem_step(m, &err);
+    size_t size = fdem_checkpoint_size(m);
+    unsigned char *buf = malloc(size);
+    CHECK(fdem_checkpoint_write(m, buf, size) == 0, "write");
+    const size_t step_at = 6 * sizeof(int32_t), time_at = step_at + sizeof(int64_t);
+    int64_t negative = -5;
+    memcpy(buf + step_at, &negative, sizeof negative);
+    CHECK(fdem_checkpoint_read(m, buf, size, &err) < 0, "a negative step was accepted");
+    CHECK(strstr(err.message, "negative step") != NULL, "message: %s", err.message);
+    CHECK(fdem_get_step(m) == 10, "the model changed: step %lld", (long long)fdem_get_step(m));
+    int64_t ten = 10;
+    double nan_time = NAN;
+    memcpy(buf + step_at, &ten, sizeof ten);
+    memcpy(buf + time_at, &nan_time, sizeof nan_time);
+    CHECK(fdem_checkpoint_read(m, buf, size, &err) < 0, "a NaN time was accepted");
+    free(buf);
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(free_fall_matches_half_g_t_squared), T(free_fall_with_changing_step),
            T(bar_period_is_4L_over_c), T(hanging_block_reaction_equals_weight),
-           T(checkpoint_round_trip_continues_identically))
+           T(checkpoint_round_trip_continues_identically), T(checkpoint_with_a_bad_header_is_refused))
