@@ -16,6 +16,8 @@ typedef struct fdemd_config {
     int max_running;          /* cases stepping at once; more are queued */
     int threads;              /* OpenMP threads per running case */
     size_t max_case_memory;   /* memory_limit handed to case_build */
+    int max_connections_per_ip; /* open connections per client address */
+    double request_timeout;   /* s for a whole request, headers and body */
 } fdemd_config;
 
 #endif

@@ -26,7 +26,8 @@ static void usage(FILE *out)
     fprintf(out,
             "usage: fdemd [--listen 127.0.0.1:8080] [--data DIR] [--token TOKEN]\n"
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
-            "             [--max-case-memory BYTES]\n"
+            "             [--max-case-memory BYTES] [--max-connections-per-ip N]\n"
+            "             [--request-timeout SECONDS]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -35,6 +36,9 @@ static void usage(FILE *out)
             "  --max-running N         cases stepping at once; later starts are queued (default: cores)\n"
             "  --threads T             OpenMP threads per running case (default 1)\n"
             "  --max-case-memory BYTES largest model a case may build (default 4G)\n"
+            "  --max-connections-per-ip N  open connections per client address (default 16)\n"
+            "  --request-timeout SECONDS   a request must arrive whole (headers and body)\n"
+            "                          within this time, or is cut (default 30)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -89,12 +93,14 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
-    enum { OPT_MAX_CASE_MEMORY = 1000 };
+    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
         {"max-running", required_argument, 0, 'r'}, {"threads", required_argument, 0, 'j'},
         {"max-case-memory", required_argument, 0, OPT_MAX_CASE_MEMORY},
+        {"max-connections-per-ip", required_argument, 0, OPT_MAX_CONNECTIONS_PER_IP},
+        {"request-timeout", required_argument, 0, OPT_REQUEST_TIMEOUT},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -105,6 +111,9 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->max_running = cores > 0 ? (int)cores : 1;
     cfg->threads = 1;
     cfg->max_case_memory = (size_t)4 << 30;
+    cfg->max_connections_per_ip = 16;
+    cfg->request_timeout = 30;
+    int request_timeout = 30;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
@@ -123,6 +132,13 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case 'j': if (parse_int(optarg, 1, &cfg->threads)) bad = "--threads takes a positive integer"; break;
         case OPT_MAX_CASE_MEMORY:
             if (parse_size(optarg, &cfg->max_case_memory) || !cfg->max_case_memory) bad = "--max-case-memory takes a positive size in bytes";
+            break;
+        case OPT_MAX_CONNECTIONS_PER_IP:
+            if (parse_int(optarg, 1, &cfg->max_connections_per_ip)) bad = "--max-connections-per-ip takes a positive integer";
+            break;
+        case OPT_REQUEST_TIMEOUT:
+            if (parse_int(optarg, 1, &request_timeout)) bad = "--request-timeout takes a positive number of seconds";
+            cfg->request_timeout = request_timeout;
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;
