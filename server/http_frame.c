@@ -23,7 +23,7 @@
 #include <string.h>
 #include <strings.h>
 
-#define FRAME_MAX_DIGITS 19 /* any 19-digit number fits in 64 bits */
+#define FRAME_MAX_DIGITS 18 /* below 10^18: fits a long long, and far above --max-upload */
 
 /* Empty lines before the request line are skipped (RFC 9112 section 2.2,
  * and libmicrohttpd does too), so they neither end nor start the block. */
@@ -123,6 +123,7 @@ static int frame_check_line(const char *line, size_t len, frame_lengths *seen,
 int http_frame_check(const char *head, size_t size, http_frame_verdict *v)
 {
     memset(v, 0, sizeof *v);
+    v->content_length = -1;
     frame_lengths seen = {0, 0, 0};
     const char *p = head + frame_skip_empty_lines(head, size), *end = head + size;
     int first = 1;
@@ -144,5 +145,6 @@ int http_frame_check(const char *head, size_t size, http_frame_verdict *v)
         return frame_refuse(v, 411, "Length required",
                             "send the body with a Content-Length header and no "
                             "Transfer-Encoding (chunked uploads are not accepted)");
+    if (seen.count) v->content_length = (long long)seen.value; /* < 10^18: fits */
     return 0;
 }

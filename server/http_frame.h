@@ -21,6 +21,7 @@ typedef struct http_frame_verdict {
     int status;        /* 0 when the framing is acceptable */
     char title[48];    /* "Bad request", ... */
     char detail[200];
+    long long content_length; /* the agreed value when acceptable, else -1 */
 } http_frame_verdict;
 
 /* Offset just past the blank line ending the header block, or 0 if `data`
