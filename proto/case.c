@@ -102,7 +102,7 @@ static void case_read_fields(case_doc *doc, const json_t *fields)
         if (!bit)
             case_problem(doc, at, "unknown field \"%.64s\"%s (fields are position, velocity, "
                                   "stress, damage)", json_string_value(f),
-                         case_did_you_mean(hint, sizeof hint, json_string_value(f),
+                         case_did_you_mean(doc, hint, sizeof hint, json_string_value(f),
                                            field_names, 4));
         doc->fields |= bit;
     }
@@ -252,6 +252,8 @@ void case_doc_free(case_doc *doc)
     free(doc->parts);
     free(doc->materials);
     free(doc->constraints);
+    json_decref(doc->material_names);
+    json_decref(doc->part_names);
 }
 
 static json_t *case_parse(const char *text, size_t length, problems *out)

@@ -26,17 +26,15 @@ static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const 
         return;
     }
     const char *wanted = json_string_value(name);
-    const char **names = malloc((size_t)(doc->part_count + 1) * sizeof *names);
-    for (int i = 0; i < doc->part_count; i++) {
-        if (strcmp(doc->parts[i].name, wanted) == 0) {
-            def->part = i;
-            free(names);
-            return;
-        }
-        if (names) names[i] = doc->parts[i].name;
+    int found = case_names_find(doc->part_names, wanted);
+    if (found >= 0) {
+        def->part = found;
+        return;
     }
+    const char **names = malloc((size_t)(doc->part_count + 1) * sizeof *names);
+    for (int i = 0; names && i < doc->part_count; i++) names[i] = doc->parts[i].name;
     char hint[96] = "";
-    if (names) case_did_you_mean(hint, sizeof hint, wanted, names, doc->part_count);
+    if (names) case_did_you_mean(doc, hint, sizeof hint, wanted, names, doc->part_count);
     free(names);
     case_problem(doc, ptr, "unknown part \"%.64s\"%s", wanted, hint);
 }

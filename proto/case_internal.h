@@ -68,6 +68,9 @@ typedef struct case_doc {
     double end_time, dt, safety, interval;
     int dt_auto;
     unsigned fields;
+    json_t *material_names;  /* name -> index into materials (case_names_add) */
+    json_t *part_names;      /* name -> index into parts */
+    long typo_cells; /* edit-distance work spent on "did you mean" so far */
 } case_doc;
 
 /* ------------------------------------------------- case_read.c: JSON values */
@@ -102,12 +105,24 @@ int case_number_member(case_doc *doc, const json_t *object, const char *base,
 int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
                     const char *const *allowed, const char *what);
 
-/* The candidate closest to `word` if it is a plausible typo, else NULL. */
-const char *case_closest(const char *word, const char *const *candidates, int count);
+/* Name -> index tables, so lookups by name are O(1). case_names_add()
+ * returns the index already stored under `name` (and stores nothing), or -1
+ * after storing `index` (or adding an out-of-memory problem). */
+int case_names_add(case_doc *doc, json_t **names, const char *name, int index);
+int case_names_find(const json_t *names, const char *name); /* -1: unknown */
 
-/* ", did you mean \"x\"?" or "" (static buffer per call site is not needed:
- * writes into `buf`). */
-const char *case_did_you_mean(char *buf, size_t size, const char *word,
+/* The candidate closest to `word` if it is a plausible typo, else NULL.
+ * Spends at most *cells_left cells of edit-distance table (and subtracts
+ * what it spent): the search stops, keeping the best so far, when a
+ * comparison would not fit. */
+const char *case_closest(const char *word, const char *const *candidates, int count,
+                         long *cells_left);
+
+/* "; did you mean \"x\"?" or "" written into `buf`. The work is charged to
+ * the document's bounded budget, and skipped once the problem list is full
+ * (the message would be dropped anyway), so validation stays linear in the
+ * size of the document however many names are unknown. */
+const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char *word,
                               const char *const *candidates, int count);
 
 /* -------------------------------------------------- the sections, pass 1 */

@@ -119,15 +119,14 @@ void case_read_materials(case_doc *doc, const json_t *materials)
         char ptr[CASE_POINTER];
         pointer_join(ptr, sizeof ptr, "/materials", name);
         m->name = name;
+        case_names_add(doc, &doc->material_names, name, doc->material_count - 1);
         material_read(doc, name, value, ptr, &m->def);
     }
 }
 
 int case_material_index(const case_doc *doc, const char *name)
 {
-    for (int i = 0; i < doc->material_count; i++)
-        if (strcmp(doc->materials[i].name, name) == 0) return i;
-    return -1;
+    return case_names_find(doc->material_names, name);
 }
 
 int case_add_materials(case_doc *doc, fdem_model *model)

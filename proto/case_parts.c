@@ -285,7 +285,7 @@ static void part_read_material(case_doc *doc, case_part *part, const json_t *val
     char hint[96] = "";
     if (names) {
         for (int i = 0; i < doc->material_count; i++) names[i] = doc->materials[i].name;
-        case_did_you_mean(hint, sizeof hint, name, names, doc->material_count);
+        case_did_you_mean(doc, hint, sizeof hint, name, names, doc->material_count);
         free(names);
     }
     case_problem(doc, at, "unknown material \"%.64s\"%s", name, hint);
@@ -321,15 +321,14 @@ static void part_read(case_doc *doc, case_part *part, int index, const json_t *v
 /* Names must be unique because constraints select parts by name. */
 static void part_check_names(case_doc *doc)
 {
-    for (int i = 1; i < doc->part_count; i++)
-        for (int j = 0; j < i; j++)
-            if (strcmp(doc->parts[i].name, doc->parts[j].name) == 0) {
-                char ptr[CASE_POINTER];
-                pointer_join_index(ptr, sizeof ptr, "/parts", i);
-                case_problem(doc, ptr, "the part name \"%s\" is already used by /parts/%d",
-                             doc->parts[i].name, j);
-                break;
-            }
+    for (int i = 0; i < doc->part_count; i++) {
+        int first = case_names_add(doc, &doc->part_names, doc->parts[i].name, i);
+        if (first < 0) continue;
+        char ptr[CASE_POINTER];
+        pointer_join_index(ptr, sizeof ptr, "/parts", i);
+        case_problem(doc, ptr, "the part name \"%s\" is already used by /parts/%d",
+                     doc->parts[i].name, first);
+    }
 }
 
 void case_read_parts(case_doc *doc, const json_t *parts)

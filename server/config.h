@@ -18,6 +18,8 @@ typedef struct fdemd_config {
     size_t max_case_memory;   /* memory_limit handed to case_build */
     size_t max_memory;        /* --max-memory: all models and uploads together */
     double checkpoint_every;  /* s of wall time between checkpoints of a running case */
+    int max_connections_per_ip; /* open connections per client address */
+    double request_timeout;   /* s for a whole request, headers and body */
 } fdemd_config;
 
 #endif

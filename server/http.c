@@ -12,6 +12,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <math.h>
 #include <netinet/in.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,16 +22,17 @@
 #include <unistd.h>
 
 #include "memory_budget.h"
+#include "gate.h"
 #include "routes.h"
 
 #define HTTP_THREADS 4
-#define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity */
+#define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity while a response is sent */
 #define HTTP_CONNECTION_LIMIT 512
-#define HTTP_PER_IP_LIMIT 128
 #define HTTP_CONNECTION_MEMORY (64 * 1024) /* request line and headers */
 
 typedef struct http_request {
     route_match route;
+    double deadline;  /* the whole request must have arrived by then */
     int answered;     /* a response was queued before the body */
     int too_large;
     char *body;
@@ -48,6 +50,9 @@ static enum MHD_Result http_queue(struct MHD_Connection *conn, unsigned status,
 {
     if (!resp)
         return MHD_NO;
+    /* One request per connection: every request then passes the gate,
+     * which alone applies the header checks and the deadline's first part. */
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
     enum MHD_Result rc = MHD_queue_response(conn, status, resp);
     MHD_destroy_response(resp);
     return rc;
@@ -209,13 +214,8 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         *rc = http_reply_not_allowed(conn, routes_allowed(r->route.kind));
         return 1;
     }
-    const char *te = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_TRANSFER_ENCODING);
+    /* Transfer-Encoding and malformed lengths were refused by the gate. */
     const char *cl = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
-    if (te && strcasecmp(te, "identity") != 0) {
-        *rc = http_reply_problem(conn, 411, "Length required",
-                                 "send the body with a Content-Length header (chunked uploads are not accepted)", NULL);
-        return 1;
-    }
     if (!cl) {
         if (routes_takes_body(r->route.kind, method)) {
             *rc = http_reply_problem(conn, 411, "Length required",
@@ -276,6 +276,38 @@ static int http_collect(http_request *r, const char *data, size_t size)
     return 0;
 }
 
+/* ------------------------------------------------------------ deadline */
+
+/* A request must arrive whole within --request-timeout of its connection
+ * being accepted. The gate enforces that until the headers are in; from
+ * then on libmicrohttpd's inactivity timeout is narrowed to the time left,
+ * so a body that stalls is cut at the deadline and one that trickles is cut
+ * at its first chunk after it. */
+static double http_request_deadline(struct MHD_Connection *conn)
+{
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    double accepted = info ? gate_accepted_at(info->connect_fd) : 0;
+    return (accepted > 0 ? accepted : gate_now()) + http_cfg->request_timeout;
+}
+
+static int http_in_time(struct MHD_Connection *conn, const http_request *r)
+{
+    double left = r->deadline - gate_now();
+    if (left <= 0)
+        return 0;
+    MHD_set_connection_option(conn, MHD_CONNECTION_OPTION_TIMEOUT, (unsigned)ceil(left));
+    return 1;
+}
+
+static enum MHD_Result http_reply_timeout(struct MHD_Connection *conn)
+{
+    char detail[128];
+    snprintf(detail, sizeof detail, "the request did not arrive whole within %g s (--request-timeout)",
+             http_cfg->request_timeout);
+    return http_reply_problem(conn, 408, "Request timeout", detail, NULL);
+}
+
 static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const char *url,
                                    const char *method, const char *version, const char *upload_data,
                                    size_t *upload_data_size, void **req_cls)
@@ -288,8 +320,13 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
         if (!r)
             return MHD_NO;
         *req_cls = r;
+        r->deadline = http_request_deadline(conn);
         routes_match(url, &r->route);
         enum MHD_Result rc = MHD_YES;
+        if (!http_in_time(conn, r)) {
+            r->answered = 1;
+            return http_reply_timeout(conn);
+        }
         if (http_check_headers(conn, method, r, &rc)) {
             r->answered = 1;
             return rc;
@@ -301,12 +338,17 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
         return MHD_YES;
     }
     if (*upload_data_size > 0) {
+        if (!http_in_time(conn, r))
+            return MHD_NO; /* nothing can be answered in the middle of a body */
         if (!r->too_large && http_collect(r, upload_data, *upload_data_size) != 0)
             return MHD_NO;
         *upload_data_size = 0;
         return MHD_YES;
     }
     r->answered = 1;
+    MHD_set_connection_option(conn, MHD_CONNECTION_OPTION_TIMEOUT, (unsigned)HTTP_CONNECTION_TIMEOUT);
+    if (gate_now() > r->deadline)
+        return http_reply_timeout(conn);
     if (r->too_large)
         return http_reply_problem(conn, 413, "Payload too large",
                                   "the body is longer than its Content-Length or --max-upload", NULL);
@@ -354,9 +396,28 @@ static size_t http_unescape(void *cls, struct MHD_Connection *conn, char *s)
 
 /* ---------------------------------------------------------------- start */
 
-int http_start(const fdemd_config *cfg)
+/* The gate counts connections per address; it must hear of every close. */
+static void http_connection_event(void *cls, struct MHD_Connection *conn, void **socket_context,
+                                  enum MHD_ConnectionNotificationCode code)
 {
-    http_cfg = cfg;
+    (void)cls;
+    (void)socket_context;
+    if (code != MHD_CONNECTION_NOTIFY_CLOSED)
+        return;
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (info)
+        gate_closed(info->connect_fd);
+}
+
+static int http_hand_over(int fd, const struct sockaddr_in *addr)
+{
+    return MHD_add_connection(http_daemon, fd, (const struct sockaddr *)addr, sizeof *addr) == MHD_YES;
+}
+
+/* Returns the listening socket and the port it got, or -1. */
+static int http_listen(const fdemd_config *cfg, int *port)
+{
     struct sockaddr_in addr;
     memset(&addr, 0, sizeof addr);
     addr.sin_family = AF_INET;
@@ -365,31 +426,61 @@ int http_start(const fdemd_config *cfg)
         fprintf(stderr, "fdemd: --listen: \"%s\" is not an IPv4 address\n", cfg->listen_host);
         return -1;
     }
-    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG;
+    int fd = socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+    int one = 1;
+    socklen_t len = sizeof addr;
+    if (fd < 0 || setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one) != 0 ||
+        bind(fd, (struct sockaddr *)&addr, sizeof addr) != 0 || listen(fd, 128) != 0 ||
+        getsockname(fd, (struct sockaddr *)&addr, &len) != 0) {
+        fprintf(stderr, "fdemd: cannot listen on %s:%d (%s)\n", cfg->listen_host, cfg->listen_port,
+                strerror(errno));
+        if (fd >= 0)
+            close(fd);
+        return -1;
+    }
+    *port = ntohs(addr.sin_port);
+    return fd;
+}
+
+int http_start(const fdemd_config *cfg)
+{
+    http_cfg = cfg;
+    int port = 0;
+    int listen_fd = http_listen(cfg, &port);
+    if (listen_fd < 0)
+        return -1;
+    /* Connections arrive through the gate (MHD_add_connection), so
+     * libmicrohttpd has no listening socket of its own and no limits of its
+     * own: the gate's counts are the ones that hold. */
+    unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_ALLOW_SUSPEND_RESUME | MHD_USE_ERROR_LOG |
+                     MHD_USE_NO_LISTEN_SOCKET | MHD_USE_ITC;
     flags |= MHD_is_feature_supported(MHD_FEATURE_EPOLL) == MHD_YES ? MHD_USE_EPOLL : MHD_USE_POLL;
     http_daemon = MHD_start_daemon(
         flags, 0, NULL, NULL, http_access, NULL,
-        MHD_OPTION_SOCK_ADDR, (struct sockaddr *)&addr,
         MHD_OPTION_THREAD_POOL_SIZE, (unsigned)HTTP_THREADS,
         MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)HTTP_CONNECTION_TIMEOUT,
-        MHD_OPTION_CONNECTION_LIMIT, (unsigned)HTTP_CONNECTION_LIMIT,
-        MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)HTTP_PER_IP_LIMIT,
+        MHD_OPTION_CONNECTION_LIMIT, (unsigned)(2 * HTTP_CONNECTION_LIMIT),
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, (size_t)HTTP_CONNECTION_MEMORY,
         MHD_OPTION_NOTIFY_COMPLETED, http_completed, NULL,
+        MHD_OPTION_NOTIFY_CONNECTION, http_connection_event, NULL,
         MHD_OPTION_UNESCAPE_CALLBACK, http_unescape, NULL,
         MHD_OPTION_END);
-    if (!http_daemon) {
-        fprintf(stderr, "fdemd: cannot listen on %s:%d (in use, or not an address of this machine)\n",
-                cfg->listen_host, cfg->listen_port);
+    gate_limits limits = {cfg->max_connections_per_ip, HTTP_CONNECTION_LIMIT, cfg->request_timeout};
+    if (!http_daemon || gate_start(listen_fd, &limits, http_hand_over) != 0) {
+        fprintf(stderr, "fdemd: cannot start the HTTP server\n");
+        if (http_daemon)
+            MHD_stop_daemon(http_daemon);
+        else
+            close(listen_fd);
+        http_daemon = NULL;
         return -1;
     }
-    const union MHD_DaemonInfo *info = MHD_get_daemon_info(http_daemon, MHD_DAEMON_INFO_BIND_PORT);
-    int port = info && info->port ? (int)info->port : cfg->listen_port;
     return port;
 }
 
 void http_stop(void)
 {
+    gate_stop(); /* no new connections while the open ones are closed */
     if (http_daemon) {
         MHD_stop_daemon(http_daemon);
         http_daemon = NULL;

@@ -5,10 +5,13 @@
  * Contract:
  *  - http_start() binds cfg->listen_host:listen_port and returns the port
  *    actually bound (useful for port 0), or -1 with a message on stderr.
+ *  - Connections come through the gate (gate.h): per-address cap, header
+ *    deadline, framing checks. Each response closes its connection, so
+ *    every request passes the gate.
  *  - Requests are checked before their body is read: 401 (token), 404/405
- *    (route), 411 (POST /cases without Content-Length, or any chunked
- *    body), 413 (Content-Length above --max-upload). Only then is the body
- *    collected and the route called.
+ *    (route), 411 (POST /cases without Content-Length), 413 (Content-Length
+ *    above --max-upload). Only then is the body collected and the route
+ *    called; a request not whole by --request-timeout gets 408 or is cut.
  *  - Every error body is RFC 9457 problem+json with an "errors" list.
  */
 #ifndef FDEMD_HTTP_H

@@ -28,7 +28,8 @@ static void usage(FILE *out)
             "usage: fdemd [--listen 127.0.0.1:8080] [--data DIR] [--token TOKEN]\n"
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
             "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
-            "             [--checkpoint-every SECONDS]\n"
+            "             [--checkpoint-every SECONDS] [--max-connections-per-ip N]\n"
+            "             [--request-timeout SECONDS]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -39,6 +40,9 @@ static void usage(FILE *out)
             "  --max-case-memory BYTES largest model a case may build (default 4G)\n"
             "  --max-memory BYTES      models and uploads held at once (default: half the RAM)\n"
             "  --checkpoint-every S    checkpoint running cases at least every S s of wall time (default 60)\n"
+            "  --max-connections-per-ip N  open connections per client address (default 16)\n"
+            "  --request-timeout SECONDS   a request must arrive whole (headers and body)\n"
+            "                          within this time, or is cut (default 30)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -104,7 +108,8 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
-    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY };
+    enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY,
+           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
@@ -112,6 +117,8 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         {"max-case-memory", required_argument, 0, OPT_MAX_CASE_MEMORY},
         {"max-memory", required_argument, 0, OPT_MAX_MEMORY},
         {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
+        {"max-connections-per-ip", required_argument, 0, OPT_MAX_CONNECTIONS_PER_IP},
+        {"request-timeout", required_argument, 0, OPT_REQUEST_TIMEOUT},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -124,6 +131,9 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->max_case_memory = (size_t)4 << 30;
     cfg->max_memory = membudget_default_limit();
     cfg->checkpoint_every = 60.0;
+    cfg->max_connections_per_ip = 16;
+    cfg->request_timeout = 30;
+    int request_timeout = 30;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
@@ -148,6 +158,13 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
             break;
         case OPT_CHECKPOINT_EVERY:
             if (parse_seconds(optarg, &cfg->checkpoint_every)) bad = "--checkpoint-every takes a positive number of seconds";
+            break;
+        case OPT_MAX_CONNECTIONS_PER_IP:
+            if (parse_int(optarg, 1, &cfg->max_connections_per_ip)) bad = "--max-connections-per-ip takes a positive integer";
+            break;
+        case OPT_REQUEST_TIMEOUT:
+            if (parse_int(optarg, 1, &request_timeout)) bad = "--request-timeout takes a positive number of seconds";
+            cfg->request_timeout = request_timeout;
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

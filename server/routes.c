@@ -187,9 +187,12 @@ static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char
         char detail[640];
         if (status == 400)
             snprintf(detail, sizeof detail, "%s", p.count ? p.items[0].message : "the body is not valid JSON");
+        else if (p.dropped)
+            snprintf(detail, sizeof detail, "%d problems in the case; the first %d are listed",
+                     p.count + p.dropped, p.count);
         else
-            snprintf(detail, sizeof detail, "%d problem%s in the case", p.count + p.dropped,
-                     p.count + p.dropped == 1 ? "" : "s");
+            snprintf(detail, sizeof detail, "%d problem%s in the case", p.count,
+                     p.count == 1 ? "" : "s");
         const char *title = p.title[0] ? p.title : status == 400 ? "Malformed JSON" : "Invalid case";
         rc = http_reply_problem(conn, (unsigned)status, title, detail, &p);
     } else {

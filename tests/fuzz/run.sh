@@ -1,16 +1,24 @@
 #!/usr/bin/env bash
-# Builds tests/fuzz/fuzz_case.c with clang + libFuzzer + ASan/UBSan against
-# the core and proto sources directly, seeds a corpus from examples/*.json,
-# tests/data/*.msh (wrapped as gmsh parts) and a few inline documents, and
-# fuzzes case_build() for FUZZ_SECONDS (default 60). Exits non-zero on a
-# crash, leak or timeout; the reproducer is left in build/fuzz/.
+# Builds the libFuzzer harnesses with clang + ASan/UBSan against the core,
+# proto and server sources they need, seeds their corpora and runs each for
+# its share of FUZZ_SECONDS (default 60 in all; the case parser gets two
+# thirds, the HTTP request path one third, so CI time does not grow):
+#   fuzz_case  case_build() and gmsh_read() on any bytes; seeds: examples,
+#              tests/data/*.msh (raw and wrapped as gmsh parts), inline docs;
+#   fuzz_http  a raw request: header block, framing checks, ?fields=, and the
+#              body as POST /cases; seeds: inline requests.
+# Exits non-zero on a crash, leak or timeout; the reproducer is left in
+# build/fuzz/.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 seconds=${FUZZ_SECONDS:-60}
+case_seconds=$(( seconds * 2 / 3 > 0 ? seconds * 2 / 3 : 1 ))
+http_seconds=$(( seconds - case_seconds > 0 ? seconds - case_seconds : 1 ))
 out=build/fuzz
 corpus=$out/corpus
-mkdir -p "$out" "$corpus"
+http_corpus=$out/corpus-http
+mkdir -p "$out" "$corpus" "$http_corpus"
 
 # core/ without the OpenMP pragmas' runtime: -fopenmp is not needed for
 # correctness and libFuzzer + libomp threads only slow the fuzzer down.
@@ -20,6 +28,9 @@ pkg=$(pkg-config --cflags --libs jansson hdf5)
 # shellcheck disable=SC2086
 clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*.c $pkg -lm \
       -o "$out/fuzz_case"
+# shellcheck disable=SC2086
+clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c core/*.c \
+      proto/*.c $pkg -lm -o "$out/fuzz_http"
 
 # Seeds: the bundled examples, every gmsh test file as a part, small docs.
 for f in examples/*.json; do [ -e "$f" ] && cp "$f" "$corpus/"; done
@@ -51,12 +62,30 @@ JSON
 printf '{"time": {"end": 1e999}}' > "$corpus/inline-overflow.json"
 printf '[[[[[[[[[[' > "$corpus/inline-deep.json"
 
-status=0
-"$out/fuzz_case" "$corpus" -dict=tests/fuzz/case.dict -max_total_time="$seconds" -max_len=65536 -timeout=10 \
-    -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 \
-    -artifact_prefix="$out/" 2>&1 | tail -n 25 || status=$?
-if [ "$status" -ne 0 ]; then
-  echo "fuzz: FAILED (exit $status); reproducer in $out/" >&2
-  exit "$status"
-fi
-echo "fuzz: no crash in ${seconds}s"
+# HTTP seeds: well-formed requests and each framing the gate refuses.
+body=$(cat "$corpus/inline-rect.json")
+printf 'POST /cases?start=true HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n%s' \
+    "${#body}" "$body" > "$http_corpus/post-rect"
+printf 'GET /cases/0123456789abcdef/state?fields=position,velocity HTTP/1.1\r\nHost: x\r\n\r\n' \
+    > "$http_corpus/get-state"
+printf 'POST /cases HTTP/1.1\r\nContent-Length: -1\r\n\r\n' > "$http_corpus/cl-negative"
+printf 'POST /cases HTTP/1.1\r\nContent-Length: 2\r\nContent-Length: 3\r\n\r\n{}' > "$http_corpus/cl-two"
+printf 'POST /cases HTTP/1.1\r\nTransfer-Encoding: identity\r\nContent-Length: 2\r\n\r\n{}' \
+    > "$http_corpus/te-identity"
+printf '\r\nPOST /cases HTTP/1.1\nContent-Length:\n 2\n\n{}' > "$http_corpus/folded-lf"
+
+# run TARGET SECONDS CORPUS [extra libFuzzer flags]
+run() {
+  local target=$1 secs=$2 dir=$3 status=0
+  shift 3
+  "$out/$target" "$dir" "$@" -max_total_time="$secs" -max_len=65536 -timeout=10 \
+      -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 \
+      -artifact_prefix="$out/$target-" 2>&1 | tail -n 25 || status=$?
+  if [ "$status" -ne 0 ]; then
+    echo "fuzz: $target FAILED (exit $status); reproducer in $out/" >&2
+    exit "$status"
+  fi
+  echo "fuzz: $target: no crash in ${secs}s"
+}
+run fuzz_case "$case_seconds" "$corpus" -dict=tests/fuzz/case.dict
+run fuzz_http "$http_seconds" "$http_corpus" -dict=tests/fuzz/http.dict

@@ -1,0 +1,330 @@
+/*
+ * gate.c - accepts connections and admits a request to libmicrohttpd only
+ * once its header block is whole and frames its body unambiguously.
+ *
+ * Why a gate in front of libmicrohttpd: its per-connection timeout bounds
+ * inactivity only, so a client sending one header line every 20 s held a
+ * slot for ever, and 130 such clients held them all; and it answers some
+ * malformed framing wrongly (see http_frame.c). Here a connection costs no
+ * libmicrohttpd slot until its headers have arrived, the deadline counts
+ * from accept(), and the checks run on the bytes as received (MSG_PEEK, so
+ * libmicrohttpd reads the request from the start as usual).
+ *
+ * One thread polls the listening socket and every held connection. The
+ * per-address and total counts cover held and handed-over connections
+ * alike; libmicrohttpd reports each close through gate_closed(), which
+ * runs before it closes the socket, so a descriptor number is never reused
+ * while its slot is still counted.
+ */
+#define _GNU_SOURCE /* accept4, pipe2: the flags come with the descriptor, no race */
+#include "gate.h"
+
+#include <arpa/inet.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <jansson.h>
+#include <poll.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "http_frame.h"
+
+#define GATE_HEAD_MAX (32 * 1024) /* larger header blocks get 431 */
+#define GATE_MAX_SLOTS 65536      /* descriptors the gate can track */
+
+typedef struct gate_slot {
+    uint32_t ip;       /* network order */
+    double accepted;
+    int live;          /* counted in gate_ips */
+} gate_slot;
+
+typedef struct gate_ip {
+    uint32_t ip;
+    int count;
+} gate_ip;
+
+typedef struct gate_held {
+    int fd;
+    struct sockaddr_in addr;
+    double deadline;
+} gate_held;
+
+static struct {
+    pthread_t thread;
+    int running;
+    int listen_fd, wake[2];
+    gate_limits limits;
+    gate_hand_over hand_over;
+    gate_held *held;          /* only the gate thread touches these two */
+    int held_count;
+    pthread_mutex_t lock;     /* guards what follows: shared with MHD threads */
+    gate_slot *slots;
+    int slot_count;
+    gate_ip *ips;             /* addresses with a connection, unordered */
+    int ip_count, total;
+} gate = {.lock = PTHREAD_MUTEX_INITIALIZER, .listen_fd = -1, .wake = {-1, -1}};
+
+double gate_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* ------------------------------------------------------------ counting */
+
+static gate_ip *gate_find_ip(uint32_t ip)
+{
+    for (int i = 0; i < gate.ip_count; i++)
+        if (gate.ips[i].ip == ip) return &gate.ips[i];
+    return NULL;
+}
+
+/* Counts a new connection; 0 when a limit refuses it (with the reason). */
+static int gate_admit(int fd, uint32_t ip, double now, const char **why)
+{
+    int ok = 0;
+    pthread_mutex_lock(&gate.lock);
+    gate_ip *entry = gate_find_ip(ip);
+    if (fd >= gate.slot_count || gate.total >= gate.limits.total) {
+        *why = "the daemon has as many connections open as it serves; try again shortly";
+    } else if (entry && entry->count >= gate.limits.per_ip) {
+        *why = "your address has as many connections open as it may "
+               "(--max-connections-per-ip); close one or try again shortly";
+    } else {
+        if (!entry) {
+            entry = &gate.ips[gate.ip_count++];
+            entry->ip = ip;
+            entry->count = 0;
+        }
+        entry->count++;
+        gate.total++;
+        gate.slots[fd] = (gate_slot){ip, now, 1};
+        ok = 1;
+    }
+    pthread_mutex_unlock(&gate.lock);
+    return ok;
+}
+
+void gate_closed(int fd)
+{
+    pthread_mutex_lock(&gate.lock);
+    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) {
+        gate.slots[fd].live = 0;
+        gate.total--;
+        gate_ip *entry = gate_find_ip(gate.slots[fd].ip);
+        if (entry && --entry->count == 0) *entry = gate.ips[--gate.ip_count];
+    }
+    pthread_mutex_unlock(&gate.lock);
+}
+
+double gate_accepted_at(int fd)
+{
+    double t = 0;
+    pthread_mutex_lock(&gate.lock);
+    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) t = gate.slots[fd].accepted;
+    pthread_mutex_unlock(&gate.lock);
+    return t;
+}
+
+/* -------------------------------------------------------------- answers */
+
+static const char *gate_reason(int status)
+{
+    switch (status) {
+    case 400: return "Bad Request";
+    case 408: return "Request Timeout";
+    case 411: return "Length Required";
+    case 413: return "Payload Too Large";
+    case 431: return "Request Header Fields Too Large";
+    default: return "Service Unavailable";
+    }
+}
+
+/* Reads what the client already sent, so that closing the socket sends a
+ * FIN after the answer rather than a reset that could discard it. */
+static void gate_drain(int fd)
+{
+    char sink[4096];
+    for (int i = 0; i < 64 && recv(fd, sink, sizeof sink, MSG_DONTWAIT) > 0; i++)
+        ;
+}
+
+/* Sends one whole problem+json answer (best effort: the socket is
+ * non-blocking and the answer small) and closes the connection. */
+static void gate_answer_and_close(int fd, int status, const char *title, const char *detail)
+{
+    gate_drain(fd);
+    json_t *body = json_pack("{s:s, s:s, s:i, s:s, s:[]}", "type", "about:blank", "title",
+                             title, "status", status, "detail", detail, "errors");
+    char *text = body ? json_dumps(body, JSON_COMPACT) : NULL;
+    json_decref(body);
+    char head[256];
+    int n = snprintf(head, sizeof head,
+                     "HTTP/1.1 %d %s\r\nContent-Type: application/problem+json\r\n"
+                     "Cache-Control: no-store\r\nConnection: close\r\n%s"
+                     "Content-Length: %zu\r\n\r\n",
+                     status, gate_reason(status), status == 503 ? "Retry-After: 1\r\n" : "",
+                     text ? strlen(text) : 0);
+    if (send(fd, head, (size_t)n, MSG_NOSIGNAL | MSG_DONTWAIT) == n && text)
+        (void)!send(fd, text, strlen(text), MSG_NOSIGNAL | MSG_DONTWAIT);
+    free(text);
+    shutdown(fd, SHUT_WR);
+    gate_closed(fd);
+    close(fd);
+}
+
+/* -------------------------------------------------------- held requests */
+
+static void gate_release(int index)
+{
+    gate.held[index] = gate.held[--gate.held_count];
+}
+
+/* Looks at what has arrived on held connection `index`; returns 1 when the
+ * connection left the gate (answered, closed or handed over). */
+static int gate_examine(int index)
+{
+    static char buf[GATE_HEAD_MAX];
+    gate_held h = gate.held[index];
+    ssize_t n = recv(h.fd, buf, sizeof buf, MSG_PEEK | MSG_DONTWAIT);
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return 0;
+    if (n <= 0) { /* closed by the client, or broken */
+        gate_release(index);
+        gate_closed(h.fd);
+        close(h.fd);
+        return 1;
+    }
+    size_t end = http_frame_head_end(buf, (size_t)n);
+    if (!end) {
+        if ((size_t)n < sizeof buf) return 0;
+        gate_release(index);
+        gate_answer_and_close(h.fd, 431, "Request header fields too large",
+                              "the request line and headers exceed 32 KiB");
+        return 1;
+    }
+    http_frame_verdict v;
+    gate_release(index);
+    if (http_frame_check(buf, end, &v)) {
+        gate_answer_and_close(h.fd, v.status, v.title, v.detail);
+        return 1;
+    }
+    /* on failure the new owner has closed the socket without telling us */
+    if (!gate.hand_over(h.fd, &h.addr)) gate_closed(h.fd);
+    return 1;
+}
+
+static void gate_accept_all(void)
+{
+    for (;;) {
+        struct sockaddr_in addr;
+        socklen_t len = sizeof addr;
+        int fd = accept4(gate.listen_fd, (struct sockaddr *)&addr, &len,
+                         SOCK_NONBLOCK | SOCK_CLOEXEC);
+        if (fd < 0) return; /* EAGAIN, or out of descriptors until some close */
+        double now = gate_now();
+        const char *why = NULL;
+        if (addr.sin_family != AF_INET || gate.held_count >= gate.limits.total ||
+            !gate_admit(fd, addr.sin_addr.s_addr, now, &why)) {
+            gate_answer_and_close(fd, 503, "Too many connections",
+                                  why ? why : "too many connections are waiting for headers");
+            continue;
+        }
+        gate.held[gate.held_count++] = (gate_held){fd, addr, now + gate.limits.timeout};
+    }
+}
+
+static void gate_cut_late(double now)
+{
+    char detail[160];
+    snprintf(detail, sizeof detail,
+             "the request headers did not arrive whole within %g s (--request-timeout)",
+             gate.limits.timeout);
+    for (int i = gate.held_count - 1; i >= 0; i--)
+        if (now >= gate.held[i].deadline) {
+            int fd = gate.held[i].fd;
+            gate_release(i);
+            gate_answer_and_close(fd, 408, "Request timeout", detail);
+        }
+}
+
+static void *gate_main(void *arg)
+{
+    (void)arg;
+    int cap = gate.limits.total + 2;
+    struct pollfd *fds = calloc((size_t)cap, sizeof *fds);
+    if (!fds) {
+        fprintf(stderr, "fdemd: gate: out of memory\n");
+        return NULL;
+    }
+    for (;;) {
+        double now = gate_now(), wait = 1.0;
+        fds[0] = (struct pollfd){.fd = gate.wake[0], .events = POLLIN};
+        fds[1] = (struct pollfd){.fd = gate.listen_fd, .events = POLLIN};
+        for (int i = 0; i < gate.held_count; i++) {
+            fds[2 + i] = (struct pollfd){.fd = gate.held[i].fd, .events = POLLIN};
+            if (gate.held[i].deadline - now < wait) wait = gate.held[i].deadline - now;
+        }
+        int polled = gate.held_count;
+        int ms = wait > 0 ? (int)(wait * 1000) + 1 : 0;
+        if (poll(fds, (nfds_t)(2 + polled), ms) < 0 && errno != EINTR) break;
+        if (fds[0].revents) break;
+        /* backwards, since gate_release() moves the last entry into i */
+        for (int i = polled - 1; i >= 0; i--)
+            if (fds[2 + i].revents) gate_examine(i);
+        gate_cut_late(gate_now());
+        if (fds[1].revents) gate_accept_all();
+    }
+    free(fds);
+    return NULL;
+}
+
+/* ------------------------------------------------------------ lifecycle */
+
+int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_over)
+{
+    struct rlimit rl;
+    int slots = GATE_MAX_SLOTS;
+    if (getrlimit(RLIMIT_NOFILE, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY &&
+        rl.rlim_cur < (rlim_t)slots)
+        slots = (int)rl.rlim_cur;
+    gate.limits = *limits;
+    gate.hand_over = hand_over;
+    gate.listen_fd = listen_fd;
+    gate.slots = calloc((size_t)slots, sizeof *gate.slots);
+    gate.ips = calloc((size_t)limits->total, sizeof *gate.ips);
+    gate.held = calloc((size_t)limits->total, sizeof *gate.held);
+    gate.slot_count = slots;
+    if (!gate.slots || !gate.ips || !gate.held || pipe2(gate.wake, O_CLOEXEC) != 0 ||
+        pthread_create(&gate.thread, NULL, gate_main, NULL) != 0) {
+        fprintf(stderr, "fdemd: cannot start the connection gate: %s\n", strerror(errno));
+        gate_stop();
+        return -1;
+    }
+    gate.running = 1;
+    return 0;
+}
+
+void gate_stop(void)
+{
+    if (gate.running) {
+        (void)!write(gate.wake[1], "x", 1);
+        pthread_join(gate.thread, NULL);
+        gate.running = 0;
+    }
+    for (int i = 0; i < gate.held_count; i++) close(gate.held[i].fd);
+    gate.held_count = 0;
+    for (int k = 0; k < 2; k++)
+        if (gate.wake[k] >= 0) close(gate.wake[k]);
+    gate.wake[0] = gate.wake[1] = -1;
+    if (gate.listen_fd >= 0) close(gate.listen_fd);
+    gate.listen_fd = -1;
+    free(gate.held);
+    gate.held = NULL;
+}

@@ -1,0 +1,41 @@
+/*
+ * gate.h - the thread that accepts connections and holds each one until
+ * its request headers have arrived whole, before libmicrohttpd gets it.
+ *
+ * Contract:
+ *  - gate_start() takes a bound, listening socket and serves it on its own
+ *    thread. Each accepted connection is refused at once (503) when its
+ *    address already has `per_ip` connections, or the daemon `total`; it is
+ *    cut (408) when its header block is not whole `timeout` seconds after it
+ *    was accepted; it is answered (400, 411, 413, 431) when the block frames
+ *    its body ambiguously (http_frame.h). Every other connection is passed
+ *    to `hand_over`, which owns the socket from then on.
+ *  - The owner of a handed-over connection calls gate_closed(fd) before it
+ *    closes the socket, so the per-address count stays true.
+ *  - gate_accepted_at(fd) is when that connection was accepted (monotonic
+ *    seconds), so the whole-request deadline can be applied to the body.
+ *  - gate_stop() stops accepting, closes held connections and joins.
+ */
+#ifndef FDEMD_GATE_H
+#define FDEMD_GATE_H
+
+#include <netinet/in.h>
+
+typedef int (*gate_hand_over)(int fd, const struct sockaddr_in *addr);
+
+typedef struct gate_limits {
+    int per_ip;        /* connections per client address */
+    int total;         /* connections in all, held or handed over */
+    double timeout;    /* seconds for a whole request */
+} gate_limits;
+
+int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_over);
+void gate_stop(void);
+
+void gate_closed(int fd);
+double gate_accepted_at(int fd);
+
+/* Monotonic clock in seconds. */
+double gate_now(void);
+
+#endif

@@ -1,0 +1,34 @@
+/*
+ * http_frame.h - checks on the raw header block of a request that decide
+ * how its body is framed (Content-Length, Transfer-Encoding), done before
+ * libmicrohttpd sees the request.
+ *
+ * Contract: pure functions on plain bytes (no sockets, no globals), so the
+ * gate and the fuzzer call the same code.
+ *  - http_frame_head_end() finds the blank line that ends the header block
+ *    (CRLF or bare LF line ends, as libmicrohttpd accepts both).
+ *  - http_frame_check() accepts a block whose body length is unambiguous:
+ *    no Transfer-Encoding, and every Content-Length field is 1*DIGIT (after
+ *    leading blanks) with the same value. Anything else gets a status (400,
+ *    411 or 413) and a one-line reason for the client.
+ */
+#ifndef FDEMD_HTTP_FRAME_H
+#define FDEMD_HTTP_FRAME_H
+
+#include <stddef.h>
+
+typedef struct http_frame_verdict {
+    int status;        /* 0 when the framing is acceptable */
+    char title[48];    /* "Bad request", ... */
+    char detail[200];
+    long long content_length; /* the agreed value when acceptable, else -1 */
+} http_frame_verdict;
+
+/* Offset just past the blank line ending the header block, or 0 if `data`
+ * does not hold a whole block yet. */
+size_t http_frame_head_end(const char *data, size_t size);
+
+/* Checks the header block head[0..size). Returns v->status. */
+int http_frame_check(const char *head, size_t size, http_frame_verdict *v);
+
+#endif
