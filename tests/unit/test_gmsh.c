@@ -238,8 +238,83 @@ static void every_prefix_of_a_real_file(void)
     free(text);
 }
 
+/* ------------------------------------------------------------ tetrahedra */
+
+/* The cube of cube.geo as the installed gmsh meshes it: 45 nodes and 100
+ * tetrahedra (counted independently with Python from the v2.2 file), volume
+ * 1 once validated (which orients every tetrahedron). */
+static void check_tet_file(const char *path)
+{
+    size_t length = 0;
+    char *text = read_file(path, &length);
+    if (!text) return;
+    fdem_tet_mesh m;
+    fdem_error err;
+    char message[256];
+    int rc = gmsh_read_tetrahedra(text, length, &m, message, sizeof message);
+    CHECK(rc == 0, "%s: %s", path, message);
+    if (rc == 0) {
+        CHECK(m.node_count == 45 && m.tet_count == 100, "%s: %d nodes, %d tetrahedra, want 45, 100",
+              path, m.node_count, m.tet_count);
+        CHECK(fdem_tet_mesh_validate(&m, NULL, &err) == 0, "%s: %s", path, err.message);
+        CHECK_NEAR(fdem_tet_mesh_volume(&m), 1.0, 1e-12);
+        double zmax = 0;
+        for (int n = 0; n < m.node_count; n++) zmax = fmax(zmax, m.xyz[3 * n + 2]);
+        CHECK(zmax == 1.0, "%s: z not read (max %g)", path, zmax);
+        fdem_tet_mesh_free(&m);
+    }
+    free(text);
+}
+
+static void cube_tetrahedra_v22(void) { check_tet_file("tests/data/cube_v22.msh"); }
+static void cube_tetrahedra_v41(void) { check_tet_file("tests/data/cube_v41.msh"); }
+
+static void tetrahedra_rejects(void)
+{
+    fdem_tet_mesh m;
+    char message[256] = "";
+    size_t length = 0;
+    char *square = read_file("tests/data/square_v22.msh", &length);
+    if (square) {
+        CHECK(gmsh_read_tetrahedra(square, length, &m, message, sizeof message) != 0 &&
+              strstr(message, "no 4-node tetrahedra"), "a 2D file: %s", message);
+        free(square);
+    }
+    static const char *no_z = V22 "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1\n4 0 0 1\n$EndNodes\n"
+                                  "$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(no_z, strlen(no_z), &m, message, sizeof message) != 0 &&
+          strstr(message, "line 8"), "a node without z: %s", message);
+    static const char *short_tet = V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                                       "$Elements\n1\n1 4 0 1 2 3\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(short_tet, strlen(short_tet), &m, message, sizeof message) != 0 &&
+          strstr(message, "4 node tags"), "three tags: %s", message);
+    static const char *unknown = V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                                     "$Elements\n1\n1 4 0 1 2 3 9\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(unknown, strlen(unknown), &m, message, sizeof message) != 0 &&
+          strstr(message, "tetrahedron refers to node 9"), "unknown node: %s", message);
+    /* every prefix of the v4.1 cube fails cleanly or (whole file) parses */
+    char *text = read_file("tests/data/cube_v41.msh", &length);
+    if (!text) return;
+    int accepted = 0, unexplained = 0;
+    for (size_t n = 0; n <= length; n++) {
+        char *copy = malloc(n ? n : 1);
+        memcpy(copy, text, n);
+        if (gmsh_read_tetrahedra(copy, n, &m, message, sizeof message) == 0) {
+            accepted++;
+            fdem_tet_mesh_free(&m);
+        } else if (strncmp(message, "gmsh", 4) != 0) {
+            unexplained++;
+        }
+        free(copy);
+    }
+    CHECK(accepted == 2, "%d prefixes accepted", accepted);
+    CHECK(unexplained == 0, "%d failures without a message", unexplained);
+    free(text);
+}
+
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
            T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
            T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
            T(rejects_bad_references), T(rejects_missing_sections),
-           T(every_prefix_of_a_real_file))
+           T(every_prefix_of_a_real_file), T(cube_tetrahedra_v22), T(cube_tetrahedra_v41),
+           T(tetrahedra_rejects))
