@@ -15,6 +15,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "vec3.h"
+
 #define CLIP_MAX 12 /* a triangle clipped by 4 planes has at most 7 vertices */
 
 typedef struct clip_vertex {
@@ -27,23 +29,6 @@ typedef struct clip_polygon {
     int count;
 } clip_polygon;
 
-static void sub3(const double *a, const double *b, double o[3])
-{
-    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double o[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* The target's barycentric map: lambda_{1..3} = rows . (x - x0). */
 typedef struct bary_map {
     double origin[3];
@@ -55,11 +40,11 @@ static bary_map bary_of(const double *p[4])
 {
     bary_map m;
     double e[3][3], c[3][3];
-    for (int k = 0; k < 3; k++) sub3(p[k + 1], p[0], e[k]);
-    cross3(e[1], e[2], c[0]);
-    cross3(e[2], e[0], c[1]);
-    cross3(e[0], e[1], c[2]);
-    double det = dot3(e[0], c[0]);
+    for (int k = 0; k < 3; k++) vec3_sub(p[k + 1], p[0], e[k]);
+    vec3_cross(e[1], e[2], c[0]);
+    vec3_cross(e[2], e[0], c[1]);
+    vec3_cross(e[0], e[1], c[2]);
+    double det = vec3_dot(e[0], c[0]);
     m.valid = fabs(det) > 0 && isfinite(det);
     memcpy(m.origin, p[0], sizeof m.origin);
     for (int k = 0; k < 3; k++)
@@ -70,10 +55,10 @@ static bary_map bary_of(const double *p[4])
 static void bary_at(const bary_map *m, const double x[3], double lambda[4])
 {
     double d[3];
-    sub3(x, m->origin, d);
-    lambda[1] = dot3(m->rows[0], d);
-    lambda[2] = dot3(m->rows[1], d);
-    lambda[3] = dot3(m->rows[2], d);
+    vec3_sub(x, m->origin, d);
+    lambda[1] = vec3_dot(m->rows[0], d);
+    lambda[2] = vec3_dot(m->rows[1], d);
+    lambda[3] = vec3_dot(m->rows[2], d);
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
@@ -106,10 +91,10 @@ static void polygon_integrals(const clip_polygon *poly, int k, double *i0, doubl
     for (int a = 1; a + 1 < poly->count; a++) {
         const clip_vertex *v[3] = {&poly->v[0], &poly->v[a], &poly->v[a + 1]};
         double u[3], w[3], n[3];
-        sub3(v[1]->x, v[0]->x, u);
-        sub3(v[2]->x, v[0]->x, w);
-        cross3(u, w, n);
-        double area = 0.5 * sqrt(dot3(n, n));
+        vec3_sub(v[1]->x, v[0]->x, u);
+        vec3_sub(v[2]->x, v[0]->x, w);
+        vec3_cross(u, w, n);
+        double area = 0.5 * sqrt(vec3_dot(n, n));
         double phi[3] = {4 * v[0]->lambda[k], 4 * v[1]->lambda[k], 4 * v[2]->lambda[k]};
         double sum_phi = phi[0] + phi[1] + phi[2];
         *i0 += area * sum_phi / 3.0;
@@ -126,15 +111,15 @@ static void face_weights(const double *a, const double *b, const double *c, cons
                          double w[3])
 {
     double ab[3], ac[3], ax[3], n[3], t[3];
-    sub3(b, a, ab);
-    sub3(c, a, ac);
-    sub3(x, a, ax);
-    cross3(ab, ac, n);
-    double n2 = dot3(n, n);
-    cross3(ax, ac, t);
-    w[1] = dot3(t, n) / n2;
-    cross3(ab, ax, t);
-    w[2] = dot3(t, n) / n2;
+    vec3_sub(b, a, ab);
+    vec3_sub(c, a, ac);
+    vec3_sub(x, a, ax);
+    vec3_cross(ab, ac, n);
+    double n2 = vec3_dot(n, n);
+    vec3_cross(ax, ac, t);
+    w[1] = vec3_dot(t, n) / n2;
+    vec3_cross(ab, ax, t);
+    w[2] = vec3_dot(t, n) / n2;
     w[0] = 1.0 - w[1] - w[2];
 }
 
@@ -163,13 +148,13 @@ static double face_in_target(const double *pc[4], int m, const bary_map *bt, dou
     if (!(i0 > 0)) return 0.0;
     /* outward unit normal of the face: away from node m */
     double ab[3], ac[3], n[3], am[3];
-    sub3(b, a, ab);
-    sub3(c, a, ac);
-    cross3(ab, ac, n);
-    sub3(pc[m], a, am);
-    double len = sqrt(dot3(n, n));
+    vec3_sub(b, a, ab);
+    vec3_sub(c, a, ac);
+    vec3_cross(ab, ac, n);
+    vec3_sub(pc[m], a, am);
+    double len = sqrt(vec3_dot(n, n));
     if (!(len > 0)) return 0.0;
-    double sign = dot3(n, am) > 0 ? -1.0 : 1.0;
+    double sign = vec3_dot(n, am) > 0 ? -1.0 : 1.0;
     double point[3], force[3], wf[3], lt[4];
     for (int i = 0; i < 3; i++) {
         point[i] = i1[i] / i0;

@@ -15,32 +15,12 @@
  * sum of the other three.
  */
 #include "element_tet.h"
+#include "vec3.h"
 
 #include <math.h>
 #include <string.h>
 
-/* ------------------------------------------------------------ 3-vectors */
-
-static inline void vsub(const double *a, const double *b, double out[3])
-{
-    out[0] = a[0] - b[0];
-    out[1] = a[1] - b[1];
-    out[2] = a[2] - b[2];
-}
-
-static inline void vcross(const double a[3], const double b[3], double out[3])
-{
-    out[0] = a[1] * b[2] - a[2] * b[1];
-    out[1] = a[2] * b[0] - a[0] * b[2];
-    out[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static inline double vdot(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline double vnorm(const double a[3]) { return sqrt(vdot(a, a)); }
+static inline double vnorm(const double a[3]) { return sqrt(vec3_dot(a, a)); }
 
 /* Edges from node 0 and their cross products c1 = e2 x e3, c2 = e3 x e1,
  * c3 = e1 x e2 (each twice the area vector of the face through node 0 and
@@ -48,13 +28,13 @@ static inline double vnorm(const double a[3]) { return sqrt(vdot(a, a)); }
 static double tet_edges(const double *p0, const double *p1, const double *p2,
                         const double *p3, double e[3][3], double c[3][3])
 {
-    vsub(p1, p0, e[0]);
-    vsub(p2, p0, e[1]);
-    vsub(p3, p0, e[2]);
-    vcross(e[1], e[2], c[0]);
-    vcross(e[2], e[0], c[1]);
-    vcross(e[0], e[1], c[2]);
-    return vdot(e[0], c[0]);
+    vec3_sub(p1, p0, e[0]);
+    vec3_sub(p2, p0, e[1]);
+    vec3_sub(p3, p0, e[2]);
+    vec3_cross(e[1], e[2], c[0]);
+    vec3_cross(e[2], e[0], c[1]);
+    vec3_cross(e[0], e[1], c[2]);
+    return vec3_dot(e[0], c[0]);
 }
 
 static const double *node_at(const double *xyz, int32_t n) { return xyz + 3 * (size_t)n; }
@@ -72,9 +52,9 @@ double tet_smallest_height(const double *p0, const double *p1, const double *p2,
 {
     double e[3][3], c[3][3], a[3], b[3], opposite[3];
     double det = tet_edges(p0, p1, p2, p3, e, c);
-    vsub(p2, p1, a);
-    vsub(p3, p1, b);
-    vcross(a, b, opposite);
+    vec3_sub(p2, p1, a);
+    vec3_sub(p3, p1, b);
+    vec3_cross(a, b, opposite);
     /* twice the face areas; h = 3V / A = det / (2A) */
     double largest = fmax(fmax(vnorm(c[0]), vnorm(c[1])), fmax(vnorm(c[2]), vnorm(opposite)));
     return largest > 0 ? fabs(det) / largest : 0.0;
@@ -100,7 +80,7 @@ void tet_deformation(const double *pos, const int32_t node[4], const tet_geometr
 {
     const double *p0 = node_at(pos, node[0]);
     double e[3][3];
-    for (int k = 0; k < 3; k++) vsub(node_at(pos, node[k + 1]), p0, e[k]);
+    for (int k = 0; k < 3; k++) vec3_sub(node_at(pos, node[k + 1]), p0, e[k]);
     /* F = [x][X]^-1: F_ij = sum_k (e_k)_i xinv_kj */
     for (int i = 0; i < 3; i++)
         for (int j = 0; j < 3; j++)
@@ -149,7 +129,7 @@ static void add_viscous(const double *vel, const int32_t node[4], const double c
     double L[3][3] = {{0}};
     for (int k = 0; k < 3; k++) {
         double dv[3];
-        vsub(node_at(vel, node[k + 1]), v0, dv);
+        vec3_sub(node_at(vel, node[k + 1]), v0, dv);
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++) L[i][j] += dv[i] * c[k][j];
     }

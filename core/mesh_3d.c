@@ -28,6 +28,7 @@
 
 #include "element_tet.h"
 #include "model.h"
+#include "vec3.h"
 
 void fdem_tet_mesh_free(fdem_tet_mesh *mesh)
 {
@@ -325,34 +326,17 @@ int fdem_tet_mesh_validate(fdem_tet_mesh *mesh, int *reoriented, fdem_error *err
 
 /* --------------------------------------------------------------- quality */
 
-static void sub3(const double *a, const double *b, double o[3])
-{
-    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
-}
-
-static void cross3(const double a[3], const double b[3], double o[3])
-{
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static double dot3(const double a[3], const double b[3])
-{
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
 /* The dihedral angle at edge (a, b) between faces (a, b, c) and (a, b, d):
  * the angle between e x (c - a) and e x (d - a), e = b - a. */
 static double dihedral(const double *pa, const double *pb, const double *pc, const double *pd)
 {
     double e[3], u[3], w[3], nu[3], nw[3];
-    sub3(pb, pa, e);
-    sub3(pc, pa, u);
-    sub3(pd, pa, w);
-    cross3(e, u, nu);
-    cross3(e, w, nw);
-    double c = dot3(nu, nw) / sqrt(dot3(nu, nu) * dot3(nw, nw));
+    vec3_sub(pb, pa, e);
+    vec3_sub(pc, pa, u);
+    vec3_sub(pd, pa, w);
+    vec3_cross(e, u, nu);
+    vec3_cross(e, w, nw);
+    double c = vec3_dot(nu, nw) / sqrt(vec3_dot(nu, nu) * vec3_dot(nw, nw));
     return acos(fmax(-1.0, fmin(1.0, c)));
 }
 
@@ -361,21 +345,21 @@ static double dihedral(const double *pa, const double *pb, const double *pc, con
 static double radius_ratio(const double *p[4])
 {
     double e[3][3], c[3][3], area = 0;
-    for (int k = 0; k < 3; k++) sub3(p[k + 1], p[0], e[k]);
-    cross3(e[1], e[2], c[0]);
-    cross3(e[2], e[0], c[1]);
-    cross3(e[0], e[1], c[2]);
-    double six_v = dot3(e[0], c[0]);
+    for (int k = 0; k < 3; k++) vec3_sub(p[k + 1], p[0], e[k]);
+    vec3_cross(e[1], e[2], c[0]);
+    vec3_cross(e[2], e[0], c[1]);
+    vec3_cross(e[0], e[1], c[2]);
+    double six_v = vec3_dot(e[0], c[0]);
     double opposite[3], u[3], w[3];
-    sub3(p[2], p[1], u);
-    sub3(p[3], p[1], w);
-    cross3(u, w, opposite);
-    area = 0.5 * (sqrt(dot3(c[0], c[0])) + sqrt(dot3(c[1], c[1])) + sqrt(dot3(c[2], c[2])) +
-                  sqrt(dot3(opposite, opposite)));
+    vec3_sub(p[2], p[1], u);
+    vec3_sub(p[3], p[1], w);
+    vec3_cross(u, w, opposite);
+    area = 0.5 * (sqrt(vec3_dot(c[0], c[0])) + sqrt(vec3_dot(c[1], c[1])) + sqrt(vec3_dot(c[2], c[2])) +
+                  sqrt(vec3_dot(opposite, opposite)));
     double s[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++)
-        for (int i = 0; i < 3; i++) s[i] += dot3(e[k], e[k]) * c[k][i];
-    double r_in = 0.5 * fabs(six_v) / area, r_circ = sqrt(dot3(s, s)) / (2 * fabs(six_v));
+        for (int i = 0; i < 3; i++) s[i] += vec3_dot(e[k], e[k]) * c[k][i];
+    double r_in = 0.5 * fabs(six_v) / area, r_circ = sqrt(vec3_dot(s, s)) / (2 * fabs(six_v));
     return 3 * r_in / r_circ;
 }
 

@@ -211,31 +211,52 @@ static void rejects_missing_sections(void)
     check_fails(V22 V22, "second $MeshFormat", 1);
 }
 
+/* Reads text with one of the two readers, freeing what it returns: 0 or -1. */
+typedef int (*gmsh_reader_fn)(const char *text, size_t length, char *message, size_t size);
+
+static int read_triangles(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_mesh m;
+    if (gmsh_read(text, length, &m, message, size) != 0) return -1;
+    fdem_mesh_free(&m);
+    return 0;
+}
+
+static int read_tetrahedra(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_tet_mesh m;
+    if (gmsh_read_tetrahedra(text, length, &m, message, size) != 0) return -1;
+    fdem_tet_mesh_free(&m);
+    return 0;
+}
+
 /* Every prefix of a real file must fail cleanly (or, for the full length,
- * succeed): exercises every truncation point under ASan. */
-static void every_prefix_of_a_real_file(void)
+ * succeed): exercises every truncation point under ASan. Only the whole
+ * file and the file without its final newline parse. */
+static void check_every_prefix(const char *path, gmsh_reader_fn reader)
 {
     size_t length = 0;
-    char *text = read_file("tests/data/square_v41.msh", &length);
+    char *text = read_file(path, &length);
     if (!text) return;
     int accepted = 0, unexplained = 0;
     for (size_t n = 0; n <= length; n++) {
         char *copy = malloc(n ? n : 1);
         memcpy(copy, text, n);
-        fdem_mesh m;
         char message[256] = "";
-        if (gmsh_read(copy, n, &m, message, sizeof message) == 0) {
+        if (reader(copy, n, message, sizeof message) == 0)
             accepted++;
-            fdem_mesh_free(&m);
-        } else if (strncmp(message, "gmsh", 4) != 0) {
+        else if (strncmp(message, "gmsh", 4) != 0)
             unexplained++;
-        }
         free(copy);
     }
-    /* Only the whole file and the file without its final newline parse. */
-    CHECK(accepted == 2, "%d prefixes accepted", accepted);
-    CHECK(unexplained == 0, "%d failures without a message", unexplained);
+    CHECK(accepted == 2, "%s: %d prefixes accepted", path, accepted);
+    CHECK(unexplained == 0, "%s: %d failures without a message", path, unexplained);
     free(text);
+}
+
+static void every_prefix_of_a_real_file(void)
+{
+    check_every_prefix("tests/data/square_v41.msh", read_triangles);
 }
 
 /* ------------------------------------------------------------ tetrahedra */
@@ -293,23 +314,7 @@ static void tetrahedra_rejects(void)
     CHECK(gmsh_read_tetrahedra(unknown, strlen(unknown), &m, message, sizeof message) != 0 &&
           strstr(message, "tetrahedron refers to node 9"), "unknown node: %s", message);
     /* every prefix of the v4.1 cube fails cleanly or (whole file) parses */
-    char *text = read_file("tests/data/cube_v41.msh", &length);
-    if (!text) return;
-    int accepted = 0, unexplained = 0;
-    for (size_t n = 0; n <= length; n++) {
-        char *copy = malloc(n ? n : 1);
-        memcpy(copy, text, n);
-        if (gmsh_read_tetrahedra(copy, n, &m, message, sizeof message) == 0) {
-            accepted++;
-            fdem_tet_mesh_free(&m);
-        } else if (strncmp(message, "gmsh", 4) != 0) {
-            unexplained++;
-        }
-        free(copy);
-    }
-    CHECK(accepted == 2, "%d prefixes accepted", accepted);
-    CHECK(unexplained == 0, "%d failures without a message", unexplained);
-    free(text);
+    check_every_prefix("tests/data/cube_v41.msh", read_tetrahedra);
 }
 
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
