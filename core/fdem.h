@@ -40,6 +40,7 @@ typedef enum fdem_item_kind {
     FDEM_ITEM_TRIANGLE,
     FDEM_ITEM_CONSTRAINT,
     FDEM_ITEM_ELEMENT, /* engine element index (after finalize) */
+    FDEM_ITEM_TETRAHEDRON, /* tetrahedron of a 3D mesh (mesh_3d.h) */
 } fdem_item_kind;
 
 typedef struct fdem_error {

@@ -53,28 +53,9 @@
  *    negative radius, are never in contact (in both detectors): the engine
  *    validates its mesh, and here they must not crash or poison the grid.
  */
-#include "nbs.h"
+#include "nbs_internal.h"
 
-#include <float.h>
-#include <math.h>
-#include <stdlib.h>
 #include <string.h>
-
-#if defined(__GNUC__)
-#define NBS_UNLIKELY(c) __builtin_expect(!!(c), 0)
-#define NBS_ALWAYS_INLINE inline __attribute__((always_inline))
-#else
-#define NBS_UNLIKELY(c) (c)
-#define NBS_ALWAYS_INLINE inline
-#endif
-
-#define NBS_EMPTY (-1)
-#define NBS_VALUE_LIMIT 1e150
-#define NBS_MIN_TABLE 4
-/* at most 2^30 circles, so table sizes and indices fit int32 */
-#define NBS_MAX_CIRCLES ((size_t)1 << 30)
-/* the integer extent is kept below 2^40 cells so int64 never overflows */
-#define NBS_MAX_CELLS_PER_AXIS 1099511627776.0
 
 /* ------------------------------------------------------------------ helpers */
 
@@ -97,57 +78,6 @@ static inline int nbs_circles_touch(double xi, double yi, double ri,
     double dist2 = dx2 + dy2;
     double reach2 = reach * reach;
     return dist2 <= reach2;
-}
-
-static inline int nbs_same_body(const int32_t *body, int32_t i, int32_t j)
-{
-    return body && body[i] >= 0 && body[i] == body[j];
-}
-
-static int nbs_pairs_grow(nbs_pairs *pairs, size_t want)
-{
-    if (want <= pairs->capacity) return 0;
-    size_t cap = pairs->capacity ? pairs->capacity : 1024;
-    while (cap < want) cap *= 2;
-    int32_t *a = realloc(pairs->a, cap * sizeof *a);
-    if (!a) return -1;
-    pairs->a = a;
-    int32_t *b = realloc(pairs->b, cap * sizeof *b);
-    if (!b) return -1;
-    pairs->b = b;
-    pairs->capacity = cap;
-    return 0;
-}
-
-static inline int nbs_pairs_push(nbs_pairs *pairs, int32_t i, int32_t j)
-{
-    if (NBS_UNLIKELY(pairs->count == pairs->capacity) &&
-        nbs_pairs_grow(pairs, pairs->count + 1) != 0)
-        return -1;
-    pairs->a[pairs->count] = i;
-    pairs->b[pairs->count] = j;
-    pairs->count++;
-    return 0;
-}
-
-static void nbs_fill_empty(int32_t *a, size_t count)
-{
-    for (size_t k = 0; k < count; k++) a[k] = NBS_EMPTY;
-}
-
-static int nbs_grow_array(int32_t **array, size_t count)
-{
-    int32_t *p = realloc(*array, count * sizeof *p);
-    if (!p) return -1;
-    *array = p;
-    return 0;
-}
-
-static size_t nbs_next_pow2(size_t n)
-{
-    size_t p = NBS_MIN_TABLE;
-    while (p < n) p *= 2;
-    return p;
 }
 
 /* --------------------------------------------------------- public lifecycle */
@@ -305,31 +235,10 @@ static nbs_bounds nbs_bounds_of(size_t n, const double *cx, const double *cy, co
     return bo;
 }
 
-/* Cell size d = largest diameter, padded so that (1) rounding of
- * (x - xmin) * (1/d) stays well below one cell even at 1e6 m from the origin
- * (a relative 1e-9 plus 32 ulps of the extent), (2) the integer extent
- * stays below 2^40 cells, (3) all-zero radii still get a positive size. */
-static double nbs_cell_size(const nbs_bounds *b)
-{
-    double span = fmax(b->xmax - b->xmin, b->ymax - b->ymin);
-    double cell = 2.0 * b->rmax * (1.0 + 1e-9) + 32.0 * DBL_EPSILON * span;
-    cell = fmax(cell, span / NBS_MAX_CELLS_PER_AXIS);
-    if (!(cell > 0.0)) cell = 1.0;
-    return cell;
-}
-
-static void nbs_axis_plan(double span, double inv_cell, int32_t table,
-                          int32_t *size, int *fold)
-{
-    double real = floor(span * inv_cell) + 1.0;
-    *fold = real > (double)table;
-    *size = *fold ? table : (int32_t)real;
-}
-
 static nbs_layout nbs_layout_plan(const nbs_bounds *b, size_t table)
 {
     nbs_layout L;
-    L.cell = nbs_cell_size(b);
+    L.cell = nbs_padded_cell(b->rmax, fmax(b->xmax - b->xmin, b->ymax - b->ymin));
     L.inv_cell = 1.0 / L.cell;
     L.xmin = b->xmin;
     L.ymin = b->ymin;
@@ -368,12 +277,6 @@ static inline void nbs_rows_build(nbs_grid *grid, const nbs_layout *L, size_t n,
         next[i] = head[ty];
         head[ty] = (int32_t)i;
     }
-}
-
-/* A row's list whether it is still new (h >= 0), old (-2 - h) or empty. */
-static inline int32_t nbs_row_list(int32_t mark)
-{
-    return mark >= NBS_EMPTY ? mark : -2 - mark;
 }
 
 /* ------------------------------------------------------------- row detection */

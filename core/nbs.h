@@ -64,4 +64,47 @@ int nbs_detect_brute(size_t n, const double *cx, const double *cy,
 /* Bytes held by the grid and pair arrays. */
 size_t nbs_memory_bytes(const nbs_grid *grid, const nbs_pairs *pairs);
 
+/* ------------------------------------------------------------------- 3D */
+/*
+ * nbs_3d.c - the same detection for bounding spheres (seed page 145):
+ *  - pairs (i, j) with |ci - cj| <= ri + rj and differing body ids (body may
+ *    be NULL), exactly those of nbs_detect_brute_3d; order unspecified.
+ *  - Elements are mapped to z-layers (heads nz, next N); each new layer and
+ *    the layer below it (its contact-mask neighbour) to y-lists (two sets of
+ *    ny heads, next N); each new row and the row below it to x-lists (two
+ *    sets of nx heads, next N); the rows of the layer below are walked
+ *    against the row's x-lists. Only non-empty layers and rows are visited,
+ *    by looping over elements; lists are cleared the same way.
+ *  - Integer RAM is exactly 3N + nz + 2nx + 2ny (nbs_integers_3d) plus the
+ *    pair list: no integer coordinates are stored, they are recomputed.
+ *    Axes are folded like the 2D ones, so RAM is O(N) whatever the extent
+ *    and never O(nx * ny * nz).
+ */
+typedef struct nbs_grid_3d {
+    int32_t *layer_head, *layer_next; /* z: nz heads, N next */
+    int32_t *row_head, *row_next;     /* y: 2 sets of ny heads, N next */
+    int32_t *cell_head, *cell_next;   /* x: 2 sets of nx heads, N next */
+    size_t n_capacity, nx_capacity, ny_capacity, nz_capacity;
+    int32_t nx, ny, nz;               /* table sizes of the last detection */
+    double cell;                      /* cell size d of the last detection */
+} nbs_grid_3d;
+
+void nbs_grid_3d_init(nbs_grid_3d *grid);
+void nbs_grid_3d_free(nbs_grid_3d *grid);
+
+/* Finds all overlapping sphere pairs; pairs->count is reset first. Returns
+ * 0, or -1 on allocation failure. body may be NULL. */
+int nbs_detect_3d(nbs_grid_3d *grid, size_t n, const double *cx, const double *cy,
+                  const double *cz, const double *r, const int32_t *body, nbs_pairs *pairs);
+
+/* All-pairs reference with the same rules. */
+int nbs_detect_brute_3d(size_t n, const double *cx, const double *cy, const double *cz,
+                        const double *r, const int32_t *body, nbs_pairs *pairs);
+
+/* Integers the grid holds: 3 n_capacity + nz + 2 nx + 2 ny (capacities). */
+size_t nbs_integers_3d(const nbs_grid_3d *grid);
+
+/* Bytes held by the grid and pair arrays. */
+size_t nbs_memory_bytes_3d(const nbs_grid_3d *grid, const nbs_pairs *pairs);
+
 #endif /* FDEM_NBS_H */

@@ -1,6 +1,6 @@
 /*
- * gmsh.c - reads the 3-node triangles of an ASCII gmsh mesh (formats 2.2 and
- * 4.1) into an engine mesh.
+ * gmsh.c - reads the 3-node triangles (2D) or the 4-node tetrahedra (3D) of
+ * an ASCII gmsh mesh (formats 2.2 and 4.1) into an engine mesh.
  *
  * The text arrives inside a JSON string from an untrusted upload, so the
  * reader works on a (pointer, length) buffer that need not be NUL-terminated,
@@ -9,9 +9,11 @@
  * It reads line by line: gmsh writes one node or element per line, and a
  * line number is what a user needs to find the fault in the file.
  *
- * Nodes are kept in file order with their tags; triangles are kept as tags
- * and resolved once every section has been read (via a tag-sorted index),
- * because tags may be non-contiguous and sections may come in any order.
+ * Nodes are kept in file order with their tags; elements of the wanted type
+ * are kept as tags and resolved once every section has been read (via a
+ * tag-sorted index), because tags may be non-contiguous and sections may
+ * come in any order. The two dimensions differ only in the element type
+ * kept (gmsh_kind) and whether z is read.
  */
 #include "gmsh.h"
 
@@ -34,13 +36,28 @@ typedef struct gmsh_line {
 
 typedef struct gmsh_node {
     long long tag;
-    double x, y;
+    double x, y, z;
 } gmsh_node;
 
-typedef struct gmsh_triangle {
-    long long tags[3];
+typedef struct gmsh_element {
+    long long tags[4];
     int line;
-} gmsh_triangle;
+} gmsh_element;
+
+/* What one dimension keeps: the gmsh element type, its node count, the
+ * coordinates read per node, and the words of its messages. */
+typedef struct gmsh_kind {
+    int type, nodes, dims;
+    const char *name;    /* "triangle" */
+    const char *missing; /* the message when the file has none */
+} gmsh_kind;
+
+static const gmsh_kind gmsh_triangles = {
+    2, 3, 2, "triangle",
+    "no 3-node triangles (element type 2) in $Elements; mesh the surfaces in 2D (gmsh -2)"};
+static const gmsh_kind gmsh_tetrahedra = {
+    4, 4, 3, "tetrahedron",
+    "no 4-node tetrahedra (element type 4) in $Elements; mesh the volumes in 3D (gmsh -3)"};
 
 typedef struct gmsh_reader {
     const char *p, *end;
@@ -48,10 +65,11 @@ typedef struct gmsh_reader {
     const char *section;   /* "$Nodes", ... for messages */
     int version;           /* 22 or 41 once $MeshFormat was read, else 0 */
     int seen_nodes, seen_elements;
+    const gmsh_kind *kind;
     gmsh_node *nodes;
     long node_count, node_capacity;
-    gmsh_triangle *triangles;
-    long triangle_count, triangle_capacity;
+    gmsh_element *elements;
+    long element_count, element_capacity;
     char *message;
     size_t message_size;
     int failed;
@@ -190,44 +208,48 @@ static int gmsh_grow(void **items, long *capacity, long need, size_t item_size)
     return 0;
 }
 
-static int gmsh_push_node(gmsh_reader *r, long long tag, double x, double y)
+static int gmsh_push_node(gmsh_reader *r, long long tag)
 {
     if (tag <= 0) return gmsh_fail(r, "node tag %lld is not positive", tag);
     if (gmsh_grow((void **)&r->nodes, &r->node_capacity, r->node_count + 1, sizeof *r->nodes))
         return gmsh_fail(r, "out of memory");
-    r->nodes[r->node_count++] = (gmsh_node){tag, x, y};
+    r->nodes[r->node_count++] = (gmsh_node){tag, 0, 0, 0};
     return 0;
 }
 
-static int gmsh_push_triangle(gmsh_reader *r, const long long tags[3])
+static int gmsh_push_element(gmsh_reader *r, const long long tags[4])
 {
-    if (gmsh_grow((void **)&r->triangles, &r->triangle_capacity, r->triangle_count + 1,
-                  sizeof *r->triangles))
+    if (gmsh_grow((void **)&r->elements, &r->element_capacity, r->element_count + 1,
+                  sizeof *r->elements))
         return gmsh_fail(r, "out of memory");
-    gmsh_triangle *t = &r->triangles[r->triangle_count++];
-    memcpy(t->tags, tags, sizeof t->tags);
-    t->line = r->line;
+    gmsh_element *e = &r->elements[r->element_count++];
+    memcpy(e->tags, tags, sizeof e->tags);
+    e->line = r->line;
     return 0;
 }
 
-/* Reads "x y [z ...]" from token `first` on. */
-static int gmsh_line_xy(gmsh_reader *r, const gmsh_line *l, int first, double *x, double *y)
+/* Reads "x y [z ...]" from token `first` on; z only in 3D (2D ignores it). */
+static int gmsh_line_xyz(gmsh_reader *r, const gmsh_line *l, int first, gmsh_node *node)
 {
-    if (l->count < first + 2) return gmsh_fail(r, "expected node coordinates x y z");
-    if (gmsh_token_double(l, first, x) < 0 || gmsh_token_double(l, first + 1, y) < 0)
+    int dims = r->kind->dims;
+    if (l->count < first + dims) return gmsh_fail(r, "expected node coordinates x y z");
+    if (gmsh_token_double(l, first, &node->x) < 0 || gmsh_token_double(l, first + 1, &node->y) < 0 ||
+        (dims == 3 && gmsh_token_double(l, first + 2, &node->z) < 0))
         return gmsh_fail(r, "node coordinates must be finite numbers");
     return 0;
 }
 
-/* The three node tags of a triangle from token `first` on. */
-static int gmsh_line_triangle(gmsh_reader *r, const gmsh_line *l, int first)
+/* The node tags of a kept element from token `first` on. */
+static int gmsh_line_element(gmsh_reader *r, const gmsh_line *l, int first)
 {
-    long long tags[3];
-    if (l->count < first + 3) return gmsh_fail(r, "a triangle needs 3 node tags");
-    for (int k = 0; k < 3; k++)
+    long long tags[4] = {0, 0, 0, 0};
+    const gmsh_kind *kind = r->kind;
+    if (l->count < first + kind->nodes)
+        return gmsh_fail(r, "a %s needs %d node tags", kind->name, kind->nodes);
+    for (int k = 0; k < kind->nodes; k++)
         if (gmsh_token_long(l, first + k, &tags[k]) < 0)
-            return gmsh_fail(r, "triangle node tag %d is not an integer", k + 1);
-    return gmsh_push_triangle(r, tags);
+            return gmsh_fail(r, "%s node tag %d is not an integer", kind->name, k + 1);
+    return gmsh_push_element(r, tags);
 }
 
 /* --------------------------------------------------------------- sections */
@@ -262,11 +284,10 @@ static int gmsh_read_nodes22(gmsh_reader *r)
     if (gmsh_check_count(r, count, 8, "nodes") < 0) return -1;
     for (long long i = 0; i < count; i++) {
         long long tag;
-        double x, y;
         if (gmsh_need_line(r, &l, "a node") < 0) return -1;
         if (gmsh_line_longs(r, &l, &tag, 1, "a node number") < 0) return -1;
-        if (gmsh_line_xy(r, &l, 1, &x, &y) < 0) return -1;
-        if (gmsh_push_node(r, tag, x, y) < 0) return -1;
+        if (gmsh_push_node(r, tag) < 0) return -1;
+        if (gmsh_line_xyz(r, &l, 1, &r->nodes[r->node_count - 1]) < 0) return -1;
     }
     return 0;
 }
@@ -287,12 +308,12 @@ static int gmsh_read_node_block41(gmsh_reader *r, long long *total)
         long long tag;
         if (gmsh_need_line(r, &l, "a node tag") < 0) return -1;
         if (gmsh_line_longs(r, &l, &tag, 1, "a node tag") < 0) return -1;
-        if (gmsh_push_node(r, tag, 0, 0) < 0) return -1;
+        if (gmsh_push_node(r, tag) < 0) return -1;
     }
     for (long long i = 0; i < n; i++) {
         if (gmsh_need_line(r, &l, "node coordinates") < 0) return -1;
         gmsh_node *node = &r->nodes[first + i];
-        if (gmsh_line_xy(r, &l, 0, &node->x, &node->y) < 0) return -1;
+        if (gmsh_line_xyz(r, &l, 0, node) < 0) return -1;
     }
     *total += n;
     return 0;
@@ -329,10 +350,10 @@ static int gmsh_read_elements22(gmsh_reader *r)
         if (gmsh_need_line(r, &l, "an element") < 0) return -1;
         if (gmsh_line_longs(r, &l, head, 3, "\"number type number-of-tags ...\"") < 0)
             return -1;
-        if (head[1] != 2) continue;
+        if (head[1] != r->kind->type) continue;
         if (head[2] < 0 || head[2] > GMSH_MAX_TOKENS)
             return gmsh_fail(r, "bad number of element tags (%lld)", head[2]);
-        if (gmsh_line_triangle(r, &l, 3 + (int)head[2]) < 0) return -1;
+        if (gmsh_line_element(r, &l, 3 + (int)head[2]) < 0) return -1;
     }
     return 0;
 }
@@ -348,7 +369,7 @@ static int gmsh_read_element_block41(gmsh_reader *r, long long *total)
     if (gmsh_check_count(r, n, 4, "elements in the block") < 0) return -1;
     for (long long i = 0; i < n; i++) {
         if (gmsh_need_line(r, &l, "an element") < 0) return -1;
-        if (head[2] == 2 && gmsh_line_triangle(r, &l, 1) < 0) return -1;
+        if (head[2] == r->kind->type && gmsh_line_element(r, &l, 1) < 0) return -1;
     }
     *total += n;
     return 0;
@@ -440,9 +461,7 @@ static int gmsh_read_sections(gmsh_reader *r)
     if (!r->version) return gmsh_fail(r, "not a gmsh mesh: no $MeshFormat section");
     if (!r->seen_nodes) return gmsh_fail(r, "no $Nodes section");
     if (!r->seen_elements) return gmsh_fail(r, "no $Elements section");
-    if (r->triangle_count == 0)
-        return gmsh_fail(r, "no 3-node triangles (element type 2) in $Elements; "
-                            "mesh the surfaces in 2D (gmsh -2)");
+    if (r->element_count == 0) return gmsh_fail(r, "%s", r->kind->missing);
     return 0;
 }
 
@@ -476,14 +495,23 @@ static long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, lo
     return -1;
 }
 
-/* Keeps only the nodes some triangle uses, renumbered in file order. */
-static int gmsh_resolve(gmsh_reader *r, fdem_mesh *out)
+/* The resolved mesh in plain arrays: dims coordinates per node, the
+ * kind's node count per element. */
+typedef struct gmsh_arrays {
+    double *coords;
+    int32_t *elements;
+    int node_count, element_count;
+} gmsh_arrays;
+
+/* Keeps only the nodes some element uses, renumbered in file order. */
+static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out)
 {
-    long n = r->node_count, m = r->triangle_count;
-    if (n > INT32_MAX || m > INT32_MAX / 3) return gmsh_fail(r, "the mesh is too large");
+    long n = r->node_count, m = r->element_count;
+    const int per = r->kind->nodes, dims = r->kind->dims;
+    if (n > INT32_MAX || m > INT32_MAX / per) return gmsh_fail(r, "the mesh is too large");
     long *sorted = malloc((size_t)(n ? n : 1) * sizeof *sorted);
     long *tmp = malloc((size_t)(n ? n : 1) * sizeof *tmp);
-    long *file_index = malloc((size_t)m * 3 * sizeof *file_index);
+    long *file_index = malloc((size_t)m * per * sizeof *file_index);
     int32_t *renumber = malloc((size_t)(n ? n : 1) * sizeof *renumber);
     int rc = -1;
     if (!sorted || !tmp || !file_index || !renumber) {
@@ -501,38 +529,38 @@ static int gmsh_resolve(gmsh_reader *r, fdem_mesh *out)
         }
     for (long i = 0; i < n; i++) renumber[i] = -1;
     for (long t = 0; t < m; t++)
-        for (int k = 0; k < 3; k++) {
-            long found = gmsh_find_tag(sorted, n, r->nodes, r->triangles[t].tags[k]);
+        for (int k = 0; k < per; k++) {
+            long found = gmsh_find_tag(sorted, n, r->nodes, r->elements[t].tags[k]);
             if (found < 0) {
                 r->section = "$Elements";
-                r->line = r->triangles[t].line;
-                gmsh_fail(r, "the triangle refers to node %lld, which is not in $Nodes",
-                          r->triangles[t].tags[k]);
+                r->line = r->elements[t].line;
+                gmsh_fail(r, "the %s refers to node %lld, which is not in $Nodes",
+                          r->kind->name, r->elements[t].tags[k]);
                 goto done;
             }
-            file_index[3 * t + k] = found;
+            file_index[(long)per * t + k] = found;
             renumber[found] = 0;
         }
     int used = 0;
     for (long i = 0; i < n; i++)
         if (renumber[i] == 0) renumber[i] = used++;
-    out->xy = malloc((size_t)used * 2 * sizeof *out->xy);
-    out->tri = malloc((size_t)m * 3 * sizeof *out->tri);
-    if (!out->xy || !out->tri) {
-        free(out->xy);
-        free(out->tri);
+    out->coords = malloc((size_t)(used ? used : 1) * dims * sizeof *out->coords);
+    out->elements = malloc((size_t)m * per * sizeof *out->elements);
+    if (!out->coords || !out->elements) {
+        free(out->coords);
+        free(out->elements);
         memset(out, 0, sizeof *out);
         gmsh_fail(r, "out of memory");
         goto done;
     }
     for (long i = 0; i < n; i++)
         if (renumber[i] >= 0) {
-            out->xy[2 * renumber[i]] = r->nodes[i].x;
-            out->xy[2 * renumber[i] + 1] = r->nodes[i].y;
+            double xyz[3] = {r->nodes[i].x, r->nodes[i].y, r->nodes[i].z};
+            memcpy(out->coords + (size_t)dims * renumber[i], xyz, (size_t)dims * sizeof *xyz);
         }
-    for (long t = 0; t < 3 * m; t++) out->tri[t] = renumber[file_index[t]];
+    for (long t = 0; t < per * m; t++) out->elements[t] = renumber[file_index[t]];
     out->node_count = used;
-    out->triangle_count = (int)m;
+    out->element_count = (int)m;
     rc = 0;
 done:
     free(sorted);
@@ -542,8 +570,8 @@ done:
     return rc;
 }
 
-int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
-              size_t message_size)
+static int gmsh_read_kind(const char *text, size_t length, const gmsh_kind *kind,
+                          gmsh_arrays *out, char *message, size_t message_size)
 {
     char scratch[8];
     memset(out, 0, sizeof *out);
@@ -551,12 +579,40 @@ int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
     if (!text) text = "", length = 0;
     r.p = text;
     r.end = text + length;
+    r.kind = kind;
     r.message = message && message_size ? message : scratch;
     r.message_size = message && message_size ? message_size : sizeof scratch;
     r.message[0] = '\0';
     int rc = gmsh_read_sections(&r);
     if (rc == 0) rc = gmsh_resolve(&r, out);
     free(r.nodes);
-    free(r.triangles);
+    free(r.elements);
     return rc;
+}
+
+int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
+              size_t message_size)
+{
+    gmsh_arrays a;
+    memset(out, 0, sizeof *out);
+    if (gmsh_read_kind(text, length, &gmsh_triangles, &a, message, message_size) != 0) return -1;
+    out->xy = a.coords;
+    out->tri = a.elements;
+    out->node_count = a.node_count;
+    out->triangle_count = a.element_count;
+    return 0;
+}
+
+int gmsh_read_tetrahedra(const char *text, size_t length, fdem_tet_mesh *out, char *message,
+                         size_t message_size)
+{
+    gmsh_arrays a;
+    memset(out, 0, sizeof *out);
+    if (gmsh_read_kind(text, length, &gmsh_tetrahedra, &a, message, message_size) != 0)
+        return -1;
+    out->xyz = a.coords;
+    out->tet = a.elements;
+    out->node_count = a.node_count;
+    out->tet_count = a.element_count;
+    return 0;
 }

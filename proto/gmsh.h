@@ -1,6 +1,6 @@
 /*
- * gmsh.h - reads the triangles of an ASCII gmsh mesh (format 2.2 or 4.1)
- * into an engine mesh.
+ * gmsh.h - reads the triangles (2D) or tetrahedra (3D) of an ASCII gmsh
+ * mesh (format 2.2 or 4.1) into an engine mesh.
  *
  * Contract: only 3-node triangles (element type 2) are kept; nodes not used
  * by any triangle are dropped and the rest renumbered 0..n-1 in file order;
@@ -13,8 +13,15 @@
 
 #include <stddef.h>
 #include "fdem.h"
+#include "mesh_3d.h"
 
 int gmsh_read(const char *text, size_t length, fdem_mesh *out,
               char *message, size_t message_size);
+
+/* The same for 3D: only 4-node tetrahedra (element type 4) are kept, z is
+ * read, and the result is a tetrahedral mesh (not yet validated: pass it to
+ * fdem_tet_mesh_validate, which orients it). */
+int gmsh_read_tetrahedra(const char *text, size_t length, fdem_tet_mesh *out,
+                         char *message, size_t message_size);
 
 #endif

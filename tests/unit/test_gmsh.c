@@ -211,35 +211,115 @@ static void rejects_missing_sections(void)
     check_fails(V22 V22, "second $MeshFormat", 1);
 }
 
+/* Reads text with one of the two readers, freeing what it returns: 0 or -1. */
+typedef int (*gmsh_reader_fn)(const char *text, size_t length, char *message, size_t size);
+
+static int read_triangles(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_mesh m;
+    if (gmsh_read(text, length, &m, message, size) != 0) return -1;
+    fdem_mesh_free(&m);
+    return 0;
+}
+
+static int read_tetrahedra(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_tet_mesh m;
+    if (gmsh_read_tetrahedra(text, length, &m, message, size) != 0) return -1;
+    fdem_tet_mesh_free(&m);
+    return 0;
+}
+
 /* Every prefix of a real file must fail cleanly (or, for the full length,
- * succeed): exercises every truncation point under ASan. */
-static void every_prefix_of_a_real_file(void)
+ * succeed): exercises every truncation point under ASan. Only the whole
+ * file and the file without its final newline parse. */
+static void check_every_prefix(const char *path, gmsh_reader_fn reader)
 {
     size_t length = 0;
-    char *text = read_file("tests/data/square_v41.msh", &length);
+    char *text = read_file(path, &length);
     if (!text) return;
     int accepted = 0, unexplained = 0;
     for (size_t n = 0; n <= length; n++) {
         char *copy = malloc(n ? n : 1);
         memcpy(copy, text, n);
-        fdem_mesh m;
         char message[256] = "";
-        if (gmsh_read(copy, n, &m, message, sizeof message) == 0) {
+        if (reader(copy, n, message, sizeof message) == 0)
             accepted++;
-            fdem_mesh_free(&m);
-        } else if (strncmp(message, "gmsh", 4) != 0) {
+        else if (strncmp(message, "gmsh", 4) != 0)
             unexplained++;
-        }
         free(copy);
     }
-    /* Only the whole file and the file without its final newline parse. */
-    CHECK(accepted == 2, "%d prefixes accepted", accepted);
-    CHECK(unexplained == 0, "%d failures without a message", unexplained);
+    CHECK(accepted == 2, "%s: %d prefixes accepted", path, accepted);
+    CHECK(unexplained == 0, "%s: %d failures without a message", path, unexplained);
     free(text);
+}
+
+static void every_prefix_of_a_real_file(void)
+{
+    check_every_prefix("tests/data/square_v41.msh", read_triangles);
+}
+
+/* ------------------------------------------------------------ tetrahedra */
+
+/* The cube of cube.geo as the installed gmsh meshes it: 45 nodes and 100
+ * tetrahedra (counted independently with Python from the v2.2 file), volume
+ * 1 once validated (which orients every tetrahedron). */
+static void check_tet_file(const char *path)
+{
+    size_t length = 0;
+    char *text = read_file(path, &length);
+    if (!text) return;
+    fdem_tet_mesh m;
+    fdem_error err;
+    char message[256];
+    int rc = gmsh_read_tetrahedra(text, length, &m, message, sizeof message);
+    CHECK(rc == 0, "%s: %s", path, message);
+    if (rc == 0) {
+        CHECK(m.node_count == 45 && m.tet_count == 100, "%s: %d nodes, %d tetrahedra, want 45, 100",
+              path, m.node_count, m.tet_count);
+        CHECK(fdem_tet_mesh_validate(&m, NULL, &err) == 0, "%s: %s", path, err.message);
+        CHECK_NEAR(fdem_tet_mesh_volume(&m), 1.0, 1e-12);
+        double zmax = 0;
+        for (int n = 0; n < m.node_count; n++) zmax = fmax(zmax, m.xyz[3 * n + 2]);
+        CHECK(zmax == 1.0, "%s: z not read (max %g)", path, zmax);
+        fdem_tet_mesh_free(&m);
+    }
+    free(text);
+}
+
+static void cube_tetrahedra_v22(void) { check_tet_file("tests/data/cube_v22.msh"); }
+static void cube_tetrahedra_v41(void) { check_tet_file("tests/data/cube_v41.msh"); }
+
+static void tetrahedra_rejects(void)
+{
+    fdem_tet_mesh m;
+    char message[256] = "";
+    size_t length = 0;
+    char *square = read_file("tests/data/square_v22.msh", &length);
+    if (square) {
+        CHECK(gmsh_read_tetrahedra(square, length, &m, message, sizeof message) != 0 &&
+              strstr(message, "no 4-node tetrahedra"), "a 2D file: %s", message);
+        free(square);
+    }
+    static const char *no_z = V22 "$Nodes\n4\n1 0 0 0\n2 1 0 0\n3 0 1\n4 0 0 1\n$EndNodes\n"
+                                  "$Elements\n1\n1 4 0 1 2 3 4\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(no_z, strlen(no_z), &m, message, sizeof message) != 0 &&
+          strstr(message, "line 8"), "a node without z: %s", message);
+    static const char *short_tet = V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                                       "$Elements\n1\n1 4 0 1 2 3\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(short_tet, strlen(short_tet), &m, message, sizeof message) != 0 &&
+          strstr(message, "4 node tags"), "three tags: %s", message);
+    static const char *unknown = V22 "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n"
+                                     "$Elements\n1\n1 4 0 1 2 3 9\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(unknown, strlen(unknown), &m, message, sizeof message) != 0 &&
+          strstr(message, "tetrahedron refers to node 9"), "unknown node: %s", message);
+    /* every prefix of the v4.1 cube fails cleanly or (whole file) parses */
+    check_every_prefix("tests/data/cube_v41.msh", read_tetrahedra);
 }
 
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
            T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
            T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
            T(rejects_bad_references), T(rejects_missing_sections),
-           T(every_prefix_of_a_real_file))
+           T(every_prefix_of_a_real_file), T(cube_tetrahedra_v22), T(cube_tetrahedra_v41),
+           T(tetrahedra_rejects))

@@ -1,0 +1,531 @@
+/*
+ * nbs_3d.c - Munjiza-NBS contact detection in 3D (Munjiza 2004, ch. 3.11,
+ * seed page 145: M = 3N + nz + 2nx + 2ny).
+ *
+ * Owns: integerising bounding spheres onto a grid of cell size d (the
+ * largest diameter), the three levels of singly connected lists of the book
+ * (z-layers: layer_head / layer_next; y-lists of a layer and the layer below
+ * it: two sets of row heads / row_next; x-lists of a row and the row below
+ * it: two sets of cell heads / cell_next), the half contact mask in 3D, and
+ * the all-pairs reference. What it shares with the 2D detector (pair list,
+ * padding, folding, the old-list encoding) is in nbs_internal.h.
+ *
+ * Why it is shaped this way:
+ *  - Integer RAM is exactly the book's 3N + nz + 2nx + 2ny: integer
+ *    coordinates are not stored (that would be 3N more) but recomputed from
+ *    the centre when needed - a subtract, a multiply and a convert, cheaper
+ *    than the memory traffic of storing them at 1e6 elements.
+ *  - Half mask: an element meets the elements of its row mapped before it
+ *    in cells x-1 .. x+1 (the row is mapped and tested in one pass), the
+ *    cells (x-1 .. x+1, y-1, z) and the nine cells (x-1 .. x+1, y-1 .. y+1,
+ *    z-1): every pair of neighbouring cells is met exactly once and no pair
+ *    needs de-duplication.
+ *  - Layers are done in runs of consecutive layers, bottom-up, and rows of a
+ *    layer likewise, exactly as the 2D rows are: the layer (row) just done
+ *    stays mapped in its set as the layer (row) below the next one, so each
+ *    element is mapped and unmapped once per level. The three rows of the
+ *    layer below are not mapped to x-lists at all: their elements are
+ *    walked against the x-lists of the row (the mask is symmetric), which
+ *    needs no third set of heads.
+ *  - Every table has at least one slot more than the cells it spans (an
+ *    unfolded axis) or is a folded power of two >= 4, so the neighbours
+ *    v - 1 and v + 1 are one wrap-around compare each and never branch on
+ *    an edge: on an unfolded axis the wrap lands on the always-empty slot.
+ *    Three consecutive slots are always distinct, so a folded pair of cells
+ *    is still met once; folding only adds candidates, which the exact
+ *    sphere test removes.
+ *  - Only non-empty layers and rows are visited, found by looping over
+ *    elements; lists are cleared by looping over the elements just mapped.
+ *    Nothing loops over nx, ny or nz, so CPU is O(N) however sparse.
+ *  - Spheres with a non-finite or absurd centre or radius take no part (in
+ *    both detectors), as in 2D.
+ */
+#include "nbs_internal.h"
+
+#include <string.h>
+
+/* --------------------------------------------------------------- spheres */
+
+static inline int nbs3_sphere_valid(double x, double y, double z, double r)
+{
+    return fabs(x) <= NBS_VALUE_LIMIT && fabs(y) <= NBS_VALUE_LIMIT &&
+           fabs(z) <= NBS_VALUE_LIMIT && r >= 0.0 && r <= NBS_VALUE_LIMIT;
+}
+
+/* The one sphere test both detectors use; split statements so that no
+ * compiler contracts it into an FMA in one detector and not the other. */
+static inline int nbs3_spheres_touch(double xi, double yi, double zi, double ri,
+                                     double xj, double yj, double zj, double rj)
+{
+    double dx = xi - xj;
+    double dy = yi - yj;
+    double dz = zi - zj;
+    double reach = ri + rj;
+    double dx2 = dx * dx;
+    double dy2 = dy * dy;
+    double dz2 = dz * dz;
+    double dist2 = dx2 + dy2 + dz2;
+    double reach2 = reach * reach;
+    return dist2 <= reach2;
+}
+
+/* ------------------------------------------------------------- lifecycle */
+
+void nbs_grid_3d_init(nbs_grid_3d *grid)
+{
+    memset(grid, 0, sizeof *grid);
+}
+
+void nbs_grid_3d_free(nbs_grid_3d *grid)
+{
+    int32_t *arrays[] = {grid->layer_head, grid->layer_next, grid->row_head,
+                         grid->row_next, grid->cell_head, grid->cell_next};
+    for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
+    nbs_grid_3d_init(grid);
+}
+
+size_t nbs_integers_3d(const nbs_grid_3d *grid)
+{
+    return 3 * grid->n_capacity + grid->nz_capacity + 2 * grid->nx_capacity +
+           2 * grid->ny_capacity;
+}
+
+size_t nbs_memory_bytes_3d(const nbs_grid_3d *grid, const nbs_pairs *pairs)
+{
+    size_t bytes = nbs_integers_3d(grid) * sizeof(int32_t);
+    if (pairs) bytes += 2 * pairs->capacity * sizeof(int32_t);
+    return bytes;
+}
+
+/* Grows a table of heads (sets of `size` slots each) to hold `want` slots a
+ * set, all empty. Between detections every head is empty, so nothing is
+ * kept across the move. */
+static int nbs3_grow_heads(int32_t **heads, size_t *capacity, size_t want, size_t sets)
+{
+    if (want <= *capacity) return 0;
+    if (nbs_grow_array(heads, sets * want)) return -1;
+    nbs_fill_empty(*heads, sets * want);
+    *capacity = want;
+    return 0;
+}
+
+static int nbs3_reserve(nbs_grid_3d *g, size_t n, int32_t nx, int32_t ny, int32_t nz)
+{
+    if (n > g->n_capacity) {
+        size_t cap = n > 2 * g->n_capacity ? n : 2 * g->n_capacity;
+        if (nbs_grow_array(&g->layer_next, cap) || nbs_grow_array(&g->row_next, cap) ||
+            nbs_grow_array(&g->cell_next, cap))
+            return -1;
+        g->n_capacity = cap;
+    }
+    if (nbs3_grow_heads(&g->layer_head, &g->nz_capacity, (size_t)nz, 1) ||
+        nbs3_grow_heads(&g->row_head, &g->ny_capacity, (size_t)ny, 2) ||
+        nbs3_grow_heads(&g->cell_head, &g->nx_capacity, (size_t)nx, 2))
+        return -1;
+    return 0;
+}
+
+static void nbs3_reset_heads(nbs_grid_3d *g)
+{
+    if (g->layer_head) nbs_fill_empty(g->layer_head, g->nz_capacity);
+    if (g->row_head) nbs_fill_empty(g->row_head, 2 * g->ny_capacity);
+    if (g->cell_head) nbs_fill_empty(g->cell_head, 2 * g->nx_capacity);
+}
+
+/* ---------------------------------------------------------------- layout */
+
+typedef struct nbs3_axis {
+    double lo;      /* smallest centre coordinate */
+    int64_t mask;   /* table - 1 when folded, all ones otherwise */
+    int32_t size;   /* table slots: cells spanned + 1, >= 3; or the fold */
+} nbs3_axis;
+
+typedef struct nbs3_bounds {
+    double lo[3], hi[3], rmax;
+    size_t valid;
+    int all_valid;
+} nbs3_bounds;
+
+/* Extremes of the valid spheres. Whether every sphere is valid is decided
+ * from a sum (finite only without NaN or infinity) and the extremes, so the
+ * usual case runs the loop without a per-sphere test. */
+static nbs3_bounds nbs3_bounds_of(size_t n, const double *const c[3], const double *r)
+{
+    nbs3_bounds b;
+    double rmin = DBL_MAX, sum = 0.0, sum_r = 0.0;
+    b.rmax = 0.0;
+    for (int a = 0; a < 3; a++) b.lo[a] = DBL_MAX, b.hi[a] = -DBL_MAX;
+    for (size_t i = 0; i < n; i++) {
+        for (int a = 0; a < 3; a++) {
+            double v = c[a][i];
+            b.lo[a] = v < b.lo[a] ? v : b.lo[a];
+            b.hi[a] = v > b.hi[a] ? v : b.hi[a];
+            sum += v;
+        }
+        rmin = r[i] < rmin ? r[i] : rmin;
+        b.rmax = r[i] > b.rmax ? r[i] : b.rmax;
+        sum_r += r[i];
+    }
+    sum += sum_r;
+    b.valid = n;
+    b.all_valid = n > 0 && isfinite(sum) &&
+                  nbs3_sphere_valid(b.lo[0], b.lo[1], b.lo[2], rmin) &&
+                  nbs3_sphere_valid(b.hi[0], b.hi[1], b.hi[2], b.rmax);
+    if (b.all_valid) return b;
+
+    b.rmax = 0.0;
+    b.valid = 0;
+    for (int a = 0; a < 3; a++) b.lo[a] = DBL_MAX, b.hi[a] = -DBL_MAX;
+    for (size_t i = 0; i < n; i++) {
+        if (!nbs3_sphere_valid(c[0][i], c[1][i], c[2][i], r[i])) continue;
+        for (int a = 0; a < 3; a++) {
+            b.lo[a] = fmin(b.lo[a], c[a][i]);
+            b.hi[a] = fmax(b.hi[a], c[a][i]);
+        }
+        b.rmax = fmax(b.rmax, r[i]);
+        b.valid++;
+    }
+    return b;
+}
+
+/* One spare slot beyond the cells spanned, so that the wrap-around
+ * neighbour of an edge cell is an empty slot; folded when that exceeds the
+ * table of O(N). */
+static nbs3_axis nbs3_axis_plan(double lo, double hi, double inv_cell, int32_t table)
+{
+    nbs3_axis ax;
+    int32_t spanned;
+    int fold;
+    nbs_axis_plan(hi - lo, inv_cell, table - 1, &spanned, &fold);
+    ax.lo = lo;
+    ax.size = fold ? table : (spanned + 1 < 3 ? 3 : spanned + 1);
+    ax.mask = fold ? (int64_t)table - 1 : INT64_MAX;
+    return ax;
+}
+
+/* --------------------------------------------------------------- the scan */
+
+/* What the detection reads and writes while it walks the lists. rows[k] and
+ * cells[k] are the two sets of heads. */
+typedef struct nbs3_scan {
+    const double *cx, *cy, *cz, *r;
+    const int32_t *body;
+    double inv;
+    nbs3_axis ax, ay, az;
+    int32_t *layer_head, *layer_next;
+    int32_t *rows[2], *row_next;
+    int32_t *cells[2], *cell_next;
+} nbs3_scan;
+
+/* x >= lo, so truncation is floor */
+static inline int32_t nbs3_coord(const nbs3_axis *a, double v, double inv)
+{
+    return (int32_t)((int64_t)((v - a->lo) * inv) & a->mask);
+}
+
+static inline int32_t nbs3_x(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->ax, s->cx[j], s->inv); }
+static inline int32_t nbs3_y(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->ay, s->cy[j], s->inv); }
+static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->az, s->cz[j], s->inv); }
+
+static inline int32_t nbs3_down(int32_t v, int32_t size) { return v > 0 ? v - 1 : size - 1; }
+static inline int32_t nbs3_up(int32_t v, int32_t size) { return v < size - 1 ? v + 1 : 0; }
+
+/* Layer `list` into y-set k, and out again (by looping over its elements). */
+static void nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
+{
+    int32_t *heads = s->rows[k];
+    for (int32_t j = list; j >= 0; j = s->layer_next[j]) {
+        int32_t y = nbs3_y(s, j);
+        s->row_next[j] = heads[y];
+        heads[y] = j;
+    }
+}
+
+static void nbs3_layer_unmap(const nbs3_scan *s, int k, int32_t list)
+{
+    int32_t *heads = s->rows[k];
+    for (int32_t j = list; j >= 0; j = s->layer_next[j]) heads[nbs3_y(s, j)] = NBS_EMPTY;
+}
+
+/* Row `list` into x-set k (head insertion: an element's link leads to the
+ * elements of its cell mapped before it); returns the row's element count. */
+static int32_t nbs3_row_map(const nbs3_scan *s, int k, int32_t list)
+{
+    int32_t *heads = s->cells[k], count = 0;
+    for (int32_t j = list; j >= 0; j = s->row_next[j], count++) {
+        int32_t x = nbs3_x(s, j);
+        s->cell_next[j] = heads[x];
+        heads[x] = j;
+    }
+    return count;
+}
+
+static void nbs3_row_unmap(const nbs3_scan *s, int k, int32_t list)
+{
+    int32_t *heads = s->cells[k];
+    for (int32_t j = list; j >= 0; j = s->row_next[j]) heads[nbs3_x(s, j)] = NBS_EMPTY;
+}
+
+/* The pair list in locals the compiler can keep in registers. */
+typedef struct nbs3_out {
+    int32_t *a, *b;
+    size_t count, capacity;
+    nbs_pairs *pairs;
+} nbs3_out;
+
+/* Makes room for `need` more pairs (one element's worst case plus the slot
+ * written past the last), so the candidate loops need no capacity test. */
+static inline int nbs3_room(nbs3_out *o, size_t need)
+{
+    if (NBS_UNLIKELY(o->capacity - o->count < need)) {
+        o->pairs->count = o->count;
+        if (nbs_pairs_grow(o->pairs, o->count + need) != 0) return -1;
+        o->a = o->pairs->a;
+        o->b = o->pairs->b;
+        o->capacity = o->pairs->capacity;
+    }
+    return 0;
+}
+
+/* An element's sphere, loaded once for all the cells it meets. */
+typedef struct nbs3_ball {
+    double x, y, z, r;
+    int32_t e;
+} nbs3_ball;
+
+static inline nbs3_ball nbs3_ball_of(const nbs3_scan *s, int32_t e)
+{
+    nbs3_ball b = {s->cx[e], s->cy[e], s->cz[e], s->r[e], e};
+    return b;
+}
+
+/* Tests a ball against one cell's list. The pair is always written and
+ * the count advanced by the outcome: no mispredicted branch on a hit. */
+static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_scan *s, int use_body, nbs3_ball b,
+                                              int32_t list, nbs3_out *o)
+{
+    const double *cx = s->cx, *cy = s->cy, *cz = s->cz, *r = s->r;
+    const int32_t *cell_next = s->cell_next;
+    for (int32_t j = list; j >= 0; j = cell_next[j]) {
+        int hit = nbs3_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j]);
+        if (use_body) hit &= !nbs_same_body(s->body, b.e, j);
+        o->a[o->count] = b.e;
+        o->b[o->count] = j;
+        o->count += (size_t)hit;
+    }
+}
+
+/* A ball against the three cells x-1, x, x+1 of an x-set. */
+static NBS_ALWAYS_INLINE void nbs3_three_cells(const nbs3_scan *s, int use_body, nbs3_ball b,
+                                               const int32_t *cells, int32_t x, nbs3_out *o)
+{
+    int32_t nx = s->ax.size;
+    nbs3_chain_test(s, use_body, b, cells[nbs3_down(x, nx)], o);
+    nbs3_chain_test(s, use_body, b, cells[x], o);
+    nbs3_chain_test(s, use_body, b, cells[nbs3_up(x, nx)], o);
+}
+
+/* A row and what its mask reaches: the row is mapped to x-set `cur` (count
+ * elements, known once mapped) while it is tested, the row below it (same
+ * layer, held_count elements) is in x-set `held`, and below[0..2] are the
+ * rows y-1, y, y+1 of the layer below. */
+typedef struct nbs3_row {
+    int32_t list, count, held_count;
+    int cur, held;
+    int32_t below[3];
+} nbs3_row;
+
+static NBS_ALWAYS_INLINE int nbs3_row_test(const nbs3_scan *s, int use_body, nbs3_row *row,
+                                           nbs_pairs *pairs)
+{
+    nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
+    int32_t *cur = s->cells[row->cur];
+    const int32_t *held = s->cells[row->held];
+    int32_t *cell_next = s->cell_next;
+    int32_t count = 0;
+    /* Mapping and testing in one pass: e meets the elements of its row
+     * mapped before it in cells x-1, x, x+1, so each pair of the row once. */
+    for (int32_t e = row->list; e >= 0; e = s->row_next[e], count++) {
+        if (nbs3_room(&o, (size_t)count + (size_t)row->held_count + 1) != 0) return -1;
+        nbs3_ball b = nbs3_ball_of(s, e);
+        int32_t x = nbs3_coord(&s->ax, b.x, s->inv);
+        nbs3_three_cells(s, use_body, b, cur, x, &o);
+        if (row->held_count) nbs3_three_cells(s, use_body, b, held, x, &o);
+        cell_next[e] = cur[x];
+        cur[x] = e;
+    }
+    row->count = count;
+    /* the layer below: each of its elements against the row's x-lists */
+    const size_t room_below = (size_t)count + 1;
+    for (int k = 0; k < 3; k++)
+        for (int32_t j = row->below[k]; j >= 0; j = s->row_next[j]) {
+            if (nbs3_room(&o, room_below) != 0) return -1;
+            nbs3_ball b = nbs3_ball_of(s, j);
+            nbs3_three_cells(s, use_body, b, cur, nbs3_coord(&s->ax, b.x, s->inv), &o);
+        }
+    pairs->count = o.count;
+    return 0;
+}
+
+static int nbs3_row_test_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs)
+{
+    return s->body ? nbs3_row_test(s, 1, row, pairs) : nbs3_row_test(s, 0, row, pairs);
+}
+
+/* The rows of a layer (its y-lists in set `cur`; the layer below in set
+ * `below`): loop over the layer's elements to find rows not yet done; each
+ * starts a run down to the lowest consecutive new row, then up while the
+ * row above is new, the row just done held in its x-set as the row below
+ * of the next. Done rows are marked old (-2 - head): they are still read
+ * as neighbours, and are emptied when the layer is unmapped. */
+static int nbs3_layer_rows(const nbs3_scan *s, int32_t layer, int cur, int below,
+                           nbs_pairs *pairs)
+{
+    int32_t *rows = s->rows[cur];
+    const int32_t *low = s->rows[below];
+    const int32_t ny = s->ay.size;
+    for (int32_t i = layer; i >= 0; i = s->layer_next[i]) {
+        int32_t y = nbs3_y(s, i);
+        if (rows[y] < 0) continue; /* done */
+        for (int32_t steps = 1; steps < ny; steps++) {
+            int32_t yb = nbs3_down(y, ny);
+            if (rows[yb] < 0) break;
+            y = yb;
+        }
+        nbs3_row row = {.held = 1};
+        int32_t held_list = nbs_row_list(rows[nbs3_down(y, ny)]);
+        row.held_count = nbs3_row_map(s, row.held, held_list);
+        for (;;) {
+            int32_t head = rows[y];
+            rows[y] = -2 - head;
+            row.list = head;
+            row.cur = 1 - row.held;
+            row.below[0] = nbs_row_list(low[nbs3_down(y, ny)]);
+            row.below[1] = nbs_row_list(low[y]);
+            row.below[2] = nbs_row_list(low[nbs3_up(y, ny)]);
+            if (nbs3_row_test_any(s, &row, pairs) != 0) return -1;
+            nbs3_row_unmap(s, row.held, held_list);
+            row.held = row.cur;
+            row.held_count = row.count;
+            held_list = head;
+            y = nbs3_up(y, ny);
+            if (rows[y] < 0) break; /* the run ends */
+        }
+        nbs3_row_unmap(s, row.held, held_list);
+    }
+    return 0;
+}
+
+/* The layers, in runs exactly like the rows: a layer is mapped to its
+ * y-set, its rows tested with the layer below held in the other set, and
+ * stays mapped as the layer below of the next. A layer head is emptied as
+ * soon as no layer can need it any more. */
+static int nbs3_layers_detect(const nbs3_scan *s, size_t n, int all_valid, nbs_pairs *pairs)
+{
+    int32_t *layers = s->layer_head;
+    const int32_t nz = s->az.size;
+    for (size_t i = 0; i < n; i++) {
+        if (!all_valid && !nbs3_sphere_valid(s->cx[i], s->cy[i], s->cz[i], s->r[i])) continue;
+        int32_t z = nbs3_z(s, (int32_t)i);
+        if (layers[z] < 0) continue;
+        for (int32_t steps = 1; steps < nz; steps++) {
+            int32_t zb = nbs3_down(z, nz);
+            if (layers[zb] < 0) break;
+            z = zb;
+        }
+        int held = 1;
+        int32_t held_list = nbs_row_list(layers[nbs3_down(z, nz)]);
+        nbs3_layer_map(s, held, held_list);
+        for (;;) {
+            int32_t head = layers[z];
+            layers[z] = -2 - head;
+            int cur = 1 - held;
+            nbs3_layer_map(s, cur, head);
+            if (nbs3_layer_rows(s, head, cur, held, pairs) != 0) return -1;
+            nbs3_layer_unmap(s, held, held_list);
+            held = cur;
+            held_list = head;
+            int32_t zb = nbs3_down(z, nz), za = nbs3_up(z, nz);
+            if (layers[zb] < NBS_EMPTY) layers[zb] = NBS_EMPTY;
+            if (layers[za] < 0) {
+                layers[z] = NBS_EMPTY;
+                break;
+            }
+            z = za;
+        }
+        nbs3_layer_unmap(s, held, held_list);
+    }
+    return 0;
+}
+
+/* Stage 1 of the book: every valid sphere onto the list of its z-layer. */
+static void nbs3_layers_build(const nbs3_scan *s, size_t n, int all_valid)
+{
+    for (size_t i = n; i-- > 0;) {
+        if (!all_valid && !nbs3_sphere_valid(s->cx[i], s->cy[i], s->cz[i], s->r[i])) continue;
+        int32_t z = nbs3_z(s, (int32_t)i);
+        s->layer_next[i] = s->layer_head[z];
+        s->layer_head[z] = (int32_t)i;
+    }
+}
+
+/* ------------------------------------------------------------- detection */
+
+int nbs_detect_3d(nbs_grid_3d *grid, size_t n, const double *cx, const double *cy,
+                  const double *cz, const double *r, const int32_t *body, nbs_pairs *pairs)
+{
+    pairs->count = 0;
+    if (n > NBS_MAX_CIRCLES) return -1;
+    if (nbs_pairs_grow(pairs, n) != 0) return -1;
+    if (n < 2) return 0;
+    const double *c[3] = {cx, cy, cz};
+    nbs3_bounds b = nbs3_bounds_of(n, c, r);
+    if (b.valid < 2) return 0;
+
+    double span = fmax(b.hi[0] - b.lo[0], fmax(b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]));
+    double cell = nbs_padded_cell(b.rmax, span);
+    int32_t table = (int32_t)nbs_next_pow2(n);
+    nbs3_scan s = {.cx = cx, .cy = cy, .cz = cz, .r = r, .body = body, .inv = 1.0 / cell};
+    s.ax = nbs3_axis_plan(b.lo[0], b.hi[0], s.inv, table);
+    s.ay = nbs3_axis_plan(b.lo[1], b.hi[1], s.inv, table);
+    s.az = nbs3_axis_plan(b.lo[2], b.hi[2], s.inv, table);
+    if (nbs3_reserve(grid, n, s.ax.size, s.ay.size, s.az.size) != 0) return -1;
+    grid->nx = s.ax.size;
+    grid->ny = s.ay.size;
+    grid->nz = s.az.size;
+    grid->cell = cell;
+
+    s.layer_head = grid->layer_head;
+    s.layer_next = grid->layer_next;
+    s.rows[0] = grid->row_head;
+    s.rows[1] = grid->row_head + grid->ny_capacity;
+    s.row_next = grid->row_next;
+    s.cells[0] = grid->cell_head;
+    s.cells[1] = grid->cell_head + grid->nx_capacity;
+    s.cell_next = grid->cell_next;
+
+    nbs3_layers_build(&s, n, b.all_valid);
+    if (nbs3_layers_detect(&s, n, b.all_valid, pairs) != 0) {
+        nbs3_reset_heads(grid);
+        return -1;
+    }
+    return 0;
+}
+
+int nbs_detect_brute_3d(size_t n, const double *cx, const double *cy, const double *cz,
+                        const double *r, const int32_t *body, nbs_pairs *pairs)
+{
+    pairs->count = 0;
+    if (n > NBS_MAX_CIRCLES) return -1;
+    for (size_t i = 0; i < n; i++) {
+        if (!nbs3_sphere_valid(cx[i], cy[i], cz[i], r[i])) continue;
+        for (size_t j = i + 1; j < n; j++) {
+            if (!nbs3_sphere_valid(cx[j], cy[j], cz[j], r[j])) continue;
+            if (!nbs3_spheres_touch(cx[i], cy[i], cz[i], r[i], cx[j], cy[j], cz[j], r[j]))
+                continue;
+            if (nbs_same_body(body, (int32_t)i, (int32_t)j)) continue;
+            if (nbs_pairs_push(pairs, (int32_t)i, (int32_t)j) != 0) return -1;
+        }
+    }
+    return 0;
+}
