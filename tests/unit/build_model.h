@@ -125,6 +125,21 @@ static inline fdem_model *build_disc_pile(int columns, int rows)
     return m;
 }
 
+/* Two undamped, frictionless blocks, 8x4 and 5x4 cells, about to meet at
+ * 5 m/s (the first also drifting up at 0.1 m/s): the collision test case of
+ * the contact and the energy tests. */
+static inline fdem_model *build_colliding_blocks(int *a, int *b)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0);
+    *a = build_rectangle(m, mat, 0, 0, 0.1, 0.05, 8, 4);
+    *b = build_rectangle(m, mat, 0.1002, 0.01, 0.06, 0.05, 5, 4);
+    fdem_set_part_velocity(m, *a, 2.0, 0.1, NULL);
+    fdem_set_part_velocity(m, *b, -3.0, 0, NULL);
+    build_finalize(m, 0.5);
+    return m;
+}
+
 static inline void run_until(fdem_model *m, double t_end)
 {
     fdem_error err;

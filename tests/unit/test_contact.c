@@ -72,13 +72,8 @@ static void momentum(const fdem_model *m, double p[2], double *scale)
 
 static void collision_conserves_momentum_and_energy(void)
 {
-    fdem_model *m = fdem_model_create();
-    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0);
-    int a = build_rectangle(m, mat, 0, 0, 0.1, 0.05, 8, 4);
-    int b = build_rectangle(m, mat, 0.1002, 0.01, 0.06, 0.05, 5, 4);
-    fdem_set_part_velocity(m, a, 2.0, 0.1, NULL);
-    fdem_set_part_velocity(m, b, -3.0, 0, NULL);
-    build_finalize(m, 0.5);
+    int a, b;
+    fdem_model *m = build_colliding_blocks(&a, &b);
     double p0[2], s0, p[2], s;
     momentum(m, p0, &s0);
     double e0 = fdem_get_energy(m).kinetic;

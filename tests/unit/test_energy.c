@@ -56,13 +56,8 @@ static void print_accounts(const char *name, const fdem_model *m, const balance 
  * through the contact penalty and back. */
 static void collision_closes_the_balance(void)
 {
-    fdem_model *m = fdem_model_create();
-    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0);
-    int a = build_rectangle(m, mat, 0, 0, 0.1, 0.05, 8, 4);
-    int b = build_rectangle(m, mat, 0.1002, 0.01, 0.06, 0.05, 5, 4);
-    fdem_set_part_velocity(m, a, 2.0, 0.1, NULL);
-    fdem_set_part_velocity(m, b, -3.0, 0, NULL);
-    build_finalize(m, 0.5);
+    int a, b;
+    fdem_model *m = build_colliding_blocks(&a, &b);
     balance bal = {0};
     run_watched(m, 0.004, &bal);
     print_accounts("collision", m, &bal);
