@@ -21,7 +21,6 @@
 #include "io_thread.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
-#define WORKER_CHECKPOINT_INTERVAL 0.5 /* s of wall time between checkpoints */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
 
 typedef enum worker_exit {
@@ -166,11 +165,12 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
-            if (done || now - clk->last_checkpoint >= WORKER_CHECKPOINT_INTERVAL) {
-                ckpt = case_checkpoint_take(m, &ckpt_size);
-                c->last_checkpoint_step = fdem_get_step(m);
-                clk->last_checkpoint = now;
-            }
+            /* Every snapshot comes with a checkpoint, so that a restart never
+             * drops a snapshot the status has reported (a restart resumes at
+             * the last checkpoint and drops the rows after it). */
+            ckpt = case_checkpoint_take(m, &ckpt_size);
+            c->last_checkpoint_step = fdem_get_step(m);
+            clk->last_checkpoint = now;
         }
         if (!ckpt && now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
             /* --checkpoint-every: progress between far-apart snapshots
