@@ -98,7 +98,8 @@ static inline uint64_t pair_hash(int32_t lo, int32_t hi)
 int contact_history_take_back(contact_state *cs)
 {
     if (contact_history_reserve(cs, cs->pairs.count)) return -1;
-    memset(cs->slip, 0, sizeof(double) * CONTACT_SLOTS * cs->pairs.count);
+    if (cs->pairs.count) /* no pairs yet: slip may still be NULL, which memset may not get */
+        memset(cs->slip, 0, sizeof(double) * CONTACT_SLOTS * cs->pairs.count);
     size_t n = cs->record_count;
     if (n == 0) return 0;
     size_t size = 16;
