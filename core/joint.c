@@ -312,8 +312,8 @@ static inline void joint_point_traction(const material *mat, double k, const joi
 {
     double ft = mat->def.fracture.tensile_strength;
     double dp = ft / k, sp = g->fs / k;
-    if (g->delta < 0) *sigma = k * g->delta; /* compression: the joint's penalty */
-    else *sigma = ft * fmin(g->delta / dp, 1.0) * z;
+    /* compression is joint_compression's, integrated along the whole face */
+    *sigma = g->delta > 0 ? ft * fmin(g->delta / dp, 1.0) * z : 0;
     double r = g->slide / sp;
     *tau = g->fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
 }
@@ -332,6 +332,43 @@ static inline int joint_gauss_elastic(const material *mat, double k, double L, d
     double ksig = k * on;
     double shear_limit = fp->cohesion * L + (on < 0 ? -ksig * mat->tan_phi : 0);
     return ksig <= fp->tensile_strength * L && fabs(k * sl) <= shear_limit;
+}
+
+/* The integrals over xi in [a, b] of c, xi c and c^2, c linear from ca to cb. */
+static inline void linear_moments(double a, double b, double ca, double cb, double out[3])
+{
+    double w = b - a;
+    out[0] = 0.5 * w * (ca + cb);
+    out[1] = w / 6 * (ca * (2 * a + b) + cb * (a + 2 * b));
+    out[2] = w / 3 * (ca * ca + ca * cb + cb * cb);
+}
+
+/* The joint's resistance to being pressed shut, k min(delta, 0) along n,
+ * integrated exactly along the face (delta linear from delta0 at a0 to
+ * delta1 at a1) and added to fa0, fa1; returns its stored energy,
+ * 1/2 k integral min(delta, 0)^2. Two Gauss points would not do: a damaged
+ * joint that opens at one end and closes at the other hinges about the
+ * Gauss point nearer the closed end, where delta is about 0, and its corner
+ * then sinks into the neighbour unresisted (tens of micrometres in the
+ * Brazilian disc). That overlap is energy nobody paid for: the contact that
+ * takes over when the joint breaks throws the faces apart with it. */
+static double joint_compression(double k, double L, double delta0, double delta1, double nx,
+                                double ny, double fa0[2], double fa1[2])
+{
+    double mom[3] = {0, 0, 0};
+    if (delta0 < 0 && delta1 < 0) {
+        linear_moments(0, 1, delta0, delta1, mom);
+    } else if (delta0 < 0 || delta1 < 0) { /* shut between a0 (or a1) and the zero */
+        double zero = delta0 / (delta0 - delta1);
+        if (delta0 < 0) linear_moments(0, zero, delta0, 0, mom);
+        else linear_moments(zero, 1, 0, delta1, mom);
+    } else {
+        return 0;
+    }
+    double s0 = k * L * (mom[0] - mom[1]), s1 = k * L * mom[1];
+    fa0[0] += s0 * nx; fa0[1] += s0 * ny;
+    fa1[0] += s1 * nx; fa1[1] += s1 * ny;
+    return 0.5 * k * L * mom[2];
 }
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
@@ -364,14 +401,16 @@ static void joint_forces_general(const material *mat, double k, const double d0[
         double xi = gauss[i], sigma, tau;
         double phi = w * joint_phi(mat, k, &g[i]);
         *dissipated += (z_old - z) * phi;
-        double squeezed = g[i].delta < 0 ? 0.5 * w * k * g[i].delta * g[i].delta : 0;
-        *stored += z * phi + squeezed;
-        if (D >= 1) *handed += squeezed; /* broken shut: its overlap goes on as contact */
+        *stored += z * phi;
         joint_point_traction(mat, k, &g[i], z, &sigma, &tau);
         double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
         fa0[0] += (1 - xi) * Tx; fa0[1] += (1 - xi) * Ty;
         fa1[0] += xi * Tx;       fa1[1] += xi * Ty;
     }
+    double squeezed = joint_compression(k, L, d0[0] * nx + d0[1] * ny, d1[0] * nx + d1[1] * ny,
+                                        nx, ny, fa0, fa1);
+    *stored += squeezed;
+    if (D >= 1) *handed += squeezed; /* broken shut: its overlap goes on as contact */
 }
 
 /* Adds the forces of intact joints [begin, end) to m->force, counts in

@@ -141,6 +141,13 @@ static void energy_report(const char *name, const fdem_model *m, const load_hist
            100 * h->residual_after / en.external_work);
     CHECK(h->residual_to_peak < 0.01 * h->peak_work, "energy residual %.3g %% of the work done",
           100 * h->residual_to_peak / h->peak_work);
+    /* Contact gives back at most what its overlaps were loaded with, which
+     * the supports paid for. A damaged joint that let a corner sink into
+     * its neighbour unresisted broke with an overlap nobody had paid for,
+     * and the contact that took it over handed out 20 (disc) and 1.1
+     * (uniaxial) times the supports' work (joint.c, joint_compression). */
+    CHECK(-en.contact < en.external_work, "contact gave %.4g J/m, the supports put in %.4g J/m",
+          -en.contact, en.external_work);
 }
 
 /* A joint's midpoint and direction in the initial configuration. */

@@ -189,6 +189,52 @@ static void elastic_joint_is_a_penalty_spring_in_any_orientation(void)
     fdem_model_destroy(m);
 }
 
+/* A damaged joint shut at b0 and open at b1 (a hinge: delta runs from -d
+ * to +4 d, zero at a fifth of the face, so both Gauss points are open)
+ * resists the shut fifth as k min(delta, 0) integrated along the face:
+ * face B is pushed out by k L d / 10 there, b0 taking 14/15 of it. Two
+ * Gauss points saw no compression at all, and the corner sank into the
+ * neighbour unresisted (tens of micrometres in the Brazilian disc); the
+ * contact that took the overlap over when the joint broke then threw the
+ * faces apart with twenty times the energy the platens had put in. */
+static void damaged_joint_shut_at_one_end_resists_along_the_shut_part(void)
+{
+    fdem_model *m = one_joint();
+    double k = m->joint_k[0], L = hypot(0.01, 0.01), ft = 1e6, dp = ft / k, d = 0.1 * dp;
+    m->joint_damage[0] = 0.5;
+    double z = joint_softening(0.5), f[8];
+    turned_joint_forces(m, 0.3, -d, 0, 4 * d, 0, f);
+    CHECK(m->joint_damage[0] == 0.5, "damage %g: the hinge is below the strengths",
+          m->joint_damage[0]);
+    /* the open part: the softened tension at the two Gauss points */
+    const double gp[2] = {0.21132486540518713, 0.78867513459481287};
+    double open_b0 = 0, open_b1 = 0;
+    for (int i = 0; i < 2; i++) {
+        double delta = -d + 5 * d * gp[i];
+        double sigma = ft * fmin(delta / dp, 1.0) * z;
+        open_b0 -= 0.5 * L * (1 - gp[i]) * sigma;
+        open_b1 -= 0.5 * L * gp[i] * sigma;
+    }
+    double shut = k * L * d / 10; /* the shut fifth, -d to 0: k L d / 10 in all */
+    const int32_t *n = m->joint_node;
+    double tx = m->pos[2 * n[1]] - m->pos[2 * n[0]], ty = m->pos[2 * n[1] + 1] - m->pos[2 * n[0] + 1];
+    double len = hypot(tx, ty), nx = ty / len, ny = -tx / len;
+    CHECK_REL(f[4] * nx + f[5] * ny, open_b0 + shut * 14 / 15, 1e-6);
+    CHECK_REL(f[6] * nx + f[7] * ny, open_b1 + shut / 15, 1e-6);
+    for (int i = 0; i < 2; i++) { /* action equals reaction */
+        CHECK_NEAR(f[i] + f[4 + i], 0, 1e-12 * k * L * dp);
+        CHECK_NEAR(f[2 + i] + f[6 + i], 0, 1e-12 * k * L * dp);
+    }
+    /* what it stores for the shut part: 1/2 k L integral min(delta, 0)^2 */
+    double open_stored = 0;
+    for (int i = 0; i < 2; i++) {
+        double delta = -d + 5 * d * gp[i];
+        open_stored += 0.5 * L * z * 0.5 * k * delta * delta;
+    }
+    CHECK_REL(m->joint_energy, open_stored + 0.5 * k * L * d * d / 15, 1e-6);
+    fdem_model_destroy(m);
+}
+
 static void softening_curve_ends(void)
 {
     CHECK_NEAR(joint_softening(0), 1.0, 1e-12);
@@ -313,5 +359,7 @@ static void intact_fracturing_bar_vibrates_like_continuum(void)
 
 CHECK_MAIN(T(softening_curve_ends), T(mode_I_energy_matches_softening_curve),
            T(mode_II_energy_matches_softening_curve),
-           T(elastic_joint_is_a_penalty_spring_in_any_orientation), T(block_of_fracturing_triangles_is_built_right),
+           T(elastic_joint_is_a_penalty_spring_in_any_orientation),
+           T(damaged_joint_shut_at_one_end_resists_along_the_shut_part),
+           T(block_of_fracturing_triangles_is_built_right),
            T(broken_joints_make_fragments), T(intact_fracturing_bar_vibrates_like_continuum))
