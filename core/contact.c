@@ -209,10 +209,12 @@ static int contactor_against_target(const fdem_model *m, const tri_now *c, const
         int na = c->node[i], nb = c->node[j];
         if (friction > 0 && len > 0) {
             if (stiffness == 0) {
-                double e0 = hypot(t->x[1] - t->x[0], t->y[1] - t->y[0]);
-                double e1 = hypot(t->x[2] - t->x[1], t->y[2] - t->y[1]);
-                double e2 = hypot(t->x[0] - t->x[2], t->y[0] - t->y[2]);
-                stiffness = 3 * penalty * max3(e0, e1, e2) / t->area2;
+                double dx0 = t->x[1] - t->x[0], dy0 = t->y[1] - t->y[0];
+                double dx1 = t->x[2] - t->x[1], dy1 = t->y[2] - t->y[1];
+                double dx2 = t->x[0] - t->x[2], dy2 = t->y[0] - t->y[2];
+                double longest2 = max3(dx0 * dx0 + dy0 * dy0, dx1 * dx1 + dy1 * dy1,
+                                       dx2 * dx2 + dy2 * dy2);
+                stiffness = 3 * penalty * sqrt(longest2) / t->area2;
             }
             double tx = ex / len, ty = ey / len;
             double k_t = (2.0 / 3.0) * stiffness * inside * len;
