@@ -306,7 +306,7 @@ static void print_first(const char *name, const first_event *e)
 static void print_loaded(const char *kind, const case_info *info, const fdem_model *m,
                          const load_run *r, double strength, double reference)
 {
-    printf("{\"kind\": \"%s\", \"case\": \"%s\", \"elements\": %d, \"joints\": %d, \"dt\": %.6g, "
+    printf("\"kind\": \"%s\", \"case\": \"%s\", \"elements\": %d, \"joints\": %d, \"dt\": %.6g, "
            "\"steps\": %lld, \"peak_force\": %.6g, \"strength\": %.6g, \"reference\": %.6g, "
            "\"peak_time\": %.6g, \"drop_time\": %.6g, ",
            kind, info->name, m->elem_count, m->joint_count, fdem_get_dt(m), r->steps, r->peak,
@@ -319,6 +319,27 @@ static void print_loaded(const char *kind, const case_info *info, const fdem_mod
     printf("\"centre_onset_time\": %.6g, \"centre_onset_force\": %.6g, ", r->centre_onset_time,
            r->centre_onset_force);
     printf("\"broken_end\": %d, \"seconds\": %.3g}\n", m->broken_joints, r->seconds);
+}
+
+/* The share of joints near the middle of the specimen (|x|, |y| within
+ * `reach`) whose direction lies within 10 degrees of `angle` from the load
+ * (y) axis: a crack can only run along element edges, so a mesh with none
+ * near the failure plane must be loaded further before it fails. */
+static double oriented_share(const fdem_model *m, double reach, double angle)
+{
+    int near = 0, oriented = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *nd = m->joint_node + 4 * j;
+        const double *p = m->pos0;
+        double x, y;
+        joint_midpoint(m, j, &x, &y);
+        if (fabs(x) > reach || fabs(y) > reach) continue;
+        double dx = fabs(p[2 * nd[1]] - p[2 * nd[0]]), dy = fabs(p[2 * nd[1] + 1] - p[2 * nd[0] + 1]);
+        double from_axis = atan2(dx, dy) * 180 / M_PI;
+        near++;
+        oriented += fabs(from_axis - angle) <= 10;
+    }
+    return near ? (double)oriented / near : 0;
 }
 
 /* The specimen is part 0; its extent gives D (disc) or W x H (block). */
@@ -344,19 +365,24 @@ static int run_fracture(const char *kind)
     double width, height;
     specimen_extent(m, &width, &height);
     const material *rock = &m->materials[m->parts[0].material];
-    double strength_per_force, reference;
+    double strength_per_force, reference, oriented;
     if (strcmp(kind, "brazilian") == 0) {
-        strength_per_force = 2 / (M_PI * width);  /* sigma_t = 2P/(pi D) */
+        /* sigma_t = 2P/(pi D); the centre splits along the loaded diameter */
+        strength_per_force = 2 / (M_PI * width);
         reference = rock->def.fracture.tensile_strength;
+        oriented = oriented_share(m, 0.25 * width, 0);
     } else {
-        double c = rock->def.fracture.cohesion;
-        double phi = rock->def.fracture.friction_angle * M_PI / 180;
+        /* Mohr-Coulomb: failure planes at 45 - phi/2 degrees from the load */
+        double c = rock->def.fracture.cohesion, phi_deg = rock->def.fracture.friction_angle;
+        double phi = phi_deg * M_PI / 180;
         strength_per_force = 1 / width;
         reference = 2 * c * cos(phi) / (1 - sin(phi));
+        oriented = oriented_share(m, 0.5 * width, 45 - 0.5 * phi_deg);
     }
     load_run r;
     if (run_loaded(m, info.end_time, 0.5 * height, reference / strength_per_force, &r)) return 1;
     double strength = r.peak * strength_per_force;
+    printf("{\"oriented\": %.4f, ", oriented);
     print_loaded(kind, &info, m, &r, strength, reference);
     fdem_model_destroy(m);
     return 0;

@@ -120,6 +120,9 @@ def example_with_mesh(name, size, tweaks=()):
         geo = f.read()
     geo, hits = re.subn(r"\bh = [0-9.eE+-]+;", "h = %r;" % size, geo)
     assert hits == 1, "no 'h = ...;' in %s.geo" % name
+    for tweak in tweaks:
+        if tweak in GEO_TWEAKS:
+            geo = tweak(geo)
     with tempfile.TemporaryDirectory() as tmp:
         with open(os.path.join(tmp, "m.geo"), "w") as f:
             f.write(geo)
@@ -132,8 +135,22 @@ def example_with_mesh(name, size, tweaks=()):
     # peak after the example's own end
     doc["time"]["end"] *= 2
     for tweak in tweaks:
-        tweak(doc)
+        if tweak not in GEO_TWEAKS:
+            tweak(doc)
     return doc
+
+
+def delaunay(geo):
+    """gmsh's Delaunay (Mesh.Algorithm 5) instead of the examples'
+    Frontal-Delaunay (6): Frontal-Delaunay lays near-equilateral triangles
+    in rows, so a whole specimen can have its edges in three directions
+    only; Delaunay's edges point every way."""
+    geo, hits = re.subn(r"Mesh\.Algorithm = \d+;", "Mesh.Algorithm = 5;", geo)
+    assert hits == 1
+    return geo
+
+
+GEO_TWEAKS = (delaunay,)
 
 
 ARC = math.radians(15)  # the loading arc 2 alpha
@@ -184,10 +201,14 @@ def fracture_table(kind, runs, across):
     """Zones are joint counts [centre / between / platen]: abs(y) below half
     the specimen's half-height, above 0.8 of it, and the rest."""
     ratio = "2P/(pi D) / f_t" if kind == "brazilian" else "peak / Mohr-Coulomb"
-    print("\n| mesh size | elements%s | %s | peak at | first softening joints (D > 0) | "
+    # joints within 10 degrees of where the crack should run: along the
+    # loaded diameter within D/4 of the centre, or at 45 - phi/2 to the load
+    # in the middle W x W of the block
+    oriented = "joints along the diameter" if kind == "brazilian" else "joints near the MC plane"
+    print("\n| mesh size | elements%s | %s | %s | peak at | first softening joints (D > 0) | "
           "first broken joints (D = 1) | ratio when the centre starts to soften | D > 0 at the peak | D >= 0.5 at the peak | steps | CPU time |"
-          % (" across" if kind == "uniaxial" else "", ratio))
-    print("|---" * 11 + "|")
+          % (" across" if kind == "uniaxial" else "", oriented, ratio))
+    print("|---" * 12 + "|")
     for size, *tweaks in runs:
         doc = example_with_mesh("brazilian-disc" if kind == "brazilian" else "uniaxial-compression",
                                 size, tweaks)
@@ -199,8 +220,8 @@ def fracture_table(kind, runs, across):
                                        1e3 * r["centre_onset_time"])) if r["centre_onset_time"] > 0 else "never"
         if r["drop_time"] < 0:
             label += " (the load never fell: the peak is a lower bound)"
-        print("| %s | %s | %.3f | %.3g ms | %s at %.3g ms | %s at %.3g ms | %s | %s | %s | %d | %.0f s |"
-              % (label, count, r["strength"] / r["reference"], 1e3 * r["peak_time"],
+        print("| %s | %s | %.0f %% | %.3f | %.3g ms | %s at %.3g ms | %s at %.3g ms | %s | %s | %s | %d | %.0f s |"
+              % (label, count, 100 * r["oriented"], r["strength"] / r["reference"], 1e3 * r["peak_time"],
                  zones(on["zones"]), 1e3 * on["time"], zones(br["zones"]), 1e3 * br["time"], centre,
                  zones(r["softening_at_peak"]), zones(r["damaged_at_peak"]), r["steps"], r["seconds"]), flush=True)
 
@@ -217,11 +238,17 @@ def main(groups):
     if "brazilian" in groups:
         fracture_table("brazilian", [(2e-3,), (1.4e-3,), (1e-3,),
                                      (2e-3, arc), (1.4e-3, arc), (1e-3, arc),
+                                     (2e-3, delaunay, arc), (1.4e-3, delaunay, arc),
+                                     (1e-3, delaunay, arc), (1e-3, delaunay),
                                      (2e-3, brittle), (1e-3, brittle),
                                      (2e-3, brittle, arc), (1e-3, brittle, arc)], 0.05)
     if "uniaxial" in groups:
-        fracture_table("uniaxial", [(2e-3,), (1.8e-3,), (1.5e-3,), (1.25e-3,), (1e-3,), (0.7e-3,),
-                                    (2e-3, frictionless), (1e-3, frictionless)], 0.025)
+        sizes = (3e-3, 2.5e-3, 2.2e-3, 2.1e-3, 2e-3, 1.95e-3, 1.9e-3, 1.8e-3, 1.5e-3, 1.25e-3,
+                 1e-3, 0.7e-3)
+        fracture_table("uniaxial", [(h,) for h in sizes] +
+                       [(h, delaunay) for h in (3e-3, 2.2e-3, 2e-3, 1.9e-3, 1.5e-3, 1e-3)] +
+                       [(1.8e-3, frictionless), (1e-3, frictionless),
+                        (2e-3, delaunay, frictionless)], 0.025)
 
 
 if __name__ == "__main__":
