@@ -3,7 +3,7 @@
 docs/physics.md: how far constant-strain triangles are from beam theory in
 bending, and how the fracture examples' peaks move with the mesh.
 
-    make limits                                  # everything, ~25 min on one core
+    make limits                                  # everything, ~10 min of CPU on one core
     LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian
 
 It writes each case document into a temporary folder (beams with the
