@@ -6,11 +6,12 @@ bending, and how the fracture examples' peaks move with the mesh.
     make limits                                  # everything, ~10 min of CPU on one core
     LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian
 
-It writes each case document into a temporary folder (beams with the
-built-in rectangle; the Brazilian disc and uniaxial specimen exactly as
-examples/*.json, with only the gmsh mesh size of examples/*.geo changed),
-runs the C driver scripts/limits.c on it (case_build + the engine, the
-daemon's own path without HTTP), and prints markdown tables.
+It builds each case document (beams with the built-in rectangle; the
+Brazilian disc and uniaxial specimen exactly as examples/*.json, with only
+the gmsh mesh size of examples/*.geo changed, or the mesh algorithm or the
+loading where a row's name says so), pipes it to the C driver
+scripts/limits.c (case_build + the engine, the daemon's own path without
+HTTP), and prints markdown tables.
 """
 import json
 import math
