@@ -5,6 +5,7 @@
 #   make test-san   the same under AddressSanitizer + UndefinedBehaviorSanitizer
 #   make bench      speed and memory figures (never part of the tests)
 #   make demo       start a daemon, run a bundled example end to end, draw a PNG
+#   make limits     the mesh-dependence figures of docs/physics.md (minutes; not a test)
 #
 # SAN=1 builds everything instrumented into build-san/ and bin-san/.
 
@@ -47,7 +48,7 @@ UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 LIBCORE    := $(BUILD)/libfdemcore.a
 LIBPROTO   := $(BUILD)/libfdemproto.a
 
-.PHONY: all deps test test-unit test-integration test-san bench demo fuzz clean
+.PHONY: all deps test test-unit test-integration test-san bench demo limits fuzz clean
 
 all: deps $(BIN)/fdemd $(BIN)/fdemctl
 
@@ -96,6 +97,11 @@ $(BUILD)/bench/%: bench/%.c $(LIBPROTO) $(LIBCORE)
 	$(CC) $(CFLAGS) -O3 -march=native $(PKG_CFLAGS) -Icore -Iproto $(LDSAN) -fopenmp -o $@ $< \
 	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
 
+$(BUILD)/scripts/%: scripts/%.c $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto $(LDSAN) -fopenmp -o $@ $< \
+	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+
 test: all $(UNIT_BIN)
 	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
@@ -110,6 +116,9 @@ bench: deps $(BENCH_SRC:bench/%.c=$(BUILD)/bench/%) $(BIN)/fdemd
 
 demo: all
 	@BIN=$(BIN) PYTHON=$(PYTHON) bash scripts/demo.sh
+
+limits: deps $(BUILD)/scripts/limits
+	@LIMITS=$(BUILD)/scripts/limits $(PYTHON) scripts/limits.py
 
 fuzz: deps
 	@bash tests/fuzz/run.sh

@@ -1,0 +1,256 @@
+#!/usr/bin/python3
+"""limits.py - reruns the figures of "Known limitations and how to mesh" in
+docs/physics.md: how far constant-strain triangles are from beam theory in
+bending, and how the fracture examples' peaks move with the mesh.
+
+    make limits                                  # everything, ~10 min of CPU on one core
+    LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian
+
+It builds each case document (beams with the built-in rectangle; the
+Brazilian disc and uniaxial specimen exactly as examples/*.json, with only
+the gmsh mesh size of examples/*.geo changed, or the mesh algorithm or the
+loading where a row's name says so), pipes it to the C driver
+scripts/limits.c (case_build + the engine, the daemon's own path without
+HTTP), and prints markdown tables.
+"""
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DRIVER = os.environ.get("LIMITS", os.path.join(ROOT, "build", "scripts", "limits"))
+
+# --------------------------------------------------------------------- beam
+# A cantilever L = 1 m, depth d = 0.1 m (L/d = 10), square cells, clamped at
+# x = 0, a tip force shared by the end nodes, no damping: the engine's
+# material damping is stiffness-proportional (a fraction of the stiffest
+# mode's critical damping), which leaves a beam's first mode almost undamped,
+# so the static deflection is taken as the mean of the free vibration about
+# it over whole periods instead.
+BEAM = {"L": 1.0, "d": 0.1, "rho": 2700, "E": 3e10, "nu": 0.25, "P": 1000.0}
+
+
+def beam_case(n):
+    b = BEAM
+    ep = b["E"] / (1 - b["nu"] ** 2)
+    inertia = b["d"] ** 3 / 12
+    omega = 1.8751 ** 2 * math.sqrt(ep * inertia / (b["rho"] * b["d"] * b["L"] ** 4))
+    end = 6 * 2 * math.pi / omega
+    return {
+        "name": "cantilever-%d" % n,
+        "materials": {"rock": {"density": b["rho"], "young": b["E"], "poisson": b["nu"]}},
+        "parts": [{"name": "beam", "material": "rock",
+                   "rectangle": {"origin": [0, -b["d"] / 2], "size": [b["L"], b["d"]],
+                                 "divisions": [round(n * b["L"] / b["d"]), n]}}],
+        "constraints": [{"box": [-1e-6, -1, 1e-6, 1], "fix": ["x", "y"]},
+                        {"box": [b["L"] - 1e-6, -1, b["L"] + 1e-6, 1], "force": [0, -b["P"]]}],
+        "time": {"end": end, "dt": "auto", "safety": 0.5},
+        "output": {"interval": end, "fields": ["position"]}}
+
+
+def timoshenko_first_period(elements=400):
+    """First period of a Timoshenko cantilever (shear k = 5/6, rotary
+    inertia), by a 1D finite-element model fine enough to be exact here."""
+    b = BEAM
+    ep, G = b["E"] / (1 - b["nu"] ** 2), b["E"] / (2 * (1 + b["nu"]))
+    A, I, k = b["d"], b["d"] ** 3 / 12, 5 / 6
+    le = b["L"] / elements
+    dofs = 2 * (elements + 1)  # w, theta per node
+    K = np.zeros((dofs, dofs))
+    M = np.zeros((dofs, dofs))
+    for e in range(elements):
+        idx = [2 * e, 2 * e + 1, 2 * e + 2, 2 * e + 3]
+        # bending: EI theta'^2; shear (one-point, no locking): kGA (w' - theta)^2
+        kb = ep * I / le * np.array([[0, 0, 0, 0], [0, 1, 0, -1], [0, 0, 0, 0], [0, -1, 0, 1]])
+        g = np.array([-1 / le, -0.5, 1 / le, -0.5])
+        ks = k * G * A * le * np.outer(g, g)
+        mw = b["rho"] * A * le / 6 * np.array([[2, 1], [1, 2]])
+        mt = b["rho"] * I * le / 6 * np.array([[2, 1], [1, 2]])
+        me = np.zeros((4, 4))
+        me[np.ix_([0, 2], [0, 2])] = mw
+        me[np.ix_([1, 3], [1, 3])] = mt
+        for a in range(4):
+            for c in range(4):
+                K[idx[a], idx[c]] += kb[a, c] + ks[a, c]
+                M[idx[a], idx[c]] += me[a, c]
+    free = list(range(2, dofs))
+    K, M = K[np.ix_(free, free)], M[np.ix_(free, free)]
+    Lc = np.linalg.cholesky(M)
+    Li = np.linalg.inv(Lc)
+    w2 = np.linalg.eigvalsh(Li @ K @ Li.T)
+    return 2 * math.pi / math.sqrt(w2[0])
+
+
+def beam_table(divisions):
+    b = BEAM
+    ep, G = b["E"] / (1 - b["nu"] ** 2), b["E"] / (2 * (1 + b["nu"]))
+    I, A = b["d"] ** 3 / 12, b["d"]
+    bending = b["P"] * b["L"] ** 3 / (3 * ep * I)
+    shear = b["P"] * b["L"] / (5 / 6 * G * A)
+    T_eb = 2 * math.pi / (1.8751 ** 2 * math.sqrt(ep * I / (b["rho"] * A * b["L"] ** 4)))
+    T_t = timoshenko_first_period()
+    print("\nCantilever L/d = 10, E %g, nu %g, plane strain E' = E/(1-nu^2); tip force %g N/m"
+          % (b["E"], b["nu"], b["P"]))
+    print("Euler-Bernoulli %.5g m, + Timoshenko shear %.5g m (%.2f %%) = %.5g m; "
+          "first period EB %.5g ms, Timoshenko %.5g ms"
+          % (bending, shear, 100 * shear / bending, bending + shear, 1e3 * T_eb, 1e3 * T_t))
+    print("\n| elements through depth | elements | deflection / Timoshenko | deflection / EB "
+          "| period / Timoshenko | periods averaged | steps | CPU time |")
+    print("|---|---|---|---|---|---|---|---|")
+    for n in divisions:
+        r = run("beam", beam_case(n))
+        print("| %d | %d | %.3f | %.3f | %.3f | %d | %d | %.1f s |"
+              % (n, r["elements"], r["deflection"] / -(bending + shear), r["deflection"] / -bending,
+                 r["period"] / T_t, r["periods"], r["steps"], r["seconds"]), flush=True)
+
+
+# ----------------------------------------------------------------- fracture
+
+def example_with_mesh(name, size, tweaks=()):
+    """examples/NAME.json with its specimen remeshed by gmsh at `size` m,
+    then changed by each of `tweaks` in turn."""
+    with open(os.path.join(ROOT, "examples", name + ".json")) as f:
+        doc = json.load(f)
+    with open(os.path.join(ROOT, "examples", name + ".geo")) as f:
+        geo = f.read()
+    geo, hits = re.subn(r"\bh = [0-9.eE+-]+;", "h = %r;" % size, geo)
+    assert hits == 1, "no 'h = ...;' in %s.geo" % name
+    for tweak in tweaks:
+        if tweak in GEO_TWEAKS:
+            geo = tweak(geo)
+    with tempfile.TemporaryDirectory() as tmp:
+        with open(os.path.join(tmp, "m.geo"), "w") as f:
+            f.write(geo)
+        subprocess.run(["gmsh", "-2", "-format", "msh22", os.path.join(tmp, "m.geo"), "-o",
+                        os.path.join(tmp, "m.msh")], check=True, stdout=subprocess.DEVNULL)
+        with open(os.path.join(tmp, "m.msh")) as f:
+            doc["parts"][0]["gmsh"] = f.read()
+    doc["name"] = "%s-%gmm" % (name, size * 1e3)
+    # the driver stops 0.1 ms after the load has fallen; a coarse mesh can
+    # peak after the example's own end
+    doc["time"]["end"] *= 2
+    for tweak in tweaks:
+        if tweak not in GEO_TWEAKS:
+            tweak(doc)
+    return doc
+
+
+def delaunay(geo):
+    """gmsh's Delaunay (Mesh.Algorithm 5) instead of the examples'
+    Frontal-Delaunay (6): Frontal-Delaunay lays near-equilateral triangles
+    in rows, so a whole specimen can have its edges in three directions
+    only; Delaunay's edges point every way."""
+    geo, hits = re.subn(r"Mesh\.Algorithm = \d+;", "Mesh.Algorithm = 5;", geo)
+    assert hits == 1
+    return geo
+
+
+GEO_TWEAKS = (delaunay,)
+
+
+ARC = math.radians(15)  # the loading arc 2 alpha
+
+
+def arc(doc):
+    """No platens: the disc's own boundary nodes on two arcs of 2 alpha = 15
+    degrees about the loaded diameter move at the platens' speed and are
+    free sideways (a frictionless rigid jaw that fits the disc, the loading
+    of Hondros' solution; held sideways, the two halves of a split disc
+    stay clamped between the jaws and carry ever more load). With a
+    uniform pressure on the arcs the centre stress is 2P/(pi D) times
+    (sin 2a - a)/a = 0.977 (Hondros 1959): the table keeps 2P/(pi D)."""
+    R = 0.025
+    half = R * math.sin(ARC / 2)
+    low = R * math.cos(ARC / 2) - 1e-6
+    v = doc["constraints"][0]["velocity"][1]
+    doc["parts"] = doc["parts"][:1]
+    doc["constraints"] = [
+        {"box": [-half, low, half, R + 1e-6], "velocity": [None, v]},
+        {"box": [-half, -R - 1e-6, half, -low], "velocity": [None, -v]}]
+    doc["name"] += "-arc"
+
+
+def brittle(doc):
+    """A tenth of the example's fracture energies (G_I 1, G_II 5 J/m^2): the
+    characteristic length E G_I / f_t^2 falls from 0.3 m (6 D) to 0.03 m."""
+    frac = doc["materials"]["rock"]["fracture"]
+    frac["energy_I"] /= 10
+    frac["energy_II"] /= 10
+    doc["name"] += "-brittle"
+
+
+def frictionless(doc):
+    """No Coulomb friction anywhere: a pair takes the larger coefficient of
+    its two materials, so the rock's must go too (which only matters once
+    cracks have opened)."""
+    for mat in doc["materials"].values():
+        mat["friction"] = 0.0
+    doc["name"] += "-frictionless"
+
+
+def zones(z):
+    return "%d / %d / %d" % tuple(z)
+
+
+def fracture_table(kind, runs, across):
+    """Zones are joint counts [centre / between / platen]: abs(y) below half
+    the specimen's half-height, above 0.8 of it, and the rest."""
+    ratio = "2P/(pi D) / f_t" if kind == "brazilian" else "peak / Mohr-Coulomb"
+    # joints within 10 degrees of where the crack should run: along the
+    # loaded diameter within D/4 of the centre, or at 45 - phi/2 to the load
+    # in the middle W x W of the block
+    oriented = "joints along the diameter" if kind == "brazilian" else "joints near the MC plane"
+    print("\n| mesh size | elements%s | %s | %s | peak at | first softening joints (D > 0) | "
+          "first broken joints (D = 1) | ratio when the centre starts to soften | D > 0 at the peak | D >= 0.5 at the peak | steps | CPU time |"
+          % (" across" if kind == "uniaxial" else "", oriented, ratio))
+    print("|---" * 12 + "|")
+    for size, *tweaks in runs:
+        doc = example_with_mesh("brazilian-disc" if kind == "brazilian" else "uniaxial-compression",
+                                size, tweaks)
+        r = run(kind, doc)
+        label = " ".join(["%g mm" % (size * 1e3)] + [t.__name__ for t in tweaks])
+        count = ("%d" % r["elements"]) if kind == "brazilian" else ("%.1f (%d)" % (across / size, r["elements"]))
+        on, br = r["onset"], r["first_broken"]
+        centre = ("%.3f at %.3g ms" % (r["centre_onset_force"] / r["peak_force"] * r["strength"] / r["reference"],
+                                       1e3 * r["centre_onset_time"])) if r["centre_onset_time"] > 0 else "never"
+        if r["drop_time"] < 0:
+            label += " (the load never fell: the peak is a lower bound)"
+        print("| %s | %s | %.0f %% | %.3f | %.3g ms | %s at %.3g ms | %s at %.3g ms | %s | %s | %s | %d | %.0f s |"
+              % (label, count, 100 * r["oriented"], r["strength"] / r["reference"], 1e3 * r["peak_time"],
+                 zones(on["zones"]), 1e3 * on["time"], zones(br["zones"]), 1e3 * br["time"], centre,
+                 zones(r["softening_at_peak"]), zones(r["damaged_at_peak"]), r["steps"], r["seconds"]), flush=True)
+
+
+def run(kind, doc):
+    out = subprocess.run([DRIVER, kind], input=json.dumps(doc), check=True, stdout=subprocess.PIPE,
+                         text=True)
+    return json.loads(out.stdout)
+
+
+def main(groups):
+    if "beam" in groups:
+        beam_table([1, 2, 4, 8, 16, 32])
+    if "brazilian" in groups:
+        fracture_table("brazilian", [(2e-3,), (1.4e-3,), (1e-3,),
+                                     (2e-3, arc), (1.4e-3, arc), (1e-3, arc),
+                                     (2e-3, delaunay, arc), (1.4e-3, delaunay, arc),
+                                     (1e-3, delaunay, arc), (1e-3, delaunay),
+                                     (2e-3, brittle), (1e-3, brittle),
+                                     (2e-3, brittle, arc), (1e-3, brittle, arc)], 0.05)
+    if "uniaxial" in groups:
+        sizes = (3e-3, 2.5e-3, 2.2e-3, 2.1e-3, 2e-3, 1.95e-3, 1.9e-3, 1.8e-3, 1.5e-3, 1.25e-3,
+                 1e-3, 0.7e-3)
+        fracture_table("uniaxial", [(h,) for h in sizes] +
+                       [(h, delaunay) for h in (3e-3, 2.2e-3, 2e-3, 1.9e-3, 1.5e-3, 1e-3)] +
+                       [(1.8e-3, frictionless), (1e-3, frictionless),
+                        (2e-3, delaunay, frictionless)], 0.025)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial"])
