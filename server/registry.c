@@ -1,6 +1,7 @@
 /*
  * registry.c - the cases the daemon holds, their state machine, their
- * status object and its persistence, and loading the data directory.
+ * status object and its persistence (loading a stored case:
+ * registry_load.c).
  *
  * The registry lock guards the list (kept oldest first), the running count
  * and the queue; each case's own lock guards its state and figures. HTTP
@@ -24,6 +25,7 @@
 #include "case_model.h"
 #include "io_thread.h"
 #include "persist.h"
+#include "registry_internal.h"
 #include "worker.h"
 
 static const fdemd_config *reg_cfg;
@@ -43,7 +45,7 @@ const char *case_state_name(case_state s)
     return (unsigned)s < sizeof state_names / sizeof *state_names ? state_names[s] : "failed";
 }
 
-static int case_state_parse(const char *name, case_state *out)
+int case_state_parse(const char *name, case_state *out)
 {
     for (unsigned i = 0; i < sizeof state_names / sizeof *state_names; i++)
         if (name && strcmp(name, state_names[i]) == 0) {
@@ -53,7 +55,7 @@ static int case_state_parse(const char *name, case_state *out)
     return -1;
 }
 
-static int case_state_is_terminal(case_state s)
+int case_state_is_terminal(case_state s)
 {
     return s == CASE_FINISHED || s == CASE_STOPPED || s == CASE_FAILED;
 }
@@ -91,7 +93,7 @@ static int id_generate(char out[CASE_ID_LEN + 1])
     return 0;
 }
 
-static void iso_time_now(char *out, size_t size)
+void iso_time_now(char *out, size_t size)
 {
     struct timespec ts;
     struct tm tm;
@@ -104,7 +106,7 @@ static void iso_time_now(char *out, size_t size)
 
 /* ------------------------------------------------------------ lifetime */
 
-static server_case *case_new(void)
+server_case *case_new(void)
 {
     server_case *c = calloc(1, sizeof *c);
     if (!c)
@@ -182,7 +184,7 @@ void case_set_snapshots(server_case *c, int snapshots)
 }
 
 /* Figures straight from the model, for cases no worker is stepping. */
-static void case_publish_from_model(server_case *c)
+void case_publish_from_model(server_case *c)
 {
     if (!c->model)
         return;
@@ -215,6 +217,15 @@ static const struct { const char *key; size_t offset; } energy_accounts[] = {
     {"residual", offsetof(fdem_energy, residual)},
 };
 #define ENERGY_ACCOUNT_COUNT (sizeof energy_accounts / sizeof energy_accounts[0])
+
+void case_energy_from_json(fdem_energy *energy, const json_t *o)
+{
+    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++) {
+        const json_t *v = json_object_get(o, energy_accounts[i].key);
+        *(double *)((char *)energy + energy_accounts[i].offset) =
+            json_is_number(v) ? json_number_value(v) : NAN;
+    }
+}
 
 json_t *case_status_json(server_case *c)
 {
@@ -974,177 +985,11 @@ server_case *registry_create(const char *body, size_t size, int start,
     return c;
 }
 
-/* ------------------------------------------------------------- loading */
-
-static void case_fail_loading(server_case *c, const char *fmt, const char *detail)
-{
-    c->state = CASE_FAILED;
-    snprintf(c->error, sizeof c->error, fmt, detail);
-    fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
-}
-
-/* A number of status.json; null (a non-finite figure) reads as NaN. */
-static double status_number(const json_t *o, const char *key)
-{
-    const json_t *v = json_object_get(o, key);
-    return json_is_number(v) ? json_number_value(v) : NAN;
-}
-
-static int status_count(const json_t *o, const char *key)
-{
-    json_int_t v = json_integer_value(json_object_get(o, key));
-    return v >= 0 && v <= INT32_MAX ? (int)v : 0;
-}
-
-/* The figures the case last published: what its status shows until it
- * runs again (no model is built to find them). */
-static void case_load_figures(server_case *c, const json_t *st)
-{
-    static const struct { const char *key; size_t offset; } counts[] = {
-        {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
-        {"joints", offsetof(fdem_counts, joints)},
-        {"broken_joints", offsetof(fdem_counts, broken_joints)},
-        {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
-    };
-    case_figures *f = &c->fig;
-    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
-        *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
-    const json_t *e = json_object_get(st, "energy");
-    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
-        *(double *)((char *)&f->energy + energy_accounts[i].offset) =
-            status_number(e, energy_accounts[i].key);
-    f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
-    f->time = status_number(st, "time");
-    f->dt = status_number(st, "dt");
-    f->snapshots = status_count(st, "snapshots");
-    const char *name = json_string_value(json_object_get(st, "name"));
-    snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
-    c->info.end_time = status_number(st, "end_time");
-}
-
-static void case_load_status(server_case *c, const char *path)
-{
-    json_error_t jerr;
-    json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
-    const char *state = st ? json_string_value(json_object_get(st, "state")) : NULL;
-    const char *created = st ? json_string_value(json_object_get(st, "created")) : NULL;
-    const char *error = st ? json_string_value(json_object_get(st, "error")) : NULL;
-    if (!st || case_state_parse(state, &c->state) != 0) {
-        case_fail_loading(c, "status.json could not be read (%s)", st ? "no valid state" : jerr.text);
-    } else if (error) {
-        snprintf(c->error, sizeof c->error, "%s", error);
-    }
-    if (created)
-        snprintf(c->created, sizeof c->created, "%s", created);
-    if (st)
-        case_load_figures(c, st);
-    json_decref(st);
-}
-
-/* A case whose restored time is already at its end (a status.json that
- * says running, e.g. edited by hand) is finished: it must never step on. */
-static void case_finish_if_at_end(server_case *c)
-{
-    if (!c->model || case_state_is_terminal(c->state))
-        return;
-    double dt = fdem_get_dt(c->model);
-    if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
-        fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
-        c->state = CASE_FINISHED;
-    }
-}
-
-/* A case that may run again is rebuilt once at start-up, when the budget
- * allows, to check its stored files and cut result.h5 back to its
- * checkpoint (a crash leaves later snapshots); the model is freed at once.
- * Short of memory the check waits for the case's start: it stays as it was
- * (memory short for a moment never makes a case fail). */
-static int case_check_stored(server_case *c)
-{
-    if (case_state_is_terminal(c->state))
-        return 0;
-    membudget_lease lease = {0};
-    fdem_model *model = NULL;
-    case_info info;
-    char err[512] = "";
-    case_model_rc rc = CASE_MODEL_NO_MEMORY;
-    if (membudget_grow(&lease, case_model_cost_of(c)) == 0)
-        rc = case_model_build(c, &lease, &model, &info, err, sizeof err);
-    int broken = 0;
-    if (rc == CASE_MODEL_BROKEN) {
-        case_fail_loading(c, "%s", err);
-        broken = 1;
-    } else if (rc == CASE_MODEL_OK) {
-        if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0) {
-            case_fail_loading(c, "result.h5 could not be recreated: %s", err);
-            broken = 1;
-        }
-        case_finish_if_at_end(c);
-        case_publish_from_model(c);
-        case_model_drop(c);
-    } else {
-        fprintf(stderr, "fdemd: case %s: not checked at start-up (--max-memory is short); it "
-                "stays %s and is checked when it starts\n", c->id, case_state_name(c->state));
-    }
-    membudget_release(&lease);
-    return broken ? -1 : 0;
-}
-
-static server_case *case_load(const char *id)
-{
-    server_case *c = case_new();
-    if (!c)
-        return NULL;
-    snprintf(c->id, sizeof c->id, "%s", id);
-    snprintf(c->dir, sizeof c->dir, "%s/%s", reg_cfg->data_dir, id);
-    char path[1200];
-    snprintf(path, sizeof path, "%s/case.json", c->dir);
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        /* Never acknowledged (the 201 follows case.json and status.json). */
-        fprintf(stderr, "fdemd: skipping %s: no case.json\n", c->dir);
-        case_release(c);
-        return NULL;
-    }
-    snprintf(path, sizeof path, "%s/status.json", c->dir);
-    if (stat(path, &st) != 0 && errno == ENOENT) {
-        /* Left by a crash during POST /cases of an older fdemd, which
-         * wrote status.json last before its 201: never acknowledged. */
-        fprintf(stderr, "fdemd: skipping %s: no status.json (a case never acknowledged)\n", c->dir);
-        case_release(c);
-        return NULL;
-    }
-    case_load_status(c, path);
-    if (!c->created[0])
-        iso_time_now(c->created, sizeof c->created);
-    if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
-        c->state = CASE_PAUSED;
-    /* A case that could not be loaded keeps its files as they are, so that
-     * once the damage is mended it comes back as it was. */
-    c->load_broken = case_check_stored(c) != 0;
-    if (!c->load_broken)
-        case_persist_status(c);
-    persist_reserve(c->dir);
-    return c;
-}
-
 static int case_order(const void *a, const void *b)
 {
     const server_case *x = *(server_case *const *)a, *y = *(server_case *const *)b;
     int d = strcmp(x->created, y->created);
     return d ? d : strcmp(x->id, y->id);
-}
-
-/* A case being created or deleted when the daemon stopped: never
- * acknowledged (or already deleted), so it goes. */
-static void registry_sweep_half_made(const char *name)
-{
-    char path[sizeof reg_cfg->data_dir + 300];
-    snprintf(path, sizeof path, "%s/%s", reg_cfg->data_dir, name);
-    if (persist_remove_dir(path) != 0)
-        fprintf(stderr, "fdemd: cannot remove the half-made case %s: %s\n", path, strerror(errno));
-    else
-        fprintf(stderr, "fdemd: removed the half-made case %s\n", path);
 }
 
 int registry_init(const fdemd_config *cfg)
@@ -1169,12 +1014,12 @@ int registry_init(const fdemd_config *cfg)
     struct dirent *e;
     while ((e = readdir(d)) != NULL) {
         if (strncmp(e->d_name, ".tmp-", 5) == 0) {
-            registry_sweep_half_made(e->d_name);
+            registry_sweep_half_made(cfg, e->d_name);
             continue;
         }
         if (!id_is_valid(e->d_name))
             continue;
-        server_case *c = case_load(e->d_name);
+        server_case *c = registry_load_case(cfg, e->d_name);
         if (c && registry_append_locked(c) != 0)
             case_release(c);
     }

@@ -1,0 +1,28 @@
+/*
+ * registry_internal.h - what registry.c shares with registry_load.c, and
+ * nothing else includes: building a case record, its state names, and
+ * loading a stored case.
+ */
+#ifndef FDEMD_REGISTRY_INTERNAL_H
+#define FDEMD_REGISTRY_INTERNAL_H
+
+#include <jansson.h>
+
+#include "config.h"
+#include "registry.h"
+
+server_case *case_new(void);
+int case_state_parse(const char *name, case_state *out);
+int case_state_is_terminal(case_state s);
+void iso_time_now(char *out, size_t size);
+/* Figures of the case's model into its published figures. */
+void case_publish_from_model(server_case *c);
+/* The status' energy object back into an fdem_energy (missing: NaN). */
+void case_energy_from_json(fdem_energy *energy, const json_t *o);
+
+/* registry_load.c: a stored case (a reference), or NULL when the directory
+ * holds no acknowledged case. */
+server_case *registry_load_case(const fdemd_config *cfg, const char *id);
+void registry_sweep_half_made(const fdemd_config *cfg, const char *name);
+
+#endif

@@ -1,0 +1,182 @@
+/*
+ * registry_load.c - a stored case read back from the data directory at
+ * start-up: its status.json (state, figures), a check of its stored files
+ * (rebuilt once when the memory budget allows, then freed), and the sweep
+ * of half-made cases.
+ *
+ * Memory short for a moment never makes a case fail; a case whose files
+ * cannot be loaded keeps them as found (load_broken), so that once mended
+ * it comes back as it was.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "case_model.h"
+#include "memory_budget.h"
+#include "persist.h"
+#include "registry.h"
+#include "registry_internal.h"
+
+static void case_fail_loading(server_case *c, const char *fmt, const char *detail)
+{
+    c->state = CASE_FAILED;
+    snprintf(c->error, sizeof c->error, fmt, detail);
+    fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
+}
+
+/* A number of status.json; null (a non-finite figure) reads as NaN. */
+static double status_number(const json_t *o, const char *key)
+{
+    const json_t *v = json_object_get(o, key);
+    return json_is_number(v) ? json_number_value(v) : NAN;
+}
+
+static int status_count(const json_t *o, const char *key)
+{
+    json_int_t v = json_integer_value(json_object_get(o, key));
+    return v >= 0 && v <= INT32_MAX ? (int)v : 0;
+}
+
+/* The figures the case last published: what its status shows until it
+ * runs again (no model is built to find them). */
+static void case_load_figures(server_case *c, const json_t *st)
+{
+    static const struct { const char *key; size_t offset; } counts[] = {
+        {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
+        {"joints", offsetof(fdem_counts, joints)},
+        {"broken_joints", offsetof(fdem_counts, broken_joints)},
+        {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
+    };
+    case_figures *f = &c->fig;
+    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
+        *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
+    case_energy_from_json(&f->energy, json_object_get(st, "energy"));
+    f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
+    f->time = status_number(st, "time");
+    f->dt = status_number(st, "dt");
+    f->snapshots = status_count(st, "snapshots");
+    const char *name = json_string_value(json_object_get(st, "name"));
+    snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
+    c->info.end_time = status_number(st, "end_time");
+}
+
+static void case_load_status(server_case *c, const char *path)
+{
+    json_error_t jerr;
+    json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
+    const char *state = st ? json_string_value(json_object_get(st, "state")) : NULL;
+    const char *created = st ? json_string_value(json_object_get(st, "created")) : NULL;
+    const char *error = st ? json_string_value(json_object_get(st, "error")) : NULL;
+    if (!st || case_state_parse(state, &c->state) != 0) {
+        case_fail_loading(c, "status.json could not be read (%s)", st ? "no valid state" : jerr.text);
+    } else if (error) {
+        snprintf(c->error, sizeof c->error, "%s", error);
+    }
+    if (created)
+        snprintf(c->created, sizeof c->created, "%s", created);
+    if (st)
+        case_load_figures(c, st);
+    json_decref(st);
+}
+
+/* A case whose restored time is already at its end (a status.json that
+ * says running, e.g. edited by hand) is finished: it must never step on. */
+static void case_finish_if_at_end(server_case *c)
+{
+    if (!c->model || case_state_is_terminal(c->state))
+        return;
+    double dt = fdem_get_dt(c->model);
+    if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
+        fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
+        c->state = CASE_FINISHED;
+    }
+}
+
+/* A case that may run again is rebuilt once at start-up, when the budget
+ * allows, to check its stored files and cut result.h5 back to its
+ * checkpoint (a crash leaves later snapshots); the model is freed at once.
+ * Short of memory the check waits for the case's start: it stays as it was
+ * (memory short for a moment never makes a case fail). */
+static int case_check_stored(server_case *c)
+{
+    if (case_state_is_terminal(c->state))
+        return 0;
+    membudget_lease lease = {0};
+    fdem_model *model = NULL;
+    case_info info;
+    char err[512] = "";
+    case_model_rc rc = CASE_MODEL_NO_MEMORY;
+    if (membudget_grow(&lease, case_model_cost_of(c)) == 0)
+        rc = case_model_build(c, &lease, &model, &info, err, sizeof err);
+    int broken = 0;
+    if (rc == CASE_MODEL_BROKEN) {
+        case_fail_loading(c, "%s", err);
+        broken = 1;
+    } else if (rc == CASE_MODEL_OK) {
+        if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0) {
+            case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+            broken = 1;
+        }
+        case_finish_if_at_end(c);
+        case_publish_from_model(c);
+        case_model_drop(c);
+    } else {
+        fprintf(stderr, "fdemd: case %s: not checked at start-up (--max-memory is short); it "
+                "stays %s and is checked when it starts\n", c->id, case_state_name(c->state));
+    }
+    membudget_release(&lease);
+    return broken ? -1 : 0;
+}
+
+server_case *registry_load_case(const fdemd_config *cfg, const char *id)
+{
+    server_case *c = case_new();
+    if (!c)
+        return NULL;
+    snprintf(c->id, sizeof c->id, "%s", id);
+    snprintf(c->dir, sizeof c->dir, "%s/%s", cfg->data_dir, id);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/case.json", c->dir);
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        /* Never acknowledged (the 201 follows case.json and status.json). */
+        fprintf(stderr, "fdemd: skipping %s: no case.json\n", c->dir);
+        case_release(c);
+        return NULL;
+    }
+    snprintf(path, sizeof path, "%s/status.json", c->dir);
+    if (stat(path, &st) != 0 && errno == ENOENT) {
+        /* Left by a crash during POST /cases of an older fdemd, which
+         * wrote status.json last before its 201: never acknowledged. */
+        fprintf(stderr, "fdemd: skipping %s: no status.json (a case never acknowledged)\n", c->dir);
+        case_release(c);
+        return NULL;
+    }
+    case_load_status(c, path);
+    if (!c->created[0])
+        iso_time_now(c->created, sizeof c->created);
+    if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
+        c->state = CASE_PAUSED;
+    /* A case that could not be loaded keeps its files as they are, so that
+     * once the damage is mended it comes back as it was. */
+    c->load_broken = case_check_stored(c) != 0;
+    if (!c->load_broken)
+        case_persist_status(c);
+    persist_reserve(c->dir);
+    return c;
+}
+
+/* A case being created or deleted when the daemon stopped: never
+ * acknowledged (or already deleted), so it goes. */
+void registry_sweep_half_made(const fdemd_config *cfg, const char *name)
+{
+    char path[sizeof cfg->data_dir + 300];
+    snprintf(path, sizeof path, "%s/%s", cfg->data_dir, name);
+    if (persist_remove_dir(path) != 0)
+        fprintf(stderr, "fdemd: cannot remove the half-made case %s: %s\n", path, strerror(errno));
+    else
+        fprintf(stderr, "fdemd: removed the half-made case %s\n", path);
+}
