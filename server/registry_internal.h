@@ -1,7 +1,7 @@
 /*
- * registry_internal.h - what registry.c shares with registry_load.c, and
- * nothing else includes: building a case record, its state names, and
- * loading a stored case.
+ * registry_internal.h - what registry.c, case_status.c and registry_load.c
+ * share, and nothing else includes: building a case record, its state
+ * names, the status object's durable write, and loading a stored case.
  */
 #ifndef FDEMD_REGISTRY_INTERNAL_H
 #define FDEMD_REGISTRY_INTERNAL_H
@@ -19,6 +19,12 @@ void iso_time_now(char *out, size_t size);
 void case_publish_from_model(server_case *c);
 /* The status' energy object back into an fdem_energy (missing: NaN). */
 void case_energy_from_json(fdem_energy *energy, const json_t *o);
+
+/* case_status.c: the status object as it would be in another state (to
+ * make that state durable before it is shown), and its atomic write to
+ * status.json (0, or -1 with the reason). */
+json_t *case_status_json_as(server_case *c, case_state state, const char *error);
+int case_write_status_json(server_case *c, json_t *o, char *reason, size_t reason_size);
 
 /* registry_load.c: a stored case (a reference), or NULL when the directory
  * holds no acknowledged case. */

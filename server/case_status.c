@@ -1,0 +1,202 @@
+/*
+ * case_status.c - a case's published figures and its status object: the
+ * JSON every status route answers with, and status.json, written before a
+ * state change is acknowledged. A write that fails ends the case failed
+ * with the file and the reason (case_record_io_failure).
+ */
+#include <errno.h>
+#include <math.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "persist.h"
+#include "registry.h"
+#include "registry_internal.h"
+
+void case_publish(server_case *c, const case_figures *fig)
+{
+    pthread_mutex_lock(&c->lock);
+    int snapshots = c->fig.snapshots;
+    c->fig = *fig;
+    if (fig->snapshots < 0)
+        c->fig.snapshots = snapshots;
+    pthread_mutex_unlock(&c->lock);
+}
+
+void case_set_snapshots(server_case *c, int snapshots)
+{
+    pthread_mutex_lock(&c->lock);
+    c->fig.snapshots = snapshots;
+    pthread_mutex_unlock(&c->lock);
+}
+
+/* Figures straight from the model, for cases no worker is stepping. */
+void case_publish_from_model(server_case *c)
+{
+    if (!c->model)
+        return;
+    case_figures fig;
+    memset(&fig, 0, sizeof fig);
+    fig.step = fdem_get_step(c->model);
+    fig.time = fdem_get_time(c->model);
+    fig.dt = fdem_get_dt(c->model);
+    fig.counts = fdem_get_counts(c->model);
+    fig.energy = fdem_get_energy(c->model);
+    fig.snapshots = -1;
+    case_publish(c, &fig);
+}
+
+/* JSON has no NaN or infinity; a failed case may hold them. */
+static json_t *json_number_or_null(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+/* The status' energy object, member by member (contract 5.1): written by
+ * case_status_json, read back from status.json by case_load_figures. */
+static const struct { const char *key; size_t offset; } energy_accounts[] = {
+    {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
+    {"joint", offsetof(fdem_energy, joint)}, {"contact", offsetof(fdem_energy, contact)},
+    {"friction", offsetof(fdem_energy, friction)}, {"fracture", offsetof(fdem_energy, fracture)},
+    {"damping", offsetof(fdem_energy, damping)},
+    {"gravity_work", offsetof(fdem_energy, gravity_work)},
+    {"external_work", offsetof(fdem_energy, external_work)},
+    {"residual", offsetof(fdem_energy, residual)},
+};
+#define ENERGY_ACCOUNT_COUNT (sizeof energy_accounts / sizeof energy_accounts[0])
+
+void case_energy_from_json(fdem_energy *energy, const json_t *o)
+{
+    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++) {
+        const json_t *v = json_object_get(o, energy_accounts[i].key);
+        *(double *)((char *)energy + energy_accounts[i].offset) =
+            json_is_number(v) ? json_number_value(v) : NAN;
+    }
+}
+
+json_t *case_status_json(server_case *c)
+{
+    pthread_mutex_lock(&c->lock);
+    case_state state = c->state;
+    case_figures f = c->fig;
+    char error[sizeof c->error];
+    memcpy(error, c->error, sizeof error);
+    pthread_mutex_unlock(&c->lock);
+
+    double end = c->info.end_time;
+    double progress = end > 0 ? f.time / end : 0.0;
+    if (!(progress >= 0))
+        progress = 0;
+    if (progress > 1)
+        progress = 1;
+    if (state == CASE_FINISHED)
+        progress = 1;
+    json_t *energy = json_object();
+    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
+        json_object_set_new(energy, energy_accounts[i].key,
+                            json_number_or_null(*(const double *)((const char *)&f.energy +
+                                                                  energy_accounts[i].offset)));
+    json_t *o = json_object();
+    json_object_set_new(o, "id", json_string(c->id));
+    json_object_set_new(o, "name", json_string(c->info.name));
+    json_object_set_new(o, "state", json_string(case_state_name(state)));
+    json_object_set_new(o, "step", json_integer((json_int_t)f.step));
+    json_object_set_new(o, "time", json_number_or_null(f.time));
+    json_object_set_new(o, "end_time", json_number_or_null(end));
+    json_object_set_new(o, "progress", json_number_or_null(progress));
+    json_object_set_new(o, "dt", json_number_or_null(f.dt));
+    json_object_set_new(o, "nodes", json_integer(f.counts.nodes));
+    json_object_set_new(o, "elements", json_integer(f.counts.elements));
+    json_object_set_new(o, "joints", json_integer(f.counts.joints));
+    json_object_set_new(o, "broken_joints", json_integer(f.counts.broken_joints));
+    json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
+    json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
+    json_object_set_new(o, "snapshots", json_integer(f.snapshots));
+    json_object_set_new(o, "energy", energy ? energy : json_null());
+    json_object_set_new(o, "steps_per_second", json_number_or_null(f.steps_per_second));
+    json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
+    json_object_set_new(o, "created", json_string(c->created));
+    return o;
+}
+
+void case_record_io_failure(server_case *c, const char *file, const char *reason)
+{
+    pthread_mutex_lock(&c->lock);
+    if (!c->io_error[0])
+        snprintf(c->io_error, sizeof c->io_error,
+                 "writing %s failed: %s; the results up to the last snapshot reported are kept",
+                 file, reason);
+    pthread_mutex_unlock(&c->lock);
+    atomic_store(&c->io_failed, 1);
+    fprintf(stderr, "fdemd: case %s: writing %s failed: %s\n", c->id, file, reason);
+}
+
+/* Writes `o` (consumed) as status.json; on a full disk the case's reserve
+ * is given up once so that at least this state becomes durable. */
+int case_write_status_json(server_case *c, json_t *o, char *reason, size_t reason_size)
+{
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    json_decref(o);
+    int rc = -1;
+    if (!text) {
+        snprintf(reason, reason_size, "out of memory");
+        return -1;
+    }
+    rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+    int saved = errno;
+    if (rc != 0 && (saved == ENOSPC || saved == EDQUOT) && persist_release_reserve(c->dir) == 0) {
+        rc = persist_write_atomic(c->dir, "status.json", text, strlen(text));
+        saved = errno;
+    }
+    if (rc != 0)
+        snprintf(reason, reason_size, "%s", strerror(saved));
+    free(text);
+    return rc;
+}
+
+/* The status object with `state` (and, when failed, `error`) as they are
+ * about to become; used to make a state durable before it is shown. */
+json_t *case_status_json_as(server_case *c, case_state state, const char *error)
+{
+    json_t *o = case_status_json(c);
+    if (!o)
+        return NULL;
+    json_object_set_new(o, "state", json_string(case_state_name(state)));
+    if (error && error[0])
+        json_object_set_new(o, "error", json_string(error));
+    if (state == CASE_FINISHED)
+        json_object_set_new(o, "progress", json_real(1.0));
+    return o;
+}
+
+/* A status.json that cannot be written is a storage fault like any other:
+ * a case no worker is stepping becomes failed at once (and we try to make
+ * that durable), a running one is ended by its worker. */
+static void case_status_write_failed(server_case *c, const char *reason)
+{
+    case_record_io_failure(c, "status.json", reason);
+    pthread_mutex_lock(&c->lock);
+    int idle = !c->worker_active && !case_state_is_terminal(c->state);
+    if (idle) {
+        c->state = CASE_FAILED;
+        snprintf(c->error, sizeof c->error, "%s", c->io_error);
+    }
+    pthread_mutex_unlock(&c->lock);
+    char again[128];
+    if (idle)
+        case_write_status_json(c, case_status_json(c), again, sizeof again);
+}
+
+int case_persist_status(server_case *c)
+{
+    if (atomic_load(&c->deleted))
+        return 0;
+    char reason[128] = "";
+    pthread_mutex_lock(&c->persist_lock);
+    int rc = case_write_status_json(c, case_status_json(c), reason, sizeof reason);
+    pthread_mutex_unlock(&c->persist_lock);
+    if (rc != 0)
+        case_status_write_failed(c, reason);
+    return rc;
+}
