@@ -58,25 +58,18 @@ static int records_reserve(contact_state *cs, size_t count)
     return 0;
 }
 
-static int slots_hold_history(const double *slip)
-{
-    for (int k = 0; k < CONTACT_SLOTS; k++)
-        if (slip[k] != 0) return 1;
-    return 0;
-}
-
 /* Appends the pairs that hold history to the pending records (a restore
  * may have put some there already). */
 int contact_history_set_aside(contact_state *cs)
 {
     size_t n = cs->record_count;
     for (size_t k = 0; k < cs->pairs.count; k++)
-        n += slots_hold_history(cs->slip + CONTACT_SLOTS * k);
+        n += cs->sprung[k];
     if (records_reserve(cs, n)) return -1;
     n = cs->record_count;
     for (size_t k = 0; k < cs->pairs.count; k++) {
+        if (!cs->sprung[k]) continue;
         const double *slip = cs->slip + CONTACT_SLOTS * k;
-        if (!slots_hold_history(slip)) continue;
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
         contact_record *r = &cs->records[n++];
         r->lo = a < b ? a : b;
@@ -138,15 +131,15 @@ size_t contact_history_checkpoint_size(const contact_state *cs)
 {
     size_t n = 0;
     for (size_t k = 0; k < cs->pairs.count; k++)
-        n += slots_hold_history(cs->slip + CONTACT_SLOTS * k);
+        n += cs->sprung[k];
     return n * sizeof(contact_record);
 }
 
 void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p)
 {
     for (size_t k = 0; k < cs->pairs.count; k++) {
+        if (!cs->sprung[k]) continue;
         const double *slip = cs->slip + CONTACT_SLOTS * k;
-        if (!slots_hold_history(slip)) continue;
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
         contact_record r;
         memset(&r, 0, sizeof r);

@@ -86,8 +86,9 @@ typedef struct contact_state {
     int active_count;
     uint8_t *in_pair;        /* scratch per element for building active */
     double *slip;            /* CONTACT_SLOTS per candidate pair: the stick springs' force */
-    uint8_t *sprung;         /* per candidate pair: some spring may be non-zero (so a pair
-                                out of reach reads one byte, not its springs) */
+    uint8_t *sprung;         /* per candidate pair: some spring is non-zero (so a pair out
+                                of reach, a detection or a checkpoint reads one byte, not
+                                six springs) */
     size_t slip_capacity;
     contact_record *records; /* history set aside across a detection or a restore */
     size_t record_count, record_capacity;

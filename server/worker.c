@@ -165,16 +165,12 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
-            /* Every snapshot comes with a checkpoint, so that a restart never
-             * drops a snapshot the status has reported (a restart resumes at
-             * the last checkpoint and drops the rows after it). */
-            ckpt = case_checkpoint_take(m, &ckpt_size);
-            c->last_checkpoint_step = fdem_get_step(m);
-            clk->last_checkpoint = now;
         }
-        if (!ckpt && now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
-            /* --checkpoint-every: progress between far-apart snapshots
-             * survives a crash; the restart resumes on the output grid. */
+        /* Every snapshot comes with a checkpoint, so that a restart never
+         * drops a snapshot the status has reported (a restart resumes at the
+         * last checkpoint and drops the rows after it); --checkpoint-every
+         * makes progress between far-apart snapshots survive a crash too. */
+        if (snap || now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
             ckpt = case_checkpoint_take(m, &ckpt_size);
             c->last_checkpoint_step = fdem_get_step(m);
             clk->last_checkpoint = now;
