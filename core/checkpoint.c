@@ -40,7 +40,8 @@ typedef struct checkpoint_header {
     int64_t detections;
     int32_t need_detect, has_detection;
     int64_t spring_records;
-    int32_t has_viscous, unused;
+    int32_t has_viscous;
+    int32_t dimension;       /* 0 in files written before 3D: 2 */
     fdem_energy energy;      /* the accounts at the checkpoint, shown until the next step */
 } checkpoint_header;
 
@@ -51,9 +52,11 @@ static int checkpoint_has_detection(const fdem_model *m) { return m->contact.ena
 static size_t checkpoint_body_size(const fdem_model *m, int has_detection, int has_viscous,
                                    size_t spring_bytes)
 {
-    return sizeof(double) * 4 * (size_t)m->node_count + sizeof(double) * (size_t)m->joint_count +
-           (has_detection ? sizeof(double) * 2 * (size_t)m->node_count : 0) +
-           (has_viscous ? sizeof(double) * 3 * (size_t)m->elem_count : 0) + spring_bytes;
+    size_t D = (size_t)m->dim;
+    return sizeof(double) * 2 * D * (size_t)m->node_count + sizeof(double) * (size_t)m->joint_count +
+           (has_detection ? sizeof(double) * D * (size_t)m->node_count : 0) +
+           (has_viscous ? sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count : 0) +
+           spring_bytes;
 }
 
 size_t fdem_checkpoint_size(const fdem_model *m)
@@ -81,12 +84,14 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.need_detect = m->contact.need_detect;
     h.has_detection = checkpoint_has_detection(m);
     h.has_viscous = m->elem_viscous != NULL;
+    h.dimension = m->dim;
     h.spring_records = (int64_t)(spring_bytes / sizeof(contact_record));
     h.energy = fdem_get_energy(m);
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
     p += sizeof h;
-    size_t nb = sizeof(double) * 2 * (size_t)m->node_count;
+    size_t nb = sizeof(double) * (size_t)m->dim * (size_t)m->node_count;
+    size_t vb = sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count;
     memcpy(p, m->pos, nb);
     p += nb;
     memcpy(p, m->vel, nb);
@@ -98,8 +103,8 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
         p += nb;
     }
     if (h.has_viscous) {
-        memcpy(p, m->elem_viscous, sizeof(double) * 3 * (size_t)m->elem_count);
-        p += sizeof(double) * 3 * (size_t)m->elem_count;
+        memcpy(p, m->elem_viscous, vb);
+        p += vb;
     }
     contact_history_checkpoint_write(&m->contact, p);
     return 0;
@@ -157,6 +162,11 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
             return -1;
         }
         memcpy(&h, buf, sizeof h);
+        if ((h.dimension ? h.dimension : 2) != m->dim) {
+            model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is of a %dD model; this one is %dD",
+                        h.dimension ? h.dimension : 2, m->dim);
+            return -1;
+        }
         if (h.spring_records < 0 || h.spring_records > (int64_t)(size / sizeof(contact_record)) ||
             h.has_detection != checkpoint_has_detection(m) ||
             h.has_viscous != (m->elem_viscous != NULL)) {
@@ -178,7 +188,8 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's friction history is damaged");
         return -1;
     }
-    size_t nb = sizeof(double) * 2 * (size_t)m->node_count;
+    size_t nb = sizeof(double) * (size_t)m->dim * (size_t)m->node_count;
+    size_t vb = sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count;
     memcpy(m->pos, p, nb);
     p += nb;
     memcpy(m->vel, p, nb);
@@ -198,7 +209,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     m->broken_joints = 0;
     for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
     if (m->joint_count) m->fragments = joint_fragment_count(m);
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    memset(m->force, 0, nb);
     if (h1.version == 1 || !h.has_detection) {
         m->contact.need_detect = 1;
     } else {
@@ -208,7 +219,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         m->contact.detections = h.detections;
     }
     if (h.has_viscous)
-        memcpy(m->elem_viscous, p, sizeof(double) * 3 * (size_t)m->elem_count);
+        memcpy(m->elem_viscous, p, vb);
     if (contact_restore_detection(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory restoring contact detection");
         return -1;
@@ -216,9 +227,9 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     m->contact.max_disp2 = h.max_disp2;
     if (h1.version == 1) { /* no accounts stored: those of the restored positions */
         element_forces(m);
-        memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+        memset(m->force, 0, nb);
         m->damping_work = h1.damping_work; /* that pass was no step */
-        if (m->elem_viscous) memset(m->elem_viscous, 0, sizeof(double) * 3 * (size_t)m->elem_count);
+        if (m->elem_viscous) memset(m->elem_viscous, 0, vb);
         m->restored_energy_valid = 0;
     } else {
         m->elastic_energy = h.energy.elastic;

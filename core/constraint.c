@@ -18,19 +18,25 @@
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+/* Box bounds: box[d] lower, box[D + d] upper, for D = m->dim. */
 static int constraint_selects(const fdem_model *m, const constraint *c, int node)
 {
     if (c->def.select == FDEM_SELECT_PART) return m->node_part[node] == c->def.part;
-    const double *b = c->def.box;
-    double x = m->pos0[2 * node], y = m->pos0[2 * node + 1];
-    return x >= b[0] && x <= b[2] && y >= b[1] && y <= b[3];
+    const double *b = c->def.box, *x = m->pos0 + (size_t)m->dim * (size_t)node;
+    int inside = 1;
+    for (int d = 0; d < m->dim; d++) inside &= x[d] >= b[d] && x[d] <= b[m->dim + d];
+    return inside;
 }
 
-static unsigned constraint_dofs(const constraint *c)
+/* The dofs a constraint prescribes, bit d for component d (2D never z). */
+static unsigned constraint_dofs(const fdem_model *m, const constraint *c)
 {
+    unsigned z = m->dim == 3 ? 4u : 0u;
     switch (c->def.kind) {
-    case FDEM_CONSTRAINT_FIX: return (c->def.fix_x ? 1u : 0u) | (c->def.fix_y ? 2u : 0u);
-    case FDEM_CONSTRAINT_VELOCITY: return (c->def.free_x ? 0u : 1u) | (c->def.free_y ? 0u : 2u);
+    case FDEM_CONSTRAINT_FIX:
+        return (c->def.fix_x ? 1u : 0u) | (c->def.fix_y ? 2u : 0u) | (c->def.fix_z ? z : 0u);
+    case FDEM_CONSTRAINT_VELOCITY:
+        return (c->def.free_x ? 0u : 1u) | (c->def.free_y ? 0u : 2u) | (c->def.free_z ? 0u : z);
     default: return 0;
     }
 }
@@ -59,32 +65,36 @@ int constraint_select(fdem_model *m, fdem_error *err)
     m->cnode = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     m->cdof = malloc((size_t)(total ? total : 1));
     m->dof_owned = calloc((size_t)m->node_count, 1);
-    m->constraint_force_out = calloc(2 * (size_t)(m->constraint_count ? m->constraint_count : 1),
+    const int D = m->dim;
+    m->constraint_force_out = calloc((size_t)D * (size_t)(m->constraint_count ? m->constraint_count : 1),
                                      sizeof(double));
-    int32_t *owner = malloc(sizeof(int32_t) * 2 * (size_t)m->node_count);
+    int32_t *owner = malloc(sizeof(int32_t) * (size_t)D * (size_t)m->node_count);
     if (!m->cnode || !m->cdof || !m->dof_owned || !m->constraint_force_out || !owner) {
         free(owner);
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for constraints");
         return -1;
     }
     m->cnode_count = total;
-    for (int i = 0; i < 2 * m->node_count; i++) owner[i] = -1;
+    for (int i = 0; i < D * m->node_count; i++) owner[i] = -1;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
-        unsigned dofs = constraint_dofs(c);
+        unsigned dofs = constraint_dofs(m, c);
         int at = c->entry_begin;
         for (int i = 0; i < m->node_count; i++) {
             if (!constraint_selects(m, c, i)) continue;
             m->cnode[at++] = i;
-            if (dofs & 1u) owner[2 * i] = k;
-            if (dofs & 2u) owner[2 * i + 1] = k;
+            for (int d = 0; d < D; d++)
+                if (dofs & (1u << d)) owner[D * i + d] = k;
         }
     }
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
             int i = m->cnode[e];
-            m->cdof[e] = (uint8_t)((owner[2 * i] == k ? 1u : 0u) | (owner[2 * i + 1] == k ? 2u : 0u));
+            unsigned own = 0;
+            for (int d = 0; d < D; d++)
+                if (owner[D * i + d] == k) own |= 1u << d;
+            m->cdof[e] = (uint8_t)own;
             m->dof_owned[i] |= m->cdof[e];
         }
     }
@@ -95,9 +105,9 @@ int constraint_select(fdem_model *m, fdem_error *err)
         if (c->def.kind == FDEM_CONSTRAINT_FORCE) continue;
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
             int i = m->cnode[e];
-            for (int d = 0; d < 2; d++)
+            for (int d = 0; d < D; d++)
                 if (m->cdof[e] & (1u << d))
-                    m->vel[2 * i + d] = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
+                    m->vel[D * i + d] = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
         }
     }
     return 0;
@@ -105,17 +115,16 @@ int constraint_select(fdem_model *m, fdem_error *err)
 
 void constraint_apply_forces(fdem_model *m)
 {
+    const int D = m->dim;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.kind != FDEM_CONSTRAINT_FORCE) continue;
-        double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
-        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-            int i = m->cnode[e];
-            m->force[2 * i] += fx;
-            m->force[2 * i + 1] += fy;
+        for (int d = 0; d < D; d++) {
+            double share = c->def.value[d] / c->entry_count;
+            for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++)
+                m->force[(size_t)D * (size_t)m->cnode[e] + (size_t)d] += share;
+            c->force[d] = c->def.value[d];
         }
-        c->force[0] = c->def.value[0];
-        c->force[1] = c->def.value[1];
     }
 }
 
@@ -125,42 +134,47 @@ void constraint_apply_forces(fdem_model *m)
 void constraint_enforce(fdem_model *m, double h, double havg)
 {
     const double *fc = m->contact.enabled ? m->contact.force : NULL;
+    const int D = m->dim;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.kind == FDEM_CONSTRAINT_FORCE) {
-            double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
             for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-                int i = m->cnode[e];
-                /* velocities were already advanced: v_old = v_new - a havg */
-                double ax = (m->force[2 * i] + (fc ? fc[2 * i] : 0)) / m->mass[i] + m->gravity[0];
-                double ay = (m->force[2 * i + 1] + (fc ? fc[2 * i + 1] : 0)) / m->mass[i] + m->gravity[1];
-                double vx = m->vel[2 * i] - 0.5 * ax * havg, vy = m->vel[2 * i + 1] - 0.5 * ay * havg;
-                m->external_work += (fx * vx + fy * vy) * havg;
+                size_t i = (size_t)m->cnode[e], at = (size_t)D * i;
+                double power = 0;
+                for (int d = 0; d < D; d++) {
+                    /* velocities were already advanced: v_old = v_new - a havg */
+                    double a = (m->force[at + d] + (fc ? fc[at + d] : 0)) / m->mass[i] + m->gravity[d];
+                    power += c->def.value[d] / c->entry_count * (m->vel[at + d] - 0.5 * a * havg);
+                }
+                m->external_work += power * havg;
             }
             continue;
         }
-        c->force[0] = c->force[1] = 0;
+        c->force[0] = c->force[1] = c->force[2] = 0;
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-            int i = m->cnode[e];
-            for (int d = 0; d < 2; d++) {
+            size_t i = (size_t)m->cnode[e], at = (size_t)D * i;
+            for (int d = 0; d < D; d++) {
                 if (!(m->cdof[e] & (1u << d))) continue;
                 double mass = m->mass[i];
-                double f = m->force[2 * i + d] + (fc ? fc[2 * i + d] : 0) + mass * m->gravity[d];
+                double f = m->force[at + d] + (fc ? fc[at + d] : 0) + mass * m->gravity[d];
                 double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
-                double v_old = m->vel[2 * i + d];
+                double v_old = m->vel[at + d];
                 double v_free = v_old + f / mass * havg;
                 double reaction = mass * (prescribed - v_free) / havg;
                 c->force[d] += reaction;
-                m->vel[2 * i + d] = prescribed;
-                m->pos[2 * i + d] += prescribed * h;
+                m->vel[at + d] = prescribed;
+                m->pos[at + d] += prescribed * h;
                 double v_mid = 0.5 * (v_old + prescribed) * havg;
                 m->external_work += reaction * v_mid;
-                if (fc) m->contact_work += fc[2 * i + d] * v_mid;
+                if (fc) m->contact_work += fc[at + d] * v_mid;
             }
             if (fc) {
-                double ux = m->pos[2 * i] - m->contact.pos_detect[2 * i];
-                double uy = m->pos[2 * i + 1] - m->contact.pos_detect[2 * i + 1];
-                m->contact.max_disp2 = fmax(m->contact.max_disp2, ux * ux + uy * uy);
+                double d2 = 0;
+                for (int d = 0; d < D; d++) {
+                    double u = m->pos[at + d] - m->contact.pos_detect[at + d];
+                    d2 += u * u;
+                }
+                m->contact.max_disp2 = fmax(m->contact.max_disp2, d2);
             }
         }
     }

@@ -450,6 +450,10 @@ int contact_init(fdem_model *m, fdem_error *err)
     for (int k = 0; k < m->part_count; k++) fracture |= m->parts[k].fracture;
     cs->enabled = m->part_count > 1 || fracture;
     if (!cs->enabled) return 0;
+    if (m->dim == 3) {
+        model_error(err, FDEM_ITEM_NONE, -1, "contact between tetrahedral parts is not built yet");
+        return -1;
+    }
     size_t E = (size_t)m->elem_count, N = (size_t)m->node_count;
     cs->cx = malloc(sizeof(double) * E);
     cs->cy = malloc(sizeof(double) * E);

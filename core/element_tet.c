@@ -174,3 +174,98 @@ double tet_stable_dt(double height, double lambda, double mu, double density, do
     double c = sqrt((lambda + 2 * mu) / density);
     return height / c * (sqrt(1 + xi * xi) - xi);
 }
+
+/* Largest eigenvalue of the symmetric 6x6 matrix a (destroyed), by cyclic
+ * Jacobi rotations: quadratically convergent, a few sweeps to round-off. */
+static double symmetric6_largest_eigenvalue(double a[6][6])
+{
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = 0, diag = 0;
+        for (int i = 0; i < 6; i++) {
+            diag += a[i][i] * a[i][i];
+            for (int j = i + 1; j < 6; j++) off += a[i][j] * a[i][j];
+        }
+        if (!(off > 1e-30 * diag)) break;
+        for (int p = 0; p < 5; p++)
+            for (int q = p + 1; q < 6; q++) {
+                if (a[p][q] == 0) continue;
+                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+                double t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
+                double c = 1 / sqrt(t * t + 1), s = t * c;
+                for (int k = 0; k < 6; k++) { /* columns p, q */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for (int k = 0; k < 6; k++) { /* rows p, q */
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+            }
+    }
+    double largest = a[0][0];
+    for (int i = 1; i < 6; i++) largest = fmax(largest, a[i][i]);
+    return largest;
+}
+
+/* Largest eigenvalue of R G R for a symmetric root R. */
+static double rooted_largest_eigenvalue(const double root[6][6], const double G[6][6])
+{
+    double t[6][6], S[6][6];
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) {
+            t[i][j] = 0;
+            for (int k = 0; k < 6; k++) t[i][j] += root[i][k] * G[k][j];
+        }
+    for (int i = 0; i < 6; i++)
+        for (int j = 0; j < 6; j++) {
+            S[i][j] = 0;
+            for (int k = 0; k < 6; k++) S[i][j] += t[i][k] * root[k][j];
+        }
+    return symmetric6_largest_eigenvalue(S);
+}
+
+double tet_stable_dt_eigen(const double *pos0, const int32_t node[4], double lambda, double mu,
+                           double density, double eta)
+{
+    double e[3][3], c[3][3];
+    double det = tet_edges(node_at(pos0, node[0]), node_at(pos0, node[1]), node_at(pos0, node[2]),
+                           node_at(pos0, node[3]), e, c);
+    /* grad N_a = c_{a-1} / det for a = 1..3, node 0 minus their sum */
+    double g[4][3];
+    for (int i = 0; i < 3; i++) {
+        g[0][i] = 0;
+        for (int a = 1; a <= 3; a++) {
+            g[a][i] = c[a - 1][i] / det;
+            g[0][i] -= g[a][i];
+        }
+    }
+    /* G = sum_a B_a B_a^T for the engineering strain (xx, yy, zz, 2yz, 2xz, 2xy) */
+    double G[6][6] = {{0}};
+    for (int a = 0; a < 4; a++) {
+        double gx = g[a][0], gy = g[a][1], gz = g[a][2];
+        const double B[6][3] = {{gx, 0, 0}, {0, gy, 0}, {0, 0, gz},
+                                {0, gz, gy}, {gz, 0, gx}, {gy, gx, 0}};
+        for (int r = 0; r < 6; r++)
+            for (int s = 0; s < 6; s++)
+                G[r][s] += B[r][0] * B[s][0] + B[r][1] * B[s][1] + B[r][2] * B[s][2];
+    }
+    /* D^1/2: the normal block has 3 lambda + 2 mu on (1,1,1)/sqrt 3 and 2 mu
+     * across it, the shear block mu */
+    double root[6][6] = {{0}};
+    double s2mu = sqrt(2 * mu), svol = sqrt(3 * lambda + 2 * mu), smu = sqrt(mu);
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) root[i][j] = (svol - s2mu) / 3;
+        root[i][i] += s2mu;
+        root[3 + i][3 + i] = smu;
+    }
+    double omega2 = 4 / density * rooted_largest_eigenvalue(root, G);
+    double rate = 0;
+    if (eta > 0) {
+        double viscous_root[6][6] = {{0}};
+        for (int i = 0; i < 6; i++) viscous_root[i][i] = i < 3 ? sqrt(2.0) : 1.0;
+        rate = 4 / density * eta * rooted_largest_eigenvalue(viscous_root, G);
+    }
+    return 2 / (sqrt(omega2 + 0.25 * rate * rate) + 0.5 * rate);
+}

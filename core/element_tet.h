@@ -68,4 +68,15 @@ double tet_viscosity(double height, double lambda, double mu, double density, do
 
 double tet_stable_dt(double height, double lambda, double mu, double density, double xi);
 
+/* The central-difference limit of the tetrahedron with lumped masses
+ * rho V / 4 by the element eigenvalue theorem: omega_max^2 is 4/rho times
+ * the largest eigenvalue of D B B^T (6x6, strain space), found by Jacobi
+ * rotations of its symmetric form D^1/2 B B^T D^1/2; the viscous stress
+ * 2 eta D gives the largest damping rate c_max = 4/rho eta times that of
+ * diag(2,2,2,1,1,1) B B^T, and a mode of frequency omega and rate c is
+ * stable for h <= 2 / (sqrt(omega^2 + c^2/4) + c/2), which falls with
+ * both. h/c (tet_stable_dt) is up to 1.6 times this on common shapes. */
+double tet_stable_dt_eigen(const double *pos0, const int32_t node[4], double lambda, double mu,
+                           double density, double eta);
+
 #endif /* FDEM_ELEMENT_TET_H */

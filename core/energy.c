@@ -30,14 +30,18 @@
 void energy_initial(fdem_model *m)
 {
     double kinetic = 0;
+    const size_t D = (size_t)m->dim;
     for (int i = 0; i < m->node_count; i++) {
-        double vx = m->vel[2 * i], vy = m->vel[2 * i + 1];
-        kinetic += 0.5 * m->mass[i] * (vx * vx + vy * vy);
+        double v2 = 0;
+        for (size_t d = 0; d < D; d++) v2 += m->vel[D * (size_t)i + d] * m->vel[D * (size_t)i + d];
+        kinetic += 0.5 * m->mass[i] * v2;
     }
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     element_forces(m);
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
-    if (m->elem_viscous) memset(m->elem_viscous, 0, sizeof(double) * 3 * (size_t)m->elem_count);
+    memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
+    if (m->elem_viscous)
+        memset(m->elem_viscous, 0,
+               sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count);
     m->damping_work = 0;
     m->initial_energy = kinetic + m->elastic_energy;
 }
@@ -47,16 +51,18 @@ void energy_initial(fdem_model *m)
 static double constraints_last_half_step(const fdem_model *m)
 {
     double power = 0;
+    const int D = m->dim;
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
         if (c->def.kind == FDEM_CONSTRAINT_FORCE) {
-            double fx = c->def.value[0] / c->entry_count, fy = c->def.value[1] / c->entry_count;
             for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-                int i = m->cnode[e];
-                power += fx * m->vel[2 * i] + fy * m->vel[2 * i + 1];
+                const double *v = m->vel + (size_t)D * (size_t)m->cnode[e];
+                double p = 0;
+                for (int d = 0; d < D; d++) p += c->def.value[d] / c->entry_count * v[d];
+                power += p;
             }
         } else if (c->def.kind == FDEM_CONSTRAINT_VELOCITY) {
-            for (int d = 0; d < 2; d++) power += c->force[d] * c->def.value[d];
+            for (int d = 0; d < D; d++) power += c->force[d] * c->def.value[d];
         }
     }
     return 0.5 * m->havg_last * power;
@@ -69,9 +75,10 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     const double havg = m->havg_last, h = m->dt_prev;
     const double *fc = m->contact.enabled && !m->contact.force_is_zero ? m->contact.force : NULL;
     double contact_power = 0, gravity_work = 0;
+    const int D = m->dim;
     for (int i = 0; i < m->node_count; i++) {
-        for (int d = 0; d < 2; d++) {
-            size_t k = 2 * (size_t)i + (size_t)d;
+        for (int d = 0; d < D; d++) {
+            size_t k = (size_t)D * (size_t)i + (size_t)d;
             double v = m->vel[k], v_old = v;
             if (!(m->dof_owned[i] & (1u << d))) {
                 double f = m->force[k] + (fc ? fc[k] : 0);

@@ -1,6 +1,6 @@
 /*
- * fdem.h - the public C API of the fdemd engine (2D combined finite-discrete
- * element method, after Munjiza 2004).
+ * fdem.h - the public C API of the fdemd engine (combined finite-discrete
+ * element method, after Munjiza 2004) in two and three dimensions.
  *
  * Contract:
  *  - A model is built in two phases. Phase 1 (building): add materials, parts
@@ -14,7 +14,12 @@
  *  - The engine owns all its memory; accessors return pointers into it that
  *    stay valid until the next fdem_step() or fdem_model_destroy().
  *  - No global mutable state: two models may be stepped from two threads.
- *  - Units are SI; 2D plane strain, unit thickness.
+ *  - Units are SI; 2D is plane strain of unit thickness (forces per metre),
+ *    3D has forces in N and energies in J.
+ *  - A model has one dimension, 2 (triangles, the default) or 3
+ *    (tetrahedra), chosen before its first part. Every node array holds
+ *    `dimension` numbers per node, every vector (gravity, velocities,
+ *    constraint values and reactions) `dimension` components.
  */
 #ifndef FDEM_H
 #define FDEM_H
@@ -84,6 +89,14 @@ typedef struct fdem_mesh {
 
 void fdem_mesh_free(fdem_mesh *mesh);
 
+/* A tetrahedral mesh (mesh_3d.h has its generators and validation): nodes
+ * are xyz triples, tetrahedra node index quadruples. */
+typedef struct fdem_tet_mesh {
+    int node_count, tet_count;
+    double *xyz;   /* 3 * node_count */
+    int32_t *tet;  /* 4 * tet_count */
+} fdem_tet_mesh;
+
 /* Structured rectangle, each of the nx*ny cells split into two triangles
  * (alternating diagonals, so the mesh has no preferred direction). */
 int fdem_mesh_rectangle(double ox, double oy, double width, double height,
@@ -104,6 +117,10 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err);
 fdem_model *fdem_model_create(void);
 void fdem_model_destroy(fdem_model *model);
 
+/* 2 or 3; only before the first part is added (default 2). */
+int fdem_set_dimension(fdem_model *model, int dimension, fdem_error *err);
+int fdem_get_dimension(const fdem_model *model);
+
 /* Returns the material index (>= 0) or -1. */
 int fdem_add_material(fdem_model *model, const fdem_material_def *def, fdem_error *err);
 
@@ -113,30 +130,41 @@ int fdem_add_material(fdem_model *model, const fdem_material_def *def, fdem_erro
 int fdem_add_part(fdem_model *model, const fdem_mesh *mesh, int material,
                   int fracture, fdem_error *err);
 
-/* Initial velocity of every node of a part. */
+/* The same for a 3D model and a tetrahedral mesh (copied, validated and
+ * reoriented). Fracture in 3D is not built yet: fracture != 0 fails. */
+int fdem_add_part_3d(fdem_model *model, const fdem_tet_mesh *mesh, int material,
+                     int fracture, fdem_error *err);
+
+/* Initial velocity of every node of a part: `dimension` components in v
+ * (the 2D form leaves vz out). */
 int fdem_set_part_velocity(fdem_model *model, int part, double vx, double vy,
                            fdem_error *err);
+int fdem_set_part_velocity_v(fdem_model *model, int part, const double *v, fdem_error *err);
 
+/* Gravity, `dimension` components in g (the 2D form leaves gz out). */
 void fdem_set_gravity(fdem_model *model, double gx, double gy);
+void fdem_set_gravity_v(fdem_model *model, const double *g);
 
 /* Node selection for a constraint: all nodes of a part, or every node whose
- * initial position lies in [xmin, xmax] x [ymin, ymax] (inclusive). */
+ * initial position lies in the box (inclusive): box[d] is the lower and
+ * box[dimension + d] the upper bound of axis d, so [xmin, ymin, xmax, ymax]
+ * in 2D and [xmin, ymin, zmin, xmax, ymax, zmax] in 3D. */
 typedef enum fdem_select_kind { FDEM_SELECT_PART, FDEM_SELECT_BOX } fdem_select_kind;
 
 typedef enum fdem_constraint_kind {
-    FDEM_CONSTRAINT_FIX,      /* fix_x / fix_y */
-    FDEM_CONSTRAINT_VELOCITY, /* prescribed velocity; free_x/free_y leave a component free */
+    FDEM_CONSTRAINT_FIX,      /* fix_x / fix_y / fix_z */
+    FDEM_CONSTRAINT_VELOCITY, /* prescribed velocity; free_x/_y/_z leave a component free */
     FDEM_CONSTRAINT_FORCE,    /* total force shared equally by the selected nodes */
 } fdem_constraint_kind;
 
 typedef struct fdem_constraint_def {
     fdem_select_kind select;
     int part;           /* FDEM_SELECT_PART */
-    double box[4];      /* FDEM_SELECT_BOX: xmin, ymin, xmax, ymax */
+    double box[6];      /* FDEM_SELECT_BOX: lower bounds, then upper bounds */
     fdem_constraint_kind kind;
-    int fix_x, fix_y;   /* FIX */
-    double value[2];    /* VELOCITY: vx, vy; FORCE: fx, fy (N per unit thickness) */
-    int free_x, free_y; /* VELOCITY: component left free (JSON null) */
+    int fix_x, fix_y, fix_z;    /* FIX */
+    double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness) */
+    int free_x, free_y, free_z; /* VELOCITY: component left free (JSON null) */
 } fdem_constraint_def;
 
 /* Returns the constraint index or -1 (e.g. a selection with no node).
@@ -211,25 +239,32 @@ double fdem_get_time(const fdem_model *model);
 fdem_counts fdem_get_counts(const fdem_model *model);
 fdem_energy fdem_get_energy(const fdem_model *model);
 
-/* Node arrays, 2 doubles per node, engine order. */
+/* Node arrays, `dimension` doubles per node, engine order. */
 const double *fdem_positions(const fdem_model *model);
 const double *fdem_initial_positions(const fdem_model *model);
 const double *fdem_velocities(const fdem_model *model);
 const double *fdem_node_masses(const fdem_model *model);
 const int32_t *fdem_node_parts(const fdem_model *model);
-/* Element arrays: 3 node indices per element (counter-clockwise), part index. */
+/* Element arrays: node indices per element (3, counter-clockwise, in 2D;
+ * 4, positive volume, in 3D), part index. fdem_triangles is NULL in 3D and
+ * fdem_tetrahedra NULL in 2D; fdem_element_nodes is whichever there is. */
+int fdem_nodes_per_element(const fdem_model *model);
+const int32_t *fdem_element_nodes(const fdem_model *model);
 const int32_t *fdem_triangles(const fdem_model *model);
+const int32_t *fdem_tetrahedra(const fdem_model *model);
 const int32_t *fdem_element_parts(const fdem_model *model);
 /* Joint arrays (4 node indices per joint: a0, a1 on one face, b0, b1 on the
  * other, a0 opposite b0), and damage 0..1 per joint. NULL when no joints. */
 const int32_t *fdem_joints(const fdem_model *model);
 const double *fdem_joint_damage(const fdem_model *model);
 
-/* Cauchy stress (sxx, syy, sxy) of every element into out[3*elements]. */
+/* Cauchy stress of every element into out[fdem_stress_components * elements]:
+ * (sxx, syy, sxy) in 2D, (sxx, syy, szz, syz, sxz, sxy) in 3D. */
+int fdem_stress_components(const fdem_model *model);
 void fdem_element_stress(const fdem_model *model, double *out);
 
 /* Total reaction (fix, velocity) or applied (force) force of each
- * constraint during the last step, 2 doubles per constraint. */
+ * constraint during the last step, `dimension` doubles per constraint. */
 const double *fdem_constraint_forces(const fdem_model *model);
 
 /* Number of nodes selected by constraint c (valid after finalize). */
@@ -265,6 +300,7 @@ size_t fdem_memory_bytes(const fdem_model *model);
 /* Estimated bytes a model with this many nodes, elements and joints will
  * need once finalized (to reject oversized cases before building them). */
 size_t fdem_memory_estimate(long nodes, long elements, long joints);
+size_t fdem_memory_estimate_3d(long nodes, long elements);
 
 #ifdef __cplusplus
 }

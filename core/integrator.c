@@ -18,20 +18,22 @@
 #include "model.h"
 
 /* The central difference update of nodes [begin, end), for every dof no
- * constraint owns. sums[0] gets a sum of the new positions and velocities:
- * non-finite if and only if some value is (cheaper than a test per value in
- * the hot loop); it is accumulated as one add per node, so that its
- * dependency chain does not pace the loop. sums[1] gets the work of the
- * contact forces (times 2 / havg) and sums[SCATTER_MAX] the largest squared
- * displacement since the last detection. with_contact (contact is on: track
- * displacements) and with_force (some contact force may be non-zero) are
- * constants at each call below, so the compiler emits each loop without the
- * loads and branches it does not need. */
-static inline void central_difference_pass(fdem_model *m, int begin, int end, int with_contact,
-                                           int with_force, double sums[SCATTER_SUMS])
+ * constraint owns, in D = 2 or 3 components (a constant at each call, so
+ * the component loop unrolls). sums[0] gets a sum of the new positions and
+ * velocities: non-finite if and only if some value is (cheaper than a test
+ * per value in the hot loop); it is accumulated as one add per node, so
+ * that its dependency chain does not pace the loop. sums[1] gets the work
+ * of the contact forces (times 2 / havg) and sums[SCATTER_MAX] the largest
+ * squared displacement since the last detection. with_contact (contact is
+ * on: track displacements) and with_force (some contact force may be
+ * non-zero) are constants at each call below, so the compiler emits each
+ * loop without the loads and branches it does not need. */
+static inline __attribute__((always_inline)) void
+central_difference_pass(fdem_model *m, int begin, int end, const int D, int with_contact,
+                        int with_force, double sums[SCATTER_SUMS])
 {
     const double h = m->dt, havg = 0.5 * (m->dt_prev + m->dt);
-    const double gx = m->gravity[0], gy = m->gravity[1];
+    const double *g = m->gravity;
     double *x = m->pos, *v = m->vel;
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
@@ -39,60 +41,57 @@ static inline void central_difference_pass(fdem_model *m, int begin, int end, in
     const double *xd = m->contact.pos_detect;
     double check = 0, max_disp2 = 0, contact_work = 0;
     for (int i = begin; i < end; i++) {
-        double fx = f[2 * i], fy = f[2 * i + 1];
-        double vx_old = v[2 * i], vy_old = v[2 * i + 1];
-        if (with_force) {
-            fx += fc[2 * i];
-            fy += fc[2 * i + 1];
-        }
+        const size_t at = (size_t)D * (size_t)i;
         unsigned own = owned[i];
-        double vx = vx_old, vy = vy_old, px = x[2 * i], py = x[2 * i + 1];
-        if (!(own & 1u)) {
-            vx += (fx * inv_mass[i] + gx) * havg;
-            px += vx * h;
-            v[2 * i] = vx;
-            x[2 * i] = px;
+        double pos_sum = 0, vel_sum = 0, work = 0, d2 = 0;
+        for (int d = 0; d < D; d++) {
+            double fd = f[at + d], v_old = v[at + d];
+            if (with_force) fd += fc[at + d];
+            double vd = v_old, pd = x[at + d];
+            if (!(own & (1u << d))) {
+                vd += (fd * inv_mass[i] + g[d]) * havg;
+                pd += vd * h;
+                v[at + d] = vd;
+                x[at + d] = pd;
+                /* f . (v_old + v_new)/2 * havg is exactly what a force adds
+                 * to the half-step kinetic energy, so the balance closes
+                 * (constrained dofs: constraint_enforce). */
+                if (with_force) work += fc[at + d] * (v_old + vd);
+            }
+            pos_sum += pd;
+            vel_sum += vd;
+            if (with_contact) {
+                double u = pd - xd[at + d];
+                d2 += u * u;
+            }
         }
-        if (!(own & 2u)) {
-            vy += (fy * inv_mass[i] + gy) * havg;
-            py += vy * h;
-            v[2 * i + 1] = vy;
-            x[2 * i + 1] = py;
-        }
-        check += (px + py) + (vx + vy);
-        /* f . (v_old + v_new)/2 * havg is exactly what a force adds to the
-         * half-step kinetic energy, so the balance closes (constrained dofs:
-         * constraint_enforce). */
-        if (with_force)
-            contact_work += ((own & 1u) ? 0 : fc[2 * i] * (vx_old + vx)) +
-                            ((own & 2u) ? 0 : fc[2 * i + 1] * (vy_old + vy));
-        if (with_contact) {
-            double ux = px - xd[2 * i], uy = py - xd[2 * i + 1];
-            double d2 = ux * ux + uy * uy;
-            if (d2 > max_disp2) max_disp2 = d2;
-        }
+        check += pos_sum + vel_sum;
+        if (with_force) contact_work += work;
+        if (with_contact && d2 > max_disp2) max_disp2 = d2;
     }
     sums[0] += check;
     sums[1] += contact_work;
     if (max_disp2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = max_disp2;
 }
 
-static void central_difference_nodes(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
-{
-    central_difference_pass(m, begin, end, 0, 0, sums);
-}
-
-static void central_difference_nodes_tracked(fdem_model *m, int begin, int end,
-                                             double sums[SCATTER_SUMS])
-{
-    central_difference_pass(m, begin, end, 1, 0, sums);
-}
-
-static void central_difference_nodes_contact(fdem_model *m, int begin, int end,
-                                             double sums[SCATTER_SUMS])
-{
-    central_difference_pass(m, begin, end, 1, 1, sums);
-}
+#define CENTRAL_DIFFERENCE_PASSES(D)                                                              \
+    static void central_difference_nodes_##D(fdem_model *m, int begin, int end,                  \
+                                             double sums[SCATTER_SUMS])                           \
+    {                                                                                             \
+        central_difference_pass(m, begin, end, D, 0, 0, sums);                                    \
+    }                                                                                             \
+    static void central_difference_tracked_##D(fdem_model *m, int begin, int end,                \
+                                               double sums[SCATTER_SUMS])                         \
+    {                                                                                             \
+        central_difference_pass(m, begin, end, D, 1, 0, sums);                                    \
+    }                                                                                             \
+    static void central_difference_contact_##D(fdem_model *m, int begin, int end,                \
+                                               double sums[SCATTER_SUMS])                         \
+    {                                                                                             \
+        central_difference_pass(m, begin, end, D, 1, 1, sums);                                    \
+    }
+CENTRAL_DIFFERENCE_PASSES(2)
+CENTRAL_DIFFERENCE_PASSES(3)
 
 /* Advances every free dof by m->dt (h_next) after a step of m->dt_prev
  * (h_current). Returns -1 if some new value is not finite. */
@@ -101,9 +100,12 @@ int central_difference_step(fdem_model *m)
     double havg = 0.5 * (m->dt_prev + m->dt);
     double sums[SCATTER_SUMS] = {0};
     sums[SCATTER_MAX] = m->contact.max_disp2;
-    scatter_block_fn pass = !m->contact.enabled      ? central_difference_nodes
-                            : m->contact.force_is_zero ? central_difference_nodes_tracked
-                                                       : central_difference_nodes_contact;
+    const int three = m->dim == 3;
+    scatter_block_fn pass = !m->contact.enabled
+                                 ? (three ? central_difference_nodes_3 : central_difference_nodes_2)
+                             : m->contact.force_is_zero
+                                 ? (three ? central_difference_tracked_3 : central_difference_tracked_2)
+                                 : (three ? central_difference_contact_3 : central_difference_contact_2);
     scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
     m->contact.max_disp2 = sums[SCATTER_MAX];
     m->contact_work += sums[1] * 0.5 * havg;
@@ -123,10 +125,11 @@ fdem_stage_times fdem_get_stage_times(const fdem_model *m) { return m->times; }
 static void report_non_finite(fdem_model *m, double h, fdem_error *err)
 {
     int node = -1;
+    const size_t D = (size_t)m->dim;
     for (int i = 0; i < m->node_count && node < 0; i++)
-        if (!isfinite(m->pos[2 * i]) || !isfinite(m->pos[2 * i + 1]) || !isfinite(m->vel[2 * i]) ||
-            !isfinite(m->vel[2 * i + 1]))
-            node = i;
+        for (size_t d = 0; d < D; d++)
+            if (!isfinite(m->pos[D * (size_t)i + d]) || !isfinite(m->vel[D * (size_t)i + d]))
+                node = i;
     int elem = node >= 0 ? element_of_node(m, node) : -1;
     model_error(err, FDEM_ITEM_ELEMENT, elem,
                 "the solution became non-finite at step %lld (t = %.6g s) in element %d (node %d) "
@@ -143,7 +146,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
     double t0 = stage_clock();
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    memset(m->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     element_forces(m);
     if (m->joint_count) {
         int broke = joint_forces(m);

@@ -23,12 +23,6 @@
 
 #include "fdem.h"
 
-typedef struct fdem_tet_mesh {
-    int node_count, tet_count;
-    double *xyz;   /* 3 * node_count */
-    int32_t *tet;  /* 4 * tet_count */
-} fdem_tet_mesh;
-
 void fdem_tet_mesh_free(fdem_tet_mesh *mesh);
 
 /* origin + [0, size] split into div[0] x div[1] x div[2] cells of six

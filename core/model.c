@@ -4,7 +4,12 @@
  * stable step), the read-only accessors and memory accounting.
  *
  * Lumped mass follows seed eqs 5.4-5.6: every triangle gives rho*A/3 to each
- * of its nodes; the mass matrix is diagonal and no stiffness matrix exists.
+ * of its nodes (a tetrahedron rho*V/4); the mass matrix is diagonal and no
+ * stiffness matrix exists.
+ *
+ * Both dimensions share this file: a part is node coordinates (dim a node)
+ * and element node lists (elem_nodes an element) whatever its dimension;
+ * only validating the mesh and preparing the element differ.
  */
 #include <math.h>
 #include <stdarg.h>
@@ -12,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mesh_3d.h"
 #include "model.h"
 
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
@@ -42,6 +48,8 @@ fdem_model *fdem_model_create(void)
 {
     fdem_model *m = calloc(1, sizeof *m);
     if (!m) return NULL;
+    m->dim = 2;
+    m->elem_nodes = 3;
     nbs_grid_init(&m->contact.grid);
     nbs_pairs_init(&m->contact.pairs);
     return m;
@@ -52,7 +60,7 @@ void fdem_model_destroy(fdem_model *m)
     if (!m) return;
     free(m->pos); free(m->vel); free(m->force); free(m->inv_mass);
     free(m->pos0); free(m->mass); free(m->node_part); free(m->node_origin); free(m->dof_owned);
-    free(m->elem); free(m->elem_part); free(m->tri); free(m->elem_h);
+    free(m->elem); free(m->tet); free(m->elem_part); free(m->elem_node); free(m->elem_h);
     free(m->materials); free(m->parts); free(m->part_velocity);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
@@ -64,6 +72,24 @@ void fdem_model_destroy(fdem_model *m)
     scatter_plan_free(&m->node_plan);
     free(m);
 }
+
+int fdem_set_dimension(fdem_model *m, int dimension, fdem_error *err)
+{
+    if (dimension != 2 && dimension != 3) {
+        model_error(err, FDEM_ITEM_NONE, -1, "dimension must be 2 or 3, not %d", dimension);
+        return -1;
+    }
+    if (m->part_count > 0 || m->finalized) {
+        model_error(err, FDEM_ITEM_NONE, -1,
+                    "the dimension is chosen before the first part is added");
+        return -1;
+    }
+    m->dim = dimension;
+    m->elem_nodes = dimension + 1;
+    return 0;
+}
+
+int fdem_get_dimension(const fdem_model *m) { return m->dim; }
 
 int fdem_add_material(fdem_model *m, const fdem_material_def *def, fdem_error *err)
 {
@@ -110,7 +136,7 @@ static int reserve_nodes(fdem_model *m, int need)
     while (newcap < need) newcap *= 2;
     double **d2[] = {&m->pos, &m->vel, &m->force, &m->pos0};
     for (size_t i = 0; i < sizeof d2 / sizeof d2[0]; i++) {
-        void *p = realloc(*d2[i], sizeof(double) * 2 * (size_t)newcap);
+        void *p = realloc(*d2[i], sizeof(double) * (size_t)m->dim * (size_t)newcap);
         if (!p) return -1;
         *d2[i] = p;
     }
@@ -136,25 +162,35 @@ static int reserve_elements(fdem_model *m, int need)
     if (need <= cap) return 0;
     int newcap = cap ? cap : 64;
     while (newcap < need) newcap *= 2;
-    void *p = realloc(m->elem, sizeof(element_hot) * (size_t)newcap);
-    if (!p) return -1;
-    m->elem = p;
+    void *p;
+    if (m->dim == 3) {
+        if (!(p = realloc(m->tet, sizeof(tet_hot) * (size_t)newcap))) return -1;
+        m->tet = p;
+    } else {
+        if (!(p = realloc(m->elem, sizeof(element_hot) * (size_t)newcap))) return -1;
+        m->elem = p;
+    }
     p = realloc(m->elem_part, sizeof(int32_t) * (size_t)newcap);
     if (!p) return -1;
     m->elem_part = p;
-    p = realloc(m->tri, sizeof(int32_t) * 3 * (size_t)newcap);
+    p = realloc(m->elem_node, sizeof(int32_t) * (size_t)m->elem_nodes * (size_t)newcap);
     if (!p) return -1;
-    m->tri = p;
+    m->elem_node = p;
     m->elem_capacity = newcap;
     return 0;
 }
 
-int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
-                  fdem_error *err)
+/* Checks what a part of either dimension needs before its mesh is read. */
+static int part_check(fdem_model *m, int material_index, int fracture, int dim, fdem_error *err)
 {
     int k = m->part_count;
     if (m->finalized) {
         model_error(err, FDEM_ITEM_PART, k, "the model is already finalized");
+        return -1;
+    }
+    if (m->dim != dim) {
+        model_error(err, FDEM_ITEM_PART, k, "part %d is a %dD mesh in a %dD model", k, dim,
+                    m->dim);
         return -1;
     }
     if (material_index < 0 || material_index >= m->material_count) {
@@ -167,6 +203,79 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
                     "part %d fractures but its material has no fracture parameters", k);
         return -1;
     }
+    return 0;
+}
+
+/* Appends a validated mesh as part k: node coordinates (dim a node) and
+ * element node lists (elem_nodes an element). A fracturing part gives every
+ * element its own nodes (joints join them). */
+static int part_append(fdem_model *m, const double *coords, int node_count, const int32_t *elems,
+                       int elem_count, int material_index, int fracture, fdem_error *err)
+{
+    int k = m->part_count, D = m->dim, K = m->elem_nodes;
+    int add_nodes = fracture ? K * elem_count : node_count;
+    if (grow((void **)&m->parts, &m->part_capacity, k + 1, sizeof *m->parts) ||
+        reserve_nodes(m, m->node_count + add_nodes) ||
+        reserve_elements(m, m->elem_count + elem_count)) {
+        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+        return -1;
+    }
+    double *pv = realloc(m->part_velocity, sizeof(double) * 3 * (size_t)m->part_capacity);
+    if (!pv) {
+        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+        return -1;
+    }
+    m->part_velocity = pv;
+    m->part_velocity[3 * k] = m->part_velocity[3 * k + 1] = m->part_velocity[3 * k + 2] = 0;
+
+    part *p = &m->parts[k];
+    p->material = material_index;
+    p->fracture = fracture;
+    p->node_begin = m->node_count;
+    p->node_count = add_nodes;
+    p->elem_begin = m->elem_count;
+    p->elem_count = elem_count;
+    for (int t = 0; t < elem_count; t++) {
+        int e = m->elem_count + t;
+        int32_t *hot_node;
+        if (D == 3) {
+            memset(&m->tet[e], 0, sizeof m->tet[e]);
+            m->tet[e].material = material_index;
+            hot_node = m->tet[e].node;
+        } else {
+            memset(&m->elem[e], 0, sizeof m->elem[e]);
+            m->elem[e].material = material_index;
+            hot_node = m->elem[e].node;
+        }
+        for (int c = 0; c < K; c++) {
+            int src = elems[K * t + c];
+            int dst = fracture ? m->node_count + K * t + c : m->node_count + src;
+            hot_node[c] = dst;
+            m->elem_node[(size_t)K * (size_t)e + (size_t)c] = dst;
+            m->node_origin[dst] = m->node_count + src;
+            if (fracture)
+                for (int d = 0; d < D; d++)
+                    m->pos0[(size_t)D * (size_t)dst + (size_t)d] = coords[(size_t)D * (size_t)src + (size_t)d];
+        }
+        m->elem_part[e] = k;
+    }
+    if (!fracture)
+        memcpy(m->pos0 + (size_t)D * (size_t)m->node_count, coords,
+               sizeof(double) * (size_t)D * (size_t)node_count);
+    for (int i = 0; i < add_nodes; i++) m->node_part[m->node_count + i] = k;
+    if (!fracture)
+        for (int i = 0; i < add_nodes; i++) m->node_origin[m->node_count + i] = m->node_count + i;
+    m->node_count += add_nodes;
+    m->elem_count += elem_count;
+    m->part_count++;
+    return 0;
+}
+
+int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
+                  fdem_error *err)
+{
+    int k = m->part_count;
+    if (part_check(m, material_index, fracture, 2, err)) return -1;
     /* Validate a private copy: the caller's mesh stays untouched. */
     fdem_mesh copy = {mesh->node_count, mesh->triangle_count, NULL, NULL};
     if (mesh->node_count < 3 || mesh->triangle_count < 1) {
@@ -182,92 +291,82 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
     }
     memcpy(copy.xy, mesh->xy, sizeof(double) * 2 * (size_t)mesh->node_count);
     memcpy(copy.tri, mesh->tri, sizeof(int32_t) * 3 * (size_t)mesh->triangle_count);
-    if (fdem_mesh_validate(&copy, NULL, err)) {
-        fdem_mesh_free(&copy);
-        return -1;
-    }
-    /* A fracturing part gives every triangle its own nodes (joints join them). */
-    int add_nodes = fracture ? 3 * copy.triangle_count : copy.node_count;
-    if (grow((void **)&m->parts, &m->part_capacity, k + 1, sizeof *m->parts) ||
-        reserve_nodes(m, m->node_count + add_nodes) ||
-        reserve_elements(m, m->elem_count + copy.triangle_count)) {
-        fdem_mesh_free(&copy);
-        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
-        return -1;
-    }
-    double *pv = realloc(m->part_velocity, sizeof(double) * 2 * (size_t)m->part_capacity);
-    if (!pv) {
-        fdem_mesh_free(&copy);
-        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
-        return -1;
-    }
-    m->part_velocity = pv;
-    m->part_velocity[2 * k] = m->part_velocity[2 * k + 1] = 0;
-
-    part *p = &m->parts[k];
-    p->material = material_index;
-    p->fracture = fracture;
-    p->node_begin = m->node_count;
-    p->node_count = add_nodes;
-    p->elem_begin = m->elem_count;
-    p->elem_count = copy.triangle_count;
-    for (int t = 0; t < copy.triangle_count; t++) {
-        element_hot *e = &m->elem[m->elem_count + t];
-        memset(e, 0, sizeof *e);
-        e->material = material_index;
-        for (int c = 0; c < 3; c++) {
-            int src = copy.tri[3 * t + c];
-            int dst = fracture ? m->node_count + 3 * t + c : m->node_count + src;
-            e->node[c] = dst;
-            m->tri[3 * (m->elem_count + t) + c] = dst;
-            m->node_origin[dst] = m->node_count + src;
-            if (fracture) {
-                m->pos0[2 * dst] = copy.xy[2 * src];
-                m->pos0[2 * dst + 1] = copy.xy[2 * src + 1];
-            }
-        }
-        m->elem_part[m->elem_count + t] = k;
-    }
-    if (!fracture)
-        memcpy(m->pos0 + 2 * m->node_count, copy.xy, sizeof(double) * 2 * (size_t)copy.node_count);
-    for (int i = 0; i < add_nodes; i++) m->node_part[m->node_count + i] = k;
-    if (!fracture)
-        for (int i = 0; i < add_nodes; i++) m->node_origin[m->node_count + i] = m->node_count + i;
-    m->node_count += add_nodes;
-    m->elem_count += copy.triangle_count;
-    m->part_count++;
-    int failed = fracture && joint_build_part(m, k, copy.tri, copy.triangle_count, err);
+    int failed = fdem_mesh_validate(&copy, NULL, err) ||
+                 part_append(m, copy.xy, copy.node_count, copy.tri, copy.triangle_count,
+                             material_index, fracture, err) ||
+                 (fracture && joint_build_part(m, k, copy.tri, copy.triangle_count, err));
     fdem_mesh_free(&copy);
     return failed ? -1 : k;
 }
 
-int fdem_set_part_velocity(fdem_model *m, int part_index, double vx, double vy, fdem_error *err)
+int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_index, int fracture,
+                     fdem_error *err)
+{
+    int k = m->part_count;
+    if (part_check(m, material_index, fracture, 3, err)) return -1;
+    if (fracture) {
+        model_error(err, FDEM_ITEM_PART, k,
+                    "part %d: fracture of tetrahedral parts is not available yet", k);
+        return -1;
+    }
+    if (mesh->node_count < 4 || mesh->tet_count < 1) {
+        model_error(err, FDEM_ITEM_PART, k, "part %d needs at least 4 nodes and 1 tetrahedron", k);
+        return -1;
+    }
+    fdem_tet_mesh copy = {mesh->node_count, mesh->tet_count, NULL, NULL};
+    copy.xyz = malloc(sizeof(double) * 3 * (size_t)mesh->node_count);
+    copy.tet = malloc(sizeof(int32_t) * 4 * (size_t)mesh->tet_count);
+    if (!copy.xyz || !copy.tet) {
+        fdem_tet_mesh_free(&copy);
+        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+        return -1;
+    }
+    memcpy(copy.xyz, mesh->xyz, sizeof(double) * 3 * (size_t)mesh->node_count);
+    memcpy(copy.tet, mesh->tet, sizeof(int32_t) * 4 * (size_t)mesh->tet_count);
+    int failed = fdem_tet_mesh_validate(&copy, NULL, err) ||
+                 part_append(m, copy.xyz, copy.node_count, copy.tet, copy.tet_count,
+                             material_index, fracture, err);
+    fdem_tet_mesh_free(&copy);
+    return failed ? -1 : k;
+}
+
+int fdem_set_part_velocity_v(fdem_model *m, int part_index, const double *v, fdem_error *err)
 {
     if (part_index < 0 || part_index >= m->part_count) {
         model_error(err, FDEM_ITEM_PART, part_index, "part %d does not exist", part_index);
         return -1;
     }
-    if (!isfinite(vx) || !isfinite(vy)) {
-        model_error(err, FDEM_ITEM_PART, part_index, "the velocity of part %d is not finite",
-                    part_index);
-        return -1;
-    }
-    m->part_velocity[2 * part_index] = vx;
-    m->part_velocity[2 * part_index + 1] = vy;
+    for (int d = 0; d < m->dim; d++)
+        if (!isfinite(v[d])) {
+            model_error(err, FDEM_ITEM_PART, part_index, "the velocity of part %d is not finite",
+                        part_index);
+            return -1;
+        }
+    for (int d = 0; d < m->dim; d++) m->part_velocity[3 * part_index + d] = v[d];
     if (m->finalized) {
         const part *p = &m->parts[part_index];
-        for (int i = p->node_begin; i < p->node_begin + p->node_count; i++) {
-            m->vel[2 * i] = vx;
-            m->vel[2 * i + 1] = vy;
-        }
+        for (int i = p->node_begin; i < p->node_begin + p->node_count; i++)
+            for (int d = 0; d < m->dim; d++) m->vel[(size_t)m->dim * (size_t)i + (size_t)d] = v[d];
     }
     return 0;
 }
 
+int fdem_set_part_velocity(fdem_model *m, int part_index, double vx, double vy, fdem_error *err)
+{
+    const double v[3] = {vx, vy, 0};
+    return fdem_set_part_velocity_v(m, part_index, v, err);
+}
+
+void fdem_set_gravity_v(fdem_model *m, const double *g)
+{
+    m->gravity[2] = 0;
+    for (int d = 0; d < m->dim; d++) m->gravity[d] = g[d];
+}
+
 void fdem_set_gravity(fdem_model *m, double gx, double gy)
 {
-    m->gravity[0] = gx;
-    m->gravity[1] = gy;
+    const double g[3] = {gx, gy, 0};
+    fdem_set_gravity_v(m, g);
 }
 
 int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_error *err)
@@ -277,19 +376,25 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
         model_error(err, FDEM_ITEM_CONSTRAINT, k, "the model is already finalized");
         return -1;
     }
-    if (def->select == FDEM_SELECT_BOX &&
-        (!isfinite(def->box[0]) || !isfinite(def->box[1]) || !isfinite(def->box[2]) ||
-         !isfinite(def->box[3]) || def->box[0] > def->box[2] || def->box[1] > def->box[3])) {
+    int D = m->dim, box_ok = 1, value_ok = 1;
+    for (int d = 0; d < D; d++) {
+        box_ok &= isfinite(def->box[d]) && isfinite(def->box[D + d]) && def->box[d] <= def->box[D + d];
+        value_ok &= isfinite(def->value[d]) != 0;
+    }
+    if (def->select == FDEM_SELECT_BOX && !box_ok) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k,
-                    "constraint %d: box must be [xmin, ymin, xmax, ymax] with min <= max", k);
+                    D == 3 ? "constraint %d: box must be [xmin, ymin, zmin, xmax, ymax, zmax] with min <= max"
+                           : "constraint %d: box must be [xmin, ymin, xmax, ymax] with min <= max",
+                    k);
         return -1;
     }
-    if (!isfinite(def->value[0]) || !isfinite(def->value[1])) {
+    if (!value_ok) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d: value is not finite", k);
         return -1;
     }
-    if (def->kind == FDEM_CONSTRAINT_FIX && !def->fix_x && !def->fix_y) {
-        model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d fixes neither x nor y", k);
+    if (def->kind == FDEM_CONSTRAINT_FIX && !def->fix_x && !def->fix_y && !(D == 3 && def->fix_z)) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    D == 3 ? "constraint %d fixes none of x, y, z" : "constraint %d fixes neither x nor y", k);
         return -1;
     }
     if (grow((void **)&m->constraints, &m->constraint_capacity, k + 1, sizeof *m->constraints)) {
@@ -298,30 +403,43 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     }
     memset(&m->constraints[k], 0, sizeof m->constraints[k]);
     m->constraints[k].def = *def;
+    if (D == 2) { /* what a 2D caller left in the third component means nothing */
+        constraint *c = &m->constraints[k];
+        c->def.fix_z = 0;
+        c->def.free_z = 1;
+        c->def.value[2] = 0;
+    }
     m->constraint_count++;
     return k;
 }
 
+/* rho A / 3 to each node of a triangle, rho V / 4 to each of a tetrahedron. */
 static void lump_masses(fdem_model *m)
 {
     memset(m->mass, 0, sizeof(double) * (size_t)m->node_count);
+    const int K = m->elem_nodes;
     for (int e = 0; e < m->elem_count; e++) {
-        const element_hot *el = &m->elem[e];
-        double third = m->materials[el->material].def.density * el->area0 / 3.0;
-        for (int c = 0; c < 3; c++) m->mass[el->node[c]] += third;
+        int mat = m->dim == 3 ? m->tet[e].material : m->elem[e].material;
+        double size = m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
+        double share = m->materials[mat].def.density * size / K;
+        const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
+        for (int c = 0; c < K; c++) m->mass[n[c]] += share;
     }
     for (int i = 0; i < m->node_count; i++) m->inv_mass[i] = 1.0 / m->mass[i];
 }
 
-/* Element nodes sit at the start of each 64-byte record, 16 int32 apart. */
+/* Element nodes sit at the start of each hot record (16 int32 apart for a
+ * triangle, 28 for a tetrahedron). */
 static int build_scatter_plans(fdem_model *m)
 {
     _Static_assert(sizeof(element_hot) % sizeof(int32_t) == 0, "element records in int32 words");
+    _Static_assert(sizeof(tet_hot) % sizeof(int32_t) == 0, "element records in int32 words");
+    const int32_t *first = m->dim == 3 ? m->tet[0].node : m->elem[0].node;
+    size_t stride = (m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) / sizeof(int32_t);
     if (m->elem_count &&
         scatter_plan_build(&m->elem_plan, m->elem_count,
-                           scatter_block_size(m->elem_count, SCATTER_BLOCK_ELEMENTS),
-                           m->elem[0].node, sizeof(element_hot) / sizeof(int32_t), 3,
-                           m->node_count))
+                           scatter_block_size(m->elem_count, SCATTER_BLOCK_ELEMENTS), first,
+                           stride, m->elem_nodes, m->node_count))
         return -1;
     if (m->joint_count &&
         scatter_plan_build(&m->joint_plan, m->joint_count,
@@ -340,14 +458,13 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         model_error(err, FDEM_ITEM_NONE, -1, "the model has no parts");
         return -1;
     }
-    memcpy(m->pos, m->pos0, sizeof(double) * 2 * (size_t)m->node_count);
-    memset(m->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    const size_t D = (size_t)m->dim;
+    memcpy(m->pos, m->pos0, sizeof(double) * D * (size_t)m->node_count);
+    memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     for (int k = 0; k < m->part_count; k++) {
         const part *p = &m->parts[k];
-        for (int i = p->node_begin; i < p->node_begin + p->node_count; i++) {
-            m->vel[2 * i] = m->part_velocity[2 * k];
-            m->vel[2 * i + 1] = m->part_velocity[2 * k + 1];
-        }
+        for (int i = p->node_begin; i < p->node_begin + p->node_count; i++)
+            for (size_t d = 0; d < D; d++) m->vel[D * (size_t)i + d] = m->part_velocity[3 * k + (int)d];
     }
     m->elem_h = malloc(sizeof(double) * (size_t)m->elem_count);
     if (!m->elem_h) {
@@ -356,10 +473,11 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     }
     int damped = 0;
     for (int e = 0; e < m->elem_count; e++) {
-        element_prepare(m, e);
-        damped |= m->elem[e].eta > 0;
+        if (element_prepare(m, e, err)) return -1;
+        damped |= (m->dim == 3 ? m->tet[e].eta : m->elem[e].eta) > 0;
     }
-    if (damped && !(m->elem_viscous = calloc(3 * (size_t)m->elem_count, sizeof(double)))) {
+    if (damped && !(m->elem_viscous = calloc((size_t)model_stress_comps(m) * (size_t)m->elem_count,
+                                             sizeof(double)))) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
         return -1;
     }
@@ -423,19 +541,23 @@ const int32_t *fdem_element_parts(const fdem_model *m) { return m->elem_part; }
 const int32_t *fdem_joints(const fdem_model *m) { return m->joint_count ? m->joint_node : NULL; }
 const double *fdem_joint_damage(const fdem_model *m) { return m->joint_count ? m->joint_damage : NULL; }
 
-const int32_t *fdem_triangles(const fdem_model *m) { return m->tri; }
+int fdem_nodes_per_element(const fdem_model *m) { return m->elem_nodes; }
+const int32_t *fdem_element_nodes(const fdem_model *m) { return m->elem_node; }
+const int32_t *fdem_triangles(const fdem_model *m) { return m->dim == 2 ? m->elem_node : NULL; }
+const int32_t *fdem_tetrahedra(const fdem_model *m) { return m->dim == 3 ? m->elem_node : NULL; }
+int fdem_stress_components(const fdem_model *m) { return model_stress_comps(m); }
 
 void fdem_element_stress(const fdem_model *m, double *out)
 {
-    for (int e = 0; e < m->elem_count; e++) element_stress_one(m, e, out + 3 * e);
+    size_t comps = (size_t)model_stress_comps(m);
+    for (int e = 0; e < m->elem_count; e++) element_stress_one(m, e, out + comps * (size_t)e);
 }
 
 const double *fdem_constraint_forces(const fdem_model *m)
 {
-    for (int c = 0; c < m->constraint_count; c++) {
-        m->constraint_force_out[2 * c] = m->constraints[c].force[0];
-        m->constraint_force_out[2 * c + 1] = m->constraints[c].force[1];
-    }
+    for (int c = 0; c < m->constraint_count; c++)
+        for (int d = 0; d < m->dim; d++)
+            m->constraint_force_out[m->dim * c + d] = m->constraints[c].force[d];
     return m->constraint_force_out;
 }
 
@@ -454,12 +576,21 @@ size_t fdem_memory_estimate(long nodes, long elements, long joints)
     return (size_t)nodes * per_node + (size_t)elements * per_elem + (size_t)joints * per_joint;
 }
 
+size_t fdem_memory_estimate_3d(long nodes, long elements)
+{
+    size_t per_node = sizeof(double) * (3 * 5 + 2) + sizeof(int32_t) + 1;
+    size_t per_elem = sizeof(tet_hot) + sizeof(int32_t) * 5 + sizeof(double) * 12 + 1 +
+                      2 * 2 * sizeof(int32_t) * 6; /* spheres, boxes, body, NBS lists, ~6 pairs */
+    return (size_t)nodes * per_node + (size_t)elements * per_elem;
+}
+
 size_t fdem_memory_bytes(const fdem_model *m)
 {
-    size_t b = sizeof *m;
-    b += (size_t)m->node_capacity * (sizeof(double) * (2 * 4 + 2) + sizeof(int32_t));
-    b += (size_t)m->node_count * (1 + (m->contact.enabled ? 4 * sizeof(double) : 0));
-    b += (size_t)m->elem_capacity * (sizeof(element_hot) + 4 * sizeof(int32_t));
+    size_t b = sizeof *m, D = (size_t)m->dim;
+    b += (size_t)m->node_capacity * (sizeof(double) * (D * 4 + 2) + sizeof(int32_t));
+    b += (size_t)m->node_count * (1 + (m->contact.enabled ? 2 * D * sizeof(double) : 0));
+    b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
+                                     ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
     if (m->contact.enabled)
         b += (size_t)m->elem_count * (7 * sizeof(double) + 2 * sizeof(int32_t) + 1) +

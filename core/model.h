@@ -33,6 +33,16 @@ typedef struct element_hot {
     double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
 } element_hot;
 
+/* Hot per-tetrahedron record (3D models): two cache lines less 16 bytes. */
+typedef struct tet_hot {
+    int32_t node[4];     /* positive volume */
+    int32_t material;
+    int32_t unused;
+    double xinv[9];      /* inverse of the initial edge matrix [X1-X0, X2-X0, X3-X0], row-major */
+    double volume0;      /* initial volume */
+    double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
+} tet_hot;
+
 typedef struct part {
     int material;
     int fracture;
@@ -45,8 +55,12 @@ typedef struct part {
 typedef struct constraint {
     fdem_constraint_def def;
     int entry_begin, entry_count;
-    double force[2];     /* reaction (fix, velocity) or applied (force) of the last step */
+    double force[3];     /* reaction (fix, velocity) or applied (force) of the last step */
 } constraint;
+
+/* Partial sums a scatter block hands back (see scatter_plan_run below). */
+#define SCATTER_SUMS 5
+#define SCATTER_MAX 4
 
 /* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
  * blocks of one colour share no node, so threads may run them side by side
@@ -100,6 +114,8 @@ typedef struct contact_state {
 
 struct fdem_model {
     int finalized;
+    int dim;                 /* 2 or 3: numbers per node in every node array */
+    int elem_nodes;          /* 3 (triangles) or 4 (tetrahedra) */
 
     /* nodes: hot */
     int node_count, node_capacity;
@@ -109,27 +125,28 @@ struct fdem_model {
     int32_t *node_part;
     int32_t *node_origin;    /* the mesh vertex a node stands for: copies in a fracturing
                                 part share it; otherwise the node itself */
-    uint8_t *dof_owned;      /* bit 0: x, bit 1: y prescribed by some constraint */
+    uint8_t *dof_owned;      /* bit d: component d prescribed by some constraint */
 
-    /* elements */
+    /* elements: triangles in elem (2D) or tetrahedra in tet (3D) */
     int elem_count, elem_capacity;
     element_hot *elem;
+    tet_hot *tet;
     int32_t *elem_part;
-    int32_t *tri;            /* 3 nodes per element, packed (cold copy for output) */
-    double *elem_h;          /* smallest altitude of the initial triangle */
+    int32_t *elem_node;      /* elem_nodes per element, packed (cold copy for output) */
+    double *elem_h;          /* smallest altitude (height) of the initial element */
 
     int material_count, material_capacity;
     material *materials;
     int part_count, part_capacity;
     part *parts;
-    double *part_velocity;   /* 2 per part, applied at finalize */
+    double *part_velocity;   /* 3 per part (2D uses 2), applied at finalize */
 
     int constraint_count, constraint_capacity;
     constraint *constraints;
     int cnode_count;
     int32_t *cnode;          /* node of each constraint entry */
-    uint8_t *cdof;           /* dofs this entry owns (bit 0 x, bit 1 y) */
-    double *constraint_force_out; /* 2 per constraint, for fdem_constraint_forces */
+    uint8_t *cdof;           /* dofs this entry owns (bit d: component d) */
+    double *constraint_force_out; /* dim per constraint, for fdem_constraint_forces */
 
     /* joints (fracture); joint_count == 0 when no part fractures */
     int joint_count;
@@ -145,7 +162,7 @@ struct fdem_model {
     int broken_joints;
     int fragments;
 
-    double gravity[2];
+    double gravity[3];
     double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
     int64_t step;
     double time;
@@ -165,7 +182,7 @@ struct fdem_model {
     double external_work;
     double initial_energy;   /* kinetic + elastic at t = 0 */
     double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
-    double *elem_viscous;    /* 3 per element: the viscous half stress of the last step, whose
+    double *elem_viscous;    /* stress_comps per element: the viscous half stress of the last step, whose
                                 work with the new velocities the next step books
                                 (element.c); NULL when no element is damped */
     fdem_energy restored_energy; /* the accounts a checkpoint held, reported until the next
@@ -187,12 +204,28 @@ double stage_clock(void);
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
-/* element.c */
-void element_prepare(fdem_model *m, int e);
+/* Stress components per element: 3 in 2D, 6 in 3D. */
+static inline int model_stress_comps(const fdem_model *m) { return m->dim == 3 ? 6 : 3; }
+
+/* element.c: the element stage of either dimension (prepare, stable step,
+ * forces through the scatter plan, stress), calling the kernels below */
+int element_prepare(fdem_model *m, int e, fdem_error *err);
 double element_stable_dt(const fdem_model *m, int e);
 void element_forces(fdem_model *m);
-void element_stress_one(const fdem_model *m, int e, double out[3]);
+void element_stress_one(const fdem_model *m, int e, double *out);
 int element_of_node(const fdem_model *m, int node);
+
+/* element_tri.c: the triangle kernel */
+void tri_element_prepare(fdem_model *m, int e);
+double tri_element_stable_dt(const fdem_model *m, int e);
+void tri_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+void tri_element_stress(const fdem_model *m, int e, double out[3]);
+
+/* element_tet_model.c: the tetrahedron kernel (element_tet.h) on the model */
+int tet_element_prepare(fdem_model *m, int e, fdem_error *err);
+double tet_element_stable_dt(const fdem_model *m, int e);
+void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+void tet_element_stress(const fdem_model *m, int e, double out[6]);
 
 /* contact.c */
 int contact_init(fdem_model *m, fdem_error *err);
@@ -235,8 +268,6 @@ int joint_fragment_count(const fdem_model *m);
  * results there: sums[0 .. SCATTER_MAX - 1] are added, block by block in
  * block order, to the same totals; totals[SCATTER_MAX] becomes the largest
  * sums[SCATTER_MAX] (and what it held before, if larger). */
-#define SCATTER_SUMS 5
-#define SCATTER_MAX 4
 typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 /* Smallest blocks, and the block count aimed at above that: a node on the
  * border of two colours is loaded once per colour, so large meshes get
