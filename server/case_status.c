@@ -238,8 +238,11 @@ int case_persist_status(server_case *c)
     if (atomic_load(&c->deleted))
         return 0;
     char reason[128] = "";
+    json_t *o = case_status_json(c);
+    if (o && c->paused_by_shutdown)
+        json_object_set_new(o, "paused_by_shutdown", json_true());
     pthread_mutex_lock(&c->persist_lock);
-    int rc = case_write_status_json(c, case_status_json(c), reason, sizeof reason);
+    int rc = case_write_status_json(c, o, reason, sizeof reason);
     pthread_mutex_unlock(&c->persist_lock);
     if (rc != 0)
         case_status_write_failed(c, reason);

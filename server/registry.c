@@ -721,12 +721,11 @@ static fdem_model *registry_build_upload(const char *body, size_t size, membudge
     return model;
 }
 
-static void registry_log_submitted(server_case *c, const case_sizing *z, int start)
+static void registry_log_submitted(server_case *c, const case_sizing *z)
 {
-    case_log(c, "submitted%s: %d nodes, %d elements, %d joints, dt = %.3g s, end = %.6g s, "
-             "%.4g steps, %.4g snapshots, about %.3g s to run", start ? " and started" : "",
-             z->nodes, z->elements, z->joints, z->dt, c->info.end_time, z->steps, z->snapshots,
-             z->estimated_seconds);
+    case_log(c, "submitted: %d nodes, %d elements, %d joints, dt = %.3g s, end = %.6g s, "
+             "%.4g steps, %.4g snapshots, about %.3g s to run", z->nodes, z->elements, z->joints,
+             z->dt, c->info.end_time, z->steps, z->snapshots, z->estimated_seconds);
 }
 
 /* registry_create() with the lease that pays for the upload. */
@@ -789,6 +788,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     case_sizing_warning(&sizing, warning, warning_size);
     c->model = NULL;
     fdem_model_destroy(model);
+    registry_log_submitted(c, &sizing); /* before a worker can log its start */
     membudget_lease unreserve = {0};
     pthread_mutex_lock(&reg_lock);
     int appended = registry_append_locked(c) == 0;
@@ -800,9 +800,12 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     }
     if (c->state == CASE_CREATED)
         unreserve = case_take_reserve_locked(c);
+    int queued = c->state == CASE_QUEUED;
     pthread_mutex_unlock(&c->lock);
     pthread_mutex_unlock(&reg_lock);
     membudget_release(&unreserve);
+    if (queued)
+        case_log(c, "queued: --max-running (%d) cases are running", reg_cfg->max_running);
     if (!appended) {
         snprintf(err, errlen, "out of memory");
         goto fail;
@@ -811,7 +814,6 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
      * is acknowledged comes back after a crash). */
     if (start)
         case_persist_status(c);
-    registry_log_submitted(c, &sizing, start);
     *http_status = 201;
     case_retain(c);
     return c;
@@ -926,6 +928,7 @@ void registry_shutdown(void)
         server_case *c = cases[i];
         pthread_mutex_lock(&c->ctl_lock);
         pthread_mutex_lock(&c->lock);
+        c->paused_by_shutdown = c->state == CASE_RUNNING || c->state == CASE_QUEUED;
         if (c->state == CASE_RUNNING)
             case_command_worker_locked(c, WORKER_PAUSE);
         else if (c->state == CASE_QUEUED)

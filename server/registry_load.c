@@ -67,7 +67,9 @@ static void case_load_figures(server_case *c, const json_t *st)
     c->info.end_time = status_number(st, "end_time");
 }
 
-static void case_load_status(server_case *c, const char *path)
+/* The state the case was in when the daemon stopped: a case the shutdown
+ * paused was running (or queued). */
+static case_state case_load_status(server_case *c, const char *path)
 {
     json_error_t jerr;
     json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
@@ -87,7 +89,11 @@ static void case_load_status(server_case *c, const char *path)
     snprintf(c->finished_at, sizeof c->finished_at, "%s", finished_at ? finished_at : "");
     if (st)
         case_load_figures(c, st);
+    case_state was = c->state;
+    if (c->state == CASE_PAUSED && json_is_true(json_object_get(st, "paused_by_shutdown")))
+        was = CASE_RUNNING;
     json_decref(st);
+    return was;
 }
 
 /* A case whose restored time is already at its end (a status.json that
@@ -145,10 +151,10 @@ static int case_check_stored(server_case *c)
 static void case_log_restored(server_case *c, case_state stored)
 {
     if (stored == CASE_RUNNING || stored == CASE_QUEUED)
-        case_log(c, "resumed after a restart: was %s, now %s at its checkpoint, step %lld "
-                 "(t = %.6g of %.6g s, %.3f s stepping so far)", case_state_name(stored),
-                 case_state_name(c->state), (long long)c->fig.step, c->fig.time, c->info.end_time,
-                 c->fig.elapsed);
+        case_log(c, "resumed after a restart: was %s when fdemd stopped, now %s at its "
+                 "checkpoint, step %lld (t = %.6g of %.6g s, %.3f s stepping so far); start it "
+                 "to go on", case_state_name(stored), case_state_name(c->state),
+                 (long long)c->fig.step, c->fig.time, c->info.end_time, c->fig.elapsed);
     else
         case_log(c, "restored after a restart: %s at step %lld (t = %.6g s)",
                  case_state_name(c->state), (long long)c->fig.step, c->fig.time);
@@ -178,10 +184,9 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
         case_release(c);
         return NULL;
     }
-    case_load_status(c, path);
+    case_state stored = case_load_status(c, path);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
-    case_state stored = c->state;
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
     /* A case that could not be loaded keeps its files as they are, so that
