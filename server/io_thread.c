@@ -261,7 +261,7 @@ double io_snapshot_seconds(void)
 static void io_run_job(io_job *j)
 {
     double started = io_now();
-    int writes_snapshot = (j->kind == IO_CREATE || j->kind == IO_APPEND) && j->snap && j->ckpt;
+    int writes_snapshot = j->kind == IO_APPEND && j->snap && j->ckpt;
     switch (j->kind) {
     case IO_CREATE: io_do_create(j); break;
     case IO_REOPEN: io_do_reopen(j); break;

@@ -15,7 +15,7 @@ import time
 import unittest
 from datetime import datetime
 
-from fdemd_harness import ROOT, SLOW, Daemon, tiny_case
+from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
@@ -39,16 +39,8 @@ def boom_case(name="boom"):
     return case
 
 
-class ServiceTest(unittest.TestCase):
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon(args=["--max-running", "2"]).start()
-
-    @classmethod
-    def tearDownClass(cls):
-        code, _ = cls.d.stop()
-        cls.d.close()
-        assert code == 0, "fdemd exited with %s" % code
+class ServiceTest(DaemonTestCase):
+    """One daemon for the class (fdemd_harness); each test leaves no case behind."""
 
     def tearDown(self):
         for st in self.d.json("GET", "/cases")[1]["cases"]:
