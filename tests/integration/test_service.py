@@ -20,7 +20,7 @@ from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
 
-FDEMCTL = os.path.join(ROOT, "bin", "fdemctl")
+FDEMCTL = os.path.join(ROOT, os.environ.get("FDEMCTL_BIN", "bin/fdemctl"))  # abs stays abs
 SIZING_KEYS = {"nodes", "elements", "joints", "dt", "steps", "snapshots", "memory_bytes",
                "result_bytes", "estimated_seconds"}
 STATES = ("created", "queued", "running", "paused", "finished", "stopped", "failed")
@@ -285,6 +285,24 @@ class ServiceTest(DaemonTestCase):
         status, problem = self.d.json("POST", "/cases/%s/start" % case_id)
         self.assertEqual(status, 409)
         self.assertEqual(self.d.json("GET", "/cases?state=finished")[1]["cases"][0]["id"], case_id)
+
+
+class DryRunLimitsTest(unittest.TestCase):
+    """A dry run is refused exactly as the upload would be."""
+
+    def test_over_max_case_memory_is_422_naming_the_size(self):
+        d = Daemon(args=["--max-case-memory", "1M"]).start()
+        try:
+            big = tiny_case("big", divisions=(200, 200))
+            status, problem = d.json("POST", "/cases?dry_run=true", big)
+            self.assertEqual(status, 422, problem)
+            self.assertEqual(problem["errors"][0]["pointer"], "/parts")
+            self.assertIn("limit", problem["errors"][0]["message"])
+            status, z = d.json("POST", "/cases?dry_run=true", tiny_case("small"))
+            self.assertEqual(status, 200)
+            self.assertLess(z["memory_bytes"], 1 << 20)
+        finally:
+            d.close()
 
 
 class ServiceLogTest(unittest.TestCase):
