@@ -239,7 +239,10 @@ int case_persist_status(server_case *c)
         return 0;
     char reason[128] = "";
     json_t *o = case_status_json(c);
-    if (o && c->paused_by_shutdown)
+    pthread_mutex_lock(&c->lock);
+    int paused_by_shutdown = c->paused_by_shutdown;
+    pthread_mutex_unlock(&c->lock);
+    if (o && paused_by_shutdown)
         json_object_set_new(o, "paused_by_shutdown", json_true());
     pthread_mutex_lock(&c->persist_lock);
     int rc = case_write_status_json(c, o, reason, sizeof reason);
@@ -280,8 +283,9 @@ void case_log_state(server_case *c, case_state state)
                  "%.4g steps/s", case_state_name(state), (long long)f.step, f.time,
                  c->info.end_time, f.snapshots, f.elapsed, rate);
         break;
-    default:
-        case_log(c, "%s at step %lld (t = %.6g s)", case_state_name(state), (long long)f.step, f.time);
+    default: /* a queued case whose model found no memory goes back */
+        case_log(c, "back to %s at step %lld (t = %.6g s)", case_state_name(state),
+                 (long long)f.step, f.time);
         break;
     }
 }

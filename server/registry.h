@@ -101,8 +101,8 @@ typedef struct server_case {
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
 
-    int paused_by_shutdown;    /* running or queued when the daemon stopped: status.json says
-                                  so, and the restart logs it as resumed */
+    int paused_by_shutdown;    /* running or queued when the daemon stopped (`lock`):
+                                  status.json says so, and the restart logs it as resumed */
     int load_broken;           /* its stored files could not be loaded at start-up: they are
                                   kept as found (so that, mended, the case comes back) */
 

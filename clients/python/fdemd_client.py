@@ -21,6 +21,7 @@ import os
 import re
 import time
 import urllib.error
+import warnings
 import urllib.parse
 import urllib.request
 
@@ -135,10 +136,16 @@ class Client:
         Raises:
             FdemdError: 422 with one error per problem for an invalid case,
                 400 for malformed JSON.
+        Warns:
+            UserWarning: the server's warning for a case that will run for
+                hours (the case is stored all the same).
         """
         body = _case_body(case)
         path = "/cases?start=true" if start else "/cases"
-        return self._json("POST", path, body)["id"]
+        status = self._json("POST", path, body)
+        if status.get("warning"):
+            warnings.warn("case %s: %s" % (status["id"], status["warning"]), stacklevel=2)
+        return status["id"]
 
     def dry_run(self, case):
         """Checks and sizes a case without storing it (POST /cases?dry_run=true).

@@ -495,6 +495,9 @@ class FetchTest(unittest.TestCase):
         client = fdemd_client.Client(self.url)
         z = client.dry_run(tiny_case("py"))
         self.assertTrue(SIZING_KEYS <= set(z))
+        with self.assertWarnsRegex(UserWarning, r"will run for about"):
+            hours = client.submit(tiny_case("py-hours", end=1e4, interval=1e3))
+        client.delete(hours)
         self.assertEqual([c["id"] for c in client.list(state="finished")], [self.case_id])
         self.assertEqual(client.list(state="running"), [])
         with self.assertRaises(fdemd_client.FdemdError) as caught:
