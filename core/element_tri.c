@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "model.h"
+#include "stable_step.h"
 
 static_assert(sizeof(element_hot) == 64, "the hot element record is one cache line");
 
@@ -85,8 +86,13 @@ static double largest_real_eigenvalue(const double M[3][3])
  * constant-strain triangle the non-zero eigenvalues of K / m are those of
  * (A / m) D B B^T, a 3x3 matrix. The older estimate h_min / c was 6-43 %
  * above this bound (depending on the shape and Poisson's ratio), so a
- * safety of 1 could diverge. Damping of the stiffest mode shrinks the
- * central-difference limit from 2/omega to (2/omega)(sqrt(1 + xi^2) - xi). */
+ * safety of 1 could diverge. The viscous stress 2 eta D is diag(2, 2, 1)
+ * eta on the engineering strain rate, so the largest damping rate is
+ * c_max = (A / m) eta times the largest eigenvalue of diag(2, 2, 1) B B^T;
+ * the limit falls with both (stable_step.h). Taking the damping ratio as
+ * the material's xi instead was up to 2x too large for strongly damped
+ * materials: eta is set from the smallest altitude h, and omega_max is
+ * well above c / h. */
 double tri_element_stable_dt(const fdem_model *m, int e)
 {
     const element_hot *el = &m->elem[e];
@@ -115,8 +121,14 @@ double tri_element_stable_dt(const fdem_model *m, int e)
         for (int k = 0; k < 3; k++)
             M[r][k] = D[r][0] * G[0][k] + D[r][1] * G[1][k] + D[r][2] * G[2][k];
     double omega2 = 3 / mat->def.density * largest_real_eigenvalue(M); /* A / m = 3 / rho */
-    double xi = mat->def.damping;
-    return 2 / sqrt(omega2) * (sqrt(1 + xi * xi) - xi);
+    double rate = 0;
+    if (el->eta > 0) {
+        const double viscous[3] = {2, 2, 1};
+        for (int r = 0; r < 3; r++)
+            for (int k = 0; k < 3; k++) M[r][k] = viscous[r] * G[r][k];
+        rate = 3 / mat->def.density * el->eta * largest_real_eigenvalue(M);
+    }
+    return damped_mode_stable_dt(omega2, rate);
 }
 
 /* ln J for the J of a stressed solid, which is almost always within a few
