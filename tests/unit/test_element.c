@@ -7,6 +7,7 @@
 #include "build_model.h"
 #include "check.h"
 #include "model.h"
+#include "power_iteration.h"
 
 static fdem_model *unit_block(double E, double nu)
 {
@@ -215,22 +216,10 @@ static void element_matrix(fdem_model *m, double *wrt, double K[6][6])
 /* Largest eigenvalue of M^-1 K (lumped M) by power iteration. */
 static double largest_mode(const fdem_model *m, double K[6][6])
 {
-    double v[6] = {1, -0.3, 0.2, 0.7, -0.5, 0.1}, lambda = 0;
-    for (int it = 0; it < 2000; it++) {
-        double w[6], norm = 0;
-        for (int i = 0; i < 6; i++) {
-            w[i] = 0;
-            for (int j = 0; j < 6; j++) w[i] += K[i][j] * v[j];
-            w[i] /= m->mass[i / 2];
-            norm += w[i] * w[i];
-        }
-        norm = sqrt(norm);
-        double vn = 0;
-        for (int i = 0; i < 6; i++) vn += v[i] * v[i];
-        lambda = norm / sqrt(vn);
-        for (int i = 0; i < 6; i++) v[i] = w[i] / norm;
-    }
-    return lambda;
+    const double start[6] = {1, -0.3, 0.2, 0.7, -0.5, 0.1};
+    double mass[6];
+    for (int i = 0; i < 6; i++) mass[i] = m->mass[i / 2];
+    return largest_eigenvalue_over_mass(6, &K[0][0], mass, start, 2000);
 }
 
 /* The stable step is 2 / omega_max of the element with its lumped masses:
