@@ -28,8 +28,13 @@
  * filled chunk whole.
  *
  * A model without constraints still gets /snapshots/constraint_force with
- * shape (S, 0, 2) (axis 1 declared unlimited, since a chunk cannot be wider
- * than a fixed zero extent), so readers can index it uniformly.
+ * shape (S, 0, dimension) (axis 1 declared unlimited, since a chunk cannot
+ * be wider than a fixed zero extent), so readers can index it uniformly.
+ *
+ * Both dimensions share the layout (contract 5.2): node rows and constraint
+ * forces have `dimension` columns, stress rows fdem_stress_components(), and
+ * the elements are /mesh/triangles (E, 3) in 2D or /mesh/tetrahedra (E, 4)
+ * in 3D; the root attribute `dimension` says which.
  *
  * Not thread-safe: one I/O thread owns every result_file (see result.h).
  */
@@ -173,9 +178,8 @@ static int write_scalar_attribute(hid_t obj, const char *name, hid_t file_type,
     return rc;
 }
 
-static int write_root_attributes(hid_t file, const case_info *info, double dt)
+static int write_root_attributes(hid_t file, const case_info *info, int dimension, double dt)
 {
-    int dimension = 2;
     const char *name = info && info->name[0] ? info->name : "";
     if (write_string_attribute(file, "format", RESULT_FORMAT) < 0) return -1;
     if (write_string_attribute(file, "name", name) < 0) return -1;
@@ -224,6 +228,8 @@ static int write_mesh_array(hid_t group, const char *name, hid_t file_type, hid_
 static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t errlen)
 {
     fdem_counts c = fdem_get_counts(model);
+    int dim = fdem_get_dimension(model);
+    const char *elements = dim == 3 ? "tetrahedra" : "triangles";
     hid_t group = H5Gcreate2(file, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (group < 0) {
         result_fail(err, errlen, "cannot create group /mesh");
@@ -235,12 +241,14 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
         const void *data;
         int rows, width;
     } arrays[] = {
-        {"position0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_initial_positions(model), c.nodes, 2},
-        {"triangles", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_triangles(model), c.elements, 3},
+        {"position0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_initial_positions(model), c.nodes,
+         dim},
+        {elements, H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_element_nodes(model), c.elements,
+         fdem_nodes_per_element(model)},
         {"node_mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_node_masses(model), c.nodes, 0},
         {"node_part", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_node_parts(model), c.nodes, 0},
         {"element_part", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_element_parts(model), c.elements, 0},
-        {"joints", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_joints(model), c.joints, 4},
+        {"joints", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_joints(model), c.joints, 2 * dim},
     };
     int rc = 0;
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0] && rc == 0; i++) {
@@ -277,17 +285,19 @@ static hid_t series_mem_type(int kind)
 static void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
+    int dim = fdem_get_dimension(model);
     for (int k = 0; k < SERIES_COUNT; k++) {
         ds[k].id = H5I_INVALID_HID;
         ds[k].rank = 1;
         ds[k].row[0] = ds[k].row[1] = 0;
     }
     struct { int kind, present, rows, width; } shapes[] = {
-        {SERIES_POSITION, (fields & CASE_FIELD_POSITION) != 0, c.nodes, 2},
-        {SERIES_VELOCITY, (fields & CASE_FIELD_VELOCITY) != 0, c.nodes, 2},
-        {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements, 3},
+        {SERIES_POSITION, (fields & CASE_FIELD_POSITION) != 0, c.nodes, dim},
+        {SERIES_VELOCITY, (fields & CASE_FIELD_VELOCITY) != 0, c.nodes, dim},
+        {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements,
+         fdem_stress_components(model)},
         {SERIES_DAMAGE, c.joints > 0, c.joints, 0},
-        {SERIES_CONSTRAINT_FORCE, 1, c.constraints, 2},
+        {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
         series *s = &ds[shapes[i].kind];
@@ -372,7 +382,7 @@ static int series_write_row(const series *s, int kind, hsize_t length, const voi
 {
     hsize_t dims[3] = {length, s->row[0], s->row[1]};
     if (H5Dset_extent(s->id, dims) < 0) return -1;
-    if (series_row_elements(s) == 0) return 0; /* (S, 0, 2): nothing to write */
+    if (series_row_elements(s) == 0) return 0; /* (S, 0, dim): nothing to write */
     hsize_t start[3] = {length - 1, 0, 0};
     hsize_t count[3] = {1, s->row[0], s->row[1]};
     hid_t file_space = H5Dget_space(s->id);
@@ -490,7 +500,7 @@ result_file *result_create(const char *path, const fdem_model *model,
         result_fail(err, errlen, "cannot create result file %s", path);
         goto fail;
     }
-    if (write_root_attributes(f->file, info, fdem_get_dt(model)) < 0) {
+    if (write_root_attributes(f->file, info, fdem_get_dimension(model), fdem_get_dt(model)) < 0) {
         result_fail(err, errlen, "cannot write the root attributes of %s", path);
         goto fail;
     }
