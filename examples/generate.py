@@ -158,3 +158,14 @@ dump("gmsh-plate", {
                     {"box": [0.199999, -1e-6, 0.200001, 0.100001], "velocity": [0.01, None]}],
     "time": {"end": 0.003, "dt": "auto", "safety": 0.5},
     "output": {"interval": 5e-5, "fields": ["position", "velocity", "stress"]}})
+# ------------------------------------------------------------------- 3D
+# Contract 5.2: "dimension": 3, every vector with three components, z up.
+dump("freefall-3d", {
+    "name": "freefall-3d",
+    "dimension": 3,
+    "materials": {"rock": dict(soft)},
+    "parts": [{"name": "block", "material": "rock",
+               "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [4, 4, 4]}}],
+    "gravity": [0, 0, -9.81],
+    "time": {"end": 0.5, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity"]}})

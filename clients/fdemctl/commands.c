@@ -220,7 +220,8 @@ static void status_print_energy(json_t *status)
 {
     json_t *energy = json_object_get(status, "energy");
     if (!json_is_object(energy)) return;
-    printf("%-14s", energy_label(status));
+    const char *label = energy_label(status);
+    printf("%-14s%s", label, strlen(label) < 14 ? "" : " ");
     const char *key;
     json_t *value;
     int first = 1;

@@ -190,6 +190,53 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertIn("out of range", r.stderr)
 
 
+class DaemonResultTests(Plot3DTestCase):
+    """A box the real daemon stepped: its mesh (mirrored Kuhn cells, not the
+    layout above) has the same analytic boundary, and the plot draws it."""
+
+    DIVISIONS = (3, 2, 2)
+
+    @classmethod
+    def setUpClass(cls):
+        cls.daemon = fdemd_harness.Daemon().start()
+        cls.client = Client("http://127.0.0.1:%d" % cls.daemon.port)
+        cls.results = tempfile.TemporaryDirectory(prefix="plot3d-daemon-")
+        case = {"name": "box-3d", "dimension": 3,
+                "materials": {"rock": {"density": 2000, "young": 1e8, "poisson": 0.25}},
+                "parts": [{"name": "block", "material": "rock",
+                           "box": {"origin": [0, 0, 0], "size": [0.3, 0.2, 0.2],
+                                   "divisions": list(cls.DIVISIONS)},
+                           "velocity": [0, 0, 1.0]}],
+                "constraints": [{"box": [-1e-6, -1, -1, 1e-6, 1, 1], "fix": ["x", "y", "z"]}],
+                "time": {"end": 0.002},
+                "output": {"interval": 0.001, "fields": ["position", "velocity", "stress"]}}
+        try:
+            case_id = cls.client.submit(case, start=True)
+        except FdemdError as e:
+            cls.tearDownClass()
+            raise AssertionError("the daemon refused a 3D box: %s %s" % (e, e.errors))
+        cls.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
+        cls.h5, _ = cls.client.fetch(case_id, os.path.join(cls.results.name, "box3d.h5"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.stop()
+        cls.daemon.close()
+        cls.results.cleanup()
+
+    def test_boundary_faces_of_the_daemons_box(self):
+        with h5py.File(self.h5, "r") as f:
+            nodes, tets = f["/mesh/position0"][:], f["/mesh/tetrahedra"][:]
+        self.assertEqual(tets.shape, (6 * 3 * 2 * 2, 4))
+        self.assert_surface_of_box(nodes, tets, self.DIVISIONS)
+
+    def test_stress_plot_of_the_bent_box(self):
+        self.assert_drawn(*self.plot(self.h5))
+
+    def test_velocity_plot(self):
+        self.assert_drawn(*self.plot(self.h5, "--field", "velocity"))
+
+
 class VonMises3DTests(unittest.TestCase):
     """The exact 3D von Mises formula on states with a known answer."""
 
