@@ -22,6 +22,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
 import h5py  # noqa: E402
+import numpy as np  # noqa: E402
 from fdemd_client import Client, FdemdConnectionError, FdemdError  # noqa: E402
 
 import fdemd_harness  # noqa: E402  (starts bin/fdemd on port 0, temp data dir)
@@ -478,6 +479,24 @@ class ExampleTests(ClientTestCase):
 
     def test_freefall_3d_drops_half_g_t_squared_along_z(self):
         self.assert_example_drops_half_g_t_squared("freefall-3d", vertical=2)
+
+    def test_collision_3d_keeps_momentum(self):
+        case_id = self.client.submit(os.path.join(self.EXAMPLES, "collision-3d.json"), start=True)
+        final = self.client.wait(case_id, interval=0.05, timeout=120 * SLOW)
+        self.assertEqual(final["state"], "finished")
+        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "collision-3d.h5"))
+        with h5py.File(h5, "r") as f:
+            mass = f["/mesh/node_mass"][:]
+            part = f["/mesh/node_part"][:]
+            v = f["/snapshots/velocity"][:]
+        momentum = np.einsum("n,snk->sk", mass, v)
+        # 2 kg at 2 m/s along x; contact forces are equal and opposite.
+        self.assertTrue(np.allclose(momentum, [4.0, 0, 0], rtol=0, atol=1e-12), momentum)
+        left = (mass[part == 0] * v[-1, part == 0, 0]).sum() / mass[part == 0].sum()
+        right = (mass[part == 1] * v[-1, part == 1, 0]).sum() / mass[part == 1].sum()
+        # The cubes did meet: most of the momentum changed hands.
+        self.assertLess(left, 0.5)
+        self.assertGreater(right, 1.5)
 
 
 def box_case_3d(name, divisions=(2, 2, 2), end=0.01):
