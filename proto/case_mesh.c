@@ -57,29 +57,42 @@ static mesh_arrays mesh_arrays_of(case_part *part, const mesh_kind *kind)
 
 /* ------------------------------------------------------- explicit mesh */
 
+/* Room for the `width` numbers of each item of the list at `ptr`, which
+ * must hold at least `min` items (`need` says so: "4 nodes"); NULL after a
+ * problem. The engine counts in int, so width * count must fit one. */
+static void *mesh_list_alloc(case_doc *doc, const json_t *list, const char *ptr, size_t min,
+                             const char *need, int width, size_t item_size, int *count)
+{
+    if (!case_expect_array(doc, list, ptr)) return NULL;
+    size_t n = json_array_size(list);
+    if (n < min || n > (size_t)(INT_MAX / width)) {
+        case_problem(doc, ptr, "a mesh needs at least %s, got %zu", need, n);
+        return NULL;
+    }
+    void *items = malloc((size_t)width * n * item_size);
+    if (!items) {
+        case_problem(doc, ptr, "out of memory");
+        return NULL;
+    }
+    *count = (int)n;
+    return items;
+}
+
 /* Nodes [[x, y(, z)], ...]; each bad node is reported. */
 static int mesh_read_nodes(case_doc *doc, const mesh_kind *kind, mesh_arrays a,
                            const json_t *nodes, const char *ptr)
 {
-    if (!case_expect_array(doc, nodes, ptr)) return 0;
-    size_t count = json_array_size(nodes);
     int dim = kind->dimension;
-    if (count < (size_t)dim + 1 || count > (size_t)(INT_MAX / dim)) {
-        case_problem(doc, ptr, "a mesh needs at least %d nodes, got %zu", dim + 1, count);
-        return 0;
-    }
-    *a.nodes = malloc((size_t)dim * count * sizeof **a.nodes);
-    if (!*a.nodes) {
-        case_problem(doc, ptr, "out of memory");
-        return 0;
-    }
-    *a.node_count = (int)count;
-    int ok = 1;
-    for (size_t i = 0; i < count; i++) {
+    char need[32];
+    snprintf(need, sizeof need, "%d nodes", dim + 1);
+    *a.nodes = mesh_list_alloc(doc, nodes, ptr, (size_t)dim + 1, need, dim, sizeof **a.nodes,
+                               a.node_count);
+    int ok = *a.nodes != NULL;
+    for (int i = 0; *a.nodes && i < *a.node_count; i++) {
         char at[CASE_POINTER];
-        pointer_join_index(at, sizeof at, ptr, (long)i);
-        ok &= case_read_vector(doc, json_array_get(nodes, i), at, dim,
-                               &(*a.nodes)[(size_t)dim * i]);
+        pointer_join_index(at, sizeof at, ptr, i);
+        ok &= case_read_vector(doc, json_array_get(nodes, (size_t)i), at, dim,
+                               &(*a.nodes)[(size_t)dim * (size_t)i]);
     }
     return ok;
 }
@@ -114,24 +127,16 @@ static int mesh_read_cell(case_doc *doc, const mesh_kind *kind, const json_t *ce
 static int mesh_read_cells(case_doc *doc, const mesh_kind *kind, mesh_arrays a,
                            const json_t *cells, const char *ptr)
 {
-    if (!case_expect_array(doc, cells, ptr)) return 0;
-    size_t count = json_array_size(cells);
-    if (count < 1 || count > (size_t)(INT_MAX / kind->corners)) {
-        case_problem(doc, ptr, "a mesh needs at least one %s", kind->cell_word);
-        return 0;
-    }
-    *a.cells = malloc((size_t)kind->corners * count * sizeof **a.cells);
-    if (!*a.cells) {
-        case_problem(doc, ptr, "out of memory");
-        return 0;
-    }
-    *a.cell_count = (int)count;
-    int ok = 1;
-    for (size_t t = 0; t < count; t++) {
+    char need[32];
+    snprintf(need, sizeof need, "one %s", kind->cell_word);
+    *a.cells = mesh_list_alloc(doc, cells, ptr, 1, need, kind->corners, sizeof **a.cells,
+                               a.cell_count);
+    int ok = *a.cells != NULL;
+    for (int t = 0; *a.cells && t < *a.cell_count; t++) {
         char at[CASE_POINTER];
-        pointer_join_index(at, sizeof at, ptr, (long)t);
-        ok &= mesh_read_cell(doc, kind, json_array_get(cells, t), at, *a.node_count,
-                             &(*a.cells)[(size_t)kind->corners * t]);
+        pointer_join_index(at, sizeof at, ptr, t);
+        ok &= mesh_read_cell(doc, kind, json_array_get(cells, (size_t)t), at, *a.node_count,
+                             &(*a.cells)[(size_t)kind->corners * (size_t)t]);
     }
     return ok;
 }

@@ -80,15 +80,22 @@ const char *case_count_word(int count)
     return count >= 0 && count <= 6 ? words[count] : "several";
 }
 
+/* 1 when `value` is an array of exactly `count` items, else a problem
+ * "expected an array of three numbers [layout], got ...". */
+static int case_expect_tuple(case_doc *doc, const json_t *value, const char *ptr, int count,
+                             const char *items, const char *layout)
+{
+    if (json_is_array(value) && json_array_size(value) == (size_t)count) return 1;
+    case_problem(doc, ptr, "expected an array of %s %s%s%s, got %s%s", case_count_word(count),
+                 items, layout[0] ? " " : "", layout, case_type_word(value),
+                 json_is_array(value) ? " of another length" : "");
+    return 0;
+}
+
 int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
                      double *out)
 {
-    if (!json_is_array(value) || json_array_size(value) != (size_t)count) {
-        case_problem(doc, ptr, "expected an array of %s numbers, got %s%s",
-                     case_count_word(count), case_type_word(value),
-                     json_is_array(value) ? " of another length" : "");
-        return 0;
-    }
+    if (!case_expect_tuple(doc, value, ptr, count, "numbers", "")) return 0;
     int ok = 1;
     for (int k = 0; k < count; k++) {
         char item[CASE_POINTER];
@@ -125,12 +132,7 @@ int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long 
 int case_read_integers(case_doc *doc, const json_t *value, const char *ptr, int count,
                        const long *lo, long hi, const char *layout, long *out)
 {
-    if (!json_is_array(value) || json_array_size(value) != (size_t)count) {
-        case_problem(doc, ptr, "expected an array of %s whole numbers %s, got %s%s",
-                     case_count_word(count), layout, case_type_word(value),
-                     json_is_array(value) ? " of another length" : "");
-        return 0;
-    }
+    if (!case_expect_tuple(doc, value, ptr, count, "whole numbers", layout)) return 0;
     int ok = 1;
     for (int k = 0; k < count; k++) {
         char item[CASE_POINTER];

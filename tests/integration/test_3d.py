@@ -9,6 +9,7 @@ the pointer; two boxes colliding once contact between tetrahedral parts is
 in the engine."""
 import os
 import shutil
+import signal
 import subprocess
 import unittest
 import xml.etree.ElementTree as ET
@@ -16,7 +17,7 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, DaemonTestCase
+from fdemd_harness import ROOT, Daemon, DaemonTestCase
 
 G = 9.81
 RHO = 2700.0
@@ -249,6 +250,36 @@ class Solid3DTest(DaemonTestCase):
             status, body = self.d.json("POST", "/cases", case)
             self.assertEqual(status, 422, (pointer, body))
             self.assertIn(pointer, [e["pointer"] for e in body["errors"]], body)
+
+
+class Restart3DTest(unittest.TestCase):
+    """A paused 3D case comes back after a restart (the case document is
+    rebuilt and its checkpoint restored): same step, the same state to the
+    bit, and it runs on to the end in free fall."""
+
+    def test_paused_3d_case_survives_a_restart(self):
+        d = Daemon().start()
+        try:
+            st = d.create(solid_case("restart", SPHERE, end=0.01), start=True)
+            d.wait(st["id"], lambda s: s["step"] > 50, what="steps")
+            paused = d.json("POST", "/cases/%s/pause" % st["id"])[1]
+            fields = "/cases/%s/state?fields=position,velocity,stress" % st["id"]
+            before = d.json("GET", fields)[1]
+            code, _ = d.stop(signal.SIGTERM)
+            self.assertEqual(code, 0, d.log_tail())
+            d.start()
+            again = d.status(st["id"])
+            self.assertEqual((again["state"], again["step"]), ("paused", paused["step"]))
+            self.assertEqual(d.json("GET", fields)[1], before)
+            self.assertEqual(d.json("POST", "/cases/%s/start" % st["id"])[0], 200)
+            done = d.wait_state(st["id"], ("finished", "failed"), timeout=60)
+            self.assertEqual(done["state"], "finished", done.get("error"))
+            z = np.array(d.json("GET", "/cases/%s/state" % st["id"])[1]["position"])[:, 2]
+            # the sphere's nodes are symmetric about its centre: mean z is the centroid
+            self.assertAlmostEqual((1.0 - z.mean()) / (0.5 * G * done["time"] ** 2), 1.0,
+                                   delta=0.01)
+        finally:
+            d.close()
 
 
 class TwoBoxes3DTest(DaemonTestCase):

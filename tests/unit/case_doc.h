@@ -14,6 +14,7 @@
 
 #include "case.h"
 #include "check.h"
+#include "read_file.h"
 
 #define GiB ((size_t)1 << 30)
 
@@ -83,22 +84,29 @@ static inline void dump_problems(const problems *p)
         fprintf(stderr, "    problem %s: %s\n", p->items[i].pointer, p->items[i].message);
 }
 
-/* Builds `doc`, expecting no model, `status`, and a problem at `pointer`
- * whose message contains `needle`. */
+/* The outcome of a refused build: no model, `status`, and a problem at
+ * `pointer` whose message contains `needle`. Frees the model and problems. */
+static inline void expect_refused(fdem_model *m, problems *p, int status, const char *pointer,
+                                  const char *needle)
+{
+    CHECK(m == NULL, "a model was built; expected a problem at %s", pointer);
+    CHECK(p->status == status, "status %d, want %d", p->status, status);
+    int found = has_problem(p, pointer, needle);
+    CHECK(found, "no problem at \"%s\" containing \"%s\"", pointer, needle);
+    if (!found) dump_problems(p);
+    if (m) fdem_model_destroy(m);
+    problems_free(p);
+}
+
+/* Builds `doc` (and frees it), expecting it refused as expect_refused says. */
 static inline void expect_doc(json_t *doc, size_t limit, int status, const char *pointer,
-                       const char *needle)
+                              const char *needle)
 {
     problems p;
     case_info info;
     fdem_model *m = build_json(doc, limit, &info, &p);
-    CHECK(m == NULL, "a model was built; expected a problem at %s", pointer);
-    CHECK(p.status == status, "status %d, want %d", p.status, status);
-    int found = has_problem(&p, pointer, needle);
-    CHECK(found, "no problem at \"%s\" containing \"%s\"", pointer, needle);
-    if (!found) dump_problems(&p);
-    if (m) fdem_model_destroy(m);
-    problems_free(&p);
     json_decref(doc);
+    expect_refused(m, &p, status, pointer, needle);
 }
 
 /* `base` (single-quoted JSON) with `value` (single-quoted, or NULL to
@@ -126,23 +134,6 @@ static inline size_t smallest_accepted_limit(const json_t *doc)
         problems_free(&p);
     }
     return hi;
-}
-
-/* A whole text file, NUL-terminated (free it); NULL and a failed check when
- * it is missing (the tests run from the repository root). */
-static inline char *read_text_file(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    CHECK(f != NULL, "cannot open %s (run from the repository root)", path);
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)n + 1);
-    size_t got = text ? fread(text, 1, (size_t)n, f) : 0;
-    fclose(f);
-    if (text) text[got] = '\0';
-    return text;
 }
 
 #endif

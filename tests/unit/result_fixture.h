@@ -25,6 +25,26 @@ static int fixture_add_block(fdem_model *m, double ox, double oy, double w, doub
     return part;
 }
 
+/* Sets dt = 0.5 x stable and fills `info` (when not NULL) as case_build
+ * would: 1000 steps, a snapshot every 5, position, velocity and stress. */
+static void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
+                         int constraints, int fracture)
+{
+    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    snprintf(info->name, sizeof info->name, "%s", name);
+    info->dt = fdem_get_dt(m);
+    info->stable_dt = fdem_stable_dt(m);
+    info->end_time = 1000 * info->dt;
+    info->safety = 0.5;
+    info->output_interval = 5 * info->dt;
+    info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS;
+    info->part_count = parts;
+    info->constraint_count = constraints;
+    info->fracture = fracture;
+}
+
 /* Returns a finalized model with dt = 0.5 x stable, or NULL (printing why).
  * `fracturing` adds the breakable slab, `constraints` the two constraints. */
 static fdem_model *fixture_model(int fracturing, int constraints, case_info *info)
@@ -56,21 +76,9 @@ static fdem_model *fixture_model(int fracturing, int constraints, case_info *inf
         fdem_model_destroy(m);
         return NULL;
     }
-    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
-    if (info) {
-        memset(info, 0, sizeof *info);
-        snprintf(info->name, sizeof info->name, "fixture \"block\" & <slab>");
-        info->dt = fdem_get_dt(m);
-        info->stable_dt = fdem_stable_dt(m);
-        info->end_time = 1000 * info->dt;
-        info->safety = 0.5;
-        info->output_interval = 5 * info->dt;
-        info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS |
-                       CASE_FIELD_DAMAGE;
-        info->part_count = fracturing ? 2 : 1;
-        info->constraint_count = constraints ? 2 : 0;
-        info->fracture = fracturing;
-    }
+    fixture_info(m, info, "fixture \"block\" & <slab>", fracturing ? 2 : 1,
+                 constraints ? 2 : 0, fracturing);
+    if (info) info->fields |= CASE_FIELD_DAMAGE;
     return m;
 }
 
@@ -108,19 +116,7 @@ static fdem_model *fixture_model_3d(int constraints, case_info *info)
         fdem_model_destroy(m);
         return NULL;
     }
-    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
-    if (info) {
-        memset(info, 0, sizeof *info);
-        snprintf(info->name, sizeof info->name, "fixture box");
-        info->dt = fdem_get_dt(m);
-        info->stable_dt = fdem_stable_dt(m);
-        info->end_time = 1000 * info->dt;
-        info->safety = 0.5;
-        info->output_interval = 5 * info->dt;
-        info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS;
-        info->part_count = 1;
-        info->constraint_count = constraints ? 2 : 0;
-    }
+    fixture_info(m, info, "fixture box", 1, constraints ? 2 : 0, 0);
     return m;
 }
 

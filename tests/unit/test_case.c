@@ -57,13 +57,7 @@ static void expect_text(const char *text, size_t length, int status, const char 
     problems p;
     problems_init(&p);
     fdem_model *m = case_build(text, length, GiB, NULL, &p);
-    CHECK(m == NULL, "a model was built from malformed text");
-    CHECK(p.status == status, "status %d, want %d", p.status, status);
-    int found = has_problem(&p, pointer, needle);
-    CHECK(found, "no problem at \"%s\" containing \"%s\"", pointer, needle);
-    if (!found) dump_problems(&p);
-    if (m) fdem_model_destroy(m);
-    problems_free(&p);
+    expect_refused(m, &p, status, pointer, needle);
 }
 
 /* --------------------------------------------------------- valid cases */

@@ -56,6 +56,23 @@ static json_t *with_shape(const char *key, json_t *shape)
     return doc;
 }
 
+/* One bad edit of a shape: `value` (NULL deletes) at `at` inside it. */
+typedef struct shape_edit {
+    const char *at, *value, *pointer, *needle;
+} shape_edit;
+
+/* Each edit of `shape` (single-quoted) as part 0's `key` must be a 422 at
+ * its pointer mentioning its needle. */
+static void expect_shape_edits(const char *key, const char *shape, const shape_edit *edits,
+                               size_t count)
+{
+    for (size_t i = 0; i < count; i++) {
+        json_t *value = load(shape);
+        edit(value, edits[i].at, edits[i].value ? load(edits[i].value) : NULL);
+        expect_doc(with_shape(key, value), GiB, 422, edits[i].pointer, edits[i].needle);
+    }
+}
+
 static fdem_model *build_ok(json_t *doc, case_info *info)
 {
     problems p;
@@ -220,10 +237,11 @@ static void gmsh_tetrahedra_build(void)
 {
     const char *files[2] = {"tests/data/cube_v22.msh", "tests/data/cube_v41.msh"};
     for (int f = 0; f < 2; f++) {
-        char *text = read_text_file(files[f]);
+        size_t length = 0;
+        char *text = read_file(files[f], &length);
         if (!text) continue;
         case_info info;
-        fdem_model *m = build_ok(with_shape("gmsh", json_string(text)), &info);
+        fdem_model *m = build_ok(with_shape("gmsh", json_stringn(text, length)), &info);
         free(text);
         if (!m) continue;
         fdem_counts c = fdem_get_counts(m);
@@ -339,16 +357,16 @@ static void box_errors(void)
 
 static void sphere_and_cylinder_errors(void)
 {
-    json_t *doc = with_shape("sphere", load("{'radius': 1, 'divisions': 7}"));
-    expect_doc(doc, GiB, 422, "/parts/0/sphere/divisions", "at least 8");
-    doc = with_shape("sphere", load("{'radius': -1, 'divisions': 8}"));
-    expect_doc(doc, GiB, 422, "/parts/0/sphere/radius", "> 0");
-    doc = with_shape("sphere", load("{'center': [0, 0], 'radius': 1, 'divisions': 8}"));
-    expect_doc(doc, GiB, 422, "/parts/0/sphere/center", "three numbers");
-    doc = with_shape("sphere", load("{'radius': 1}"));
-    expect_doc(doc, GiB, 422, "/parts/0/sphere", "great circle");
+    static const shape_edit bad_sphere[] = {
+        {"/divisions", "7", "/parts/0/sphere/divisions", "at least 8"},
+        {"/radius", "-1", "/parts/0/sphere/radius", "> 0"},
+        {"/center", "[0, 0]", "/parts/0/sphere/center", "three numbers"},
+        {"/divisions", NULL, "/parts/0/sphere", "great circle"},
+    };
+    expect_shape_edits("sphere", "{'radius': 1, 'divisions': 8}", bad_sphere,
+                       sizeof bad_sphere / sizeof bad_sphere[0]);
     const char *cylinder = "{'axis': 'z', 'radius': 1, 'length': 2, 'divisions': [8, 2]}";
-    struct { const char *at, *value, *pointer, *needle; } bad[] = {
+    static const shape_edit bad[] = {
         {"/axis", "'w'", "/parts/0/cylinder/axis", "\"x\", \"y\" or \"z\", got \"w\""},
         {"/axis", "2", "/parts/0/cylinder/axis", "got a number"},
         {"/axis", NULL, "/parts/0/cylinder", "missing required \"axis\""},
@@ -359,16 +377,12 @@ static void sphere_and_cylinder_errors(void)
         {"/divisions", "8", "/parts/0/cylinder/divisions", "[around the rim, along the axis]"},
         {"/center", "[0, 0, 0, 0]", "/parts/0/cylinder/center", "three numbers"},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        json_t *shape = load(cylinder);
-        edit(shape, bad[i].at, bad[i].value ? load(bad[i].value) : NULL);
-        expect_doc(with_shape("cylinder", shape), GiB, 422, bad[i].pointer, bad[i].needle);
-    }
+    expect_shape_edits("cylinder", cylinder, bad, sizeof bad / sizeof bad[0]);
 }
 
 static void explicit_mesh_errors(void)
 {
-    struct { const char *at, *value, *pointer, *needle; } bad[] = {
+    static const shape_edit bad[] = {
         {"/tetrahedra/1", "[1, 2, 3, 9]", "/parts/0/mesh/tetrahedra/1",
          "node index 9 is out of range"},
         {"/tetrahedra/1", "[1, 2, 3, -1]", "/parts/0/mesh/tetrahedra/1/3", "at least 0"},
@@ -384,19 +398,16 @@ static void explicit_mesh_errors(void)
         {"/tetrahedra", NULL, "/parts/0/mesh", "missing required \"tetrahedra\""},
         {"/triangles", "[[0, 1, 2]]", "/parts/0/mesh/triangles", "unknown key \"triangles\""},
     };
-    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
-        json_t *mesh = load(two_tets);
-        edit(mesh, bad[i].at, bad[i].value ? load(bad[i].value) : NULL);
-        expect_doc(with_shape("mesh", mesh), GiB, 422, bad[i].pointer, bad[i].needle);
-    }
+    expect_shape_edits("mesh", two_tets, bad, sizeof bad / sizeof bad[0]);
 }
 
 static void gmsh_errors(void)
 {
     /* a 2D file has no tetrahedra */
-    char *square = read_text_file("tests/data/square_v41.msh");
+    size_t length = 0;
+    char *square = read_file("tests/data/square_v41.msh", &length);
     if (square) {
-        expect_doc(with_shape("gmsh", json_string(square)), GiB, 422, "/parts/0/gmsh",
+        expect_doc(with_shape("gmsh", json_stringn(square, length)), GiB, 422, "/parts/0/gmsh",
                    "no 4-node tetrahedra");
         free(square);
     }

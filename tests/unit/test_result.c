@@ -191,6 +191,19 @@ static void run_end(run *r)
     fdem_model_destroy(r->model);
 }
 
+/* Writes r's sidecar as `xdmf_name` and has result_check.py compare it
+ * with `h5_name` and the expected `json_name`; `what` labels a failure. */
+static void run_check_xdmf(run *r, const char *xdmf_name, const char *h5_name,
+                           const char *json_name, const char *what)
+{
+    char xdmf[512], extra[600];
+    tmp_path(xdmf, sizeof xdmf, xdmf_name);
+    CHECK(xdmf_write(xdmf, "result.h5", r->model, &r->info, r->file, r->err, sizeof r->err) == 0,
+          "xdmf_write: %s", r->err);
+    snprintf(extra, sizeof extra, "'%s'", xdmf);
+    CHECK(run_checker(h5_name, json_name, "xdmf", extra) == 0, "%s", what);
+}
+
 /* ----------------------------------------------------------------- tests */
 
 static void test_result_layout_and_swmr_reads(void)
@@ -550,24 +563,14 @@ static void test_xdmf_matches_file(void)
     if (run_start(&r, 1, 1, 0, "result.h5") == 0) {
         for (int i = 0; i < 3; i++) run_append(&r);
         expect_save(r.expect, "result.json");
-        char xdmf[512], extra[600];
-        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
-        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
-              "xdmf_write: %s", r.err);
-        snprintf(extra, sizeof extra, "'%s'", xdmf);
-        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf with stress");
+        run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf with stress");
     }
     run_end(&r);
     /* Without position the geometry is the initial mesh. */
     if (run_start(&r, 0, 0, CASE_FIELD_VELOCITY, "result.h5") == 0) {
         for (int i = 0; i < 2; i++) run_append(&r);
         expect_save(r.expect, "result.json");
-        char xdmf[512], extra[600];
-        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
-        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
-              "xdmf_write: %s", r.err);
-        snprintf(extra, sizeof extra, "'%s'", xdmf);
-        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf, position0");
+        run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf, position0");
     }
     run_end(&r);
 }
@@ -584,12 +587,7 @@ static void test_result_3d_layout_and_xdmf(void)
         for (int i = 0; i < 3; i++) run_append(&r);
         expect_save(r.expect, "solid.json");
         CHECK(run_checker("solid.h5", "solid.json", "swmr", NULL) == 0, "3D layout, swmr");
-        char xdmf[512], extra[600];
-        tmp_path(xdmf, sizeof xdmf, "solid.xdmf");
-        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
-              "xdmf_write: %s", r.err);
-        snprintf(extra, sizeof extra, "'%s'", xdmf);
-        CHECK(run_checker("solid.h5", "solid.json", "xdmf", extra) == 0, "3D xdmf");
+        run_check_xdmf(&r, "solid.xdmf", "solid.h5", "solid.json", "3D xdmf");
         CHECK(result_close(r.file) == 0, "result_close");
         r.file = NULL;
         CHECK(run_checker("solid.h5", "solid.json", "plain", NULL) == 0, "3D, closed file");
