@@ -30,6 +30,14 @@ static fdem_material_def solid(double density, double young, double damping, dou
     return d;
 }
 
+static int add_material(fdem_model *m, fdem_material_def def)
+{
+    fdem_error err = {0};
+    int index = fdem_add_material(m, &def, &err);
+    CHECK(index >= 0, "%s", err.message);
+    return index;
+}
+
 /* A 3D model to add parts to. */
 static fdem_model *model_3d(void)
 {
@@ -149,9 +157,8 @@ static void momentum(const fdem_model *m, double p[3], double *scale)
 static void boxes_collide(const double v[3], const double offset[2], double mu, const char *name)
 {
     fdem_model *m = model_3d();
-    fdem_material_def rock = solid(2700, 1e9, 0, mu, 0);
     fdem_error err = {0};
-    int mat = fdem_add_material(m, &rock, &err);
+    int mat = add_material(m, solid(2700, 1e9, 0, mu, 0));
     const double size[3] = {0.1, 0.1, 0.1}, o1[3] = {0, 0, 0};
     const double o2[3] = {0.1002, offset[0], offset[1]};
     const int div[3] = {3, 3, 3};
@@ -211,11 +218,8 @@ static double slab_slide(double theta_deg, double mu, double t_settled, double t
 {
     double th = theta_deg * M_PI / 180, g = 9.81;
     fdem_model *m = model_3d();
-    fdem_material_def slab_def = solid(1000, 1e7, 0, mu, 1e7);
-    fdem_material_def box_def = solid(1000, 1e7, 0.2, mu, 1e7);
-    fdem_error err = {0};
-    int slab_mat = fdem_add_material(m, &slab_def, &err);
-    int box_mat = fdem_add_material(m, &box_def, &err);
+    int slab_mat = add_material(m, solid(1000, 1e7, 0, mu, 1e7));
+    int box_mat = add_material(m, solid(1000, 1e7, 0.2, mu, 1e7));
     const double slab_origin[3] = {0, -0.15, -0.1}, slab_dims[3] = {0.4, 0.3, 0.1};
     const int slab_div[3] = {4, 3, 1};
     const double box_origin[3] = {0.05, -0.1, 0}, box_dims[3] = {0.2, 0.2, 0.1};
@@ -355,11 +359,8 @@ static double sphere_inscribed_radius(double R)
 static void sphere_pile_settles_without_interpenetration(void)
 {
     fdem_model *m = model_3d();
-    fdem_material_def wall_def = solid(1000, 3e5, 0.1, 0.3, 1e6);
-    fdem_material_def ball_def = solid(1000, 3e5, 0.3, 0.3, 1e6);
-    fdem_error err = {0};
-    int wall = fdem_add_material(m, &wall_def, &err);
-    int ball = fdem_add_material(m, &ball_def, &err);
+    int wall = add_material(m, solid(1000, 3e5, 0.1, 0.3, 1e6));
+    int ball = add_material(m, solid(1000, 3e5, 0.3, 0.3, 1e6));
     enum { SPHERES = 8 };
     const double R = 0.05, pitch = 2 * R + 0.002, X = 3 * pitch, Y = 2 * pitch;
     add_container(m, wall, X, Y, 0.25, 0.04);
@@ -424,17 +425,14 @@ static void sphere_pile_settles_without_interpenetration(void)
 static fdem_model *sliding_box(int threads)
 {
     fdem_model *m = model_3d();
-    fdem_material_def slab_def = solid(1000, 1e7, 0.1, 0.4, 0);
-    fdem_material_def box_def = solid(1000, 1e7, 0.1, 0.4, 0);
     fdem_error err = {0};
-    int slab_mat = fdem_add_material(m, &slab_def, &err);
-    int box_mat = fdem_add_material(m, &box_def, &err);
+    int mat = add_material(m, solid(1000, 1e7, 0.1, 0.4, 0));
     const double slab_origin[3] = {0, 0, -0.05}, slab_dims[3] = {0.4, 0.3, 0.05};
     const int slab_div[3] = {8, 6, 1};
     const double box_origin[3] = {0.05, 0.05, 0.0}, box_dims[3] = {0.2, 0.2, 0.1};
     const int box_div[3] = {4, 4, 2};
-    fix_part(m, add_box(m, slab_mat, slab_origin, slab_dims, slab_div, NULL, NULL));
-    int box = add_box(m, box_mat, box_origin, box_dims, box_div, NULL, NULL);
+    fix_part(m, add_box(m, mat, slab_origin, slab_dims, slab_div, NULL, NULL));
+    int box = add_box(m, mat, box_origin, box_dims, box_div, NULL, NULL);
     const double v[3] = {0.5, 0.2, -0.05}, g[3] = {2, 0, -9.81};
     CHECK(fdem_set_part_velocity_v(m, box, v, &err) == 0, "%s", err.message);
     fdem_set_gravity_v(m, g);
