@@ -203,7 +203,8 @@ class Client:
         Returns:
             {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
             per node, stress [[sxx, syy, sxy], ...] per element, damage per
-            joint.
+            joint; in 3D [[x, y, z], ...] and [[sxx, syy, szz, syz, sxz,
+            sxy], ...] (contract 5.2).
         """
         suffix = "/state"
         if fields:
