@@ -397,9 +397,14 @@ double contact_stable_dt(const fdem_model *m)
     return dt;
 }
 
+/* The threaded runs' touch lists and the stick springs (slots doubles and
+ * a flag per candidate pair, the records set aside across a detection):
+ * in 3D the springs are 24 doubles a pair, the largest per-pair cost. */
 size_t contact_memory_bytes(const contact_state *cs)
 {
     size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + 1);
+    b += cs->record_capacity * sizeof(contact_record);
     for (int t = 0; t < cs->touch_lists; t++)
         b += cs->touches[t].capacity * (sizeof(long) + sizeof(double) * (size_t)cs->pair_out);
     return b;

@@ -243,7 +243,7 @@ void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m);
 int contact_restore_detection(fdem_model *m);
-size_t contact_memory_bytes(const contact_state *c); /* threaded runs' lists only */
+size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
 
 /* contact_history.c */
 int contact_history_reserve(contact_state *cs, size_t pairs);
