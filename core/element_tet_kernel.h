@@ -23,6 +23,10 @@
  *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
  *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
  *    the other three: the four sum to zero exactly.
+ *  - Each of edges, faces, gradient, stress and forces also exists as
+ *    name_pair over tet_pair, two elements in the lanes of one SIMD
+ *    register (element_tet_kernel_body.h is written once for both), with
+ *    the same bits per element as the scalar one.
  */
 #ifndef FDEM_ELEMENT_TET_KERNEL_H
 #define FDEM_ELEMENT_TET_KERNEL_H
@@ -41,63 +45,42 @@
 #define TET_UNROLL
 #endif
 
-TET_KERNEL void tet_kernel_edges(const double *p0, const double *p1, const double *p2,
-                                    const double *p3, double e[3][3])
+/* Two elements side by side: lane k of every number is element k's. */
+typedef double tet_pair __attribute__((vector_size(16)));
+
+/* ln J and 1/J of a pair: the series on both lanes in the usual case
+ * (lane by lane, bit for bit what one element gets), the division as one
+ * vector; the rare lane outside it through the scalar path. */
+static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ, tet_pair *invJ)
 {
-    TET_UNROLL
-    for (int i = 0; i < 3; i++) {
-        e[0][i] = p1[i] - p0[i];
-        e[1][i] = p2[i] - p0[i];
-        e[2][i] = p3[i] - p0[i];
+    tet_pair x = J - 1.0;
+    if (fabs(x[0]) <= LOG_SHORT_RANGE && fabs(x[1]) <= LOG_SHORT_RANGE) {
+        *lnJ = (tet_pair){log_short_series(x[0]), log_short_series(x[1])};
+        *invJ = 1.0 / J;
+        return;
     }
+    double l0, l1, i0, i1;
+    neo_hookean_log_inverse(J[0], j_min, &l0, &i0);
+    neo_hookean_log_inverse(J[1], j_min, &l1, &i1);
+    *lnJ = (tet_pair){l0, l1};
+    *invJ = (tet_pair){i0, i1};
 }
 
-TET_KERNEL double tet_kernel_faces(const double e[3][3], double c[3][3])
-{
-    TET_UNROLL
-    for (int k = 0; k < 3; k++) {
-        const double *a = e[(k + 1) % 3], *b = e[(k + 2) % 3];
-        c[k][0] = a[1] * b[2] - a[2] * b[1];
-        c[k][1] = a[2] * b[0] - a[0] * b[2];
-        c[k][2] = a[0] * b[1] - a[1] * b[0];
-    }
-    return e[0][0] * c[0][0] + e[0][1] * c[0][1] + e[0][2] * c[0][2];
-}
+#define TET_T double
+#define TET_FN(name) name
+#define TET_LOG_INVERSE neo_hookean_log_inverse
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
 
-/* F_ij = sum_k (e_k)_i xinv_kj */
-TET_KERNEL void tet_kernel_gradient(const double e[3][3], const double xinv[9], double F[9])
-{
-    TET_UNROLL
-    for (int i = 0; i < 3; i++)
-        TET_UNROLL
-        for (int j = 0; j < 3; j++)
-            F[3 * i + j] = e[0][i] * xinv[j] + e[1][i] * xinv[3 + j] + e[2][i] * xinv[6 + j];
-}
-
-TET_KERNEL double tet_kernel_stress(const double F[9], double smu, double slambda,
-                                       double hmu, double hlambda, double s[6], double *J_out)
-{
-    double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-               F[2] * (F[3] * F[7] - F[4] * F[6]);
-    double lnJ, invJ;
-    neo_hookean_log_inverse(J, TET_J_MIN, &lnJ, &invJ);
-    /* B = F F^T */
-    double B00 = F[0] * F[0] + F[1] * F[1] + F[2] * F[2];
-    double B11 = F[3] * F[3] + F[4] * F[4] + F[5] * F[5];
-    double B22 = F[6] * F[6] + F[7] * F[7] + F[8] * F[8];
-    double B12 = F[3] * F[6] + F[4] * F[7] + F[5] * F[8];
-    double B02 = F[0] * F[6] + F[1] * F[7] + F[2] * F[8];
-    double B01 = F[0] * F[3] + F[1] * F[4] + F[2] * F[5];
-    double muJ = smu * invJ, vol = slambda * lnJ * invJ;
-    s[0] = muJ * (B00 - 1.0) + vol;
-    s[1] = muJ * (B11 - 1.0) + vol;
-    s[2] = muJ * (B22 - 1.0) + vol;
-    s[3] = muJ * B12;
-    s[4] = muJ * B02;
-    s[5] = muJ * B01;
-    *J_out = J;
-    return hmu * (B00 + B11 + B22 - 3.0 - 2.0 * lnJ) + hlambda * lnJ * lnJ;
-}
+#define TET_T tet_pair
+#define TET_FN(name) name##_pair
+#define TET_LOG_INVERSE tet_log_inverse_pair
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
 
 TET_KERNEL void tet_kernel_rate(const double *v0, const double *v1, const double *v2,
                                    const double *v3, const double c[3][3], double S[6])
@@ -122,19 +105,6 @@ TET_KERNEL void tet_kernel_rate(const double *v0, const double *v1, const double
 TET_KERNEL double tet_kernel_contract(const double s[6], const double S[6])
 {
     return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
-}
-
-TET_KERNEL void tet_kernel_forces(const double s[6], const double c[3][3], double f[4][3])
-{
-    TET_UNROLL
-    for (int a = 1; a <= 3; a++) {
-        const double *ca = c[a - 1];
-        f[a][0] = -(s[0] * ca[0] + s[5] * ca[1] + s[4] * ca[2]);
-        f[a][1] = -(s[5] * ca[0] + s[1] * ca[1] + s[3] * ca[2]);
-        f[a][2] = -(s[4] * ca[0] + s[3] * ca[1] + s[2] * ca[2]);
-    }
-    TET_UNROLL
-    for (int i = 0; i < 3; i++) f[0][i] = -(f[1][i] + f[2][i] + f[3][i]);
 }
 
 #endif /* FDEM_ELEMENT_TET_KERNEL_H */
