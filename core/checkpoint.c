@@ -85,7 +85,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.has_detection = checkpoint_has_detection(m);
     h.has_viscous = m->elem_viscous != NULL;
     h.dimension = m->dim;
-    h.spring_records = (int64_t)(spring_bytes / sizeof(contact_record));
+    h.spring_records = (int64_t)(spring_bytes / contact_record_bytes(&m->contact));
     h.energy = fdem_get_energy(m);
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
@@ -167,14 +167,15 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
                         h.dimension ? h.dimension : 2, m->dim);
             return -1;
         }
-        if (h.spring_records < 0 || h.spring_records > (int64_t)(size / sizeof(contact_record)) ||
+        size_t record_bytes = contact_record_bytes(&m->contact);
+        if (h.spring_records < 0 || h.spring_records > (int64_t)(size / record_bytes) ||
             h.has_detection != checkpoint_has_detection(m) ||
             h.has_viscous != (m->elem_viscous != NULL)) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's contact section does not fit");
             return -1;
         }
         expected = header + checkpoint_body_size(m, h.has_detection, h.has_viscous,
-                                                 (size_t)h.spring_records * sizeof(contact_record));
+                                                 (size_t)h.spring_records * record_bytes);
     }
     if (size != expected) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,

@@ -258,6 +258,32 @@ const int32_t *fdem_element_parts(const fdem_model *model);
 const int32_t *fdem_joints(const fdem_model *model);
 const double *fdem_joint_damage(const fdem_model *model);
 
+/* Fragments (contract 5.4): pieces connected through shared nodes or
+ * intact joints. fdem_fragment_labels writes each element's fragment id
+ * into label[elements]: ids 0 .. count-1, numbered in the order of each
+ * fragment's first element, so they do not depend on how the pieces were
+ * found; returns count, or -1 when out of memory. fdem_fragments returns
+ * the same count and sets *out (free() it) to one record per id: size is
+ * the initial area (2D) or volume (3D) of its elements, mass their
+ * density times that (exactly the lumped node masses they hold), diameter
+ * the circle (sphere) of that size, centroid and velocity the mass-weighted
+ * means over its nodes at the current step. */
+typedef struct fdem_fragment {
+    int elements;
+    double mass, size, diameter;
+    double centroid[3], velocity[3]; /* dimension components used */
+} fdem_fragment;
+
+int fdem_fragment_labels(const fdem_model *model, int32_t *label);
+int fdem_fragments(const fdem_model *model, fdem_fragment **out);
+
+/* The sieve curve of fragments: for each distinct diameter d, in
+ * increasing order, the mass fraction of fragments no larger than d.
+ * Writes up to count points into diameter[] and passing[] and returns how
+ * many it wrote (count distinct diameters). */
+int fdem_sieve_curve(const fdem_fragment *fragments, int count, double *diameter,
+                     double *passing);
+
 /* Cauchy stress of every element into out[fdem_stress_components * elements]:
  * (sxx, syy, sxy) in 2D, (sxx, syy, szz, syz, sxz, sxy) in 3D. */
 int fdem_stress_components(const fdem_model *model);

@@ -271,26 +271,47 @@ static int part_append(fdem_model *m, const double *coords, int node_count, cons
     return 0;
 }
 
+/* A private copy of a mesh's arrays (dim numbers a node, m->elem_nodes
+ * an element) to validate and reorient: the caller's mesh stays untouched.
+ * Checks the counts first; returns 0, or -1 with err filled. */
+static int part_copy_arrays(fdem_model *m, const double *coords, int node_count,
+                            const int32_t *elems, int elem_count, double **coords_out,
+                            int32_t **elems_out, fdem_error *err)
+{
+    int k = m->part_count, K = m->elem_nodes;
+    *coords_out = NULL;
+    *elems_out = NULL;
+    if (node_count < K || elem_count < 1) {
+        model_error(err, FDEM_ITEM_PART, k, "part %d needs at least %d nodes and 1 %s", k, K,
+                    m->dim == 3 ? "tetrahedron" : "triangle");
+        return -1;
+    }
+    size_t coord_bytes = sizeof(double) * (size_t)m->dim * (size_t)node_count;
+    size_t elem_bytes = sizeof(int32_t) * (size_t)K * (size_t)elem_count;
+    *coords_out = malloc(coord_bytes);
+    *elems_out = malloc(elem_bytes);
+    if (!*coords_out || !*elems_out) {
+        free(*coords_out);
+        free(*elems_out);
+        *coords_out = NULL;
+        *elems_out = NULL;
+        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+        return -1;
+    }
+    memcpy(*coords_out, coords, coord_bytes);
+    memcpy(*elems_out, elems, elem_bytes);
+    return 0;
+}
+
 int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
                   fdem_error *err)
 {
     int k = m->part_count;
-    if (part_check(m, material_index, fracture, 2, err)) return -1;
-    /* Validate a private copy: the caller's mesh stays untouched. */
     fdem_mesh copy = {mesh->node_count, mesh->triangle_count, NULL, NULL};
-    if (mesh->node_count < 3 || mesh->triangle_count < 1) {
-        model_error(err, FDEM_ITEM_PART, k, "part %d needs at least 3 nodes and 1 triangle", k);
+    if (part_check(m, material_index, fracture, 2, err) ||
+        part_copy_arrays(m, mesh->xy, mesh->node_count, mesh->tri, mesh->triangle_count, &copy.xy,
+                         &copy.tri, err))
         return -1;
-    }
-    copy.xy = malloc(sizeof(double) * 2 * (size_t)mesh->node_count);
-    copy.tri = malloc(sizeof(int32_t) * 3 * (size_t)mesh->triangle_count);
-    if (!copy.xy || !copy.tri) {
-        fdem_mesh_free(&copy);
-        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
-        return -1;
-    }
-    memcpy(copy.xy, mesh->xy, sizeof(double) * 2 * (size_t)mesh->node_count);
-    memcpy(copy.tri, mesh->tri, sizeof(int32_t) * 3 * (size_t)mesh->triangle_count);
     int failed = fdem_mesh_validate(&copy, NULL, err) ||
                  part_append(m, copy.xy, copy.node_count, copy.tri, copy.triangle_count,
                              material_index, fracture, err) ||
@@ -309,20 +330,10 @@ int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_inde
                     "part %d: fracture of tetrahedral parts is not available yet", k);
         return -1;
     }
-    if (mesh->node_count < 4 || mesh->tet_count < 1) {
-        model_error(err, FDEM_ITEM_PART, k, "part %d needs at least 4 nodes and 1 tetrahedron", k);
-        return -1;
-    }
     fdem_tet_mesh copy = {mesh->node_count, mesh->tet_count, NULL, NULL};
-    copy.xyz = malloc(sizeof(double) * 3 * (size_t)mesh->node_count);
-    copy.tet = malloc(sizeof(int32_t) * 4 * (size_t)mesh->tet_count);
-    if (!copy.xyz || !copy.tet) {
-        fdem_tet_mesh_free(&copy);
-        model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+    if (part_copy_arrays(m, mesh->xyz, mesh->node_count, mesh->tet, mesh->tet_count, &copy.xyz,
+                         &copy.tet, err))
         return -1;
-    }
-    memcpy(copy.xyz, mesh->xyz, sizeof(double) * 3 * (size_t)mesh->node_count);
-    memcpy(copy.tet, mesh->tet, sizeof(int32_t) * 4 * (size_t)mesh->tet_count);
     int failed = fdem_tet_mesh_validate(&copy, NULL, err) ||
                  part_append(m, copy.xyz, copy.node_count, copy.tet, copy.tet_count,
                              material_index, fracture, err);
@@ -592,9 +603,10 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
-    if (m->contact.enabled)
-        b += (size_t)m->elem_count * (7 * sizeof(double) + 2 * sizeof(int32_t) + 1) +
-             nbs_memory_bytes(&m->contact.grid, &m->contact.pairs);
+    if (m->contact.enabled) /* spheres (centre, radius), boxes (2 dim), body, piece */
+        b += (size_t)m->elem_count * ((3 * D + 1) * sizeof(double) + 2 * sizeof(int32_t) + 1) +
+             (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
+                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
     if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
