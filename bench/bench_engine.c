@@ -13,7 +13,9 @@
  *  4. the elastic and fracturing blocks on 1 thread and on every core
  *     (fdem_set_threads): ns per element-step and the speed-up;
  *  5. the same elastic block in 3D (tetrahedra of a box mesh, 1e4 .. 1e6)
- *     with its bandwidth bound, and on 1 thread and every core.
+ *     with its bandwidth bound, and on 1 thread and every core;
+ *  6. a pile of tetrahedral spheres dropped into a box, with contact: ns
+ *     per element-step split over the stages, against the 3D elastic block.
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -164,6 +166,108 @@ static void bench_disc_pile(void)
     }
 }
 
+/* A 3D tetrahedral mesh appended to a model as one part (dies on failure). */
+static int add_part_3d(fdem_model *m, int mat, fdem_tet_mesh *mesh, fdem_error *err)
+{
+    int p = fdem_add_part_3d(m, mesh, mat, 0, err);
+    fdem_tet_mesh_free(mesh);
+    if (p < 0) build_die("3D part", err);
+    return p;
+}
+
+/* Spheres of radius r (8 divisions) on a cubic lattice of pitch 2.02 r,
+ * nx x ny x nz of them, dropped into a box of fixed slabs (floor and four
+ * walls) meshed about as finely as the spheres (NBS sizes its cells by the
+ * largest element). */
+static fdem_model *sphere_pile(int nx, int ny, int nz)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err;
+    if (fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
+    int wall = build_material(m, 1000, 1e7, 0.25, 0.1, 0.3);
+    int ball = build_material(m, 1000, 1e7, 0.25, 0.2, 0.3);
+    const double r = 0.01, pitch = 2.02 * r, T = 0.01, e = 0.008;
+    const double X = nx * pitch, Y = ny * pitch, H = nz * pitch + 2 * r;
+    const double slabs[5][2][3] = {
+        {{-T, -T, -T}, {X + 2 * T, Y + 2 * T, T}}, /* floor */
+        {{-T, 0, 0}, {T, Y, H}},                   /* walls */
+        {{X, 0, 0}, {T, Y, H}},
+        {{-T, -T, 0}, {X + 2 * T, T, H}},
+        {{-T, Y, 0}, {X + 2 * T, T, H}},
+    };
+    for (int k = 0; k < 5; k++) {
+        int div[3];
+        for (int d = 0; d < 3; d++) div[d] = (int)fmax(1, ceil(slabs[k][1][d] / e));
+        fdem_tet_mesh mesh = {0};
+        if (fdem_tet_mesh_box(slabs[k][0], slabs[k][1], div, &mesh, &err)) build_die("slab", &err);
+        build_fix_part(m, add_part_3d(m, wall, &mesh, &err));
+    }
+    for (int iz = 0; iz < nz; iz++)
+        for (int iy = 0; iy < ny; iy++)
+            for (int ix = 0; ix < nx; ix++) {
+                /* a little off the lattice, so the pile does not stand as columns */
+                double c[3] = {(ix + 0.5) * pitch + 0.0005 * (iz % 2), (iy + 0.5) * pitch,
+                               r * 1.02 + iz * pitch};
+                fdem_tet_mesh mesh = {0};
+                if (fdem_tet_mesh_sphere(c, r, 8, &mesh, &err)) build_die("sphere", &err);
+                add_part_3d(m, ball, &mesh, &err);
+            }
+    const double g[3] = {0, 0, -9.81};
+    fdem_set_gravity_v(m, g);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+/* The sphere pile with contact, its time split over the stages, beside the
+ * 3D elastic block of about as many elements (goal: <= 4x that). */
+static void bench_sphere_pile(void)
+{
+    printf("\n## Sphere pile in a box, 3D with contact (spheres of 8 divisions, fixed slabs)\n");
+    printf("%8s %9s %7s %13s %9s %9s %9s %9s %8s %8s %10s %9s\n", "spheres", "elements", "steps",
+           "ns/elem-step", "forces%", "detect%", "contact%", "integr%", "pairs/el", "touch/el",
+           "elastic ns", "x elastic");
+    int dims[][3] = {{3, 3, 3}, {6, 6, 4}}; /* contact is slow yet: keep make bench short */
+    for (int k = 0; k < 2; k++) {
+        fdem_model *m = sphere_pile(dims[k][0], dims[k][1], dims[k][2]);
+        fdem_error err;
+        /* let the spheres fall into contact: measure a loaded pile */
+        for (int s = 0; s < 400; s++) fdem_step(m, &err);
+        int E = m->elem_count;
+        int steps = (int)(2e6 / E);
+        if (steps < 20) steps = 20;
+        fdem_stage_times before = fdem_get_stage_times(m);
+        double best = INFINITY;
+        for (int rep = 0; rep < 3; rep++) {
+            double t0 = now();
+            for (int s = 0; s < steps; s++) fdem_step(m, &err);
+            best = fmin(best, now() - t0);
+        }
+        fdem_stage_times after = fdem_get_stage_times(m);
+        double fe = after.elements - before.elements, de = after.detection - before.detection;
+        double co = after.contact - before.contact, in = after.integration - before.integration;
+        double sum = fe + de + co + in, ns = best * 1e9 / ((double)steps * E);
+        fdem_counts c = fdem_get_counts(m);
+
+        fdem_model *block = elastic_block(&BLOCK_3D, E);
+        for (int s = 0; s < 3; s++) fdem_step(block, &err);
+        int block_steps = (int)(1e7 / block->elem_count) + 20;
+        double block_best = INFINITY;
+        for (int rep = 0; rep < 3; rep++) {
+            double t0 = now();
+            for (int s = 0; s < block_steps; s++) fdem_step(block, &err);
+            block_best = fmin(block_best, now() - t0);
+        }
+        double elastic = block_best * 1e9 / ((double)block_steps * block->elem_count);
+        fdem_model_destroy(block);
+        printf("%8d %9d %7d %13.1f %9.1f %9.1f %9.1f %9.1f %8.2f %8.3f %10.1f %9.2f\n",
+               dims[k][0] * dims[k][1] * dims[k][2], E, steps, ns, 100 * fe / sum, 100 * de / sum,
+               100 * co / sum, 100 * in / sum, (double)c.contact_pairs / E, (double)c.contacts / E,
+               elastic, ns / elastic);
+        fdem_model_destroy(m);
+    }
+    printf("goal: the pile within 4x the elastic block per element-step\n");
+}
+
 /* A block vibrating at small strain (no joint breaks), fracturing or not. */
 /* A bench that broke joints would time the wrong thing: say so loudly. */
 #define CHECK_BROKEN(n) \
@@ -287,7 +391,7 @@ static void bench_threads(int rows_2d, int rows_3d)
 }
 
 /* With no argument every section runs; otherwise only those named
- * (block, block3d, pile, fracture, threads, threads3d), to iterate on one kernel. */
+ * (block, block3d, pile, pile3d, fracture, threads, threads3d), to iterate on one kernel. */
 static int wanted(int argc, char **argv, const char *name)
 {
     if (argc < 2) return 1;
@@ -302,6 +406,7 @@ int main(int argc, char **argv)
     printf("# fdemd engine bench (single core)\nsingle-core triad bandwidth: %.1f GB/s\n", bw);
     if (wanted(argc, argv, "block")) bench_elastic_block(&BLOCK_2D, bw);
     if (wanted(argc, argv, "block3d")) bench_elastic_block(&BLOCK_3D, bw);
+    if (wanted(argc, argv, "pile3d")) bench_sphere_pile();
     if (wanted(argc, argv, "pile")) bench_disc_pile();
     if (wanted(argc, argv, "fracture")) bench_fracturing_block(bw);
     if (wanted(argc, argv, "threads") || wanted(argc, argv, "threads3d"))
