@@ -25,6 +25,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "../tests/unit/build_container_3d.h"
 #include "../tests/unit/build_model.h"
 #include "mesh_3d.h"
 #include "model.h"
@@ -188,8 +189,8 @@ static int add_part_3d(fdem_model *m, int mat, fdem_tet_mesh *mesh, fdem_error *
 
 /* Spheres of radius r (8 divisions) on a cubic lattice of pitch 2.02 r,
  * nx x ny x nz of them, dropped into a box of fixed slabs (floor and four
- * walls) meshed about as finely as the spheres (NBS sizes its cells by the
- * largest element). */
+ * walls, one part: build_container_mesh) meshed about as finely as the
+ * spheres (NBS sizes its cells by the largest element). */
 static fdem_model *sphere_pile(int nx, int ny, int nz)
 {
     fdem_model *m = fdem_model_create();
@@ -199,20 +200,9 @@ static fdem_model *sphere_pile(int nx, int ny, int nz)
     int ball = build_material(m, 1000, 1e7, 0.25, 0.2, 0.3);
     const double r = 0.01, pitch = 2.02 * r, T = 0.01, e = 0.008;
     const double X = nx * pitch, Y = ny * pitch, H = nz * pitch + 2 * r;
-    const double slabs[5][2][3] = {
-        {{-T, -T, -T}, {X + 2 * T, Y + 2 * T, T}}, /* floor */
-        {{-T, 0, 0}, {T, Y, H}},                   /* walls */
-        {{X, 0, 0}, {T, Y, H}},
-        {{-T, -T, 0}, {X + 2 * T, T, H}},
-        {{-T, Y, 0}, {X + 2 * T, T, H}},
-    };
-    for (int k = 0; k < 5; k++) {
-        int div[3];
-        for (int d = 0; d < 3; d++) div[d] = (int)fmax(1, ceil(slabs[k][1][d] / e));
-        fdem_tet_mesh mesh = {0};
-        if (fdem_tet_mesh_box(slabs[k][0], slabs[k][1], div, &mesh, &err)) build_die("slab", &err);
-        build_fix_part(m, add_part_3d(m, wall, &mesh, &err));
-    }
+    fdem_tet_mesh box = {0};
+    if (build_container_mesh(X, Y, H, T, e, &box, &err)) build_die("container", &err);
+    build_fix_part(m, add_part_3d(m, wall, &box, &err));
     for (int iz = 0; iz < nz; iz++)
         for (int iy = 0; iy < ny; iy++)
             for (int ix = 0; ix < nx; ix++) {

@@ -23,6 +23,7 @@
 #include <time.h>
 
 #include "nbs.h"
+#include "nbs_internal.h" /* the sphere test NBS uses, for the baseline */
 #include "stream.h"
 
 #define GRID_MAX_CELLS ((int64_t)1 << 26) /* 256 MB of int32 counts */
@@ -273,18 +274,6 @@ static inline uint32_t cell_hash(int64_t x, int64_t y, int64_t z, uint32_t mask)
     return (uint32_t)((key * 0x9e3779b97f4a7c15ull) >> 40) & mask;
 }
 
-static inline int touch3(double xi, double yi, double zi, double ri, double xj, double yj,
-                         double zj, double rj)
-{
-    double dx = xi - xj, dy = yi - yj, dz = zi - zj, reach = ri + rj;
-    double dx2 = dx * dx;
-    double dy2 = dy * dy;
-    double dz2 = dz * dz;
-    double dist2 = dx2 + dy2 + dz2;
-    double reach2 = reach * reach;
-    return dist2 <= reach2;
-}
-
 static int hash_detect_3d(hash_ws *w, const circles *c, nbs_pairs *pairs)
 {
     size_t n = c->n;
@@ -341,7 +330,7 @@ static int hash_detect_3d(hash_ws *w, const circles *c, nbs_pairs *pairs)
             uint32_t b = cell_hash(x, y, z, mask);
             for (int32_t j = start[b]; j < start[b + 1]; j++)
                 if ((d > 13 || j > k) && w->cx[j] == x && w->cy[j] == y && w->cz[j] == z &&
-                    touch3(xk, yk, zk, rk, w->sx[j], w->sy[j], w->sz[j], w->sr[j]) &&
+                    nbs_spheres_touch(xk, yk, zk, rk, w->sx[j], w->sy[j], w->sz[j], w->sr[j]) &&
                     push(pairs, w->order[k], w->order[j]))
                     return -1;
         }
