@@ -58,9 +58,10 @@ static inline int element_material(const fdem_model *m, int e)
     return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
 }
 
+/* From the hot record, which also holds the material: one cache line. */
 static inline const int32_t *element_nodes(const fdem_model *m, int e)
 {
-    return m->elem_node + (size_t)m->elem_nodes * (size_t)e;
+    return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
 }
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
@@ -71,11 +72,11 @@ static inline int boxes_overlap(const double *a, const double *b, int dim)
     return !apart;
 }
 
-static inline void element_box(const fdem_model *m, int e, double *b)
+/* D and K are constants where it is called (element_box), so each
+ * dimension gets its own unrolled copy of this one loop. */
+static inline __attribute__((always_inline)) void box_of_nodes(const double *p, const int32_t *n,
+                                                               int D, int K, double *b)
 {
-    const int D = m->dim, K = m->elem_nodes;
-    const double *p = m->pos;
-    const int32_t *n = element_nodes(m, e);
     for (int d = 0; d < D; d++) {
         double lo = p[D * n[0] + d], hi = lo;
         for (int c = 1; c < K; c++) {
@@ -86,6 +87,12 @@ static inline void element_box(const fdem_model *m, int e, double *b)
         b[2 * d] = lo;
         b[2 * d + 1] = hi;
     }
+}
+
+static inline void element_box(const fdem_model *m, int e, double *b)
+{
+    if (m->dim == 3) box_of_nodes(m->pos, m->tet[e].node, 3, 4, b);
+    else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
 
 /* The current box of every element in some candidate pair. Most candidate
@@ -138,34 +145,60 @@ static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, dou
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
  * what its friction dissipated to the friction account; called in pair
  * order, so every sum is formed in the same order on any thread count. */
-static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
+static inline __attribute__((always_inline)) void scatter_nodes(double *f, const int32_t *n1,
+                                                                 const int32_t *n2, int D, int K,
+                                                                 const double *out)
 {
-    double *f = m->contact.force;
-    const int D = m->dim, K = m->elem_nodes;
-    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
     for (int c = 0; c < K; c++)
         for (int d = 0; d < D; d++) f[D * n1[c] + d] += out[D * c + d];
     for (int c = 0; c < K; c++)
         for (int d = 0; d < D; d++) f[D * n2[c] + d] += out[D * (K + c) + d];
-    m->friction_energy += out[2 * D * K];
+}
+
+static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
+{
+    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
+    if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
+    else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
+    m->friction_energy += out[2 * m->dim * m->elem_nodes];
 }
 
 /* A pair whose boxes no longer overlap lets its stick springs go. */
-static inline void pair_springs_release(contact_state *cs, size_t k)
+static inline void pair_springs_release(contact_state *cs, size_t k, int slots)
 {
     if (!cs->sprung[k]) return;
-    double *springs = cs->slip + (size_t)cs->slots * k;
-    for (int s = 0; s < cs->slots; s++) springs[s] = 0;
+    double *springs = cs->slip + (size_t)slots * k;
+    for (int s = 0; s < slots; s++) springs[s] = 0;
     cs->sprung[k] = 0;
 }
 
 /* Notes whether pair k's springs hold anything after its evaluation. */
-static inline void pair_springs_mark(contact_state *cs, size_t k)
+static inline void pair_springs_mark(contact_state *cs, size_t k, int slots)
 {
-    const double *springs = cs->slip + (size_t)cs->slots * k;
+    const double *springs = cs->slip + (size_t)slots * k;
     int any = 0;
-    for (int s = 0; s < cs->slots; s++) any |= springs[s] != 0;
+    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
     cs->sprung[k] = (uint8_t)any;
+}
+
+/* Candidate pair k this step: boxes apart, it lets its springs go (-1);
+ * otherwise its force into out (pair_out numbers), 1 if it touched. D is a
+ * constant where it is called, so each dimension's walk is compiled on
+ * its own with the box and spring loops unrolled. */
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t k, double h,
+                                                               double *out, int D)
+{
+    contact_state *cs = &m->contact;
+    const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
+    const size_t width = 2 * (size_t)D;
+    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+    if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
+        pair_springs_release(cs, k, slots);
+        return -1;
+    }
+    int touched = contact_pair_force(m, a, b, h, cs->slip + (size_t)slots * k, out);
+    pair_springs_mark(cs, k, slots);
+    return touched;
 }
 
 /* Force between two elements, both roles, added to the contact force
@@ -404,27 +437,23 @@ static int contact_touch_lists(contact_state *cs, int threads)
 
 /* Every candidate pair's force, added to the contact force array in pair
  * order, one pair at a time. Returns the number of pairs that touched. */
-static int contact_pairs_forces_serial(fdem_model *m, double h)
+static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
+                                                                     int D)
 {
     contact_state *cs = &m->contact;
     int touching = 0;
-    const double *box = cs->box;
-    const int D = m->dim;
-    const size_t width = 2 * (size_t)D;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
-        double out[CONTACT_PAIR_OUT_MAX], *springs = cs->slip + (size_t)cs->slots * k;
-        if (!boxes_overlap(box + width * (size_t)a, box + width * (size_t)b, D)) {
-            pair_springs_release(cs, k);
-            continue;
-        }
-        int touched = contact_pair_force(m, a, b, h, springs, out);
-        pair_springs_mark(cs, k);
-        if (!touched) continue;
-        contact_pair_scatter(m, a, b, out);
+        double out[CONTACT_PAIR_OUT_MAX];
+        if (pair_evaluate(m, k, h, out, D) <= 0) continue;
+        contact_pair_scatter(m, cs->pairs.a[k], cs->pairs.b[k], out);
         touching++;
     }
     return touching;
+}
+
+static int contact_pairs_forces_serial(fdem_model *m, double h)
+{
+    return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
 }
 
 /* The same on several threads: each takes a contiguous share of the pairs
@@ -433,14 +462,26 @@ static int contact_pairs_forces_serial(fdem_model *m, double h)
  * the order the serial loop forms it: the same bits on any thread count.
  * Returns the number of pairs that touched, or -1 if a list could not grow
  * (nothing has been added then). */
+static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
+                                                                     long begin, long end,
+                                                                     contact_touches *list, int D)
+{
+    int touching = 0;
+    for (long k = begin; k < end; k++) {
+        double force[CONTACT_PAIR_OUT_MAX];
+        if (pair_evaluate(m, (size_t)k, h, force, D) <= 0) continue;
+        touching++;
+        if (contact_touch_push(list, k, force, m->contact.pair_out)) return -1;
+    }
+    return touching;
+}
+
 static int contact_pairs_forces_threaded(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
     long n = (long)cs->pairs.count;
     const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b;
     int touching = 0, failed = 0, used = 1;
-    const int D = m->dim;
-    const size_t width = 2 * (size_t)D;
     contact_touches *lists = cs->touches;
 #pragma omp parallel num_threads(m->threads) reduction(+ : touching)
     {
@@ -453,22 +494,13 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
         contact_touches *list = &lists[t];
         list->count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
-        const double *box = cs->box;
-        for (long k = begin; k < end; k++) {
-            double force[CONTACT_PAIR_OUT_MAX], *springs = cs->slip + (size_t)cs->slots * k;
-            if (!boxes_overlap(box + width * (size_t)pa[k], box + width * (size_t)pb[k], D)) {
-                pair_springs_release(cs, (size_t)k);
-                continue;
-            }
-            int touched = contact_pair_force(m, pa[k], pb[k], h, springs, force);
-            pair_springs_mark(cs, (size_t)k);
-            if (!touched) continue;
-            touching++;
-            if (contact_touch_push(list, k, force, cs->pair_out)) {
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, begin, end, list, 3)
+                               : pairs_forces_listed(m, h, begin, end, list, 2);
+        if (mine < 0) {
 #pragma omp atomic write
-                failed = 1;
-                break;
-            }
+            failed = 1;
+        } else {
+            touching += mine;
         }
     }
     if (failed) return -1;

@@ -60,8 +60,8 @@ typedef struct constraint {
 } constraint;
 
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
-#define SCATTER_SUMS 5
-#define SCATTER_MAX 4
+#define SCATTER_SUMS 6
+#define SCATTER_MAX 5
 
 /* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
  * blocks of one colour share no node, so threads may run them side by side
@@ -183,7 +183,9 @@ struct fdem_model {
     double elastic_energy;   /* of the last force evaluation */
     double joint_energy;     /* stored in intact joints, last force evaluation */
     double contact_work;     /* work of all contact forces (normal and friction) */
-    double friction_energy;  /* dissipated by Coulomb sliding (>= 0) */
+    double friction_energy;  /* dissipated by Coulomb sliding of contacts (>= 0) */
+    double joint_friction_energy; /* by the sigma_c tan(phi) part of intact joints' shear
+                                     strength as they slide (joint.c) */
     double fracture_energy;  /* dissipated by joint softening and breaking (>= 0) */
     double damping_work;     /* energy dissipated by viscous damping */
     double external_work;

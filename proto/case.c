@@ -21,7 +21,8 @@
 #define CASE_DEFAULT_SAFETY 0.5
 
 static const char *const top_keys[] = {
-    "name", "materials", "parts", "constraints", "gravity", "time", "output", NULL,
+    "name", "dimension", "materials", "parts", "constraints", "gravity", "time", "output",
+    NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
@@ -130,9 +131,25 @@ static void case_read_output(case_doc *doc, const json_t *output)
     if (fields) case_read_fields(doc, fields);
 }
 
+/* 2 (the default) or 3. Everything with vectors or shapes depends on it,
+ * so it is read first; an invalid value leaves 2 so the rest of the
+ * document is still checked. */
+static void case_read_dimension(case_doc *doc, const json_t *dimension)
+{
+    doc->dimension = 2;
+    if (!dimension) return;
+    double d = 0;
+    if (!json_is_number(dimension))
+        case_problem(doc, "/dimension", "expected 2 or 3, got %s", case_type_word(dimension));
+    else if (case_read_number(doc, dimension, "/dimension", &d) && d != 2 && d != 3)
+        case_problem(doc, "/dimension", "the dimension is 2 or 3, got %g", d);
+    else if (d == 3)
+        doc->dimension = 3;
+}
+
 static void case_read_gravity(case_doc *doc, const json_t *gravity)
 {
-    if (gravity) case_read_vec2(doc, gravity, "/gravity", doc->gravity);
+    if (gravity) case_read_vector(doc, gravity, "/gravity", doc->dimension, doc->gravity);
 }
 
 /* Pass 1 over the whole document. */
@@ -143,6 +160,7 @@ static void case_read(case_doc *doc, const json_t *root)
         return;
     }
     case_check_keys(doc, root, "", top_keys, "the case");
+    case_read_dimension(doc, json_object_get(root, "dimension"));
     case_read_name(doc, root);
     json_t *materials = json_object_get(root, "materials");
     if (materials) case_read_materials(doc, materials);
@@ -218,10 +236,12 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
         return NULL;
     }
     fdem_error err = {0};
-    int ok = case_add_materials(doc, model) == 0 && case_add_parts(doc, model) == 0 &&
-             case_add_constraints(doc, model) == 0;
+    int ok = fdem_set_dimension(model, doc->dimension, &err) == 0;
+    if (!ok) case_engine_problem(doc, &err, "/dimension");
+    ok = ok && case_add_materials(doc, model) == 0 && case_add_parts(doc, model) == 0 &&
+         case_add_constraints(doc, model) == 0;
     if (ok) {
-        fdem_set_gravity(model, doc->gravity[0], doc->gravity[1]);
+        fdem_set_gravity_v(model, doc->gravity);
         ok = fdem_model_finalize(model, &err) == 0;
         if (!ok) case_engine_problem(doc, &err, "");
     }
@@ -248,7 +268,10 @@ static void case_fill_info(const case_doc *doc, case_info *info)
 
 void case_doc_free(case_doc *doc)
 {
-    for (int i = 0; i < doc->part_count; i++) fdem_mesh_free(&doc->parts[i].mesh);
+    for (int i = 0; i < doc->part_count; i++) {
+        fdem_mesh_free(&doc->parts[i].mesh);
+        fdem_tet_mesh_free(&doc->parts[i].tet_mesh);
+    }
     free(doc->parts);
     free(doc->materials);
     free(doc->constraints);

@@ -39,34 +39,51 @@ static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const 
     case_problem(doc, ptr, "unknown part \"%.64s\"%s", wanted, hint);
 }
 
+/* "[xmin, ymin, xmax, ymax]" or the 3D six. */
+static const char *box_layout(int dimension)
+{
+    return dimension == 3 ? "[xmin, ymin, zmin, xmax, ymax, zmax]" : "[xmin, ymin, xmax, ymax]";
+}
+
+/* Lower bounds, then upper bounds: the engine's layout of def->box. */
 static void constraint_read_box(case_doc *doc, fdem_constraint_def *def, const json_t *box,
                                 const char *ptr)
 {
+    static const char *const axes = "xyz";
+    int dim = doc->dimension;
     def->select = FDEM_SELECT_BOX;
-    if (!json_is_array(box) || json_array_size(box) != 4) {
-        case_problem(doc, ptr, "expected [xmin, ymin, xmax, ymax], got %s%s",
-                     case_type_word(box), json_is_array(box) ? " of another length" : "");
+    if (!json_is_array(box) || json_array_size(box) != (size_t)(2 * dim)) {
+        case_problem(doc, ptr, "expected %s, got %s%s", box_layout(dim), case_type_word(box),
+                     json_is_array(box) ? " of another length" : "");
         return;
     }
-    int ok = 1;
-    for (int k = 0; k < 4; k++) {
-        char at[CASE_POINTER];
-        pointer_join_index(at, sizeof at, ptr, k);
-        ok &= case_read_number(doc, json_array_get(box, (size_t)k), at, &def->box[k]);
-    }
-    if (ok && (def->box[0] > def->box[2] || def->box[1] > def->box[3]))
-        case_problem(doc, ptr, "the box must be [xmin, ymin, xmax, ymax] with xmin <= xmax and "
-                               "ymin <= ymax, got [%g, %g, %g, %g]",
-                     def->box[0], def->box[1], def->box[2], def->box[3]);
+    if (!case_read_vector(doc, box, ptr, 2 * dim, def->box)) return;
+    for (int d = 0; d < dim; d++)
+        if (def->box[d] > def->box[dim + d]) {
+            case_problem(doc, ptr, "the box must be %s with %cmin <= %cmax, got %cmin = %g > "
+                                   "%cmax = %g", box_layout(dim), axes[d], axes[d], axes[d],
+                         def->box[d], axes[d], def->box[dim + d]);
+            return;
+        }
+}
+
+/* "\"x\" or \"y\"" / "\"x\", \"y\" or \"z\"" */
+static const char *axis_names(int dimension)
+{
+    return dimension == 3 ? "\"x\", \"y\" or \"z\"" : "\"x\" or \"y\"";
 }
 
 static void constraint_read_fix(case_doc *doc, fdem_constraint_def *def, const json_t *fix,
                                 const char *ptr)
 {
+    static const char *const axes[] = {"x", "y", "z"};
+    int *flags[3] = {&def->fix_x, &def->fix_y, &def->fix_z};
+    int dim = doc->dimension;
     def->kind = FDEM_CONSTRAINT_FIX;
-    if (!json_is_array(fix) || json_array_size(fix) == 0 || json_array_size(fix) > 2) {
-        case_problem(doc, ptr, "expected a list of the components to fix, [\"x\"], [\"y\"] or "
-                               "[\"x\", \"y\"], got %s", case_type_word(fix));
+    if (!json_is_array(fix) || json_array_size(fix) == 0 ||
+        json_array_size(fix) > (size_t)dim) {
+        case_problem(doc, ptr, "expected a list of the components to fix (some of %s), got %s",
+                     axis_names(dim), case_type_word(fix));
         return;
     }
     size_t i;
@@ -75,41 +92,48 @@ static void constraint_read_fix(case_doc *doc, fdem_constraint_def *def, const j
         char at[CASE_POINTER];
         pointer_join_index(at, sizeof at, ptr, (long)i);
         const char *s = json_is_string(c) ? json_string_value(c) : NULL;
-        if (s && strcmp(s, "x") == 0)
-            def->fix_x = 1;
-        else if (s && strcmp(s, "y") == 0)
-            def->fix_y = 1;
+        int axis = -1;
+        for (int d = 0; s && d < dim; d++)
+            if (strcmp(s, axes[d]) == 0) axis = d;
+        if (axis >= 0)
+            *flags[axis] = 1;
         else if (s)
-            case_problem(doc, at, "expected \"x\" or \"y\", got \"%.32s\"", s);
+            case_problem(doc, at, "expected %s, got \"%.32s\"", axis_names(dim), s);
         else
-            case_problem(doc, at, "expected \"x\" or \"y\", got %s", case_type_word(c));
+            case_problem(doc, at, "expected %s, got %s", axis_names(dim), case_type_word(c));
     }
 }
 
-/* [vx, vy] where null leaves that component free. */
+/* [vx, vy(, vz)] where null leaves that component free. */
 static void constraint_read_velocity(case_doc *doc, fdem_constraint_def *def, const json_t *v,
                                      const char *ptr)
 {
+    int dim = doc->dimension;
+    const char *layout = dim == 3 ? "[vx, vy, vz]" : "[vx, vy]";
     def->kind = FDEM_CONSTRAINT_VELOCITY;
-    if (!json_is_array(v) || json_array_size(v) != 2) {
-        case_problem(doc, ptr, "expected [vx, vy] (null leaves a component free), got %s%s",
+    if (!json_is_array(v) || json_array_size(v) != (size_t)dim) {
+        case_problem(doc, ptr, "expected %s (null leaves a component free), got %s%s", layout,
                      case_type_word(v), json_is_array(v) ? " of another length" : "");
         return;
     }
-    int *free_flag[2] = {&def->free_x, &def->free_y};
-    for (int k = 0; k < 2; k++) {
+    int *free_flag[3] = {&def->free_x, &def->free_y, &def->free_z};
+    int free_count = 0;
+    for (int k = 0; k < dim; k++) {
         char at[CASE_POINTER];
         pointer_join_index(at, sizeof at, ptr, k);
         json_t *c = json_array_get(v, (size_t)k);
-        if (json_is_null(c))
+        if (json_is_null(c)) {
             *free_flag[k] = 1;
-        else if (!json_is_number(c))
+            free_count++;
+        } else if (!json_is_number(c)) {
             case_problem(doc, at, "expected a number or null, got %s", case_type_word(c));
-        else
+        } else {
             case_read_number(doc, c, at, &def->value[k]);
+        }
     }
-    if (def->free_x && def->free_y)
-        case_problem(doc, ptr, "[null, null] constrains nothing; give vx, vy or both");
+    if (free_count == dim)
+        case_problem(doc, ptr, "all null constrains nothing; give at least one component of %s",
+                     layout);
 }
 
 /* Exactly one of the keys in `keys[0..count)`; returns its index or -1. */
@@ -139,9 +163,10 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
     snprintf(what, sizeof what, "constraint %d", index);
     case_check_keys(doc, value, ptr, constraint_keys, what);
 
-    int selector = constraint_pick(doc, value, ptr, selectors, 2,
-                                   "a selector: \"part\" (a part name) or \"box\" "
-                                   "[xmin, ymin, xmax, ymax]");
+    char selector_what[96];
+    snprintf(selector_what, sizeof selector_what,
+             "a selector: \"part\" (a part name) or \"box\" %s", box_layout(doc->dimension));
+    int selector = constraint_pick(doc, value, ptr, selectors, 2, selector_what);
     if (selector >= 0) {
         json_t *s = case_member(value, ptr, selectors[selector], at);
         if (selector == 0) constraint_read_part(doc, &c->def, s, at);
@@ -157,7 +182,7 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         constraint_read_velocity(doc, &c->def, a, at);
     } else {
         c->def.kind = FDEM_CONSTRAINT_FORCE;
-        case_read_vec2(doc, a, at, c->def.value);
+        case_read_vector(doc, a, at, doc->dimension, c->def.value);
     }
 }
 

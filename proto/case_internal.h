@@ -18,6 +18,7 @@
 
 #include "case.h"
 #include "fdem.h"
+#include "mesh_3d.h"
 #include "problems.h"
 
 #define CASE_POINTER 256 /* = sizeof problem.pointer */
@@ -34,20 +35,30 @@ typedef enum case_shape {
     CASE_SHAPE_DISC,
     CASE_SHAPE_MESH,
     CASE_SHAPE_GMSH,
+    CASE_SHAPE_BOX,
+    CASE_SHAPE_SPHERE,
+    CASE_SHAPE_CYLINDER,
 } case_shape;
+
+/* The JSON key of each shape, indexed by case_shape - 1. */
+extern const char *const case_shape_keys[];
+#define CASE_SHAPE_KINDS 7
 
 typedef struct case_part {
     char name[CASE_NAME];
     int material;            /* index into case_doc.materials, -1 if unknown */
     int fracture;
     int has_velocity;
-    double velocity[2];
+    double velocity[3];      /* `dimension` components */
     case_shape shape;
-    double at[2];            /* rectangle origin or disc centre */
-    double size[2];          /* rectangle width, height */
-    double radius;           /* disc */
-    long divisions[2];       /* rectangle nx, ny; disc rim divisions in [0] */
-    fdem_mesh mesh;          /* MESH, GMSH: read in pass 1; others: pass 3 */
+    double at[3];            /* rectangle or box origin; disc, sphere or cylinder centre */
+    double size[3];          /* rectangle, box */
+    double radius;           /* disc, sphere, cylinder */
+    double length;           /* cylinder */
+    int axis;                /* cylinder: 0, 1, 2 for x, y, z */
+    long divisions[3];       /* rectangle, box: per axis; disc, sphere: [0]; cylinder: 2 */
+    fdem_mesh mesh;          /* 2D; MESH, GMSH: read in pass 1; others: pass 3 */
+    fdem_tet_mesh tet_mesh;  /* 3D, the same */
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
 } case_part;
 
@@ -57,6 +68,7 @@ typedef struct case_constraint {
 
 typedef struct case_doc {
     problems *out;
+    int dimension;           /* 2 or 3, read before everything that has vectors */
     char name[CASE_NAME];
     case_material *materials;
     int material_count;
@@ -64,7 +76,7 @@ typedef struct case_doc {
     int part_count;
     case_constraint *constraints;
     int constraint_count;
-    double gravity[2];
+    double gravity[3];
     double end_time, dt, safety, interval;
     int dt_auto;
     unsigned fields;
@@ -88,10 +100,19 @@ json_t *case_member(const json_t *object, const char *base, const char *key, cha
 int case_expect_object(case_doc *doc, const json_t *value, const char *ptr);
 int case_expect_array(case_doc *doc, const json_t *value, const char *ptr);
 int case_read_number(case_doc *doc, const json_t *value, const char *ptr, double *out);
-int case_read_vec2(case_doc *doc, const json_t *value, const char *ptr, double out[2]);
+/* An array of exactly `count` finite numbers (a vector of the case's
+ * dimension, a box selector, ...); the message says how many. */
+int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
+                     double *out);
+/* "two", "three", ... for "expected an array of three numbers". */
+const char *case_count_word(int count);
 /* An integer-valued number (2 or 2.0 or 1e3) in [lo, hi]. */
 int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long lo, long hi,
                       long *out);
+/* An array of `count` such integers, entry k in [lo[k], hi]; `layout` names
+ * them for the message ("[nx, ny]"). */
+int case_read_integers(case_doc *doc, const json_t *value, const char *ptr, int count,
+                       const long *lo, long hi, const char *layout, long *out);
 int case_read_bool(case_doc *doc, const json_t *value, const char *ptr, int *out);
 
 /* Optional number member: 1 read (or absent, leaving *out), 0 on a problem.
@@ -129,6 +150,21 @@ const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char 
 void case_read_materials(case_doc *doc, const json_t *materials);
 int case_material_index(const case_doc *doc, const char *name);
 void case_read_parts(case_doc *doc, const json_t *parts);
+/* case_shapes.c: the generated shapes of both dimensions (pass 1 reads,
+ * pass 3 meshes after the memory check). */
+void case_read_block(case_doc *doc, case_part *part, const json_t *block, const char *ptr);
+void case_read_round(case_doc *doc, case_part *part, const json_t *round, const char *ptr);
+void case_read_cylinder(case_doc *doc, case_part *part, const json_t *cylinder,
+                        const char *ptr);
+/* Meshes a generated shape into part->mesh or part->tet_mesh (0, or -1 with err). */
+int case_generate_shape(case_part *part, fdem_error *err);
+/* case_mesh.c: explicit meshes and gmsh text of the case's dimension. */
+void case_read_mesh(case_doc *doc, case_part *part, const json_t *mesh, const char *ptr);
+void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const char *ptr);
+/* An engine error about a node or element of part i's mesh, at the pointer
+ * of that item when the mesh was given explicitly ("/parts/2/mesh/nodes/4"),
+ * else at `fallback`. */
+void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
 
 /* ----------------------------------------------------- pass 2 and pass 3 */

@@ -2,8 +2,8 @@
  * case_memory.c - pass 2 of the case builder: how big would the model be?
  *
  * Counts are estimated from the shapes alone (in doubles, so absurd
- * divisions cannot overflow) and priced with fdem_memory_estimate() before
- * any generator runs: an oversized case costs the daemon nothing but this
+ * divisions cannot overflow) and priced with fdem_memory_estimate() (or its
+ * 3D form for tetrahedra) before any generator runs: an oversized case costs the daemon nothing but this
  * arithmetic, and the user learns how large the model would have been.
  */
 #include <limits.h>
@@ -28,9 +28,27 @@ static void memory_disc_counts(double divisions, double *nodes, double *elements
     *elements = 2 * *nodes;
 }
 
+/* The 3D generators map a lattice of cells, six tetrahedra each, onto the
+ * shape. A sphere (cylinder cross-section) of d edges around the rim is a
+ * cube (square) of n cells a side, n = d / 4 rounded up to even, as
+ * cells_for_circle() in core/mesh_3d.c chooses it. */
+static double memory_cells_for_circle(double divisions)
+{
+    double n = ceil(divisions / 4);
+    return n + fmod(n, 2);
+}
+
+static void memory_lattice_counts(double nx, double ny, double nz, double *nodes,
+                                  double *elements)
+{
+    *nodes = (nx + 1) * (ny + 1) * (nz + 1);
+    *elements = 6 * nx * ny * nz;
+}
+
 static void memory_part_counts(case_part *part)
 {
     double nx = (double)part->divisions[0], ny = (double)part->divisions[1];
+    double nz = (double)part->divisions[2], n = memory_cells_for_circle(nx);
     switch (part->shape) {
     case CASE_SHAPE_RECTANGLE:
         part->nodes = (nx + 1) * (ny + 1);
@@ -39,28 +57,39 @@ static void memory_part_counts(case_part *part)
     case CASE_SHAPE_DISC:
         memory_disc_counts(nx, &part->nodes, &part->elements);
         break;
+    case CASE_SHAPE_BOX:
+        memory_lattice_counts(nx, ny, nz, &part->nodes, &part->elements);
+        break;
+    case CASE_SHAPE_SPHERE:
+        memory_lattice_counts(n, n, n, &part->nodes, &part->elements);
+        break;
+    case CASE_SHAPE_CYLINDER:
+        memory_lattice_counts(n, n, ny, &part->nodes, &part->elements);
+        break;
     case CASE_SHAPE_MESH:
     case CASE_SHAPE_GMSH:
-        part->nodes = part->mesh.node_count;
-        part->elements = part->mesh.triangle_count;
+        part->nodes = part->mesh.node_count + part->tet_mesh.node_count;
+        part->elements = part->mesh.triangle_count + part->tet_mesh.tet_count;
         break;
     case CASE_SHAPE_NONE:
         break;
     }
     part->joints = 0;
     if (part->fracture) {
-        /* every triangle gets its own 3 nodes; one joint per interior edge */
+        /* every triangle gets its own 3 nodes; one joint per interior edge
+         * (3D parts do not fracture yet) */
         part->nodes = 3 * part->elements;
         part->joints = 1.5 * part->elements;
     }
 }
 
-static double memory_bytes(double nodes, double elements, double joints)
+static double memory_bytes(int dimension, double nodes, double elements, double joints)
 {
     double largest = fmax(nodes, fmax(elements, joints));
     double scale = largest > MEMORY_EXACT_COUNT ? largest / MEMORY_EXACT_COUNT : 1;
-    size_t bytes = fdem_memory_estimate((long)(nodes / scale), (long)(elements / scale),
-                                        (long)(joints / scale));
+    long n = (long)(nodes / scale), e = (long)(elements / scale);
+    size_t bytes = dimension == 3 ? fdem_memory_estimate_3d(n, e)
+                                  : fdem_memory_estimate(n, e, (long)(joints / scale));
     return (double)bytes * scale;
 }
 
@@ -97,7 +126,7 @@ double case_check_memory(case_doc *doc, size_t memory_limit)
         elements += doc->parts[i].elements;
         joints += doc->parts[i].joints;
     }
-    double bytes = memory_bytes(nodes, elements, joints);
+    double bytes = memory_bytes(doc->dimension, nodes, elements, joints);
     char need[32], limit[32], counts[96];
     memory_format(bytes, need, sizeof need);
     memory_describe(nodes, elements, joints, counts, sizeof counts);

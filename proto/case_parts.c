@@ -3,213 +3,60 @@
  * fracture flag, initial velocity and its one shape (pass 1), and turning
  * the shapes into engine parts (pass 3).
  *
- * Explicit meshes and gmsh text are parsed in pass 1 because their size is
- * bounded by the upload and their errors (a bad triangle, a gmsh line) are
- * part of the full list of problems. Generated shapes are only described in
- * pass 1; pass 2 (case_memory.c) estimates their size before any of them is
- * generated, so `"divisions": [1e9, 1e9]` is refused without allocating.
+ * Which shapes a part may have depends on the case's dimension: rectangle
+ * and disc in 2D, box, sphere and cylinder in 3D, mesh and gmsh in both
+ * (triangles in 2D, tetrahedra in 3D). A shape of the other dimension is a
+ * problem at the shape, saying which dimension it belongs to. The shapes
+ * themselves are read by case_shapes.c (generated) and case_mesh.c (given).
  */
-#include <limits.h>
-#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "case_internal.h"
-#include "gmsh.h"
+
+const char *const case_shape_keys[CASE_SHAPE_KINDS] = {
+    "rectangle", "disc", "mesh", "gmsh", "box", "sphere", "cylinder",
+};
 
 static const char *const part_keys[] = {
-    "name", "material", "fracture", "velocity", "rectangle", "disc", "mesh", "gmsh", NULL,
+    "name", "material", "fracture", "velocity", "rectangle", "disc", "mesh", "gmsh", "box",
+    "sphere", "cylinder", NULL,
 };
-static const char *const shape_keys[] = {"rectangle", "disc", "mesh", "gmsh"};
-static const char *const rectangle_keys[] = {"origin", "size", "divisions", NULL};
-static const char *const disc_keys[] = {"center", "radius", "divisions", NULL};
-static const char *const mesh_keys[] = {"nodes", "triangles", NULL};
 
-/* Divisions beyond this are refused outright; anything below it is left to
- * the memory estimate, which says how large the model would be. */
-#define PART_DIVISIONS_MAX 1000000000000L
-
-/* ---------------------------------------------------------------- shapes */
-
-static void part_read_rectangle(case_doc *doc, case_part *part, const json_t *rect,
-                                const char *ptr)
+/* The dimension a shape belongs to, 0 for both. */
+static int shape_dimension(case_shape shape)
 {
-    if (!case_expect_object(doc, rect, ptr)) return;
-    case_check_keys(doc, rect, ptr, rectangle_keys, "a rectangle");
-    char at[CASE_POINTER];
-    json_t *origin = case_member(rect, ptr, "origin", at);
-    if (origin) case_read_vec2(doc, origin, at, part->at);
-    json_t *size = case_member(rect, ptr, "size", at);
-    if (!size)
-        case_problem(doc, ptr, "missing required \"size\" [width, height]");
-    else if (case_read_vec2(doc, size, at, part->size)) {
-        if (!(part->size[0] > 0 && part->size[1] > 0))
-            case_problem(doc, at, "width and height must be > 0, got [%g, %g]", part->size[0],
-                         part->size[1]);
-        else if (!isfinite(part->at[0] + part->size[0]) || !isfinite(part->at[1] + part->size[1]))
-            case_problem(doc, at, "the rectangle reaches beyond the range of numbers");
-    }
-    json_t *divisions = case_member(rect, ptr, "divisions", at);
-    if (!divisions) {
-        case_problem(doc, ptr, "missing required \"divisions\" [nx, ny]");
-    } else if (!json_is_array(divisions) || json_array_size(divisions) != 2) {
-        case_problem(doc, at, "expected an array of two whole numbers [nx, ny], got %s",
-                     case_type_word(divisions));
-    } else {
-        for (int k = 0; k < 2; k++) {
-            char item[CASE_POINTER];
-            pointer_join_index(item, sizeof item, at, k);
-            case_read_integer(doc, json_array_get(divisions, (size_t)k), item, 1,
-                              PART_DIVISIONS_MAX, &part->divisions[k]);
-        }
+    switch (shape) {
+    case CASE_SHAPE_RECTANGLE:
+    case CASE_SHAPE_DISC: return 2;
+    case CASE_SHAPE_BOX:
+    case CASE_SHAPE_SPHERE:
+    case CASE_SHAPE_CYLINDER: return 3;
+    default: return 0;
     }
 }
 
-static void part_read_disc(case_doc *doc, case_part *part, const json_t *disc,
-                           const char *ptr)
+static const char *shapes_of_dimension(int dimension)
 {
-    if (!case_expect_object(doc, disc, ptr)) return;
-    case_check_keys(doc, disc, ptr, disc_keys, "a disc");
-    char at[CASE_POINTER];
-    json_t *center = case_member(disc, ptr, "center", at);
-    if (center) case_read_vec2(doc, center, at, part->at);
-    if (case_number_member(doc, disc, ptr, "radius", 1, &part->radius)) {
-        pointer_join(at, sizeof at, ptr, "radius");
-        if (!(part->radius > 0))
-            case_problem(doc, at, "radius must be > 0, got %g", part->radius);
-        else if (!isfinite(fabs(part->at[0]) + fabs(part->at[1]) + 2 * part->radius))
-            case_problem(doc, at, "the disc reaches beyond the range of numbers");
-    }
-    json_t *divisions = case_member(disc, ptr, "divisions", at);
-    if (!divisions)
-        case_problem(doc, ptr, "missing required \"divisions\" (nodes on the rim, at least 6)");
+    return dimension == 3 ? "box, sphere, cylinder, mesh or gmsh"
+                          : "rectangle, disc, mesh or gmsh";
+}
+
+/* 1 when the shape belongs to the case's dimension, else a problem at it. */
+static int shape_fits_dimension(case_doc *doc, case_shape shape, const char *ptr)
+{
+    int only = shape_dimension(shape);
+    if (only == 0 || only == doc->dimension) return 1;
+    const char *name = case_shape_keys[shape - 1];
+    if (only == 3)
+        case_problem(doc, ptr, "\"%s\" is a 3D shape and this case is 2D; set \"dimension\": "
+                               "3 at the top of the case, or use a %s", name,
+                     shapes_of_dimension(2));
     else
-        case_read_integer(doc, divisions, at, 6, PART_DIVISIONS_MAX, &part->divisions[0]);
-}
-
-/* Explicit nodes [[x, y], ...]; each bad node is reported. */
-static int part_read_nodes(case_doc *doc, fdem_mesh *mesh, const json_t *nodes,
-                           const char *ptr)
-{
-    if (!case_expect_array(doc, nodes, ptr)) return 0;
-    size_t count = json_array_size(nodes);
-    if (count < 3 || count > INT_MAX / 2) {
-        case_problem(doc, ptr, "a mesh needs at least 3 nodes, got %zu", count);
-        return 0;
-    }
-    mesh->xy = malloc(2 * count * sizeof *mesh->xy);
-    if (!mesh->xy) {
-        case_problem(doc, ptr, "out of memory");
-        return 0;
-    }
-    mesh->node_count = (int)count;
-    int ok = 1;
-    for (size_t i = 0; i < count; i++) {
-        char at[CASE_POINTER];
-        pointer_join_index(at, sizeof at, ptr, (long)i);
-        ok &= case_read_vec2(doc, json_array_get(nodes, i), at, &mesh->xy[2 * i]);
-    }
-    return ok;
-}
-
-/* Triangles [[i, j, k], ...] with 0-based indices into the nodes. */
-static int part_read_triangles(case_doc *doc, fdem_mesh *mesh, const json_t *triangles,
-                               const char *ptr, int node_count)
-{
-    if (!case_expect_array(doc, triangles, ptr)) return 0;
-    size_t count = json_array_size(triangles);
-    if (count < 1 || count > INT_MAX / 3) {
-        case_problem(doc, ptr, "a mesh needs at least one triangle");
-        return 0;
-    }
-    mesh->tri = malloc(3 * count * sizeof *mesh->tri);
-    if (!mesh->tri) {
-        case_problem(doc, ptr, "out of memory");
-        return 0;
-    }
-    mesh->triangle_count = (int)count;
-    int ok = 1;
-    for (size_t t = 0; t < count; t++) {
-        char at[CASE_POINTER];
-        pointer_join_index(at, sizeof at, ptr, (long)t);
-        json_t *tri = json_array_get(triangles, t);
-        if (!json_is_array(tri) || json_array_size(tri) != 3) {
-            case_problem(doc, at, "expected three node indices [i, j, k], got %s%s",
-                         case_type_word(tri), json_is_array(tri) ? " of another length" : "");
-            ok = 0;
-            continue;
-        }
-        for (int k = 0; k < 3; k++) {
-            char item[CASE_POINTER];
-            long index = 0;
-            pointer_join_index(item, sizeof item, at, k);
-            json_t *v = json_array_get(tri, (size_t)k);
-            if (!case_read_integer(doc, v, item, 0, LONG_MAX, &index)) {
-                ok = 0;
-            } else if (node_count > 0 && index >= node_count) {
-                case_problem(doc, at, "node index %ld is out of range: the mesh has %d nodes "
-                                      "(indices 0 to %d)", index, node_count, node_count - 1);
-                ok = 0;
-            } else {
-                mesh->tri[3 * t + (size_t)k] = (int32_t)index;
-            }
-        }
-    }
-    return ok;
-}
-
-/* Runs the engine's mesh check (finite nodes, zero areas, unused nodes;
- * reorients clockwise triangles) and maps the item it names to a pointer. */
-static void part_validate_mesh(case_doc *doc, case_part *part, const char *ptr)
-{
-    int reoriented = 0;
-    fdem_error err = {0};
-    if (fdem_mesh_validate(&part->mesh, &reoriented, &err) == 0) return;
-    char at[CASE_POINTER];
-    const char *list = err.kind == FDEM_ITEM_NODE ? "nodes" : "triangles";
-    if (part->shape == CASE_SHAPE_GMSH) {
-        case_problem(doc, ptr, "in the gmsh mesh: %s", err.message);
-    } else if ((err.kind == FDEM_ITEM_TRIANGLE || err.kind == FDEM_ITEM_NODE) && err.item >= 0) {
-        char list_ptr[CASE_POINTER];
-        pointer_join(list_ptr, sizeof list_ptr, ptr, list);
-        pointer_join_index(at, sizeof at, list_ptr, err.item);
-        case_problem(doc, at, "%s", err.message);
-    } else {
-        case_problem(doc, ptr, "%s", err.message);
-    }
-}
-
-static void part_read_mesh(case_doc *doc, case_part *part, const json_t *mesh,
-                           const char *ptr)
-{
-    if (!case_expect_object(doc, mesh, ptr)) return;
-    case_check_keys(doc, mesh, ptr, mesh_keys, "a mesh");
-    char nodes_ptr[CASE_POINTER], tri_ptr[CASE_POINTER];
-    json_t *nodes = case_member(mesh, ptr, "nodes", nodes_ptr);
-    json_t *triangles = case_member(mesh, ptr, "triangles", tri_ptr);
-    if (!nodes) case_problem(doc, ptr, "missing required \"nodes\" [[x, y], ...]");
-    if (!triangles) case_problem(doc, ptr, "missing required \"triangles\" [[i, j, k], ...]");
-    if (!nodes || !triangles) return;
-    int ok = part_read_nodes(doc, &part->mesh, nodes, nodes_ptr);
-    ok &= part_read_triangles(doc, &part->mesh, triangles, tri_ptr, part->mesh.node_count);
-    if (ok) part_validate_mesh(doc, part, ptr);
-}
-
-static void part_read_gmsh(case_doc *doc, case_part *part, const json_t *text,
-                           const char *ptr)
-{
-    if (!json_is_string(text)) {
-        case_problem(doc, ptr, "expected the text of a .msh file, got %s", case_type_word(text));
-        return;
-    }
-    char message[400];
-    if (gmsh_read(json_string_value(text), json_string_length(text), &part->mesh, message,
-                  sizeof message) < 0) {
-        case_problem(doc, ptr, "%s", message);
-        return;
-    }
-    part_validate_mesh(doc, part, ptr);
+        case_problem(doc, ptr, "\"%s\" is a 2D shape and this case has \"dimension\": 3; use "
+                               "a %s", name, shapes_of_dimension(3));
+    return 0;
 }
 
 /* Exactly one of the shape keys; the pointer of the part names the problem. */
@@ -217,15 +64,16 @@ static void part_read_shape(case_doc *doc, case_part *part, const json_t *value,
                             const char *ptr)
 {
     int found = 0;
-    char list[64] = "";
-    for (int s = 0; s < 4; s++) {
-        if (!json_object_get(value, shape_keys[s])) continue;
+    char list[128] = "";
+    for (int s = 0; s < CASE_SHAPE_KINDS; s++) {
+        if (!json_object_get(value, case_shape_keys[s])) continue;
         if (found++ == 0) part->shape = (case_shape)(CASE_SHAPE_RECTANGLE + s);
         size_t n = strlen(list);
-        snprintf(list + n, sizeof list - n, "%s%s", n ? " and " : "", shape_keys[s]);
+        snprintf(list + n, sizeof list - n, "%s%s", n ? " and " : "", case_shape_keys[s]);
     }
     if (found == 0) {
-        case_problem(doc, ptr, "a part needs a shape: one of rectangle, disc, mesh or gmsh");
+        case_problem(doc, ptr, "a part needs a shape: one of %s",
+                     shapes_of_dimension(doc->dimension));
         return;
     }
     if (found > 1) {
@@ -234,12 +82,19 @@ static void part_read_shape(case_doc *doc, case_part *part, const json_t *value,
         return;
     }
     char at[CASE_POINTER];
-    const json_t *shape = case_member(value, ptr, shape_keys[part->shape - 1], at);
+    const json_t *shape = case_member(value, ptr, case_shape_keys[part->shape - 1], at);
+    if (!shape_fits_dimension(doc, part->shape, at)) {
+        part->shape = CASE_SHAPE_NONE;
+        return;
+    }
     switch (part->shape) {
-    case CASE_SHAPE_RECTANGLE: part_read_rectangle(doc, part, shape, at); break;
-    case CASE_SHAPE_DISC: part_read_disc(doc, part, shape, at); break;
-    case CASE_SHAPE_MESH: part_read_mesh(doc, part, shape, at); break;
-    case CASE_SHAPE_GMSH: part_read_gmsh(doc, part, shape, at); break;
+    case CASE_SHAPE_RECTANGLE:
+    case CASE_SHAPE_BOX: case_read_block(doc, part, shape, at); break;
+    case CASE_SHAPE_DISC:
+    case CASE_SHAPE_SPHERE: case_read_round(doc, part, shape, at); break;
+    case CASE_SHAPE_CYLINDER: case_read_cylinder(doc, part, shape, at); break;
+    case CASE_SHAPE_MESH: case_read_mesh(doc, part, shape, at); break;
+    case CASE_SHAPE_GMSH: case_read_gmsh(doc, part, shape, at); break;
     case CASE_SHAPE_NONE: break;
     }
 }
@@ -296,12 +151,17 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
 {
     char at[CASE_POINTER];
     json_t *fracture = case_member(value, ptr, "fracture", at);
-    if (fracture && case_read_bool(doc, fracture, at, &part->fracture) && part->fracture &&
-        part->material >= 0 && !doc->materials[part->material].def.has_fracture)
-        case_problem(doc, at, "\"fracture\": true needs a \"fracture\" block in material "
-                              "\"%.64s\"", doc->materials[part->material].name);
+    if (fracture && case_read_bool(doc, fracture, at, &part->fracture) && part->fracture) {
+        if (doc->dimension == 3)
+            case_problem(doc, at, "fracture of 3D parts is not built yet: a part of a case "
+                                  "with \"dimension\": 3 cannot have \"fracture\": true");
+        else if (part->material >= 0 && !doc->materials[part->material].def.has_fracture)
+            case_problem(doc, at, "\"fracture\": true needs a \"fracture\" block in material "
+                                  "\"%.64s\"", doc->materials[part->material].name);
+    }
     json_t *velocity = case_member(value, ptr, "velocity", at);
-    if (velocity) part->has_velocity = case_read_vec2(doc, velocity, at, part->velocity);
+    if (velocity)
+        part->has_velocity = case_read_vector(doc, velocity, at, doc->dimension, part->velocity);
 }
 
 static void part_read(case_doc *doc, case_part *part, int index, const json_t *value)
@@ -363,53 +223,38 @@ void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr)
     if (shape == CASE_SHAPE_NONE)
         snprintf(ptr, CASE_POINTER, "%s", base);
     else
-        pointer_join(ptr, CASE_POINTER, base, shape_keys[shape - 1]);
+        pointer_join(ptr, CASE_POINTER, base, case_shape_keys[shape - 1]);
+}
+
+static int part_add_mesh(const case_doc *doc, fdem_model *model, case_part *part,
+                         fdem_error *err)
+{
+    if (doc->dimension == 3)
+        return fdem_add_part_3d(model, &part->tet_mesh, part->material, part->fracture, err);
+    return fdem_add_part(model, &part->mesh, part->material, part->fracture, err);
 }
 
 /* Generated shapes are meshed here, after the memory check. */
-static int part_generate(case_part *part, fdem_error *err)
-{
-    if (part->shape == CASE_SHAPE_RECTANGLE)
-        return fdem_mesh_rectangle(part->at[0], part->at[1], part->size[0], part->size[1],
-                                   (int)part->divisions[0], (int)part->divisions[1],
-                                   &part->mesh, err);
-    if (part->shape == CASE_SHAPE_DISC)
-        return fdem_mesh_disc(part->at[0], part->at[1], part->radius,
-                              (int)part->divisions[0], &part->mesh, err);
-    return 0;
-}
-
 static int part_add(case_doc *doc, fdem_model *model, int i)
 {
     case_part *part = &doc->parts[i];
-    char ptr[CASE_POINTER];
+    char part_ptr[CASE_POINTER], ptr[CASE_POINTER];
     fdem_error err = {0};
+    pointer_join_index(part_ptr, sizeof part_ptr, "/parts", i);
     case_part_mesh_pointer(doc, i, ptr);
-    if (part_generate(part, &err) < 0) {
+    if (case_generate_shape(part, &err) < 0) {
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }
-    int index = fdem_add_part(model, &part->mesh, part->material, part->fracture, &err);
-    if (part->shape == CASE_SHAPE_RECTANGLE || part->shape == CASE_SHAPE_DISC)
-        fdem_mesh_free(&part->mesh); /* the engine keeps its own copy */
+    int index = part_add_mesh(doc, model, part, &err);
+    fdem_mesh_free(&part->mesh); /* the engine keeps its own copy */
+    fdem_tet_mesh_free(&part->tet_mesh);
     if (index != i) {
-        if (part->shape == CASE_SHAPE_MESH &&
-            (err.kind == FDEM_ITEM_TRIANGLE || err.kind == FDEM_ITEM_NODE) && err.item >= 0) {
-            char list[CASE_POINTER], at[CASE_POINTER];
-            pointer_join(list, sizeof list, ptr,
-                         err.kind == FDEM_ITEM_NODE ? "nodes" : "triangles");
-            pointer_join_index(at, sizeof at, list, err.item);
-            case_problem(doc, at, "%s", err.message);
-        } else {
-            pointer_join_index(ptr, sizeof ptr, "/parts", i);
-            case_problem(doc, ptr, "%s", err.message);
-        }
+        case_mesh_problem(doc, i, &err, part_ptr);
         return -1;
     }
-    if (part->has_velocity &&
-        fdem_set_part_velocity(model, i, part->velocity[0], part->velocity[1], &err) < 0) {
-        pointer_join_index(ptr, sizeof ptr, "/parts", i);
-        pointer_join(ptr, sizeof ptr, ptr, "velocity");
+    if (part->has_velocity && fdem_set_part_velocity_v(model, i, part->velocity, &err) < 0) {
+        pointer_join(ptr, sizeof ptr, part_ptr, "velocity");
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }

@@ -74,15 +74,30 @@ int case_read_number(case_doc *doc, const json_t *value, const char *ptr, double
     return 1;
 }
 
-int case_read_vec2(case_doc *doc, const json_t *value, const char *ptr, double out[2])
+const char *case_count_word(int count)
 {
-    if (!json_is_array(value) || json_array_size(value) != 2) {
-        case_problem(doc, ptr, "expected an array of two numbers, got %s%s",
-                     case_type_word(value), json_is_array(value) ? " of another length" : "");
-        return 0;
-    }
+    static const char *const words[] = {"zero", "one", "two", "three", "four", "five", "six"};
+    return count >= 0 && count <= 6 ? words[count] : "several";
+}
+
+/* 1 when `value` is an array of exactly `count` items, else a problem
+ * "expected an array of three numbers [layout], got ...". */
+static int case_expect_tuple(case_doc *doc, const json_t *value, const char *ptr, int count,
+                             const char *items, const char *layout)
+{
+    if (json_is_array(value) && json_array_size(value) == (size_t)count) return 1;
+    case_problem(doc, ptr, "expected an array of %s %s%s%s, got %s%s", case_count_word(count),
+                 items, layout[0] ? " " : "", layout, case_type_word(value),
+                 json_is_array(value) ? " of another length" : "");
+    return 0;
+}
+
+int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
+                     double *out)
+{
+    if (!case_expect_tuple(doc, value, ptr, count, "numbers", "")) return 0;
     int ok = 1;
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < count; k++) {
         char item[CASE_POINTER];
         pointer_join_index(item, sizeof item, ptr, k);
         ok &= case_read_number(doc, json_array_get(value, (size_t)k), item, &out[k]);
@@ -112,6 +127,19 @@ int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long 
     }
     *out = (long)v; /* in range, so the conversion is defined */
     return 1;
+}
+
+int case_read_integers(case_doc *doc, const json_t *value, const char *ptr, int count,
+                       const long *lo, long hi, const char *layout, long *out)
+{
+    if (!case_expect_tuple(doc, value, ptr, count, "whole numbers", layout)) return 0;
+    int ok = 1;
+    for (int k = 0; k < count; k++) {
+        char item[CASE_POINTER];
+        pointer_join_index(item, sizeof item, ptr, k);
+        ok &= case_read_integer(doc, json_array_get(value, (size_t)k), item, lo[k], hi, &out[k]);
+    }
+    return ok;
 }
 
 int case_read_bool(case_doc *doc, const json_t *value, const char *ptr, int *out)

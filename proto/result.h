@@ -20,8 +20,11 @@
  *  - result_check_file() opens a closed result file read-only and says
  *    whether it is whole (a truncated or replaced file is refused).
  *  - xdmf_write() rewrites the XDMF2 sidecar atomically (temp + rename):
- *    a temporal collection with one grid per snapshot, Triangle topology,
- *    XY geometry and attributes as HyperSlabs into the .h5 file.
+ *    a temporal collection with one grid per snapshot, Triangle topology
+ *    and XY geometry (3D: Tetrahedron, XYZ) and attributes as HyperSlabs
+ *    into the .h5 file.
+ *  - Both dimensions share one layout (contract 5.2); the root attribute
+ *    `dimension` says which, and /mesh/triangles becomes /mesh/tetrahedra.
  */
 #ifndef FDEM_RESULT_H
 #define FDEM_RESULT_H

@@ -13,7 +13,7 @@
  *    snapshot. A failed append leaves time alone, and the next append
  *    overwrites the partial rows because extents are absolute.
  *  - a crash leaves the superblock marked "open for writing"; reopening
- *    clears the mark through the "clear_status_flags" file-access property
+ *    (result_reopen.c) clears the mark through the "clear_status_flags" file-access property
  *    (the one `h5clear -s` sets; present in HDF5 1.10 and later), then
  *    trims every dataset to the committed length and to keep_until_step.
  *  - a download copy is a byte copy taken between appends (the writer has
@@ -28,71 +28,36 @@
  * filled chunk whole.
  *
  * A model without constraints still gets /snapshots/constraint_force with
- * shape (S, 0, 2) (axis 1 declared unlimited, since a chunk cannot be wider
- * than a fixed zero extent), so readers can index it uniformly.
+ * shape (S, 0, dimension) (axis 1 declared unlimited, since a chunk cannot
+ * be wider than a fixed zero extent), so readers can index it uniformly.
+ *
+ * Both dimensions share the layout (contract 5.2): node rows and constraint
+ * forces have `dimension` columns, stress rows fdem_stress_components(), and
+ * the elements are /mesh/triangles (E, 3) in 2D or /mesh/tetrahedra (E, 4)
+ * in 3D; the root attribute `dimension` says which.
  *
  * Not thread-safe: one I/O thread owns every result_file (see result.h).
  */
 #include "result.h"
+#include "result_internal.h"
 
-#include <errno.h>
-#include <fcntl.h>
 #include <hdf5.h>
-#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#define RESULT_FORMAT "fdem-result/1"
 #define CHUNK_SMALL_BYTES (8u * 1024u)
 #define CHUNK_MAX_BYTES (1024u * 1024u)
 #define CHUNK_MAX_SNAPSHOTS 1024u
 
-/* The /snapshots datasets in append order: time must stay last. */
-enum series_kind {
-    SERIES_STEP,
-    SERIES_POSITION,
-    SERIES_VELOCITY,
-    SERIES_STRESS,
-    SERIES_DAMAGE,
-    SERIES_CONSTRAINT_FORCE,
-    SERIES_KINETIC,
-    SERIES_ELASTIC,
-    SERIES_CONTACT,
-    SERIES_FRICTION,
-    SERIES_JOINT,
-    SERIES_FRACTURE,
-    SERIES_DAMPING,
-    SERIES_GRAVITY_WORK,
-    SERIES_EXTERNAL_WORK,
-    SERIES_TIME,
-    SERIES_COUNT
-};
-
-static const char *const series_names[SERIES_COUNT] = {
+const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage",
     "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
-};
-
-typedef struct series {
-    hid_t id;       /* H5I_INVALID_HID when the model does not have it */
-    int rank;       /* including the snapshot axis */
-    hsize_t row[2]; /* per-snapshot extent after the snapshot axis */
-} series;
-
-struct result_file {
-    hid_t file;
-    series ds[SERIES_COUNT];
-    int count;     /* complete snapshots (= len(/snapshots/time)) */
-    double *times; /* the time of each of them, for the XDMF sidecar */
-    int times_capacity;
 };
 
 /* ------------------------------------------------------------------ errors */
@@ -112,9 +77,7 @@ static herr_t h5_error_visit(unsigned n, const H5E_error2_t *e, void *data)
 }
 
 /* Formats "what: innermost HDF5 message" into err and clears the stack. */
-static void result_fail(char *err, size_t errlen, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
-static void result_fail(char *err, size_t errlen, const char *fmt, ...)
+void result_fail(char *err, size_t errlen, const char *fmt, ...)
 {
     h5_message m = {{0}};
     H5Ewalk2(H5E_DEFAULT, H5E_WALK_DOWNWARD, h5_error_visit, &m);
@@ -134,7 +97,7 @@ static void result_fail(char *err, size_t errlen, const char *fmt, ...)
 /* HDF5 prints its error stack to stderr by default; the daemon reports
  * errors through `err` instead. The setting is per thread in thread-safe
  * builds, so every entry point repeats it. */
-static void h5_quiet(void)
+void h5_quiet(void)
 {
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 }
@@ -173,9 +136,8 @@ static int write_scalar_attribute(hid_t obj, const char *name, hid_t file_type,
     return rc;
 }
 
-static int write_root_attributes(hid_t file, const case_info *info, double dt)
+static int write_root_attributes(hid_t file, const case_info *info, int dimension, double dt)
 {
-    int dimension = 2;
     const char *name = info && info->name[0] ? info->name : "";
     if (write_string_attribute(file, "format", RESULT_FORMAT) < 0) return -1;
     if (write_string_attribute(file, "name", name) < 0) return -1;
@@ -185,7 +147,7 @@ static int write_root_attributes(hid_t file, const case_info *info, double dt)
 }
 
 /* 1 when the file's root says format = "fdem-result/1". */
-static int has_result_format(hid_t file)
+int has_result_format(hid_t file)
 {
     if (H5Aexists(file, "format") <= 0) return 0;
     hid_t attr = H5Aopen(file, "format", H5P_DEFAULT);
@@ -224,6 +186,8 @@ static int write_mesh_array(hid_t group, const char *name, hid_t file_type, hid_
 static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t errlen)
 {
     fdem_counts c = fdem_get_counts(model);
+    int dim = fdem_get_dimension(model);
+    const char *elements = dim == 3 ? "tetrahedra" : "triangles";
     hid_t group = H5Gcreate2(file, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (group < 0) {
         result_fail(err, errlen, "cannot create group /mesh");
@@ -235,12 +199,14 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
         const void *data;
         int rows, width;
     } arrays[] = {
-        {"position0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_initial_positions(model), c.nodes, 2},
-        {"triangles", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_triangles(model), c.elements, 3},
+        {"position0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_initial_positions(model), c.nodes,
+         dim},
+        {elements, H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_element_nodes(model), c.elements,
+         fdem_nodes_per_element(model)},
         {"node_mass", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, fdem_node_masses(model), c.nodes, 0},
         {"node_part", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_node_parts(model), c.nodes, 0},
         {"element_part", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_element_parts(model), c.elements, 0},
-        {"joints", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_joints(model), c.joints, 4},
+        {"joints", H5T_STD_I32LE, H5T_NATIVE_INT32, fdem_joints(model), c.joints, 2 * dim},
     };
     int rc = 0;
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0] && rc == 0; i++) {
@@ -266,7 +232,7 @@ static hid_t series_file_type(int kind)
     return kind == SERIES_STEP ? H5T_STD_I64LE : H5T_IEEE_F64LE;
 }
 
-static hid_t series_mem_type(int kind)
+hid_t series_mem_type(int kind)
 {
     return kind == SERIES_STEP ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
 }
@@ -274,20 +240,22 @@ static hid_t series_mem_type(int kind)
 /* Which datasets this model has and their per-snapshot shape. Damage is
  * stored whenever the model has joints (contract: "when some part
  * fractures"), the node and element fields only when requested. */
-static void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
+void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
+    int dim = fdem_get_dimension(model);
     for (int k = 0; k < SERIES_COUNT; k++) {
         ds[k].id = H5I_INVALID_HID;
         ds[k].rank = 1;
         ds[k].row[0] = ds[k].row[1] = 0;
     }
     struct { int kind, present, rows, width; } shapes[] = {
-        {SERIES_POSITION, (fields & CASE_FIELD_POSITION) != 0, c.nodes, 2},
-        {SERIES_VELOCITY, (fields & CASE_FIELD_VELOCITY) != 0, c.nodes, 2},
-        {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements, 3},
+        {SERIES_POSITION, (fields & CASE_FIELD_POSITION) != 0, c.nodes, dim},
+        {SERIES_VELOCITY, (fields & CASE_FIELD_VELOCITY) != 0, c.nodes, dim},
+        {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements,
+         fdem_stress_components(model)},
         {SERIES_DAMAGE, c.joints > 0, c.joints, 0},
-        {SERIES_CONSTRAINT_FORCE, 1, c.constraints, 2},
+        {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
         series *s = &ds[shapes[i].kind];
@@ -372,7 +340,7 @@ static int series_write_row(const series *s, int kind, hsize_t length, const voi
 {
     hsize_t dims[3] = {length, s->row[0], s->row[1]};
     if (H5Dset_extent(s->id, dims) < 0) return -1;
-    if (series_row_elements(s) == 0) return 0; /* (S, 0, 2): nothing to write */
+    if (series_row_elements(s) == 0) return 0; /* (S, 0, dim): nothing to write */
     hsize_t start[3] = {length - 1, 0, 0};
     hsize_t count[3] = {1, s->row[0], s->row[1]};
     hid_t file_space = H5Dget_space(s->id);
@@ -408,7 +376,7 @@ static int create_snapshot_series(result_file *f, char *err, size_t errlen)
 
 /* Latest format: required for SWMR, and its extensible-array chunk index
  * makes appending one row cheap. */
-static hid_t file_access_latest(int clear_status_flags)
+hid_t file_access_latest(int clear_status_flags)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     if (fapl < 0) return fapl;
@@ -425,7 +393,7 @@ fail:
     return H5I_INVALID_HID;
 }
 
-static result_file *result_alloc(void)
+result_file *result_alloc(void)
 {
     result_file *f = calloc(1, sizeof *f);
     if (!f) return NULL;
@@ -435,7 +403,7 @@ static result_file *result_alloc(void)
 }
 
 /* Closes every handle; returns -1 if HDF5 reported a failure. */
-static int result_release(result_file *f)
+int result_release(result_file *f)
 {
     int rc = 0;
     for (int k = 0; k < SERIES_COUNT; k++)
@@ -459,7 +427,7 @@ static int times_push(result_file *f, double t)
     return 0;
 }
 
-static int start_swmr(result_file *f, const char *path, char *err, size_t errlen)
+int start_swmr(result_file *f, const char *path, char *err, size_t errlen)
 {
     if (H5Fflush(f->file, H5F_SCOPE_LOCAL) < 0 || H5Fstart_swmr_write(f->file) < 0) {
         result_fail(err, errlen, "cannot start SWMR writing of %s", path);
@@ -490,7 +458,7 @@ result_file *result_create(const char *path, const fdem_model *model,
         result_fail(err, errlen, "cannot create result file %s", path);
         goto fail;
     }
-    if (write_root_attributes(f->file, info, fdem_get_dt(model)) < 0) {
+    if (write_root_attributes(f->file, info, fdem_get_dimension(model), fdem_get_dt(model)) < 0) {
         result_fail(err, errlen, "cannot write the root attributes of %s", path);
         goto fail;
     }
@@ -594,174 +562,6 @@ int result_close(result_file *f)
     H5Eclear2(H5E_DEFAULT);
     return rc;
 }
-
-/* ------------------------------------------------------------------ reopen */
-
-/* Opens /snapshots/<name> and checks it has the shape this model needs. */
-static int series_open(hid_t group, int kind, series *s, char *err, size_t errlen)
-{
-    if (s->rank == 0) return 0;
-    if (H5Lexists(group, series_names[kind], H5P_DEFAULT) <= 0) {
-        snprintf(err, errlen, "the result file has no /snapshots/%s; it was written for "
-                 "a different case or output fields", series_names[kind]);
-        return -1;
-    }
-    s->id = H5Dopen2(group, series_names[kind], H5P_DEFAULT);
-    if (s->id < 0) {
-        result_fail(err, errlen, "cannot open /snapshots/%s", series_names[kind]);
-        return -1;
-    }
-    hid_t space = H5Dget_space(s->id);
-    hsize_t dims[3] = {0, 0, 0};
-    int rank = space >= 0 ? H5Sget_simple_extent_dims(space, dims, NULL) : -1;
-    if (space >= 0) H5Sclose(space);
-    if (rank != s->rank || (rank >= 2 && dims[1] != s->row[0]) ||
-        (rank == 3 && dims[2] != s->row[1])) {
-        snprintf(err, errlen, "/snapshots/%s in the result file does not match the model's "
-                 "node, element, joint or constraint count", series_names[kind]);
-        return -1;
-    }
-    return 0;
-}
-
-static hsize_t series_length(const series *s)
-{
-    hsize_t dims[3] = {0, 0, 0};
-    hid_t space = H5Dget_space(s->id);
-    if (space < 0) return 0;
-    H5Sget_simple_extent_dims(space, dims, NULL);
-    H5Sclose(space);
-    return dims[0];
-}
-
-/* Reads the first `count` entries of a 1-D series. */
-static int series_read_head(const series *s, int kind, hsize_t count, void *out)
-{
-    if (count == 0) return 0;
-    hsize_t start = 0;
-    hid_t file_space = H5Dget_space(s->id);
-    hid_t mem_space = H5Screate_simple(1, &count, NULL);
-    int rc = -1;
-    if (file_space >= 0 && mem_space >= 0 &&
-        H5Sselect_hyperslab(file_space, H5S_SELECT_SET, &start, NULL, &count, NULL) >= 0 &&
-        H5Dread(s->id, series_mem_type(kind), mem_space, file_space, H5P_DEFAULT, out) >= 0)
-        rc = 0;
-    if (mem_space >= 0) H5Sclose(mem_space);
-    if (file_space >= 0) H5Sclose(file_space);
-    return rc;
-}
-
-/* How many snapshots survive: rows every dataset holds (a crash may have
- * left some longer than time), and of those the ones up to keep_until_step.
- * Fills f->times for them. */
-static int committed_snapshots(result_file *f, int64_t keep_until_step, hsize_t *keep,
-                               char *err, size_t errlen)
-{
-    hsize_t committed = series_length(&f->ds[SERIES_TIME]);
-    for (int k = 0; k < SERIES_COUNT; k++)
-        if (f->ds[k].id >= 0 && series_length(&f->ds[k]) < committed)
-            committed = series_length(&f->ds[k]);
-    int64_t *steps = malloc((committed ? committed : 1) * sizeof *steps);
-    double *times = malloc((committed ? committed : 1) * sizeof *times);
-    int rc = -1;
-    if (!steps || !times) {
-        snprintf(err, errlen, "out of memory reading %llu snapshot steps",
-                 (unsigned long long)committed);
-    } else if (series_read_head(&f->ds[SERIES_STEP], SERIES_STEP, committed, steps) < 0 ||
-               series_read_head(&f->ds[SERIES_TIME], SERIES_TIME, committed, times) < 0) {
-        result_fail(err, errlen, "cannot read /snapshots/step and /snapshots/time");
-    } else {
-        hsize_t n = 0;
-        while (n < committed && steps[n] <= keep_until_step) n++;
-        *keep = n;
-        f->times = times;
-        f->times_capacity = (int)(committed ? committed : 1);
-        f->count = (int)n;
-        times = NULL;
-        rc = 0;
-    }
-    free(steps);
-    free(times);
-    return rc;
-}
-
-static int truncate_series(result_file *f, hsize_t length, char *err, size_t errlen)
-{
-    for (int k = 0; k < SERIES_COUNT; k++) {
-        series *s = &f->ds[k];
-        if (s->id < 0) continue;
-        hsize_t dims[3] = {length, s->row[0], s->row[1]};
-        if (H5Dset_extent(s->id, dims) < 0) {
-            result_fail(err, errlen, "cannot truncate /snapshots/%s to %llu snapshots",
-                        series_names[k], (unsigned long long)length);
-            return -1;
-        }
-    }
-    return 0;
-}
-
-static int open_snapshot_series(result_file *f, char *err, size_t errlen)
-{
-    hid_t group = H5Gopen2(f->file, "snapshots", H5P_DEFAULT);
-    if (group < 0) {
-        result_fail(err, errlen, "the result file has no /snapshots group");
-        return -1;
-    }
-    int rc = 0;
-    for (int k = 0; k < SERIES_COUNT && rc == 0; k++)
-        rc = series_open(group, k, &f->ds[k], err, errlen);
-    H5Gclose(group);
-    return rc;
-}
-
-result_file *result_reopen(const char *path, const fdem_model *model,
-                           const case_info *info, int64_t keep_until_step,
-                           char *err, size_t errlen)
-{
-    h5_quiet();
-    if (!path || !model || !info) {
-        snprintf(err, errlen, "result_reopen: missing path, model or case info");
-        return NULL;
-    }
-    if (access(path, F_OK) != 0) {
-        snprintf(err, errlen, "cannot reopen result file %s: %s", path, strerror(errno));
-        return NULL;
-    }
-    result_file *f = result_alloc();
-    if (!f) {
-        snprintf(err, errlen, "out of memory reopening %s", path);
-        return NULL;
-    }
-    hid_t fapl = file_access_latest(1);
-    if (fapl < 0) {
-        result_fail(err, errlen, "this HDF5 library cannot clear the status flags of %s "
-                    "(run `h5clear -s` on it)", path);
-        goto fail;
-    }
-    f->file = H5Fopen(path, H5F_ACC_RDWR, fapl);
-    H5Pclose(fapl);
-    if (f->file < 0) {
-        result_fail(err, errlen, "cannot reopen result file %s", path);
-        goto fail;
-    }
-    if (!has_result_format(f->file)) {
-        H5Eclear2(H5E_DEFAULT);
-        snprintf(err, errlen, "%s is not an fdem result file (no format = \"%s\")", path,
-                 RESULT_FORMAT);
-        goto fail;
-    }
-    series_layout(f->ds, model, info->fields);
-    if (open_snapshot_series(f, err, errlen) < 0) goto fail;
-    hsize_t keep = 0;
-    if (committed_snapshots(f, keep_until_step, &keep, err, errlen) < 0) goto fail;
-    if (truncate_series(f, keep, err, errlen) < 0) goto fail;
-    if (start_swmr(f, path, err, errlen) < 0) goto fail;
-    return f;
-fail:
-    result_release(f);
-    return NULL;
-}
-
 /* ----------------------------------------------------------- downloads */
 
 int result_flush(result_file *f, char *err, size_t errlen)
@@ -769,34 +569,6 @@ int result_flush(result_file *f, char *err, size_t errlen)
     h5_quiet();
     if (!f || H5Fflush(f->file, H5F_SCOPE_LOCAL) < 0) {
         result_fail(err, errlen, "cannot flush the result file");
-        return -1;
-    }
-    return 0;
-}
-
-int result_check_file(const char *path, char *err, size_t errlen)
-{
-    h5_quiet();
-    struct stat st;
-    if (stat(path, &st) != 0) {
-        snprintf(err, errlen, "%s: %s", path, strerror(errno));
-        return -1;
-    }
-    if (!S_ISREG(st.st_mode)) {
-        snprintf(err, errlen, "%s is not a regular file", path);
-        return -1;
-    }
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (file < 0) {
-        result_fail(err, errlen, "%s does not open as HDF5", path);
-        return -1;
-    }
-    int ok = has_result_format(file) && H5Lexists(file, "snapshots", H5P_DEFAULT) > 0;
-    H5Fclose(file);
-    H5Eclear2(H5E_DEFAULT);
-    if (!ok) {
-        snprintf(err, errlen, "%s is not an fdem result file (no format \"%s\" or no /snapshots)",
-                 path, RESULT_FORMAT);
         return -1;
     }
     return 0;

@@ -3,22 +3,25 @@
  * as a time series (XDMF2, read by ParaView's "XDMF Reader").
  *
  * Layout: a Temporal collection with one Uniform grid per complete snapshot.
- * Every grid shares /mesh/triangles as its Triangle topology; its XY
- * geometry and node/cell attributes are HyperSlab DataItems that pick row s
- * out of the (S, ...) datasets, so the sidecar holds no numbers of its own
- * and stays small.
+ * Every grid shares /mesh/triangles as its Triangle topology (2D) or
+ * /mesh/tetrahedra as its Tetrahedron topology (3D); its XY (XYZ) geometry
+ * and node/cell attributes are HyperSlab DataItems that pick row s out of
+ * the (S, ...) datasets, so the sidecar holds no numbers of its own and
+ * stays small. One writer serves both dimensions through the xdmf_ctx.
  *
  * Choices ParaView dictates:
  *  - velocity is a Node "Vector" with 2 components; VTK's XDMF2 reader pads
  *    2-component vectors with z = 0, so glyphs work.
- *  - stress is written as three Cell scalars stress_xx, stress_yy, stress_xy
- *    (hyperslabs picking one component each) rather than a fake 3-vector
+ *  - stress is written as Cell scalars stress_xx, stress_yy, stress_xy (3D:
+ *    stress_xx, stress_yy, stress_zz, stress_yz, stress_xz, stress_xy),
+ *    hyperslabs picking one component each, rather than a fake vector
  *    whose magnitude would mean nothing.
- *  - damage lives on joints, which are not cells of the triangle mesh: a
+ *  - damage lives on joints, which are not cells of the element mesh: a
  *    second Temporal collection ("joints", present when the model has
- *    joints) draws each joint as a line along its face A (columns a0, a1 of
- *    /mesh/joints) on the same moving nodes, with damage as its cell value.
- *    ParaView's reader turns the two collections into two blocks.
+ *    joints) draws each joint as its face A (columns a0, a1 of /mesh/joints
+ *    as a line in 2D; a0, a1, a2 as a triangle in 3D) on the same moving
+ *    nodes, with damage as its cell value. ParaView's reader turns the two
+ *    collections into two blocks.
  *  - node_part and element_part are static attributes from /mesh, handy for
  *    colouring bodies.
  *
@@ -36,6 +39,9 @@ typedef struct xdmf_ctx {
     FILE *out;
     char h5[1024]; /* XML-escaped file name the DataItems refer to */
     long nodes, elements, joints;
+    int dimension;         /* 2 or 3: columns of the node datasets */
+    int corners;           /* nodes per element */
+    int stress_components; /* 3 or 6 */
     int snapshots;
     unsigned fields;
 } xdmf_ctx;
@@ -100,29 +106,36 @@ static void xdmf_row_item(const xdmf_ctx *x, int s, long rows, int width, int wi
 static void xdmf_geometry(const xdmf_ctx *x, int s)
 {
     char dims[64];
-    fprintf(x->out, "      <Geometry GeometryType=\"XY\">\n");
+    fprintf(x->out, "      <Geometry GeometryType=\"%s\">\n", x->dimension == 3 ? "XYZ" : "XY");
     if (x->fields & CASE_FIELD_POSITION) {
-        xdmf_row_item(x, s, x->nodes, 2, -1, "position");
+        xdmf_row_item(x, s, x->nodes, x->dimension, -1, "position");
     } else {
-        snprintf(dims, sizeof dims, "%ld 2", x->nodes);
+        snprintf(dims, sizeof dims, "%ld %d", x->nodes, x->dimension);
         xdmf_mesh_item(x, dims, "Float", 8, "position0");
     }
     fprintf(x->out, "      </Geometry>\n");
 }
 
+/* Face A of each joint: a line (a0, a1) in 2D, a triangle (a0, a1, a2) in
+ * 3D, picked out of the (J, 2 * dimension) /mesh/joints. */
 static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
 {
     long J = x->joints;
+    int face = x->dimension, width = 2 * x->dimension;
     fprintf(x->out, "    <Grid Name=\"joints %d\" GridType=\"Uniform\">\n", s);
     fprintf(x->out, "      <Time Value=\"%.17g\"/>\n", time);
-    fprintf(x->out, "      <Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" "
-            "NumberOfElements=\"%ld\">\n", J);
-    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld 2\" "
-            "Type=\"HyperSlab\">\n", J);
+    if (face == 2)
+        fprintf(x->out, "      <Topology TopologyType=\"Polyline\" NodesPerElement=\"2\" "
+                "NumberOfElements=\"%ld\">\n", J);
+    else
+        fprintf(x->out, "      <Topology TopologyType=\"Triangle\" NumberOfElements=\"%ld\">\n",
+                J);
+    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld %d\" "
+            "Type=\"HyperSlab\">\n", J, face);
     fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
-            "0 0  1 1  %ld 2</DataItem>\n", J);
-    fprintf(x->out, "          <DataItem Dimensions=\"%ld 4\" NumberType=\"Int\" Precision=\"4\" "
-            "Format=\"HDF\">%s:/mesh/joints</DataItem>\n", J, x->h5);
+            "0 0  1 1  %ld %d</DataItem>\n", J, face);
+    fprintf(x->out, "          <DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" Precision=\"4\" "
+            "Format=\"HDF\">%s:/mesh/joints</DataItem>\n", J, width, x->h5);
     fprintf(x->out, "        </DataItem>\n");
     fprintf(x->out, "      </Topology>\n");
     xdmf_geometry(x, s);
@@ -144,10 +157,11 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     fprintf(x->out, "    <Grid Name=\"snapshot %d\" GridType=\"Uniform\">\n", s);
     fprintf(x->out, "      <Time Value=\"%.17g\"/>\n", time);
 
-    fprintf(x->out, "      <Topology TopologyType=\"Triangle\" NumberOfElements=\"%ld\">\n",
-            x->elements);
-    snprintf(dims, sizeof dims, "%ld 3", x->elements);
-    xdmf_mesh_item(x, dims, "Int", 4, "triangles");
+    int solid = x->dimension == 3;
+    fprintf(x->out, "      <Topology TopologyType=\"%s\" NumberOfElements=\"%ld\">\n",
+            solid ? "Tetrahedron" : "Triangle", x->elements);
+    snprintf(dims, sizeof dims, "%ld %d", x->elements, x->corners);
+    xdmf_mesh_item(x, dims, "Int", 4, solid ? "tetrahedra" : "triangles");
     fprintf(x->out, "      </Topology>\n");
 
     xdmf_geometry(x, s);
@@ -155,15 +169,18 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     if (x->fields & CASE_FIELD_VELOCITY) {
         fprintf(x->out, "      <Attribute Name=\"velocity\" AttributeType=\"Vector\" "
                 "Center=\"Node\">\n");
-        xdmf_row_item(x, s, x->nodes, 2, -1, "velocity");
+        xdmf_row_item(x, s, x->nodes, x->dimension, -1, "velocity");
         fprintf(x->out, "      </Attribute>\n");
     }
     if (x->fields & CASE_FIELD_STRESS) {
-        static const char *const names[3] = {"stress_xx", "stress_yy", "stress_xy"};
-        for (int k = 0; k < 3; k++) {
+        static const char *const plane[3] = {"stress_xx", "stress_yy", "stress_xy"};
+        static const char *const solid_names[6] = {"stress_xx", "stress_yy", "stress_zz",
+                                                   "stress_yz", "stress_xz", "stress_xy"};
+        const char *const *names = solid ? solid_names : plane;
+        for (int k = 0; k < x->stress_components; k++) {
             fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
                     "Center=\"Cell\">\n", names[k]);
-            xdmf_row_item(x, s, x->elements, 3, k, "stress");
+            xdmf_row_item(x, s, x->elements, x->stress_components, k, "stress");
             fprintf(x->out, "      </Attribute>\n");
         }
     }
@@ -209,6 +226,9 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
     }
     fdem_counts counts = fdem_get_counts(model);
     xdmf_ctx x = {.nodes = counts.nodes, .elements = counts.elements, .joints = counts.joints,
+                  .dimension = fdem_get_dimension(model),
+                  .corners = fdem_nodes_per_element(model),
+                  .stress_components = fdem_stress_components(model),
                   .snapshots = result_snapshot_count(f), .fields = info->fields};
     xml_escape(x.h5, sizeof x.h5, h5_name);
     char name[512];

@@ -31,10 +31,10 @@ static double *copy_doubles(const double *src, size_t count, int *failed)
     return dst;
 }
 
-static double *copy_stress(const fdem_model *model, size_t elements, int *failed)
+static double *copy_stress(const fdem_model *model, size_t values, int *failed)
 {
-    if (elements == 0) return NULL;
-    double *dst = malloc(3 * elements * sizeof *dst);
+    if (values == 0) return NULL;
+    double *dst = malloc(values * sizeof *dst);
     if (!dst) {
         *failed = 1;
         return NULL;
@@ -56,20 +56,23 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
     s->elements = counts.elements;
     s->joints = counts.joints;
     s->constraints = counts.constraints;
+    s->dimension = fdem_get_dimension(model);
+    s->stress_components = fdem_stress_components(model);
     s->energy = fdem_get_energy(model);
 
     int failed = 0;
+    size_t dim = (size_t)s->dimension;
     size_t nodes = (size_t)counts.nodes, elements = (size_t)counts.elements;
     if (fields & CASE_FIELD_POSITION) {
-        s->position = copy_doubles(fdem_positions(model), 2 * nodes, &failed);
+        s->position = copy_doubles(fdem_positions(model), dim * nodes, &failed);
         if (s->position) s->fields |= CASE_FIELD_POSITION;
     }
     if (fields & CASE_FIELD_VELOCITY) {
-        s->velocity = copy_doubles(fdem_velocities(model), 2 * nodes, &failed);
+        s->velocity = copy_doubles(fdem_velocities(model), dim * nodes, &failed);
         if (s->velocity) s->fields |= CASE_FIELD_VELOCITY;
     }
     if (fields & CASE_FIELD_STRESS) {
-        s->stress = copy_stress(model, elements, &failed);
+        s->stress = copy_stress(model, (size_t)s->stress_components * elements, &failed);
         if (s->stress) s->fields |= CASE_FIELD_STRESS;
     }
     if (counts.joints > 0) {
@@ -77,7 +80,7 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
         if (s->damage && (fields & CASE_FIELD_DAMAGE)) s->fields |= CASE_FIELD_DAMAGE;
     }
     s->constraint_force = copy_doubles(fdem_constraint_forces(model),
-                                       2 * (size_t)counts.constraints, &failed);
+                                       dim * (size_t)counts.constraints, &failed);
     if (failed) {
         snapshot_free(s);
         return NULL;

@@ -66,11 +66,11 @@ json_t *state_to_json(const snapshot *s)
     rc |= set_or_fail(obj, "step", json_integer((json_int_t)s->step));
     rc |= set_or_fail(obj, "time", number_or_null(s->time));
     if ((s->fields & CASE_FIELD_POSITION) && s->position)
-        rc |= set_or_fail(obj, "position", rows_to_json(s->position, s->nodes, 2));
+        rc |= set_or_fail(obj, "position", rows_to_json(s->position, s->nodes, s->dimension));
     if ((s->fields & CASE_FIELD_VELOCITY) && s->velocity)
-        rc |= set_or_fail(obj, "velocity", rows_to_json(s->velocity, s->nodes, 2));
+        rc |= set_or_fail(obj, "velocity", rows_to_json(s->velocity, s->nodes, s->dimension));
     if ((s->fields & CASE_FIELD_STRESS) && s->stress)
-        rc |= set_or_fail(obj, "stress", rows_to_json(s->stress, s->elements, 3));
+        rc |= set_or_fail(obj, "stress", rows_to_json(s->stress, s->elements, s->stress_components));
     if ((s->fields & CASE_FIELD_DAMAGE) && s->damage)
         rc |= set_or_fail(obj, "damage", list_to_json(s->damage, s->joints));
     if (rc != 0) {

@@ -2,8 +2,10 @@
  * state_json.h - engine state as the JSON of GET /cases/ID/state.
  *
  * Contract: {"step", "time", "<field>": ...} with position/velocity as
- * [[x, y], ...] per node, stress as [[sxx, syy, sxy], ...] per element and
- * damage as a number per joint; only the fields present in the snapshot.
+ * [[x, y], ...] per node ([[x, y, z], ...] in 3D), stress as
+ * [[sxx, syy, sxy], ...] per element ([[sxx, syy, szz, syz, sxz, sxy], ...]
+ * in 3D) and damage as a number per joint; only the fields present in the
+ * snapshot.
  */
 #ifndef FDEM_STATE_JSON_H
 #define FDEM_STATE_JSON_H

@@ -55,8 +55,8 @@ say "fdemctl wait $id"
 say "fdemctl status $id"
 "$BIN/fdemctl" status "$id"
 
-say "fdemctl fetch $id -o $OUT/$name.h5"
-"$BIN/fdemctl" fetch "$id" -o "$OUT/$name.h5"
+say "fdemctl fetch $id -o $OUT/$name.h5 --force"
+"$BIN/fdemctl" fetch "$id" -o "$OUT/$name.h5" --force   # the demo replaces its own output
 
 say "plot_result.py -> $OUT/$name.png"
 "$PYTHON" clients/python/plot_result.py "$OUT/$name.h5" -o "$OUT/$name.png"

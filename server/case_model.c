@@ -40,6 +40,7 @@ size_t case_model_cost_of(server_case *c)
 int case_model_gate(void *ctx, double estimate)
 {
     case_model_gate_ctx *g = ctx;
+    g->estimate = estimate;
     size_t cost = case_model_cost(estimate);
     /* The tree is gone by now; what the lease held for it is the model's. */
     size_t spare = g->lease->bytes > g->kept ? g->lease->bytes - g->kept : 0;
@@ -81,7 +82,7 @@ static case_model_rc case_model_parse(server_case *c, membudget_lease *lease, fd
     }
     problems p;
     problems_init(&p);
-    case_model_gate_ctx gate = {lease, case_model_document_cost(size)};
+    case_model_gate_ctx gate = {lease, case_model_document_cost(size), 0};
     /* No --max-case-memory here: the case was admitted when it was stored,
      * and a lower limit since must not turn it into a broken case. */
     membudget_meter_begin(lease, 0);
@@ -129,10 +130,10 @@ static case_model_rc case_model_restore(server_case *c, fdem_model *model, char 
 }
 
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
-                                    case_info *info, problems *p)
+                                    case_info *info, problems *p, double *model_bytes)
 {
     size_t kept = case_model_document_cost(size);
-    case_model_gate_ctx gate = {lease, kept};
+    case_model_gate_ctx gate = {lease, kept, 0};
     membudget_meter_begin(lease, lease->bytes > kept ? lease->bytes - kept : 0);
     fdem_model *model = case_build_gated(body, size, registry_config()->max_case_memory,
                                          case_model_gate, &gate, info, p);
@@ -145,6 +146,8 @@ fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lea
         problems_add(p, 503, "", "parsing this case needs more memory than the daemon has to "
                                  "spare now (--max-memory); try again later");
     }
+    if (model_bytes)
+        *model_bytes = gate.estimate;
     return model;
 }
 

@@ -39,14 +39,16 @@ size_t case_model_cost_of(server_case *c);
 typedef struct case_model_gate_ctx {
     membudget_lease *lease;
     size_t kept; /* bytes of the lease still in use while the model is built */
+    double estimate; /* the builder's estimate of the model's bytes, once asked */
 } case_model_gate_ctx;
 int case_model_gate(void *ctx, double estimate);
 
 /* case_build() of an upload: `lease` already holds the request's admission
  * (membudget_upload_cost); the JSON tree and the model are charged to it.
- * Memory short now is one problem with status 503. */
+ * Memory short now is one problem with status 503. model_bytes (may be
+ * NULL) gets the builder's estimate of the model (proto/case_memory.c). */
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
-                                    case_info *info, problems *p);
+                                    case_info *info, problems *p, double *model_bytes);
 case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_model **model,
                                case_info *info, char *err, size_t errlen);
 /* 0, or -1 with err when no result file could be opened or made. */

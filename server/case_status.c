@@ -6,6 +6,7 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <string.h>
@@ -18,9 +19,12 @@ void case_publish(server_case *c, const case_figures *fig)
 {
     pthread_mutex_lock(&c->lock);
     int snapshots = c->fig.snapshots;
+    double elapsed = c->fig.elapsed;
     c->fig = *fig;
     if (fig->snapshots < 0)
         c->fig.snapshots = snapshots;
+    if (fig->elapsed < 0)
+        c->fig.elapsed = elapsed;
     pthread_mutex_unlock(&c->lock);
 }
 
@@ -44,6 +48,7 @@ void case_publish_from_model(server_case *c)
     fig.counts = fdem_get_counts(c->model);
     fig.energy = fdem_get_energy(c->model);
     fig.snapshots = -1;
+    fig.elapsed = -1;
     case_publish(c, &fig);
 }
 
@@ -75,23 +80,54 @@ void case_energy_from_json(fdem_energy *energy, const json_t *o)
     }
 }
 
+void case_mark_ended_locked(server_case *c, case_state state)
+{
+    if (case_state_is_terminal(state) && !c->finished_at[0])
+        iso_time_now(c->finished_at, sizeof c->finished_at);
+}
+
+/* Progress 1 means finished: a case that has stepped to its end but is
+ * still writing its last snapshot (or was stopped there) shows just under
+ * it, so no client prints "running 100 %". */
+#define CASE_PROGRESS_UNFINISHED_MAX 0.999
+
+static double case_progress(case_state state, double time, double end)
+{
+    if (state == CASE_FINISHED)
+        return 1.0;
+    double progress = end > 0 ? time / end : 0.0;
+    if (!(progress >= 0))
+        progress = 0;
+    return progress > CASE_PROGRESS_UNFINISHED_MAX ? CASE_PROGRESS_UNFINISHED_MAX : progress;
+}
+
+/* A running case shows its current speed; any other the mean over every
+ * step it took (step / elapsed), so a finished case does not show 0. */
+static double case_steps_per_second(case_state state, const case_figures *f)
+{
+    if (state == CASE_RUNNING)
+        return f->steps_per_second;
+    return f->elapsed > 0 ? (double)f->step / f->elapsed : 0.0;
+}
+
+static json_t *json_string_or_null(const char *s)
+{
+    return s[0] ? json_string(s) : json_null();
+}
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);
     case_state state = c->state;
     case_figures f = c->fig;
-    char error[sizeof c->error];
+    char error[sizeof c->error], started[sizeof c->started], finished_at[sizeof c->finished_at];
     memcpy(error, c->error, sizeof error);
+    memcpy(started, c->started, sizeof started);
+    memcpy(finished_at, c->finished_at, sizeof finished_at);
     pthread_mutex_unlock(&c->lock);
 
     double end = c->info.end_time;
-    double progress = end > 0 ? f.time / end : 0.0;
-    if (!(progress >= 0))
-        progress = 0;
-    if (progress > 1)
-        progress = 1;
-    if (state == CASE_FINISHED)
-        progress = 1;
+    double progress = case_progress(state, f.time, end);
     json_t *energy = json_object();
     for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
         json_object_set_new(energy, energy_accounts[i].key,
@@ -114,9 +150,13 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
     json_object_set_new(o, "snapshots", json_integer(f.snapshots));
     json_object_set_new(o, "energy", energy ? energy : json_null());
-    json_object_set_new(o, "steps_per_second", json_number_or_null(f.steps_per_second));
+    json_object_set_new(o, "steps_per_second",
+                        json_number_or_null(case_steps_per_second(state, &f)));
     json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
     json_object_set_new(o, "created", json_string(c->created));
+    json_object_set_new(o, "started", json_string_or_null(started));
+    json_object_set_new(o, "finished_at", json_string_or_null(finished_at));
+    json_object_set_new(o, "elapsed", json_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
     return o;
 }
 
@@ -165,8 +205,12 @@ json_t *case_status_json_as(server_case *c, case_state state, const char *error)
     json_object_set_new(o, "state", json_string(case_state_name(state)));
     if (error && error[0])
         json_object_set_new(o, "error", json_string(error));
-    if (state == CASE_FINISHED)
-        json_object_set_new(o, "progress", json_real(1.0));
+    pthread_mutex_lock(&c->lock);
+    case_figures f = c->fig;
+    double end = c->info.end_time;
+    pthread_mutex_unlock(&c->lock);
+    json_object_set_new(o, "progress", json_real(case_progress(state, f.time, end)));
+    json_object_set_new(o, "steps_per_second", json_real(case_steps_per_second(state, &f)));
     return o;
 }
 
@@ -181,6 +225,7 @@ static void case_status_write_failed(server_case *c, const char *reason)
     if (idle) {
         c->state = CASE_FAILED;
         snprintf(c->error, sizeof c->error, "%s", c->io_error);
+        case_mark_ended_locked(c, CASE_FAILED);
     }
     pthread_mutex_unlock(&c->lock);
     char again[128];
@@ -193,10 +238,54 @@ int case_persist_status(server_case *c)
     if (atomic_load(&c->deleted))
         return 0;
     char reason[128] = "";
+    json_t *o = case_status_json(c);
+    pthread_mutex_lock(&c->lock);
+    int paused_by_shutdown = c->paused_by_shutdown;
+    pthread_mutex_unlock(&c->lock);
+    if (o && paused_by_shutdown)
+        json_object_set_new(o, "paused_by_shutdown", json_true());
     pthread_mutex_lock(&c->persist_lock);
-    int rc = case_write_status_json(c, case_status_json(c), reason, sizeof reason);
+    int rc = case_write_status_json(c, o, reason, sizeof reason);
     pthread_mutex_unlock(&c->persist_lock);
     if (rc != 0)
         case_status_write_failed(c, reason);
     return rc;
+}
+
+/* ------------------------------------------------------------- the log */
+
+void case_log(server_case *c, const char *fmt, ...)
+{
+    char line[1400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    /* One fprintf per line: lines of concurrent cases never interleave. */
+    fprintf(stderr, "fdemd: case %s \"%s\": %s\n", c->id, c->info.name, line);
+}
+
+void case_log_state(server_case *c, case_state state)
+{
+    pthread_mutex_lock(&c->lock);
+    case_figures f = c->fig;
+    char error[sizeof c->error];
+    memcpy(error, c->error, sizeof error);
+    pthread_mutex_unlock(&c->lock);
+    double rate = f.elapsed > 0 ? (double)f.step / f.elapsed : 0.0;
+    switch (state) {
+    case CASE_FAILED:
+        case_log(c, "failed at step %lld (t = %.6g s) after %.3f s: %s", (long long)f.step, f.time,
+                 f.elapsed, error[0] ? error : "no reason recorded");
+        break;
+    case CASE_PAUSED: case CASE_STOPPED: case CASE_FINISHED:
+        case_log(c, "%s at step %lld (t = %.6g of %.6g s): %d snapshots, %.3f s stepping, "
+                 "%.4g steps/s", case_state_name(state), (long long)f.step, f.time,
+                 c->info.end_time, f.snapshots, f.elapsed, rate);
+        break;
+    default: /* a queued case whose model found no memory goes back */
+        case_log(c, "back to %s at step %lld (t = %.6g s)", case_state_name(state),
+                 (long long)f.step, f.time);
+        break;
+    }
 }

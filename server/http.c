@@ -214,6 +214,11 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         *rc = http_reply_not_allowed(conn, routes_allowed(r->route.kind));
         return 1;
     }
+    char query_problem[300];
+    if (routes_check_query(conn, r->route.kind, method, query_problem, sizeof query_problem) != 0) {
+        *rc = http_reply_problem(conn, 400, "Bad request", query_problem, NULL);
+        return 1;
+    }
     /* Transfer-Encoding and malformed lengths were refused by the gate. */
     const char *cl = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
     if (!cl) {

@@ -223,8 +223,45 @@ static void io_do_fetch(io_job *j)
     j->rc = 0;
 }
 
+/* Wall seconds a snapshot takes to become durable here (result.h5 row,
+ * checkpoint.bin and status.json, fsynced), a moving average over the
+ * recent snapshot jobs: what a dry run charges per snapshot. */
+#define IO_SNAPSHOT_AVERAGE_WEIGHT 0.2
+static pthread_mutex_t io_cost_lock = PTHREAD_MUTEX_INITIALIZER;
+static double io_snapshot_cost;
+static int io_snapshot_cost_measured;
+
+static void io_note_snapshot_cost(double seconds)
+{
+    pthread_mutex_lock(&io_cost_lock);
+    if (io_snapshot_cost_measured)
+        io_snapshot_cost += IO_SNAPSHOT_AVERAGE_WEIGHT * (seconds - io_snapshot_cost);
+    else
+        io_snapshot_cost = seconds;
+    io_snapshot_cost_measured = 1;
+    pthread_mutex_unlock(&io_cost_lock);
+}
+
+void io_seed_snapshot_seconds(double seconds)
+{
+    pthread_mutex_lock(&io_cost_lock);
+    if (!io_snapshot_cost_measured)
+        io_snapshot_cost = seconds;
+    pthread_mutex_unlock(&io_cost_lock);
+}
+
+double io_snapshot_seconds(void)
+{
+    pthread_mutex_lock(&io_cost_lock);
+    double seconds = io_snapshot_cost;
+    pthread_mutex_unlock(&io_cost_lock);
+    return seconds;
+}
+
 static void io_run_job(io_job *j)
 {
+    double started = io_now();
+    int writes_snapshot = j->kind == IO_APPEND && j->snap && j->ckpt;
     switch (j->kind) {
     case IO_CREATE: io_do_create(j); break;
     case IO_REOPEN: io_do_reopen(j); break;
@@ -233,6 +270,8 @@ static void io_run_job(io_job *j)
     case IO_FETCH: io_do_fetch(j); break;
     case IO_QUIT: break;
     }
+    if (writes_snapshot && j->rc == 0)
+        io_note_snapshot_cost(io_now() - started);
 }
 
 static void io_job_free(io_job *j)

@@ -42,5 +42,9 @@ void io_close(server_case *c);
 int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
                     char *err, size_t errlen);
 void io_release_hold(server_case *c);
+/* Mean wall seconds of the recent snapshot writes (a result.h5 row with its
+ * checkpoint and status, fsynced); before any, the seed given at start-up. */
+double io_snapshot_seconds(void);
+void io_seed_snapshot_seconds(double seconds);
 
 #endif

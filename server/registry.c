@@ -23,6 +23,7 @@
 #include <time.h>
 
 #include "case_model.h"
+#include "case_sizing.h"
 #include "io_thread.h"
 #include "persist.h"
 #include "registry_internal.h"
@@ -238,6 +239,8 @@ static int case_start_locked(server_case *c)
             return -1;
         reg_running++;
         c->state = CASE_RUNNING;
+        if (!c->started[0])
+            iso_time_now(c->started, sizeof c->started);
     } else {
         c->state = CASE_QUEUED;
         c->queue_seq = ++reg_next_queue_seq;
@@ -266,6 +269,7 @@ static server_case *registry_dispatch_one_locked(void)
     if (!ok && next->state == CASE_QUEUED) {
         next->state = CASE_FAILED;
         snprintf(next->error, sizeof next->error, "the daemon could not start a thread for this case");
+        case_mark_ended_locked(next, CASE_FAILED);
         membudget_release(&next->reserve);
     }
     pthread_mutex_unlock(&next->lock);
@@ -299,6 +303,7 @@ static case_state case_settle_final_state(server_case *c, case_state final_state
         final_state = CASE_FAILED;
         snprintf(error, error_size, "%s", c->io_error);
     }
+    case_mark_ended_locked(c, final_state);
     pthread_mutex_unlock(&c->lock);
     if (atomic_load(&c->deleted))
         return final_state;
@@ -311,6 +316,7 @@ static case_state case_settle_final_state(server_case *c, case_state final_state
         final_state = CASE_FAILED;
         pthread_mutex_lock(&c->lock);
         snprintf(error, error_size, "%s", c->io_error);
+        case_mark_ended_locked(c, final_state);
         pthread_mutex_unlock(&c->lock);
         case_write_status_json(c, case_status_json_as(c, final_state, error), reason, sizeof reason);
     }
@@ -332,6 +338,8 @@ void registry_worker_exited(server_case *c, case_state final_state)
     pthread_mutex_unlock(&c->lock);
     reg_running--;
     pthread_mutex_unlock(&reg_lock);
+    if (!atomic_load(&c->deleted))
+        case_log_state(c, final_state);
     registry_dispatch();
 }
 
@@ -371,8 +379,9 @@ static void case_mark_broken(server_case *c, const char *why)
     pthread_mutex_lock(&c->lock);
     c->state = CASE_FAILED;
     snprintf(c->error, sizeof c->error, "%s", why);
+    case_mark_ended_locked(c, CASE_FAILED);
     pthread_mutex_unlock(&c->lock);
-    fprintf(stderr, "fdemd: case %s: %s\n", c->id, why);
+    case_log_state(c, CASE_FAILED);
     case_persist_status(c);
 }
 
@@ -461,6 +470,8 @@ int registry_start(server_case *c, char *msg, size_t msglen)
     }
     if (status == 0)
         case_persist_status(c);
+    if (queued)
+        case_log(c, "queued: --max-running (%d) cases are running", reg_cfg->max_running);
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
 }
@@ -484,7 +495,7 @@ static case_state case_command_worker_locked(server_case *c, worker_command cmd)
 
 int registry_pause(server_case *c, char *msg, size_t msglen)
 {
-    int status = 0;
+    int status = 0, logged = 1; /* a worker logs its own exit */
     membudget_lease unreserve = {0};
     pthread_mutex_lock(&c->ctl_lock);
     pthread_mutex_lock(&c->lock);
@@ -499,6 +510,7 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
     } else if (c->state == CASE_QUEUED) {
         c->state = CASE_PAUSED;
         unreserve = case_take_reserve_locked(c);
+        logged = 0;
     } else {
         snprintf(msg, msglen, "the case is %s; pause is allowed only when it is running or queued",
                  case_state_name(c->state));
@@ -508,6 +520,8 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
     membudget_release(&unreserve);
     if (status == 0)
         case_persist_status(c);
+    if (status == 0 && !logged)
+        case_log(c, "paused while queued");
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
 }
@@ -528,6 +542,7 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
         }
     } else if (!case_state_is_terminal(c->state)) {
         c->state = CASE_STOPPED;
+        case_mark_ended_locked(c, CASE_STOPPED);
         unreserve = case_take_reserve_locked(c);
         close_result = 1;
     } else {
@@ -542,6 +557,8 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
         io_close(c);
     if (status == 0)
         case_persist_status(c);
+    if (close_result)
+        case_log_state(c, CASE_STOPPED);
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
 }
@@ -597,6 +614,7 @@ int registry_delete(server_case *c, char *msg, size_t msglen)
     if (c->worker_active)
         case_command_worker_locked(c, WORKER_ABANDON);
     c->state = CASE_STOPPED;
+    case_mark_ended_locked(c, CASE_STOPPED);
     atomic_store(&c->deleted, 1);
     membudget_lease unreserve = case_take_reserve_locked(c);
     pthread_mutex_unlock(&c->lock);
@@ -616,6 +634,7 @@ int registry_delete(server_case *c, char *msg, size_t msglen)
         case_persist_status(c);
         status = 500;
     } else {
+        case_log(c, "deleted (was %s)", case_state_name(before));
         registry_unlist(c);
     }
     pthread_mutex_unlock(&c->ctl_lock);
@@ -687,20 +706,40 @@ static int case_publish_dir(server_case *c, const char *final_dir, char *err, si
     return 0;
 }
 
-/* registry_create() with the lease that pays for the upload. */
-static server_case *registry_store_upload(const char *body, size_t size, int start,
-                                          membudget_lease *lease, problems *p, int *http_status,
-                                          char *err, size_t errlen)
+/* The model of an uploaded case, or NULL with `p` and *http_status. */
+static fdem_model *registry_build_upload(const char *body, size_t size, membudget_lease *lease,
+                                         case_info *info, double *model_bytes, problems *p,
+                                         int *http_status)
 {
-    case_info info;
-    memset(&info, 0, sizeof info);
-    fdem_model *model = case_model_build_upload(body, size, lease, &info, p);
+    memset(info, 0, sizeof *info);
+    fdem_model *model = case_model_build_upload(body, size, lease, info, p, model_bytes);
     if (!model) {
         *http_status = p->status ? p->status : 422;
         if (p->count == 0)
             problems_add(p, 422, "", "the case could not be built");
-        return NULL;
     }
+    return model;
+}
+
+static void registry_log_submitted(server_case *c, const case_sizing *z)
+{
+    case_log(c, "submitted: %d nodes, %d elements, %d joints, dt = %.3g s, end = %.6g s, "
+             "%.4g steps, %.4g snapshots, about %.3g s to run", z->nodes, z->elements, z->joints,
+             z->dt, c->info.end_time, z->steps, z->snapshots, z->estimated_seconds);
+}
+
+/* registry_create() with the lease that pays for the upload. */
+static server_case *registry_store_upload(const char *body, size_t size, int start,
+                                          membudget_lease *lease, problems *p, int *http_status,
+                                          char *warning, size_t warning_size,
+                                          char *err, size_t errlen)
+{
+    case_info info;
+    double model_bytes = 0;
+    fdem_model *model = registry_build_upload(body, size, lease, &info, &model_bytes, p,
+                                              http_status);
+    if (!model)
+        return NULL;
     server_case *c = case_new();
     if (!c) {
         fdem_model_destroy(model);
@@ -740,7 +779,16 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         goto fail;
     fdem_counts n = fdem_get_counts(model);
     size_t cost = case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
-    fdem_model *unused = NULL;
+    /* Its t = 0 is stored: the model is stepped for a moment to time the
+     * run, then freed; a start builds it again from the stored files, as
+     * every later start does. */
+    case_sizing sizing;
+    case_sizing_measure(model, &info, model_bytes, reg_cfg->threads, io_snapshot_seconds(),
+                        &sizing);
+    case_sizing_warning(&sizing, warning, warning_size);
+    c->model = NULL;
+    fdem_model_destroy(model);
+    registry_log_submitted(c, &sizing); /* before a worker can log its start */
     membudget_lease unreserve = {0};
     pthread_mutex_lock(&reg_lock);
     int appended = registry_append_locked(c) == 0;
@@ -750,19 +798,14 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         c->queued_from = CASE_CREATED;
         case_start_locked(c);
     }
-    if (c->state != CASE_RUNNING) {
-        /* No other thread has found the case yet (the registry lock is
-         * still held), so the model can be taken back without model_lock. */
-        unused = c->model;
-        c->model = NULL;
-    }
     if (c->state == CASE_CREATED)
         unreserve = case_take_reserve_locked(c);
+    int queued = c->state == CASE_QUEUED;
     pthread_mutex_unlock(&c->lock);
     pthread_mutex_unlock(&reg_lock);
-    if (unused)
-        fdem_model_destroy(unused);
     membudget_release(&unreserve);
+    if (queued)
+        case_log(c, "queued: --max-running (%d) cases are running", reg_cfg->max_running);
     if (!appended) {
         snprintf(err, errlen, "out of memory");
         goto fail;
@@ -782,18 +825,42 @@ fail:
     return NULL;
 }
 
-server_case *registry_create(const char *body, size_t size, int start,
-                             problems *p, int *http_status, char *err, size_t errlen)
+server_case *registry_create(const char *body, size_t size, int start, problems *p,
+                             int *http_status, char *warning, size_t warning_size,
+                             char *err, size_t errlen)
 {
     membudget_lease own = {0};
     membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
-    server_case *c = registry_store_upload(body, size, start, lease, p, http_status, err, errlen);
+    server_case *c = registry_store_upload(body, size, start, lease, p, http_status, warning,
+                                           warning_size, err, errlen);
     /* Only the body is left (until the answer is sent); the tree, the meshes
      * and the model are gone, so the client's next request already finds the
      * budget as it will be. */
     membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);
     membudget_release(&own);
     return c;
+}
+
+json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_status)
+{
+    membudget_lease own = {0};
+    membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
+    case_info info;
+    double model_bytes = 0;
+    fdem_model *model = registry_build_upload(body, size, lease, &info, &model_bytes, p,
+                                              http_status);
+    json_t *answer = NULL;
+    if (model) {
+        case_sizing sizing;
+        case_sizing_measure(model, &info, model_bytes, reg_cfg->threads, io_snapshot_seconds(),
+                        &sizing);
+        fdem_model_destroy(model);
+        answer = case_sizing_json(&sizing);
+        *http_status = 200;
+    }
+    membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);
+    membudget_release(&own);
+    return answer;
 }
 
 static int case_order(const void *a, const void *b)
@@ -811,7 +878,15 @@ int registry_init(const fdemd_config *cfg)
                 strerror(errno));
         return -1;
     }
-    if (persist_check_writable(cfg->data_dir) != 0) {
+    struct timespec before, after;
+    clock_gettime(CLOCK_MONOTONIC, &before);
+    int writable = persist_check_writable(cfg->data_dir) == 0;
+    clock_gettime(CLOCK_MONOTONIC, &after);
+    /* One fsynced write, timed: a snapshot makes about four (checkpoint.bin
+     * and status.json, each file and directory), until real ones are timed. */
+    io_seed_snapshot_seconds(4 * ((double)(after.tv_sec - before.tv_sec) +
+                                  1e-9 * (double)(after.tv_nsec - before.tv_nsec)));
+    if (!writable) {
         fprintf(stderr, "fdemd: the data directory %s cannot be written (%s); "
                 "give fdemd a writable --data directory\n", cfg->data_dir, strerror(errno));
         return -1;
@@ -853,6 +928,7 @@ void registry_shutdown(void)
         server_case *c = cases[i];
         pthread_mutex_lock(&c->ctl_lock);
         pthread_mutex_lock(&c->lock);
+        c->paused_by_shutdown = c->state == CASE_RUNNING || c->state == CASE_QUEUED;
         if (c->state == CASE_RUNNING)
             case_command_worker_locked(c, WORKER_PAUSE);
         else if (c->state == CASE_QUEUED)

@@ -51,6 +51,7 @@ typedef struct case_figures {
     fdem_energy energy;
     double steps_per_second;
     int snapshots;
+    double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
 } case_figures;
 
 #define CASE_ID_LEN 16
@@ -59,6 +60,8 @@ typedef struct server_case {
     char id[CASE_ID_LEN + 1];
     char dir[1100];
     char created[40];          /* ISO 8601 UTC, sorts like time */
+    char started[40];          /* first start (ISO 8601), "" = never (guarded by `lock`) */
+    char finished_at[40];      /* reached a terminal state, "" = not yet (`lock`) */
     uint64_t seq;              /* creation order (oldest first listings) */
     atomic_int refs;
 
@@ -98,6 +101,8 @@ typedef struct server_case {
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
 
+    int paused_by_shutdown;    /* running or queued when the daemon stopped (`lock`):
+                                  status.json says so, and the restart logs it as resumed */
     int load_broken;           /* its stored files could not be loaded at start-up: they are
                                   kept as found (so that, mended, the case comes back) */
 
@@ -119,9 +124,15 @@ void registry_list_free(server_case **cases, int count);
 void registry_counts(int *cases, int *running);
 
 /* Validates and stores a case. Returns the new case (a reference), or NULL
- * with `p` filled (400/422), or NULL with *http_status = 500 and `err`. */
-server_case *registry_create(const char *body, size_t size, int start,
-                             problems *p, int *http_status, char *err, size_t errlen);
+ * with `p` filled (400/422), or NULL with *http_status = 500 and `err`.
+ * `warning` gets a sentence when the case will run for hours, else "". */
+server_case *registry_create(const char *body, size_t size, int start, problems *p,
+                             int *http_status, char *warning, size_t warning_size,
+                             char *err, size_t errlen);
+/* Validates and sizes a case without storing it (?dry_run=true): the
+ * answer of case_sizing_json with *http_status 200, or NULL with `p` filled
+ * and *http_status 400/422/503. */
+json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_status);
 
 /* start/pause/stop: 0, or 409 (or 503: no memory for the model now) with a
  * sentence in msg. */
@@ -139,6 +150,15 @@ snapshot *case_take_state(server_case *c, unsigned fields, int *status);
 
 json_t *case_status_json(server_case *c);
 const char *case_state_name(case_state s);
+int case_state_parse(const char *name, case_state *out);
+/* Stamps finished_at the first time the case reaches a terminal `state`
+ * (with the case lock held; a no-op for other states). */
+void case_mark_ended_locked(server_case *c, case_state state);
+/* One line on stderr per case event (submitted, started, paused, ...):
+ * "fdemd: case ID "name": <event>". */
+void case_log(server_case *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* The event line of a case that has just settled in `state`, with its figures. */
+void case_log_state(server_case *c, case_state state);
 /* Writes status.json durably; 0, or -1 after recording the failure with
  * case_record_io_failure (a case with no worker becomes failed at once). */
 int case_persist_status(server_case *c);

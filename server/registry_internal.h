@@ -12,7 +12,6 @@
 #include "registry.h"
 
 server_case *case_new(void);
-int case_state_parse(const char *name, case_state *out);
 int case_state_is_terminal(case_state s);
 void iso_time_now(char *out, size_t size);
 /* Figures of the case's model into its published figures. */

@@ -24,6 +24,7 @@ static void case_fail_loading(server_case *c, const char *fmt, const char *detai
 {
     c->state = CASE_FAILED;
     snprintf(c->error, sizeof c->error, fmt, detail);
+    case_mark_ended_locked(c, CASE_FAILED);
     fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
 }
 
@@ -58,12 +59,17 @@ static void case_load_figures(server_case *c, const json_t *st)
     f->time = status_number(st, "time");
     f->dt = status_number(st, "dt");
     f->snapshots = status_count(st, "snapshots");
+    f->elapsed = status_number(st, "elapsed");
+    if (!(f->elapsed >= 0))
+        f->elapsed = 0; /* written by an fdemd from before `elapsed` */
     const char *name = json_string_value(json_object_get(st, "name"));
     snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
     c->info.end_time = status_number(st, "end_time");
 }
 
-static void case_load_status(server_case *c, const char *path)
+/* The state the case was in when the daemon stopped: a case the shutdown
+ * paused was running (or queued). */
+static case_state case_load_status(server_case *c, const char *path)
 {
     json_error_t jerr;
     json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
@@ -77,9 +83,17 @@ static void case_load_status(server_case *c, const char *path)
     }
     if (created)
         snprintf(c->created, sizeof c->created, "%s", created);
+    const char *started = st ? json_string_value(json_object_get(st, "started")) : NULL;
+    const char *finished_at = st ? json_string_value(json_object_get(st, "finished_at")) : NULL;
+    snprintf(c->started, sizeof c->started, "%s", started ? started : "");
+    snprintf(c->finished_at, sizeof c->finished_at, "%s", finished_at ? finished_at : "");
     if (st)
         case_load_figures(c, st);
+    case_state was = c->state;
+    if (c->state == CASE_PAUSED && json_is_true(json_object_get(st, "paused_by_shutdown")))
+        was = CASE_RUNNING;
     json_decref(st);
+    return was;
 }
 
 /* A case whose restored time is already at its end (a status.json that
@@ -92,6 +106,7 @@ static void case_finish_if_at_end(server_case *c)
     if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
         fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
         c->state = CASE_FINISHED;
+        case_mark_ended_locked(c, CASE_FINISHED);
     }
 }
 
@@ -131,6 +146,20 @@ static int case_check_stored(server_case *c)
     return broken ? -1 : 0;
 }
 
+/* The restart's line for the log: a case that was running or queued is
+ * resumed paused at its last checkpoint (its figures are that step's). */
+static void case_log_restored(server_case *c, case_state stored)
+{
+    if (stored == CASE_RUNNING || stored == CASE_QUEUED)
+        case_log(c, "resumed after a restart: was %s when fdemd stopped, now %s at its "
+                 "checkpoint, step %lld (t = %.6g of %.6g s, %.3f s stepping so far); start it "
+                 "to go on", case_state_name(stored), case_state_name(c->state),
+                 (long long)c->fig.step, c->fig.time, c->info.end_time, c->fig.elapsed);
+    else
+        case_log(c, "restored after a restart: %s at step %lld (t = %.6g s)",
+                 case_state_name(c->state), (long long)c->fig.step, c->fig.time);
+}
+
 server_case *registry_load_case(const fdemd_config *cfg, const char *id)
 {
     server_case *c = case_new();
@@ -155,7 +184,7 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
         case_release(c);
         return NULL;
     }
-    case_load_status(c, path);
+    case_state stored = case_load_status(c, path);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
@@ -166,6 +195,7 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
     if (!c->load_broken)
         case_persist_status(c);
     persist_reserve(c->dir);
+    case_log_restored(c, stored);
     return c;
 }
 

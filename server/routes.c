@@ -143,6 +143,64 @@ static int routes_flag(struct MHD_Connection *conn, const char *name)
     return -1;
 }
 
+/* --------------------------------------------------------- query arguments */
+
+/* The query arguments each route and method takes; any other is a 400
+ * naming it, so a misspelt "?strat=true" is not silently ignored. */
+static const char *const *routes_query_names(route_kind kind, const char *method)
+{
+    static const char *const create[] = {"start", "dry_run", NULL};
+    static const char *const list[] = {"state", NULL};
+    static const char *const state[] = {"fields", NULL};
+    static const char *const none[] = {NULL};
+    if (kind == ROUTE_CASES)
+        return strcmp(method, "POST") == 0 ? create : list;
+    return kind == ROUTE_CASE_STATE ? state : none;
+}
+
+typedef struct routes_query_check {
+    const char *const *allowed;
+    char *detail;
+    size_t detail_size;
+    int seen;   /* bit i: allowed[i] given already */
+    int bad;
+} routes_query_check;
+
+static enum MHD_Result routes_query_visit(void *cls, enum MHD_ValueKind kind, const char *key,
+                                          const char *value)
+{
+    (void)kind;
+    (void)value;
+    routes_query_check *q = cls;
+    for (int i = 0; q->allowed[i]; i++) {
+        if (strcmp(key, q->allowed[i]) != 0)
+            continue;
+        if (q->seen & (1 << i)) {
+            snprintf(q->detail, q->detail_size, "the query parameter \"%.64s\" is given twice", key);
+            q->bad = 1;
+            return MHD_NO;
+        }
+        q->seen |= 1 << i;
+        return MHD_YES;
+    }
+    char names[128] = "";
+    for (int i = 0; q->allowed[i]; i++)
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s\"%s\"",
+                 i ? ", " : "", q->allowed[i]);
+    snprintf(q->detail, q->detail_size, "unknown query parameter \"%.64s\"; %s%s", key,
+             names[0] ? "this route takes " : "this route takes none", names);
+    q->bad = 1;
+    return MHD_NO;
+}
+
+int routes_check_query(struct MHD_Connection *conn, route_kind kind, const char *method,
+                       char *detail, size_t detail_size)
+{
+    routes_query_check q = {routes_query_names(kind, method), detail, detail_size, 0, 0};
+    MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, routes_query_visit, &q);
+    return q.bad ? -1 : 0;
+}
+
 /* ----------------------------------------------------------------- routes */
 
 static enum MHD_Result route_health(struct MHD_Connection *conn)
@@ -156,11 +214,26 @@ static enum MHD_Result route_health(struct MHD_Connection *conn)
 
 static enum MHD_Result route_list_cases(struct MHD_Connection *conn)
 {
+    const char *wanted = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "state");
+    case_state only = CASE_CREATED;
+    if (wanted && case_state_parse(wanted, &only) != 0) {
+        char detail[200];
+        snprintf(detail, sizeof detail, "?state= takes one of created, queued, running, paused, "
+                 "finished, stopped, failed; not \"%.64s\"", wanted);
+        return http_reply_problem(conn, 400, "Bad request", detail, NULL);
+    }
     int count = 0;
     server_case **cases = registry_list(&count);
     json_t *arr = json_array();
-    for (int i = 0; i < count; i++)
-        json_array_append_new(arr, case_status_json(cases[i]));
+    for (int i = 0; i < count; i++) {
+        json_t *st = case_status_json(cases[i]);
+        /* Filtered on the state in the object itself, so a case changing
+         * state meanwhile is listed as it is shown. */
+        if (wanted && strcmp(json_string_value(json_object_get(st, "state")), wanted) != 0)
+            json_decref(st);
+        else
+            json_array_append_new(arr, st);
+    }
     registry_list_free(cases, count);
     return http_reply_json(conn, 200, json_pack("{s:o}", "cases", arr), NULL);
 }
@@ -170,16 +243,32 @@ static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char
     int start = routes_flag(conn, "start");
     if (start < 0)
         return http_reply_problem(conn, 400, "Bad request", "?start= takes true or false", NULL);
+    int dry_run = routes_flag(conn, "dry_run");
+    if (dry_run < 0)
+        return http_reply_problem(conn, 400, "Bad request", "?dry_run= takes true or false", NULL);
+    if (dry_run && start)
+        return http_reply_problem(conn, 400, "Bad request", "?dry_run=true stores nothing, so it "
+                                  "cannot be combined with ?start=true", NULL);
     problems p;
     problems_init(&p);
     int status = 0;
-    char err[300] = "";
-    server_case *c = registry_create(body, size, start, &p, &status, err, sizeof err);
+    char err[300] = "", warning[400] = "";
+    server_case *c = NULL;
+    json_t *sizing = NULL;
+    if (dry_run)
+        sizing = registry_dry_run(body, size, &p, &status);
+    else
+        c = registry_create(body, size, start, &p, &status, warning, sizeof warning, err, sizeof err);
     enum MHD_Result rc;
-    if (c) {
+    if (sizing) {
+        rc = http_reply_json(conn, 200, sizing, NULL);
+    } else if (c) {
         char location[64];
         snprintf(location, sizeof location, "/cases/%s", c->id);
-        rc = http_reply_json(conn, 201, case_status_json(c), location);
+        json_t *st = case_status_json(c);
+        if (warning[0])
+            json_object_set_new(st, "warning", json_string(warning));
+        rc = http_reply_json(conn, 201, st, location);
         case_release(c);
     } else if (status == 503) {
         rc = http_reply_unavailable(conn, p.count ? p.items[0].message : "short of memory", &p);

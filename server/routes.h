@@ -30,6 +30,10 @@ void routes_match(const char *url, route_match *out);
 const char *routes_allowed(route_kind kind);
 int routes_method_allowed(route_kind kind, const char *method);
 int routes_takes_body(route_kind kind, const char *method);
+/* 0 when every query argument is one the route takes, each at most once;
+ * else -1 with a sentence naming the offending one (a 400). */
+int routes_check_query(struct MHD_Connection *conn, route_kind kind, const char *method,
+                       char *detail, size_t detail_size);
 
 enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
                               const char *method, const char *body, size_t body_size);

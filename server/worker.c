@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "case_model.h"
+#include "case_sizing.h"
 #include "io_thread.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
@@ -31,6 +32,8 @@ typedef struct worker_clock {
     double last_publish, last_checkpoint;
     int64_t steps_at_publish;
     double steps_per_second;
+    double run_started;     /* when this run began stepping */
+    double elapsed_before;  /* wall seconds spent stepping in earlier runs */
 } worker_clock;
 
 static double worker_now(void)
@@ -40,18 +43,10 @@ static double worker_now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static double worker_output_interval(const server_case *c)
-{
-    double interval = c->info.output_interval;
-    if (!(interval > 0))
-        interval = c->info.end_time / 100.0;
-    return interval > 0 ? interval : 1.0;
-}
-
 /* The first output time strictly after `t` on the grid k * interval. */
 static double worker_next_output(const server_case *c, double t)
 {
-    double interval = worker_output_interval(c);
+    double interval = sizing_output_interval(&c->info);
     double k = floor(t / interval * (1.0 + 1e-12) + 1e-9);
     return (k + 1.0) * interval;
 }
@@ -76,6 +71,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     }
     fig.steps_per_second = running ? clk->steps_per_second : 0.0;
     fig.snapshots = -1; /* owned by the I/O thread */
+    fig.elapsed = clk->elapsed_before + (now - clk->run_started);
     case_publish(c, &fig);
 }
 
@@ -143,7 +139,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * exactly at time.end (a shorter step is always stable, and central
          * difference takes a changing step). */
         double t0 = fdem_get_time(m);
-        int cut = t0 + dt >= end - 1e-9 * dt; /* no sliver of a step left over */
+        int cut = sizing_is_last_step(t0, dt, end);
         if (cut)
             fdem_set_dt(m, end - t0);
         fdem_error err;
@@ -263,7 +259,14 @@ static void *worker_main(void *arg)
     case_state final_state = CASE_FAILED;
     if (worker_take_model(c, &final_state) == 0) {
         fdem_set_threads(c->model, cfg->threads);
-        worker_clock clk = {worker_now(), worker_now(), fdem_get_step(c->model), 0.0};
+        double now = worker_now();
+        pthread_mutex_lock(&c->lock);
+        double elapsed_before = c->fig.elapsed > 0 ? c->fig.elapsed : 0.0;
+        pthread_mutex_unlock(&c->lock);
+        worker_clock clk = {now, now, fdem_get_step(c->model), 0.0, now, elapsed_before};
+        case_log(c, "started at step %lld (t = %.6g of %.6g s, dt = %.3g s)",
+                 (long long)fdem_get_step(c->model), fdem_get_time(c->model), c->info.end_time,
+                 fdem_get_dt(c->model));
         c->next_output = worker_next_output(c, fdem_get_time(c->model));
         why = worker_loop(c, &clk);
         worker_wind_down(c, why, &clk);

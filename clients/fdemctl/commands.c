@@ -124,30 +124,82 @@ int cmd_health(const ctl_options *o, int argc, char **argv)
 /* ----------------------------------------------------------------- submit */
 
 static const char USAGE_SUBMIT[] =
-    "usage: fdemctl submit FILE|- [--start]\n"
+    "usage: fdemctl submit FILE|- [--start | --dry-run]\n"
     "  Uploads a case document (a file, or stdin for -), prints the new case id.\n"
-    "  --start   start it at once (POST /cases?start=true)\n"
-    "  An invalid case prints every problem as 'pointer: message' and exits 1.\n";
+    "  --start    start it at once (POST /cases?start=true)\n"
+    "  --dry-run  only check and size it (POST /cases?dry_run=true): prints the\n"
+    "             nodes, steps, snapshots, memory, result size and estimated time;\n"
+    "             nothing is stored\n"
+    "  An invalid case prints every problem as 'pointer: message' and exits 1.\n"
+    "  A case that will run for hours is stored with a warning on stderr.\n";
+
+/* "1.5 GiB" */
+static void submit_format_bytes(double bytes, char *out, size_t size)
+{
+    static const char *const units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB"};
+    int unit = 0;
+    while (bytes >= 1024 && unit < 5) { bytes /= 1024; unit++; }
+    if (unit == 0) snprintf(out, size, "%.0f bytes", bytes);
+    else snprintf(out, size, "%.3g %s", bytes, units[unit]);
+}
+
+static int submit_print_sizing(const http_response *r)
+{
+    json_t *z = json_loadb(r->body, r->length, 0, NULL);
+    if (!json_is_object(z)) {
+        fprintf(stderr, "fdemctl: the server's dry run answer is not a JSON object\n");
+        json_decref(z);
+        return CTL_FAIL;
+    }
+    char memory[32], result[32];
+    submit_format_bytes(status_number(z, "memory_bytes"), memory, sizeof memory);
+    submit_format_bytes(status_number(z, "result_bytes"), result, sizeof result);
+    printf("%-18s%.0f nodes, %.0f elements, %.0f joints\n", "mesh", status_number(z, "nodes"),
+           status_number(z, "elements"), status_number(z, "joints"));
+    printf("%-18s%.0f of %.4g s\n", "steps", status_number(z, "steps"), status_number(z, "dt"));
+    printf("%-18s%.0f\n", "snapshots", status_number(z, "snapshots"));
+    printf("%-18s%s\n", "memory", memory);
+    printf("%-18s%s\n", "result.h5", result);
+    printf("%-18s%.3g s\n", "estimated time", status_number(z, "estimated_seconds"));
+    const char *warning = status_text(z, "warning", NULL);
+    if (warning) fprintf(stderr, "fdemctl: warning: %s\n", warning);
+    json_decref(z);
+    return CTL_OK;
+}
 
 int cmd_submit(const ctl_options *o, int argc, char **argv)
 {
-    int start = 0;
+    int start = 0, dry_run = 0;
     const char *file[1];
-    ctl_option_spec specs[] = {{"--start", NULL, NULL, &start}, {0}};
+    ctl_option_spec specs[] = {{"--start", NULL, NULL, &start},
+                               {"--dry-run", NULL, NULL, &dry_run}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_SUBMIT, file, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    if (start && dry_run) {
+        fprintf(stderr, "fdemctl submit: --dry-run stores nothing, so it cannot --start\n%s",
+                USAGE_SUBMIT);
+        return CTL_USAGE;
+    }
 
     size_t length;
     char *text = read_all(file[0], &length);
     if (!text) return CTL_FAIL;
     http_response r;
-    int code = ctl_call(o, "POST", start ? "/cases?start=true" : "/cases", text, length, 201, &r);
+    const char *path = dry_run ? "/cases?dry_run=true" : start ? "/cases?start=true" : "/cases";
+    int code = ctl_call(o, "POST", path, text, length, dry_run ? 200 : 201, &r);
     free(text);
     if (code) return code;
+    if (dry_run) {
+        code = submit_print_sizing(&r);
+        http_response_free(&r);
+        return code;
+    }
     json_t *status = json_loadb(r.body, r.length, 0, NULL);
     const char *id = status_text(status, "id", NULL);
+    const char *warning = status_text(status, "warning", NULL);
     if (id) printf("%s\n", id);
     else fprintf(stderr, "fdemctl: the server created the case but sent no id\n");
+    if (warning) fprintf(stderr, "fdemctl: warning: %s\n", warning);
     json_decref(status);
     http_response_free(&r);
     return id ? CTL_OK : CTL_FAIL;
@@ -156,8 +208,10 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
 /* ------------------------------------------------------------------- list */
 
 static const char USAGE_LIST[] =
-    "usage: fdemctl list\n"
-    "  One line per case, oldest first: id, name, state, progress, step, time.\n";
+    "usage: fdemctl list [--state STATE]\n"
+    "  One line per case, oldest first: id, name, state, progress, step, time.\n"
+    "  --state S   only the cases in state S (created, queued, running, paused,\n"
+    "              finished, stopped or failed)\n";
 
 static void list_print_row(json_t *c, int id_width, int name_width)
 {
@@ -169,11 +223,24 @@ static void list_print_row(json_t *c, int id_width, int name_width)
 
 int cmd_list(const ctl_options *o, int argc, char **argv)
 {
-    ctl_option_spec specs[] = {{0}};
+    const char *state = NULL;
+    ctl_option_spec specs[] = {{"--state", NULL, &state, NULL}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_LIST, NULL, 0, 0);
     if (n < 0) return ctl_args_exit(n);
+    char path[64] = "/cases";
+    if (state) {
+        /* State names are lower-case words: nothing to escape, and the
+         * server names the valid ones if this is not one. */
+        size_t len = strspn(state, "abcdefghijklmnopqrstuvwxyz");
+        if (len == 0 || state[len] != '\0' || len > 32) {
+            fprintf(stderr, "fdemctl list: --state takes a state name such as running, not '%s'\n",
+                    state);
+            return CTL_USAGE;
+        }
+        snprintf(path, sizeof path, "/cases?state=%s", state);
+    }
     http_response r;
-    int code = ctl_call(o, "GET", "/cases", NULL, 0, 200, &r);
+    int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
     if (code) return code;
     json_t *doc = json_loadb(r.body, r.length, 0, NULL);
     http_response_free(&r);
@@ -207,10 +274,21 @@ static const char USAGE_STATUS[] =
     "  Shows the progress and figures of one case.\n"
     "  --json    print the server's status object exactly as it was sent\n";
 
-static void status_print_energy(json_t *energy)
+/* 2D energies are per metre of thickness, 3D ones plain joules (contract
+ * 5.2); a status that does not say its dimension gets both units named. */
+static const char *energy_label(json_t *status)
 {
+    json_t *dimension = json_object_get(status, "dimension");
+    if (!json_is_integer(dimension)) return "energy [J/m; J in 3D]";
+    return json_integer_value(dimension) == 3 ? "energy [J]" : "energy [J/m]";
+}
+
+static void status_print_energy(json_t *status)
+{
+    json_t *energy = json_object_get(status, "energy");
     if (!json_is_object(energy)) return;
-    printf("%-14s", "energy [J/m]");
+    const char *label = energy_label(status);
+    printf("%-14s%s", label, strlen(label) < 14 ? "" : " ");
     const char *key;
     json_t *value;
     int first = 1;
@@ -258,7 +336,7 @@ static void status_print_table(json_t *s)
            json_integer_value(json_object_get(s, "broken_joints")));
     printf("%-14s%lld\n", "contacts", json_integer_value(json_object_get(s, "contacts")));
     printf("%-14s%lld\n", "snapshots", json_integer_value(json_object_get(s, "snapshots")));
-    status_print_energy(json_object_get(s, "energy"));
+    status_print_energy(s);
     printf("%-14s%.4g steps/s\n", "speed", status_number(s, "steps_per_second"));
     status_print_others(s);
     const char *error = status_text(s, "error", NULL);
@@ -356,7 +434,8 @@ static const char USAGE_STATE[] =
     "usage: fdemctl state ID [--fields position,velocity,stress,damage]\n"
     "  Prints the current state (taken at one step boundary) as JSON:\n"
     "  position/velocity [[x, y], ...] per node, stress [[sxx, syy, sxy], ...]\n"
-    "  per element, damage per joint.\n";
+    "  per element, damage per joint; in 3D [[x, y, z], ...] and\n"
+    "  [[sxx, syy, szz, syz, sxz, sxy], ...].\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

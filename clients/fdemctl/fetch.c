@@ -11,15 +11,18 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <jansson.h>
 #include "fdemctl.h"
 
 static const char USAGE_FETCH[] =
-    "usage: fdemctl fetch ID [-o FILE.h5]\n"
-    "  Downloads the case's result.h5 to FILE.h5 (default <name>.h5, or <id>.h5)\n"
-    "  and its XDMF sidecar to FILE.xdmf beside it, rewritten to refer to FILE.h5,\n"
-    "  so ParaView opens FILE.xdmf directly. Works while the case runs (the file\n"
-    "  then holds every snapshot written so far).\n";
+    "usage: fdemctl fetch ID [-o FILE.h5] [--force]\n"
+    "  Downloads the case's result.h5 to FILE.h5 (default <name>.h5 with <name> the\n"
+    "  case's name, or <id>.h5) and its XDMF sidecar to FILE.xdmf beside it,\n"
+    "  rewritten to refer to FILE.h5, so ParaView opens FILE.xdmf directly. Works\n"
+    "  while the case runs (the file then holds every snapshot written so far).\n"
+    "  --force   replace FILE.h5 / FILE.xdmf if they exist (else fetch refuses,\n"
+    "            exit 1, and downloads nothing)\n";
 
 #define FETCH_SERVER_H5 "result.h5"
 
@@ -168,10 +171,26 @@ static int fetch_xdmf(const ctl_options *o, const char *id, const char *xdmf_fil
     return code;
 }
 
+/* 0 when neither file exists (or --force), else CTL_FAIL after saying which. */
+static int fetch_check_overwrite(const char *h5_file, const char *xdmf_file, int force)
+{
+    const char *files[] = {h5_file, xdmf_file};
+    for (int i = 0; i < 2 && !force; i++) {
+        if (access(files[i], F_OK) == 0) {
+            fprintf(stderr, "fdemctl: %s exists; not overwriting it (use --force to replace it, "
+                    "or -o to save elsewhere)\n", files[i]);
+            return CTL_FAIL;
+        }
+    }
+    return CTL_OK;
+}
+
 int cmd_fetch(const ctl_options *o, int argc, char **argv)
 {
     const char *id[1], *output = NULL;
-    ctl_option_spec specs[] = {{"--output", "-o", &output, NULL}, {0}};
+    int force = 0;
+    ctl_option_spec specs[] = {{"--output", "-o", &output, NULL},
+                               {"--force", "-f", NULL, &force}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_FETCH, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
 
@@ -192,6 +211,7 @@ int cmd_fetch(const ctl_options *o, int argc, char **argv)
         json_decref(s);
     }
     fetch_xdmf_path(xdmf_file, sizeof xdmf_file, h5_file);
+    if (fetch_check_overwrite(h5_file, xdmf_file, force) != CTL_OK) return CTL_FAIL;
 
     int code = fetch_download(o, path, h5_file);
     if (code) return code;

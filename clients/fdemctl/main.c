@@ -22,8 +22,8 @@ typedef struct ctl_command {
 } ctl_command;
 
 static const ctl_command ctl_commands[] = {
-    {"submit", cmd_submit, "submit FILE|- [--start]   upload a case, print its id"},
-    {"list",   cmd_list,   "list                      all cases: id, name, state, progress"},
+    {"submit", cmd_submit, "submit FILE|- [--start]   upload a case, print its id (--dry-run: only size it)"},
+    {"list",   cmd_list,   "list [--state S]          cases (in state S): id, name, state, progress"},
     {"status", cmd_status, "status ID [--json]        progress and figures of one case"},
     {"start",  cmd_control, "start ID                  run a created or paused case"},
     {"pause",  cmd_control, "pause ID                  pause a running case"},
@@ -31,7 +31,7 @@ static const ctl_command ctl_commands[] = {
     {"delete", cmd_delete, "delete ID                 remove a case and its files"},
     {"wait",   cmd_wait,   "wait ID [--interval S]    follow progress; exit 0 iff finished"},
     {"state",  cmd_state,  "state ID [--fields LIST]  current state as JSON"},
-    {"fetch",  cmd_fetch,  "fetch ID [-o FILE.h5]     download result.h5 + .xdmf"},
+    {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
     {"case",   cmd_case,   "case ID                   the case document as uploaded"},
     {"health", cmd_health, "health                    is the server alive"},
     {NULL, NULL, NULL},

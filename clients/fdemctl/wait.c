@@ -56,6 +56,9 @@ static wait_progress wait_read(json_t *s)
     if (!p.state) p.state = "?";
     if (!(p.progress >= 0)) p.progress = 0;
     if (p.progress > 1) p.progress = 1;
+    /* 100 % is shown for a finished case only: one that has stepped to its
+     * end but is still writing (or an older server's 1.0) shows 99.9 %. */
+    if (strcmp(p.state, "finished") != 0 && p.progress > 0.999) p.progress = 0.999;
     return p;
 }
 

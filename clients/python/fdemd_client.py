@@ -1,14 +1,15 @@
 """fdemd_client - a Python client for the fdemd simulation daemon.
 
 Standard library only (urllib.request, json), so it runs wherever Python 3
-does. It speaks the HTTP API of CONTRACT.md section 2::
+does. It speaks the HTTP API documented in docs/api.md of the fdemd
+repository (routes, the status object, states, errors)::
 
     from fdemd_client import Client, FdemdError
 
     c = Client()                       # FDEMD_URL / FDEMD_TOKEN, else localhost:8080
     case_id = c.submit("examples/collision.json", start=True)
     final = c.wait(case_id, callback=lambda s: print(s["progress"]))
-    h5, xdmf = c.fetch(case_id, "collision.h5")
+    h5, xdmf = c.fetch(case_id, "collision.h5")   # force=True to replace
 
 Every refusal of the server raises FdemdError carrying the problem details
 (status, title, detail and the list of {"pointer", "message"} errors), so a
@@ -20,6 +21,7 @@ import os
 import re
 import time
 import urllib.error
+import warnings
 import urllib.parse
 import urllib.request
 
@@ -134,20 +136,39 @@ class Client:
         Raises:
             FdemdError: 422 with one error per problem for an invalid case,
                 400 for malformed JSON.
+        Warns:
+            UserWarning: the server's warning for a case that will run for
+                hours (the case is stored all the same).
         """
-        if isinstance(case, dict):
-            body = json.dumps(case).encode("utf-8")
-        elif isinstance(case, (bytes, bytearray)):
-            body = bytes(case)
-        else:
-            with open(case, "rb") as f:
-                body = f.read()
+        body = _case_body(case)
         path = "/cases?start=true" if start else "/cases"
-        return self._json("POST", path, body)["id"]
+        status = self._json("POST", path, body)
+        if status.get("warning"):
+            warnings.warn("case %s: %s" % (status["id"], status["warning"]), stacklevel=2)
+        return status["id"]
 
-    def list(self):
-        """All cases' status objects, oldest first."""
-        return self._json("GET", "/cases")["cases"]
+    def dry_run(self, case):
+        """Checks and sizes a case without storing it (POST /cases?dry_run=true).
+
+        Args:
+            case: as for submit().
+        Returns:
+            {"nodes", "elements", "joints", "dt", "steps", "snapshots",
+            "memory_bytes", "result_bytes", "estimated_seconds"}, plus
+            "warning" when the case would run for hours.
+        Raises:
+            FdemdError: as submit() does for an invalid case.
+        """
+        return self._json("POST", "/cases?dry_run=true", _case_body(case))
+
+    def list(self, state=None):
+        """The cases' status objects, oldest first; only those in `state`
+        ("created", "queued", "running", "paused", "finished", "stopped" or
+        "failed") when given."""
+        path = "/cases"
+        if state is not None:
+            path += "?state=" + urllib.parse.quote(str(state), safe="")
+        return self._json("GET", path)["cases"]
 
     def status(self, case_id):
         """The status object of one case (state, step, time, progress, ...)."""
@@ -182,7 +203,8 @@ class Client:
         Returns:
             {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
             per node, stress [[sxx, syy, sxy], ...] per element, damage per
-            joint.
+            joint; in 3D [[x, y, z], ...] and [[sxx, syy, szz, syz, sxz,
+            sxy], ...] (contract 5.2).
         """
         suffix = "/state"
         if fields:
@@ -220,7 +242,7 @@ class Client:
             raise FdemdError(None, "Case %s %s" % (case_id, s["state"]), detail, case_status=s)
         return s
 
-    def fetch(self, case_id, path=None):
+    def fetch(self, case_id, path=None, force=False):
         """Downloads result.h5 to `path` and the XDMF sidecar beside it.
 
         The XDMF gets the same stem (``run.h5`` -> ``run.xdmf``) and its
@@ -230,9 +252,15 @@ class Client:
         result. Works while the case runs (every snapshot written so far).
 
         Args:
-            path: where to save the .h5 (default "<name>.h5", else "<id>.h5").
+            path: where to save the .h5 (default "<name>.h5" with <name> the
+                case's name, else "<id>.h5").
+            force: replace the .h5 or .xdmf if it exists; without it an
+                existing file is never overwritten.
         Returns:
             (h5_path, xdmf_path)
+        Raises:
+            FileExistsError: the .h5 or .xdmf exists and force is False
+                (nothing is downloaded).
         """
         if path is None:
             name = self.status(case_id).get("name") or str(case_id)
@@ -240,6 +268,10 @@ class Client:
         path = os.fspath(path)
         stem = re.sub(r"\.(h5|hdf5|hdf)$", "", path)
         xdmf_path = stem + ".xdmf"
+        for existing in (path, xdmf_path):
+            if not force and os.path.exists(existing):
+                raise FileExistsError(
+                    "%s exists; not overwriting it (pass force=True to replace it)" % existing)
 
         with self._open("GET", self._case_path(case_id, "/result.h5")) as response:
             _save_stream(response, path)
@@ -252,6 +284,16 @@ class Client:
 
 
 # ---------------------------------------------------------------- helpers
+
+def _case_body(case):
+    """The JSON text of a case given as a dict, bytes or a file path."""
+    if isinstance(case, dict):
+        return json.dumps(case).encode("utf-8")
+    if isinstance(case, (bytes, bytearray)):
+        return bytes(case)
+    with open(case, "rb") as f:
+        return f.read()
+
 
 def _problem_from(status, body):
     """FdemdError from an error answer (problem details, or anything else)."""

@@ -45,13 +45,14 @@ def check_root(f, exp):
     need(isinstance(fmt, str), f"format attribute is {type(fmt).__name__}, not str")
     need(fmt == "fdem-result/1", f"format = {fmt!r}")
     need(f.attrs["name"] == exp["name"], f"name = {f.attrs['name']!r}")
-    need(int(f.attrs["dimension"]) == 2, "dimension != 2")
+    dim = exp.get("dimension", 2)
+    need(int(f.attrs["dimension"]) == dim, f"dimension = {f.attrs['dimension']}, want {dim}")
     need(float(f.attrs["dt"]) == exp["dt"], f"dt = {f.attrs['dt']!r}, want {exp['dt']!r}")
 
 
 def check_mesh(f, exp):
     mesh = exp["mesh"]
-    kinds = {"position0": "f8", "triangles": "i4", "node_mass": "f8",
+    kinds = {"position0": "f8", "triangles": "i4", "tetrahedra": "i4", "node_mass": "f8",
              "node_part": "i4", "element_part": "i4", "joints": "i4"}
     for name, kind in kinds.items():
         path = "/mesh/" + name
@@ -70,7 +71,8 @@ def want_series(exp, name, snaps):
     """The expected (S, ...) array of a dataset."""
     if name == "constraint_force":
         rows = [s["constraint_force"] for s in snaps]
-        return np.array(rows, dtype="f8").reshape(len(snaps), exp["constraints"], 2)
+        return np.array(rows, dtype="f8").reshape(len(snaps), exp["constraints"],
+                                                  exp.get("dimension", 2))
     if name == "step":
         return np.array([s["step"] for s in snaps], dtype="i8")
     return np.array([s[name] for s in snaps], dtype="f8")
@@ -193,23 +195,26 @@ def check_xdmf(f, exp, xdmf_path, h5_name):
     grids = coll.findall("Grid")
     times = f["snapshots/time"][()]
     need(len(grids) == len(times), f"{len(grids)} grids for {len(times)} snapshots")
+    dim = exp.get("dimension", 2)
+    cells, topology, geometry = (("tetrahedra", "Tetrahedron", "XYZ") if dim == 3
+                                 else ("triangles", "Triangle", "XY"))
     n_nodes = len(exp["mesh"]["position0"])
-    n_elems = len(exp["mesh"]["triangles"])
+    n_elems = len(exp["mesh"][cells])
     names = None
     for s, grid in enumerate(grids):
         need(float(grid.find("Time").get("Value")) == times[s], f"grid {s} time differs")
         topo = grid.find("Topology")
-        need(topo.get("TopologyType") == "Triangle", "topology is not Triangle")
+        need(topo.get("TopologyType") == topology, f"topology is not {topology}")
         need(int(topo.get("NumberOfElements")) == n_elems, "NumberOfElements wrong")
         check_hdf_item(f, topo.find("DataItem"), h5_name)
         geo = grid.find("Geometry")
-        need(geo.get("GeometryType") == "XY", "geometry is not XY")
+        need(geo.get("GeometryType") == geometry, f"geometry is not {geometry}")
         item = geo.find("DataItem")
         if item.get("ItemType") == "HyperSlab":
             check_hyperslab(f, item, h5_name, s)
         else:
             check_hdf_item(f, item, h5_name)
-        need(dataitem_dims(item) == (n_nodes, 2), "geometry is not N x 2")
+        need(dataitem_dims(item) == (n_nodes, dim), f"geometry is not N x {dim}")
         attrs = {}
         for a in grid.findall("Attribute"):
             item = a.find("DataItem")

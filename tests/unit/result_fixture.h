@@ -1,7 +1,8 @@
 /*
  * result_fixture.h - a small real model for the snapshot and result tests:
  * a fixed 4x2 rock block under gravity and, optionally, a fracturing 2x1
- * slab above it (so the model has joints) pushed by a force constraint.
+ * slab above it (so the model has joints) pushed by a force constraint; and
+ * a 3D box of tetrahedra for the 3D layout.
  * Small on purpose: the tests compare every number, and must stay fast.
  */
 #ifndef RESULT_FIXTURE_H
@@ -12,6 +13,7 @@
 
 #include "case.h"
 #include "fdem.h"
+#include "mesh_3d.h"
 
 static int fixture_add_block(fdem_model *m, double ox, double oy, double w, double h, int nx,
                              int ny, int material, int fracture, fdem_error *err)
@@ -21,6 +23,26 @@ static int fixture_add_block(fdem_model *m, double ox, double oy, double w, doub
     int part = fdem_add_part(m, &mesh, material, fracture, err);
     fdem_mesh_free(&mesh);
     return part;
+}
+
+/* Sets dt = 0.5 x stable and fills `info` (when not NULL) as case_build
+ * would: 1000 steps, a snapshot every 5, position, velocity and stress. */
+static void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
+                         int constraints, int fracture)
+{
+    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
+    if (!info) return;
+    memset(info, 0, sizeof *info);
+    snprintf(info->name, sizeof info->name, "%s", name);
+    info->dt = fdem_get_dt(m);
+    info->stable_dt = fdem_stable_dt(m);
+    info->end_time = 1000 * info->dt;
+    info->safety = 0.5;
+    info->output_interval = 5 * info->dt;
+    info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS;
+    info->part_count = parts;
+    info->constraint_count = constraints;
+    info->fracture = fracture;
 }
 
 /* Returns a finalized model with dt = 0.5 x stable, or NULL (printing why).
@@ -54,21 +76,47 @@ static fdem_model *fixture_model(int fracturing, int constraints, case_info *inf
         fdem_model_destroy(m);
         return NULL;
     }
-    fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
-    if (info) {
-        memset(info, 0, sizeof *info);
-        snprintf(info->name, sizeof info->name, "fixture \"block\" & <slab>");
-        info->dt = fdem_get_dt(m);
-        info->stable_dt = fdem_stable_dt(m);
-        info->end_time = 1000 * info->dt;
-        info->safety = 0.5;
-        info->output_interval = 5 * info->dt;
-        info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS |
-                       CASE_FIELD_DAMAGE;
-        info->part_count = fracturing ? 2 : 1;
-        info->constraint_count = constraints ? 2 : 0;
-        info->fracture = fracturing;
+    fixture_info(m, info, "fixture \"block\" & <slab>", fracturing ? 2 : 1,
+                 constraints ? 2 : 0, fracturing);
+    if (info) info->fields |= CASE_FIELD_DAMAGE;
+    return m;
+}
+
+/* The 3D counterpart: one 0.4 x 0.2 x 0.2 m box of 4 x 2 x 2 cells (six
+ * tetrahedra each) under gravity along -z, fixed at z = 0 and, with
+ * `constraints`, pushed by a force; one part, so no contact is needed. */
+static fdem_model *fixture_model_3d(int constraints, case_info *info)
+{
+    fdem_error err = {0};
+    fdem_model *m = fdem_model_create();
+    fdem_material_def rock = {.density = 2700, .young = 3e10, .poisson = 0.25};
+    fdem_tet_mesh box = {0};
+    const double origin[3] = {0, 0, 0}, size[3] = {0.4, 0.2, 0.2};
+    const int div[3] = {4, 2, 2};
+    int ok = m && fdem_set_dimension(m, 3, &err) == 0;
+    int mat = ok ? fdem_add_material(m, &rock, &err) : -1;
+    ok = mat >= 0 && fdem_tet_mesh_box(origin, size, div, &box, &err) == 0 &&
+         fdem_add_part_3d(m, &box, mat, 0, &err) >= 0;
+    fdem_tet_mesh_free(&box);
+    if (ok && constraints) {
+        fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1, -1, -0.001, 1, 1, 0.001},
+                                   .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1,
+                                   .fix_z = 1};
+        fdem_constraint_def push = {.select = FDEM_SELECT_PART, .part = 0,
+                                    .kind = FDEM_CONSTRAINT_FORCE, .value = {1e5, -2e5, 3e5}};
+        ok = fdem_add_constraint(m, &fix, &err) >= 0 && fdem_add_constraint(m, &push, &err) >= 0;
     }
+    if (ok) {
+        const double g[3] = {0, 0, -9.81};
+        fdem_set_gravity_v(m, g);
+        ok = fdem_model_finalize(m, &err) >= 0;
+    }
+    if (!ok) {
+        fprintf(stderr, "  3D fixture model: %s\n", err.message);
+        fdem_model_destroy(m);
+        return NULL;
+    }
+    fixture_info(m, info, "fixture box", 1, constraints ? 2 : 0, 0);
     return m;
 }
 

@@ -11,21 +11,7 @@
 
 #include "check.h"
 #include "gmsh.h"
-
-/* Reads a whole file; NULL (and a failed check) if it is missing. */
-static char *read_file(const char *path, size_t *length)
-{
-    FILE *f = fopen(path, "rb");
-    CHECK(f != NULL, "cannot open %s (run from the repository root)", path);
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)n);
-    *length = fread(text, 1, (size_t)n, f);
-    fclose(f);
-    return text;
-}
+#include "read_file.h"
 
 static double mesh_area(const fdem_mesh *m)
 {

@@ -80,13 +80,16 @@ static json_t *ints_rows(const int32_t *v, int rows, int width)
 static json_t *expect_new(const fdem_model *m, const case_info *info)
 {
     fdem_counts c = fdem_get_counts(m);
+    int dim = fdem_get_dimension(m);
     json_t *mesh = json_object();
-    json_object_set_new(mesh, "position0", doubles_rows(fdem_initial_positions(m), c.nodes, 2));
-    json_object_set_new(mesh, "triangles", ints_rows(fdem_triangles(m), c.elements, 3));
+    json_object_set_new(mesh, "position0", doubles_rows(fdem_initial_positions(m), c.nodes, dim));
+    json_object_set_new(mesh, dim == 3 ? "tetrahedra" : "triangles",
+                        ints_rows(fdem_element_nodes(m), c.elements, fdem_nodes_per_element(m)));
     json_object_set_new(mesh, "node_mass", doubles_rows(fdem_node_masses(m), c.nodes, 0));
     json_object_set_new(mesh, "node_part", ints_rows(fdem_node_parts(m), c.nodes, 0));
     json_object_set_new(mesh, "element_part", ints_rows(fdem_element_parts(m), c.elements, 0));
-    if (c.joints > 0) json_object_set_new(mesh, "joints", ints_rows(fdem_joints(m), c.joints, 4));
+    if (c.joints > 0)
+        json_object_set_new(mesh, "joints", ints_rows(fdem_joints(m), c.joints, 2 * dim));
 
     json_t *series = json_pack("[sssss]", "step", "time", "kinetic_energy", "elastic_energy",
                                "constraint_force");
@@ -95,9 +98,9 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
     if (info->fields & CASE_FIELD_STRESS) json_array_append_new(series, json_string("stress"));
     if (c.joints > 0) json_array_append_new(series, json_string("damage"));
 
-    return json_pack("{s:s, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name, "dt",
-                     fdem_get_dt(m), "constraints", c.constraints, "h5_name", "result.h5",
-                     "series", series, "mesh", mesh, "snapshots");
+    return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
+                     "dimension", dim, "dt", fdem_get_dt(m), "constraints", c.constraints,
+                     "h5_name", "result.h5", "series", series, "mesh", mesh, "snapshots");
 }
 
 /* One snapshot as the file must hold it: the state JSON (which the daemon
@@ -107,7 +110,8 @@ static void expect_snapshot(json_t *doc, const snapshot *s)
     snapshot all = *s;
     all.fields |= s->damage ? CASE_FIELD_DAMAGE : 0;
     json_t *j = state_to_json(&all);
-    json_object_set_new(j, "constraint_force", doubles_rows(s->constraint_force, s->constraints, 2));
+    json_object_set_new(j, "constraint_force", doubles_rows(s->constraint_force, s->constraints,
+                                                                s->dimension));
     json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
     json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
     json_array_append_new(json_object_get(doc, "snapshots"), j);
@@ -149,10 +153,10 @@ typedef struct run {
     char err[512];
 } run;
 
-static int run_start(run *r, int fracturing, int constraints, unsigned fields, const char *name)
+/* Takes `model` (from a fixture, filling r->info) and creates the file. */
+static int run_start_with(run *r, fdem_model *model, unsigned fields, const char *name)
 {
-    memset(r, 0, sizeof *r);
-    r->model = fixture_model(fracturing, constraints, &r->info);
+    r->model = model;
     if (!r->model) return -1;
     if (fields) r->info.fields = fields;
     r->expect = expect_new(r->model, &r->info);
@@ -161,6 +165,12 @@ static int run_start(run *r, int fracturing, int constraints, unsigned fields, c
     r->file = result_create(path, r->model, &r->info, r->err, sizeof r->err);
     CHECK(r->file != NULL, "result_create: %s", r->err);
     return r->file ? 0 : -1;
+}
+
+static int run_start(run *r, int fracturing, int constraints, unsigned fields, const char *name)
+{
+    memset(r, 0, sizeof *r);
+    return run_start_with(r, fixture_model(fracturing, constraints, &r->info), fields, name);
 }
 
 /* Takes a snapshot now, appends it and records it as expected; then steps. */
@@ -179,6 +189,19 @@ static void run_end(run *r)
     if (r->file) CHECK(result_close(r->file) == 0, "result_close");
     json_decref(r->expect);
     fdem_model_destroy(r->model);
+}
+
+/* Writes r's sidecar as `xdmf_name` and has result_check.py compare it
+ * with `h5_name` and the expected `json_name`; `what` labels a failure. */
+static void run_check_xdmf(run *r, const char *xdmf_name, const char *h5_name,
+                           const char *json_name, const char *what)
+{
+    char xdmf[512], extra[600];
+    tmp_path(xdmf, sizeof xdmf, xdmf_name);
+    CHECK(xdmf_write(xdmf, "result.h5", r->model, &r->info, r->file, r->err, sizeof r->err) == 0,
+          "xdmf_write: %s", r->err);
+    snprintf(extra, sizeof extra, "'%s'", xdmf);
+    CHECK(run_checker(h5_name, json_name, "xdmf", extra) == 0, "%s", what);
 }
 
 /* ----------------------------------------------------------------- tests */
@@ -540,24 +563,34 @@ static void test_xdmf_matches_file(void)
     if (run_start(&r, 1, 1, 0, "result.h5") == 0) {
         for (int i = 0; i < 3; i++) run_append(&r);
         expect_save(r.expect, "result.json");
-        char xdmf[512], extra[600];
-        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
-        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
-              "xdmf_write: %s", r.err);
-        snprintf(extra, sizeof extra, "'%s'", xdmf);
-        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf with stress");
+        run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf with stress");
     }
     run_end(&r);
     /* Without position the geometry is the initial mesh. */
     if (run_start(&r, 0, 0, CASE_FIELD_VELOCITY, "result.h5") == 0) {
         for (int i = 0; i < 2; i++) run_append(&r);
         expect_save(r.expect, "result.json");
-        char xdmf[512], extra[600];
-        tmp_path(xdmf, sizeof xdmf, "result.xdmf");
-        CHECK(xdmf_write(xdmf, "result.h5", r.model, &r.info, r.file, r.err, sizeof r.err) == 0,
-              "xdmf_write: %s", r.err);
-        snprintf(extra, sizeof extra, "'%s'", xdmf);
-        CHECK(run_checker("result.h5", "result.json", "xdmf", extra) == 0, "xdmf, position0");
+        run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf, position0");
+    }
+    run_end(&r);
+}
+
+/* The 3D layout of contract 5.2: dimension = 3, /mesh/tetrahedra (E, 4),
+ * (S, N, 3) node series, (S, E, 6) stress, (S, C, 3) constraint forces,
+ * read back by h5py under SWMR and as a closed file, and an XDMF with
+ * Tetrahedron topology and XYZ geometry that matches the file. */
+static void test_result_3d_layout_and_xdmf(void)
+{
+    run r;
+    memset(&r, 0, sizeof r);
+    if (run_start_with(&r, fixture_model_3d(1, &r.info), 0, "solid.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        expect_save(r.expect, "solid.json");
+        CHECK(run_checker("solid.h5", "solid.json", "swmr", NULL) == 0, "3D layout, swmr");
+        run_check_xdmf(&r, "solid.xdmf", "solid.h5", "solid.json", "3D xdmf");
+        CHECK(result_close(r.file) == 0, "result_close");
+        r.file = NULL;
+        CHECK(run_checker("solid.h5", "solid.json", "plain", NULL) == 0, "3D, closed file");
     }
     run_end(&r);
 }
@@ -630,7 +663,8 @@ int main(int argc, char **argv)
         T(test_result_writer_stopped_mid_append), T(test_result_reopen_after_crash), T(test_result_reopen_clean_file_keeps_all),
         T(test_result_image_opens_plainly), T(test_result_image_checksum_matches_hdf5),
         T(test_result_check_file_refuses_damage), T(test_result_minimal_fields_without_constraints),
-        T(test_xdmf_matches_file), T(test_result_bad_input_is_an_error),
+        T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),
+        T(test_result_bad_input_is_an_error),
     };
     setup();
     int rc = check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);

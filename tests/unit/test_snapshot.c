@@ -131,6 +131,33 @@ static void test_snapshot_without_joints_has_no_damage(void)
     fdem_model_destroy(m);
 }
 
+/* 3D: three numbers per node and per constraint, six stress components
+ * per element, exactly the engine's. */
+static void test_snapshot_of_a_3d_model(void)
+{
+    fdem_model *m = fixture_model_3d(1, NULL);
+    CHECK(m != NULL, "3D fixture model");
+    if (!m) return;
+    CHECK(fixture_step(m, 20) == 0, "stepping");
+    snapshot *s = snapshot_take(m, CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS);
+    CHECK(s != NULL, "snapshot_take");
+    if (s) {
+        size_t nodes = (size_t)s->nodes, n = 6 * (size_t)s->elements;
+        CHECK(s->dimension == 3 && s->stress_components == 6, "dimension %d, %d components",
+              s->dimension, s->stress_components);
+        CHECK(equal_doubles(s->position, fdem_positions(m), 3 * nodes), "position");
+        CHECK(equal_doubles(s->velocity, fdem_velocities(m), 3 * nodes), "velocity");
+        CHECK(equal_doubles(s->constraint_force, fdem_constraint_forces(m), 6),
+              "constraint forces");
+        double *want = malloc(n * sizeof *want);
+        fdem_element_stress(m, want);
+        CHECK(equal_doubles(s->stress, want, n), "stress differs from fdem_element_stress");
+        free(want);
+    }
+    snapshot_free(s);
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(test_snapshot_copies_requested_fields), T(test_snapshot_is_a_copy),
            T(test_snapshot_stress_matches_engine), T(test_snapshot_damage_of_fracturing_model),
-           T(test_snapshot_without_joints_has_no_damage))
+           T(test_snapshot_without_joints_has_no_damage), T(test_snapshot_of_a_3d_model))

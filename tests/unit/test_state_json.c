@@ -27,6 +27,8 @@ static snapshot two_node_snapshot(unsigned fields)
     s.elements = 1;
     s.joints = 2;
     s.constraints = 1;
+    s.dimension = 2;
+    s.stress_components = 3;
     s.position = position;
     s.velocity = velocity;
     s.stress = stress;
@@ -127,5 +129,35 @@ static void test_state_json_non_finite_becomes_null(void)
     json_decref(j);
 }
 
+/* 3D: three numbers per node, six stress components per element, each
+ * row in the engine's order (xx, yy, zz, yz, xz, xy). */
+static void test_state_json_three_dimensions(void)
+{
+    double position3[6] = {0, 1, 2, 3, 4, 5};
+    double stress6[6] = {1, 2, 3, 4, 5, 6};
+    snapshot s = two_node_snapshot(CASE_FIELD_POSITION | CASE_FIELD_VELOCITY |
+                                   CASE_FIELD_STRESS);
+    s.dimension = 3;
+    s.stress_components = 6;
+    s.position = s.velocity = position3;
+    s.stress = stress6;
+    json_t *j = state_to_json(&s);
+    CHECK(j != NULL, "no JSON");
+    if (!j) return;
+    json_t *pos = json_object_get(j, "position"), *str = json_object_get(j, "stress");
+    CHECK(json_array_size(pos) == 2 && json_array_size(json_array_get(pos, 0)) == 3,
+          "position rows %zu of %zu", json_array_size(pos),
+          json_array_size(json_array_get(pos, 0)));
+    CHECK(number_at(pos, 1, 2) == 5, "z of node 1: %g", number_at(pos, 1, 2));
+    CHECK(json_array_size(json_object_get(j, "velocity")) == 2, "velocity rows");
+    CHECK(json_array_size(str) == 1 && json_array_size(json_array_get(str, 0)) == 6,
+          "stress row of %zu", json_array_size(json_array_get(str, 0)));
+    for (int k = 0; k < 6; k++)
+        CHECK(number_at(str, 0, (size_t)k) == stress6[k], "stress[%d] %g", k,
+              number_at(str, 0, (size_t)k));
+    json_decref(j);
+}
+
 CHECK_MAIN(T(test_state_json_all_fields), T(test_state_json_only_requested_fields),
-           T(test_state_json_round_trip_is_exact), T(test_state_json_non_finite_becomes_null))
+           T(test_state_json_round_trip_is_exact), T(test_state_json_non_finite_becomes_null),
+           T(test_state_json_three_dimensions))

@@ -1,0 +1,70 @@
+/*
+ * result_internal.h - what result_h5.c (writing) and result_reopen.c
+ * (reading back a file an earlier run left) share: the layout of the
+ * /snapshots datasets and the handle. Not part of any public contract;
+ * result.h is the interface. Every function here runs on the I/O thread.
+ */
+#ifndef FDEM_RESULT_INTERNAL_H
+#define FDEM_RESULT_INTERNAL_H
+
+#include <hdf5.h>
+
+#include "result.h"
+
+#define RESULT_FORMAT "fdem-result/1"
+
+/* The /snapshots datasets in append order: time must stay last. */
+enum series_kind {
+    SERIES_STEP,
+    SERIES_POSITION,
+    SERIES_VELOCITY,
+    SERIES_STRESS,
+    SERIES_DAMAGE,
+    SERIES_CONSTRAINT_FORCE,
+    SERIES_KINETIC,
+    SERIES_ELASTIC,
+    SERIES_CONTACT,
+    SERIES_FRICTION,
+    SERIES_JOINT,
+    SERIES_FRACTURE,
+    SERIES_DAMPING,
+    SERIES_GRAVITY_WORK,
+    SERIES_EXTERNAL_WORK,
+    SERIES_TIME,
+    SERIES_COUNT
+};
+
+extern const char *const series_names[SERIES_COUNT]; /* dataset names under /snapshots */
+
+typedef struct series {
+    hid_t id;       /* H5I_INVALID_HID when the model does not have it */
+    int rank;       /* including the snapshot axis */
+    hsize_t row[2]; /* per-snapshot extent after the snapshot axis */
+} series;
+
+struct result_file {
+    hid_t file;
+    series ds[SERIES_COUNT];
+    int count;     /* complete snapshots (= len(/snapshots/time)) */
+    double *times; /* the time of each of them, for the XDMF sidecar */
+    int times_capacity;
+};
+
+/* "what: innermost HDF5 message" into err; clears the HDF5 error stack. */
+void result_fail(char *err, size_t errlen, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* Keeps HDF5 from printing its error stack (per thread). */
+void h5_quiet(void);
+/* 1 when the file's root says format = RESULT_FORMAT. */
+int has_result_format(hid_t file);
+hid_t series_mem_type(int kind);
+/* Which /snapshots datasets this model has, and their per-snapshot shape. */
+void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields);
+/* File access with the latest format (SWMR); optionally clearing the
+ * status flags a crashed writer left. */
+hid_t file_access_latest(int clear_status_flags);
+result_file *result_alloc(void);
+int result_release(result_file *f);
+int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,55 @@
+/*
+ * case_sizing.h - how long and how large a case will be before it runs:
+ * POST /cases?dry_run=true, and the warning in the 201 of a case that will
+ * run for hours (contract 5.4).
+ *
+ * Contract:
+ *  - sizing_is_last_step() is the worker's rule for the one step that is
+ *    cut to land on time.end; sizing_steps_to_end() counts steps under the
+ *    same rule, so a dry run's `steps` is the number the run then takes.
+ *  - sizing_output_interval() is the snapshot interval the worker uses.
+ *  - case_sizing_measure() sizes a model just built from a case document
+ *    (model_bytes: the builder's own estimate, see case_model_build_upload):
+ *    counts, dt, steps, snapshots, memory charged while it runs, result.h5
+ *    bytes, and a wall time: the slower of stepping (timed on the model for
+ *    a moment) and writing the snapshots (snapshot_seconds each, see
+ *    io_snapshot_seconds). It ADVANCES the model: call it only on a model
+ *    that is thrown away.
+ */
+#ifndef FDEMD_CASE_SIZING_H
+#define FDEMD_CASE_SIZING_H
+
+#include <jansson.h>
+#include <stdint.h>
+
+#include "case.h"
+#include "fdem.h"
+
+/* A case whose estimated run is at least this long gets a warning. */
+#define SIZING_WARN_SECONDS 3600.0
+
+typedef struct case_sizing {
+    int nodes, elements, joints;
+    double dt;
+    double steps;             /* a double: absurd end times do not overflow */
+    double snapshots;
+    double memory_bytes, result_bytes;
+    double steps_per_second;  /* measured on the model */
+    double estimated_seconds;
+} case_sizing;
+
+int sizing_is_last_step(double t0, double dt, double end);
+double sizing_steps_to_end(double t0, double end, double dt);
+double sizing_output_interval(const case_info *info);
+
+void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
+                         int threads, double snapshot_seconds, case_sizing *out);
+/* The dry run's answer: {"nodes", "elements", "joints", "dt", "steps",
+ * "snapshots", "memory_bytes", "result_bytes", "estimated_seconds"} (and
+ * "warning" for a long run). */
+json_t *case_sizing_json(const case_sizing *s);
+/* "this case will run for about 5.2 hours (...)" into out, or "" when it
+ * is not long; returns whether there is a warning. */
+int case_sizing_warning(const case_sizing *s, char *out, size_t size);
+
+#endif

@@ -1,0 +1,30 @@
+/*
+ * read_file.h - a whole test data file in memory, for the tests that feed
+ * files of tests/data to a reader (gmsh text, case documents).
+ */
+#ifndef FDEM_READ_FILE_H
+#define FDEM_READ_FILE_H
+
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "check.h"
+
+/* The file's bytes in a buffer of exactly their length (no NUL: ASan then
+ * catches a reader that goes past `length`); free it. NULL and a failed
+ * check when the file is missing (the tests run from the repository root). */
+static inline char *read_file(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    CHECK(f != NULL, "cannot open %s (run from the repository root)", path);
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = malloc(n > 0 ? (size_t)n : 1);
+    *length = text ? fread(text, 1, (size_t)n, f) : 0;
+    fclose(f);
+    return text;
+}
+
+#endif
