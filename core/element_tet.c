@@ -3,9 +3,10 @@
  * rotation: edge matrices, deformation gradient, neo-Hookean Cauchy stress,
  * viscous damping, nodal forces, strain energy and the stable step.
  *
- * The triangle kernel (element.c) and this one are the same method in two
- * dimensions; they share no code because each is a handful of expressions
- * written out for its own matrix size, and the hot loops want them inline.
+ * The per-element expressions are element_tet_kernel.h's, inline, which the
+ * engine's loop (element_tet_model.c) uses too: what the unit tests hold
+ * here is what the engine runs. The triangle kernel (element_tri.c) shares
+ * the law's ln J (log_near1.h); the rest is written out for its own size.
  *
  * Nodal forces come from face vectors, as the triangle's come from edge
  * normals: with current edges e_k = x_k - x_0 and det = e1 . (e2 x e3) = 6V,
@@ -15,6 +16,7 @@
  * sum of the other three.
  */
 #include "element_tet.h"
+#include "element_tet_kernel.h"
 #include "stable_step.h"
 #include "vec3.h"
 
@@ -23,19 +25,13 @@
 
 static inline double vnorm(const double a[3]) { return sqrt(vec3_dot(a, a)); }
 
-/* Edges from node 0 and their cross products c1 = e2 x e3, c2 = e3 x e1,
- * c3 = e1 x e2 (each twice the area vector of the face through node 0 and
- * the other two edges' ends); returns det = e1 . c1 = 6V. */
+/* Edges from node 0 and their face vectors (element_tet_kernel.h);
+ * returns det = 6V. */
 static double tet_edges(const double *p0, const double *p1, const double *p2,
                         const double *p3, double e[3][3], double c[3][3])
 {
-    vec3_sub(p1, p0, e[0]);
-    vec3_sub(p2, p0, e[1]);
-    vec3_sub(p3, p0, e[2]);
-    vec3_cross(e[1], e[2], c[0]);
-    vec3_cross(e[2], e[0], c[1]);
-    vec3_cross(e[0], e[1], c[2]);
-    return vec3_dot(e[0], c[0]);
+    tet_kernel_edges(p0, p1, p2, p3, e);
+    return tet_kernel_faces(e, c);
 }
 
 static const double *node_at(const double *xyz, int32_t n) { return xyz + 3 * (size_t)n; }
@@ -79,86 +75,43 @@ int tet_prepare(const double *pos0, const int32_t node[4], tet_geometry *out)
 void tet_deformation(const double *pos, const int32_t node[4], const tet_geometry *g,
                      double F[9])
 {
-    const double *p0 = node_at(pos, node[0]);
     double e[3][3];
-    for (int k = 0; k < 3; k++) vec3_sub(node_at(pos, node[k + 1]), p0, e[k]);
-    /* F = [x][X]^-1: F_ij = sum_k (e_k)_i xinv_kj */
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            F[3 * i + j] = e[0][i] * g->xinv[j] + e[1][i] * g->xinv[3 + j] +
-                           e[2][i] * g->xinv[6 + j];
+    tet_kernel_edges(node_at(pos, node[0]), node_at(pos, node[1]), node_at(pos, node[2]),
+                     node_at(pos, node[3]), e);
+    tet_kernel_gradient(e, g->xinv, F);
 }
 
 /* ------------------------------------------------------------------ stress */
 
-/* Voigt slots of (i, j) in the order xx, yy, zz, yz, xz, xy */
-static const int voigt[3][3] = {{0, 5, 4}, {5, 1, 3}, {4, 3, 2}};
-
 double tet_stress(const double F[9], double lambda, double mu, double sigma[6], double *J_out)
 {
-    double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-               F[2] * (F[3] * F[7] - F[4] * F[6]);
-    double lnJ, invJ;
-    if (J >= TET_J_MIN) {
-        lnJ = log(J);
-        invJ = 1.0 / J;
-    } else { /* the tangent of the law at J_MIN: finite, and pushing open */
-        lnJ = log(TET_J_MIN) + (J - TET_J_MIN) / TET_J_MIN;
-        invJ = 1.0 / TET_J_MIN;
-    }
-    /* B = F F^T */
-    double B[3][3];
-    for (int i = 0; i < 3; i++)
-        for (int j = i; j < 3; j++)
-            B[i][j] = F[3 * i] * F[3 * j] + F[3 * i + 1] * F[3 * j + 1] + F[3 * i + 2] * F[3 * j + 2];
-    double muJ = mu * invJ, vol = lambda * lnJ * invJ;
-    for (int i = 0; i < 3; i++) {
-        sigma[i] = muJ * (B[i][i] - 1.0) + vol;
-        for (int j = i + 1; j < 3; j++) sigma[voigt[i][j]] = muJ * B[i][j];
-    }
+    double J;
+    double w = tet_kernel_stress(F, mu, lambda, 0.5 * mu, 0.5 * lambda, sigma, &J);
     if (J_out) *J_out = J;
-    double trB = B[0][0] + B[1][1] + B[2][2];
-    return 0.5 * mu * (trB - 3.0 - 2.0 * lnJ) + 0.5 * lambda * lnJ * lnJ;
-}
-
-/* Adds 2 eta D, D = sym(L), L = [v][x]^-1 = sum_a (v_a - v_0) (x) c_a / det. */
-static void add_viscous(const double *vel, const int32_t node[4], const double c[3][3],
-                        double det, double eta, double sigma[6])
-{
-    if (!vel || !(eta > 0) || !(fabs(det) > 0)) return;
-    const double *v0 = node_at(vel, node[0]);
-    double L[3][3] = {{0}};
-    for (int k = 0; k < 3; k++) {
-        double dv[3];
-        vec3_sub(node_at(vel, node[k + 1]), v0, dv);
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++) L[i][j] += dv[i] * c[k][j];
-    }
-    double scale = eta / det; /* 2 eta * (L + L^T)/2 / det */
-    for (int i = 0; i < 3; i++)
-        for (int j = i; j < 3; j++) sigma[voigt[i][j]] += scale * (L[i][j] + L[j][i]);
+    return w;
 }
 
 double tet_forces(const double *pos, const double *vel, const int32_t node[4],
                   const tet_geometry *g, const tet_law *law, double f[12], double sigma_out[6])
 {
     double F[9], sigma[6], J, e[3][3], c[3][3];
-    tet_deformation(pos, node, g, F);
+    const double *p[4];
+    for (int a = 0; a < 4; a++) p[a] = node_at(pos, node[a]);
+    tet_kernel_edges(p[0], p[1], p[2], p[3], e);
+    tet_kernel_gradient(e, g->xinv, F);
     double w = tet_stress(F, law->lambda, law->mu, sigma, &J);
-    double det = tet_edges(node_at(pos, node[0]), node_at(pos, node[1]), node_at(pos, node[2]),
-                           node_at(pos, node[3]), e, c);
-    add_viscous(vel, node, c, det, law->eta, sigma);
-    const double s[3][3] = {{sigma[0], sigma[5], sigma[4]},
-                            {sigma[5], sigma[1], sigma[3]},
-                            {sigma[4], sigma[3], sigma[2]}};
-    double sum[3] = {0, 0, 0};
-    for (int a = 1; a <= 3; a++)
-        for (int i = 0; i < 3; i++) {
-            double fi = -(s[i][0] * c[a - 1][0] + s[i][1] * c[a - 1][1] + s[i][2] * c[a - 1][2]) / 6.0;
-            f[3 * a + i] = fi;
-            sum[i] += fi;
-        }
-    for (int i = 0; i < 3; i++) f[i] = -sum[i];
+    double det = tet_kernel_faces(e, c);
+    /* 2 eta D, D = S / det */
+    if (vel && law->eta > 0 && fabs(det) > 0) {
+        double S[6];
+        tet_kernel_rate(node_at(vel, node[0]), node_at(vel, node[1]), node_at(vel, node[2]),
+                        node_at(vel, node[3]), c, S);
+        for (int k = 0; k < 6; k++) sigma[k] += 2 * law->eta / det * S[k];
+    }
+    double sixth[6], fa[4][3];
+    for (int k = 0; k < 6; k++) sixth[k] = sigma[k] * (1.0 / 6);
+    tet_kernel_forces(sixth, c, fa);
+    memcpy(f, fa, sizeof fa);
     if (sigma_out) memcpy(sigma_out, sigma, sizeof sigma);
     return g->volume0 * w;
 }

@@ -23,6 +23,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "log_near1.h"
 #include "model.h"
 #include "stable_step.h"
 
@@ -131,41 +132,7 @@ double tri_element_stable_dt(const fdem_model *m, int e)
     return damped_mode_stable_dt(omega2, rate);
 }
 
-/* ln J for the J of a stressed solid, which is almost always within a few
- * per mille of 1. libm's log() was ~4 ns of a ~23 ns element-step, so near
- * 1 the Taylor series of ln(1 + x), x = J - 1, is used instead:
- *   ln(1 + x) = x + x^2 q(x),  q(x) = sum_{k=2..K} (-1)^(k+1) x^(k-2) / k,
- * with K = 5 for |x| <= 2^-10 (volumetric strain below ~1e-3: the usual
- * case, 9 operations) and K = 9 for |x| <= 2^-6. x is exact there
- * (Sterbenz); the truncation error is below |x|^K / (K + 1) of the result,
- * < 2^-50 / 6 resp. 2^-54 / 10, i.e. < 1e-16; x^2 q is at most 1/128 of x,
- * so its rounding hardly reaches the sum: the result is within about one
- * ulp of log(J) (tested against log() in test_element.c; measured worst
- * 2.3e-16). q is evaluated in Estrin's form, a short dependency chain that
- * overlaps with the division 1/J. Everything else goes to log(). */
-#define LOG_SERIES_RANGE 0x1p-6
-#define LOG_SHORT_RANGE 0x1p-10
-static inline double log_short_series(double x)
-{
-    double x2 = x * x;
-    double q = (-1.0 / 2 + x * (1.0 / 3)) + x2 * (-1.0 / 4 + x * (1.0 / 5));
-    return x + x2 * q;
-}
-
-static inline double log_near1(double J)
-{
-    double x = J - 1.0;
-    if (fabs(x) <= LOG_SHORT_RANGE) return log_short_series(x);
-    if (!(fabs(x) <= LOG_SERIES_RANGE)) return log(J);
-    double x2 = x * x;
-    double x4 = x2 * x2;
-    double p01 = -1.0 / 2 + x * (1.0 / 3), p23 = -1.0 / 4 + x * (1.0 / 5);
-    double p45 = -1.0 / 6 + x * (1.0 / 7), p67 = -1.0 / 8 + x * (1.0 / 9);
-    double q = (p01 + x2 * p23) + x4 * (p45 + x2 * p67);
-    return x + x2 * q;
-}
-
-/* The same function, for the test that holds it to log(). */
+/* log_near1 (log_near1.h) as a function, for the test that holds it to log(). */
 double element_log_near1(double J);
 double element_log_near1(double J) { return log_near1(J); }
 
@@ -179,17 +146,8 @@ static inline double neo_hookean_half(double a, double b, double c, double d, do
                                       double hmu, double hs[3], double *w)
 {
     double J = a * d - b * c;
-    double lnJ, invJ, x = J - 1.0;
-    if (fabs(x) <= LOG_SHORT_RANGE) { /* the usual case first: one test */
-        lnJ = log_short_series(x);
-        invJ = 1.0 / J;
-    } else if (J >= J_MIN) {
-        lnJ = log_near1(J);
-        invJ = 1.0 / J;
-    } else {
-        lnJ = log(J_MIN) + (J - J_MIN) / J_MIN;
-        invJ = 1.0 / J_MIN;
-    }
+    double lnJ, invJ;
+    neo_hookean_log_inverse(J, J_MIN, &lnJ, &invJ);
     double B11 = a * a + b * b, B22 = c * c + d * d, B12 = a * c + b * d;
     double hmuJ = hmu * invJ, hl_lnJ = hlambda * lnJ, hvol = hl_lnJ * invJ;
     hs[0] = hmuJ * (B11 - 1) + hvol;

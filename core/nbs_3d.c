@@ -52,23 +52,6 @@ static inline int nbs3_sphere_valid(double x, double y, double z, double r)
            fabs(z) <= NBS_VALUE_LIMIT && r >= 0.0 && r <= NBS_VALUE_LIMIT;
 }
 
-/* The one sphere test both detectors use; split statements so that no
- * compiler contracts it into an FMA in one detector and not the other. */
-static inline int nbs3_spheres_touch(double xi, double yi, double zi, double ri,
-                                     double xj, double yj, double zj, double rj)
-{
-    double dx = xi - xj;
-    double dy = yi - yj;
-    double dz = zi - zj;
-    double reach = ri + rj;
-    double dx2 = dx * dx;
-    double dy2 = dy * dy;
-    double dz2 = dz * dz;
-    double dist2 = dx2 + dy2 + dz2;
-    double reach2 = reach * reach;
-    return dist2 <= reach2;
-}
-
 /* ------------------------------------------------------------- lifecycle */
 
 void nbs_grid_3d_init(nbs_grid_3d *grid)
@@ -307,7 +290,7 @@ static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_scan *s, int use_body, 
     const double *cx = s->cx, *cy = s->cy, *cz = s->cz, *r = s->r;
     const int32_t *cell_next = s->cell_next;
     for (int32_t j = list; j >= 0; j = cell_next[j]) {
-        int hit = nbs3_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j]);
+        int hit = nbs_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j]);
         if (use_body) hit &= !nbs_same_body(s->body, b.e, j);
         o->a[o->count] = b.e;
         o->b[o->count] = j;
@@ -521,7 +504,7 @@ int nbs_detect_brute_3d(size_t n, const double *cx, const double *cy, const doub
         if (!nbs3_sphere_valid(cx[i], cy[i], cz[i], r[i])) continue;
         for (size_t j = i + 1; j < n; j++) {
             if (!nbs3_sphere_valid(cx[j], cy[j], cz[j], r[j])) continue;
-            if (!nbs3_spheres_touch(cx[i], cy[i], cz[i], r[i], cx[j], cy[j], cz[j], r[j]))
+            if (!nbs_spheres_touch(cx[i], cy[i], cz[i], r[i], cx[j], cy[j], cz[j], r[j]))
                 continue;
             if (nbs_same_body(body, (int32_t)i, (int32_t)j)) continue;
             if (nbs_pairs_push(pairs, (int32_t)i, (int32_t)j) != 0) return -1;

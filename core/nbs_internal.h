@@ -2,7 +2,7 @@
  * nbs_internal.h - what the 2D and 3D Munjiza-NBS detectors share (nbs.c,
  * nbs_3d.c); not part of the engine's interface.
  *
- * Contract: the pair list growth, the list-array helpers, the "old list"
+ * Contract: the sphere test, the pair list growth, the list-array helpers, the "old list"
  * encoding of a head (a list already processed but still needed as a
  * neighbour is stored as -2 - head), the validity limit on a centre or
  * radius, the padded cell size and the folding plan of one axis. Both
@@ -33,6 +33,24 @@
 #define NBS_MAX_CIRCLES ((size_t)1 << 30)
 /* the integer extent is kept below 2^40 cells so int64 never overflows */
 #define NBS_MAX_CELLS_PER_AXIS 1099511627776.0
+
+/* The one sphere test of the 3D detectors (nbs_3d.c's two, and the bench's
+ * baseline); split statements so that no compiler contracts it into an FMA
+ * in one detector and not the other. */
+static inline int nbs_spheres_touch(double xi, double yi, double zi, double ri, double xj,
+                                    double yj, double zj, double rj)
+{
+    double dx = xi - xj;
+    double dy = yi - yj;
+    double dz = zi - zj;
+    double reach = ri + rj;
+    double dx2 = dx * dx;
+    double dy2 = dy * dy;
+    double dz2 = dz * dz;
+    double dist2 = dx2 + dy2 + dz2;
+    double reach2 = reach * reach;
+    return dist2 <= reach2;
+}
 
 static inline int nbs_same_body(const int32_t *body, int32_t i, int32_t j)
 {

@@ -86,6 +86,7 @@ static inline void build_fix_part(fdem_model *m, int part)
     c.part = part;
     c.kind = FDEM_CONSTRAINT_FIX;
     c.fix_x = c.fix_y = 1;
+    c.fix_z = fdem_get_dimension(m) == 3;
     fdem_error err;
     if (fdem_add_constraint(m, &c, &err) < 0) build_die("constraint", &err);
 }

@@ -8,6 +8,7 @@
  * fixed slabs settles with no sphere through another; two threads give the
  * bits of one; a checkpoint holding stick springs restores to the same bits.
  */
+#include "build_container_3d.h"
 #include "check.h"
 #include "fdem.h"
 #include "mesh_3d.h"
@@ -275,38 +276,11 @@ static void box_sticks_on_slab_below_friction_angle(void)
  * not contact each other: one mesh of five pieces. */
 static void add_container(fdem_model *m, int mat, double X, double Y, double H, double T)
 {
-    const double slabs[5][2][3] = {
-        {{-T, -T, -T}, {X + 2 * T, Y + 2 * T, T}}, /* floor */
-        {{-T, 0, 0}, {T, Y, H}},                   /* walls */
-        {{X, 0, 0}, {T, Y, H}},
-        {{-T, -T, 0}, {X + 2 * T, T, H}},
-        {{-T, Y, 0}, {X + 2 * T, T, H}},
-    };
     fdem_tet_mesh all = {0};
     fdem_error err = {0};
-    for (int k = 0; k < 5; k++) {
-        int div[3];
-        for (int d = 0; d < 3; d++) div[d] = (int)fmax(1, lround(slabs[k][1][d] / 0.08));
-        fdem_tet_mesh one = {0};
-        CHECK(fdem_tet_mesh_box(slabs[k][0], slabs[k][1], div, &one, &err) == 0, "%s", err.message);
-        double *xyz = realloc(all.xyz, sizeof(double) * 3 * (size_t)(all.node_count + one.node_count));
-        if (xyz) all.xyz = xyz;
-        int32_t *tet = realloc(all.tet, sizeof(int32_t) * 4 * (size_t)(all.tet_count + one.tet_count));
-        if (tet) all.tet = tet;
-        if (!xyz || !tet) {
-            CHECK(0, "out of memory");
-            fdem_tet_mesh_free(&one);
-            fdem_tet_mesh_free(&all);
-            return;
-        }
-        memcpy(all.xyz + 3 * all.node_count, one.xyz, sizeof(double) * 3 * (size_t)one.node_count);
-        for (int i = 0; i < 4 * one.tet_count; i++)
-            all.tet[4 * all.tet_count + i] = one.tet[i] + all.node_count;
-        all.node_count += one.node_count;
-        all.tet_count += one.tet_count;
-        fdem_tet_mesh_free(&one);
-    }
-    fix_part(m, add_mesh(m, &all, mat, NULL, NULL));
+    int ok = build_container_mesh(X, Y, H, T, 0.08, &all, &err) == 0;
+    CHECK(ok, "%s", err.message);
+    if (ok) fix_part(m, add_mesh(m, &all, mat, NULL, NULL));
 }
 
 /* The radius of the largest sphere inside the polyhedron the sphere

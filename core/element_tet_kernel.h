@@ -1,0 +1,110 @@
+/*
+ * element_tet_kernel.h - the per-element arithmetic of the constant-strain
+ * tetrahedron, inline, so that the plain-array functions of element_tet.c
+ * (what the unit tests hold to closed forms) and the engine's hot loop in
+ * element_tet_model.c are the same expressions, not two versions of them.
+ *
+ * Contract (positions and velocities are xyz triples; Voigt order xx, yy,
+ * zz, yz, xz, xy as in contract 5.2):
+ *  - tet_kernel_edges: e_k = x_{k+1} - x_0; tet_kernel_faces: the face
+ *    vectors c_1 = e_2 x e_3, c_2 = e_3 x e_1, c_3 = e_1 x e_2 (twice the
+ *    area vectors of the faces through node 0), returns det = e_1 . c_1 = 6V.
+ *  - tet_kernel_gradient: F = [x][X]^-1 from the edges and the stored
+ *    [X]^-1 (row-major).
+ *  - tet_kernel_stress: the neo-Hookean Cauchy stress times a scale s,
+ *    s sigma = (s mu / J)(B - I) + (s lambda / J) ln J I, for the constants
+ *    already scaled (smu = s mu, slambda = s lambda); returns the strain
+ *    energy density per initial volume from hmu = mu/2, hlambda = lambda/2.
+ *    Scaling the constants instead of the stress is free in a loop that
+ *    loads them once per material. ln J by log_near1.h; below TET_J_MIN
+ *    the law continues along its tangent.
+ *  - tet_kernel_rate: the symmetric part of sum_k (v_k - v_0) (x) c_k, which
+ *    is det times the rate of deformation D (no division here).
+ *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
+ *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
+ *    the other three: the four sum to zero exactly.
+ *  - Each of edges, faces, gradient, stress and forces also exists as
+ *    name_pair over tet_pair, two elements in the lanes of one SIMD
+ *    register (element_tet_kernel_body.h is written once for both), with
+ *    the same bits per element as the scalar one.
+ */
+#ifndef FDEM_ELEMENT_TET_KERNEL_H
+#define FDEM_ELEMENT_TET_KERNEL_H
+
+#include "element_tet.h"
+#include "log_near1.h"
+
+/* Forced inline, and the small loops fully unrolled (gcc -O2 keeps some as
+ * loops): otherwise F, the stress and the forces go through memory, and
+ * wide loads of narrow stores stall on store forwarding. */
+#if defined(__GNUC__)
+#define TET_KERNEL static inline __attribute__((always_inline))
+#define TET_UNROLL _Pragma("GCC unroll 16")
+#else
+#define TET_KERNEL static inline
+#define TET_UNROLL
+#endif
+
+/* Two elements side by side: lane k of every number is element k's. */
+typedef double tet_pair __attribute__((vector_size(16)));
+
+/* ln J and 1/J of a pair: the series on both lanes in the usual case
+ * (lane by lane, bit for bit what one element gets), the division as one
+ * vector; the rare lane outside it through the scalar path. */
+static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ, tet_pair *invJ)
+{
+    tet_pair x = J - 1.0;
+    if (fabs(x[0]) <= LOG_SHORT_RANGE && fabs(x[1]) <= LOG_SHORT_RANGE) {
+        *lnJ = (tet_pair){log_short_series(x[0]), log_short_series(x[1])};
+        *invJ = 1.0 / J;
+        return;
+    }
+    double l0, l1, i0, i1;
+    neo_hookean_log_inverse(J[0], j_min, &l0, &i0);
+    neo_hookean_log_inverse(J[1], j_min, &l1, &i1);
+    *lnJ = (tet_pair){l0, l1};
+    *invJ = (tet_pair){i0, i1};
+}
+
+#define TET_T double
+#define TET_FN(name) name
+#define TET_LOG_INVERSE neo_hookean_log_inverse
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
+
+#define TET_T tet_pair
+#define TET_FN(name) name##_pair
+#define TET_LOG_INVERSE tet_log_inverse_pair
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
+
+TET_KERNEL void tet_kernel_rate(const double *v0, const double *v1, const double *v2,
+                                   const double *v3, const double c[3][3], double S[6])
+{
+    double dv[3][3];
+    tet_kernel_edges(v0, v1, v2, v3, dv);
+    double L[3][3];
+    TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        TET_UNROLL
+        for (int j = 0; j < 3; j++)
+            L[i][j] = dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
+    S[0] = L[0][0];
+    S[1] = L[1][1];
+    S[2] = L[2][2];
+    S[3] = 0.5 * (L[1][2] + L[2][1]);
+    S[4] = 0.5 * (L[0][2] + L[2][0]);
+    S[5] = 0.5 * (L[0][1] + L[1][0]);
+}
+
+/* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */
+TET_KERNEL double tet_kernel_contract(const double s[6], const double S[6])
+{
+    return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
+}
+
+#endif /* FDEM_ELEMENT_TET_KERNEL_H */

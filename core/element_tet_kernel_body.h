@@ -1,0 +1,83 @@
+/*
+ * element_tet_kernel_body.h - the tetrahedron's per-element expressions,
+ * written once over a number type TET_T and included twice by
+ * element_tet_kernel.h: for double (one element) and for a pair of doubles
+ * (two elements side by side in one SIMD register, TET_FN suffix _pair).
+ * Vector lanes round exactly as scalars do (IEEE, no contraction under
+ * -std=c11), so a pair gives each element the bits it gets alone.
+ * Not a header of its own: include element_tet_kernel.h.
+ */
+#if !defined(TET_T) || !defined(TET_FN) || !defined(TET_LOG_INVERSE)
+#error "include element_tet_kernel.h, not this file"
+#endif
+
+TET_KERNEL void TET_FN(tet_kernel_edges)(const TET_T *p0, const TET_T *p1, const TET_T *p2,
+                                         const TET_T *p3, TET_T e[3][3])
+{
+    TET_UNROLL
+    for (int i = 0; i < 3; i++) {
+        e[0][i] = p1[i] - p0[i];
+        e[1][i] = p2[i] - p0[i];
+        e[2][i] = p3[i] - p0[i];
+    }
+}
+
+TET_KERNEL TET_T TET_FN(tet_kernel_faces)(const TET_T e[3][3], TET_T c[3][3])
+{
+    TET_UNROLL
+    for (int k = 0; k < 3; k++) {
+        const TET_T *a = e[(k + 1) % 3], *b = e[(k + 2) % 3];
+        c[k][0] = a[1] * b[2] - a[2] * b[1];
+        c[k][1] = a[2] * b[0] - a[0] * b[2];
+        c[k][2] = a[0] * b[1] - a[1] * b[0];
+    }
+    return e[0][0] * c[0][0] + e[0][1] * c[0][1] + e[0][2] * c[0][2];
+}
+
+/* F_ij = sum_k (e_k)_i xinv_kj */
+TET_KERNEL void TET_FN(tet_kernel_gradient)(const TET_T e[3][3], const TET_T xinv[9], TET_T F[9])
+{
+    TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        TET_UNROLL
+        for (int j = 0; j < 3; j++)
+            F[3 * i + j] = e[0][i] * xinv[j] + e[1][i] * xinv[3 + j] + e[2][i] * xinv[6 + j];
+}
+
+TET_KERNEL TET_T TET_FN(tet_kernel_stress)(const TET_T F[9], double smu, double slambda,
+                                           double hmu, double hlambda, TET_T s[6], TET_T *J_out)
+{
+    TET_T J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+              F[2] * (F[3] * F[7] - F[4] * F[6]);
+    TET_T lnJ, invJ;
+    TET_LOG_INVERSE(J, TET_J_MIN, &lnJ, &invJ);
+    /* B = F F^T */
+    TET_T B00 = F[0] * F[0] + F[1] * F[1] + F[2] * F[2];
+    TET_T B11 = F[3] * F[3] + F[4] * F[4] + F[5] * F[5];
+    TET_T B22 = F[6] * F[6] + F[7] * F[7] + F[8] * F[8];
+    TET_T B12 = F[3] * F[6] + F[4] * F[7] + F[5] * F[8];
+    TET_T B02 = F[0] * F[6] + F[1] * F[7] + F[2] * F[8];
+    TET_T B01 = F[0] * F[3] + F[1] * F[4] + F[2] * F[5];
+    TET_T muJ = smu * invJ, vol = slambda * lnJ * invJ;
+    s[0] = muJ * (B00 - 1.0) + vol;
+    s[1] = muJ * (B11 - 1.0) + vol;
+    s[2] = muJ * (B22 - 1.0) + vol;
+    s[3] = muJ * B12;
+    s[4] = muJ * B02;
+    s[5] = muJ * B01;
+    *J_out = J;
+    return hmu * (B00 + B11 + B22 - 3.0 - 2.0 * lnJ) + hlambda * lnJ * lnJ;
+}
+
+TET_KERNEL void TET_FN(tet_kernel_forces)(const TET_T s[6], const TET_T c[3][3], TET_T f[4][3])
+{
+    TET_UNROLL
+    for (int a = 1; a <= 3; a++) {
+        const TET_T *ca = c[a - 1];
+        f[a][0] = -(s[0] * ca[0] + s[5] * ca[1] + s[4] * ca[2]);
+        f[a][1] = -(s[5] * ca[0] + s[1] * ca[1] + s[3] * ca[2]);
+        f[a][2] = -(s[4] * ca[0] + s[3] * ca[1] + s[2] * ca[2]);
+    }
+    TET_UNROLL
+    for (int i = 0; i < 3; i++) f[0][i] = -(f[1][i] + f[2][i] + f[3][i]);
+}
