@@ -16,6 +16,7 @@
 
 #include "contact_pair.h"
 #include "fdem.h"
+#include "joint_law.h"
 #include "nbs.h"
 
 typedef struct material {
@@ -260,8 +261,7 @@ int constraint_select(fdem_model *m, fdem_error *err);
 void constraint_apply_forces(fdem_model *m);
 void constraint_enforce(fdem_model *m, double h, double havg);
 
-/* joint.c */
-double joint_softening(double D);
+/* joint.c (the cohesive law itself, joint_softening included: joint_law.h) */
 int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
                      fdem_error *err);
 int joint_prepare(fdem_model *m, fdem_error *err);
