@@ -7,7 +7,8 @@
  * of a partly shut damaged joint are the gradient of its stored energy
  * (the clipped compression integral); and a joint pulled apart in pure
  * mode I (sheared in pure mode II) absorbs energy_I (energy_II) times its
- * area, both as work of its forces and in the fracture account.
+ * area, both as work of its forces and in the fracture account; sheared
+ * while pressed shut, its work closes against stored + fracture + friction.
  */
 #include "check.h"
 #include "joint_law.h"
@@ -309,6 +310,57 @@ static void mode_II_dissipates_energy_II(void)
             work / face_area, dissipated / face_area, GII);
 }
 
+/* Sheared to breakage while pressed shut: the shear strength gains
+ * sigma_c tan(phi), which is friction, booked as the joint slides. The
+ * work of the sliding force is then what the joint stores (and, once
+ * broken shut, hands to contact), dissipates by damage and by friction:
+ * the balance closes to 1 % over the whole path. */
+static void sheared_under_compression_closes_the_balance(void)
+{
+    joint_law law = law_of();
+    double R[9], pos[18], vel[18] = {0}, fa[9];
+    rotation(axis, 1.3, R);
+    double shut = -0.5 * FT / law.k; /* sigma_c = f_t / 2 */
+    double fs = COHESION + 0.5 * FT * law.tan_phi, sp = fs / law.k;
+    double total = 1.5 * (sp + softening_span(fs, sp, GII)), dir[3] = {0.6, 0.8, 0}, world[3];
+    apply(R, dir, world);
+    int steps = 40000;
+    double h = 1.0; /* the step between evaluations: vel = increment / h */
+    double damage = 0, work = 0, prev = 0, stored0 = 0, stored = 0;
+    joint_energy acc = {0, 0, 0, 0};
+    for (int s = 0; s <= steps; s++) {
+        double f = total * s / steps, gap[9];
+        for (int i = 0; i < 3; i++) {
+            gap[3 * i] = f * dir[0];
+            gap[3 * i + 1] = f * dir[1];
+            gap[3 * i + 2] = shut;
+        }
+        place_pair(R, shift, gap, pos);
+        for (int i = 0; i < 3; i++)
+            for (int c = 0; c < 3; c++) vel[9 + 3 * i + c] = s ? world[c] * total / steps / h : 0;
+        joint_energy e = {0, 0, 0, 0};
+        joint_tet_forces(&law, pos, vel, h, six, &damage, fa, &e);
+        acc.dissipated += e.dissipated;
+        acc.friction += e.friction;
+        acc.handed += e.handed;
+        stored = e.stored;
+        if (s == 0) stored0 = stored;
+        double pull = 0;
+        for (int i = 0; i < 3; i++)
+            for (int c = 0; c < 3; c++) pull += fa[3 * i + c] * world[c];
+        if (s) work += 0.5 * (pull + prev) * total / steps;
+        prev = pull;
+    }
+    CHECK(damage >= 1, "joint still holds: D = %g", damage);
+    double booked = stored + acc.handed - stored0 + acc.dissipated + acc.friction;
+    CHECK(acc.friction > 0, "no friction booked");
+    CHECK(acc.handed > 0, "a joint broken shut hands nothing to contact");
+    CHECK_REL(booked, work, 0.01);
+    fprintf(stderr, "  sheared shut: work %.6g J, fracture %.6g, friction %.6g, handed %.6g, "
+            "residual %.3g %%\n", work, acc.dissipated, acc.friction, acc.handed - stored0,
+            100 * fabs(booked - work) / work);
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -319,6 +371,8 @@ int main(int argc, char **argv)
         {"shut_part_forces_are_energy_gradient", shut_part_forces_are_energy_gradient},
         {"mode_I_dissipates_energy_I", mode_I_dissipates_energy_I},
         {"mode_II_dissipates_energy_II", mode_II_dissipates_energy_II},
+        {"sheared_under_compression_closes_the_balance",
+         sheared_under_compression_closes_the_balance},
     };
     return check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }
