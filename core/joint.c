@@ -27,7 +27,10 @@
  *
  * The law at one integration point is joint_law.h's, shared with the 3D
  * joint (joint_tet.c); this file owns the 2D geometry around it: the edge,
- * its Gauss points, the exact elastic and compression integrals.
+ * its Gauss points, the exact elastic and compression integrals. What does
+ * not depend on the dimension (stiffness, breakage, contact exclusion,
+ * fragments) serves 6-node joints too; joint_tet_model.c builds those and
+ * computes their forces.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -52,6 +55,28 @@ static int edge_compare(const void *pa, const void *pb)
     return a->tri < b->tri ? -1 : a->tri > b->tri;
 }
 
+/* Scratch for building part_index's joints, with the error filled when
+ * there is no memory. */
+void *joint_build_scratch(size_t bytes, int part_index, fdem_error *err)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (!p) model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+    return p;
+}
+
+/* Room for J joints in all (2 dim nodes and 2 elements each). */
+int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err)
+{
+    size_t room = (size_t)(J ? J : 1);
+    int32_t *jn = realloc(m->joint_node, sizeof(int32_t) * 2 * (size_t)m->dim * room);
+    if (jn) m->joint_node = jn;
+    int32_t *je = realloc(m->joint_elem, sizeof(int32_t) * 2 * room);
+    if (je) m->joint_elem = je;
+    if (jn && je) return 0;
+    model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+    return -1;
+}
+
 /* Adds a joint on every edge shared by two triangles of the fracturing part
  * whose elements start at elem_begin; tri holds the part's original
  * (validated, counter-clockwise) connectivity. */
@@ -59,11 +84,8 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
                      fdem_error *err)
 {
     size_t ne = 3 * (size_t)triangle_count;
-    edge_ref *edges = malloc(sizeof *edges * ne);
-    if (!edges) {
-        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
-        return -1;
-    }
+    edge_ref *edges = joint_build_scratch(sizeof *edges * ne, part_index, err);
+    if (!edges) return -1;
     for (int t = 0; t < triangle_count; t++)
         for (int c = 0; c < 3; c++) {
             int32_t p = tri[3 * t + c], q = tri[3 * t + (c + 1) % 3];
@@ -79,13 +101,8 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
         if (edges[k].lo == edges[k + 1].lo && edges[k].hi == edges[k + 1].hi) shared++;
 
     int J0 = m->joint_count, J = J0 + shared;
-    int32_t *jn = realloc(m->joint_node, sizeof(int32_t) * 4 * (size_t)(J ? J : 1));
-    if (jn) m->joint_node = jn;
-    int32_t *je = realloc(m->joint_elem, sizeof(int32_t) * 2 * (size_t)(J ? J : 1));
-    if (je) m->joint_elem = je;
-    if (!jn || !je) {
+    if (joint_reserve(m, J, part_index, err)) {
         free(edges);
-        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
         return -1;
     }
     const part *p = &m->parts[part_index];
@@ -133,24 +150,26 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     m->joint_h = malloc(sizeof(double) * J);
     m->joint_k = malloc(sizeof(double) * J);
     m->joint_material = malloc(sizeof(int32_t) * J);
-    m->elem_joint = malloc(sizeof(int32_t) * 3 * (size_t)m->elem_count);
+    int faces = m->dim + 1; /* an element's faces, so at most its joints */
+    m->elem_joint = malloc(sizeof(int32_t) * (size_t)faces * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
     if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k ||
         !m->joint_material) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
     }
-    for (int k = 0; k < 3 * m->elem_count; k++) m->elem_joint[k] = -1;
+    for (int k = 0; k < faces * m->elem_count; k++) m->elem_joint[k] = -1;
     for (int j = 0; j < m->joint_count; j++) {
         int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
         m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
-        m->joint_material[j] = m->elem[ea].material;
-        m->joint_k[j] = m->materials[m->elem[ea].material].penalty / m->joint_h[j];
+        int mat = m->parts[m->elem_part[ea]].material;
+        m->joint_material[j] = mat;
+        m->joint_k[j] = m->materials[mat].penalty / m->joint_h[j];
         for (int s = 0; s < 2; s++) {
             int e = m->joint_elem[2 * j + s];
-            for (int c = 0; c < 3; c++)
-                if (m->elem_joint[3 * e + c] < 0) {
-                    m->elem_joint[3 * e + c] = j;
+            for (int c = 0; c < faces; c++)
+                if (m->elem_joint[faces * e + c] < 0) {
+                    m->elem_joint[faces * e + c] = j;
                     break;
                 }
         }
@@ -162,6 +181,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
  * p L / (2h) from one joint and sits on two joints, against its own mass. */
 double joint_stable_dt(const fdem_model *m)
 {
+    if (m->dim == 3) return joint_stable_dt_3d(m);
     double dt = INFINITY;
     for (int j = 0; j < m->joint_count; j++) {
         const int32_t *n = m->joint_node + 4 * j;
@@ -169,7 +189,7 @@ double joint_stable_dt(const fdem_model *m)
         const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
         double L = hypot(m->pos0[2 * n[1]] - m->pos0[2 * n[0]], m->pos0[2 * n[1] + 1] - m->pos0[2 * n[0] + 1]);
         double k = 2 * mat->penalty * L / m->joint_h[j]; /* two joints, both faces */
-        dt = fmin(dt, 0.9 * 2 * sqrt(mass / (2 * k)));
+        dt = fmin(dt, joint_spring_dt(mass, k));
     }
     return dt;
 }
@@ -178,8 +198,9 @@ double joint_stable_dt(const fdem_model *m)
 int joint_holds(const fdem_model *m, int a, int b)
 {
     if (!m->joint_count) return 0;
-    for (int c = 0; c < 3; c++) {
-        int j = m->elem_joint[3 * a + c];
+    int faces = m->dim + 1;
+    for (int c = 0; c < faces; c++) {
+        int j = m->elem_joint[faces * a + c];
         if (j < 0) continue;
         int other = m->joint_elem[2 * j] == a ? m->joint_elem[2 * j + 1] : m->joint_elem[2 * j];
         if (other == b && m->joint_damage[j] < 1.0) return 1;
@@ -194,9 +215,8 @@ void joint_mark_broken_vertices(fdem_model *m)
     memset(m->vertex_broken, 0, (size_t)m->node_count);
     for (int j = 0; j < m->joint_count; j++) {
         if (m->joint_damage[j] < 1.0) continue;
-        const int32_t *n = m->joint_node + 4 * j;
-        m->vertex_broken[m->node_origin[n[0]]] = 1;
-        m->vertex_broken[m->node_origin[n[1]]] = 1;
+        const int32_t *n = m->joint_node + 2 * m->dim * (size_t)j;
+        for (int i = 0; i < m->dim; i++) m->vertex_broken[m->node_origin[n[i]]] = 1;
     }
 }
 
@@ -209,9 +229,11 @@ void joint_mark_broken_vertices(fdem_model *m)
  * point pairs per triangle. Valid after joint_mark_broken_vertices. */
 static int element_on_crack(const fdem_model *m, int e)
 {
-    const int32_t *n = m->elem[e].node;
-    return m->vertex_broken[m->node_origin[n[0]]] | m->vertex_broken[m->node_origin[n[1]]] |
-           m->vertex_broken[m->node_origin[n[2]]];
+    int K = m->elem_nodes;
+    const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
+    int on = 0;
+    for (int i = 0; i < K; i++) on |= m->vertex_broken[m->node_origin[n[i]]];
+    return on;
 }
 
 /* True when contact between a and b (of one fracturing part) can be left
@@ -231,11 +253,13 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
 int joint_fan_holds(const fdem_model *m, int a, int b)
 {
     if (joint_holds(m, a, b)) return 1;
-    const int32_t *na = m->elem[a].node, *nb = m->elem[b].node;
-    for (int i = 0; i < 3; i++) {
+    int K = m->elem_nodes;
+    const int32_t *na = m->elem_node + (size_t)K * (size_t)a;
+    const int32_t *nb = m->elem_node + (size_t)K * (size_t)b;
+    for (int i = 0; i < K; i++) {
         int32_t v = m->node_origin[na[i]];
         if (m->vertex_broken[v]) continue;
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < K; k++)
             if (m->node_origin[nb[k]] == v) return 1;
     }
     return 0;
@@ -281,14 +305,6 @@ static double joint_compression(double k, double L, double delta0, double delta1
     fa0[0] += s0 * nx; fa0[1] += s0 * ny;
     fa1[0] += s1 * nx; fa1[1] += s1 * ny;
     return 0.5 * k * L * mom[2];
-}
-
-/* The cohesive constants of joint material mat at stiffness k. */
-static inline joint_law joint_law_of(const material *mat, double k)
-{
-    const fdem_fracture_params *fp = &mat->def.fracture;
-    return (joint_law){k, fp->tensile_strength, fp->cohesion, mat->tan_phi, fp->energy_I,
-                       fp->energy_II};
 }
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
@@ -432,7 +448,8 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
 int joint_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
-    scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
+    scatter_plan_run(&m->joint_plan, m, m->threads,
+                     m->dim == 3 ? joint_forces_range_3d : joint_forces_range, sums);
     m->joint_energy = sums[1];
     m->fracture_energy += sums[2];
     m->joint_friction_energy += sums[4];
