@@ -25,6 +25,7 @@
  */
 #include "contact_tet.h"
 #include "contact_pair.h"
+#include "element_tet.h"
 
 #include <math.h>
 #include <string.h>
@@ -151,8 +152,6 @@ static void face_weights(const double *a, const double *b, const double *c, cons
     w[0] = 1.0 - w[1] - w[2];
 }
 
-static const int face_nodes[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
-
 /* One contactor face inside the target's potential: where and how hard the
  * potential pushes it. */
 typedef struct face_touch {
@@ -181,7 +180,7 @@ static int outside_one_face(const double (*lambda)[4], const int *which, int n)
 static int face_in_target(const double *pc[4], const double (*lambda)[4], int m,
                           const bary_map *bt, face_touch *ft)
 {
-    const int *fn = face_nodes[m];
+    const int *fn = tet_face_nodes[m];
     if (outside_one_face(lambda, fn, 3)) return 0;
     const double *a = pc[fn[0]], *b = pc[fn[1]], *c = pc[fn[2]];
     clip_polygon face;
@@ -227,7 +226,7 @@ static int face_in_target(const double *pc[4], const double (*lambda)[4], int m,
 static void face_force_apply(const face_touch *ft, int m, const double force[3], double f_c[12],
                              double f_t[12])
 {
-    const int *fn = face_nodes[m];
+    const int *fn = tet_face_nodes[m];
     for (int v = 0; v < 3; v++)
         for (int i = 0; i < 3; i++) f_c[3 * fn[v] + i] += ft->wf[v] * force[i];
     for (int v = 0; v < 4; v++)
@@ -250,7 +249,7 @@ static double tet_smallest_height_now(const double *pt[4], double det)
 {
     double largest = 0;
     for (int m = 0; m < 4; m++) {
-        const int *fn = face_nodes[m];
+        const int *fn = tet_face_nodes[m];
         double ab[3], ac[3], n[3];
         vec3_sub(pt[fn[1]], pt[fn[0]], ab);
         vec3_sub(pt[fn[2]], pt[fn[0]], ac);
@@ -266,7 +265,7 @@ static double tet_smallest_height_now(const double *pt[4], double det)
 static void face_friction(const face_touch *ft, int m, double k_n, double f_n, tet_friction *fr,
                           double force[3])
 {
-    const int *fn = face_nodes[m];
+    const int *fn = tet_face_nodes[m];
     const double *v = fr->vel, *n = ft->normal;
     double rel[3] = {0, 0, 0};
     for (int i = 0; i < 3; i++) {

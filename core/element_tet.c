@@ -34,6 +34,8 @@ static double tet_edges(const double *p0, const double *p1, const double *p2,
     return tet_kernel_faces(e, c);
 }
 
+const int tet_face_nodes[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
 static const double *node_at(const double *xyz, int32_t n) { return xyz + 3 * (size_t)n; }
 
 /* --------------------------------------------------------------- geometry */

@@ -29,6 +29,10 @@
 
 #define TET_J_MIN 0.05
 
+/* The four faces of a positively oriented tetrahedron, face f opposite
+ * node f, each ordered so that (x1-x0) x (x2-x0) points out of it. */
+extern const int tet_face_nodes[4][3];
+
 typedef struct tet_geometry {
     double xinv[9];  /* [X]^-1, row-major */
     double volume0;  /* initial volume */

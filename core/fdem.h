@@ -131,7 +131,8 @@ int fdem_add_part(fdem_model *model, const fdem_mesh *mesh, int material,
                   int fracture, fdem_error *err);
 
 /* The same for a 3D model and a tetrahedral mesh (copied, validated and
- * reoriented). Fracture in 3D is not built yet: fracture != 0 fails. */
+ * reoriented). fracture != 0 gives every tetrahedron its own nodes and a
+ * 6-node joint on every face shared by two tetrahedra. */
 int fdem_add_part_3d(fdem_model *model, const fdem_tet_mesh *mesh, int material,
                      int fracture, fdem_error *err);
 
@@ -254,8 +255,9 @@ const int32_t *fdem_element_nodes(const fdem_model *model);
 const int32_t *fdem_triangles(const fdem_model *model);
 const int32_t *fdem_tetrahedra(const fdem_model *model);
 const int32_t *fdem_element_parts(const fdem_model *model);
-/* Joint arrays (4 node indices per joint: a0, a1 on one face, b0, b1 on the
- * other, a0 opposite b0), and damage 0..1 per joint. NULL when no joints. */
+/* Joint arrays (2 dim node indices per joint: a0, a1 (, a2) on one face,
+ * b0, b1 (, b2) the matching nodes of the other, a_i opposite b_i), and
+ * damage 0..1 per joint. NULL when no joints. */
 const int32_t *fdem_joints(const fdem_model *model);
 const double *fdem_joint_damage(const fdem_model *model);
 

@@ -24,25 +24,20 @@
  * is irreversible); at D = 1 the joint is broken, exerts nothing, and its
  * two triangles meet through contact from then on. Compression is resisted
  * by the joint's penalty while it holds.
+ *
+ * The law at one integration point is joint_law.h's, shared with the 3D
+ * joint (joint_tet.c); this file owns the 2D geometry around it: the edge,
+ * its Gauss points, the exact elastic and compression integrals. What does
+ * not depend on the dimension (stiffness, breakage, contact exclusion,
+ * fragments) serves 6-node joints too; joint_tet_model.c builds those and
+ * computes their forces.
  */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "joint_law.h"
 #include "model.h"
-
-#define Z_A 0.63
-#define Z_B 1.8
-#define Z_C 6.0
-
-double joint_softening(double D)
-{
-    if (D <= 0) return 1.0;
-    if (D >= 1) return 0.0;
-    double ab = Z_A + Z_B;
-    double e = exp(D * (Z_A + Z_C * Z_B) / (ab * (1 - ab)));
-    return (1 - (ab - 1) / ab * e) * (Z_A * (1 - D) + Z_B * pow(1 - D, Z_C));
-}
 
 /* ------------------------------------------------------------ building */
 
@@ -60,6 +55,28 @@ static int edge_compare(const void *pa, const void *pb)
     return a->tri < b->tri ? -1 : a->tri > b->tri;
 }
 
+/* Scratch for building part_index's joints, with the error filled when
+ * there is no memory. */
+void *joint_build_scratch(size_t bytes, int part_index, fdem_error *err)
+{
+    void *p = malloc(bytes ? bytes : 1);
+    if (!p) model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+    return p;
+}
+
+/* Room for J joints in all (2 dim nodes and 2 elements each). */
+int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err)
+{
+    size_t room = (size_t)(J ? J : 1);
+    int32_t *jn = realloc(m->joint_node, sizeof(int32_t) * 2 * (size_t)m->dim * room);
+    if (jn) m->joint_node = jn;
+    int32_t *je = realloc(m->joint_elem, sizeof(int32_t) * 2 * room);
+    if (je) m->joint_elem = je;
+    if (jn && je) return 0;
+    model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
+    return -1;
+}
+
 /* Adds a joint on every edge shared by two triangles of the fracturing part
  * whose elements start at elem_begin; tri holds the part's original
  * (validated, counter-clockwise) connectivity. */
@@ -67,11 +84,8 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
                      fdem_error *err)
 {
     size_t ne = 3 * (size_t)triangle_count;
-    edge_ref *edges = malloc(sizeof *edges * ne);
-    if (!edges) {
-        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
-        return -1;
-    }
+    edge_ref *edges = joint_build_scratch(sizeof *edges * ne, part_index, err);
+    if (!edges) return -1;
     for (int t = 0; t < triangle_count; t++)
         for (int c = 0; c < 3; c++) {
             int32_t p = tri[3 * t + c], q = tri[3 * t + (c + 1) % 3];
@@ -87,13 +101,8 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
         if (edges[k].lo == edges[k + 1].lo && edges[k].hi == edges[k + 1].hi) shared++;
 
     int J0 = m->joint_count, J = J0 + shared;
-    int32_t *jn = realloc(m->joint_node, sizeof(int32_t) * 4 * (size_t)(J ? J : 1));
-    if (jn) m->joint_node = jn;
-    int32_t *je = realloc(m->joint_elem, sizeof(int32_t) * 2 * (size_t)(J ? J : 1));
-    if (je) m->joint_elem = je;
-    if (!jn || !je) {
+    if (joint_reserve(m, J, part_index, err)) {
         free(edges);
-        model_error(err, FDEM_ITEM_PART, part_index, "out of memory building joints");
         return -1;
     }
     const part *p = &m->parts[part_index];
@@ -141,24 +150,26 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     m->joint_h = malloc(sizeof(double) * J);
     m->joint_k = malloc(sizeof(double) * J);
     m->joint_material = malloc(sizeof(int32_t) * J);
-    m->elem_joint = malloc(sizeof(int32_t) * 3 * (size_t)m->elem_count);
+    int faces = m->dim + 1; /* an element's faces, so at most its joints */
+    m->elem_joint = malloc(sizeof(int32_t) * (size_t)faces * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
     if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k ||
         !m->joint_material) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
     }
-    for (int k = 0; k < 3 * m->elem_count; k++) m->elem_joint[k] = -1;
+    for (int k = 0; k < faces * m->elem_count; k++) m->elem_joint[k] = -1;
     for (int j = 0; j < m->joint_count; j++) {
         int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
         m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
-        m->joint_material[j] = m->elem[ea].material;
-        m->joint_k[j] = m->materials[m->elem[ea].material].penalty / m->joint_h[j];
+        int mat = m->parts[m->elem_part[ea]].material;
+        m->joint_material[j] = mat;
+        m->joint_k[j] = m->materials[mat].penalty / m->joint_h[j];
         for (int s = 0; s < 2; s++) {
             int e = m->joint_elem[2 * j + s];
-            for (int c = 0; c < 3; c++)
-                if (m->elem_joint[3 * e + c] < 0) {
-                    m->elem_joint[3 * e + c] = j;
+            for (int c = 0; c < faces; c++)
+                if (m->elem_joint[faces * e + c] < 0) {
+                    m->elem_joint[faces * e + c] = j;
                     break;
                 }
         }
@@ -170,6 +181,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
  * p L / (2h) from one joint and sits on two joints, against its own mass. */
 double joint_stable_dt(const fdem_model *m)
 {
+    if (m->dim == 3) return joint_stable_dt_3d(m);
     double dt = INFINITY;
     for (int j = 0; j < m->joint_count; j++) {
         const int32_t *n = m->joint_node + 4 * j;
@@ -177,7 +189,7 @@ double joint_stable_dt(const fdem_model *m)
         const material *mat = &m->materials[m->elem[m->joint_elem[2 * j]].material];
         double L = hypot(m->pos0[2 * n[1]] - m->pos0[2 * n[0]], m->pos0[2 * n[1] + 1] - m->pos0[2 * n[0] + 1]);
         double k = 2 * mat->penalty * L / m->joint_h[j]; /* two joints, both faces */
-        dt = fmin(dt, 0.9 * 2 * sqrt(mass / (2 * k)));
+        dt = fmin(dt, joint_spring_dt(mass, k));
     }
     return dt;
 }
@@ -186,8 +198,9 @@ double joint_stable_dt(const fdem_model *m)
 int joint_holds(const fdem_model *m, int a, int b)
 {
     if (!m->joint_count) return 0;
-    for (int c = 0; c < 3; c++) {
-        int j = m->elem_joint[3 * a + c];
+    int faces = m->dim + 1;
+    for (int c = 0; c < faces; c++) {
+        int j = m->elem_joint[faces * a + c];
         if (j < 0) continue;
         int other = m->joint_elem[2 * j] == a ? m->joint_elem[2 * j + 1] : m->joint_elem[2 * j];
         if (other == b && m->joint_damage[j] < 1.0) return 1;
@@ -202,9 +215,8 @@ void joint_mark_broken_vertices(fdem_model *m)
     memset(m->vertex_broken, 0, (size_t)m->node_count);
     for (int j = 0; j < m->joint_count; j++) {
         if (m->joint_damage[j] < 1.0) continue;
-        const int32_t *n = m->joint_node + 4 * j;
-        m->vertex_broken[m->node_origin[n[0]]] = 1;
-        m->vertex_broken[m->node_origin[n[1]]] = 1;
+        const int32_t *n = m->joint_node + 2 * m->dim * (size_t)j;
+        for (int i = 0; i < m->dim; i++) m->vertex_broken[m->node_origin[n[i]]] = 1;
     }
 }
 
@@ -217,9 +229,11 @@ void joint_mark_broken_vertices(fdem_model *m)
  * point pairs per triangle. Valid after joint_mark_broken_vertices. */
 static int element_on_crack(const fdem_model *m, int e)
 {
-    const int32_t *n = m->elem[e].node;
-    return m->vertex_broken[m->node_origin[n[0]]] | m->vertex_broken[m->node_origin[n[1]]] |
-           m->vertex_broken[m->node_origin[n[2]]];
+    int K = m->elem_nodes;
+    const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
+    int on = 0;
+    for (int i = 0; i < K; i++) on |= m->vertex_broken[m->node_origin[n[i]]];
+    return on;
 }
 
 /* True when contact between a and b (of one fracturing part) can be left
@@ -239,11 +253,13 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
 int joint_fan_holds(const fdem_model *m, int a, int b)
 {
     if (joint_holds(m, a, b)) return 1;
-    const int32_t *na = m->elem[a].node, *nb = m->elem[b].node;
-    for (int i = 0; i < 3; i++) {
+    int K = m->elem_nodes;
+    const int32_t *na = m->elem_node + (size_t)K * (size_t)a;
+    const int32_t *nb = m->elem_node + (size_t)K * (size_t)b;
+    for (int i = 0; i < K; i++) {
         int32_t v = m->node_origin[na[i]];
         if (m->vertex_broken[v]) continue;
-        for (int k = 0; k < 3; k++)
+        for (int k = 0; k < K; k++)
             if (m->node_origin[nb[k]] == v) return 1;
     }
     return 0;
@@ -251,109 +267,8 @@ int joint_fan_holds(const fdem_model *m, int a, int b)
 
 /* --------------------------------------------------------------- forces */
 
-/* The area under Munjiza's curve, integral of z(D) over [0, 1] (held to a
- * Simpson sum of joint_softening in test_joint.c). */
-#define Z_INTEGRAL 0.38630729474388764
-
-/* The softening spans delta_c - delta_p (or s_c - s_p) for strength f,
- * elastic limit p = f / k and fracture energy G. A joint pulled apart in
- * one mode absorbs 1/2 f p while elastic and f span Z_INTEGRAL while it
- * softens; the span is chosen so that the two add up to G exactly. A joint
- * too soft for its G (1/2 f p >= G / 2) keeps a span of p, and absorbs more
- * than G: the fracture account then reports what it really dissipated. */
-static inline double softening_span(double f, double p, double G)
-{
-    double span = (G - 0.5 * f * p) / (f * Z_INTEGRAL);
-    return span > p ? span : p;
-}
-
-/* One Gauss point of a joint leaving its elastic range or already damaged. */
-typedef struct joint_point {
-    double delta, slide;   /* opening and sliding */
-    double fs;             /* shear strength there: cohesion + compression tan(phi) */
-    double D;              /* the damage its opening and sliding ask for */
-} joint_point;
-
-static inline void joint_point_measure(const material *mat, double k, double delta, double slide,
-                                       joint_point *g)
-{
-    const fdem_fracture_params *fp = &mat->def.fracture;
-    double ft = fp->tensile_strength;
-    g->delta = delta;
-    g->slide = slide;
-    g->fs = fp->cohesion + (delta < 0 ? -k * delta * mat->tan_phi : 0);
-    double dp = ft / k, sp = g->fs / k;
-    double dn = delta > dp ? (delta - dp) / softening_span(ft, dp, fp->energy_I) : 0;
-    double ds = fabs(slide) > sp ? (fabs(slide) - sp) / softening_span(g->fs, sp, fp->energy_II) : 0;
-    g->D = sqrt(dn * dn + ds * ds);
-}
-
-/* The stored energy psi = z(D) phi(delta, s) (plus 1/2 k delta^2 in
- * compression, which damage leaves alone): phi is the undamaged joint's
- * energy, 1/2 k x^2 up to the elastic limit and linear beyond it, for the
- * opening and the sliding alike. The tractions are f_t min(delta/delta_p, 1) z
- * and f_s clamp(s/s_p) z. Damage growing by dD dissipates -z'(D) phi dD,
- * which joint_forces_general books as (z_old - z_new) phi.
- *
- * Beyond the elastic slip s_p, phi grows with the cohesion c only: the rest
- * of the shear strength, sigma_c tan(phi), is friction, and its work is
- * dissipated as the joint slides (joint_friction_slip), not stored. Storing
- * it (f_s (|s| - s_p / 2), as before) made psi follow the strength when the
- * compression changed, without the normal force doing that work: the law is
- * not the gradient of such a psi (d tau / d delta != d sigma / d s), and
- * after the peak of a Brazilian disc 10.9 % of the work went to no account. */
-static inline double joint_phi(const material *mat, double k, const joint_point *g)
-{
-    const fdem_fracture_params *fp = &mat->def.fracture;
-    double ft = fp->tensile_strength;
-    double dp = ft / k, sp = g->fs / k, phi = 0;
-    if (g->delta > 0)
-        phi += g->delta <= dp ? 0.5 * k * g->delta * g->delta : ft * (g->delta - 0.5 * dp);
-    double s = fabs(g->slide);
-    phi += s <= sp ? 0.5 * k * s * s : 0.5 * k * sp * sp + fp->cohesion * (s - sp);
-    return phi;
-}
-
-/* The slide beyond the elastic limit s_p that the last step added at a
- * Gauss point (negative when it slid back toward s_p), on the side the
- * joint is on now; the frictional traction sigma_c tan(phi) z works through
- * it. slide_before is the sliding a step ago (the step's relative
- * displacement taken off the current one). Zero within the elastic limit. */
-static inline double joint_friction_slip(const joint_point *g, double k, double slide_before)
-{
-    double sp = g->fs / k, s = fabs(g->slide);
-    if (!(s > sp)) return 0;
-    double side = g->slide > 0 ? 1 : -1;
-    return s - fmax(side * slide_before, sp);
-}
-
-/* Tractions at a Gauss point for damage with softening factor z. */
-static inline void joint_point_traction(const material *mat, double k, const joint_point *g,
-                                        double z, double *sigma, double *tau)
-{
-    double ft = mat->def.fracture.tensile_strength;
-    double dp = ft / k, sp = g->fs / k;
-    /* compression is joint_compression's, integrated along the whole face */
-    *sigma = g->delta > 0 ? ft * fmin(g->delta / dp, 1.0) * z : 0;
-    double r = g->slide / sp;
-    *tau = g->fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
-}
-
 /* Two-point Gauss rule along the edge, as fractions from a0 (b0) to a1 (b1). */
 static const double gauss[2] = {0.21132486540518713, 0.78867513459481287};
-
-/* The elastic test of joint_point_measure at one Gauss point, on unnormalised
- * projections: on = L delta and sl = L slide (d against the face normal and
- * tangent scaled by the face length L), so it needs neither the unit
- * vectors nor a division. */
-static inline int joint_gauss_elastic(const material *mat, double k, double L, double on,
-                                      double sl)
-{
-    const fdem_fracture_params *fp = &mat->def.fracture;
-    double ksig = k * on;
-    double shear_limit = fp->cohesion * L + (on < 0 ? -ksig * mat->tan_phi : 0);
-    return ksig <= fp->tensile_strength * L && fabs(k * sl) <= shear_limit;
-}
 
 /* The integrals over xi in [a, b] of c, xi c and c^2, c linear from ca to cb. */
 static inline void linear_moments(double a, double b, double ca, double cb, double out[3])
@@ -394,54 +309,46 @@ static double joint_compression(double k, double L, double delta0, double delta1
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
  * that is damaged or leaving its elastic range; updates *damage (the
- * largest either Gauss point asks for, never less than before) and adds the
- * joint's stored energy to *stored, what the damage growth dissipated to
- * *dissipated and the work of the frictional part of the shear traction
- * over the last step to *friction; a joint that breaks while pressed shut
- * adds the energy of its compression, which the contact of its faces takes
- * over, to *handed. d0 and d1 are the displacements of b0 against a0 and b1
- * against a1, step0 and step1 how much they changed in the last step;
- * (tx, ty) the unit face tangent and L the face length. */
-static void joint_forces_general(const material *mat, double k, const double d0[2],
-                                 const double d1[2], const double step0[2],
-                                 const double step1[2], double tx, double ty, double L,
-                                 double *damage, double fa0[2], double fa1[2], double *stored,
-                                 double *dissipated, double *friction, double *handed)
+ * largest either Gauss point asks for, never less than before) and adds to
+ * *e the joint's stored energy, what the damage growth dissipated and the
+ * work of the frictional part of the shear traction over the last step; a
+ * joint that breaks while pressed shut adds the energy of its compression,
+ * which the contact of its faces takes over, to e->handed. d0 and d1 are
+ * the displacements of b0 against a0 and b1 against a1, step0 and step1 how
+ * much they changed in the last step; (tx, ty) the unit face tangent and L
+ * the face length. */
+static void joint_forces_general(const joint_law *law, const double d0[2], const double d1[2],
+                                 const double step0[2], const double step1[2], double tx,
+                                 double ty, double L, double *damage, double fa0[2],
+                                 double fa1[2], joint_energy *e)
 {
     double nx = ty, ny = -tx; /* A's outward normal */
     joint_point g[2];
     double slide_before[2];
-    double D = *damage;
     for (int i = 0; i < 2; i++) {
         double xi = gauss[i];
         double dx = (1 - xi) * d0[0] + xi * d1[0], dy = (1 - xi) * d0[1] + xi * d1[1];
-        joint_point_measure(mat, k, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
-        if (g[i].D > D) D = g[i].D;
+        joint_point_measure(law, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
         double ux = dx - ((1 - xi) * step0[0] + xi * step1[0]);
         double uy = dy - ((1 - xi) * step0[1] + xi * step1[1]);
         slide_before[i] = ux * tx + uy * ty;
     }
-    if (D > 1) D = 1;
+    double D = joint_points_damage(g, 2, *damage);
     double z_old = joint_softening(*damage), z = joint_softening(D);
     *damage = D;
     double w = 0.5 * L; /* Gauss weight */
     fa0[0] = fa0[1] = fa1[0] = fa1[1] = 0;
     for (int i = 0; i < 2; i++) {
         double xi = gauss[i], sigma, tau;
-        double phi = w * joint_phi(mat, k, &g[i]);
-        *dissipated += (z_old - z) * phi;
-        *stored += z * phi;
-        double frictional = g[i].fs - mat->def.fracture.cohesion; /* sigma_c tan(phi) */
-        *friction += w * z * frictional * joint_friction_slip(&g[i], k, slide_before[i]);
-        joint_point_traction(mat, k, &g[i], z, &sigma, &tau);
+        joint_point_respond(law, &g[i], w, z_old, z, slide_before[i], e, &sigma, &tau);
         double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
         fa0[0] += (1 - xi) * Tx; fa0[1] += (1 - xi) * Ty;
         fa1[0] += xi * Tx;       fa1[1] += xi * Ty;
     }
-    double squeezed = joint_compression(k, L, d0[0] * nx + d0[1] * ny, d1[0] * nx + d1[1] * ny,
-                                        nx, ny, fa0, fa1);
-    *stored += squeezed;
-    if (D >= 1) *handed += squeezed; /* broken shut: its overlap goes on as contact */
+    double squeezed = joint_compression(law->k, L, d0[0] * nx + d0[1] * ny,
+                                        d1[0] * nx + d1[1] * ny, nx, ny, fa0, fa1);
+    e->stored += squeezed;
+    if (D >= 1) e->handed += squeezed; /* broken shut: its overlap goes on as contact */
 }
 
 /* Adds the forces of intact joints [begin, end) to m->force, counts in
@@ -469,8 +376,8 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 4 * j;
-        const material *mat = &mats[m->joint_material[j]];
-        double k = m->joint_k[j];
+        const joint_law law = joint_law_of(&mats[m->joint_material[j]], m->joint_k[j]);
+        const double k = law.k;
         const double *a0 = x + 2 * (size_t)n[0], *a1 = x + 2 * (size_t)n[1];
         const double *b0 = x + 2 * (size_t)n[2], *b1 = x + 2 * (size_t)n[3];
         double d0[2] = {b0[0] - a0[0], b0[1] - a0[1]}, d1[2] = {b1[0] - a1[0], b1[1] - a1[1]};
@@ -488,8 +395,8 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             double g1x = (1 - gauss[1]) * d0[0] + gauss[1] * d1[0];
             double g1y = (1 - gauss[1]) * d0[1] + gauss[1] * d1[1];
             /* (tx, ty) has length L, normal (ty, -tx): projections are L x */
-            elastic = joint_gauss_elastic(mat, k, L, g0x * ty - g0y * tx, g0x * tx + g0y * ty) &&
-                      joint_gauss_elastic(mat, k, L, g1x * ty - g1y * tx, g1x * tx + g1y * ty);
+            elastic = joint_point_elastic(&law, L, g0x * ty - g0y * tx, g0x * tx + g0y * ty) &&
+                      joint_point_elastic(&law, L, g1x * ty - g1y * tx, g1x * tx + g1y * ty);
         }
         if (elastic) {
             double s = L * k * (1.0 / 6);
@@ -500,25 +407,24 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             /* 1/2 integral of k |d|^2 along the face, exact for linear d */
             stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
         } else {
-            /* locals, so that the loop's sums stay in registers */
-            double inv_L = 1.0 / L, joint_stored = 0, joint_dissipated = 0, joint_handed = 0;
-            double joint_friction = 0;
+            /* a local, so that the loop's sums stay in registers */
+            double inv_L = 1.0 / L;
+            joint_energy e = {0, 0, 0, 0};
             const double *va0 = v + 2 * (size_t)n[0], *va1 = v + 2 * (size_t)n[1];
             const double *vb0 = v + 2 * (size_t)n[2], *vb1 = v + 2 * (size_t)n[3];
             double step0[2] = {h_last * (vb0[0] - va0[0]), h_last * (vb0[1] - va0[1])};
             double step1[2] = {h_last * (vb1[0] - va1[0]), h_last * (vb1[1] - va1[1])};
-            joint_forces_general(mat, k, d0, d1, step0, step1, tx * inv_L, ty * inv_L, L, &damage,
-                                 fa0, fa1, &joint_stored, &joint_dissipated, &joint_friction,
-                                 &joint_handed);
-            dissipated += joint_dissipated;
-            handed += joint_handed;
-            friction += joint_friction;
+            joint_forces_general(&law, d0, d1, step0, step1, tx * inv_L, ty * inv_L, L, &damage,
+                                 fa0, fa1, &e);
+            dissipated += e.dissipated;
+            handed += e.handed;
+            friction += e.friction;
             if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
                 m->joint_damage[j] = 1.0;
                 broke++;
                 continue;
             }
-            stored += joint_stored;
+            stored += e.stored;
             m->joint_damage[j] = damage;
         }
         double *ga0 = f + 2 * (size_t)n[0], *ga1 = f + 2 * (size_t)n[1];
@@ -542,7 +448,8 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
 int joint_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
-    scatter_plan_run(&m->joint_plan, m, m->threads, joint_forces_range, sums);
+    scatter_plan_run(&m->joint_plan, m, m->threads,
+                     m->dim == 3 ? joint_forces_range_3d : joint_forces_range, sums);
     m->joint_energy = sums[1];
     m->fracture_energy += sums[2];
     m->joint_friction_energy += sums[4];

@@ -325,18 +325,14 @@ int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_inde
 {
     int k = m->part_count;
     if (part_check(m, material_index, fracture, 3, err)) return -1;
-    if (fracture) {
-        model_error(err, FDEM_ITEM_PART, k,
-                    "part %d: fracture of tetrahedral parts is not available yet", k);
-        return -1;
-    }
     fdem_tet_mesh copy = {mesh->node_count, mesh->tet_count, NULL, NULL};
     if (part_copy_arrays(m, mesh->xyz, mesh->node_count, mesh->tet, mesh->tet_count, &copy.xyz,
                          &copy.tet, err))
         return -1;
     int failed = fdem_tet_mesh_validate(&copy, NULL, err) ||
                  part_append(m, copy.xyz, copy.node_count, copy.tet, copy.tet_count,
-                             material_index, fracture, err);
+                             material_index, fracture, err) ||
+                 (fracture && joint_build_part_3d(m, k, copy.tet, copy.tet_count, err));
     fdem_tet_mesh_free(&copy);
     return failed ? -1 : k;
 }
@@ -455,7 +451,7 @@ static int build_scatter_plans(fdem_model *m)
     if (m->joint_count &&
         scatter_plan_build(&m->joint_plan, m->joint_count,
                            scatter_block_size(m->joint_count, SCATTER_BLOCK_JOINTS),
-                           m->joint_node, 4, 4, m->node_count))
+                           m->joint_node, 2 * m->dim, 2 * m->dim, m->node_count))
         return -1;
     return scatter_plan_build_disjoint(&m->node_plan, m->node_count,
                                        scatter_block_size(m->node_count, SCATTER_BLOCK_NODES));
@@ -607,8 +603,9 @@ size_t fdem_memory_bytes(const fdem_model *m)
         b += (size_t)m->elem_count * ((3 * D + 1) * sizeof(double) + 2 * sizeof(int32_t) + 1) +
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
                           : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
-    b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
-    if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);
+    /* joints: 2 dim nodes and 2 elements; damage, h, k, material; elem_joint */
+    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 2 * sizeof(double));
+    if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
     b += contact_memory_bytes(&m->contact);
     return b;

@@ -16,6 +16,7 @@
 
 #include "contact_pair.h"
 #include "fdem.h"
+#include "joint_law.h"
 #include "nbs.h"
 
 typedef struct material {
@@ -157,13 +158,14 @@ struct fdem_model {
 
     /* joints (fracture); joint_count == 0 when no part fractures */
     int joint_count;
-    int32_t *joint_node;     /* 4 per joint: a0, a1 (face A), b0, b1 (their copies in B) */
+    int32_t *joint_node;     /* 2 dim per joint: a0, a1 (, a2) on face A (outward of A),
+                                b0, b1 (, b2) their copies in B */
     int32_t *joint_elem;     /* 2 per joint: elements A and B */
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
     double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
     int32_t *joint_material; /* element A's material */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
-    int32_t *elem_joint;     /* 3 per element: its joints, -1 where none */
+    int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
                                 refreshed at each contact detection */
     int broken_joints;
@@ -260,8 +262,22 @@ int constraint_select(fdem_model *m, fdem_error *err);
 void constraint_apply_forces(fdem_model *m);
 void constraint_enforce(fdem_model *m, double h, double havg);
 
-/* joint.c */
-double joint_softening(double D);
+/* joint.c (the cohesive law itself, joint_softening included: joint_law.h) */
+/* The cohesive constants of joint material mat at stiffness k. */
+static inline joint_law joint_law_of(const material *mat, double k)
+{
+    const fdem_fracture_params *fp = &mat->def.fracture;
+    return (joint_law){k, fp->tensile_strength, fp->cohesion, mat->tan_phi, fp->energy_I,
+                       fp->energy_II};
+}
+/* The central-difference limit of a joint node of mass `mass` held by
+ * stiffness k (all its joints, both faces), with a 0.9 margin. */
+static inline double joint_spring_dt(double mass, double k)
+{
+    return 0.9 * 2 * sqrt(mass / (2 * k));
+}
+void *joint_build_scratch(size_t bytes, int part_index, fdem_error *err);
+int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err);
 int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
                      fdem_error *err);
 int joint_prepare(fdem_model *m, fdem_error *err);
@@ -273,6 +289,11 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
 int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 int joint_fragment_count(const fdem_model *m);
+/* joint_tet_model.c: the 3D geometry of joints (6 nodes, a face each) */
+int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
+                        fdem_error *err);
+double joint_stable_dt_3d(const fdem_model *m);
+void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 
 /* scatter_plan.c: fn runs items [begin, end) of one block and may add into
  * node arrays. It starts from sums zeroed and leaves its block's partial

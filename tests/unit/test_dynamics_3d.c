@@ -12,6 +12,7 @@
 #include "fdem.h"
 #include "mesh_3d.h"
 #include "power_iteration.h"
+#include "bar_period_3d.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -195,7 +196,6 @@ static void fixed_free_bar_period_is_4L_over_c(void)
     fdem_energy e0 = fdem_get_energy(m);
     (void)e0;
     fdem_counts counts = fdem_get_counts(m);
-    const double *x0 = fdem_initial_positions(m);
     double kinetic0 = 0;
     for (int i = 0; i < counts.nodes; i++) {
         const double *v = fdem_velocities(m) + 3 * i;
@@ -203,35 +203,22 @@ static void fixed_free_bar_period_is_4L_over_c(void)
     }
     fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
     /* tip displacement: mean over the nodes at x = L */
-    double prev_u = 0, prev_t = 0, crossing = -1, worst_residual = 0;
-    int went_out = 0, went_in = 0;
+    bar_crossing bar = {0, 0, -1, 0, 0};
+    double worst_residual = 0;
     double u_max = 0.1 * L / c;
-    while (fdem_get_time(m) < 1.5 * period && crossing < 0) {
+    while (fdem_get_time(m) < 1.5 * period && bar.crossing < 0) {
         if (run_steps(m, 1)) { CHECK(0, "run"); break; }
-        const double *x = fdem_positions(m);
-        double u = 0;
-        int n = 0;
-        for (int i = 0; i < counts.nodes; i++)
-            if (x0[3 * i] > L - 1e-9) {
-                u += x[3 * i] - x0[3 * i];
-                n++;
-            }
-        u /= n;
-        double t = fdem_get_time(m);
-        went_out |= u > 0.5 * u_max;
-        went_in |= went_out && u < -0.5 * u_max;
+        double u = bar_tip_displacement(m, L), t = fdem_get_time(m);
         if (getenv("BAR_TRACE")) fprintf(stderr, "%g %g\n", t, u);
-        if (went_in && prev_u < 0 && u >= 0) crossing = prev_t + (t - prev_t) * prev_u / (prev_u - u);
-        prev_u = u;
-        prev_t = t;
+        bar_crossing_update(&bar, t, u, u_max);
         worst_residual = fmax(worst_residual, fabs(fdem_get_energy(m).residual));
     }
-    CHECK(crossing > 0, "the tip never came back");
-    CHECK_REL(crossing, period, 0.03);
+    CHECK(bar.crossing > 0, "the tip never came back");
+    CHECK_REL(bar.crossing, period, 0.03);
     CHECK(worst_residual <= 1e-3 * kinetic0, "energy residual %g J of %g J", worst_residual,
           kinetic0);
     fprintf(stderr, "  first period %.6g s, 4L/c %.6g s (%+.2f %%); worst residual %.3g of %.3g J\n",
-            crossing, period, 100 * (crossing / period - 1), worst_residual, kinetic0);
+            bar.crossing, period, 100 * (bar.crossing / period - 1), worst_residual, kinetic0);
     fdem_model_destroy(m);
 }
 

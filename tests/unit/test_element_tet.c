@@ -10,6 +10,7 @@
  */
 #include "check.h"
 #include "element_tet.h"
+#include "rotation_3d.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -33,18 +34,6 @@ static void map_affine(const double *X, int nodes, const double A[9], const doub
         for (int i = 0; i < 3; i++)
             x[3 * n + i] = A[3 * i] * X[3 * n] + A[3 * i + 1] * X[3 * n + 1] +
                            A[3 * i + 2] * X[3 * n + 2] + t[i];
-}
-
-/* Rotation by angle about the unit axis u (Rodrigues). */
-static void rotation(const double axis[3], double angle, double R[9])
-{
-    double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
-    double u[3] = {axis[0] / n, axis[1] / n, axis[2] / n}, c = cos(angle), s = sin(angle);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) R[3 * i + j] = (i == j ? c : 0) + (1 - c) * u[i] * u[j];
-    R[1] -= s * u[2], R[2] += s * u[1];
-    R[3] += s * u[2], R[5] -= s * u[0];
-    R[6] -= s * u[1], R[7] += s * u[0];
 }
 
 static void test_tet_prepare_geometry(void)

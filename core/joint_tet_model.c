@@ -1,0 +1,165 @@
+/*
+ * joint_tet_model.c - 6-node joints in a model of tetrahedra: one on every
+ * face shared by two tetrahedra of a fracturing part (each tetrahedron
+ * keeps its own nodes), their forces through joint_tet.c's kernel, and
+ * their stable step. The dimension-free joint machinery (stiffness,
+ * contact exclusion, fragments, breakage counting) stays in joint.c, which
+ * calls in here where the geometry is a triangle and not an edge.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "element_tet.h"
+#include "joint_tet.h"
+#include "model.h"
+#include "vec3.h"
+
+typedef struct face_ref {
+    int32_t key[3];   /* original node ids, ascending */
+    int32_t tet;      /* tetrahedron within the part */
+    int32_t face;     /* tet_face_nodes row */
+} face_ref;
+
+static int face_compare(const void *pa, const void *pb)
+{
+    const face_ref *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->key[i] != b->key[i]) return a->key[i] < b->key[i] ? -1 : 1;
+    return a->tet < b->tet ? -1 : a->tet > b->tet;
+}
+
+static int same_face(const face_ref *a, const face_ref *b)
+{
+    return a->key[0] == b->key[0] && a->key[1] == b->key[1] && a->key[2] == b->key[2];
+}
+
+static void sort3(int32_t k[3])
+{
+    int32_t t;
+    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
+    if (k[1] > k[2]) t = k[1], k[1] = k[2], k[2] = t;
+    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
+}
+
+/* Writes joint j between face f_a of element ea and the same face of eb:
+ * a0, a1, a2 in ea's outward order, b_i eb's copy of a_i's original node. */
+static void joint_set_3d(fdem_model *m, int j, const int32_t *tet, const face_ref *a,
+                         const face_ref *b, int ea, int eb)
+{
+    int32_t *jn = m->joint_node + 6 * (size_t)j;
+    for (int i = 0; i < 3; i++) {
+        int corner = tet_face_nodes[a->face][i];
+        int32_t orig = tet[4 * a->tet + corner];
+        jn[i] = m->tet[ea].node[corner];
+        for (int c = 0; c < 4; c++)
+            if (tet[4 * b->tet + c] == orig) jn[3 + i] = m->tet[eb].node[c];
+    }
+    m->joint_elem[2 * j] = ea;
+    m->joint_elem[2 * j + 1] = eb;
+}
+
+/* Adds a joint on every face shared by two tetrahedra of the fracturing
+ * part part_index; tet holds its original (validated, positively oriented)
+ * connectivity. */
+int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
+                        fdem_error *err)
+{
+    size_t nf = 4 * (size_t)tet_count;
+    face_ref *faces = joint_build_scratch(sizeof *faces * nf, part_index, err);
+    if (!faces) return -1;
+    for (int t = 0; t < tet_count; t++)
+        for (int f = 0; f < 4; f++) {
+            face_ref *r = &faces[4 * (size_t)t + f];
+            for (int i = 0; i < 3; i++) r->key[i] = tet[4 * t + tet_face_nodes[f][i]];
+            sort3(r->key);
+            r->tet = t;
+            r->face = f;
+        }
+    qsort(faces, nf, sizeof *faces, face_compare);
+    int shared = 0;
+    for (size_t k = 0; k + 1 < nf; k++) {
+        if (!same_face(&faces[k], &faces[k + 1])) continue;
+        if (k + 2 < nf && same_face(&faces[k], &faces[k + 2])) {
+            int32_t n0 = faces[k].key[0], n1 = faces[k].key[1], n2 = faces[k].key[2];
+            free(faces);
+            model_error(err, FDEM_ITEM_PART, part_index,
+                        "face %d-%d-%d of part %d is shared by more than two tetrahedra", n0, n1,
+                        n2, part_index);
+            return -1;
+        }
+        shared++;
+        k++;
+    }
+    int J0 = m->joint_count, J = J0 + shared;
+    if (joint_reserve(m, J, part_index, err)) {
+        free(faces);
+        return -1;
+    }
+    int begin = m->parts[part_index].elem_begin, j = J0;
+    for (size_t k = 0; k + 1 < nf; k++) {
+        if (!same_face(&faces[k], &faces[k + 1])) continue;
+        joint_set_3d(m, j++, tet, &faces[k], &faces[k + 1], begin + faces[k].tet,
+                     begin + faces[k + 1].tet);
+        k++;
+    }
+    m->joint_count = J;
+    free(faces);
+    return 0;
+}
+
+/* Initial area of joint j's face A. */
+static double joint_face_area0(const fdem_model *m, int j)
+{
+    const int32_t *n = m->joint_node + 6 * (size_t)j;
+    double e1[3], e2[3], c[3];
+    vec3_sub(m->pos0 + 3 * (size_t)n[1], m->pos0 + 3 * (size_t)n[0], e1);
+    vec3_sub(m->pos0 + 3 * (size_t)n[2], m->pos0 + 3 * (size_t)n[0], e2);
+    vec3_cross(e1, e2, c);
+    return 0.5 * sqrt(vec3_dot(c, c));
+}
+
+/* Joint springs in series with the element: a face node takes about
+ * k A / 3 from each of its tetrahedron's three faces, k A in all, and both
+ * faces move (2 k A), as a 2D node takes k L / 2 from each of two joints. */
+double joint_stable_dt_3d(const fdem_model *m)
+{
+    double dt = INFINITY;
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *n = m->joint_node + 6 * (size_t)j;
+        double mass = INFINITY;
+        for (int i = 0; i < 6; i++) mass = fmin(mass, m->mass[n[i]]);
+        dt = fmin(dt, joint_spring_dt(mass, 2 * m->joint_k[j] * joint_face_area0(m, j)));
+    }
+    return dt;
+}
+
+/* The 3D counterpart of joint.c's joint_forces_range, with the same sums. */
+void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    double *f = m->force;
+    int broke = 0;
+    joint_energy e = {0, 0, 0, 0};
+    for (int j = begin; j < end; j++) {
+        double damage = m->joint_damage[j];
+        if (damage >= 1.0) continue;
+        const int32_t *n = m->joint_node + 6 * (size_t)j;
+        const joint_law law = joint_law_of(&m->materials[m->joint_material[j]], m->joint_k[j]);
+        double fa[9];
+        int holds = joint_tet_forces(&law, m->pos, m->vel, m->dt_prev, n, &damage, fa, &e);
+        m->joint_damage[j] = damage;
+        if (!holds) {
+            broke++;
+            continue;
+        }
+        for (int i = 0; i < 3; i++)
+            for (int c = 0; c < 3; c++) {
+                f[3 * (size_t)n[i] + c] += fa[3 * i + c];
+                f[3 * (size_t)n[3 + i] + c] -= fa[3 * i + c];
+            }
+    }
+    sums[0] += broke;
+    sums[1] += e.stored;
+    sums[2] += e.dissipated;
+    sums[3] += e.handed;
+    sums[4] += e.friction;
+}

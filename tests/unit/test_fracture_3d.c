@@ -1,0 +1,229 @@
+/*
+ * test_fracture_3d.c - fracturing tetrahedral parts in the model: a joint
+ * on every face shared by two tetrahedra (counted against the box mesh's
+ * faces, oriented out of A, joining copies of one mesh vertex); an intact
+ * fracturing bar vibrates with the period of the continuous one (4L/c);
+ * a bar pulled apart at both ends breaks into pieces with the energy
+ * balance closed, and 1 and 2 threads give the same bits.
+ */
+#include "bar_period_3d.h"
+#include "build_model.h"
+#include "check.h"
+#include "mesh_3d.h"
+#include "model.h"
+
+#include <stdint.h>
+#include <stdlib.h>
+
+/* build_fracturing_rock's rock, optionally too strong to break. */
+static fdem_material_def rock(int strong, double damping)
+{
+    /* penalty 0: 10 E (fdem_add_material) */
+    fdem_material_def d = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = damping,
+                           .friction = 0.3, .has_fracture = 1,
+                           .fracture = {1e6, 3e6, 30, 10, 50}};
+    if (strong) d.fracture = (fdem_fracture_params){1e9, 3e9, 30, 1e6, 5e6};
+    return d;
+}
+
+static fdem_model *box_model(const double size[3], const int div[3], fdem_material_def mat,
+                             int fracture)
+{
+    fdem_error err = {0};
+    fdem_tet_mesh mesh = {0};
+    const double origin[3] = {0, 0, 0};
+    fdem_model *m = fdem_model_create();
+    int ok = m && fdem_set_dimension(m, 3, &err) == 0 &&
+             fdem_tet_mesh_box(origin, size, div, &mesh, &err) == 0 &&
+             fdem_add_material(m, &mat, &err) == 0 &&
+             fdem_add_part_3d(m, &mesh, 0, fracture, &err) == 0;
+    fdem_tet_mesh_free(&mesh);
+    if (!ok) build_die("box", &err);
+    return m;
+}
+
+static void add_end_constraint(fdem_model *m, double x, fdem_constraint_kind kind, double vx)
+{
+    fdem_constraint_def c = {0};
+    c.select = FDEM_SELECT_BOX;
+    const double box[6] = {x - 1e-9, -1, -1, x + 1e-9, 1, 1};
+    for (int k = 0; k < 6; k++) c.box[k] = box[k];
+    c.kind = kind;
+    c.fix_x = c.fix_y = c.fix_z = 1;
+    c.value[0] = vx;
+    c.free_y = c.free_z = 1;
+    fdem_error err;
+    if (fdem_add_constraint(m, &c, &err) < 0) build_die("constraint", &err);
+}
+
+static void joints_on_interior_faces(void)
+{
+    const double size[3] = {0.03, 0.02, 0.01};
+    const int div[3] = {3, 2, 1};
+    fdem_model *m = box_model(size, div, rock(0, 0), 1);
+    build_finalize(m, 0.5);
+    int T = m->elem_count;
+    int boundary = 2 * 2 * (div[0] * div[1] + div[1] * div[2] + div[0] * div[2]);
+    CHECK(m->joint_count == (4 * T - boundary) / 2, "joints %d, tetrahedra %d, boundary faces %d",
+          m->joint_count, T, boundary);
+    CHECK(m->node_count == 4 * T, "every tetrahedron keeps its own nodes: %d of %d",
+          m->node_count, 4 * T);
+    int wrong_side = 0, wrong_copy = 0, wrong_elem = 0, wrong_h = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *n = m->joint_node + 6 * j;
+        int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
+        const double *x = m->pos0;
+        double e1[3], e2[3], N[3], centre[3] = {0, 0, 0};
+        for (int c = 0; c < 3; c++) {
+            e1[c] = x[3 * n[1] + c] - x[3 * n[0] + c];
+            e2[c] = x[3 * n[2] + c] - x[3 * n[0] + c];
+            for (int k = 0; k < 4; k++) centre[c] += 0.25 * x[3 * m->tet[ea].node[k] + c];
+        }
+        N[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        N[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        N[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double out = 0;
+        for (int c = 0; c < 3; c++) out += N[c] * (x[3 * n[0] + c] - centre[c]);
+        wrong_side += !(out > 0);
+        for (int i = 0; i < 3; i++) {
+            wrong_copy += m->node_origin[n[i]] != m->node_origin[n[3 + i]] || n[i] == n[3 + i];
+            int in_a = 0, in_b = 0;
+            for (int k = 0; k < 4; k++) {
+                in_a |= m->tet[ea].node[k] == n[i];
+                in_b |= m->tet[eb].node[k] == n[3 + i];
+            }
+            wrong_elem += !in_a || !in_b;
+        }
+        wrong_h += m->joint_h[j] != fmin(m->elem_h[ea], m->elem_h[eb]);
+    }
+    CHECK(wrong_side == 0, "%d joints whose face A points into A", wrong_side);
+    CHECK(wrong_copy == 0, "%d joint nodes not joining copies of one vertex", wrong_copy);
+    CHECK(wrong_elem == 0, "%d joint nodes outside their tetrahedron", wrong_elem);
+    CHECK(wrong_h == 0, "%d joints not sized by the smaller height", wrong_h);
+    CHECK(fdem_get_counts(m).fragments == 1, "an intact part is %d fragments",
+          fdem_get_counts(m).fragments);
+    fprintf(stderr, "  %d tetrahedra, %d joints\n", T, m->joint_count);
+    fdem_model_destroy(m);
+}
+
+/* The first period of a fixed-free bar given an axial velocity. */
+static double bar_period(int fracture, double penalty_factor)
+{
+    const double L = 0.5, size[3] = {L, 0.05, 0.05};
+    const int div[3] = {20, 1, 1};
+    fdem_material_def mat = rock(1, 0);
+    mat.penalty = penalty_factor * mat.young;
+    fdem_model *m = box_model(size, div, mat, fracture);
+    add_end_constraint(m, 0, FDEM_CONSTRAINT_FIX, 0);
+    const double v0[3] = {0.1, 0, 0};
+    fdem_error err;
+    if (fdem_set_part_velocity_v(m, 0, v0, &err)) build_die("velocity", &err);
+    build_finalize(m, 0.5);
+    double period = 4 * L / sqrt(3e10 / 2700), u_max = 0.1 * period / 4;
+    bar_crossing bar = {0, 0, -1, 0, 0};
+    while (fdem_get_time(m) < 1.5 * period && bar.crossing < 0) {
+        if (fdem_step(m, &err)) build_die("step", &err);
+        bar_crossing_update(&bar, fdem_get_time(m), bar_tip_displacement(m, L), u_max);
+    }
+    CHECK(fdem_get_counts(m).broken_joints == 0, "joints broke in a small-strain vibration");
+    fdem_model_destroy(m);
+    return bar.crossing;
+}
+
+/* An intact joint is a penalty spring p/h per unit area in series with the
+ * elements, so the bar's stiffness K falls to 1 / (1/K + c/p): the period
+ * grows by (T/T_0)^2 - 1 = c K / p, inversely with the penalty. On this
+ * mesh (a box cell cut into tetrahedra, several faces across the axis,
+ * heights well below the cell) the default 10 E gives +12 % on the period
+ * (2D: under 3 %), an open point for issue 13; at 100 E the bar vibrates
+ * within 3 % of the continuous one. The excess (T/T_0)^2 - 1 falls about
+ * tenfold (12.1: the series law is static, the first mode of a 20-element
+ * chain is not quite); only its falling is held here. */
+static void intact_fracturing_bar_vibrates_like_continuum(void)
+{
+    double continuous = bar_period(0, 10), soft = bar_period(1, 10), stiff = bar_period(1, 100);
+    double exact = 4 * 0.5 / sqrt(3e10 / 2700);
+    CHECK_REL(continuous, exact, 0.03);
+    CHECK_REL(stiff, continuous, 0.03);
+    double excess_soft = soft * soft / (continuous * continuous) - 1;
+    double excess_stiff = stiff * stiff / (continuous * continuous) - 1;
+    CHECK(excess_soft > 5 * excess_stiff && excess_stiff > 0,
+          "joint compliance does not fall with the penalty: %g at 10 E, %g at 100 E", excess_soft,
+          excess_stiff);
+    fprintf(stderr, "  bar period: exact %.4g s, continuous %.4g s, fracturing %.4g s (%+.2f%%) "
+            "at penalty 10 E, %.4g s (%+.2f%%) at 100 E; compliance ratio %.3g\n",
+            exact, continuous, soft, 100 * (soft / continuous - 1), stiff,
+            100 * (stiff / continuous - 1), excess_soft / excess_stiff);
+}
+
+/* A bar pulled at both ends at 5 m/s, as test_fragments' 2D bar. */
+static fdem_model *pulled_bar(int threads)
+{
+    const double size[3] = {0.1, 0.01, 0.01};
+    const int div[3] = {10, 1, 1};
+    fdem_model *m = box_model(size, div, rock(0, 0.1), 1);
+    add_end_constraint(m, 0, FDEM_CONSTRAINT_VELOCITY, -5);
+    add_end_constraint(m, 0.1, FDEM_CONSTRAINT_VELOCITY, 5);
+    fdem_set_threads(m, threads);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+static int run_until_broken(fdem_model *m, int max_steps)
+{
+    fdem_error err;
+    int s = 0;
+    for (; s < max_steps && fdem_get_counts(m).fragments < 2; s++)
+        if (fdem_step(m, &err)) build_die("step", &err);
+    for (int k = 0; k < 200; k++)
+        if (fdem_step(m, &err)) build_die("step", &err);
+    return s;
+}
+
+static void pulled_bar_breaks_with_the_balance_closed(void)
+{
+    fdem_model *m = pulled_bar(1);
+    double worst = 0, scale = 0;
+    fdem_error err;
+    for (int s = 0; s < 40000 && fdem_get_counts(m).fragments < 2; s++) {
+        if (fdem_step(m, &err)) build_die("step", &err);
+        fdem_energy e = fdem_get_energy(m);
+        worst = fmax(worst, fabs(e.residual));
+        scale = fmax(scale, fabs(e.external_work));
+    }
+    for (int k = 0; k < 500; k++) {
+        if (fdem_step(m, &err)) build_die("step", &err);
+        fdem_energy e = fdem_get_energy(m);
+        worst = fmax(worst, fabs(e.residual));
+        scale = fmax(scale, fabs(e.external_work));
+    }
+    fdem_counts c = fdem_get_counts(m);
+    fdem_energy e = fdem_get_energy(m);
+    CHECK(c.fragments >= 2, "the bar did not break: %d fragments", c.fragments);
+    CHECK(e.fracture > 0, "no fracture energy");
+    /* at least one cross-section (0.01 x 0.01 m) opened in mode I */
+    CHECK(e.fracture >= 0.97 * 10 * 1e-4, "fracture %g J < G_I times a cross-section", e.fracture);
+    CHECK(worst <= 0.01 * scale, "energy residual %g J of %g J of work", worst, scale);
+    fprintf(stderr, "  pulled bar: %d fragments, %d of %d joints broken at step %lld; work %.4g J, "
+            "fracture %.4g J (G_I A = %.4g J), worst residual %.3g %%\n",
+            c.fragments, c.broken_joints, c.joints, (long long)fdem_get_step(m), scale, e.fracture,
+            10 * 1e-4, 100 * worst / scale);
+    fdem_model_destroy(m);
+}
+
+static void two_threads_give_the_same_bits(void)
+{
+    fdem_model *a = pulled_bar(1), *b = pulled_bar(2);
+    int sa = run_until_broken(a, 40000), sb = run_until_broken(b, 40000);
+    CHECK(sa == sb, "broke at step %d with 1 thread, %d with 2", sa, sb);
+    int n = 3 * fdem_get_counts(a).nodes;
+    CHECK(memcmp(fdem_positions(a), fdem_positions(b), sizeof(double) * (size_t)n) == 0,
+          "positions differ");
+    CHECK(memcmp(a->joint_damage, b->joint_damage, sizeof(double) * (size_t)a->joint_count) == 0,
+          "damage differs");
+    fdem_model_destroy(a);
+    fdem_model_destroy(b);
+}
+
+CHECK_MAIN(T(joints_on_interior_faces), T(intact_fracturing_bar_vibrates_like_continuum),
+           T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits))
