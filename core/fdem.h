@@ -329,7 +329,7 @@ size_t fdem_memory_bytes(const fdem_model *model);
 /* Estimated bytes a model with this many nodes, elements and joints will
  * need once finalized (to reject oversized cases before building them). */
 size_t fdem_memory_estimate(long nodes, long elements, long joints);
-size_t fdem_memory_estimate_3d(long nodes, long elements);
+size_t fdem_memory_estimate_3d(long nodes, long elements, long joints);
 
 #ifdef __cplusplus
 }

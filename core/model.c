@@ -583,12 +583,17 @@ size_t fdem_memory_estimate(long nodes, long elements, long joints)
     return (size_t)nodes * per_node + (size_t)elements * per_elem + (size_t)joints * per_joint;
 }
 
-size_t fdem_memory_estimate_3d(long nodes, long elements)
+size_t fdem_memory_estimate_3d(long nodes, long elements, long joints)
 {
     size_t per_node = sizeof(double) * (3 * 5 + 2) + sizeof(int32_t) + 1;
     size_t per_elem = sizeof(tet_hot) + sizeof(int32_t) * 5 + sizeof(double) * 12 + 1 +
                       2 * 2 * sizeof(int32_t) * 6; /* spheres, boxes, body, NBS lists, ~6 pairs */
-    return (size_t)nodes * per_node + (size_t)elements * per_elem;
+    /* six nodes and two tetrahedra, damage, h, k and room; one face slot per
+     * tetrahedron face once there are joints */
+    size_t per_joint = sizeof(int32_t) * 8 + sizeof(double) * 8;
+    size_t elem_joint = joints > 0 ? (size_t)elements * 4 * sizeof(int32_t) : 0;
+    return (size_t)nodes * per_node + (size_t)elements * per_elem + (size_t)joints * per_joint +
+           elem_joint;
 }
 
 size_t fdem_memory_bytes(const fdem_model *m)

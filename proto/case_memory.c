@@ -45,7 +45,7 @@ static void memory_lattice_counts(double nx, double ny, double nz, double *nodes
     *elements = 6 * nx * ny * nz;
 }
 
-static void memory_part_counts(case_part *part)
+static void memory_part_counts(case_part *part, int dimension)
 {
     double nx = (double)part->divisions[0], ny = (double)part->divisions[1];
     double nz = (double)part->divisions[2], n = memory_cells_for_circle(nx);
@@ -76,10 +76,12 @@ static void memory_part_counts(case_part *part)
     }
     part->joints = 0;
     if (part->fracture) {
-        /* every triangle gets its own 3 nodes; one joint per interior edge
-         * (3D parts do not fracture yet) */
-        part->nodes = 3 * part->elements;
-        part->joints = 1.5 * part->elements;
+        /* every element gets its own nodes and a joint on each interior
+         * side: an edge is shared by two of 3 per triangle, a face by two of
+         * 4 per tetrahedron (rounded up: the hull sides have none) */
+        int corners = dimension + 1;
+        part->nodes = corners * part->elements;
+        part->joints = corners / 2.0 * part->elements;
     }
 }
 
@@ -88,8 +90,8 @@ static double memory_bytes(int dimension, double nodes, double elements, double 
     double largest = fmax(nodes, fmax(elements, joints));
     double scale = largest > MEMORY_EXACT_COUNT ? largest / MEMORY_EXACT_COUNT : 1;
     long n = (long)(nodes / scale), e = (long)(elements / scale);
-    size_t bytes = dimension == 3 ? fdem_memory_estimate_3d(n, e)
-                                  : fdem_memory_estimate(n, e, (long)(joints / scale));
+    long j = (long)(joints / scale);
+    size_t bytes = dimension == 3 ? fdem_memory_estimate_3d(n, e, j) : fdem_memory_estimate(n, e, j);
     return (double)bytes * scale;
 }
 
@@ -121,7 +123,7 @@ double case_check_memory(case_doc *doc, size_t memory_limit)
 {
     double nodes = 0, elements = 0, joints = 0;
     for (int i = 0; i < doc->part_count; i++) {
-        memory_part_counts(&doc->parts[i]);
+        memory_part_counts(&doc->parts[i], doc->dimension);
         nodes += doc->parts[i].nodes;
         elements += doc->parts[i].elements;
         joints += doc->parts[i].joints;

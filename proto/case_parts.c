@@ -152,10 +152,7 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     char at[CASE_POINTER];
     json_t *fracture = case_member(value, ptr, "fracture", at);
     if (fracture && case_read_bool(doc, fracture, at, &part->fracture) && part->fracture) {
-        if (doc->dimension == 3)
-            case_problem(doc, at, "fracture of 3D parts is not built yet: a part of a case "
-                                  "with \"dimension\": 3 cannot have \"fracture\": true");
-        else if (part->material >= 0 && !doc->materials[part->material].def.has_fracture)
+        if (part->material >= 0 && !doc->materials[part->material].def.has_fracture)
             case_problem(doc, at, "\"fracture\": true needs a \"fracture\" block in material "
                                   "\"%.64s\"", doc->materials[part->material].name);
     }

@@ -417,15 +417,28 @@ static void gmsh_errors(void)
                "text of a .msh file");
 }
 
-static void fracture_is_refused_in_3d(void)
+/* A fracturing box gets its own four nodes per tetrahedron and a joint on
+ * every interior face: 2 x 3 x 4 cells of 6 tetrahedra have 4 x 144 faces,
+ * 2 x 52 of them on the hull, the rest paired. */
+static void fracture_builds_a_joint_on_every_interior_face(void)
 {
-    expect_variant("/parts/0/fracture", "true", "/parts/0/fracture", "not built yet");
-    /* false is fine */
     json_t *doc = load(base3d);
-    edit(doc, "/parts/0/fracture", json_false());
+    edit(doc, "/parts/0/fracture", json_true());
     case_info info;
     fdem_model *m = build_ok(doc, &info);
-    if (m) fdem_model_destroy(m);
+    if (m) {
+        fdem_counts c = fdem_get_counts(m);
+        CHECK(c.elements == 144 && c.nodes == 4 * 144, "%d elements, %d nodes", c.elements,
+              c.nodes);
+        CHECK(c.joints == (4 * 144 - 2 * 52) / 2 && c.broken_joints == 0, "%d joints, %d broken",
+              c.joints, c.broken_joints);
+        fdem_model_destroy(m);
+    }
+    /* the material must say how it breaks */
+    doc = load(base3d);
+    edit(doc, "/parts/0/fracture", json_true());
+    edit(doc, "/materials/rock/fracture", NULL);
+    expect_doc(doc, GiB, 422, "/parts/0/fracture", "needs a \"fracture\" block");
 }
 
 /* ------------------------------------------------------------- memory */
@@ -446,13 +459,15 @@ static void absurd_3d_divisions_are_refused_by_size(void)
  * model it builds, and not absurdly more (the 2D check, for each 3D shape). */
 static void memory_estimate_3d_is_not_low(void)
 {
-    const char *shapes[3][2] = {
+    const char *shapes[4][2] = {
         {"box", "{'size': [1, 1, 1], 'divisions': [5, 7, 3]}"},
         {"sphere", "{'radius': 1, 'divisions': 30}"},
         {"cylinder", "{'axis': 'x', 'radius': 1, 'length': 3, 'divisions': [22, 9]}"},
+        {"box", "{'size': [1, 1, 1], 'divisions': [5, 7, 3]}"}, /* fracturing */
     };
-    for (int s = 0; s < 3; s++) {
+    for (int s = 0; s < 4; s++) {
         json_t *doc = with_shape(shapes[s][0], load(shapes[s][1]));
+        if (s == 3) edit(doc, "/parts/0/fracture", json_true());
         problems p;
         case_info info;
         fdem_model *m = build_json(doc, GiB, &info, &p);
@@ -460,7 +475,7 @@ static void memory_estimate_3d_is_not_low(void)
         problems_free(&p);
         if (m) {
             fdem_counts c = fdem_get_counts(m);
-            size_t priced = fdem_memory_estimate_3d(c.nodes, c.elements);
+            size_t priced = fdem_memory_estimate_3d(c.nodes, c.elements, c.joints);
             size_t limit = smallest_accepted_limit(doc);
             CHECK(limit >= priced, "%s accepted at %zu bytes, the real counts price at %zu",
                   shapes[s][0], limit, priced);
@@ -496,6 +511,6 @@ CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds)
            T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact),
            T(dimension_must_be_2_or_3), T(vectors_have_three_components),
            T(shapes_of_the_other_dimension), T(box_errors), T(sphere_and_cylinder_errors),
-           T(explicit_mesh_errors), T(gmsh_errors), T(fracture_is_refused_in_3d),
+           T(explicit_mesh_errors), T(gmsh_errors), T(fracture_builds_a_joint_on_every_interior_face),
            T(absurd_3d_divisions_are_refused_by_size), T(memory_estimate_3d_is_not_low),
            T(all_problems_are_collected))
