@@ -239,6 +239,7 @@ class Solid3DTest(DaemonTestCase):
             (dict(solid_case("g", BOX), gravity=[0, -9.81]), "/gravity"),
             (solid_case("r", {"rectangle": {"size": [1, 1], "divisions": [1, 1]}}),
              "/parts/0/rectangle"),
+            # fracture needs the material's "fracture" block, which rock lacks here
             (solid_case("f", dict(BOX, fracture=True)), "/parts/0/fracture"),
             (solid_case("m", {"mesh": {"nodes": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]],
                                        "tetrahedra": [[0, 1, 2, 3]]}}),
