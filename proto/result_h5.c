@@ -54,7 +54,7 @@
 #define CHUNK_MAX_SNAPSHOTS 1024u
 
 const char *const series_names[SERIES_COUNT] = {
-    "step", "position", "velocity", "stress", "damage",
+    "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
     "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
@@ -229,17 +229,22 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
 
 static hid_t series_file_type(int kind)
 {
-    return kind == SERIES_STEP ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+    return kind == SERIES_STEP       ? H5T_STD_I64LE
+         : kind == SERIES_FRAGMENT   ? H5T_STD_I32LE
+                                     : H5T_IEEE_F64LE;
 }
 
 hid_t series_mem_type(int kind)
 {
-    return kind == SERIES_STEP ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
+    return kind == SERIES_STEP       ? H5T_NATIVE_INT64
+         : kind == SERIES_FRAGMENT   ? H5T_NATIVE_INT32
+                                     : H5T_NATIVE_DOUBLE;
 }
 
 /* Which datasets this model has and their per-snapshot shape. Damage is
  * stored whenever the model has joints (contract: "when some part
- * fractures"), the node and element fields only when requested. */
+ * fractures"), the fragment id of every element always (contract 5.4), the
+ * node and element fields only when requested. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
@@ -255,6 +260,10 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements,
          fdem_stress_components(model)},
         {SERIES_DAMAGE, c.joints > 0, c.joints, 0},
+        {SERIES_FRAGMENT, 1, c.elements, 0},
+        {SERIES_STRAIN, (fields & CASE_FIELD_STRAIN) != 0, c.elements,
+         fdem_stress_components(model)},
+        {SERIES_PRINCIPAL_STRESS, (fields & CASE_FIELD_PRINCIPAL_STRESS) != 0, c.elements, dim},
         {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
@@ -313,6 +322,9 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_VELOCITY: return s->velocity;
     case SERIES_STRESS: return s->stress;
     case SERIES_DAMAGE: return s->damage;
+    case SERIES_FRAGMENT: return s->fragment;
+    case SERIES_STRAIN: return s->strain;
+    case SERIES_PRINCIPAL_STRESS: return s->principal_stress;
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;
@@ -439,6 +451,13 @@ int start_swmr(result_file *f, const char *path, char *err, size_t errlen)
 result_file *result_create(const char *path, const fdem_model *model,
                            const case_info *info, char *err, size_t errlen)
 {
+    return result_create_described(path, model, info, NULL, 0, err, errlen);
+}
+
+result_file *result_create_described(const char *path, const fdem_model *model,
+                                     const case_info *info, const char *document,
+                                     size_t document_length, char *err, size_t errlen)
+{
     h5_quiet();
     if (!path || !model || !info) {
         snprintf(err, errlen, "result_create: missing path, model or case info");
@@ -463,6 +482,7 @@ result_file *result_create(const char *path, const fdem_model *model,
         goto fail;
     }
     if (write_mesh(f->file, model, err, errlen) < 0) goto fail;
+    if (result_describe(f->file, document, document_length, err, errlen) < 0) goto fail;
     series_layout(f->ds, model, info->fields);
     if (create_snapshot_series(f, err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;

@@ -20,6 +20,9 @@ enum series_kind {
     SERIES_VELOCITY,
     SERIES_STRESS,
     SERIES_DAMAGE,
+    SERIES_FRAGMENT,
+    SERIES_STRAIN,
+    SERIES_PRINCIPAL_STRESS,
     SERIES_CONSTRAINT_FORCE,
     SERIES_KINETIC,
     SERIES_ELASTIC,
@@ -65,6 +68,9 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
 hid_t file_access_latest(int clear_status_flags);
 result_file *result_alloc(void);
 int result_release(result_file *f);
+/* The root attribute `case` (the document) and /mesh/part_names,
+ * /mesh/material_names; nothing when text is NULL (result_describe.c). */
+int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
 int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
 
 #endif
