@@ -9,13 +9,14 @@
  * same bits as the one that wrote it.
  */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
-#define CHECKPOINT_VERSION 2
+#define CHECKPOINT_VERSION 3
 
 /* Version 1 (fdemd 0.1): the header up to external_work, then positions,
  * velocities and damage. Read for cases stored by that version; they carry
@@ -43,7 +44,13 @@ typedef struct checkpoint_header {
     int32_t has_viscous;
     int32_t dimension;       /* 0 in files written before 3D: 2 */
     fdem_energy energy;      /* the accounts at the checkpoint, shown until the next step */
+    /* version 3: the friction of intact joints (0 from a version 2 file,
+     * written before joints booked any) */
+    double joint_friction_energy;
 } checkpoint_header;
+
+/* The header of a version 2 file: everything before joint_friction_energy. */
+#define CHECKPOINT_HEADER_V2 offsetof(checkpoint_header, joint_friction_energy)
 
 static int checkpoint_has_detection(const fdem_model *m) { return m->contact.enabled; }
 
@@ -79,13 +86,14 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.havg_last = m->havg_last;
     h.friction_energy = m->friction_energy;
     h.fracture_energy = m->fracture_energy;
+    h.joint_friction_energy = m->joint_friction_energy;
     h.max_disp2 = m->contact.max_disp2;
     h.detections = m->contact.detections;
     h.need_detect = m->contact.need_detect;
     h.has_detection = checkpoint_has_detection(m);
     h.has_viscous = m->elem_viscous != NULL;
     h.dimension = m->dim;
-    h.spring_records = (int64_t)(spring_bytes / sizeof(contact_record));
+    h.spring_records = (int64_t)(spring_bytes / contact_record_bytes(&m->contact));
     h.energy = fdem_get_energy(m);
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
@@ -136,7 +144,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         return -1;
     }
     memcpy(&h1, buf, sizeof h1);
-    if (h1.magic != CHECKPOINT_MAGIC || (h1.version != 1 && h1.version != CHECKPOINT_VERSION)) {
+    if (h1.magic != CHECKPOINT_MAGIC || h1.version < 1 || h1.version > CHECKPOINT_VERSION) {
         model_error(err, FDEM_ITEM_NONE, -1, "not an fdemd checkpoint (or of another version)");
         return -1;
     }
@@ -156,25 +164,26 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     if (h1.version == 1) {
         expected = header + checkpoint_body_size(m, 0, 0, 0);
     } else {
-        header = sizeof h;
+        header = h1.version == 2 ? CHECKPOINT_HEADER_V2 : sizeof h;
         if (size < header) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is truncated (%zu bytes)", size);
             return -1;
         }
-        memcpy(&h, buf, sizeof h);
+        memcpy(&h, buf, header);
         if ((h.dimension ? h.dimension : 2) != m->dim) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is of a %dD model; this one is %dD",
                         h.dimension ? h.dimension : 2, m->dim);
             return -1;
         }
-        if (h.spring_records < 0 || h.spring_records > (int64_t)(size / sizeof(contact_record)) ||
+        size_t record_bytes = contact_record_bytes(&m->contact);
+        if (h.spring_records < 0 || h.spring_records > (int64_t)(size / record_bytes) ||
             h.has_detection != checkpoint_has_detection(m) ||
             h.has_viscous != (m->elem_viscous != NULL)) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's contact section does not fit");
             return -1;
         }
         expected = header + checkpoint_body_size(m, h.has_detection, h.has_viscous,
-                                                 (size_t)h.spring_records * sizeof(contact_record));
+                                                 (size_t)h.spring_records * record_bytes);
     }
     if (size != expected) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,
@@ -206,6 +215,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     m->havg_last = h.havg_last;
     m->friction_energy = h.friction_energy;
     m->fracture_energy = h.fracture_energy;
+    m->joint_friction_energy = h.joint_friction_energy;
     m->broken_joints = 0;
     for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
     if (m->joint_count) m->fragments = joint_fragment_count(m);

@@ -1,35 +1,22 @@
 /*
- * contact.c - contact between finite elements of different bodies: when to
- * run detection, and the distributed potential contact force of Munjiza &
- * Andrews (2000) with Coulomb friction.
+ * contact.c - the contact stage of either dimension: when to run detection,
+ * which candidate pairs to evaluate, and how their forces reach the nodes.
+ * The force between two elements is a dimension's kernel (contact_pair.h):
+ * triangles in contact_tri.c, tetrahedra in contact_tet.c; everything else
+ * is the same algorithm for both and is written here once.
  *
- * Detection (nbs.c) runs on bounding circles inflated by a buffer, and only
- * again once some node has moved more than half the buffer since the last
- * run: until then every pair that can overlap is already a candidate.
+ * Detection (nbs.c, nbs_3d.c) runs on bounding circles or spheres inflated
+ * by a buffer, and only again once some node has moved more than half the
+ * buffer since the last run: until then every pair that can overlap is
+ * already a candidate. Each step the candidates whose element boxes overlap
+ * go to the kernel; their forces are added to the contact force array in
+ * pair order, on one thread or several (each thread lists its touching
+ * pairs, the lists are added in thread order): the same bits on any thread
+ * count.
  *
- * Force. Each triangle carries the potential phi = 3 min_k lambda_k (lambda
- * the area coordinates): 1 at the centroid, 0 on the boundary. The force on
- * a contactor c from a target t is -p * integral over the overlap of
- * grad phi_t, which the divergence theorem turns into an integral along the
- * contactor's edges inside t:  F = -p * integral (phi_t n_c) ds. phi_t is
- * piecewise linear along an edge (it changes branch where two area
- * coordinates cross), so the integral and its first moment are exact sums.
- * The resultant acts at the potential's centroid s* along the edge: it is
- * shared by the edge's two nodes by lever rule, and the equal and opposite
- * force goes to the target's nodes by the area coordinates of that same
- * point. Action equals reaction at one point, so both linear and angular
- * momentum are conserved to round-off. Then the roles swap.
- *
- * Friction is Coulomb with elastic stick (PHYSICS.md, "Friction"): each
- * contactor edge of a pair carries a tangential spring, loaded by the
- * relative tangential displacement at the point of action and capped at
- * mu Fn, beyond which the surfaces slide and the spring stays at the cap.
- * The spring's stiffness is 2/3 of the normal one, p L / (h/3) for the
- * length L of the edge inside the target of smallest altitude h, so it adds
- * nothing to the stable step; its force is kept per pair across steps
- * (contact_history.c). A block on a slope below its friction angle then
- * stays put for as long as one runs it, whatever the step; the energy that
- * sliding dissipates, cap x slip, is booked in the friction account.
+ * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
+ * dimension's count of slots each (cs->slots), across steps, detections and
+ * checkpoints (contact_history.c); a pair whose boxes part lets them go.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -38,236 +25,90 @@
 #include <omp.h>
 #endif
 
+#include "contact_pair.h"
 #include "model.h"
 
 /* Fewer candidate pairs than this are evaluated on one thread: below it the
  * threads' start-up costs more than they share. */
 #define CONTACT_THREADED_PAIRS 2048
 
-/* What a pair's evaluation hands back: two forces per corner of e1, then of
- * e2, then the energy friction dissipated. */
-#define PAIR_OUT 13
-#define PAIR_DISSIPATED 12
+/* A dimension's pair kernel and the numbers the shared stage sizes by. */
+typedef struct contact_kernel {
+    int slots;          /* stick springs per pair */
+    int pair_out;       /* forces on both elements' nodes, then the dissipation */
+    int (*pair_force)(const contact_pair_in *in, double *springs, double *out);
+    double dt_factor;   /* contact_stable_dt: dt_factor h sqrt(rho / p) */
+} contact_kernel;
 
-/* A thread's pairs that touched, in pair order, with their forces. */
-typedef struct contact_touch {
-    long pair;
-    double force[PAIR_OUT];
-} contact_touch;
+static const contact_kernel contact_kernels[2] = {
+    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, 0.25},
+    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153},
+};
 
+/* A thread's pairs that touched, in pair order, with their forces
+ * (pair_out numbers each). */
 typedef struct contact_touches {
-    contact_touch *item;
+    long *pair;
+    double *force;
     size_t count, capacity;
 } contact_touches;
 
-/* The current geometry of one triangle, gathered once per pair. */
-typedef struct tri_now {
-    int node[3];
-    double x[3], y[3];
-    double area2;       /* twice the signed area (> 0 unless inverted) */
-    double penalty, friction;
-} tri_now;
-
-/* libm's fmin/fmax are calls unless NaN semantics are relaxed; these are not. */
-static inline double min2(double a, double b) { return a < b ? a : b; }
-static inline double max2(double a, double b) { return a > b ? a : b; }
-static inline double min3(double a, double b, double c) { return min2(a, min2(b, c)); }
-static inline double max3(double a, double b, double c) { return max2(a, max2(b, c)); }
-
-static inline void tri_gather(const fdem_model *m, int e, tri_now *t)
+static inline int element_material(const fdem_model *m, int e)
 {
-    const element_hot *el = &m->elem[e];
-    for (int c = 0; c < 3; c++) {
-        t->node[c] = el->node[c];
-        t->x[c] = m->pos[2 * el->node[c]];
-        t->y[c] = m->pos[2 * el->node[c] + 1];
-    }
+    return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
 }
 
-/* The rest of the record, needed only for pairs whose boxes overlap. */
-static inline void tri_complete(const fdem_model *m, int e, tri_now *t)
+/* From the hot record, which also holds the material: one cache line. */
+static inline const int32_t *element_nodes(const fdem_model *m, int e)
 {
-    const material *mat = &m->materials[m->elem[e].material];
-    t->area2 = (t->x[1] - t->x[0]) * (t->y[2] - t->y[0]) - (t->y[1] - t->y[0]) * (t->x[2] - t->x[0]);
-    t->penalty = mat->penalty;
-    t->friction = mat->def.friction;
+    return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
 }
 
-/* Area coordinates of (px, py) in t: lambda_k belongs to node k. */
-static inline void area_coordinates(const tri_now *t, double px, double py, double l[3])
+/* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
+static inline int boxes_overlap(const double *a, const double *b, int dim)
 {
-    double inv = 1.0 / t->area2;
-    for (int k = 0; k < 3; k++) {
-        int i = (k + 1) % 3, j = (k + 2) % 3;
-        l[k] = ((t->x[i] - px) * (t->y[j] - py) - (t->y[i] - py) * (t->x[j] - px)) * inv;
-    }
+    int apart = a[1] < b[0] || b[1] < a[0] || a[3] < b[2] || b[3] < a[2];
+    if (dim == 3) apart |= a[5] < b[4] || b[5] < a[4];
+    return !apart;
 }
 
-/* Integral over s in [0,1] of phi(s) = 3 min_k lambda_k(s), clipped to where
- * all lambda_k >= 0, its first moment, and the fraction of the edge inside.
- * Returns 0 when the edge misses. */
-static int edge_potential_integral(const double la[3], const double lb[3], double *i0, double *i1,
-                                   double *inside)
+/* D and K are constants where it is called (element_box), so each
+ * dimension gets its own unrolled copy of this one loop. */
+static inline __attribute__((always_inline)) void box_of_nodes(const double *p, const int32_t *n,
+                                                               int D, int K, double *b)
 {
-    double smin = 0, smax = 1;
-    for (int k = 0; k < 3; k++) {
-        if (la[k] < 0 && lb[k] < 0) return 0;
-        if (la[k] < 0) smin = max2(smin, la[k] / (la[k] - lb[k]));
-        else if (lb[k] < 0) smax = min2(smax, la[k] / (la[k] - lb[k]));
-    }
-    if (!(smax > smin)) return 0;
-
-    double s[5];
-    int n = 0;
-    s[n++] = smin;
-    for (int k = 0; k < 3; k++) { /* where two coordinates cross, phi changes branch */
-        int j = (k + 1) % 3;
-        double denom = (lb[k] - la[k]) - (lb[j] - la[j]);
-        if (fabs(denom) < 1e-300) continue;
-        double sc = (la[j] - la[k]) / denom;
-        if (sc > smin && sc < smax) s[n++] = sc;
-    }
-    s[n++] = smax;
-    for (int a = 1; a < n; a++) /* insertion sort of at most 5 */
-        for (int b = a; b > 0 && s[b] < s[b - 1]; b--) {
-            double tmp = s[b]; s[b] = s[b - 1]; s[b - 1] = tmp;
+    for (int d = 0; d < D; d++) {
+        double lo = p[D * n[0] + d], hi = lo;
+        for (int c = 1; c < K; c++) {
+            double x = p[D * n[c] + d];
+            lo = min2(lo, x);
+            hi = max2(hi, x);
         }
-    double sum0 = 0, sum1 = 0, prev_s = s[0];
-    double prev_phi = 3 * max2(0, min3(la[0] + prev_s * (lb[0] - la[0]), la[1] + prev_s * (lb[1] - la[1]),
-                                       la[2] + prev_s * (lb[2] - la[2])));
-    for (int a = 1; a < n; a++) {
-        double sa = s[a];
-        double phi = 3 * max2(0, min3(la[0] + sa * (lb[0] - la[0]), la[1] + sa * (lb[1] - la[1]),
-                                      la[2] + sa * (lb[2] - la[2])));
-        double ds = sa - prev_s;
-        sum0 += 0.5 * ds * (prev_phi + phi);
-        sum1 += ds / 6.0 * (prev_phi * (2 * prev_s + sa) + phi * (prev_s + 2 * sa));
-        prev_s = sa;
-        prev_phi = phi;
+        b[2 * d] = lo;
+        b[2 * d + 1] = hi;
     }
-    *i0 = sum0;
-    *i1 = sum1;
-    *inside = smax - smin;
-    return sum0 > 0;
 }
 
-/* The friction force on edge (na, nb) of a contactor, acting at sbar along
- * it and lbar in the target t: the edge's stick spring `spring` is loaded
- * by the relative tangential displacement of the last step (velocity times
- * h, the last step's size), capped at mu Fn; *dissipated gets cap x slip. */
-static double friction_force(const fdem_model *m, const tri_now *t, int na, int nb, double sbar,
-                             const double lbar[3], double tx, double ty, double k_t, double cap,
-                             double h, double *spring, double *dissipated)
+static inline void element_box(const fdem_model *m, int e, double *b)
 {
-    const double *v = m->vel;
-    double vcx = (1 - sbar) * v[2 * na] + sbar * v[2 * nb];
-    double vcy = (1 - sbar) * v[2 * na + 1] + sbar * v[2 * nb + 1];
-    double vtx = 0, vty = 0;
-    for (int k = 0; k < 3; k++) {
-        vtx += lbar[k] * v[2 * t->node[k]];
-        vty += lbar[k] * v[2 * t->node[k] + 1];
-    }
-    double slide = ((vcx - vtx) * tx + (vcy - vty) * ty) * h;
-    double f = *spring - k_t * slide;
-    if (fabs(f) > cap) {
-        *dissipated += cap * (fabs(f) - cap) / k_t;
-        f = f > 0 ? cap : -cap;
-    }
-    *spring = f;
-    return f;
-}
-
-/* Forces of target t's potential on contactor c's edges, added to fc (two
- * per corner of c), and their reactions on t, added to ft; springs holds the
- * stick springs of c's three edges against t (updated; an edge that does not
- * touch lets its spring go) and *dissipated gets what friction dissipated.
- * Returns 1 if any force acted. Reads the model, writes nothing in it:
- * pairs can be evaluated side by side. */
-static int contactor_against_target(const fdem_model *m, const tri_now *c, const tri_now *t,
-                                    double penalty, double friction, double h, double springs[3],
-                                    double fc[6], double ft[6], double *dissipated)
-{
-    double lam[3][3];
-    for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
-    double stiffness = 0; /* p / (h_t / 3), h_t the target's smallest altitude */
-    int acted = 0;
-    for (int i = 0; i < 3; i++) {
-        int j = (i + 1) % 3;
-        double i0, i1, inside;
-        if (!edge_potential_integral(lam[i], lam[j], &i0, &i1, &inside)) {
-            springs[i] = 0;
-            continue;
-        }
-        acted = 1;
-        double ex = c->x[j] - c->x[i], ey = c->y[j] - c->y[i];
-        double len = hypot(ex, ey);
-        double sbar = i1 / i0;
-        /* normal: -p * i0 * (length-scaled outward normal) */
-        double fx = -penalty * i0 * ey, fy = penalty * i0 * ex;
-        double lbar[3];
-        for (int k = 0; k < 3; k++) lbar[k] = lam[i][k] + sbar * (lam[j][k] - lam[i][k]);
-        int na = c->node[i], nb = c->node[j];
-        if (friction > 0 && len > 0) {
-            if (stiffness == 0) {
-                double dx0 = t->x[1] - t->x[0], dy0 = t->y[1] - t->y[0];
-                double dx1 = t->x[2] - t->x[1], dy1 = t->y[2] - t->y[1];
-                double dx2 = t->x[0] - t->x[2], dy2 = t->y[0] - t->y[2];
-                double longest2 = max3(dx0 * dx0 + dy0 * dy0, dx1 * dx1 + dy1 * dy1,
-                                       dx2 * dx2 + dy2 * dy2);
-                stiffness = 3 * penalty * sqrt(longest2) / t->area2;
-            }
-            double tx = ex / len, ty = ey / len;
-            double k_t = (2.0 / 3.0) * stiffness * inside * len;
-            double f_t = friction_force(m, t, na, nb, sbar, lbar, tx, ty, k_t,
-                                        friction * penalty * i0 * len, h, &springs[i], dissipated);
-            fx += f_t * tx;
-            fy += f_t * ty;
-        } else {
-            springs[i] = 0;
-        }
-        fc[2 * i] += (1 - sbar) * fx;
-        fc[2 * i + 1] += (1 - sbar) * fy;
-        fc[2 * j] += sbar * fx;
-        fc[2 * j + 1] += sbar * fy;
-        for (int k = 0; k < 3; k++) {
-            ft[2 * k] -= lbar[k] * fx;
-            ft[2 * k + 1] -= lbar[k] * fy;
-        }
-    }
-    return acted;
-}
-
-/* Axis-aligned boxes (xmin, xmax, ymin, ymax) that overlap or touch. */
-static inline int boxes_overlap(const double *a, const double *b)
-{
-    return !(a[1] < b[0] || b[1] < a[0] || a[3] < b[2] || b[3] < a[2]);
-}
-
-static inline void element_box(const fdem_model *m, int e, double b[4])
-{
-    const double *p = m->pos;
-    const int32_t *n = m->elem[e].node;
-    double x0 = p[2 * n[0]], y0 = p[2 * n[0] + 1], x1 = p[2 * n[1]], y1 = p[2 * n[1] + 1];
-    double x2 = p[2 * n[2]], y2 = p[2 * n[2] + 1];
-    b[0] = min3(x0, x1, x2);
-    b[1] = max3(x0, x1, x2);
-    b[2] = min3(y0, y1, y2);
-    b[3] = max3(y0, y1, y2);
+    if (m->dim == 3) box_of_nodes(m->pos, m->tet[e].node, 3, 4, b);
+    else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
 
 /* The current box of every element in some candidate pair. Most candidate
  * pairs do not touch (their bounding circles, inflated by the buffer,
- * overlap; their triangles do not): the box test then reads two 32-byte
- * boxes instead of two element records and six scattered nodes. */
+ * overlap; their elements do not): the box test then reads two boxes
+ * instead of two element records and their scattered nodes. */
 static void contact_boxes(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     const int32_t *active = cs->active;
     double *box = cs->box;
     int count = cs->active_count;
+    size_t width = 2 * (size_t)m->dim;
 #pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
     schedule(static)
-    for (int k = 0; k < count; k++) element_box(m, active[k], box + 4 * (size_t)active[k]);
+    for (int k = 0; k < count; k++) element_box(m, active[k], box + width * (size_t)active[k]);
 }
 
 /* The elements of the candidate pairs, once each and in element order (so
@@ -285,134 +126,161 @@ static void contact_collect_active(contact_state *cs, int elem_count)
     cs->active_count = count;
 }
 
-/* Force between two elements whose boxes overlap, both roles, into out;
- * springs are the pair's CONTACT_SLOTS stick springs (updated), h the last
- * step's size. Returns 1 if they touched (out is then filled; otherwise it
- * may be left as it was). Writes nothing in m. */
-static int contact_pair_force(const fdem_model *m, int e1, int e2, double h,
-                              double springs[CONTACT_SLOTS], double out[PAIR_OUT])
+/* Force between two elements whose boxes overlap, both roles, into out
+ * (pair_out numbers); springs are the pair's stick springs (updated), h the
+ * last step's size. The softer surface sets the penalty; friction is the
+ * larger of the two, so giving it on one material is enough. Returns 1 if
+ * they touched. Writes nothing in m. */
+static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
+                              double *out)
 {
-    tri_now a, b;
-    tri_gather(m, e1, &a);
-    tri_gather(m, e2, &b);
-    tri_complete(m, e1, &a);
-    tri_complete(m, e2, &b);
-    if (!(a.area2 > 0) || !(b.area2 > 0)) { /* inverted: no potential defined */
-        memset(springs, 0, sizeof(double) * CONTACT_SLOTS);
-        return 0;
-    }
-    /* The softer surface sets the penalty; friction is the larger of the two,
-     * so giving it on one material is enough. */
-    double penalty = min2(a.penalty, b.penalty);
-    double friction = max2(a.friction, b.friction);
-    for (int k = 0; k < PAIR_OUT; k++) out[k] = 0;
-    double *dissipated = &out[PAIR_DISSIPATED];
-    int touched = contactor_against_target(m, &a, &b, penalty, friction, h, springs, out, out + 6,
-                                           dissipated);
-    touched |= contactor_against_target(m, &b, &a, penalty, friction, h, springs + 3, out + 6,
-                                        out, dissipated);
-    return touched;
+    const material *ma = &m->materials[element_material(m, e1)];
+    const material *mb = &m->materials[element_material(m, e2)];
+    contact_pair_in in = {m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
+                          min2(ma->penalty, mb->penalty),
+                          max2(ma->def.friction, mb->def.friction), h};
+    return m->contact.kernel->pair_force(&in, springs, out);
 }
 
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
  * what its friction dissipated to the friction account; called in pair
  * order, so every sum is formed in the same order on any thread count. */
-static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double out[PAIR_OUT])
+static inline __attribute__((always_inline)) void scatter_nodes(double *f, const int32_t *n1,
+                                                                 const int32_t *n2, int D, int K,
+                                                                 const double *out)
 {
-    double *f = m->contact.force;
-    const int32_t *n1 = m->elem[e1].node, *n2 = m->elem[e2].node;
-    for (int c = 0; c < 3; c++) {
-        f[2 * n1[c]] += out[2 * c];
-        f[2 * n1[c] + 1] += out[2 * c + 1];
-    }
-    for (int c = 0; c < 3; c++) {
-        f[2 * n2[c]] += out[6 + 2 * c];
-        f[2 * n2[c] + 1] += out[6 + 2 * c + 1];
-    }
-    m->friction_energy += out[PAIR_DISSIPATED];
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n1[c] + d] += out[D * c + d];
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n2[c] + d] += out[D * (K + c) + d];
+}
+
+static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
+{
+    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
+    if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
+    else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
+    m->friction_energy += out[2 * m->dim * m->elem_nodes];
 }
 
 /* A pair whose boxes no longer overlap lets its stick springs go. */
-static inline void pair_springs_release(contact_state *cs, size_t k)
+static inline void pair_springs_release(contact_state *cs, size_t k, int slots)
 {
     if (!cs->sprung[k]) return;
-    double *springs = cs->slip + CONTACT_SLOTS * k;
-    for (int s = 0; s < CONTACT_SLOTS; s++) springs[s] = 0;
+    double *springs = cs->slip + (size_t)slots * k;
+    for (int s = 0; s < slots; s++) springs[s] = 0;
     cs->sprung[k] = 0;
 }
 
 /* Notes whether pair k's springs hold anything after its evaluation. */
-static inline void pair_springs_mark(contact_state *cs, size_t k)
+static inline void pair_springs_mark(contact_state *cs, size_t k, int slots)
 {
-    const double *springs = cs->slip + CONTACT_SLOTS * k;
+    const double *springs = cs->slip + (size_t)slots * k;
     int any = 0;
-    for (int s = 0; s < CONTACT_SLOTS; s++) any |= springs[s] != 0;
+    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
     cs->sprung[k] = (uint8_t)any;
+}
+
+/* Candidate pair k this step: boxes apart, it lets its springs go (-1);
+ * otherwise its force into out (pair_out numbers), 1 if it touched. D is a
+ * constant where it is called, so each dimension's walk is compiled on
+ * its own with the box and spring loops unrolled. */
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t k, double h,
+                                                               double *out, int D)
+{
+    contact_state *cs = &m->contact;
+    const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
+    const size_t width = 2 * (size_t)D;
+    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+    if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
+        pair_springs_release(cs, k, slots);
+        return -1;
+    }
+    int touched = contact_pair_force(m, a, b, h, cs->slip + (size_t)slots * k, out);
+    pair_springs_mark(cs, k, slots);
+    return touched;
 }
 
 /* Force between two elements, both roles, added to the contact force
  * array, with no friction history (for tests). Returns 1 if they touched. */
 int contact_potential_force(fdem_model *m, int e1, int e2, double h)
 {
-    double b1[4], b2[4], out[PAIR_OUT], springs[CONTACT_SLOTS] = {0};
+    double b1[6] = {0}, b2[6] = {0}, out[CONTACT_PAIR_OUT_MAX], springs[CONTACT_SLOTS_MAX] = {0};
     element_box(m, e1, b1);
     element_box(m, e2, b2);
-    if (!boxes_overlap(b1, b2) || !contact_pair_force(m, e1, e2, h, springs, out)) return 0;
+    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out)) return 0;
     contact_pair_scatter(m, e1, e2, out);
     return 1;
 }
 
-static void element_circle(const double *p, const element_hot *el, double *cx, double *cy,
+/* The bounding circle (2D) or sphere (3D) of element e at positions p:
+ * centred on the centroid, through the farthest node. */
+static void element_sphere(const fdem_model *m, const double *p, int e, double centre[3],
                            double *r)
 {
-    double x = 0, y = 0;
-    for (int c = 0; c < 3; c++) {
-        x += p[2 * el->node[c]];
-        y += p[2 * el->node[c] + 1];
-    }
-    x /= 3;
-    y /= 3;
+    const int D = m->dim, K = m->elem_nodes;
+    const int32_t *n = element_nodes(m, e);
+    double x[3] = {0, 0, 0};
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) x[d] += p[D * n[c] + d];
+    for (int d = 0; d < D; d++) x[d] /= K;
     double r2 = 0;
-    for (int c = 0; c < 3; c++) {
-        double dx = p[2 * el->node[c]] - x, dy = p[2 * el->node[c] + 1] - y;
-        r2 = fmax(r2, dx * dx + dy * dy);
+    for (int c = 0; c < K; c++) {
+        double s = 0;
+        for (int d = 0; d < D; d++) {
+            double dx = p[D * n[c] + d] - x[d];
+            s += dx * dx;
+        }
+        r2 = fmax(r2, s);
     }
-    *cx = x;
-    *cy = y;
+    for (int d = 0; d < 3; d++) centre[d] = x[d];
     *r = sqrt(r2);
 }
 
-/* Candidate pairs from the bounding circles of the elements at `pos` (the
- * current positions, or a checkpoint's positions at its last detection),
- * with the stick springs of the pairs that stay. */
+/* Pairs of triangles glued by intact joints never contact: they leave the
+ * candidate list. */
+static void contact_drop_joined(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    joint_mark_broken_vertices(m);
+    joint_fragment_labels(m, cs->piece);
+    size_t kept = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int a = cs->pairs.a[k], b = cs->pairs.b[k];
+        if (m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, cs->piece, a, b))
+            continue;
+        cs->pairs.a[kept] = cs->pairs.a[k];
+        cs->pairs.b[kept] = cs->pairs.b[k];
+        kept++;
+    }
+    cs->pairs.count = kept;
+}
+
+/* Candidate pairs from the bounding circles or spheres of the elements at
+ * `pos` (the current positions, or a checkpoint's positions at its last
+ * detection), with the stick springs of the pairs that stay. */
 static int contact_detect_at(fdem_model *m, const double *pos)
 {
     contact_state *cs = &m->contact;
     if (contact_history_set_aside(cs)) return -1;
     for (int e = 0; e < m->elem_count; e++) {
-        element_circle(pos, &m->elem[e], &cs->cx[e], &cs->cy[e], &cs->r[e]);
+        double c[3];
+        element_sphere(m, pos, e, c, &cs->r[e]);
+        cs->cx[e] = c[0];
+        cs->cy[e] = c[1];
+        if (cs->cz) cs->cz[e] = c[2];
         cs->r[e] += 0.5 * cs->buffer;
     }
-    if (nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs))
-        return -1;
-    if (m->joint_count) { /* triangles glued by intact joints never contact */
-        joint_mark_broken_vertices(m);
-        joint_fragment_labels(m, cs->piece);
-        size_t kept = 0;
-        for (size_t k = 0; k < cs->pairs.count; k++) {
-            int a = cs->pairs.a[k], b = cs->pairs.b[k];
-            if (m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, cs->piece, a, b))
-                continue;
-            cs->pairs.a[kept] = cs->pairs.a[k];
-            cs->pairs.b[kept] = cs->pairs.b[k];
-            kept++;
-        }
-        cs->pairs.count = kept;
-    }
+    int failed = m->dim == 3 ? nbs_detect_3d(&cs->grid3, (size_t)m->elem_count, cs->cx, cs->cy,
+                                             cs->cz, cs->r, cs->body, &cs->pairs)
+                             : nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r,
+                                          cs->body, &cs->pairs);
+    if (failed) return -1;
+    if (m->joint_count) contact_drop_joined(m);
     if (contact_history_take_back(cs)) return -1;
     contact_collect_active(cs, m->elem_count);
     if (pos != cs->pos_detect)
-        memcpy(cs->pos_detect, pos, sizeof(double) * 2 * (size_t)m->node_count);
+        memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
     cs->detections++;
     return 0;
@@ -434,7 +302,7 @@ int contact_restore_detection(fdem_model *m)
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
     cs->pairs.count = 0;
-    memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = 1;
     if (cs->need_detect) return 0; /* the next step detects anyway */
     long detections = cs->detections;
@@ -448,30 +316,30 @@ int contact_init(fdem_model *m, fdem_error *err)
     contact_state *cs = &m->contact;
     int fracture = 0;
     for (int k = 0; k < m->part_count; k++) fracture |= m->parts[k].fracture;
+    cs->kernel = &contact_kernels[m->dim == 3];
+    cs->slots = cs->kernel->slots;
+    cs->pair_out = cs->kernel->pair_out;
     cs->enabled = m->part_count > 1 || fracture;
     if (!cs->enabled) return 0;
-    if (m->dim == 3) {
-        model_error(err, FDEM_ITEM_NONE, -1, "contact between tetrahedral parts is not built yet");
-        return -1;
-    }
-    size_t E = (size_t)m->elem_count, N = (size_t)m->node_count;
+    size_t E = (size_t)m->elem_count, N = (size_t)m->node_count, D = (size_t)m->dim;
     cs->cx = malloc(sizeof(double) * E);
     cs->cy = malloc(sizeof(double) * E);
+    cs->cz = D == 3 ? malloc(sizeof(double) * E) : NULL;
     cs->r = malloc(sizeof(double) * E);
     cs->body = malloc(sizeof(int32_t) * E);
     cs->piece = malloc(sizeof(int32_t) * E);
-    cs->pos_detect = malloc(sizeof(double) * 2 * N);
-    cs->force = calloc(2 * N, sizeof(double));
+    cs->pos_detect = malloc(sizeof(double) * D * N);
+    cs->force = calloc(D * N, sizeof(double));
     cs->force_is_zero = 1;
-    cs->box = malloc(sizeof(double) * 4 * E);
+    cs->box = malloc(sizeof(double) * 2 * D * E);
     cs->active = malloc(sizeof(int32_t) * E);
     cs->in_pair = malloc(E);
-    if (!cs->cx || !cs->cy || !cs->r || !cs->body || !cs->piece || !cs->pos_detect || !cs->force ||
-        !cs->box || !cs->active || !cs->in_pair) {
+    if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
+        !cs->pos_detect || !cs->force || !cs->box || !cs->active || !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
-    /* Triangles of one unbroken part never touch each other; those of a
+    /* Elements of one unbroken part never touch each other; those of a
      * fracturing part each count as a body of their own. */
     for (int e = 0; e < m->elem_count; e++) {
         int p = m->elem_part[e];
@@ -479,8 +347,8 @@ int contact_init(fdem_model *m, fdem_error *err)
     }
     double rmax = 0;
     for (int e = 0; e < m->elem_count; e++) {
-        double x, y, r;
-        element_circle(m->pos, &m->elem[e], &x, &y, &r);
+        double c[3], r;
+        element_sphere(m, m->pos, e, c, &r);
         rmax = fmax(rmax, r);
     }
     cs->buffer = 0.4 * rmax;
@@ -490,15 +358,19 @@ int contact_init(fdem_model *m, fdem_error *err)
 
 void contact_free(contact_state *cs)
 {
-    free(cs->cx); free(cs->cy); free(cs->r); free(cs->body); free(cs->piece);
+    free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
     free(cs->box); free(cs->active); free(cs->in_pair);
-    for (int t = 0; t < cs->touch_lists; t++) free(cs->touches[t].item);
+    for (int t = 0; t < cs->touch_lists; t++) {
+        free(cs->touches[t].pair);
+        free(cs->touches[t].force);
+    }
     free(cs->touches);
     free(cs->slip);
     free(cs->sprung);
     free(cs->records);
     nbs_grid_free(&cs->grid);
+    nbs_grid_3d_free(&cs->grid3);
     nbs_pairs_free(&cs->pairs);
     memset(cs, 0, sizeof *cs);
 }
@@ -513,11 +385,14 @@ double contact_stable_dt(const fdem_model *m)
      * safety 1: measured on flat impacts of shared-node and fracturing
      * blocks (test_contact.c), the energy after the impact is within 1 % of
      * the energy before at every safety up to 1 (0.45, the earlier factor,
-     * gained 20 % at safety 1). */
-    double dt = INFINITY;
+     * gained 20 % at safety 1). A tetrahedron's potential is steeper
+     * (p 4 d / h), and its corner node (mass rho h^3 / 24 against rho h^2 / 6)
+     * sits on three faces of area h^2 / 2 (a third each): 8/3 times the
+     * stiffness per unit mass, so the factor is 0.25 sqrt(3/8) = 0.153. */
+    double dt = INFINITY, factor = m->contact.kernel->dt_factor;
     for (int e = 0; e < m->elem_count; e++) {
-        const material *mat = &m->materials[m->elem[e].material];
-        dt = fmin(dt, 0.25 * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
+        const material *mat = &m->materials[element_material(m, e)];
+        dt = fmin(dt, factor * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
     }
     return dt;
 }
@@ -525,22 +400,26 @@ double contact_stable_dt(const fdem_model *m)
 size_t contact_memory_bytes(const contact_state *cs)
 {
     size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
-    for (int t = 0; t < cs->touch_lists; t++) b += cs->touches[t].capacity * sizeof(contact_touch);
+    for (int t = 0; t < cs->touch_lists; t++)
+        b += cs->touches[t].capacity * (sizeof(long) + sizeof(double) * (size_t)cs->pair_out);
     return b;
 }
 
-static int contact_touch_push(contact_touches *list, long pair, const double force[PAIR_OUT])
+static int contact_touch_push(contact_touches *list, long pair, const double *force, int width)
 {
     if (list->count == list->capacity) {
         size_t cap = list->capacity ? 2 * list->capacity : 1024;
-        contact_touch *p = realloc(list->item, cap * sizeof *p);
+        long *p = realloc(list->pair, cap * sizeof *p);
         if (!p) return -1;
-        list->item = p;
+        list->pair = p;
+        double *f = realloc(list->force, cap * (size_t)width * sizeof *f);
+        if (!f) return -1;
+        list->force = f;
         list->capacity = cap;
     }
-    contact_touch *t = &list->item[list->count++];
-    t->pair = pair;
-    memcpy(t->force, force, sizeof t->force);
+    list->pair[list->count] = pair;
+    memcpy(list->force + list->count * (size_t)width, force, sizeof(double) * (size_t)width);
+    list->count++;
     return 0;
 }
 
@@ -558,25 +437,23 @@ static int contact_touch_lists(contact_state *cs, int threads)
 
 /* Every candidate pair's force, added to the contact force array in pair
  * order, one pair at a time. Returns the number of pairs that touched. */
-static int contact_pairs_forces_serial(fdem_model *m, double h)
+static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
+                                                                     int D)
 {
     contact_state *cs = &m->contact;
     int touching = 0;
-    const double *box = cs->box;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
-        double out[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
-        if (!boxes_overlap(box + 4 * (size_t)a, box + 4 * (size_t)b)) {
-            pair_springs_release(cs, k);
-            continue;
-        }
-        int touched = contact_pair_force(m, a, b, h, springs, out);
-        pair_springs_mark(cs, k);
-        if (!touched) continue;
-        contact_pair_scatter(m, a, b, out);
+        double out[CONTACT_PAIR_OUT_MAX];
+        if (pair_evaluate(m, k, h, out, D) <= 0) continue;
+        contact_pair_scatter(m, cs->pairs.a[k], cs->pairs.b[k], out);
         touching++;
     }
     return touching;
+}
+
+static int contact_pairs_forces_serial(fdem_model *m, double h)
+{
+    return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
 }
 
 /* The same on several threads: each takes a contiguous share of the pairs
@@ -585,6 +462,20 @@ static int contact_pairs_forces_serial(fdem_model *m, double h)
  * the order the serial loop forms it: the same bits on any thread count.
  * Returns the number of pairs that touched, or -1 if a list could not grow
  * (nothing has been added then). */
+static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
+                                                                     long begin, long end,
+                                                                     contact_touches *list, int D)
+{
+    int touching = 0;
+    for (long k = begin; k < end; k++) {
+        double force[CONTACT_PAIR_OUT_MAX];
+        if (pair_evaluate(m, (size_t)k, h, force, D) <= 0) continue;
+        touching++;
+        if (contact_touch_push(list, k, force, m->contact.pair_out)) return -1;
+    }
+    return touching;
+}
+
 static int contact_pairs_forces_threaded(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
@@ -603,29 +494,20 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
         contact_touches *list = &lists[t];
         list->count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
-        const double *box = cs->box;
-        for (long k = begin; k < end; k++) {
-            double force[PAIR_OUT], *springs = cs->slip + CONTACT_SLOTS * k;
-            if (!boxes_overlap(box + 4 * (size_t)pa[k], box + 4 * (size_t)pb[k])) {
-                pair_springs_release(cs, (size_t)k);
-                continue;
-            }
-            int touched = contact_pair_force(m, pa[k], pb[k], h, springs, force);
-            pair_springs_mark(cs, (size_t)k);
-            if (!touched) continue;
-            touching++;
-            if (contact_touch_push(list, k, force)) {
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, begin, end, list, 3)
+                               : pairs_forces_listed(m, h, begin, end, list, 2);
+        if (mine < 0) {
 #pragma omp atomic write
-                failed = 1;
-                break;
-            }
+            failed = 1;
+        } else {
+            touching += mine;
         }
     }
     if (failed) return -1;
     for (int t = 0; t < used; t++)
         for (size_t i = 0; i < lists[t].count; i++) {
-            const contact_touch *c = &lists[t].item[i];
-            contact_pair_scatter(m, pa[c->pair], pb[c->pair], c->force);
+            long k = lists[t].pair[i];
+            contact_pair_scatter(m, pa[k], pb[k], lists[t].force + i * (size_t)cs->pair_out);
         }
     return touching;
 }
@@ -662,7 +544,8 @@ int contact_forces(fdem_model *m)
     }
     /* With no candidate pair (bodies apart, an intact fracturing block) the
      * force array stays zero, and the integrator skips reading it. */
-    if (!cs->force_is_zero) memset(cs->force, 0, sizeof(double) * 2 * (size_t)m->node_count);
+    if (!cs->force_is_zero)
+        memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (cs->pairs.count) contact_boxes(m);
     int touching = contact_pairs_forces(m, m->dt_prev);

@@ -1,12 +1,13 @@
 /*
- * contact_history.c - the stick springs of Coulomb friction: one tangential
- * force per contactor edge of every candidate pair, kept across steps,
- * detections and checkpoints.
+ * contact_history.c - the stick springs of Coulomb friction: a tangential
+ * force per contactor edge (2D) or face (3D, a vector) of every candidate
+ * pair, kept across steps, detections and checkpoints.
  *
  * Friction with elastic stick needs to remember, per touching pair, how far
  * its surfaces have been sheared against each other (PHYSICS.md,
- * "Friction"). The history sits beside the candidate pair list (six values
- * a pair: the three edges of each element as contactor), because that is
+ * "Friction"). The history sits beside the candidate pair list (cs->slots
+ * values a pair: 2D the three edges of each element as contactor, 3D the
+ * three components for each of four faces), because that is
  * where the force loop walks. Detection rebuilds the pair list in an order
  * of its own, so before it runs the pairs that hold some history are set
  * aside as records keyed by their two elements, and afterwards every new
@@ -22,9 +23,9 @@
 /* Slots of a pair (a, b): the edges of a against b, then those of b against
  * a. Records store them for (lo, hi) = (min, max) of the two elements; this
  * turns one order into the other (either way: it swaps the halves or not). */
-static void pair_slots_oriented(const double *slip, int a, int b, double out[CONTACT_SLOTS])
+static void pair_slots_oriented(const double *slip, int a, int b, int slots, double *out)
 {
-    int half = CONTACT_SLOTS / 2;
+    int half = slots / 2;
     for (int k = 0; k < half; k++) {
         out[k] = slip[a < b ? k : k + half];
         out[k + half] = slip[a < b ? k + half : k];
@@ -36,7 +37,7 @@ int contact_history_reserve(contact_state *cs, size_t pairs)
     if (pairs <= cs->slip_capacity) return 0;
     size_t cap = cs->slip_capacity ? cs->slip_capacity : 1024;
     while (cap < pairs) cap *= 2;
-    double *s = realloc(cs->slip, sizeof(double) * CONTACT_SLOTS * cap);
+    double *s = realloc(cs->slip, sizeof(double) * (size_t)cs->slots * cap);
     if (!s) return -1;
     cs->slip = s;
     uint8_t *f = realloc(cs->sprung, cap);
@@ -69,12 +70,12 @@ int contact_history_set_aside(contact_state *cs)
     n = cs->record_count;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         if (!cs->sprung[k]) continue;
-        const double *slip = cs->slip + CONTACT_SLOTS * k;
+        const double *slip = cs->slip + (size_t)cs->slots * k;
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
         contact_record *r = &cs->records[n++];
         r->lo = a < b ? a : b;
         r->hi = a < b ? b : a;
-        pair_slots_oriented(slip, a, b, r->slip);
+        pair_slots_oriented(slip, a, b, cs->slots, r->slip);
     }
     cs->record_count = n;
     return 0;
@@ -95,7 +96,7 @@ int contact_history_take_back(contact_state *cs)
 {
     if (contact_history_reserve(cs, cs->pairs.count)) return -1;
     if (cs->pairs.count) {
-        memset(cs->slip, 0, sizeof(double) * CONTACT_SLOTS * cs->pairs.count);
+        memset(cs->slip, 0, sizeof(double) * (size_t)cs->slots * cs->pairs.count);
         memset(cs->sprung, 0, cs->pairs.count);
     }
     size_t n = cs->record_count;
@@ -117,7 +118,7 @@ int contact_history_take_back(contact_state *cs)
         for (; table[i] >= 0; i = (i + 1) & (size - 1)) {
             const contact_record *r = &cs->records[table[i]];
             if (r->lo != lo || r->hi != hi) continue;
-            pair_slots_oriented(r->slip, a, b, cs->slip + CONTACT_SLOTS * k);
+            pair_slots_oriented(r->slip, a, b, cs->slots, cs->slip + (size_t)cs->slots * k);
             cs->sprung[k] = 1;
             break;
         }
@@ -127,27 +128,35 @@ int contact_history_take_back(contact_state *cs)
     return 0;
 }
 
+/* In a checkpoint a record is lo, hi and the slots in use: 56 bytes in 2D,
+ * as sizeof(contact_record) was before 3D, so 2D checkpoints read as they
+ * were written. */
+size_t contact_record_bytes(const contact_state *cs)
+{
+    return 2 * sizeof(int32_t) + sizeof(double) * (size_t)cs->slots;
+}
+
 size_t contact_history_checkpoint_size(const contact_state *cs)
 {
     size_t n = 0;
     for (size_t k = 0; k < cs->pairs.count; k++)
         n += cs->sprung[k];
-    return n * sizeof(contact_record);
+    return n * contact_record_bytes(cs);
 }
 
 void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p)
 {
+    size_t springs = sizeof(double) * (size_t)cs->slots;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         if (!cs->sprung[k]) continue;
-        const double *slip = cs->slip + CONTACT_SLOTS * k;
+        const double *slip = cs->slip + (size_t)cs->slots * k;
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
-        contact_record r;
-        memset(&r, 0, sizeof r);
-        r.lo = a < b ? a : b;
-        r.hi = a < b ? b : a;
-        pair_slots_oriented(slip, a, b, r.slip);
-        memcpy(p, &r, sizeof r);
-        p += sizeof r;
+        int32_t key[2] = {a < b ? a : b, a < b ? b : a};
+        double oriented[CONTACT_SLOTS_MAX];
+        pair_slots_oriented(slip, a, b, cs->slots, oriented);
+        memcpy(p, key, sizeof key);
+        memcpy(p + sizeof key, oriented, springs);
+        p += sizeof key + springs;
     }
 }
 
@@ -155,9 +164,13 @@ int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, s
                                     int elements)
 {
     if (records_reserve(cs, count)) return -1;
+    size_t bytes = contact_record_bytes(cs);
     for (size_t k = 0; k < count; k++) {
         contact_record *r = &cs->records[k];
-        memcpy(r, p + k * sizeof *r, sizeof *r);
+        memset(r, 0, sizeof *r);
+        memcpy(&r->lo, p + k * bytes, sizeof r->lo);
+        memcpy(&r->hi, p + k * bytes + sizeof r->lo, sizeof r->hi);
+        memcpy(r->slip, p + k * bytes + 2 * sizeof(int32_t), bytes - 2 * sizeof(int32_t));
         if (r->lo < 0 || r->hi <= r->lo || r->hi >= elements) return -1;
     }
     cs->record_count = count;

@@ -17,9 +17,11 @@
  *    point. Then the roles swap. Linear and angular momentum are conserved
  *    to round-off by construction.
  *  - The contactor face normal (not the target sub-tetrahedron's base face)
- *    carries the force, exactly as the triangle contact (contact.c) uses the
+ *    carries the force, exactly as the triangle contact (contact_tri.c) uses the
  *    contactor edge normal: the two dimensions are the same method.
- *  - Friction is not here.
+ *  - tet_contact_one_way / tet_contact_pair give the normal force alone;
+ *    the contact stage's kernel, tet_contact_pair_force (contact_pair.h),
+ *    adds Coulomb friction with elastic stick.
  */
 #ifndef FDEM_CONTACT_TET_H
 #define FDEM_CONTACT_TET_H

@@ -15,6 +15,7 @@
  * sum of the other three.
  */
 #include "element_tet.h"
+#include "stable_step.h"
 #include "vec3.h"
 
 #include <math.h>
@@ -267,5 +268,5 @@ double tet_stable_dt_eigen(const double *pos0, const int32_t node[4], double lam
         for (int i = 0; i < 6; i++) viscous_root[i][i] = i < 3 ? sqrt(2.0) : 1.0;
         rate = 4 / density * eta * rooted_largest_eigenvalue(viscous_root, G);
     }
-    return 2 / (sqrt(omega2 + 0.25 * rate * rate) + 0.5 * rate);
+    return damped_mode_stable_dt(omega2, rate);
 }

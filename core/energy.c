@@ -17,9 +17,11 @@
  *    (damping is booked that way in element.c, element by element);
  *  - gravity's work is exact: M g . (centre of mass at x_n - at x_0).
  * Friction and fracture are booked where they dissipate (contact.c,
- * joint.c), exactly and never negative. What remains in `residual` is the
- * time discretisation of the non-linear forces: finite strain, the contact
- * potential's changing overlap, joint softening, and the stick springs.
+ * joint.c). The friction of contacts is part of their work, so `contact`
+ * leaves it out; the friction of intact joints (joint_friction_energy) is
+ * not. What remains in `residual` is the time discretisation of the
+ * non-linear forces: finite strain, the contact potential's changing
+ * overlap, joint softening and sliding, and the stick springs.
  */
 #include <math.h>
 #include <string.h>
@@ -91,7 +93,7 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     }
     en.elastic = m->elastic_energy;
     en.joint = m->joint_energy;
-    en.friction = m->friction_energy;
+    en.friction = m->friction_energy + m->joint_friction_energy;
     en.fracture = m->fracture_energy;
     en.contact = -(m->contact_work - 0.5 * havg * contact_power) - m->friction_energy;
     en.damping = m->damping_work;

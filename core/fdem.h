@@ -217,7 +217,8 @@ typedef struct fdem_energy {
     double contact;       /* minus the work of the contact forces, less what friction
                              dissipated: what the penalty (normal and stick) springs hold;
                              negative means the contact discretisation gave energy */
-    double friction;      /* dissipated by Coulomb sliding (>= 0) */
+    double friction;      /* dissipated by Coulomb sliding of contacts and by the sigma_c tan(phi)
+                             part of intact joints' shear strength (>= 0) */
     double fracture;      /* dissipated by joint softening and breaking (>= 0, never decreases) */
     double damping;       /* dissipated by viscous damping (>= 0) */
     double gravity_work;  /* work done by gravity */

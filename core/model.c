@@ -603,9 +603,10 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
-    if (m->contact.enabled)
-        b += (size_t)m->elem_count * (7 * sizeof(double) + 2 * sizeof(int32_t) + 1) +
-             nbs_memory_bytes(&m->contact.grid, &m->contact.pairs);
+    if (m->contact.enabled) /* spheres (centre, radius), boxes (2 dim), body, piece */
+        b += (size_t)m->elem_count * ((3 * D + 1) * sizeof(double) + 2 * sizeof(int32_t) + 1) +
+             (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
+                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     b += (size_t)m->joint_count * (6 * sizeof(int32_t) + 2 * sizeof(double));
     if (m->joint_count) b += (size_t)m->elem_count * 3 * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);

@@ -14,6 +14,7 @@
 
 #include <stdint.h>
 
+#include "contact_pair.h"
 #include "fdem.h"
 #include "nbs.h"
 
@@ -59,8 +60,8 @@ typedef struct constraint {
 } constraint;
 
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
-#define SCATTER_SUMS 5
-#define SCATTER_MAX 4
+#define SCATTER_SUMS 6
+#define SCATTER_MAX 5
 
 /* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
  * blocks of one colour share no node, so threads may run them side by side
@@ -74,41 +75,47 @@ typedef struct scatter_plan {
 } scatter_plan;
 
 /* Stick-spring history of one pair of elements lo < hi (contact_history.c):
- * the tangential force on each edge of lo against hi, then of hi against lo. */
-#define CONTACT_SLOTS 6
+ * the tangential springs of lo's contactor boundaries against hi, then of
+ * hi's against lo, slots of them (contact_pair.h: 6 for triangles, 24 for
+ * tetrahedra). A checkpoint stores lo, hi and the slots used, so a 2D record
+ * there is 56 bytes as before 3D (contact_record_bytes). */
 typedef struct contact_record {
     int32_t lo, hi;
-    double slip[CONTACT_SLOTS];
+    double slip[CONTACT_SLOTS_MAX];
 } contact_record;
 
 typedef struct contact_state {
     int enabled;             /* some pair of elements can ever touch */
+    const struct contact_kernel *kernel; /* the dimension's pair kernel (contact.c) */
+    int slots;               /* stick springs per pair */
+    int pair_out;            /* numbers a pair evaluation hands back */
     double buffer;           /* added to circle diameters; re-detect after buffer/2 */
     double max_disp2;        /* largest squared node displacement since detection */
     int need_detect;
     long detections;
     int touching;            /* pairs with non-zero force in the last step */
-    double *cx, *cy, *r;     /* bounding circles, one per element */
+    double *cx, *cy, *cz, *r; /* bounding circles (cz NULL) or spheres, one per element */
     double *pos_detect;      /* node positions at the last detection */
     double *force;           /* contact force per node (kept apart for its work) */
     int force_is_zero;       /* force holds only zeros: no pair was evaluated */
     int32_t *body;           /* body id per element: pairs of one body never touch */
     int32_t *piece;          /* scratch: piece label per element (fracturing models) */
-    double *box;             /* 4 per element: xmin, xmax, ymin, ymax, each step, of the
+    double *box;             /* 2 dim per element: lo, hi of each axis, each step, of the
                                 elements in some candidate pair */
     int32_t *active;         /* the elements in some candidate pair, once each */
     int active_count;
     uint8_t *in_pair;        /* scratch per element for building active */
-    double *slip;            /* CONTACT_SLOTS per candidate pair: the stick springs' force */
+    double *slip;            /* slots per candidate pair: the stick springs' force */
     uint8_t *sprung;         /* per candidate pair: some spring is non-zero (so a pair out
                                 of reach, a detection or a checkpoint reads one byte, not
-                                six springs) */
+                                all its springs) */
     size_t slip_capacity;
     contact_record *records; /* history set aside across a detection or a restore */
     size_t record_count, record_capacity;
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
-    nbs_grid grid;
+    nbs_grid grid;           /* 2D detection */
+    nbs_grid_3d grid3;       /* 3D detection */
     nbs_pairs pairs;
 } contact_state;
 
@@ -176,7 +183,9 @@ struct fdem_model {
     double elastic_energy;   /* of the last force evaluation */
     double joint_energy;     /* stored in intact joints, last force evaluation */
     double contact_work;     /* work of all contact forces (normal and friction) */
-    double friction_energy;  /* dissipated by Coulomb sliding (>= 0) */
+    double friction_energy;  /* dissipated by Coulomb sliding of contacts (>= 0) */
+    double joint_friction_energy; /* by the sigma_c tan(phi) part of intact joints' shear
+                                     strength as they slide (joint.c) */
     double fracture_energy;  /* dissipated by joint softening and breaking (>= 0) */
     double damping_work;     /* energy dissipated by viscous damping */
     double external_work;
@@ -227,7 +236,8 @@ double tet_element_stable_dt(const fdem_model *m, int e);
 void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 void tet_element_stress(const fdem_model *m, int e, double out[6]);
 
-/* contact.c */
+/* contact.c: the contact stage of both dimensions over the pair kernels of
+ * contact_tri.c and contact_tet.c (contact_pair.h) */
 int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
@@ -243,6 +253,7 @@ size_t contact_history_checkpoint_size(const contact_state *cs);
 void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p);
 int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, size_t count,
                                     int elements);
+size_t contact_record_bytes(const contact_state *cs); /* one record in a checkpoint */
 
 /* constraint.c */
 int constraint_select(fdem_model *m, fdem_error *err);

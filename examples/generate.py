@@ -4,8 +4,8 @@
     /usr/bin/python3 examples/generate.py
 
 The JSON files are committed, so this is only needed to change them: it keeps
-the layouts that are tedious by hand (the 30 discs of disc-pile.json) and the
-gmsh mesh of gmsh-plate.json (made from gmsh-plate.geo with the installed
+the layouts that are tedious by hand (the 30 discs of disc-pile.json, the
+tetrahedral box of sphere-pile.json) and the gmsh mesh of gmsh-plate.json (made from gmsh-plate.geo with the installed
 `gmsh -2 -format msh22`) reproducible. Numbers are written the way a person
 would type them (3e10, not 30000000000.0).
 """
@@ -158,3 +158,82 @@ dump("gmsh-plate", {
                     {"box": [0.199999, -1e-6, 0.200001, 0.100001], "velocity": [0.01, None]}],
     "time": {"end": 0.003, "dt": "auto", "safety": 0.5},
     "output": {"interval": 5e-5, "fields": ["position", "velocity", "stress"]}})
+# ------------------------------------------------------------------- 3D
+# Contract 5.2: "dimension": 3, every vector with three components, z up.
+dump("freefall-3d", {
+    "name": "freefall-3d",
+    "dimension": 3,
+    "materials": {"rock": dict(soft)},
+    "parts": [{"name": "block", "material": "rock",
+               "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [4, 4, 4]}}],
+    "gravity": [0, 0, -9.81],
+    "time": {"end": 0.5, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
+dump("collision-3d", {
+    "name": "collision-3d",
+    "dimension": 3,
+    "materials": {"rock": dict(soft, friction=0.0)},
+    "parts": [{"name": "left", "material": "rock",
+               "box": {"origin": [-0.105, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [4, 4, 4]},
+               "velocity": [2.0, 0, 0]},
+              {"name": "right", "material": "rock",
+               "box": {"origin": [0.005, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [4, 4, 4]}}],
+    "time": {"end": 0.015, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 2e-4, "fields": ["position", "velocity", "stress"]}})
+
+
+def container_mesh(cells, cell, origin):
+    """An open box of cubic cells as one tetrahedral mesh: the floor layer
+    and the four side walls of a cells[0] x cells[1] x cells[2] block, each
+    cell split into the six Kuhn tetrahedra of its 000-111 diagonal (the
+    same split in every cell, so neighbours share their face diagonals)."""
+    nx, ny, nz = cells
+    kept = [(i, j, k) for i in range(nx) for j in range(ny) for k in range(nz)
+            if k == 0 or i in (0, nx - 1) or j in (0, ny - 1)]
+    index, nodes, tets = {}, [], []
+
+    def node(ijk):
+        if ijk not in index:
+            index[ijk] = len(nodes)
+            nodes.append([round(o + cell * n, 6) for o, n in zip(origin, ijk)])
+        return index[ijk]
+
+    for i, j, k in kept:
+        for order in ((0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)):
+            corner = [i, j, k]
+            path = [node(tuple(corner))]
+            for axis in order:
+                corner[axis] += 1
+                path.append(node(tuple(corner)))
+            tets.append(path)
+    return nodes, tets
+
+
+# A 0.2 x 0.2 m floor at z = 0 walled in 0.2 m high: one fixed part made of
+# the floor slab and four wall slabs (one body, so the slabs do not contact
+# each other), and 2 x 2 x 2 spheres dropped into it, the upper layer a few
+# mm off the columns of the lower so it topples into the pockets. Every
+# element is about as large as a sphere's (0.05 m cells, spheres of 8 edges
+# around), since NBS sizes its cells by the largest element; grains are
+# soft (1 MPa, the penalty equal to it) so the contact step is 68 us (1 us
+# at the default penalty of a 50 MPa grain), which keeps the run near 15 s.
+nodes, tets = container_mesh((6, 6, 5), 0.05, (-0.15, -0.15, -0.05))
+parts = [{"name": "box", "material": "wall", "mesh": {"nodes": nodes, "tetrahedra": tets}}]
+centres = [(-0.05 + 0.1 * i, -0.05 + 0.1 * j, 0.045) for i in range(2) for j in range(2)]
+centres += [(x + 0.004, y - 0.003, z + 0.09) for x, y, z in centres]
+for k, (x, y, z) in enumerate(centres):
+    parts.append({"name": "sphere-%d" % k, "material": "grain",
+                  "sphere": {"center": [round(x, 4), round(y, 4), z], "radius": 0.04,
+                             "divisions": 8}})
+dump("sphere-pile", {
+    "name": "sphere-pile",
+    "dimension": 3,
+    "materials": {"grain": {"density": 2000, "young": 1e6, "poisson": 0.25, "damping": 0.3,
+                            "penalty": 1e6, "friction": 0.4},
+                  "wall": {"density": 2000, "young": 1e6, "poisson": 0.25, "penalty": 1e6,
+                           "friction": 0.4}},
+    "parts": parts,
+    "constraints": [{"part": "box", "fix": ["x", "y", "z"]}],
+    "gravity": [0, 0, -9.81],
+    "time": {"end": 0.7, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity"]}})

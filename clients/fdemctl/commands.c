@@ -274,10 +274,21 @@ static const char USAGE_STATUS[] =
     "  Shows the progress and figures of one case.\n"
     "  --json    print the server's status object exactly as it was sent\n";
 
-static void status_print_energy(json_t *energy)
+/* 2D energies are per metre of thickness, 3D ones plain joules (contract
+ * 5.2); a status that does not say its dimension gets both units named. */
+static const char *energy_label(json_t *status)
 {
+    json_t *dimension = json_object_get(status, "dimension");
+    if (!json_is_integer(dimension)) return "energy [J/m; J in 3D]";
+    return json_integer_value(dimension) == 3 ? "energy [J]" : "energy [J/m]";
+}
+
+static void status_print_energy(json_t *status)
+{
+    json_t *energy = json_object_get(status, "energy");
     if (!json_is_object(energy)) return;
-    printf("%-14s", "energy [J/m]");
+    const char *label = energy_label(status);
+    printf("%-14s%s", label, strlen(label) < 14 ? "" : " ");
     const char *key;
     json_t *value;
     int first = 1;
@@ -325,7 +336,7 @@ static void status_print_table(json_t *s)
            json_integer_value(json_object_get(s, "broken_joints")));
     printf("%-14s%lld\n", "contacts", json_integer_value(json_object_get(s, "contacts")));
     printf("%-14s%lld\n", "snapshots", json_integer_value(json_object_get(s, "snapshots")));
-    status_print_energy(json_object_get(s, "energy"));
+    status_print_energy(s);
     printf("%-14s%.4g steps/s\n", "speed", status_number(s, "steps_per_second"));
     status_print_others(s);
     const char *error = status_text(s, "error", NULL);
@@ -422,9 +433,10 @@ int cmd_case(const ctl_options *o, int argc, char **argv)
 static const char USAGE_STATE[] =
     "usage: fdemctl state ID [--fields position,velocity,stress,damage,strain,principal_stress]\n"
     "  Prints the current state (taken at one step boundary) as JSON:\n"
-    "  position/velocity [[x, y], ...] per node, stress and strain\n"
-    "  [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz, xz, xy),\n"
-    "  principal_stress [[s1, s2], ...] (3D: three) descending, damage per joint.\n";
+    "  position/velocity [[x, y], ...] per node ([[x, y, z], ...] in 3D),\n"
+    "  stress and strain [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz,\n"
+    "  xz, xy), principal_stress [[s1, s2], ...] (3D: three) descending,\n"
+    "  damage per joint.\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

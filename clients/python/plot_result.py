@@ -2,10 +2,11 @@
 """plot_result.py - draw one snapshot of an fdemd result.h5 as a PNG.
 
     /usr/bin/python3 clients/python/plot_result.py result.h5 -o out.png \\
-        [--field stress|velocity|damage] [--snapshot -1]
+        [--field stress|velocity|damage] [--snapshot -1] [--component C]
 
 Draws the deformed mesh of the chosen snapshot (positions from
-/snapshots/position, else the initial /mesh/position0) coloured by
+/snapshots/position, else the initial /mesh/position0). A 2D result is drawn
+as its triangles, coloured by
 
   stress    von Mises stress per element, from the Cauchy stress
             (sxx, syy, sxy) of /snapshots/stress. Plane strain: the
@@ -18,6 +19,17 @@ Draws the deformed mesh of the chosen snapshot (positions from
   velocity  speed |v| per node from /snapshots/velocity.
   damage    every joint of /mesh/joints as a segment coloured by its damage
             (0 intact ... 1 broken) over the mesh in grey.
+
+A 3D result (root attribute dimension = 3, /mesh/tetrahedra) is drawn as
+the boundary faces of its tetrahedral mesh (faces of exactly one
+tetrahedron) in an equal-aspect perspective view (--view ELEV,AZIM), each
+face coloured by its tetrahedron's von Mises stress, exact from the six
+components (xx, yy, zz, yz, xz, xy) of /snapshots/stress, or by the mean
+speed of its three nodes for --field velocity. Only the surface is drawn:
+stress inside a body does not show.
+
+--component xx|yy|xy (3D also zz|yz|xz) colours by that Cauchy stress
+component instead of von Mises, on a diverging scale centred on zero.
 
 The default field is stress when the file has it, else velocity.
 The file may still be written by a running case: it is opened plainly first,
@@ -36,6 +48,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+# Stress components as stored: 2D (sxx, syy, sxy); 3D (contract 5.2)
+# (sxx, syy, szz, syz, sxz, sxy).
+COMPONENTS = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
 
 
 def open_result(path):
@@ -59,6 +76,13 @@ def von_mises_plane_strain(stress, nu):
     sxx, syy, sxy = stress[:, 0], stress[:, 1], stress[:, 2]
     szz = nu * (sxx + syy)
     return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2) + 3.0 * sxy ** 2)
+
+
+def von_mises_3d(stress):
+    """von Mises stress of (E, 6) [sxx, syy, szz, syz, sxz, sxy]."""
+    sxx, syy, szz, syz, sxz, sxy = (stress[:, k] for k in range(6))
+    return np.sqrt(0.5 * ((sxx - syy) ** 2 + (syy - szz) ** 2 + (szz - sxx) ** 2)
+                   + 3.0 * (syz ** 2 + sxz ** 2 + sxy ** 2))
 
 
 def element_poisson(f, case_path, default_nu):
@@ -97,7 +121,29 @@ def scaled_unit(values, unit):
     return values, unit
 
 
+def stress_component(f, s, dimension, component):
+    """One Cauchy stress component per element, and its colourbar label."""
+    names = COMPONENTS[dimension]
+    if component not in names:
+        sys.exit("plot_result: --component %s does not exist in %dD (use %s)"
+                 % (component, dimension, ", ".join(names)))
+    stress = require(f, "/snapshots/stress", 'add "stress" to output.fields')[s]
+    values, unit = scaled_unit(stress[:, names.index(component)], "Pa")
+    return values, "stress s%s [%s]" % (component, unit)
+
+
+def symmetric_limits(values):
+    """Colour limits centred on zero, so tension and compression read apart."""
+    peak = float(np.nanmax(np.abs(values))) if values.size else 0.0
+    return (-peak, peak) if peak > 0 else (-1.0, 1.0)
+
+
 def draw_stress(ax, f, tri, s, args):
+    if args.component:
+        values, label = stress_component(f, s, 2, args.component)
+        art = ax.tripcolor(tri, facecolors=values, cmap="coolwarm")
+        art.set_clim(*symmetric_limits(values))
+        return art, label
     stress = require(f, "/snapshots/stress", 'add "stress" to output.fields')[s]
     vm = von_mises_plane_strain(stress, element_poisson(f, args.case, args.poisson))
     values, unit = scaled_unit(vm, "Pa")
@@ -127,33 +173,142 @@ def draw_damage(ax, f, tri, s, args):
 DRAW = {"stress": draw_stress, "velocity": draw_velocity, "damage": draw_damage}
 
 
+def snapshot_positions(f, s):
+    """Node positions of snapshot s, and which positions they are."""
+    if "/snapshots/position" in f:
+        return f["/snapshots/position"][s], "deformed"
+    return f["/mesh/position0"][:], "initial positions"
+
+
+def title(f, args, s, count, where):
+    name = attr_text(f, "name", args.result)
+    t = float(f["/snapshots/time"][s])
+    return "%s   t = %.4g s   (snapshot %d of %d, %s)" % (name, t, s + 1, count, where)
+
+
+def plot_2d(f, args, field):
+    s, count = snapshot_index(f, args.snapshot)
+    triangles = f["/mesh/triangles"][:]
+    xy, where = snapshot_positions(f, s)
+    tri = Triangulation(xy[:, 0], xy[:, 1], triangles)
+
+    width = np.ptp(xy[:, 0]) or 1.0
+    height = np.ptp(xy[:, 1]) or 1.0
+    wide = width > 2.0 * height    # e.g. a bar: colourbar below, not beside
+    fig, ax = plt.subplots(figsize=(10, 5) if wide else (8, 6.5), dpi=args.dpi)
+    art, label = DRAW[field](ax, f, tri, s, args)
+    if field != "damage" and triangles.shape[0] <= 20000:
+        ax.triplot(tri, color="k", linewidth=0.1, alpha=0.4)
+    fig.colorbar(art, ax=ax, label=label, fraction=0.046, pad=0.18 if wide else 0.04,
+                 orientation="horizontal" if wide else "vertical")
+    ax.set_title(title(f, args, s, count, where))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.autoscale_view()
+    return fig
+
+
+# ------------------------------------------------------------------ 3D
+
+# The faces of a positive-volume tetrahedron (a, b, c, d), each listed so its
+# normal by the right-hand rule points out of the element: a face that ends
+# up on the boundary then faces the viewer the right way for shading.
+TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
+
+
+def boundary_faces(tetrahedra):
+    """The faces used by exactly one tetrahedron.
+
+    Returns (faces (F, 3) node indices, outward, and element (F,) the
+    tetrahedron each belongs to). A face shared by two tetrahedra is inside
+    the body; one of a single tetrahedron is on its surface (or on a crack
+    or contact surface between parts, which have their own nodes).
+    """
+    tetrahedra = np.asarray(tetrahedra, dtype=np.int64)
+    faces = tetrahedra[:, TET_FACES].reshape(-1, 3)
+    element = np.repeat(np.arange(tetrahedra.shape[0]), 4)
+    _, first, uses = np.unique(np.sort(faces, axis=1), axis=0,
+                               return_index=True, return_counts=True)
+    once = np.sort(first[uses == 1])
+    return faces[once], element[once]
+
+
+def face_stress(f, s, element, args):
+    """Per boundary face: its tetrahedron's stress value, label, colour map."""
+    if args.component:
+        values, label = stress_component(f, s, 3, args.component)
+        return values[element], label, "coolwarm"
+    stress = require(f, "/snapshots/stress", 'add "stress" to output.fields')[s]
+    values, unit = scaled_unit(von_mises_3d(stress), "Pa")
+    return values[element], "von Mises stress [%s]" % unit, "viridis"
+
+
+def face_speed(f, s, faces):
+    """Per boundary face: the mean speed of its three nodes."""
+    v = require(f, "/snapshots/velocity", 'add "velocity" to output.fields')[s]
+    speed = np.linalg.norm(v, axis=1)
+    return speed[faces].mean(axis=1), "speed |v| [m/s] (face mean of its nodes)", "plasma"
+
+
+def equal_aspect_3d(ax, xyz):
+    """One metre is as long along x, y and z: a cube around the points."""
+    low, high = xyz.min(axis=0), xyz.max(axis=0)
+    centre, half = (low + high) / 2.0, max(float(np.max(high - low)) / 2.0, 1e-12)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+
+
+def view_angles(text):
+    try:
+        elevation, azimuth = (float(x) for x in text.split(","))
+    except ValueError:
+        sys.exit("plot_result: --view takes ELEVATION,AZIMUTH in degrees, not %r" % text)
+    return elevation, azimuth
+
+
+def plot_3d(f, args, field):
+    if field == "damage":
+        sys.exit("plot_result: --field damage is drawn for 2D results only")
+    s, count = snapshot_index(f, args.snapshot)
+    xyz, where = snapshot_positions(f, s)
+    faces, element = boundary_faces(f["/mesh/tetrahedra"][:])
+    if field == "stress":
+        values, label, cmap = face_stress(f, s, element, args)
+    else:
+        values, label, cmap = face_speed(f, s, faces)
+
+    fig = plt.figure(figsize=(8, 7), dpi=args.dpi)
+    ax = fig.add_subplot(projection="3d")
+    surface = Poly3DCollection(xyz[faces], cmap=cmap,
+                               edgecolors=(0, 0, 0, 0.25) if faces.shape[0] <= 20000 else "none",
+                               linewidths=0.2)
+    surface.set_array(np.asarray(values, dtype=float))
+    if args.component:
+        surface.set_clim(*symmetric_limits(values))
+    ax.add_collection3d(surface)
+    equal_aspect_3d(ax, xyz)
+    ax.view_init(*view_angles(args.view))
+    fig.colorbar(surface, ax=ax, label=label, shrink=0.7, pad=0.1)
+    ax.set_title(title(f, args, s, count, where), fontsize=10)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    return fig
+
+
+def result_dimension(f):
+    """3 for a tetrahedral result (contract 5.2), else 2."""
+    return int(f.attrs.get("dimension", 3 if "/mesh/tetrahedra" in f else 2))
+
+
 def plot(args):
     with open_result(args.result) as f:
-        s, count = snapshot_index(f, args.snapshot)
-        triangles = f["/mesh/triangles"][:]
-        if "/snapshots/position" in f:
-            xy, where = f["/snapshots/position"][s], "deformed"
-        else:
-            xy, where = f["/mesh/position0"][:], "initial positions"
-        tri = Triangulation(xy[:, 0], xy[:, 1], triangles)
         field = args.field or ("stress" if "/snapshots/stress" in f else "velocity")
-
-        width = np.ptp(xy[:, 0]) or 1.0
-        height = np.ptp(xy[:, 1]) or 1.0
-        wide = width > 2.0 * height    # e.g. a bar: colourbar below, not beside
-        fig, ax = plt.subplots(figsize=(10, 5) if wide else (8, 6.5), dpi=args.dpi)
-        art, label = DRAW[field](ax, f, tri, s, args)
-        if field != "damage" and triangles.shape[0] <= 20000:
-            ax.triplot(tri, color="k", linewidth=0.1, alpha=0.4)
-        fig.colorbar(art, ax=ax, label=label, fraction=0.046, pad=0.18 if wide else 0.04,
-                     orientation="horizontal" if wide else "vertical")
-        name = attr_text(f, "name", args.result)
-        t = float(f["/snapshots/time"][s])
-        ax.set_title("%s   t = %.4g s   (snapshot %d of %d, %s)" % (name, t, s + 1, count, where))
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.autoscale_view()
+        draw = plot_3d if result_dimension(f) == 3 else plot_2d
+        fig = draw(f, args, field)
         fig.tight_layout()
         fig.savefig(args.output)
         plt.close(fig)
@@ -168,6 +323,11 @@ def main(argv=None):
     p.add_argument("--poisson", type=float, default=0.25,
                    help="Poisson's ratio for the plane-strain szz (default 0.25)")
     p.add_argument("--case", help="case JSON: take each part's Poisson's ratio from it")
+    p.add_argument("--component", choices=COMPONENTS[3],
+                   help="colour by this stress component instead of von Mises "
+                        "(2D: xx, yy, xy)")
+    p.add_argument("--view", default="25,-60",
+                   help="3D only: ELEVATION,AZIMUTH of the view in degrees (25,-60)")
     p.add_argument("--dpi", type=int, default=120)
     args = p.parse_args(argv)
     try:

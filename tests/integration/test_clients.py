@@ -22,6 +22,7 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
 import h5py  # noqa: E402
+import numpy as np  # noqa: E402
 from fdemd_client import Client, FdemdConnectionError, FdemdError  # noqa: E402
 
 import fdemd_harness  # noqa: E402  (starts bin/fdemd on port 0, temp data dir)
@@ -413,6 +414,9 @@ class PlotTests(ClientTestCase):
     def test_velocity_plot_of_the_first_snapshot(self):
         self.assert_png(*self.plot("--field", "velocity", "--snapshot", "0"))
 
+    def test_stress_component_plot(self):
+        self.assert_png(*self.plot("--component", "xy"))
+
     def test_plot_reads_a_file_the_daemon_is_still_writing(self):
         doc = long_case("live")
         doc["output"]["interval"] = 0.005
@@ -456,17 +460,118 @@ class ExampleTests(ClientTestCase):
                 self.assertGreater(s["elements"], 0)
                 self.client.delete(case_id)
 
-    def test_freefall_drops_half_g_t_squared(self):
-        case_id = self.client.submit(os.path.join(self.EXAMPLES, "freefall.json"), start=True)
+    def assert_example_drops_half_g_t_squared(self, name, vertical):
+        case_id = self.client.submit(os.path.join(self.EXAMPLES, name + ".json"), start=True)
         final = self.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
         self.assertEqual(final["state"], "finished")
-        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "freefall.h5"))
+        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, name + ".h5"))
         with h5py.File(h5, "r") as f:
             t = f["/snapshots/time"][-1]
-            drop = f["/mesh/position0"][:, 1] - f["/snapshots/position"][-1][:, 1]
+            drop = (f["/mesh/position0"][:, vertical]
+                    - f["/snapshots/position"][-1][:, vertical])
+        self.assertEqual(t, 0.5)
         # Central difference integrates constant acceleration exactly.
         for d in drop:
             self.assertAlmostEqual(d, 0.5 * 9.81 * t * t, delta=1e-9)
+
+    def test_freefall_drops_half_g_t_squared(self):
+        self.assert_example_drops_half_g_t_squared("freefall", vertical=1)
+
+    def test_freefall_3d_drops_half_g_t_squared_along_z(self):
+        self.assert_example_drops_half_g_t_squared("freefall-3d", vertical=2)
+
+    def test_collision_3d_keeps_momentum(self):
+        case_id = self.client.submit(os.path.join(self.EXAMPLES, "collision-3d.json"), start=True)
+        final = self.client.wait(case_id, interval=0.05, timeout=120 * SLOW)
+        self.assertEqual(final["state"], "finished")
+        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "collision-3d.h5"))
+        with h5py.File(h5, "r") as f:
+            mass = f["/mesh/node_mass"][:]
+            part = f["/mesh/node_part"][:]
+            v = f["/snapshots/velocity"][:]
+        momentum = np.einsum("n,snk->sk", mass, v)
+        # 2 kg at 2 m/s along x; contact forces are equal and opposite.
+        self.assertTrue(np.allclose(momentum, [4.0, 0, 0], rtol=0, atol=1e-12), momentum)
+        left = (mass[part == 0] * v[-1, part == 0, 0]).sum() / mass[part == 0].sum()
+        right = (mass[part == 1] * v[-1, part == 1, 0]).sum() / mass[part == 1].sum()
+        # The cubes did meet: most of the momentum changed hands.
+        self.assertLess(left, 0.5)
+        self.assertGreater(right, 1.5)
+
+
+def box_case_3d(name, divisions=(2, 2, 2), end=0.01):
+    """A 3D box (contract 5.2) falling under gravity along -z."""
+    return {
+        "name": name,
+        "dimension": 3,
+        "materials": {"rock": dict(MATERIAL)},
+        "parts": [{"name": "block", "material": "rock",
+                   "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1],
+                           "divisions": list(divisions)}}],
+        "gravity": [0, 0, -9.81],
+        "time": {"end": end},
+        "output": {"interval": end / 10, "fields": ["position", "velocity", "stress"]},
+    }
+
+
+class Clients3DTests(ClientTestCase):
+    """The clients are used the same way on a 3D case: nothing in them may
+    assume two components per node or three stresses per element."""
+
+    NODES, ELEMENTS = 27, 48      # a 2 x 2 x 2 box: 3^3 nodes, 6 tetrahedra a cell
+
+    def finished_3d_case(self, name):
+        case_id = self.submit(box_case_3d(name), "--start")
+        r = self.ctl("wait", case_id, "--interval", "0.1")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        return case_id
+
+    def assert_falling_3d_state(self, state):
+        self.assertEqual(len(state["position"]), self.NODES)
+        self.assertEqual({len(p) for p in state["position"]}, {3})
+        self.assertEqual(len(state["stress"]), self.ELEMENTS)
+        self.assertEqual({len(s) for s in state["stress"]}, {6})
+        # Free fall along -z (exact for central difference up to half a step).
+        for vx, vy, vz in state["velocity"]:
+            self.assertAlmostEqual(vx, 0.0, places=9)
+            self.assertAlmostEqual(vy, 0.0, places=9)
+            self.assertAlmostEqual(vz, -9.81 * state["time"], delta=9.81 * 1e-3)
+
+    def test_fdemctl_state_of_a_3d_case(self):
+        case_id = self.finished_3d_case("state-3d")
+        r = self.ctl("state", case_id, "--fields", "position,velocity,stress")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assert_falling_3d_state(json.loads(r.stdout))
+
+    def test_python_client_state_of_a_3d_case(self):
+        case_id = self.finished_3d_case("py-state-3d")
+        self.assert_falling_3d_state(
+            self.client.state(case_id, ["position", "velocity", "stress"]))
+
+    def test_fdemctl_status_of_a_3d_case(self):
+        case_id = self.finished_3d_case("status-3d")
+        r = self.ctl("status", case_id)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("%d nodes, %d elements" % (self.NODES, self.ELEMENTS), r.stdout)
+        self.assertNotIn("energy [J/m]", r.stdout)   # 3D energies are not per metre
+
+    def test_fdemctl_and_python_fetch_of_a_3d_case(self):
+        case_id = self.finished_3d_case("fetch-3d")
+        r = self.ctl("fetch", case_id, "-o", "run3d.h5")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        h5 = os.path.join(self.work.name, "run3d.h5")
+        py_h5, py_xdmf = self.client.fetch(case_id, os.path.join(self.work.name, "py3d.h5"))
+        snapshots = self.client.status(case_id)["snapshots"]
+        for path in (h5, py_h5):
+            with h5py.File(path, "r") as f:
+                self.assertEqual(int(f.attrs["dimension"]), 3)
+                self.assertEqual(f["/mesh/tetrahedra"].shape, (self.ELEMENTS, 4))
+                self.assertEqual(f["/snapshots/position"].shape, (snapshots, self.NODES, 3))
+                self.assertEqual(f["/snapshots/stress"].shape, (snapshots, self.ELEMENTS, 6))
+        with open(os.path.join(self.work.name, "run3d.xdmf")) as f:
+            self.assertIn("run3d.h5:/", f.read())
+        with open(py_xdmf) as f:
+            self.assertIn("py3d.h5:/", f.read())
 
 
 class VonMisesTests(unittest.TestCase):

@@ -11,6 +11,7 @@
 #include "element_tet.h"
 #include "fdem.h"
 #include "mesh_3d.h"
+#include "power_iteration.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -82,22 +83,12 @@ static double tet_omega2_by_power_iteration(const double X[12], double lambda, d
         tet_forces(x, NULL, quad, &g, &law, fm, NULL);
         for (int i = 0; i < 12; i++) K[i][j] = -(fp[i] - fm[i]) / (2 * step);
     }
-    double mass = density * g.volume0 / 4, v[12], w[12], omega2 = 0;
-    for (int i = 0; i < 12; i++) v[i] = 1.0 + 0.1 * i * (i % 3 == 1 ? -1 : 1);
-    for (int it = 0; it < 5000; it++) {
-        double norm = 0;
-        for (int i = 0; i < 12; i++) {
-            w[i] = 0;
-            for (int j = 0; j < 12; j++) w[i] += K[i][j] * v[j] / mass;
-            norm += w[i] * w[i];
-        }
-        norm = sqrt(norm);
-        double vnorm = 0;
-        for (int i = 0; i < 12; i++) vnorm += v[i] * v[i];
-        omega2 = norm / sqrt(vnorm);
-        for (int i = 0; i < 12; i++) v[i] = w[i] / norm;
+    double mass[12], start[12];
+    for (int i = 0; i < 12; i++) {
+        mass[i] = density * g.volume0 / 4;
+        start[i] = 1.0 + 0.1 * i * (i % 3 == 1 ? -1 : 1);
     }
-    return omega2;
+    return largest_eigenvalue_over_mass(12, &K[0][0], mass, start, 5000);
 }
 
 /* The model's stable step is 2/omega_max of its one element, to 1e-4, for

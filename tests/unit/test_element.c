@@ -7,6 +7,7 @@
 #include "build_model.h"
 #include "check.h"
 #include "model.h"
+#include "power_iteration.h"
 
 static fdem_model *unit_block(double E, double nu)
 {
@@ -180,6 +181,47 @@ static void element_forces_sum_to_zero_exactly(void)
     fdem_model_destroy(m);
 }
 
+/* One scalene triangle of material (rho 2000, E 1 GPa, nu, damping xi). */
+static fdem_model *scalene_element(double nu, double xi)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 2000, 1e9, nu, xi, 0);
+    fdem_mesh mesh = {3, 1, (double[]){0, 0, 0.1, 0, 0.03, 0.05}, (int32_t[]){0, 1, 2}};
+    fdem_error err;
+    if (fdem_add_part(m, &mesh, mat, 0, &err) < 0) build_die("part", &err);
+    build_finalize(m, 1.0);
+    return m;
+}
+
+/* The element's stiffness (velocity = 0) or viscosity (positions = pos0)
+ * matrix by central differences of element_forces: -d f / d x or -d f / d v. */
+static void element_matrix(fdem_model *m, double *wrt, double K[6][6])
+{
+    double h = 1e-9;
+    memcpy(m->pos, m->pos0, sizeof(double) * 6);
+    memset(m->vel, 0, sizeof(double) * 6);
+    for (int j = 0; j < 6; j++) {
+        double f[2][6], keep = wrt[j];
+        for (int sgn = 0; sgn < 2; sgn++) {
+            wrt[j] = keep + (sgn ? -h : h);
+            memset(m->force, 0, sizeof(double) * 6);
+            element_forces(m);
+            memcpy(f[sgn], m->force, sizeof(double) * 6);
+        }
+        wrt[j] = keep;
+        for (int i = 0; i < 6; i++) K[i][j] = -(f[0][i] - f[1][i]) / (2 * h);
+    }
+}
+
+/* Largest eigenvalue of M^-1 K (lumped M) by power iteration. */
+static double largest_mode(const fdem_model *m, double K[6][6])
+{
+    const double start[6] = {1, -0.3, 0.2, 0.7, -0.5, 0.1};
+    double mass[6];
+    for (int i = 0; i < 6; i++) mass[i] = m->mass[i / 2];
+    return largest_eigenvalue_over_mass(6, &K[0][0], mass, start, 2000);
+}
+
 /* The stable step is 2 / omega_max of the element with its lumped masses:
  * here omega_max comes from the element's own forces (a stiffness matrix by
  * central differences of element_forces at small strain, then power
@@ -188,40 +230,10 @@ static void stable_step_is_that_of_the_fastest_element_mode(void)
 {
     const double nus[3] = {0.0, 0.3, 0.45};
     for (int t = 0; t < 3; t++) {
-        fdem_model *m = fdem_model_create();
-        int mat = build_material(m, 2000, 1e9, nus[t], 0, 0);
-        fdem_mesh mesh = {3, 1, (double[]){0, 0, 0.1, 0, 0.03, 0.05}, (int32_t[]){0, 1, 2}};
-        fdem_error err;
-        if (fdem_add_part(m, &mesh, mat, 0, &err) < 0) build_die("part", &err);
-        build_finalize(m, 1.0);
-        double K[6][6], h = 1e-9;
-        for (int j = 0; j < 6; j++) {
-            double f[2][6];
-            for (int sgn = 0; sgn < 2; sgn++) {
-                memcpy(m->pos, m->pos0, sizeof(double) * 6);
-                m->pos[j] += sgn ? -h : h;
-                memset(m->force, 0, sizeof(double) * 6);
-                element_forces(m);
-                memcpy(f[sgn], m->force, sizeof(double) * 6);
-            }
-            for (int i = 0; i < 6; i++) K[i][j] = -(f[0][i] - f[1][i]) / (2 * h);
-        }
-        double v[6] = {1, -0.3, 0.2, 0.7, -0.5, 0.1}, lambda = 0;
-        for (int it = 0; it < 2000; it++) {
-            double w[6], norm = 0;
-            for (int i = 0; i < 6; i++) {
-                w[i] = 0;
-                for (int j = 0; j < 6; j++) w[i] += K[i][j] * v[j];
-                w[i] /= m->mass[i / 2];
-                norm += w[i] * w[i];
-            }
-            norm = sqrt(norm);
-            double vn = 0;
-            for (int i = 0; i < 6; i++) vn += v[i] * v[i];
-            lambda = norm / sqrt(vn);
-            for (int i = 0; i < 6; i++) v[i] = w[i] / norm;
-        }
-        double want = 2 / sqrt(lambda);
+        fdem_model *m = scalene_element(nus[t], 0);
+        double K[6][6];
+        element_matrix(m, m->pos, K);
+        double want = 2 / sqrt(largest_mode(m, K));
         CHECK_REL(fdem_stable_dt(m), want, 1e-4);
         fprintf(stderr, "  nu %.2f: stable step %.6g s, 2/omega_max %.6g s, h_min/c %.6g s\n",
                 nus[t], fdem_stable_dt(m), want,
@@ -230,7 +242,60 @@ static void stable_step_is_that_of_the_fastest_element_mode(void)
     }
 }
 
-CHECK_MAIN(T(stable_step_is_that_of_the_fastest_element_mode), T(rigid_rotation_gives_zero_stress), T(small_strain_is_linear_plane_strain),
+/* With damping, the limit of the lagged-velocity central difference is
+ * 2 / (sqrt(omega^2 + c^2/4) + c/2) with omega^2 the largest eigenvalue of
+ * M^-1 K and c that of M^-1 C, both by power iteration on the element's own
+ * forces. The material's damping fraction is not the fastest mode's
+ * damping ratio (eta is set from the smallest altitude), so the older
+ * (2/omega)(sqrt(1 + xi^2) - xi) was too large here. */
+static void damped_stable_step_is_that_of_the_fastest_damped_mode(void)
+{
+    const double xis[3] = {0.1, 0.5, 0.9};
+    for (int t = 0; t < 3; t++) {
+        fdem_model *m = scalene_element(0.3, xis[t]);
+        double K[6][6], C[6][6];
+        element_matrix(m, m->pos, K);
+        element_matrix(m, m->vel, C);
+        double omega2 = largest_mode(m, K), rate = largest_mode(m, C);
+        double want = 2 / (sqrt(omega2 + 0.25 * rate * rate) + 0.5 * rate);
+        double by_xi = 2 / sqrt(omega2) * (sqrt(1 + xis[t] * xis[t]) - xis[t]);
+        CHECK_REL(fdem_stable_dt(m), want, 1e-4);
+        fprintf(stderr, "  xi %.1f: stable step %.6g s, power iteration %.6g s, by xi %.6g s "
+                "(fastest mode's damping ratio %.3f)\n",
+                xis[t], fdem_stable_dt(m), want, by_xi, rate / (2 * sqrt(omega2)));
+        fdem_model_destroy(m);
+    }
+}
+
+/* A strongly damped element at safety 1 must not grow: the scheme is run
+ * from a velocity in every mode, and its elastic plus kinetic energy, which
+ * damping can only take away, must stay at or below the start's (plus
+ * round-off) for 2000 steps. At the older step it grows without bound. */
+static void strongly_damped_element_at_safety_one_stays_bounded(void)
+{
+    const double xis[2] = {0.5, 0.9};
+    for (int t = 0; t < 2; t++) {
+        fdem_model *m = scalene_element(0.3, xis[t]);
+        const double v0[6] = {0.01, -0.02, -0.015, 0.005, 0.003, 0.012};
+        memcpy(m->vel, v0, sizeof v0);
+        double start = 0, worst = 0;
+        for (int i = 0; i < 6; i++) start += 0.5 * m->mass[i / 2] * v0[i] * v0[i];
+        fdem_error err;
+        for (int s = 0; s < 2000; s++) {
+            if (fdem_step(m, &err)) break;
+            fdem_energy e = fdem_get_energy(m);
+            double now = e.kinetic + e.elastic;
+            if (!(now <= worst)) worst = isfinite(now) ? now : INFINITY;
+        }
+        CHECK(worst <= start * (1 + 1e-9), "xi %.1f: energy rose to %.6g of %.6g", xis[t],
+              worst, start);
+        fdem_model_destroy(m);
+    }
+}
+
+CHECK_MAIN(T(stable_step_is_that_of_the_fastest_element_mode),
+           T(damped_stable_step_is_that_of_the_fastest_damped_mode),
+           T(strongly_damped_element_at_safety_one_stays_bounded), T(rigid_rotation_gives_zero_stress), T(small_strain_is_linear_plane_strain),
            T(forces_balance_and_energy_matches), T(stretched_block_pulls_nodes_inward),
            T(inverted_element_stays_finite), T(log_series_matches_log),
            T(element_forces_sum_to_zero_exactly))

@@ -1,0 +1,54 @@
+/*
+ * contact_pair.h - what the contact stage (contact.c) hands a dimension's
+ * pair kernel, and what it gets back: the triangle kernel (contact_tri.c)
+ * and the tetrahedron kernel (contact_tet.c) answer the same call.
+ *
+ * Contract:
+ *  - The kernel gets the two elements' node lists (3 or 4 nodes, positive
+ *    area or volume at rest), node positions and velocities (dim numbers a
+ *    node), the pair's penalty and Coulomb coefficient, and h, the last
+ *    step's size, which turns relative velocities into slip.
+ *  - springs are the pair's stick springs, read and updated: first the
+ *    contactor boundaries (edges, faces) of a against b, then those of b
+ *    against a, the same count for each (so swapping the halves turns the
+ *    pair (a, b) into (b, a)). A boundary that does not touch, or a pair
+ *    without friction, leaves its springs at zero.
+ *  - It returns 1 if the pair touched; out then holds the forces on a's
+ *    nodes (dim per node, node by node), then on b's, then the energy
+ *    friction dissipated. It returns 0 if not (out is then undefined). An
+ *    inverted element has no potential: no force, springs let go.
+ *  - Action equals reaction at one point per boundary: linear and angular
+ *    momentum are conserved to round-off. Kernels write nothing else, so
+ *    pairs can be evaluated side by side.
+ */
+#ifndef FDEM_CONTACT_PAIR_H
+#define FDEM_CONTACT_PAIR_H
+
+#include <stdint.h>
+
+typedef struct contact_pair_in {
+    const double *pos, *vel;
+    const int32_t *node_a, *node_b;
+    double penalty, friction, h;
+} contact_pair_in;
+
+/* Triangles: one tangential spring per edge, 3 edges x 2 roles; forces
+ * 2 x 3 nodes x 2 components, then the dissipated energy. */
+#define TRI_CONTACT_SLOTS 6
+#define TRI_PAIR_OUT 13
+/* Tetrahedra: a tangential spring vector per face, 4 faces x 2 roles x 3
+ * components; forces 2 x 4 nodes x 3 components, then the dissipation. */
+#define TET_CONTACT_SLOTS 24
+#define TET_PAIR_OUT 25
+
+#define CONTACT_SLOTS_MAX TET_CONTACT_SLOTS
+#define CONTACT_PAIR_OUT_MAX TET_PAIR_OUT
+
+/* libm's fmin/fmax are calls unless NaN semantics are relaxed; these are not. */
+static inline double min2(double a, double b) { return a < b ? a : b; }
+static inline double max2(double a, double b) { return a > b ? a : b; }
+
+int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
+int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
+
+#endif /* FDEM_CONTACT_PAIR_H */
