@@ -101,18 +101,7 @@ static int write_case_attribute(hid_t file, const char *text, size_t length)
     if (!copy) return -1;
     memcpy(copy, text, length);
     copy[length] = '\0';
-    hid_t type = H5Tcopy(H5T_C_S1);
-    hid_t space = H5Screate(H5S_SCALAR);
-    hid_t attr = H5I_INVALID_HID;
-    int rc = -1;
-    if (type >= 0 && space >= 0 && H5Tset_size(type, H5T_VARIABLE) >= 0 &&
-        H5Tset_cset(type, H5T_CSET_UTF8) >= 0 &&
-        (attr = H5Acreate2(file, "case", type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
-        H5Awrite(attr, type, &copy) >= 0)
-        rc = 0;
-    if (attr >= 0) H5Aclose(attr);
-    if (space >= 0) H5Sclose(space);
-    if (type >= 0) H5Tclose(type);
+    int rc = write_string_attribute(file, "case", copy);
     free(copy);
     return rc;
 }

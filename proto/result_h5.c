@@ -104,7 +104,7 @@ void h5_quiet(void)
 
 /* --------------------------------------------------------------- attributes */
 
-static int write_string_attribute(hid_t obj, const char *name, const char *value)
+int write_string_attribute(hid_t obj, const char *name, const char *value)
 {
     hid_t type = H5Tcopy(H5T_C_S1);
     hid_t space = H5Screate(H5S_SCALAR);

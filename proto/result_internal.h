@@ -58,6 +58,8 @@ void result_fail(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* Keeps HDF5 from printing its error stack (per thread). */
 void h5_quiet(void);
+/* A scalar variable-length UTF-8 string attribute (h5py reads a str). */
+int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
 hid_t series_mem_type(int kind);
