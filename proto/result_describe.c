@@ -23,12 +23,11 @@
 static int write_string_list(hid_t group, const char *name, const char *const *values, size_t count)
 {
     hsize_t dims[1] = {count};
-    hid_t type = H5Tcopy(H5T_C_S1);
+    hid_t type = utf8_string_type();
     hid_t space = H5Screate_simple(1, dims, NULL);
     hid_t ds = H5I_INVALID_HID;
     int rc = -1;
     if (type < 0 || space < 0) goto done;
-    if (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0) goto done;
     ds = H5Dcreate2(group, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (ds < 0) goto done;
     if (count > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0) goto done;

@@ -104,15 +104,24 @@ void h5_quiet(void)
 
 /* --------------------------------------------------------------- attributes */
 
-int write_string_attribute(hid_t obj, const char *name, const char *value)
+/* Variable length so that h5py hands back a str, not bytes. */
+hid_t utf8_string_type(void)
 {
     hid_t type = H5Tcopy(H5T_C_S1);
+    if (type >= 0 && (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0)) {
+        H5Tclose(type);
+        return H5I_INVALID_HID;
+    }
+    return type;
+}
+
+int write_string_attribute(hid_t obj, const char *name, const char *value)
+{
+    hid_t type = utf8_string_type();
     hid_t space = H5Screate(H5S_SCALAR);
     hid_t attr = H5I_INVALID_HID;
     int rc = -1;
     if (type < 0 || space < 0) goto done;
-    /* Variable length so that h5py hands back a str, not bytes. */
-    if (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0) goto done;
     attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
     if (attr < 0) goto done;
     if (H5Awrite(attr, type, &value) < 0) goto done;
@@ -152,11 +161,10 @@ int has_result_format(hid_t file)
     if (H5Aexists(file, "format") <= 0) return 0;
     hid_t attr = H5Aopen(file, "format", H5P_DEFAULT);
     if (attr < 0) return 0;
-    hid_t type = H5Tcopy(H5T_C_S1);
+    hid_t type = utf8_string_type();
     char *value = NULL;
     int ok = 0;
-    if (type >= 0 && H5Tset_size(type, H5T_VARIABLE) >= 0 &&
-        H5Tset_cset(type, H5T_CSET_UTF8) >= 0 && H5Aread(attr, type, &value) >= 0) {
+    if (type >= 0 && H5Aread(attr, type, &value) >= 0) {
         ok = value && strcmp(value, RESULT_FORMAT) == 0;
         H5free_memory(value);
     }

@@ -58,7 +58,9 @@ void result_fail(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* Keeps HDF5 from printing its error stack (per thread). */
 void h5_quiet(void);
-/* A scalar variable-length UTF-8 string attribute (h5py reads a str). */
+/* The variable-length UTF-8 string type (h5py reads a str), and a scalar
+ * attribute of it. */
+hid_t utf8_string_type(void);
 int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
