@@ -9,7 +9,8 @@
  * numbers parts by their place in "parts" (unnamed ones are "part<i>") and
  * materials in the order of the "materials" object, which is the order
  * jansson iterates; reading it the same way gives the same indices. The
- * names are variable-length UTF-8 strings, so h5py hands back str.
+ * name lists are fixed-length strings (see write_string_list); the
+ * `case` attribute is variable length, as the other root attributes.
  * Runs before SWMR writing starts: a SWMR writer cannot add objects.
  */
 #include "result_internal.h"
@@ -19,23 +20,34 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A 1-D dataset of variable-length UTF-8 strings. */
+/* A 1-D dataset of fixed-length strings as wide as the longest name
+ * (NUL-padded; the bytes of a name are its UTF-8). Fixed length and the
+ * default (ASCII) character set because Octave's load('-hdf5') reads only
+ * those (HDF5 converts neither variable-length nor UTF-8 strings to what
+ * it asks for), and one dataset it cannot read drops the whole /mesh group. */
 static int write_string_list(hid_t group, const char *name, const char *const *values, size_t count)
 {
+    size_t width = 1;
+    for (size_t i = 0; i < count; i++)
+        if (strlen(values[i]) > width) width = strlen(values[i]);
+    char *packed = calloc(count ? count : 1, width);
     hsize_t dims[1] = {count};
-    hid_t type = utf8_string_type();
+    hid_t type = H5Tcopy(H5T_C_S1);
     hid_t space = H5Screate_simple(1, dims, NULL);
     hid_t ds = H5I_INVALID_HID;
     int rc = -1;
-    if (type < 0 || space < 0) goto done;
+    if (!packed || type < 0 || space < 0) goto done;
+    for (size_t i = 0; i < count; i++) memcpy(packed + i * width, values[i], strlen(values[i]));
+    if (H5Tset_size(type, width) < 0 || H5Tset_strpad(type, H5T_STR_NULLPAD) < 0) goto done;
     ds = H5Dcreate2(group, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (ds < 0) goto done;
-    if (count > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values) < 0) goto done;
+    if (count > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, packed) < 0) goto done;
     rc = 0;
 done:
     if (ds >= 0) H5Dclose(ds);
     if (space >= 0) H5Sclose(space);
     if (type >= 0) H5Tclose(type);
+    free(packed);
     return rc;
 }
 
