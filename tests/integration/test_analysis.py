@@ -12,6 +12,7 @@ boxes are two fragments of rho V each (skipped with the daemon's reason
 while multi-part 3D cases are refused)."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import unittest
@@ -125,6 +126,9 @@ class FragmentsThroughDaemon(DaemonTestCase):
             parts = [n.decode() if isinstance(n, bytes) else n for n in f["/mesh/part_names"][...]]
             materials = [n.decode() if isinstance(n, bytes) else n
                          for n in f["/mesh/material_names"][...]]
+            # fixed-length: Octave's load('-hdf5') cannot read variable-length ones
+            self.assertEqual(f["/mesh/part_names"].dtype.kind, "S")
+            self.assertEqual(f["/mesh/material_names"].dtype.kind, "S")
         self.assertIsInstance(doc, str)
         self.assertEqual(json.loads(doc), self.case)
         self.assertEqual(parts, ["bar"])
@@ -155,6 +159,20 @@ class FragmentsThroughDaemon(DaemonTestCase):
         self.assertEqual(state["step"], self.fragments["step"])
         np.testing.assert_array_equal(np.array(state["strain"]), strain[-1])
         np.testing.assert_array_equal(np.array(state["principal_stress"]), principal[-1])
+
+    def test_octave_loads_the_file(self):
+        octave = shutil.which("octave-cli")
+        if not octave:
+            self.skipTest("octave-cli is not installed (Debian's octave package)")
+        script = ("r = load('-hdf5', '%s'); printf('%%s|%%s|%%d|%%d\\n', r.mesh.part_names, "
+                  "r.mesh.material_names, size(r.snapshots.fragment, 1), "
+                  "max(r.snapshots.fragment(:, end)) + 1);" % self.h5)
+        r = subprocess.run([octave, "--no-gui", "--eval", script], capture_output=True,
+                           text=True, timeout=120 * SLOW)
+        line = [x for x in r.stdout.splitlines() if "|" in x]
+        self.assertTrue(line, r.stdout + r.stderr)
+        self.assertEqual(line[0].split("|"), ["bar", "rock", str(self.final["elements"]),
+                                              str(len(self.fragments["fragments"]))])
 
     def test_fdemctl_prints_table_and_curve(self):
         env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
