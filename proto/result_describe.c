@@ -52,7 +52,7 @@ done:
 }
 
 /* Part names in "parts" order; an unnamed part is "part<i>" as the builder
- * calls it. `scratch` holds the made-up names (count * 24 bytes). */
+ * calls it. `scratch` holds the made-up names (count * 32 bytes). */
 static const char **part_names(const json_t *parts, size_t count, char *scratch)
 {
     const char **names = calloc(count ? count : 1, sizeof *names);
@@ -62,8 +62,8 @@ static const char **part_names(const json_t *parts, size_t count, char *scratch)
         if (json_is_string(name) && json_string_length(name) > 0) {
             names[i] = json_string_value(name);
         } else {
-            snprintf(scratch + 24 * i, 24, "part%zu", i);
-            names[i] = scratch + 24 * i;
+            snprintf(scratch + 32 * i, 32, "part%zu", i);
+            names[i] = scratch + 32 * i;
         }
     }
     return names;
@@ -85,7 +85,7 @@ static int write_names(hid_t file, const json_t *root, char *err, size_t errlen)
 {
     const json_t *parts = json_object_get(root, "parts");
     size_t part_count = json_is_array(parts) ? json_array_size(parts) : 0, material_count = 0;
-    char *scratch = malloc(24 * (part_count ? part_count : 1));
+    char *scratch = malloc(32 * (part_count ? part_count : 1));
     const char **parts_list = scratch ? part_names(parts, part_count, scratch) : NULL;
     const char **materials_list = material_names(json_object_get(root, "materials"), &material_count);
     hid_t mesh = H5Gopen2(file, "mesh", H5P_DEFAULT);
