@@ -137,9 +137,9 @@ class Solid3DTest(DaemonTestCase):
             self.assertEqual(topo.find("DataItem").text.strip(), "result.h5:/mesh/tetrahedra")
             self.assertEqual(grid.find("Geometry").get("GeometryType"), "XYZ")
             names = sorted(a.get("Name") for a in grid.findall("Attribute"))
-            self.assertEqual(names, ["element_part", "node_part", "stress_xx", "stress_xy",
-                                     "stress_xz", "stress_yy", "stress_yz", "stress_zz",
-                                     "velocity"])
+            self.assertEqual(names, ["element_part", "fragment", "node_part", "stress_xx",
+                                     "stress_xy", "stress_xz", "stress_yy", "stress_yz",
+                                     "stress_zz", "velocity"])
         return root
 
     def check_pvpython(self, xdmf, h5, st):

@@ -97,6 +97,10 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
     if (info->fields & CASE_FIELD_VELOCITY) json_array_append_new(series, json_string("velocity"));
     if (info->fields & CASE_FIELD_STRESS) json_array_append_new(series, json_string("stress"));
     if (c.joints > 0) json_array_append_new(series, json_string("damage"));
+    json_array_append_new(series, json_string("fragment"));
+    if (info->fields & CASE_FIELD_STRAIN) json_array_append_new(series, json_string("strain"));
+    if (info->fields & CASE_FIELD_PRINCIPAL_STRESS)
+        json_array_append_new(series, json_string("principal_stress"));
 
     return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
                      "dimension", dim, "dt", fdem_get_dt(m), "constraints", c.constraints,
@@ -113,6 +117,7 @@ static void expect_snapshot(json_t *doc, const snapshot *s)
     json_object_set_new(j, "constraint_force", doubles_rows(s->constraint_force, s->constraints,
                                                                 s->dimension));
     json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
+    json_object_set_new(j, "fragment", ints_rows(s->fragment, s->elements, 0));
     json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
     json_array_append_new(json_object_get(doc, "snapshots"), j);
 }
