@@ -301,7 +301,7 @@ static void series_chunk(const series *s, hsize_t chunk[3])
     chunk[2] = width;
 }
 
-static int series_create(hid_t group, int kind, series *s)
+int series_create(hid_t group, int kind, series *s)
 {
     if (s->rank == 0) return 0;
     hsize_t dims[3] = {0, s->row[0], s->row[1]};
@@ -312,7 +312,11 @@ static int series_create(hid_t group, int kind, series *s)
     hid_t space = H5Screate_simple(s->rank, dims, maxdims);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     int rc = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, s->rank, chunk) >= 0) {
+    /* fragment ids not recorded (rows of a file written before fragments
+     * existed, see result_reopen.c) read as -1, never as a real id */
+    const int32_t unrecorded = -1;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, s->rank, chunk) >= 0 &&
+        (kind != SERIES_FRAGMENT || H5Pset_fill_value(dcpl, H5T_NATIVE_INT32, &unrecorded) >= 0)) {
         s->id = H5Dcreate2(group, series_names[kind], series_file_type(kind), space,
                            H5P_DEFAULT, dcpl, H5P_DEFAULT);
         rc = s->id >= 0 ? 0 : -1;

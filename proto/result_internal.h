@@ -77,4 +77,7 @@ int result_release(result_file *f);
 int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
 int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
 
+/* Creates /snapshots/<series_names[kind]> empty and extendible (result_h5.c). */
+int series_create(hid_t group, int kind, series *s);
+
 #endif
