@@ -14,6 +14,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "jacobi.h"
 #include "model.h"
 
 /* Tensor slot (i, j) -> Voigt index, in the order of fdem_element_stress. */
@@ -63,35 +64,6 @@ void fdem_element_strain(const fdem_model *m, double *out)
     }
 }
 
-/* Eigenvalues of the symmetric 3x3 matrix a (destroyed) by cyclic Jacobi. */
-static void jacobi_eigenvalues3(double a[3][3], double out[3])
-{
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]);
-        double scale = fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]);
-        if (off == 0 || off <= 1e-300 || off <= 1e-17 * scale) break;
-        for (int p = 0; p < 2; p++)
-            for (int q = p + 1; q < 3; q++) {
-                if (a[p][q] == 0) continue;
-                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = (theta >= 0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 3; k++) { /* A <- A J */
-                    double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 3; k++) { /* A <- J^T A */
-                    double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                a[p][q] = a[q][p] = 0;
-            }
-    }
-    for (int k = 0; k < 3; k++) out[k] = a[k][k];
-}
-
 static void sort_descending(double *v, int n)
 {
     for (int i = 1; i < n; i++)
@@ -108,7 +80,7 @@ void fdem_principal_values(int dim, const double *voigt, double *out)
         double a[3][3];
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++) a[i][j] = voigt[voigt_index(3, i, j)];
-        jacobi_eigenvalues3(a, out);
+        jacobi_eigenvalues(&a[0][0], 3, out);
     } else {
         double centre = 0.5 * (voigt[0] + voigt[1]);
         double radius = hypot(0.5 * (voigt[0] - voigt[1]), voigt[2]);
