@@ -16,6 +16,7 @@
  * sum of the other three.
  */
 #include "element_tet.h"
+#include "jacobi.h"
 #include "element_tet_kernel.h"
 #include "stable_step.h"
 #include "vec3.h"
@@ -131,37 +132,13 @@ double tet_stable_dt(double height, double lambda, double mu, double density, do
     return height / c * (sqrt(1 + xi * xi) - xi);
 }
 
-/* Largest eigenvalue of the symmetric 6x6 matrix a (destroyed), by cyclic
- * Jacobi rotations: quadratically convergent, a few sweeps to round-off. */
+/* Largest eigenvalue of the symmetric 6x6 matrix a (destroyed). */
 static double symmetric6_largest_eigenvalue(double a[6][6])
 {
-    for (int sweep = 0; sweep < 50; sweep++) {
-        double off = 0, diag = 0;
-        for (int i = 0; i < 6; i++) {
-            diag += a[i][i] * a[i][i];
-            for (int j = i + 1; j < 6; j++) off += a[i][j] * a[i][j];
-        }
-        if (!(off > 1e-30 * diag)) break;
-        for (int p = 0; p < 5; p++)
-            for (int q = p + 1; q < 6; q++) {
-                if (a[p][q] == 0) continue;
-                double theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
-                double t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
-                double c = 1 / sqrt(t * t + 1), s = t * c;
-                for (int k = 0; k < 6; k++) { /* columns p, q */
-                    double akp = a[k][p], akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for (int k = 0; k < 6; k++) { /* rows p, q */
-                    double apk = a[p][k], aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-            }
-    }
-    double largest = a[0][0];
-    for (int i = 1; i < 6; i++) largest = fmax(largest, a[i][i]);
+    double eigen[6];
+    jacobi_eigenvalues(&a[0][0], 6, eigen);
+    double largest = eigen[0];
+    for (int i = 1; i < 6; i++) largest = fmax(largest, eigen[i]);
     return largest;
 }
 

@@ -247,7 +247,7 @@ void tri_element_forces_range(fdem_model *m, int begin, int end_index,
     int32_t cur_mat = -1;
     double hlambda = 0, hmu = 0;
     const element_hot *el = m->elem + begin, *end = m->elem + end_index;
-    for (; el < end; el++, prev += prev ? 3 : 0) {
+    for (; el < end; el++) {
         ELEM_PREFETCH_READ(end - el > ELEM_PREFETCH ? el + ELEM_PREFETCH : el);
         int n0 = el->node[0], n1 = el->node[1], n2 = el->node[2];
         const double *p0 = pos + 2 * (size_t)n0, *p1 = pos + 2 * (size_t)n1,
@@ -281,6 +281,7 @@ void tri_element_forces_range(fdem_model *m, int begin, int end_index,
             hs[2] += hv[2];
         }
         edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
+        if (prev) prev += 3; /* NULL + 0 would be undefined: undamped models have no array */
     }
     sums[0] += energy;
     sums[1] += power[0];

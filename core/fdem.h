@@ -292,6 +292,17 @@ int fdem_sieve_curve(const fdem_fragment *fragments, int count, double *diameter
 int fdem_stress_components(const fdem_model *model);
 void fdem_element_stress(const fdem_model *model, double *out);
 
+/* Derived element fields for output (contract 5.4), element_fields.c.
+ * fdem_element_strain: Green-Lagrange strain E = (F^T F - I)/2 in the
+ * layout of fdem_element_stress (tensor components, so E_xy is half the
+ * engineering shear). fdem_element_principal_stress: the principal values
+ * of each element's Cauchy stress, `dimension` per element, descending (2D:
+ * of the in-plane tensor). fdem_principal_values does one stress given in
+ * that Voigt layout. */
+void fdem_element_strain(const fdem_model *model, double *out);
+void fdem_element_principal_stress(const fdem_model *model, double *out);
+void fdem_principal_values(int dimension, const double *voigt, double *out);
+
 /* Total reaction (fix, velocity) or applied (force) force of each
  * constraint during the last step, `dimension` doubles per constraint. */
 const double *fdem_constraint_forces(const fdem_model *model);

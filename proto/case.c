@@ -26,7 +26,11 @@ static const char *const top_keys[] = {
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
-static const char *const field_names[] = {"position", "velocity", "stress", "damage"};
+/* In CASE_FIELD_* bit order: names[k] is bit 1u << k. */
+static const char *const field_names[] = {"position", "velocity", "stress", "damage",
+                                          "strain", "principal_stress"};
+#define FIELD_NAME_COUNT (int)(sizeof field_names / sizeof field_names[0])
+#define FIELD_NAME_LIST "position, velocity, stress, damage, strain, principal_stress"
 
 /* ------------------------------------------------------- small sections */
 
@@ -97,14 +101,14 @@ static void case_read_fields(case_doc *doc, const json_t *fields)
             continue;
         }
         unsigned bit = 0;
-        for (int k = 0; k < 4; k++)
+        for (int k = 0; k < FIELD_NAME_COUNT; k++)
             if (strcmp(json_string_value(f), field_names[k]) == 0) bit = 1u << k;
         char hint[96];
         if (!bit)
-            case_problem(doc, at, "unknown field \"%.64s\"%s (fields are position, velocity, "
-                                  "stress, damage)", json_string_value(f),
+            case_problem(doc, at, "unknown field \"%.64s\"%s (fields are " FIELD_NAME_LIST ")",
+                         json_string_value(f),
                          case_did_you_mean(doc, hint, sizeof hint, json_string_value(f),
-                                           field_names, 4));
+                                           field_names, FIELD_NAME_COUNT));
         doc->fields |= bit;
     }
 }
@@ -360,13 +364,12 @@ unsigned case_parse_fields(const char *csv, problems *out)
         const char *comma = strchr(p, ',');
         size_t n = comma ? (size_t)(comma - p) : strlen(p);
         unsigned bit = 0;
-        for (int k = 0; k < 4; k++)
+        for (int k = 0; k < FIELD_NAME_COUNT; k++)
             if (strlen(field_names[k]) == n && strncmp(p, field_names[k], n) == 0)
                 bit = 1u << k;
         if (!bit && n > 0) {
             if (!out->title[0]) snprintf(out->title, sizeof out->title, "Unknown field");
-            problems_add(out, 400, "", "unknown field \"%.*s\"; fields are position, velocity, "
-                                       "stress, damage", (int)(n < 64 ? n : 64), p);
+            problems_add(out, 400, "", "unknown field \"%.*s\"; fields are " FIELD_NAME_LIST, (int)(n < 64 ? n : 64), p);
         }
         fields |= bit;
         p += n;

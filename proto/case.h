@@ -24,6 +24,8 @@ enum case_field {
     CASE_FIELD_VELOCITY = 1u << 1,
     CASE_FIELD_STRESS   = 1u << 2,
     CASE_FIELD_DAMAGE   = 1u << 3,
+    CASE_FIELD_STRAIN   = 1u << 4,
+    CASE_FIELD_PRINCIPAL_STRESS = 1u << 5,
 };
 
 #define CASE_MAX_PARTS 1024

@@ -39,6 +39,12 @@ typedef struct result_file result_file;
 
 result_file *result_create(const char *path, const fdem_model *model,
                            const case_info *info, char *err, size_t errlen);
+/* result_create() that also stores the case document (the root attribute
+ * `case`) and the part and material names it gives (/mesh/part_names,
+ * /mesh/material_names), contract 5.4. */
+result_file *result_create_described(const char *path, const fdem_model *model,
+                                     const case_info *info, const char *document,
+                                     size_t document_length, char *err, size_t errlen);
 result_file *result_reopen(const char *path, const fdem_model *model,
                            const case_info *info, int64_t keep_until_step,
                            char *err, size_t errlen);

@@ -54,7 +54,7 @@
 #define CHUNK_MAX_SNAPSHOTS 1024u
 
 const char *const series_names[SERIES_COUNT] = {
-    "step", "position", "velocity", "stress", "damage",
+    "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
     "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
@@ -104,15 +104,24 @@ void h5_quiet(void)
 
 /* --------------------------------------------------------------- attributes */
 
-static int write_string_attribute(hid_t obj, const char *name, const char *value)
+/* Variable length so that h5py hands back a str, not bytes. */
+hid_t utf8_string_type(void)
 {
     hid_t type = H5Tcopy(H5T_C_S1);
+    if (type >= 0 && (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0)) {
+        H5Tclose(type);
+        return H5I_INVALID_HID;
+    }
+    return type;
+}
+
+int write_string_attribute(hid_t obj, const char *name, const char *value)
+{
+    hid_t type = utf8_string_type();
     hid_t space = H5Screate(H5S_SCALAR);
     hid_t attr = H5I_INVALID_HID;
     int rc = -1;
     if (type < 0 || space < 0) goto done;
-    /* Variable length so that h5py hands back a str, not bytes. */
-    if (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0) goto done;
     attr = H5Acreate2(obj, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
     if (attr < 0) goto done;
     if (H5Awrite(attr, type, &value) < 0) goto done;
@@ -152,11 +161,10 @@ int has_result_format(hid_t file)
     if (H5Aexists(file, "format") <= 0) return 0;
     hid_t attr = H5Aopen(file, "format", H5P_DEFAULT);
     if (attr < 0) return 0;
-    hid_t type = H5Tcopy(H5T_C_S1);
+    hid_t type = utf8_string_type();
     char *value = NULL;
     int ok = 0;
-    if (type >= 0 && H5Tset_size(type, H5T_VARIABLE) >= 0 &&
-        H5Tset_cset(type, H5T_CSET_UTF8) >= 0 && H5Aread(attr, type, &value) >= 0) {
+    if (type >= 0 && H5Aread(attr, type, &value) >= 0) {
         ok = value && strcmp(value, RESULT_FORMAT) == 0;
         H5free_memory(value);
     }
@@ -229,17 +237,22 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
 
 static hid_t series_file_type(int kind)
 {
-    return kind == SERIES_STEP ? H5T_STD_I64LE : H5T_IEEE_F64LE;
+    return kind == SERIES_STEP       ? H5T_STD_I64LE
+         : kind == SERIES_FRAGMENT   ? H5T_STD_I32LE
+                                     : H5T_IEEE_F64LE;
 }
 
 hid_t series_mem_type(int kind)
 {
-    return kind == SERIES_STEP ? H5T_NATIVE_INT64 : H5T_NATIVE_DOUBLE;
+    return kind == SERIES_STEP       ? H5T_NATIVE_INT64
+         : kind == SERIES_FRAGMENT   ? H5T_NATIVE_INT32
+                                     : H5T_NATIVE_DOUBLE;
 }
 
 /* Which datasets this model has and their per-snapshot shape. Damage is
  * stored whenever the model has joints (contract: "when some part
- * fractures"), the node and element fields only when requested. */
+ * fractures"), the fragment id of every element always (contract 5.4), the
+ * node and element fields only when requested. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
@@ -255,6 +268,10 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         {SERIES_STRESS, (fields & CASE_FIELD_STRESS) != 0, c.elements,
          fdem_stress_components(model)},
         {SERIES_DAMAGE, c.joints > 0, c.joints, 0},
+        {SERIES_FRAGMENT, 1, c.elements, 0},
+        {SERIES_STRAIN, (fields & CASE_FIELD_STRAIN) != 0, c.elements,
+         fdem_stress_components(model)},
+        {SERIES_PRINCIPAL_STRESS, (fields & CASE_FIELD_PRINCIPAL_STRESS) != 0, c.elements, dim},
         {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
@@ -284,7 +301,7 @@ static void series_chunk(const series *s, hsize_t chunk[3])
     chunk[2] = width;
 }
 
-static int series_create(hid_t group, int kind, series *s)
+int series_create(hid_t group, int kind, series *s)
 {
     if (s->rank == 0) return 0;
     hsize_t dims[3] = {0, s->row[0], s->row[1]};
@@ -295,7 +312,11 @@ static int series_create(hid_t group, int kind, series *s)
     hid_t space = H5Screate_simple(s->rank, dims, maxdims);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     int rc = -1;
-    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, s->rank, chunk) >= 0) {
+    /* fragment ids not recorded (rows of a file written before fragments
+     * existed, see result_reopen.c) read as -1, never as a real id */
+    const int32_t unrecorded = -1;
+    if (space >= 0 && dcpl >= 0 && H5Pset_chunk(dcpl, s->rank, chunk) >= 0 &&
+        (kind != SERIES_FRAGMENT || H5Pset_fill_value(dcpl, H5T_NATIVE_INT32, &unrecorded) >= 0)) {
         s->id = H5Dcreate2(group, series_names[kind], series_file_type(kind), space,
                            H5P_DEFAULT, dcpl, H5P_DEFAULT);
         rc = s->id >= 0 ? 0 : -1;
@@ -313,6 +334,9 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_VELOCITY: return s->velocity;
     case SERIES_STRESS: return s->stress;
     case SERIES_DAMAGE: return s->damage;
+    case SERIES_FRAGMENT: return s->fragment;
+    case SERIES_STRAIN: return s->strain;
+    case SERIES_PRINCIPAL_STRESS: return s->principal_stress;
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;
@@ -439,6 +463,13 @@ int start_swmr(result_file *f, const char *path, char *err, size_t errlen)
 result_file *result_create(const char *path, const fdem_model *model,
                            const case_info *info, char *err, size_t errlen)
 {
+    return result_create_described(path, model, info, NULL, 0, err, errlen);
+}
+
+result_file *result_create_described(const char *path, const fdem_model *model,
+                                     const case_info *info, const char *document,
+                                     size_t document_length, char *err, size_t errlen)
+{
     h5_quiet();
     if (!path || !model || !info) {
         snprintf(err, errlen, "result_create: missing path, model or case info");
@@ -463,6 +494,7 @@ result_file *result_create(const char *path, const fdem_model *model,
         goto fail;
     }
     if (write_mesh(f->file, model, err, errlen) < 0) goto fail;
+    if (result_describe(f->file, document, document_length, err, errlen) < 0) goto fail;
     series_layout(f->ds, model, info->fields);
     if (create_snapshot_series(f, err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;

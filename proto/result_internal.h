@@ -20,6 +20,9 @@ enum series_kind {
     SERIES_VELOCITY,
     SERIES_STRESS,
     SERIES_DAMAGE,
+    SERIES_FRAGMENT,
+    SERIES_STRAIN,
+    SERIES_PRINCIPAL_STRESS,
     SERIES_CONSTRAINT_FORCE,
     SERIES_KINETIC,
     SERIES_ELASTIC,
@@ -55,6 +58,10 @@ void result_fail(char *err, size_t errlen, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* Keeps HDF5 from printing its error stack (per thread). */
 void h5_quiet(void);
+/* The variable-length UTF-8 string type (h5py reads a str), and a scalar
+ * attribute of it. */
+hid_t utf8_string_type(void);
+int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
 hid_t series_mem_type(int kind);
@@ -65,6 +72,12 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
 hid_t file_access_latest(int clear_status_flags);
 result_file *result_alloc(void);
 int result_release(result_file *f);
+/* The root attribute `case` (the document) and /mesh/part_names,
+ * /mesh/material_names; nothing when text is NULL (result_describe.c). */
+int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
 int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
+
+/* Creates /snapshots/<series_names[kind]> empty and extendible (result_h5.c). */
+int series_create(hid_t group, int kind, series *s);
 
 #endif

@@ -122,6 +122,36 @@ static int truncate_series(result_file *f, hsize_t length, char *err, size_t err
     return 0;
 }
 
+/* A file written before fragments were recorded has no /snapshots/fragment:
+ * a case paused or cut off by an older daemon must still go on, so the
+ * series is added, as long as /snapshots/time, its earlier rows -1 (not
+ * recorded). Done before SWMR writing starts, which allows no new objects. */
+static int add_fragment_series(hid_t group, result_file *f, char *err, size_t errlen)
+{
+    series *s = &f->ds[SERIES_FRAGMENT];
+    if (s->rank == 0 || H5Lexists(group, series_names[SERIES_FRAGMENT], H5P_DEFAULT) > 0)
+        return 0;
+    hid_t time = H5Dopen2(group, series_names[SERIES_TIME], H5P_DEFAULT);
+    hsize_t rows = 0;
+    if (time >= 0) {
+        hid_t space = H5Dget_space(time);
+        if (space >= 0) {
+            H5Sget_simple_extent_dims(space, &rows, NULL);
+            H5Sclose(space);
+        }
+        H5Dclose(time);
+    }
+    hsize_t dims[3] = {rows, s->row[0], s->row[1]};
+    if (time < 0 || series_create(group, SERIES_FRAGMENT, s) < 0 || H5Dset_extent(s->id, dims) < 0) {
+        result_fail(err, errlen, "cannot add /snapshots/fragment to a result file written "
+                    "before fragments were recorded");
+        return -1;
+    }
+    H5Dclose(s->id);
+    s->id = -1;
+    return 0;
+}
+
 static int open_snapshot_series(result_file *f, char *err, size_t errlen)
 {
     hid_t group = H5Gopen2(f->file, "snapshots", H5P_DEFAULT);
@@ -129,7 +159,7 @@ static int open_snapshot_series(result_file *f, char *err, size_t errlen)
         result_fail(err, errlen, "the result file has no /snapshots group");
         return -1;
     }
-    int rc = 0;
+    int rc = add_fragment_series(group, f, err, errlen);
     for (int k = 0; k < SERIES_COUNT && rc == 0; k++)
         rc = series_open(group, k, &f->ds[k], err, errlen);
     H5Gclose(group);

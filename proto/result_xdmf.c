@@ -22,6 +22,9 @@
  *    as a line in 2D; a0, a1, a2 as a triangle in 3D) on the same moving
  *    nodes, with damage as its cell value. ParaView's reader turns the two
  *    collections into two blocks.
+ *  - strain likewise (strain_xx ...), principal_stress as principal_stress_1
+ *    (largest) ... and fragment (the fragment id of each element, an Int
+ *    cell scalar in every grid).
  *  - node_part and element_part are static attributes from /mesh, handy for
  *    colouring bodies.
  *
@@ -76,6 +79,20 @@ static void xdmf_mesh_item(const xdmf_ctx *x, const char *dims, const char *numb
             "        <DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
             "Format=\"HDF\">%s:/mesh/%s</DataItem>\n",
             dims, number_type, precision, x->h5, dataset);
+}
+
+/* Row `s` of a (S, rows) /snapshots dataset of the given number type. */
+static void xdmf_scalar_row_item(const xdmf_ctx *x, int s, long rows, const char *number_type,
+                                 int precision, const char *dataset)
+{
+    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld\" "
+            "Type=\"HyperSlab\">\n", rows);
+    fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
+            "%d 0  1 1  1 %ld</DataItem>\n", s, rows);
+    fprintf(x->out, "          <DataItem Dimensions=\"%d %ld\" NumberType=\"%s\" Precision=\"%d\" "
+            "Format=\"HDF\">%s:/snapshots/%s</DataItem>\n", x->snapshots, rows, number_type,
+            precision, x->h5, dataset);
+    fprintf(x->out, "        </DataItem>\n");
 }
 
 /* Row `s` (and, when width_pick >= 0, only that component) of a
@@ -140,15 +157,27 @@ static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
     fprintf(x->out, "      </Topology>\n");
     xdmf_geometry(x, s);
     fprintf(x->out, "      <Attribute Name=\"damage\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
-    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld\" "
-            "Type=\"HyperSlab\">\n", J);
-    fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
-            "%d 0  1 1  1 %ld</DataItem>\n", s, J);
-    fprintf(x->out, "          <DataItem Dimensions=\"%d %ld\" NumberType=\"Float\" Precision=\"8\" "
-            "Format=\"HDF\">%s:/snapshots/damage</DataItem>\n", x->snapshots, J, x->h5);
-    fprintf(x->out, "        </DataItem>\n");
+    xdmf_scalar_row_item(x, s, J, "Float", 8, "damage");
     fprintf(x->out, "      </Attribute>\n");
     fprintf(x->out, "    </Grid>\n");
+}
+
+/* One Cell scalar per column of a (S, E, width) element dataset, named
+ * dataset_xx ... in the Voigt order of stress (width 3 or 6), or
+ * dataset_1 ... for principal values (width = dimension). */
+static void xdmf_cell_components(const xdmf_ctx *x, int s, const char *dataset, int width)
+{
+    static const char *const plane[3] = {"xx", "yy", "xy"};
+    static const char *const solid[6] = {"xx", "yy", "zz", "yz", "xz", "xy"};
+    static const char *const principal[3] = {"1", "2", "3"};
+    int tensor = width == x->stress_components;
+    const char *const *suffix = !tensor ? principal : x->dimension == 3 ? solid : plane;
+    for (int k = 0; k < width; k++) {
+        fprintf(x->out, "      <Attribute Name=\"%s_%s\" AttributeType=\"Scalar\" "
+                "Center=\"Cell\">\n", dataset, suffix[k]);
+        xdmf_row_item(x, s, x->elements, width, k, dataset);
+        fprintf(x->out, "      </Attribute>\n");
+    }
 }
 
 static void xdmf_grid(const xdmf_ctx *x, int s, double time)
@@ -172,18 +201,16 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
         xdmf_row_item(x, s, x->nodes, x->dimension, -1, "velocity");
         fprintf(x->out, "      </Attribute>\n");
     }
-    if (x->fields & CASE_FIELD_STRESS) {
-        static const char *const plane[3] = {"stress_xx", "stress_yy", "stress_xy"};
-        static const char *const solid_names[6] = {"stress_xx", "stress_yy", "stress_zz",
-                                                   "stress_yz", "stress_xz", "stress_xy"};
-        const char *const *names = solid ? solid_names : plane;
-        for (int k = 0; k < x->stress_components; k++) {
-            fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
-                    "Center=\"Cell\">\n", names[k]);
-            xdmf_row_item(x, s, x->elements, x->stress_components, k, "stress");
-            fprintf(x->out, "      </Attribute>\n");
-        }
-    }
+    if (x->fields & CASE_FIELD_STRESS)
+        xdmf_cell_components(x, s, "stress", x->stress_components);
+    if (x->fields & CASE_FIELD_STRAIN)
+        xdmf_cell_components(x, s, "strain", x->stress_components);
+    if (x->fields & CASE_FIELD_PRINCIPAL_STRESS)
+        xdmf_cell_components(x, s, "principal_stress", x->dimension);
+    fprintf(x->out, "      <Attribute Name=\"fragment\" AttributeType=\"Scalar\" "
+            "Center=\"Cell\">\n");
+    xdmf_scalar_row_item(x, s, x->elements, "Int", 4, "fragment");
+    fprintf(x->out, "      </Attribute>\n");
     fprintf(x->out, "      <Attribute Name=\"node_part\" AttributeType=\"Scalar\" "
             "Center=\"Node\">\n");
     snprintf(dims, sizeof dims, "%ld", x->nodes);

@@ -31,7 +31,9 @@ static double *copy_doubles(const double *src, size_t count, int *failed)
     return dst;
 }
 
-static double *copy_stress(const fdem_model *model, size_t values, int *failed)
+/* A per-element field the engine computes into a buffer of `values`. */
+static double *copy_element_field(const fdem_model *model, size_t values,
+                                  void (*compute)(const fdem_model *, double *), int *failed)
 {
     if (values == 0) return NULL;
     double *dst = malloc(values * sizeof *dst);
@@ -39,8 +41,19 @@ static double *copy_stress(const fdem_model *model, size_t values, int *failed)
         *failed = 1;
         return NULL;
     }
-    fdem_element_stress(model, dst);
+    compute(model, dst);
     return dst;
+}
+
+static int32_t *copy_fragment_labels(const fdem_model *model, size_t elements, int *failed)
+{
+    int32_t *label = malloc((elements ? elements : 1) * sizeof *label);
+    if (!label || fdem_fragment_labels(model, label) < 0) {
+        free(label);
+        *failed = 1;
+        return NULL;
+    }
+    return label;
 }
 
 snapshot *snapshot_take(const fdem_model *model, unsigned fields)
@@ -72,8 +85,25 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
         if (s->velocity) s->fields |= CASE_FIELD_VELOCITY;
     }
     if (fields & CASE_FIELD_STRESS) {
-        s->stress = copy_stress(model, (size_t)s->stress_components * elements, &failed);
+        s->stress = copy_element_field(model, (size_t)s->stress_components * elements,
+                                       fdem_element_stress, &failed);
         if (s->stress) s->fields |= CASE_FIELD_STRESS;
+    }
+    if (fields & CASE_FIELD_STRAIN) {
+        s->strain = copy_element_field(model, (size_t)s->stress_components * elements,
+                                       fdem_element_strain, &failed);
+        if (s->strain) s->fields |= CASE_FIELD_STRAIN;
+    }
+    if (fields & CASE_FIELD_PRINCIPAL_STRESS) {
+        s->principal_stress = copy_element_field(model, dim * elements,
+                                                 fdem_element_principal_stress, &failed);
+        if (s->principal_stress) s->fields |= CASE_FIELD_PRINCIPAL_STRESS;
+    }
+    s->fragment = copy_fragment_labels(model, elements, &failed);
+    if (fields & SNAPSHOT_FRAGMENTS) {
+        s->fragment_count = fdem_fragments(model, &s->fragments);
+        if (s->fragment_count < 0) failed = 1;
+        else s->fields |= SNAPSHOT_FRAGMENTS;
     }
     if (counts.joints > 0) {
         s->damage = copy_doubles(fdem_joint_damage(model), (size_t)counts.joints, &failed);
@@ -95,6 +125,10 @@ void snapshot_free(snapshot *s)
     free(s->velocity);
     free(s->stress);
     free(s->damage);
+    free(s->strain);
+    free(s->principal_stress);
+    free(s->fragment);
+    free(s->fragments);
     free(s->constraint_force);
     free(s);
 }

@@ -6,13 +6,21 @@
  * worker keeps stepping. constraint_force, energies, step and time are
  * always copied; damage only when the model has joints. Node rows and
  * constraint forces have `dimension` numbers, stress rows
- * `stress_components` (3 in 2D, 6 in 3D).
+ * `stress_components` (3 in 2D, 6 in 3D), and so do strain rows;
+ * principal_stress rows have `dimension` numbers.
+ * The fragment id of every element is always copied (result.h5 stores it
+ * with every snapshot, contract 5.4); the fragment records are computed only
+ * when SNAPSHOT_FRAGMENTS is in `fields` (GET /cases/ID/fragments).
  */
 #ifndef FDEM_SNAPSHOT_H
 #define FDEM_SNAPSHOT_H
 
 #include <stdint.h>
 #include "fdem.h"
+
+/* Not a case field (no name parses to it): asks snapshot_take for the
+ * fragment records as well. */
+#define SNAPSHOT_FRAGMENTS (1u << 16)
 
 typedef struct snapshot {
     int64_t step;
@@ -25,6 +33,11 @@ typedef struct snapshot {
     double *velocity;           /* dimension * nodes, or NULL */
     double *stress;             /* stress_components * elements, or NULL */
     double *damage;             /* joints, or NULL */
+    double *strain;             /* stress_components * elements, or NULL */
+    double *principal_stress;   /* dimension * elements, or NULL */
+    int32_t *fragment;          /* fragment id per element (always) */
+    fdem_fragment *fragments;   /* fragment_count records, with SNAPSHOT_FRAGMENTS */
+    int fragment_count;
     double *constraint_force;   /* dimension * constraints */
     fdem_energy energy;
 } snapshot;

@@ -9,6 +9,7 @@
 #include "state_json.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 #include "case.h"
 
@@ -57,6 +58,13 @@ static int set_or_fail(json_t *obj, const char *key, json_t *value)
     return json_object_set_new(obj, key, value);
 }
 
+/* Appends value to array, taking ownership; NULL counts as a failure. */
+static int set_or_fail_append(json_t *array, json_t *value)
+{
+    if (!value) return -1;
+    return json_array_append_new(array, value);
+}
+
 json_t *state_to_json(const snapshot *s)
 {
     if (!s) return NULL;
@@ -73,6 +81,78 @@ json_t *state_to_json(const snapshot *s)
         rc |= set_or_fail(obj, "stress", rows_to_json(s->stress, s->elements, s->stress_components));
     if ((s->fields & CASE_FIELD_DAMAGE) && s->damage)
         rc |= set_or_fail(obj, "damage", list_to_json(s->damage, s->joints));
+    if ((s->fields & CASE_FIELD_STRAIN) && s->strain)
+        rc |= set_or_fail(obj, "strain", rows_to_json(s->strain, s->elements, s->stress_components));
+    if ((s->fields & CASE_FIELD_PRINCIPAL_STRESS) && s->principal_stress)
+        rc |= set_or_fail(obj, "principal_stress",
+                          rows_to_json(s->principal_stress, s->elements, s->dimension));
+    if (rc != 0) {
+        json_decref(obj);
+        return NULL;
+    }
+    return obj;
+}
+
+/* {"id", "elements", "mass", "size", "diameter", "centroid", "velocity"} */
+static json_t *fragment_to_json(const fdem_fragment *f, int id, int dimension)
+{
+    json_t *o = json_object();
+    if (!o) return NULL;
+    int rc = 0;
+    rc |= set_or_fail(o, "id", json_integer(id));
+    rc |= set_or_fail(o, "elements", json_integer(f->elements));
+    rc |= set_or_fail(o, "mass", number_or_null(f->mass));
+    rc |= set_or_fail(o, "size", number_or_null(f->size));
+    rc |= set_or_fail(o, "diameter", number_or_null(f->diameter));
+    rc |= set_or_fail(o, "centroid", list_to_json(f->centroid, dimension));
+    rc |= set_or_fail(o, "velocity", list_to_json(f->velocity, dimension));
+    if (rc != 0) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
+/* The sieve curve as [{"diameter", "passing"}, ...]. */
+static json_t *distribution_to_json(const fdem_fragment *f, int count)
+{
+    json_t *array = json_array();
+    double *diameter = malloc(sizeof(double) * (size_t)(count ? count : 1));
+    double *passing = malloc(sizeof(double) * (size_t)(count ? count : 1));
+    int points = array && diameter && passing ? fdem_sieve_curve(f, count, diameter, passing) : -1;
+    for (int k = 0; k < points; k++) {
+        json_t *point = json_object();
+        if (!point || json_array_append_new(array, point) < 0 ||
+            set_or_fail(point, "diameter", number_or_null(diameter[k])) < 0 ||
+            set_or_fail(point, "passing", number_or_null(passing[k])) < 0) {
+            points = -1;
+            break;
+        }
+    }
+    free(diameter);
+    free(passing);
+    if (points < 0) {
+        json_decref(array);
+        return NULL;
+    }
+    return array;
+}
+
+json_t *fragments_to_json(const snapshot *s)
+{
+    if (!s || !(s->fields & SNAPSHOT_FRAGMENTS)) return NULL;
+    json_t *obj = json_object(), *list = json_array();
+    int rc = obj && list ? 0 : -1;
+    for (int k = 0; k < s->fragment_count && rc == 0; k++)
+        rc = set_or_fail_append(list, fragment_to_json(&s->fragments[k], k, s->dimension));
+    if (rc == 0) {
+        rc |= set_or_fail(obj, "step", json_integer((json_int_t)s->step));
+        rc |= set_or_fail(obj, "time", number_or_null(s->time));
+        rc |= set_or_fail(obj, "fragments", list);
+        list = NULL;
+        rc |= set_or_fail(obj, "distribution", distribution_to_json(s->fragments, s->fragment_count));
+    }
+    json_decref(list);
     if (rc != 0) {
         json_decref(obj);
         return NULL;

@@ -5,7 +5,8 @@
  * [[x, y], ...] per node ([[x, y, z], ...] in 3D), stress as
  * [[sxx, syy, sxy], ...] per element ([[sxx, syy, szz, syz, sxz, sxy], ...]
  * in 3D) and damage as a number per joint; only the fields present in the
- * snapshot.
+ * snapshot; strain like stress, principal_stress as `dimension` numbers per
+ * element, descending.
  */
 #ifndef FDEM_STATE_JSON_H
 #define FDEM_STATE_JSON_H
@@ -14,5 +15,11 @@
 #include "snapshot.h"
 
 json_t *state_to_json(const snapshot *s);
+
+/* GET /cases/ID/fragments (contract 5.4): {"step", "time", "fragments":
+ * [{"id", "elements", "mass", "size", "diameter", "centroid", "velocity"},
+ * ...], "distribution": [{"diameter", "passing"}, ...]} of a snapshot taken
+ * with SNAPSHOT_FRAGMENTS; NULL without them or when out of memory. */
+json_t *fragments_to_json(const snapshot *s);
 
 #endif

@@ -20,7 +20,6 @@
 #include "io_thread.h"
 #include "persist.h"
 
-#define CASE_MODEL_MAX_DOCUMENT ((size_t)1 << 34)
 #define CASE_MODEL_MAX_CHECKPOINT ((size_t)1 << 40)
 
 size_t case_model_cost(double estimate)

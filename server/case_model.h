@@ -23,6 +23,9 @@
 #include "memory_budget.h"
 #include "registry.h"
 
+/* The largest case.json read back (the upload limit is far below it). */
+#define CASE_MODEL_MAX_DOCUMENT ((size_t)1 << 34)
+
 typedef enum case_model_rc {
     CASE_MODEL_OK = 0,
     CASE_MODEL_NO_MEMORY, /* the budget is short now; nothing changed */

@@ -60,8 +60,9 @@ static double sizing_snapshots(const case_info *info, double steps)
 
 /* result.h5 as proto/result_h5.c lays it out: /mesh once, then per
  * snapshot the requested node and element fields, damage when there are
- * joints, the constraint forces and the scalar series (step, time and the
- * energy accounts). HDF5's own metadata and part-filled chunks come on top. */
+ * joints, the fragment id of every element, the constraint forces and the
+ * scalar series (step, time and the energy accounts). HDF5's own metadata,
+ * part-filled chunks and the case document with its names come on top. */
 static double sizing_result_bytes(const fdem_model *model, const case_info *info, double snapshots)
 {
     fdem_counts c = fdem_get_counts(model);
@@ -69,13 +70,17 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
     double stress_width = dim == 3 ? 6 : 3;
     double nodes = c.nodes, elements = c.elements, joints = c.joints;
     double mesh = nodes * (dim * 8 + 8 + 4) + elements * ((dim + 1) * 4 + 4) + joints * 2 * dim * 4;
-    double row = 2 * 8 + 9 * 8 + (double)c.constraints * dim * 8 + joints * 8;
+    double row = 2 * 8 + 9 * 8 + (double)c.constraints * dim * 8 + joints * 8 + elements * 4;
     if (info->fields & CASE_FIELD_POSITION)
         row += nodes * dim * 8;
     if (info->fields & CASE_FIELD_VELOCITY)
         row += nodes * dim * 8;
     if (info->fields & CASE_FIELD_STRESS)
         row += elements * stress_width * 8;
+    if (info->fields & CASE_FIELD_STRAIN)
+        row += elements * stress_width * 8;
+    if (info->fields & CASE_FIELD_PRINCIPAL_STRESS)
+        row += elements * dim * 8;
     return mesh + snapshots * row;
 }
 

@@ -20,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "case_model.h"
 #include "persist.h"
 
 typedef enum io_job_kind {
@@ -109,7 +110,20 @@ static void io_do_create(io_job *j)
     server_case *c = j->c;
     char path[1200];
     snprintf(path, sizeof path, "%s/result.h5", c->dir);
-    c->result = result_create(path, c->model, &c->info, j->err, sizeof j->err);
+    /* case.json is stored before the result is created (registry.c); the
+     * file carries it so that it explains itself (contract 5.4). */
+    char document_path[1200], *document = NULL;
+    size_t document_size = 0;
+    snprintf(document_path, sizeof document_path, "%s/case.json", c->dir);
+    if (persist_read_file(document_path, &document, &document_size, CASE_MODEL_MAX_DOCUMENT) != 0) {
+        snprintf(j->err, sizeof j->err, "case.json could not be read for result.h5: %s",
+                 strerror(errno));
+        j->rc = -1;
+        return;
+    }
+    c->result = result_create_described(path, c->model, &c->info, document, document_size,
+                                        j->err, sizeof j->err);
+    free(document);
     if (!c->result) {
         j->rc = -1;
         return;

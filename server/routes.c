@@ -53,6 +53,7 @@ void routes_match(const char *url, route_match *out)
         {"start", ROUTE_CASE_START}, {"pause", ROUTE_CASE_PAUSE}, {"stop", ROUTE_CASE_STOP},
         {"case", ROUTE_CASE_DOCUMENT}, {"state", ROUTE_CASE_STATE},
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
+        {"fragments", ROUTE_CASE_FRAGMENTS},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
@@ -307,6 +308,41 @@ static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c
     return http_reply_problem(conn, (unsigned)status, "Conflict", msg, NULL);
 }
 
+/* The state at one step boundary (taken between steps of a running case,
+ * rebuilt from the checkpoint of a stopped one) turned into JSON by
+ * to_json: GET /state and GET /fragments share the lock and the path. */
+static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_case *c,
+                                           unsigned fields, json_t *(*to_json)(const snapshot *))
+{
+    int status = 0;
+    snapshot *s = case_take_state(c, fields, &status);
+    if (!s && status == 503)
+        return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
+                                      "from its checkpoint, and that would take the daemon past "
+                                      "its memory budget (--max-memory) now", NULL);
+    if (!s)
+        return http_reply_problem(conn, 409, "Conflict",
+                                  "the stored case could not be rebuilt to read its state", NULL);
+    /* The JSON tree of a state is ~100 bytes per number: it is charged to
+     * the budget, and its pages go back to the OS once it is sent off. */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
+    json_t *o = to_json(s);
+    membudget_meter_end();
+    snapshot_free(s);
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of this state would take the daemon past "
+                                    "its memory budget (--max-memory) now", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 409, "Conflict",
+                                "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
+}
+
 static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
 {
     const char *csv = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "fields");
@@ -323,33 +359,7 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
         }
         problems_free(&p);
     }
-    int status = 0;
-    snapshot *s = case_take_state(c, fields, &status);
-    if (!s && status == 503)
-        return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
-                                      "from its checkpoint, and that would take the daemon past "
-                                      "its memory budget (--max-memory) now", NULL);
-    if (!s)
-        return http_reply_problem(conn, 409, "Conflict",
-                                  "the stored case could not be rebuilt to read its state", NULL);
-    /* The JSON tree of a state is ~100 bytes per number: it is charged to
-     * the budget, and its pages go back to the OS once it is sent off. */
-    membudget_lease lease = {0};
-    membudget_meter_begin(&lease, 0);
-    json_t *o = state_to_json(s);
-    membudget_meter_end();
-    snapshot_free(s);
-    enum MHD_Result rc;
-    if (!o && membudget_meter_refused())
-        rc = http_reply_unavailable(conn, "the JSON form of this state would take the daemon past "
-                                    "its memory budget (--max-memory) now", NULL);
-    else if (!o)
-        rc = http_reply_problem(conn, 409, "Conflict",
-                                "the state holds non-finite numbers (the case failed) and has no JSON form", NULL);
-    else
-        rc = http_reply_json(conn, 200, o, NULL);
-    membudget_release(&lease);
-    return rc;
+    return route_snapshot_json(conn, c, fields, state_to_json);
 }
 
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
@@ -377,6 +387,8 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return routes_serve_file(conn, c, "case.json", "application/json");
     case ROUTE_CASE_STATE:
         return route_state(conn, c);
+    case ROUTE_CASE_FRAGMENTS:
+        return route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, fragments_to_json);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c);
     case ROUTE_CASE_RESULT_XDMF:

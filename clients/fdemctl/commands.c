@@ -431,11 +431,12 @@ int cmd_case(const ctl_options *o, int argc, char **argv)
 }
 
 static const char USAGE_STATE[] =
-    "usage: fdemctl state ID [--fields position,velocity,stress,damage]\n"
+    "usage: fdemctl state ID [--fields position,velocity,stress,damage,strain,principal_stress]\n"
     "  Prints the current state (taken at one step boundary) as JSON:\n"
-    "  position/velocity [[x, y], ...] per node, stress [[sxx, syy, sxy], ...]\n"
-    "  per element, damage per joint; in 3D [[x, y, z], ...] and\n"
-    "  [[sxx, syy, szz, syz, sxz, sxy], ...].\n";
+    "  position/velocity [[x, y], ...] per node ([[x, y, z], ...] in 3D),\n"
+    "  stress and strain [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz,\n"
+    "  xz, xy), principal_stress [[s1, s2], ...] (3D: three) descending,\n"
+    "  damage per joint.\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

@@ -198,13 +198,15 @@ class Client:
         """The current state, taken at one step boundary.
 
         Args:
-            fields: names among "position", "velocity", "stress", "damage"
-                (a list or a comma-separated string); None = server default.
+            fields: names among "position", "velocity", "stress", "damage",
+                "strain", "principal_stress" (a list or a comma-separated
+                string); None = server default.
         Returns:
             {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
-            per node, stress [[sxx, syy, sxy], ...] per element, damage per
-            joint; in 3D [[x, y, z], ...] and [[sxx, syy, szz, syz, sxz,
-            sxy], ...] (contract 5.2).
+            per node ([[x, y, z], ...] in 3D), stress and strain [[xx, yy,
+            xy], ...] per element (3D: xx, yy, zz, yz, xz, xy, contract 5.2;
+            strain is Green-Lagrange), principal_stress [[s1, s2], ...] (3D:
+            three) descending, damage per joint.
         """
         suffix = "/state"
         if fields:
@@ -212,6 +214,19 @@ class Client:
                 fields = ",".join(fields)
             suffix += "?fields=" + urllib.parse.quote(fields, safe=",")
         return self._json("GET", self._case_path(case_id, suffix))
+
+    def fragments(self, case_id):
+        """The pieces the case has broken into, at one step boundary.
+
+        Returns:
+            {"step", "time", "fragments": [{"id", "elements", "mass", "size",
+            "diameter", "centroid", "velocity"}, ...], "distribution":
+            [{"diameter", "passing"}, ...]}: size is the area (2D, mass per
+            metre of thickness) or volume (3D), diameter that of the circle
+            or sphere of that size, and distribution the sieve curve (mass
+            fraction of fragments no larger than each diameter).
+        """
+        return self._json("GET", self._case_path(case_id, "/fragments"))
 
     def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
         """Polls until the case is finished, failed or stopped.

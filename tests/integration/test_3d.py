@@ -137,9 +137,9 @@ class Solid3DTest(DaemonTestCase):
             self.assertEqual(topo.find("DataItem").text.strip(), "result.h5:/mesh/tetrahedra")
             self.assertEqual(grid.find("Geometry").get("GeometryType"), "XYZ")
             names = sorted(a.get("Name") for a in grid.findall("Attribute"))
-            self.assertEqual(names, ["element_part", "node_part", "stress_xx", "stress_xy",
-                                     "stress_xz", "stress_yy", "stress_yz", "stress_zz",
-                                     "velocity"])
+            self.assertEqual(names, ["element_part", "fragment", "node_part", "stress_xx",
+                                     "stress_xy", "stress_xz", "stress_yy", "stress_yz",
+                                     "stress_zz", "velocity"])
         return root
 
     def check_pvpython(self, xdmf, h5, st):
@@ -149,15 +149,28 @@ class Solid3DTest(DaemonTestCase):
         os.makedirs(folder, exist_ok=True)
         shutil.copy(xdmf, os.path.join(folder, "result.xdmf"))
         shutil.copy(h5, os.path.join(folder, "result.h5"))
+        # the cell count, and the mesh's lowest z at the first and the last
+        # time step: ParaView must see the tetrahedra move
         script = ("from paraview.simple import *\n"
                   "r = XDMFReader(FileNames=[%r])\n"
-                  "r.UpdatePipeline()\n"
-                  "print(r.GetDataInformation().GetNumberOfCells())\n"
+                  "times = list(r.TimestepValues)\n"
+                  "r.UpdatePipeline(times[0])\n"
+                  "z0 = r.GetDataInformation().GetBounds()[4]\n"
+                  "r.UpdatePipeline(times[-1])\n"
+                  "z1 = r.GetDataInformation().GetBounds()[4]\n"
+                  "print(r.GetDataInformation().GetNumberOfCells(), len(times), repr(z0), repr(z1))\n"
                   % os.path.join(folder, "result.xdmf"))
         out = subprocess.run([pvpython, "-c", script], capture_output=True, text=True,
                              timeout=120)
         self.assertEqual(out.returncode, 0, out.stderr[-2000:])
-        self.assertEqual(int(out.stdout.strip().splitlines()[-1]), st["elements"])
+        cells, steps, z0, z1 = out.stdout.strip().splitlines()[-1].split()
+        self.assertEqual(int(cells), st["elements"])
+        with h5py.File(h5, "r") as f:
+            position = f["/snapshots/position"][...]
+        self.assertEqual(int(steps), position.shape[0])
+        self.assertEqual(float(z0), position[0, :, 2].min())
+        self.assertEqual(float(z1), position[-1, :, 2].min())
+        self.assertLess(float(z1), float(z0))
 
     def check_state(self, st):
         status, body = self.d.json("GET", "/cases/%s/state?fields=position,velocity,stress"

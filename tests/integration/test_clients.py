@@ -117,7 +117,7 @@ class FdemctlTests(ClientTestCase):
         r = self.ctl("--help")
         self.assertEqual(r.returncode, 0)
         for command in ("submit", "list", "status", "start", "pause", "stop", "delete",
-                        "wait", "state", "fetch"):
+                        "wait", "state", "fetch", "fragments"):
             self.assertIn(command, r.stdout)
             h = self.ctl(command, "--help")
             self.assertEqual(h.returncode, 0, command)

@@ -28,6 +28,7 @@ SERIES = {  # dataset -> key in the expected snapshot
     "step": "step", "time": "time", "position": "position", "velocity": "velocity",
     "stress": "stress", "damage": "damage", "constraint_force": "constraint_force",
     "kinetic_energy": "kinetic_energy", "elastic_energy": "elastic_energy",
+    "fragment": "fragment", "strain": "strain", "principal_stress": "principal_stress",
 }
 
 
@@ -75,6 +76,8 @@ def want_series(exp, name, snaps):
                                                   exp.get("dimension", 2))
     if name == "step":
         return np.array([s["step"] for s in snaps], dtype="i8")
+    if name == "fragment":
+        return np.array([s["fragment"] for s in snaps], dtype="i4")
     return np.array([s[name] for s in snaps], dtype="f8")
 
 
@@ -176,7 +179,7 @@ def check_hdf_item(f, item, h5_name):
 def check_hyperslab(f, item, h5_name, s):
     children = item.findall("DataItem")
     need(len(children) == 2, "HyperSlab needs a selection and a source DataItem")
-    sel = np.array(children[0].text.split(), dtype=int).reshape(3, 3)
+    sel = np.array(children[0].text.split(), dtype=int).reshape(3, -1)
     ds = check_hdf_item(f, children[1], h5_name)
     start, stride, count = sel
     need(start[0] == s and count[0] == 1, f"hyperslab of grid {s} selects snapshot {start[0]}")

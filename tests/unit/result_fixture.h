@@ -26,7 +26,8 @@ static int fixture_add_block(fdem_model *m, double ox, double oy, double w, doub
 }
 
 /* Sets dt = 0.5 x stable and fills `info` (when not NULL) as case_build
- * would: 1000 steps, a snapshot every 5, position, velocity and stress. */
+ * would: 1000 steps, a snapshot every 5, position, velocity, stress, strain
+ * and principal_stress. */
 static void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
                          int constraints, int fracture)
 {
@@ -39,7 +40,8 @@ static void fixture_info(fdem_model *m, case_info *info, const char *name, int p
     info->end_time = 1000 * info->dt;
     info->safety = 0.5;
     info->output_interval = 5 * info->dt;
-    info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS;
+    info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS |
+                   CASE_FIELD_STRAIN | CASE_FIELD_PRINCIPAL_STRESS;
     info->part_count = parts;
     info->constraint_count = constraints;
     info->fracture = fracture;

@@ -97,6 +97,10 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
     if (info->fields & CASE_FIELD_VELOCITY) json_array_append_new(series, json_string("velocity"));
     if (info->fields & CASE_FIELD_STRESS) json_array_append_new(series, json_string("stress"));
     if (c.joints > 0) json_array_append_new(series, json_string("damage"));
+    json_array_append_new(series, json_string("fragment"));
+    if (info->fields & CASE_FIELD_STRAIN) json_array_append_new(series, json_string("strain"));
+    if (info->fields & CASE_FIELD_PRINCIPAL_STRESS)
+        json_array_append_new(series, json_string("principal_stress"));
 
     return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
                      "dimension", dim, "dt", fdem_get_dt(m), "constraints", c.constraints,
@@ -113,6 +117,7 @@ static void expect_snapshot(json_t *doc, const snapshot *s)
     json_object_set_new(j, "constraint_force", doubles_rows(s->constraint_force, s->constraints,
                                                                 s->dimension));
     json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
+    json_object_set_new(j, "fragment", ints_rows(s->fragment, s->elements, 0));
     json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
     json_array_append_new(json_object_get(doc, "snapshots"), j);
 }
@@ -458,6 +463,52 @@ static void test_result_reopen_clean_file_keeps_all(void)
     run_end(&r);
 }
 
+/* A file from before fragments were recorded (no /snapshots/fragment): a
+ * paused case must go on. The series is added with its earlier rows -1
+ * (not recorded), and the rows appended after carry the ids. */
+static void test_result_reopen_adds_fragment_series_to_older_file(void)
+{
+    run r;
+    if (run_start(&r, 0, 1, 0, "older.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        CHECK(result_close(r.file) == 0, "result_close");
+        char path[512];
+        tmp_path(path, sizeof path, "older.h5");
+        hid_t file = H5Fopen(path, H5F_ACC_RDWR, H5P_DEFAULT);
+        CHECK(file >= 0 && H5Ldelete(file, "/snapshots/fragment", H5P_DEFAULT) >= 0,
+              "making the older file");
+        if (file >= 0) H5Fclose(file);
+        r.file = result_reopen(path, r.model, &r.info, INT64_MAX, r.err, sizeof r.err);
+        CHECK(r.file != NULL, "result_reopen of an older file: %s", r.err);
+        if (r.file) {
+            CHECK(result_snapshot_count(r.file) == 3, "count %d", result_snapshot_count(r.file));
+            run_append(&r);
+            CHECK(result_close(r.file) == 0, "result_close");
+            r.file = NULL;
+            file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+            hid_t ds = file >= 0 ? H5Dopen2(file, "/snapshots/fragment", H5P_DEFAULT) : -1;
+            hid_t space = ds >= 0 ? H5Dget_space(ds) : -1;
+            hsize_t dims[2] = {0, 0};
+            if (space >= 0) H5Sget_simple_extent_dims(space, dims, NULL);
+            CHECK(dims[0] == 4, "fragment rows %llu", (unsigned long long)dims[0]);
+            int32_t *ids = dims[0] == 4 ? malloc(sizeof(int32_t) * 4 * dims[1]) : NULL;
+            if (ids && H5Dread(ds, H5T_NATIVE_INT32, H5S_ALL, H5S_ALL, H5P_DEFAULT, ids) >= 0) {
+                int unrecorded = 0, recorded = 0;
+                for (hsize_t e = 0; e < 3 * dims[1]; e++) unrecorded += ids[e] == -1;
+                for (hsize_t e = 3 * dims[1]; e < 4 * dims[1]; e++) recorded += ids[e] >= 0;
+                CHECK(unrecorded == (int)(3 * dims[1]), "earlier rows: %d of %d are -1",
+                      unrecorded, (int)(3 * dims[1]));
+                CHECK(recorded == (int)dims[1], "new row: %d of %d ids", recorded, (int)dims[1]);
+            }
+            free(ids);
+            if (space >= 0) H5Sclose(space);
+            if (ds >= 0) H5Dclose(ds);
+            if (file >= 0) H5Fclose(file);
+        }
+    }
+    run_end(&r);
+}
+
 /* What a download does: flush on the I/O thread, then a byte copy taken by
  * any thread with the superblock's open-for-writing flags cleared. */
 static int image_copy(run *r, const char *name)
@@ -661,6 +712,7 @@ int main(int argc, char **argv)
     static const check_test tests[] = {
         T(test_result_layout_and_swmr_reads), T(test_result_reader_follows_writer),
         T(test_result_writer_stopped_mid_append), T(test_result_reopen_after_crash), T(test_result_reopen_clean_file_keeps_all),
+        T(test_result_reopen_adds_fragment_series_to_older_file),
         T(test_result_image_opens_plainly), T(test_result_image_checksum_matches_hdf5),
         T(test_result_check_file_refuses_damage), T(test_result_minimal_fields_without_constraints),
         T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),

@@ -1,0 +1,94 @@
+/*
+ * fragments.c - `fdemctl fragments ID`: the pieces a case has broken into
+ * and their sieve curve (GET /cases/ID/fragments, contract 5.4), as a
+ * table a person reads; --json passes the server's answer through for
+ * scripts.
+ *
+ * Why a file of its own: the table and the curve are the one place fdemctl
+ * formats fragment records; commands.c stays with the status-like commands.
+ */
+#include "fdemctl.h"
+
+#include <jansson.h>
+#include <string.h>
+
+static const char USAGE_FRAGMENTS[] =
+    "usage: fdemctl fragments ID [--json]\n"
+    "  The fragments of the case at one step boundary: id, elements, mass,\n"
+    "  size (area in 2D, volume in 3D), equivalent diameter, centroid and\n"
+    "  velocity of each, then the sieve curve (mass fraction of fragments no\n"
+    "  larger than each diameter). --json prints the server's JSON instead.\n";
+
+static double number_at(const json_t *o, const char *key)
+{
+    return json_number_value(json_object_get(o, key));
+}
+
+/* "(x, y)" or "(x, y, z)" of a JSON array of numbers, %.4g each. */
+static void vector_text(const json_t *v, char *out, size_t size)
+{
+    size_t n = (size_t)snprintf(out, size, "(");
+    for (size_t k = 0; k < json_array_size(v) && n < size; k++)
+        n += (size_t)snprintf(out + n, size - n, "%s%.4g", k ? ", " : "",
+                              json_number_value(json_array_get(v, k)));
+    if (n < size) snprintf(out + n, size - n, ")");
+}
+
+static void print_fragments(const json_t *body)
+{
+    const json_t *list = json_object_get(body, "fragments");
+    double total = 0;
+    for (size_t i = 0; i < json_array_size(list); i++) total += number_at(json_array_get(list, i), "mass");
+    printf("step %lld, t = %.6g s: %zu fragments, total mass %.6g kg (per metre in 2D)\n",
+           (long long)json_integer_value(json_object_get(body, "step")), number_at(body, "time"),
+           json_array_size(list), total);
+    printf("%6s %9s %12s %12s %12s  %-30s %s\n", "id", "elements", "mass", "size", "diameter",
+           "centroid", "velocity");
+    for (size_t i = 0; i < json_array_size(list); i++) {
+        const json_t *f = json_array_get(list, i);
+        char centroid[96], velocity[96];
+        vector_text(json_object_get(f, "centroid"), centroid, sizeof centroid);
+        vector_text(json_object_get(f, "velocity"), velocity, sizeof velocity);
+        printf("%6lld %9lld %12.6g %12.6g %12.6g  %-30s %s\n",
+               (long long)json_integer_value(json_object_get(f, "id")),
+               (long long)json_integer_value(json_object_get(f, "elements")), number_at(f, "mass"),
+               number_at(f, "size"), number_at(f, "diameter"), centroid, velocity);
+    }
+    const json_t *curve = json_object_get(body, "distribution");
+    printf("\nsieve curve: mass fraction passing\n%12s %9s\n", "diameter", "passing");
+    for (size_t i = 0; i < json_array_size(curve); i++) {
+        const json_t *p = json_array_get(curve, i);
+        printf("%12.6g %8.2f %%\n", number_at(p, "diameter"), 100 * number_at(p, "passing"));
+    }
+}
+
+int cmd_fragments(const ctl_options *o, int argc, char **argv)
+{
+    int raw = 0;
+    const char *id[1];
+    ctl_option_spec specs[] = {{"--json", NULL, NULL, &raw}, {0}};
+    int n = ctl_parse_args(argc, argv, specs, USAGE_FRAGMENTS, id, 1, 1);
+    if (n < 0) return ctl_args_exit(n);
+    char path[1024];
+    if (http_case_path(path, sizeof path, id[0], "/fragments") != 0) {
+        fprintf(stderr, "fdemctl fragments: case id too long\n");
+        return CTL_USAGE;
+    }
+    http_response r;
+    int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
+    if (code) return code;
+    json_error_t error;
+    json_t *body = raw ? NULL : json_loadb(r.body, r.length, 0, &error);
+    if (raw) {
+        fwrite(r.body, 1, r.length, stdout);
+        if (r.length == 0 || r.body[r.length - 1] != '\n') fputc('\n', stdout);
+    } else if (!body || !json_is_array(json_object_get(body, "fragments"))) {
+        fprintf(stderr, "fdemctl fragments: the server's answer is not a fragment list\n");
+        code = CTL_FAIL;
+    } else {
+        print_fragments(body);
+    }
+    json_decref(body);
+    http_response_free(&r);
+    return code;
+}
