@@ -7,7 +7,8 @@ more than one fragment; result.h5 has /mesh/joints (J, 6) of valid node
 indices whose two faces are copies of the same points, and
 /snapshots/damage (S, J) in [0, 1], never decreasing; the energy accounts
 are there, fracture > 0 (at least G_I times one cross-section) and the
-residual within 1 % of the work done; result.xdmf parses and draws the
+residual within 1 % of the work done; the fragments route, the status and
+/snapshots/fragment agree on the pieces; result.xdmf parses and draws the
 joints as triangles."""
 import os
 import unittest
@@ -18,7 +19,7 @@ import numpy as np
 
 from fdemd_harness import DaemonTestCase
 
-LENGTH, SIDE, SPEED = 0.1, 0.01, 5.0
+LENGTH, SIDE, SPEED, RHO = 0.1, 0.01, 5.0, 2700.0
 ENERGY_I = 10.0
 CELLS = 10
 TETS = 6 * CELLS
@@ -33,7 +34,7 @@ def pulled_bar_case():
         "name": "pulled-bar-3d",
         "dimension": 3,
         "materials": {"rock": {
-            "density": 2700, "young": 3e10, "poisson": 0.25, "damping": 0.1, "friction": 0.3,
+            "density": RHO, "young": 3e10, "poisson": 0.25, "damping": 0.1, "friction": 0.3,
             "fracture": {"tensile_strength": 1e6, "cohesion": 3e6, "friction_angle": 30,
                          "energy_I": ENERGY_I, "energy_II": 50}}},
         "parts": [{"name": "bar", "material": "rock", "fracture": True,
@@ -54,6 +55,7 @@ class PulledBar3DThroughDaemon(DaemonTestCase):
         super().setUpClass()
         st = cls.d.create(pulled_bar_case(), start=True)
         cls.final = cls.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=120)
+        cls.pieces = cls.d.json("GET", "/cases/%s/fragments" % st["id"])
         cls.files = {}
         for name in ("result.h5", "result.xdmf"):
             status, _, data = cls.d.request("GET", "/cases/%s/%s" % (st["id"], name))
@@ -89,6 +91,25 @@ class PulledBar3DThroughDaemon(DaemonTestCase):
         self.assertTrue(np.all(damage[0] == 0))
         self.assertTrue(np.all(np.diff(damage, axis=0) >= 0), "damage decreased")
         self.assertEqual(int((damage[-1] >= 1).sum()), st["broken_joints"])
+
+    def test_fragments_are_the_pieces_of_the_bar(self):
+        """The fragments route, the status and /snapshots/fragment agree, and
+        the pieces add up to the bar: its mass rho L A and its volume."""
+        status, body = self.pieces
+        self.assertEqual(status, 200, body)
+        pieces = body["fragments"]
+        self.assertEqual(len(pieces), self.final["fragments"])
+        self.assertEqual(sum(p["elements"] for p in pieces), TETS)
+        volume = LENGTH * SIDE * SIDE
+        self.assertAlmostEqual(sum(p["size"] for p in pieces) / volume, 1.0, delta=1e-9)
+        self.assertAlmostEqual(sum(p["mass"] for p in pieces) / (RHO * volume), 1.0, delta=1e-9)
+        self.assertTrue(all(len(p["centroid"]) == 3 and len(p["velocity"]) == 3 for p in pieces))
+        self.assertEqual(body["distribution"][-1]["passing"], 1.0)
+        with h5py.File(self.files["result.h5"], "r") as f:
+            label = f["/snapshots/fragment"][...]
+        self.assertEqual(label.shape[1], TETS)
+        self.assertTrue(np.all(label[0] == 0), "the bar starts in one piece")
+        self.assertEqual(int(label[-1].max()) + 1, self.final["fragments"])
 
     def test_energy_balance_closes_with_fracture(self):
         e = self.final["energy"]
