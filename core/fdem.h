@@ -228,6 +228,7 @@ typedef struct fdem_energy {
 } fdem_energy;
 
 typedef struct fdem_counts {
+    int dimension;     /* 2 or 3 */
     int nodes, elements, parts, materials, constraints;
     int joints, broken_joints;
     int fragments;     /* connected pieces through intact joints (parts count as one each) */
@@ -341,6 +342,9 @@ size_t fdem_memory_bytes(const fdem_model *model);
  * need once finalized (to reject oversized cases before building them). */
 size_t fdem_memory_estimate(long nodes, long elements, long joints);
 size_t fdem_memory_estimate_3d(long nodes, long elements, long joints);
+/* The estimate of the counts' dimension (a dimension of 0, as in counts
+ * stored before 3D, is 2). */
+size_t fdem_memory_estimate_of(const fdem_counts *counts);
 
 #ifdef __cplusplus
 }

@@ -525,6 +525,7 @@ double fdem_get_time(const fdem_model *m) { return m->time; }
 fdem_counts fdem_get_counts(const fdem_model *m)
 {
     fdem_counts c = {0};
+    c.dimension = m->dim;
     c.nodes = m->node_count;
     c.elements = m->elem_count;
     c.parts = m->part_count;
@@ -594,6 +595,12 @@ size_t fdem_memory_estimate_3d(long nodes, long elements, long joints)
     size_t elem_joint = joints > 0 ? (size_t)elements * 4 * sizeof(int32_t) : 0;
     return (size_t)nodes * per_node + (size_t)elements * per_elem + (size_t)joints * per_joint +
            elem_joint;
+}
+
+size_t fdem_memory_estimate_of(const fdem_counts *n)
+{
+    return n->dimension == 3 ? fdem_memory_estimate_3d(n->nodes, n->elements, n->joints)
+                             : fdem_memory_estimate(n->nodes, n->elements, n->joints);
 }
 
 size_t fdem_memory_bytes(const fdem_model *m)

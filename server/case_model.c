@@ -33,7 +33,7 @@ size_t case_model_cost_of(server_case *c)
     pthread_mutex_lock(&c->lock);
     fdem_counts n = c->fig.counts;
     pthread_mutex_unlock(&c->lock);
-    return case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
+    return case_model_cost((double)fdem_memory_estimate_of(&n));
 }
 
 int case_model_gate(void *ctx, double estimate)
@@ -166,7 +166,7 @@ case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_mode
         return rc;
     }
     fdem_counts n = fdem_get_counts(*model);
-    size_t cost = case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
+    size_t cost = case_model_cost((double)fdem_memory_estimate_of(&n));
     if (lease->bytes > cost)
         membudget_shrink(lease, lease->bytes - cost); /* the file and its tree are freed */
     return CASE_MODEL_OK;

@@ -142,6 +142,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "end_time", json_number_or_null(end));
     json_object_set_new(o, "progress", json_number_or_null(progress));
     json_object_set_new(o, "dt", json_number_or_null(f.dt));
+    json_object_set_new(o, "dimension", json_integer(f.counts.dimension ? f.counts.dimension : 2));
     json_object_set_new(o, "nodes", json_integer(f.counts.nodes));
     json_object_set_new(o, "elements", json_integer(f.counts.elements));
     json_object_set_new(o, "joints", json_integer(f.counts.joints));

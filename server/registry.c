@@ -778,7 +778,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     if (case_publish_dir(c, final_dir, err, errlen) != 0)
         goto fail;
     fdem_counts n = fdem_get_counts(model);
-    size_t cost = case_model_cost((double)fdem_memory_estimate(n.nodes, n.elements, n.joints));
+    size_t cost = case_model_cost((double)fdem_memory_estimate_of(&n));
     /* Its t = 0 is stored: the model is stepped for a moment to time the
      * run, then freed; a start builds it again from the stored files, as
      * every later start does. */

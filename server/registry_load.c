@@ -46,7 +46,7 @@ static int status_count(const json_t *o, const char *key)
 static void case_load_figures(server_case *c, const json_t *st)
 {
     static const struct { const char *key; size_t offset; } counts[] = {
-        {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
+        {"dimension", offsetof(fdem_counts, dimension)}, {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
         {"joints", offsetof(fdem_counts, joints)},
         {"broken_joints", offsetof(fdem_counts, broken_joints)},
         {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},

@@ -186,6 +186,7 @@ class Solid3DTest(DaemonTestCase):
     def run_free_fall(self, case):
         st = self.run_case(case)
         self.assertEqual(st["state"], "finished", st.get("error"))
+        self.assertEqual(st["dimension"], 3)
         self.assertEqual(st["joints"], 0)
         self.assertEqual(st["fragments"], 1)
         state = self.check_state(st)
