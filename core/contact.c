@@ -53,17 +53,6 @@ typedef struct contact_touches {
     size_t count, capacity;
 } contact_touches;
 
-static inline int element_material(const fdem_model *m, int e)
-{
-    return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
-}
-
-/* From the hot record, which also holds the material: one cache line. */
-static inline const int32_t *element_nodes(const fdem_model *m, int e)
-{
-    return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
-}
-
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
 static inline int boxes_overlap(const double *a, const double *b, int dim)
 {

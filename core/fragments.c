@@ -34,16 +34,6 @@ int fdem_fragment_labels(const fdem_model *m, int32_t *label)
     return count;
 }
 
-static double element_size0(const fdem_model *m, int e)
-{
-    return m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
-}
-
-static int element_material(const fdem_model *m, int e)
-{
-    return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
-}
-
 /* Diameter of the circle (2D) or sphere (3D) of the given size. */
 static double equivalent_diameter(int dim, double size)
 {

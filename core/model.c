@@ -426,9 +426,7 @@ static void lump_masses(fdem_model *m)
     memset(m->mass, 0, sizeof(double) * (size_t)m->node_count);
     const int K = m->elem_nodes;
     for (int e = 0; e < m->elem_count; e++) {
-        int mat = m->dim == 3 ? m->tet[e].material : m->elem[e].material;
-        double size = m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
-        double share = m->materials[mat].def.density * size / K;
+        double share = m->materials[element_material(m, e)].def.density * element_size0(m, e) / K;
         const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
         for (int c = 0; c < K; c++) m->mass[n[c]] += share;
     }
@@ -441,7 +439,7 @@ static int build_scatter_plans(fdem_model *m)
 {
     _Static_assert(sizeof(element_hot) % sizeof(int32_t) == 0, "element records in int32 words");
     _Static_assert(sizeof(tet_hot) % sizeof(int32_t) == 0, "element records in int32 words");
-    const int32_t *first = m->dim == 3 ? m->tet[0].node : m->elem[0].node;
+    const int32_t *first = element_nodes(m, 0);
     size_t stride = (m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) / sizeof(int32_t);
     if (m->elem_count &&
         scatter_plan_build(&m->elem_plan, m->elem_count,
@@ -481,7 +479,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     int damped = 0;
     for (int e = 0; e < m->elem_count; e++) {
         if (element_prepare(m, e, err)) return -1;
-        damped |= (m->dim == 3 ? m->tet[e].eta : m->elem[e].eta) > 0;
+        damped |= element_eta(m, e) > 0;
     }
     if (damped && !(m->elem_viscous = calloc((size_t)model_stress_comps(m) * (size_t)m->elem_count,
                                              sizeof(double)))) {

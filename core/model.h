@@ -218,6 +218,28 @@ void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt
 /* Stress components per element: 3 in 2D, 6 in 3D. */
 static inline int model_stress_comps(const fdem_model *m) { return m->dim == 3 ? 6 : 3; }
 
+/* What every element's hot record holds, whichever its dimension. */
+static inline int element_material(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
+}
+
+static inline const int32_t *element_nodes(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
+}
+
+/* Initial area (2D) or volume (3D), set by element_prepare. */
+static inline double element_size0(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
+}
+
+static inline double element_eta(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].eta : m->elem[e].eta;
+}
+
 /* element.c: the element stage of either dimension (prepare, stable step,
  * forces through the scatter plan, stress), calling the kernels below */
 int element_prepare(fdem_model *m, int e, fdem_error *err);
