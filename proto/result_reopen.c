@@ -131,18 +131,12 @@ static int add_fragment_series(hid_t group, result_file *f, char *err, size_t er
     series *s = &f->ds[SERIES_FRAGMENT];
     if (s->rank == 0 || H5Lexists(group, series_names[SERIES_FRAGMENT], H5P_DEFAULT) > 0)
         return 0;
-    hid_t time = H5Dopen2(group, series_names[SERIES_TIME], H5P_DEFAULT);
-    hsize_t rows = 0;
-    if (time >= 0) {
-        hid_t space = H5Dget_space(time);
-        if (space >= 0) {
-            H5Sget_simple_extent_dims(space, &rows, NULL);
-            H5Sclose(space);
-        }
-        H5Dclose(time);
-    }
+    series time = {0};
+    time.id = H5Dopen2(group, series_names[SERIES_TIME], H5P_DEFAULT);
+    hsize_t rows = time.id >= 0 ? series_length(&time) : 0;
+    if (time.id >= 0) H5Dclose(time.id);
     hsize_t dims[3] = {rows, s->row[0], s->row[1]};
-    if (time < 0 || series_create(group, SERIES_FRAGMENT, s) < 0 || H5Dset_extent(s->id, dims) < 0) {
+    if (time.id < 0 || series_create(group, SERIES_FRAGMENT, s) < 0 || H5Dset_extent(s->id, dims) < 0) {
         result_fail(err, errlen, "cannot add /snapshots/fragment to a result file written "
                     "before fragments were recorded");
         return -1;
