@@ -547,7 +547,46 @@ static void checkpoint_carries_ramped_loads(void)
     fdem_model_destroy(second);
 }
 
+/* A fracturing part has its own nodes in every element, joined by joints:
+ * its boundary is still only the outline (facets are matched by mesh
+ * vertex), so a pressure on the part loads 2 (nx + ny) edges in 2D and the
+ * 2 x 2 (nx ny + ny nz + nz nx) outer triangles of a box in 3D, and sums
+ * to zero. */
+static void fracturing_part_boundary_is_its_outline(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = fdem_model_create();
+        fdem_error err;
+        if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
+        int mat = build_fracturing_rock(m, 0);
+        int body, want;
+        if (dim == 2) {
+            body = build_rectangle_part(m, mat, 0, 0, 0.3, 0.2, 6, 4, 1);
+            want = 2 * (6 + 4);
+        } else {
+            const double origin[3] = {0, 0, 0}, size[3] = {0.3, 0.2, 0.1};
+            const int div[3] = {3, 2, 2};
+            fdem_tet_mesh mesh;
+            if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box", &err);
+            body = fdem_add_part_3d(m, &mesh, mat, 1, &err);
+            fdem_tet_mesh_free(&mesh);
+            if (body < 0) build_die("part", &err);
+            want = 2 * 2 * (3 * 2 + 2 * 2 + 2 * 3);
+        }
+        fdem_constraint_def all = pressure_on_part(body, 1e6);
+        add_constraint(m, &all);
+        build_finalize(m, 0.5);
+        CHECK(fdem_get_counts(m).joints > 0, "%dD: no joints", dim);
+        CHECK(m->constraints[0].facet_count == want, "%dD: %d facets loaded, want %d", dim,
+              m->constraints[0].facet_count, want);
+        const double *f = forces_after_one_step(m);
+        for (int d = 0; d < dim; d++) CHECK_NEAR(f[d], 0, 1e-9 * 1e6 * 0.1);
+        fdem_model_destroy(m);
+    }
+}
+
 static const check_test tests[] = {
+    {"fracturing_part_boundary_is_its_outline", fracturing_part_boundary_is_its_outline},
     {"checkpoint_carries_ramped_loads", checkpoint_carries_ramped_loads},
     {"pulse_leaves_through_absorbing_end", pulse_leaves_through_absorbing_end},
     {"pulse_reflects_from_free_end", pulse_reflects_from_free_end},
