@@ -674,6 +674,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 2 * sizeof(double));
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
+    /* boundary facets of pressures and dashpots: nodes, element, forces */
+    b += (size_t)m->bfacet_count * ((D + 1) * sizeof(int32_t) + D * D * sizeof(double));
     b += contact_memory_bytes(&m->contact);
     return b;
 }
