@@ -7,7 +7,11 @@
  *  - a thick ring under a slowly ramped internal pressure carries Lame's
  *    hoop stress at the bore, p (b^2 + a^2) / (b^2 - a^2), to 5 %;
  *  - a plane P pulse leaves a bar through an absorbing end (under 5 % of its
- *    energy stays) and comes back from a free end without it (over 80 %);
+ *    energy stays) and comes back from a free end without it (over 80 %),
+ *    and so does a plane S pulse; each puts in the energy its impedance
+ *    takes;
+ *  - a fracturing part's pressure loads its outline only;
+ *  - a checkpoint carries ramped loads across a restore to the bit;
  *  - a velocity ramped from zero starts without the force step of an
  *    impedance rho c v;
  *  - the energy balance closes with pressures, dashpots and a ramped
@@ -298,8 +302,9 @@ static double bar_wave_speed(void)
 }
 
 /* The bar in 2D (triangles) or 3D (a 200 x 2 x 2 box of tetrahedra, H x H
- * across, held in y and z). */
-static fdem_model *build_bar(int dim)
+ * across), held in y and z for P waves, in x and z for S waves polarised
+ * in y (shear != 0). */
+static fdem_model *build_bar(int dim, int shear)
 {
     fdem_model *m = fdem_model_create();
     fdem_error err;
@@ -317,7 +322,7 @@ static fdem_model *build_bar(int dim)
         if (body < 0) build_die("bar", &err);
     }
     fdem_constraint_def lateral = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_FIX,
-                                   .fix_y = 1, .fix_z = 1};
+                                   .fix_x = shear, .fix_y = !shear, .fix_z = 1};
     for (int d = 0; d < dim; d++) {
         lateral.box[d] = -1;
         lateral.box[dim + d] = bar_L + 1;
@@ -341,7 +346,7 @@ static void bar_end_box(int dim, double x0, double x1, double box[6])
  * Lysmer dashpot: next to nothing (R = 0 for a plane wave). */
 static double energy_left_after_pulse(int dim, int absorb)
 {
-    fdem_model *m = build_bar(dim);
+    fdem_model *m = build_bar(dim, 0);
     const double c = bar_wave_speed(), tau = 1.0 / c;
     double table[2 * 21];
     for (int k = 0; k <= 20; k++) {
@@ -370,6 +375,10 @@ static double energy_left_after_pulse(int dim, int absorb)
             dim, absorb ? "absorbing" : "free", en.external_work, 100 * left, en.damping,
             100 * worst / en.external_work);
     CHECK(worst < 0.01 * en.external_work, "residual %g J/m", worst);
+    /* what a pressure p(t) puts into a bar of impedance rho c: the integral
+     * of p^2 A / (rho c), 3/8 p0^2 A tau / (rho c) for a sin^2 pulse */
+    double area = dim == 3 ? bar_H * bar_H : bar_H;
+    CHECK_REL(en.external_work, 0.375 * 1e12 * area * tau / (bar_rho * c), 0.03);
     fdem_model_destroy(m);
     return left;
 }
@@ -386,6 +395,52 @@ static void pulse_reflects_from_free_end(void)
     CHECK(energy_left_after_pulse(3, 0) > 0.80, "less than 80 %% reflected (3D)");
 }
 
+/* The same for a plane S wave: a sin^2 velocity pulse in y (0.1 m/s, 1 m
+ * long at c_s = sqrt(mu / rho)) on the end x = 0, held still after it; the
+ * far end's tangential dashpot rho c_s takes it out. */
+static double energy_left_after_shear_pulse(int dim, int absorb)
+{
+    fdem_model *m = build_bar(dim, 1);
+    const double c_s = sqrt(bar_E / (2 * (1 + bar_nu) * bar_rho)), tau = 1.0 / c_s;
+    double table[2 * 21];
+    for (int k = 0; k <= 20; k++) {
+        table[2 * k] = tau * k / 20;
+        table[2 * k + 1] = pow(sin(M_PI * k / 20), 2);
+    }
+    fdem_constraint_def drive = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_VELOCITY,
+                                 .value = {0, 0.1, 0}, .free_x = 1, .free_z = 1,
+                                 .amplitude = table, .amplitude_count = 21};
+    fdem_constraint_def end = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_ABSORB};
+    bar_end_box(dim, -1, 1e-6, drive.box);
+    bar_end_box(dim, bar_L - 1e-6, bar_L + 1, end.box);
+    add_constraint(m, &drive);
+    if (absorb) add_constraint(m, &end);
+    build_finalize(m, 0.5);
+    fdem_error err;
+    while (fdem_get_time(m) < tau + 1.5 * bar_L / c_s)
+        if (fdem_step(m, &err)) build_die("step", &err);
+    fdem_energy en = fdem_get_energy(m);
+    double left = (en.kinetic + en.elastic) / en.external_work;
+    fprintf(stderr, "  %dD S pulse, %s end: %.4g J/m in, %.4g %% left, %.4g J/m absorbed, residual "
+                    "%.3g J/m\n",
+            dim, absorb ? "absorbing" : "free", en.external_work, 100 * left, en.damping,
+            en.residual);
+    CHECK(fabs(en.residual) < 0.01 * en.external_work, "residual %g J/m", en.residual);
+    /* a velocity v(t) drives rho c_s A v^2: 3/8 rho c_s A v0^2 tau for sin^2 */
+    double area = dim == 3 ? bar_H * bar_H : bar_H;
+    CHECK_REL(en.external_work, 0.375 * bar_rho * c_s * area * 0.01 * tau, 0.03);
+    fdem_model_destroy(m);
+    return left;
+}
+
+static void shear_pulse_leaves_through_absorbing_end(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        CHECK(energy_left_after_shear_pulse(dim, 1) < 0.05, "%dD: more than 5 %% reflected", dim);
+        CHECK(energy_left_after_shear_pulse(dim, 0) > 0.80, "%dD: less than 80 %% reflected", dim);
+    }
+}
+
 /* The reaction of a velocity v0 on the bar's end over its first steps: a
  * plane wave needs a stress rho c v, so a step in velocity is a step to
  * F = rho c v0 H at once, and a velocity ramped over T a force rising as
@@ -393,7 +448,7 @@ static void pulse_reflects_from_free_end(void)
  * steps and, via at_half, the reaction at T / 2. */
 static double end_reaction(int ramped, int steps, double T, double *at_half)
 {
-    fdem_model *m = build_bar(2);
+    fdem_model *m = build_bar(2, 0);
     double table[4] = {0, 0, T, 1};
     fdem_constraint_def drive = {.select = FDEM_SELECT_BOX, .box = {-1, -1, 1e-6, 1},
                                  .kind = FDEM_CONSTRAINT_VELOCITY, .value = {0.1, 0},
@@ -590,6 +645,7 @@ static const check_test tests[] = {
     {"checkpoint_carries_ramped_loads", checkpoint_carries_ramped_loads},
     {"pulse_leaves_through_absorbing_end", pulse_leaves_through_absorbing_end},
     {"pulse_reflects_from_free_end", pulse_reflects_from_free_end},
+    {"shear_pulse_leaves_through_absorbing_end", shear_pulse_leaves_through_absorbing_end},
     {"ramped_velocity_has_no_force_step", ramped_velocity_has_no_force_step},
     {"ramped_gravity_settles_and_balances", ramped_gravity_settles_and_balances},
     {"pressure_totals_2d", pressure_totals_2d},
