@@ -34,6 +34,24 @@ static fdem_constraint_def pressure_on_part(int body, double p)
                                  .kind = FDEM_CONSTRAINT_PRESSURE, .value = {p}};
 }
 
+/* 21 (t, a) pairs: a ramp 0 -> 1 as (1 - cos)/2 over T, and a sin^2 pulse
+ * lasting tau, smooth enough to excite little beyond their own time scale. */
+static void ramp_table(double table[42], double T)
+{
+    for (int k = 0; k <= 20; k++) {
+        table[2 * k] = T * k / 20;
+        table[2 * k + 1] = 0.5 * (1 - cos(M_PI * k / 20));
+    }
+}
+
+static void pulse_table(double table[42], double tau)
+{
+    for (int k = 0; k <= 20; k++) {
+        table[2 * k] = tau * k / 20;
+        table[2 * k + 1] = pow(sin(M_PI * k / 20), 2);
+    }
+}
+
 /* The pressure's nodal forces after one step, as the constraint reports. */
 static const double *forces_after_one_step(fdem_model *m)
 {
@@ -225,10 +243,7 @@ static double ring_under_internal_pressure(int dim, int nr, int nt)
     double period = 2 * M_PI * 0.75 / c_p * 1.6; /* about the breathing mode's, and longer */
     double T = 10 * period;
     double table[2 * 21];
-    for (int k = 0; k <= 20; k++) {
-        table[2 * k] = T * k / 20;
-        table[2 * k + 1] = 0.5 * (1 - cos(M_PI * k / 20));
-    }
+    ramp_table(table, T);
     fdem_constraint_def bore = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_PRESSURE,
                                 .value = {p}, .amplitude = table, .amplitude_count = 21};
     for (int d = 0; d < dim; d++) {
@@ -349,10 +364,7 @@ static double energy_left_after_pulse(int dim, int absorb)
     fdem_model *m = build_bar(dim, 0);
     const double c = bar_wave_speed(), tau = 1.0 / c;
     double table[2 * 21];
-    for (int k = 0; k <= 20; k++) {
-        table[2 * k] = tau * k / 20;
-        table[2 * k + 1] = pow(sin(M_PI * k / 20), 2);
-    }
+    pulse_table(table, tau);
     fdem_constraint_def pulse = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_PRESSURE,
                                  .value = {1e6}, .amplitude = table, .amplitude_count = 21};
     fdem_constraint_def end = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_ABSORB};
@@ -403,10 +415,7 @@ static double energy_left_after_shear_pulse(int dim, int absorb)
     fdem_model *m = build_bar(dim, 1);
     const double c_s = sqrt(bar_E / (2 * (1 + bar_nu) * bar_rho)), tau = 1.0 / c_s;
     double table[2 * 21];
-    for (int k = 0; k <= 20; k++) {
-        table[2 * k] = tau * k / 20;
-        table[2 * k + 1] = pow(sin(M_PI * k / 20), 2);
-    }
+    pulse_table(table, tau);
     fdem_constraint_def drive = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_VELOCITY,
                                  .value = {0, 0.1, 0}, .free_x = 1, .free_z = 1,
                                  .amplitude = table, .amplitude_count = 21};
@@ -504,10 +513,7 @@ static double block_under_gravity(int ramped, double *worst, double *elastic)
     fdem_set_gravity(m, 0, -9.81);
     double c = sqrt(E * (1 - nu) / (rho * (1 + nu) * (1 - 2 * nu))), period = 4 * H / c;
     double T = 10 * period, table[2 * 21];
-    for (int k = 0; k <= 20; k++) {
-        table[2 * k] = T * k / 20;
-        table[2 * k + 1] = 0.5 * (1 - cos(M_PI * k / 20));
-    }
+    ramp_table(table, T);
     fdem_error err;
     if (ramped && fdem_set_gravity_amplitude(m, table, 21, &err)) build_die("amplitude", &err);
     build_finalize(m, 0.5);
