@@ -355,44 +355,61 @@ static void bar_end_box(int dim, double x0, double x1, double box[6])
     }
 }
 
-/* A sin^2 pressure pulse of 1 m (20 cells) enters at x = 0 and runs to
- * the far end; 1.5 transits later the energy still in the bar (kinetic +
- * elastic) is what the far end sent back. Free end: all of it (R = 1);
- * Lysmer dashpot: next to nothing (R = 0 for a plane wave). */
-static double energy_left_after_pulse(int dim, int absorb)
+/* Sends a sin^2 pulse 1 m (20 cells) long into the bar at x = 0 and runs
+ * until 1.5 transits after it: a P pulse of pressure (1 MPa) on a bar held
+ * in y, or (shear) an S pulse of velocity (0.1 m/s in y, the end held still
+ * after it) on a bar held in x. The far end is free or absorbing. Returns
+ * the accounts at the end; *worst gets the largest |residual| on the way. */
+static fdem_energy send_pulse(int dim, int shear, int absorb, double c, double *worst)
 {
-    fdem_model *m = build_bar(dim, 0);
-    const double c = bar_wave_speed(), tau = 1.0 / c;
+    fdem_model *m = build_bar(dim, shear);
+    const double tau = 1.0 / c;
     double table[2 * 21];
     pulse_table(table, tau);
-    fdem_constraint_def pulse = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_PRESSURE,
-                                 .value = {1e6}, .amplitude = table, .amplitude_count = 21};
+    fdem_constraint_def drive = {.select = FDEM_SELECT_BOX, .amplitude = table,
+                                 .amplitude_count = 21};
+    if (shear) {
+        drive.kind = FDEM_CONSTRAINT_VELOCITY;
+        drive.value[1] = 0.1;
+        drive.free_x = drive.free_z = 1;
+    } else {
+        drive.kind = FDEM_CONSTRAINT_PRESSURE;
+        drive.value[0] = 1e6;
+    }
     fdem_constraint_def end = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_ABSORB};
-    bar_end_box(dim, -1, 1e-6, pulse.box);
+    bar_end_box(dim, -1, 1e-6, drive.box);
     bar_end_box(dim, bar_L - 1e-6, bar_L + 1, end.box);
-    add_constraint(m, &pulse);
+    add_constraint(m, &drive);
     if (absorb) add_constraint(m, &end);
     build_finalize(m, 0.5);
     fdem_error err;
-    double worst = 0;
+    *worst = 0;
     while (fdem_get_time(m) < tau + 1.5 * bar_L / c) {
         if (fdem_step(m, &err)) build_die("step", &err);
-        fdem_energy en = fdem_get_energy(m);
-        worst = fmax(worst, fabs(en.residual));
+        *worst = fmax(*worst, fabs(fdem_get_energy(m).residual));
     }
     fdem_energy en = fdem_get_energy(m);
-    double left = (en.kinetic + en.elastic) / en.external_work;
-    fprintf(stderr, "  %dD pulse, %s end: %.4g J/m in, %.4g %% left, %.4g J/m absorbed; worst residual "
-                    "%.3g %% of the input\n",
-            dim, absorb ? "absorbing" : "free", en.external_work, 100 * left, en.damping,
-            100 * worst / en.external_work);
-    CHECK(worst < 0.01 * en.external_work, "residual %g J/m", worst);
-    /* what a pressure p(t) puts into a bar of impedance rho c: the integral
-     * of p^2 A / (rho c), 3/8 p0^2 A tau / (rho c) for a sin^2 pulse */
-    double area = dim == 3 ? bar_H * bar_H : bar_H;
-    CHECK_REL(en.external_work, 0.375 * 1e12 * area * tau / (bar_rho * c), 0.03);
+    fprintf(stderr, "  %dD %s pulse, %s end: %.4g J/m in, %.4g %% left, %.4g J/m absorbed; worst "
+                    "residual %.3g %% of the input\n",
+            dim, shear ? "S" : "P", absorb ? "absorbing" : "free", en.external_work,
+            100 * (en.kinetic + en.elastic) / en.external_work, en.damping,
+            100 * *worst / en.external_work);
+    CHECK(*worst < 0.01 * en.external_work, "residual %g J/m", *worst);
     fdem_model_destroy(m);
-    return left;
+    return en;
+}
+
+/* P pulse: free end, all of the energy stays (R = 1); Lysmer dashpot, next
+ * to nothing (R = 0 for a plane wave). What the pressure puts in a bar of
+ * impedance rho c is the integral of p^2 A / (rho c), 3/8 p0^2 A tau /
+ * (rho c) for a sin^2 pulse. Returns the fraction left. */
+static double energy_left_after_pulse(int dim, int absorb)
+{
+    const double c = bar_wave_speed(), area = dim == 3 ? bar_H * bar_H : bar_H;
+    double worst;
+    fdem_energy en = send_pulse(dim, 0, absorb, c, &worst);
+    CHECK_REL(en.external_work, 0.375 * 1e12 * area / (c * bar_rho * c), 0.03);
+    return (en.kinetic + en.elastic) / en.external_work;
 }
 
 static void pulse_leaves_through_absorbing_end(void)
@@ -407,39 +424,16 @@ static void pulse_reflects_from_free_end(void)
     CHECK(energy_left_after_pulse(3, 0) > 0.80, "less than 80 %% reflected (3D)");
 }
 
-/* The same for a plane S wave: a sin^2 velocity pulse in y (0.1 m/s, 1 m
- * long at c_s = sqrt(mu / rho)) on the end x = 0, held still after it; the
- * far end's tangential dashpot rho c_s takes it out. */
+/* S pulse: the far end's tangential dashpot rho c_s takes it out. A
+ * velocity v(t) drives rho c_s A v^2: 3/8 rho c_s A v0^2 tau for sin^2. */
 static double energy_left_after_shear_pulse(int dim, int absorb)
 {
-    fdem_model *m = build_bar(dim, 1);
-    const double c_s = sqrt(bar_E / (2 * (1 + bar_nu) * bar_rho)), tau = 1.0 / c_s;
-    double table[2 * 21];
-    pulse_table(table, tau);
-    fdem_constraint_def drive = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_VELOCITY,
-                                 .value = {0, 0.1, 0}, .free_x = 1, .free_z = 1,
-                                 .amplitude = table, .amplitude_count = 21};
-    fdem_constraint_def end = {.select = FDEM_SELECT_BOX, .kind = FDEM_CONSTRAINT_ABSORB};
-    bar_end_box(dim, -1, 1e-6, drive.box);
-    bar_end_box(dim, bar_L - 1e-6, bar_L + 1, end.box);
-    add_constraint(m, &drive);
-    if (absorb) add_constraint(m, &end);
-    build_finalize(m, 0.5);
-    fdem_error err;
-    while (fdem_get_time(m) < tau + 1.5 * bar_L / c_s)
-        if (fdem_step(m, &err)) build_die("step", &err);
-    fdem_energy en = fdem_get_energy(m);
-    double left = (en.kinetic + en.elastic) / en.external_work;
-    fprintf(stderr, "  %dD S pulse, %s end: %.4g J/m in, %.4g %% left, %.4g J/m absorbed, residual "
-                    "%.3g J/m\n",
-            dim, absorb ? "absorbing" : "free", en.external_work, 100 * left, en.damping,
-            en.residual);
-    CHECK(fabs(en.residual) < 0.01 * en.external_work, "residual %g J/m", en.residual);
-    /* a velocity v(t) drives rho c_s A v^2: 3/8 rho c_s A v0^2 tau for sin^2 */
-    double area = dim == 3 ? bar_H * bar_H : bar_H;
-    CHECK_REL(en.external_work, 0.375 * bar_rho * c_s * area * 0.01 * tau, 0.03);
-    fdem_model_destroy(m);
-    return left;
+    const double c_s = sqrt(bar_E / (2 * (1 + bar_nu) * bar_rho));
+    const double area = dim == 3 ? bar_H * bar_H : bar_H;
+    double worst;
+    fdem_energy en = send_pulse(dim, 1, absorb, c_s, &worst);
+    CHECK_REL(en.external_work, 0.375 * bar_rho * c_s * area * 0.01 / c_s, 0.03);
+    return (en.kinetic + en.elastic) / en.external_work;
 }
 
 static void shear_pulse_leaves_through_absorbing_end(void)
