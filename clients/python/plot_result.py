@@ -15,10 +15,11 @@ as its triangles, coloured by
                 svm = sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2) / 2
                            + 3 * sxy^2).
             nu is each part's material's "poisson", read from the case
-            document the file carries (root attribute `case`, contract
-            5.4). --case CASE.json reads it from that document instead, and
-            --poisson NU uses NU for every element. A file without the
-            attribute (written before it existed) needs one of the two.
+            document the file carries (root attribute `case`,
+            docs/results.md). --case CASE.json reads it from that
+            document instead, and --poisson NU uses NU for every element.
+            A file without the attribute (written before it existed)
+            needs one of the two.
   velocity  speed |v| per node from /snapshots/velocity.
   damage    every joint of /mesh/joints as a segment coloured by its damage
             (0 intact ... 1 broken) over the mesh in grey.
@@ -53,7 +54,7 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-# Stress components as stored: 2D (sxx, syy, sxy); 3D (contract 5.2)
+# Stress components as stored: 2D (sxx, syy, sxy); 3D (docs/results.md)
 # (sxx, syy, szz, syz, sxz, sxy).
 COMPONENTS = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
 
@@ -324,7 +325,7 @@ def plot_3d(f, args, field):
 
 
 def result_dimension(f):
-    """3 for a tetrahedral result (contract 5.2), else 2."""
+    """3 for a tetrahedral result (docs/results.md, "Three dimensions"), else 2."""
     return int(f.attrs.get("dimension", 3 if "/mesh/tetrahedra" in f else 2))
 
 

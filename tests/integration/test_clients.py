@@ -621,6 +621,29 @@ class Clients3DTests(ClientTestCase):
             self.assertIn("py3d.h5:/", f.read())
 
 
+class DocReferenceTests(unittest.TestCase):
+    """Every doc the Python clients' docstrings and comments send a reader
+    to exists in the repository, with the section they name."""
+
+    def test_referenced_docs_exist(self):
+        import re
+        found = 0
+        for name in ("fdemd_client.py", "plot_result.py"):
+            with open(os.path.join(ROOT, "clients", "python", name)) as f:
+                text = " ".join(f.read().split())  # references may wrap lines
+            self.assertNotRegex(text, r"[Cc]ontract \d", "%s cites the spec, not a doc" % name)
+            for doc, section in re.findall(r"(docs/[\w-]+\.md)(?:, \"([^\"]+)\")?", text):
+                found += 1
+                path = os.path.join(ROOT, doc)
+                self.assertTrue(os.path.exists(path), "%s names %s" % (name, doc))
+                if section:
+                    with open(path) as f:
+                        headings = [line.lstrip("#").strip() for line in f
+                                    if line.startswith("#")]
+                    self.assertIn(section, headings, "%s names %s, %r" % (name, doc, section))
+        self.assertGreaterEqual(found, 3)
+
+
 class VonMisesTests(unittest.TestCase):
     """The plane-strain von Mises formula of plot_result.py on known states."""
 
