@@ -247,8 +247,9 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
     fdem_error err = {0};
     int ok = fdem_set_dimension(model, doc->dimension, &err) == 0;
     if (!ok) case_engine_problem(doc, &err, "/dimension");
-    ok = ok && case_add_materials(doc, model) == 0 && case_add_parts(doc, model) == 0 &&
-         case_add_constraints(doc, model) == 0;
+    /* parts and constraints both, whatever the other finds (one answer) */
+    ok = ok && case_add_materials(doc, model) == 0;
+    ok = ok && (case_add_parts(doc, model) == 0) & (case_add_constraints(doc, model) == 0);
     if (ok) {
         fdem_set_gravity_v(model, doc->gravity);
         ok = fdem_model_finalize(model, &err) == 0;

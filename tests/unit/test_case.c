@@ -602,6 +602,20 @@ static void independent_problems_in_one_pass(void)
     problems_free(&p);
     json_decref(doc);
 
+    /* the engine refuses two meshes: both are named */
+    doc = load(base_text);
+    edit(doc, "/parts/2/mesh/nodes", load("[[1, 0], [2, 0], [3, 0], [2, 1]]"));
+    edit(doc, "/parts/3", load("{'name': 'flat', 'material': 'rock', 'mesh': {'nodes': "
+                               "[[5, 5], [6, 6], [7, 7]], 'triangles': [[0, 1, 2]]}}"));
+    m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(p.count == 2 && has_problem(&p, "/parts/2/mesh/triangles/0", "") &&
+          has_problem(&p, "/parts/3/mesh/triangles/0", ""), "%d problems, want both meshes",
+          p.count);
+    if (p.count != 2) dump_problems(&p);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+
     doc = load(base_text);
     edit(doc, "/time/dt", json_real(1e-3));
     edit(doc, "/constraints/1/box", load("[10, 10, 11, 11]"));
