@@ -194,7 +194,9 @@ int fdem_model_finalize(fdem_model *model, fdem_error *err);
 
 /* Largest stable step of the finalized model: the smallest of the elements'
  * dilatational-wave limit (reduced for damping) and the contact penalty
- * limit (only if some body can touch another). Multiply by a safety factor. */
+ * limit (only if some body can touch another). Multiply by a safety factor.
+ * Also set when finalize failed only at a constraint's node selection (so a
+ * caller can judge its dt in the same answer); 0 after any earlier failure. */
 double fdem_stable_dt(const fdem_model *model);
 
 /* Step size of the next step; may change between steps (central difference

@@ -544,9 +544,6 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     lump_masses(m);
     if (joint_prepare(m, err)) return -1;
     m->fragments = joint_fragment_count(m);
-    constraint_set_time(m, 0);
-    if (constraint_select(m, err)) return -1;
-    if (boundary_load_select(m, err)) return -1;
     if (contact_init(m, err)) return -1;
     if (build_scatter_plans(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
@@ -560,6 +557,11 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     }
     dt = fmin(dt, contact_stable_dt(m));
     m->stable_dt = fmin(dt, joint_stable_dt(m));
+    /* After the stable step, so a case refused for its constraints can
+     * still be told whether its dt would do (one answer, every problem). */
+    constraint_set_time(m, 0);
+    if (constraint_select(m, err)) return -1;
+    if (boundary_load_select(m, err)) return -1;
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;

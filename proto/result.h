@@ -21,8 +21,10 @@
  *    whether it is whole (a truncated or replaced file is refused).
  *  - xdmf_write() rewrites the XDMF2 sidecar atomically (temp + rename):
  *    a temporal collection with one grid per snapshot, Triangle topology
- *    and XY geometry (3D: Tetrahedron, XYZ) and attributes as HyperSlabs
- *    into the .h5 file.
+ *    and XY geometry (3D: Tetrahedron, XYZ); each snapshot's fields are
+ *    its /xdmf views once result_finish() made them (every ParaView XDMF
+ *    reader opens that), HyperSlabs into /snapshots before (the legacy
+ *    XDMF Reader only).
  *  - Both dimensions share one layout (contract 5.2); the root attribute
  *    `dimension` says which, and /mesh/triangles becomes /mesh/tetrahedra.
  */
@@ -61,6 +63,12 @@ int result_snapshot_count(const result_file *f);
 /* Simulated time of complete snapshot `index` (NAN when out of range). */
 double result_snapshot_time(const result_file *f, int index);
 int result_close(result_file *f);
+/* Ends SWMR writing and adds the /xdmf views (result_views.c) of every
+ * snapshot; `f` stays valid for xdmf_write() and must still be closed with
+ * result_close(). -1 with err on failure (the file keeps what it had). */
+int result_finish(result_file *f, const char *path, int dimension, char *err, size_t errlen);
+/* Snapshots that have /xdmf views; the sidecar names them directly. */
+int result_view_count(const result_file *f);
 
 /* h5_name is the .h5 file name as the .xdmf refers to it (same folder). */
 int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *model,

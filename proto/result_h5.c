@@ -235,7 +235,7 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
 
 /* ---------------------------------------------------------------- snapshots */
 
-static hid_t series_file_type(int kind)
+hid_t series_file_type(int kind)
 {
     return kind == SERIES_STEP       ? H5T_STD_I64LE
          : kind == SERIES_FRAGMENT   ? H5T_STD_I32LE

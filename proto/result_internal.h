@@ -51,6 +51,7 @@ struct result_file {
     int count;     /* complete snapshots (= len(/snapshots/time)) */
     double *times; /* the time of each of them, for the XDMF sidecar */
     int times_capacity;
+    int views;     /* snapshots with /xdmf views (result_views.c) */
 };
 
 /* "what: innermost HDF5 message" into err; clears the HDF5 error stack. */
@@ -65,6 +66,7 @@ int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
 hid_t series_mem_type(int kind);
+hid_t series_file_type(int kind);
 /* Which /snapshots datasets this model has, and their per-snapshot shape. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields);
 /* File access with the latest format (SWMR); optionally clearing the

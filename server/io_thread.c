@@ -187,8 +187,14 @@ static void io_do_close(io_job *j)
     server_case *c = j->c;
     if (!c->result)
         return;
-    if (c->xdmf_dirty && !c->deleted)
+    if (!c->deleted && c->model) {
+        /* the views let every ParaView XDMF reader open the sidecar */
+        char path[1200], err[256] = "";
+        snprintf(path, sizeof path, "%s/result.h5", c->dir);
+        if (result_finish(c->result, path, fdem_get_dimension(c->model), err, sizeof err) != 0)
+            case_record_io_failure(c, "result.h5", err);
         io_write_xdmf(c, 1);
+    }
     if (result_close(c->result) != 0 && !c->deleted)
         case_record_io_failure(c, "result.h5", "its final flush failed (disk full or I/O error)");
     c->result = NULL;

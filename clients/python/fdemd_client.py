@@ -204,9 +204,10 @@ class Client:
         Returns:
             {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
             per node ([[x, y, z], ...] in 3D), stress and strain [[xx, yy,
-            xy], ...] per element (3D: xx, yy, zz, yz, xz, xy, contract 5.2;
-            strain is Green-Lagrange), principal_stress [[s1, s2], ...] (3D:
-            three) descending, damage per joint.
+            xy], ...] per element (3D: xx, yy, zz, yz, xz, xy; strain is
+            Green-Lagrange), principal_stress [[s1, s2], ...] (3D: three)
+            descending, damage per joint; docs/api.md, "GET
+            /cases/ID/state".
         """
         suffix = "/state"
         if fields:
