@@ -47,6 +47,11 @@ static int stages_read_end(const char *body, size_t size, double *end, problems 
     if (!root)
         return 400;
     snprintf(p->title, sizeof p->title, "Invalid extend request");
+    if (!json_is_object(root)) {
+        problems_add(p, 422, "", "the body must be an object {\"end\": seconds}");
+        json_decref(root);
+        return 422;
+    }
     const char *key;
     json_t *v;
     json_object_foreach(root, key, v) {
