@@ -39,6 +39,19 @@ def staged_case(name, end):
     return tiny_case(name, end=end, interval=INTERVAL)
 
 
+def staged_case_3d(name, end):
+    """A tetrahedral box pressed onto its fixed base, on the same grid."""
+    return {
+        "name": name, "dimension": 3,
+        "materials": {"rock": {"density": 2700, "young": 3e10, "poisson": 0.25}},
+        "parts": [{"name": "box", "material": "rock", "velocity": [0, 0, -1],
+                   "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [2, 2, 2]}}],
+        "constraints": [{"box": [-1, -1, -0.001, 1, 1, 0.001], "fix": ["x", "y", "z"]}],
+        "time": {"end": end},
+        "output": {"interval": INTERVAL, "fields": ["position", "velocity", "stress"]},
+    }
+
+
 def read_result(daemon, case_id):
     """Every /snapshots dataset and the root attribute `case`, from a download."""
     status, _, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
@@ -80,14 +93,20 @@ class StagesCheck:
 
 class ExtendTests(DaemonTestCase, StagesCheck):
 
-    def finished(self, name, end=OLD_END):
-        case_id = self.d.create(staged_case(name, end), start=True)["id"]
+    def finished(self, name, end=OLD_END, make=staged_case):
+        case_id = self.d.create(make(name, end), start=True)["id"]
         self.d.wait_state(case_id, "finished")
         return case_id
 
     def test_extend_continues_the_same_files_bit_identically(self):
+        self.check_extend(staged_case)
+
+    def test_extend_of_a_3d_case_is_bit_identical_too(self):
+        self.check_extend(staged_case_3d)
+
+    def check_extend(self, make):
         d = self.d
-        case_id = self.finished("extended")
+        case_id = self.finished("extended", make=make)
         before = read_result(d, case_id)
         status, st = d.json("POST", "/cases/%s/extend" % case_id, {"end": NEW_END})
         self.assertEqual(status, 200, st)
@@ -104,7 +123,7 @@ class ExtendTests(DaemonTestCase, StagesCheck):
         self.assertEqual((st["time"], st["end_time"]), (NEW_END, NEW_END))
         after = read_result(d, case_id)
         self.assertEqual(st["snapshots"], len(after["time"]))
-        straight = read_result(d, self.finished("straight", NEW_END))
+        straight = read_result(d, self.finished("straight", NEW_END, make))
         self.check_continued(before, after, straight)
         with open(os.path.join(d.data_dir, case_id, "result.xdmf")) as f:
             self.assertEqual(f.read().count("<Time "), len(after["time"]))
