@@ -108,8 +108,11 @@ class ExtendTests(DaemonTestCase, StagesCheck):
         d = self.d
         case_id = self.finished("extended", make=make)
         before = read_result(d, case_id)
+        state_path = "/cases/%s/state?fields=position,velocity,stress" % case_id
+        end_state = d.json("GET", state_path)[1]
         status, st = d.json("POST", "/cases/%s/extend" % case_id, {"end": NEW_END})
         self.assertEqual(status, 200, st)
+        self.assertEqual(d.json("GET", state_path)[1], end_state)
         self.assertEqual((st["state"], st["end_time"], st["finished_at"]),
                          ("paused", NEW_END, None))
         self.assertEqual((st["time"], st["snapshots"]), (OLD_END, len(before["time"])))
