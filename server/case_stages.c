@@ -133,6 +133,10 @@ static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_
         output = json_object();
         json_object_set_new(doc, "output", output);
     }
+    if (!json_is_object(output)) {
+        snprintf(msg, msglen, "the stored case.json has an output that is not an object");
+        return 500;
+    }
     json_t *given = json_object_get(output, "interval");
     double interval = json_is_number(given) ? json_number_value(given)
                                             : old_end / CASE_DEFAULT_SNAPSHOTS;
@@ -143,8 +147,7 @@ static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_
                      CASE_MAX_SNAPSHOTS);
         return 422;
     }
-    if (!json_is_object(output) || (!given && json_object_set_new(output, "interval",
-                                                                  json_real(interval)) != 0) ||
+    if ((!given && json_object_set_new(output, "interval", json_real(interval)) != 0) ||
         json_object_set_new(time, "end", json_real(end)) != 0) {
         snprintf(msg, msglen, "out of memory rewriting the case document");
         return 500;
