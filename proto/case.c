@@ -16,8 +16,6 @@
 
 #include "case_internal.h"
 
-#define CASE_MAX_SNAPSHOTS 1e6
-#define CASE_DEFAULT_SNAPSHOTS 100
 #define CASE_DEFAULT_SAFETY 0.5
 
 static const char *const top_keys[] = {

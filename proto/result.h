@@ -47,6 +47,10 @@ result_file *result_create(const char *path, const fdem_model *model,
 result_file *result_create_described(const char *path, const fdem_model *model,
                                      const case_info *info, const char *document,
                                      size_t document_length, char *err, size_t errlen);
+/* Replaces the root attribute `case` of a closed result file (POST
+ * /cases/ID/extend rewrites the stored document); 0, or -1 with err. */
+int result_replace_document(const char *path, const char *text, size_t length, char *err,
+                            size_t errlen);
 result_file *result_reopen(const char *path, const fdem_model *model,
                            const case_info *info, int64_t keep_until_step,
                            char *err, size_t errlen);

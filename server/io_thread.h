@@ -32,6 +32,13 @@ int io_reopen(server_case *c, int64_t keep_until_step, int close_after,
               char *err, size_t errlen);
 /* Appends `s` (may be NULL) then writes `ckpt` (may be NULL) as checkpoint.bin. */
 void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size);
+/* Writes `ckpt` as DIR/ID/<name> (a string literal) after the jobs queued
+ * before it; takes ownership, returns at once. */
+void io_write_named_checkpoint(server_case *c, const char *name, void *ckpt, size_t ckpt_size);
+/* Replaces the root attribute `case` of the closed result.h5 with `text`
+ * (extend); waits. 0, or -1 with err. */
+int io_replace_document(server_case *c, const char *text, size_t length, char *err,
+                        size_t errlen);
 void io_close(server_case *c);
 /* An open descriptor of result.h5 and its size. A finished file is checked
  * and served as it is (*held = 0). A file still being written was flushed

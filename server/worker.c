@@ -114,6 +114,17 @@ static void worker_describe_failure(server_case *c, const fdem_error *err, doubl
     pthread_mutex_unlock(&c->lock);
 }
 
+/* The state before the step that is cut to land on time.end: an extend
+ * goes on from it, on the step grid of an uninterrupted run, instead of
+ * from the end (case_model.h). With model_lock held. */
+static void worker_keep_end_checkpoint(server_case *c)
+{
+    size_t size = 0;
+    void *ckpt = case_checkpoint_take(c->model, &size);
+    if (ckpt)
+        io_write_named_checkpoint(c, CASE_END_CHECKPOINT, ckpt, size);
+}
+
 /* Runs steps until a command, the end time or a failure. */
 static worker_exit worker_loop(server_case *c, worker_clock *clk)
 {
@@ -140,6 +151,8 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * difference takes a changing step). */
         double t0 = fdem_get_time(m);
         int cut = sizing_is_last_step(t0, dt, end);
+        if (cut)
+            worker_keep_end_checkpoint(c);
         if (cut)
             fdem_set_dt(m, end - t0);
         fdem_error err;

@@ -87,6 +87,8 @@ static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_O
  * holds the exit code). The caller json_decref()s it. */
 struct json_t;
 struct json_t *ctl_get_status(const ctl_options *o, const char *id, int *code);
+/* A whole file (or stdin for "-"), NUL-terminated; NULL after saying why. */
+char *ctl_read_all(const char *path, size_t *length);
 
 /* --- commands --------------------------------------------------------- */
 
@@ -101,5 +103,7 @@ int cmd_state(const ctl_options *o, int argc, char **argv);
 int cmd_wait(const ctl_options *o, int argc, char **argv);
 int cmd_fetch(const ctl_options *o, int argc, char **argv);
 int cmd_fragments(const ctl_options *o, int argc, char **argv);
+int cmd_extend(const ctl_options *o, int argc, char **argv);    /* stages.c */
+int cmd_clone(const ctl_options *o, int argc, char **argv);
 
 #endif

@@ -33,6 +33,8 @@ static const ctl_command ctl_commands[] = {
     {"state",  cmd_state,  "state ID [--fields LIST]  current state as JSON"},
     {"fragments", cmd_fragments, "fragments ID [--json]     fragments (mass, size, diameter...) and sieve curve"},
     {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
+    {"extend", cmd_extend, "extend ID END [--start]   run a finished or paused case on to a later end"},
+    {"clone",  cmd_clone,  "clone ID PATCH|- [--start] new case from a stored one + a JSON Merge Patch"},
     {"case",   cmd_case,   "case ID                   the case document as uploaded"},
     {"health", cmd_health, "health                    is the server alive"},
     {NULL, NULL, NULL},
