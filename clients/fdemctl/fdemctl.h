@@ -101,5 +101,6 @@ int cmd_state(const ctl_options *o, int argc, char **argv);
 int cmd_wait(const ctl_options *o, int argc, char **argv);
 int cmd_fetch(const ctl_options *o, int argc, char **argv);
 int cmd_fragments(const ctl_options *o, int argc, char **argv);
+int cmd_events(const ctl_options *o, int argc, char **argv);
 
 #endif

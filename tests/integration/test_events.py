@@ -13,14 +13,25 @@ time T shows broken exactly the joints of the events with time <= T;
 405, unknown cases 404, a case without fracture has none. A case paused
 mid-run and resumed by a restarted daemon reports the very events of an
 uninterrupted run."""
-import math
+import json
 import os
+import subprocess
+import sys
 import unittest
 
 import h5py
 import numpy as np
 
-from fdemd_harness import Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
+
+sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
+from fdemd_client import Client  # noqa: E402
+
+FDEMCTL = os.environ.get("FDEMCTL_BIN", "bin/fdemctl")
+if not os.path.isabs(FDEMCTL):
+    FDEMCTL = os.path.join(ROOT, FDEMCTL)
+PLOT = os.path.join(ROOT, "clients", "python", "plot_fragments.py")
+PYTHON = "/usr/bin/python3"
 
 LENGTH, SIDE, SPEED = 0.1, 0.01, 0.5
 ENERGY_I = 10.0
@@ -51,6 +62,11 @@ def pulled_bar(dimension, speed=SPEED, end=2.5e-4, interval=1e-5):
         "time": {"end": end, "safety": 0.5},
         "output": {"interval": interval, "fields": ["position", "damage"]},
     }
+
+
+def passing_at(curve, x):
+    """The mass fraction of a sieve curve no larger than x."""
+    return max([p["passing"] for p in curve if p["diameter"] <= x] + [0.0])
 
 
 def face_size(x0, nodes, dimension):
@@ -189,6 +205,94 @@ class EventsThroughDaemon(DaemonTestCase):
         self.d.wait_state(st["id"], "finished")
         status, body = self.d.json("GET", "/cases/%s/events" % st["id"])
         self.assertEqual((status, body["events"]), (200, []))
+
+
+    # ---- what a user runs on the same two bars
+
+    def url(self):
+        return "http://127.0.0.1:%d" % self.d.port
+
+    def ctl(self, *args):
+        env = dict(os.environ, FDEMD_URL=self.url())
+        env.pop("FDEMD_TOKEN", None)
+        return subprocess.run([FDEMCTL] + list(args), capture_output=True, text=True, env=env,
+                              timeout=30 * SLOW)
+
+    def test_fdemctl_events(self):
+        for dimension, case_id, _, body, _ in self.each():
+            events = body["events"]
+            r = self.ctl("events", case_id)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            lines = r.stdout.splitlines()
+            self.assertEqual(lines[0], "%d fracture events" % len(events))
+            rows = lines[2:2 + len(events)]
+            self.assertEqual([int(row.split()[1]) for row in rows], [e["joint"] for e in events])
+            modes = {1: "tensile", 2: "shear", 3: "mixed"}
+            for row, e in zip(rows, events):
+                self.assertIn(" %s " % modes[e["mode"]], row)
+            total = sum(e["energy"] for e in events)
+            self.assertAlmostEqual(float(rows[-1].split()[-1]), total, delta=1e-5 * total)
+            since = events[0]["time"]
+            r = self.ctl("events", case_id, "--since", repr(since))
+            self.assertEqual(r.returncode, 0, r.stderr)
+            later = [e for e in events if e["time"] > since]
+            self.assertEqual(r.stdout.splitlines()[0], "%d fracture events" % len(later))
+            r = self.ctl("events", case_id, "--json")
+            self.assertEqual(json.loads(r.stdout), body)
+        self.assertEqual(self.ctl("events", case_id, "--since", "soon").returncode, 2)
+        self.assertEqual(self.ctl("events").returncode, 2)
+        self.assertNotEqual(self.ctl("events", "0123456789abcdef").returncode, 0)
+
+    def test_python_client_events(self):
+        client = Client(self.url())
+        for dimension, case_id, _, body, _ in self.each():
+            self.assertEqual(client.events(case_id), body)
+            since = body["events"][-1]["time"]
+            self.assertEqual(client.events(case_id, since=since)["events"], [])
+            self.assertEqual(client.events(case_id, since=0)["events"], body["events"])
+
+    def check_pngs(self, prefix):
+        import matplotlib.image
+        for kind in ("sieve", "events"):
+            path = "%s-%s.png" % (prefix, kind)
+            self.assertTrue(os.path.exists(path), path)
+            self.assertGreater(os.path.getsize(path), 10000, path)
+            image = matplotlib.image.imread(path)[..., :3]
+            colours = np.unique(image.reshape(-1, 3), axis=0)
+            self.assertGreater(len(colours), 20, "%s is nearly blank" % path)
+
+    def test_plot_fragments_from_the_file_and_the_server(self):
+        for dimension, case_id, _, body, path in self.each():
+            pieces = self.d.json("GET", "/cases/%s/fragments" % case_id)[1]
+            prefix = os.path.join(self.tmp, "file-%dd" % dimension)
+            r = subprocess.run([PYTHON, PLOT, path, "-o", prefix, "--print"],
+                               capture_output=True, text=True, timeout=120 * SLOW)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.check_pngs(prefix)
+            drawn = json.loads(r.stdout)
+            self.assertEqual(drawn["fragments"], len(pieces["fragments"]))
+            # the file's sieve curve is the route's: the same mass fraction
+            # passes between and above its diameters (equal pieces whose
+            # sizes were summed in another order may differ by an ulp, so
+            # not at a diameter itself)
+            route = sorted(p["diameter"] for p in pieces["distribution"])
+            probes = [np.sqrt(a * b) for a, b in zip(route, route[1:]) if b > a * (1 + 1e-6)]
+            probes += [route[0] * 0.5, route[-1] * 2]
+            for x in probes:
+                self.assertAlmostEqual(passing_at(drawn["distribution"], x),
+                                       passing_at(pieces["distribution"], x), delta=1e-9)
+            self.assertEqual(drawn["events"]["time"], [e["time"] for e in body["events"]])
+            self.assertAlmostEqual(drawn["events"]["energy"][-1],
+                                   sum(e["energy"] for e in body["events"]), delta=1e-12)
+            if dimension == 3:
+                continue  # the server's side is the same code in either dimension
+            prefix = os.path.join(self.tmp, "server-%dd" % dimension)
+            r = subprocess.run([PYTHON, PLOT, "--server", self.url(), "--case", case_id, "-o",
+                                prefix, "--print"], capture_output=True, text=True,
+                               timeout=120 * SLOW)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            self.check_pngs(prefix)
+            self.assertEqual(json.loads(r.stdout)["distribution"], pieces["distribution"])
 
 
 class EventsSurviveARestart(unittest.TestCase):
