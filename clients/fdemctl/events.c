@@ -78,21 +78,5 @@ int cmd_events(const ctl_options *o, int argc, char **argv)
         size_t used = strlen(path);
         snprintf(path + used, sizeof path - used, "?since=%.17g", t);
     }
-    http_response r;
-    int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
-    if (code) return code;
-    json_error_t error;
-    json_t *body = raw ? NULL : json_loadb(r.body, r.length, 0, &error);
-    if (raw) {
-        fwrite(r.body, 1, r.length, stdout);
-        if (r.length == 0 || r.body[r.length - 1] != '\n') fputc('\n', stdout);
-    } else if (!body || !json_is_array(json_object_get(body, "events"))) {
-        fprintf(stderr, "fdemctl events: the server's answer is not an event list\n");
-        code = CTL_FAIL;
-    } else {
-        print_events(body);
-    }
-    json_decref(body);
-    http_response_free(&r);
-    return code;
+    return ctl_show_list(o, path, raw, "events", "an event list", print_events);
 }

@@ -40,18 +40,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-
-
-def open_result(path):
-    """Opens result.h5 read-only, as a SWMR reader if a writer holds it."""
-    import h5py
-    try:
-        return h5py.File(path, "r")
-    except OSError as plain_error:
-        try:
-            return h5py.File(path, "r", libver="latest", swmr=True)
-        except OSError:
-            raise plain_error from None
+sys.path.insert(0, HERE)
+from plot_result import open_result  # noqa: E402  (plain, else as a SWMR reader)
 
 
 def element_sizes(x0, elements):
@@ -113,7 +103,6 @@ def events_from_file(f):
 
 
 def from_server(args):
-    sys.path.insert(0, HERE)
     from fdemd_client import Client
     client = Client(args.server, token=args.token)
     pieces = client.fragments(args.case)

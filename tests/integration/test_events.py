@@ -22,14 +22,11 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import FDEMCTL_BIN, ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 from fdemd_client import Client  # noqa: E402
 
-FDEMCTL = os.environ.get("FDEMCTL_BIN", "bin/fdemctl")
-if not os.path.isabs(FDEMCTL):
-    FDEMCTL = os.path.join(ROOT, FDEMCTL)
 PLOT = os.path.join(ROOT, "clients", "python", "plot_fragments.py")
 PYTHON = "/usr/bin/python3"
 
@@ -215,7 +212,7 @@ class EventsThroughDaemon(DaemonTestCase):
     def ctl(self, *args):
         env = dict(os.environ, FDEMD_URL=self.url())
         env.pop("FDEMD_TOKEN", None)
-        return subprocess.run([FDEMCTL] + list(args), capture_output=True, text=True, env=env,
+        return subprocess.run([FDEMCTL_BIN] + list(args), capture_output=True, text=True, env=env,
                               timeout=30 * SLOW)
 
     def test_fdemctl_events(self):
