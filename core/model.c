@@ -70,6 +70,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
     free(m->joint_k); free(m->joint_material);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
+    free(m->joint_fracture); free(m->joint_broke); free(m->events);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     scatter_plan_free(&m->joint_plan);
@@ -673,7 +674,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
                           : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     /* joints: 2 dim nodes and 2 elements; damage, h, k, material; elem_joint */
-    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 2 * sizeof(double));
+    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 3 * sizeof(double) + 1);
+    b += (size_t)m->event_capacity * sizeof(fdem_event);
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
     /* boundary facets of pressures and dashpots: nodes, element, forces */

@@ -12,7 +12,11 @@
  *    marker, so a SWMR reader never sees a snapshot half written.
  *  - result_reopen() reopens a file left by a previous run (clearing the
  *    status flags a crash leaves, as `h5clear -s` does), drops snapshots
- *    whose step is after `keep_until_step` and resumes SWMR writing.
+ *    whose step is after `keep_until_step` and fracture events of joints
+ *    that are not broken in `model` (the model the run resumes from), and
+ *    resumes SWMR writing.
+ *  - /events (contract 5.4) follows the same commit discipline as
+ *    /snapshots, with /events/time as its marker (result_events.c).
  *  - Downloads while running: result_flush() on the I/O thread, then, with
  *    no append in between, any thread may copy the bytes with
  *    result_image_copy_step() (no HDF5 call; it clears the superblock's
@@ -55,6 +59,16 @@ result_file *result_reopen(const char *path, const fdem_model *model,
                            const case_info *info, int64_t keep_until_step,
                            char *err, size_t errlen);
 int result_append(result_file *f, const snapshot *s, char *err, size_t errlen);
+/* Appends fracture events to /events (result_events.c); the daemon appends
+ * a step's events before the snapshot after them. */
+int result_append_events(result_file *f, const fdem_event *events, int count, char *err,
+                         size_t errlen);
+/* The events with time > since of an open result file (f), or of the closed
+ * file at path (f NULL; a file written before events has none): *out
+ * (free() it) gets *count of them, *dimension the position width (0 for a
+ * file without /events). */
+int result_read_events(result_file *f, const char *path, double since, fdem_event **out,
+                       int *count, int *dimension, char *err, size_t errlen);
 int result_flush(result_file *f, char *err, size_t errlen);
 int result_check_file(const char *path, char *err, size_t errlen);
 /* Copies the next piece of bytes [done, size) of src to the same place in

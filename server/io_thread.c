@@ -24,13 +24,16 @@
 #include "persist.h"
 
 typedef enum io_job_kind {
-    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_QUIT,
+    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_QUIT,
 } io_job_kind;
 
 typedef struct io_job {
     io_job_kind kind;
     server_case *c;
     snapshot *snap;
+    fdem_event *events;     /* IO_APPEND: written first; IO_EVENTS: the answer */
+    int event_count, dimension;
+    double since;           /* IO_EVENTS */
     void *ckpt;
     size_t ckpt_size;
     const char *ckpt_name;     /* IO_APPEND: NULL = checkpoint.bin */
@@ -177,6 +180,13 @@ static int io_snapshot_is_new(const server_case *c, const snapshot *s)
 static void io_do_append(io_job *j)
 {
     server_case *c = j->c;
+    if (j->event_count && c->result && !c->deleted) {
+        char err[256] = "";
+        if (result_append_events(c->result, j->events, j->event_count, err, sizeof err) != 0) {
+            case_record_io_failure(c, "result.h5", err);
+            io_close_after_failure(c);
+        }
+    }
     if (j->snap && c->result && !c->deleted && io_snapshot_is_new(c, j->snap)) {
         char err[256] = "";
         if (result_append(c->result, j->snap, err, sizeof err) != 0) {
@@ -274,6 +284,21 @@ static void io_do_fetch(io_job *j)
     j->rc = 0;
 }
 
+/* The events of the open file, or of the one on disk; none before it exists. */
+static void io_do_events(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+        j->rc = 0;
+        return;
+    }
+    j->rc = result_read_events(c->result, path, j->since, &j->events, &j->event_count,
+                               &j->dimension, j->err, sizeof j->err);
+}
+
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
  * checkpoint.bin and status.json, fsynced), a moving average over the
  * recent snapshot jobs: what a dry run charges per snapshot. */
@@ -320,6 +345,7 @@ static void io_run_job(io_job *j)
     case IO_CLOSE: io_do_close(j); break;
     case IO_FETCH: io_do_fetch(j); break;
     case IO_DESCRIBE: io_do_describe(j); break;
+    case IO_EVENTS: io_do_events(j); break;
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
@@ -330,6 +356,7 @@ static void io_job_free(io_job *j)
 {
     if (j->snap)
         snapshot_free(j->snap);
+    free(j->events);
     free(j->ckpt);
     if (j->c)
         case_release(j->c);
@@ -507,15 +534,18 @@ int io_reopen(server_case *c, int64_t keep_until_step, int close_after, char *er
     return rc;
 }
 
-static void io_queue_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size,
-                            const char *ckpt_name)
+static void io_queue_append(server_case *c, fdem_event *events, int event_count, snapshot *s,
+                            void *ckpt, size_t ckpt_size, const char *ckpt_name)
 {
     io_job *j = io_job_new(IO_APPEND, c);
     if (!j) {
+        free(events);
         snapshot_free(s);
         free(ckpt);
         return;
     }
+    j->events = events;
+    j->event_count = event_count;
     pthread_mutex_lock(&c->lock);
     c->io_pending++;
     pthread_mutex_unlock(&c->lock);
@@ -526,14 +556,16 @@ static void io_queue_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt
     io_enqueue(j);
 }
 
-void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size)
+void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s, void *ckpt,
+               size_t ckpt_size)
 {
-    io_queue_append(c, s, ckpt, ckpt_size, NULL);
+    io_queue_append(c, events, event_count, s, ckpt, ckpt_size, NULL);
 }
 
-void io_write_named_checkpoint(server_case *c, const char *name, void *ckpt, size_t ckpt_size)
+void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,
+                               int event_count, void *ckpt, size_t ckpt_size)
 {
-    io_queue_append(c, NULL, ckpt, ckpt_size, name);
+    io_queue_append(c, events, event_count, NULL, ckpt, ckpt_size, name);
 }
 
 int io_replace_document(server_case *c, const char *text, size_t length, char *err,
@@ -565,6 +597,30 @@ void io_close(server_case *c)
         return;
     io_run_and_wait(j);
     io_job_free(j);
+}
+
+int io_read_events(server_case *c, double since, fdem_event **out, int *count, int *dimension,
+                   char *err, size_t errlen)
+{
+    *out = NULL;
+    *count = 0;
+    io_job *j = io_job_new(IO_EVENTS, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    j->since = since;
+    int rc = io_run_and_wait(j);
+    if (rc == 0) {
+        *out = j->events;
+        *count = j->event_count;
+        *dimension = j->dimension;
+        j->events = NULL;
+    } else {
+        snprintf(err, errlen, "%s", j->err);
+    }
+    io_job_free(j);
+    return rc;
 }
 
 int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,

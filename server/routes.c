@@ -9,6 +9,8 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -16,6 +18,7 @@
 
 #include "case_stages.h"
 #include "download.h"
+#include "events_json.h"
 #include "http.h"
 #include "io_thread.h"
 #include "memory_budget.h"
@@ -55,7 +58,7 @@ void routes_match(const char *url, route_match *out)
         {"case", ROUTE_CASE_DOCUMENT}, {"state", ROUTE_CASE_STATE},
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
         {"fragments", ROUTE_CASE_FRAGMENTS}, {"extend", ROUTE_CASE_EXTEND},
-        {"clone", ROUTE_CASE_CLONE},
+        {"clone", ROUTE_CASE_CLONE}, {"events", ROUTE_CASE_EVENTS},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
@@ -157,12 +160,13 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const create[] = {"start", "dry_run", NULL};
     static const char *const list[] = {"state", NULL};
     static const char *const state[] = {"fields", NULL};
+    static const char *const events[] = {"since", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
-    return kind == ROUTE_CASE_STATE ? state : none;
+    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events : none;
 }
 
 typedef struct routes_query_check {
@@ -375,6 +379,55 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
     return route_snapshot_json(conn, c, fields, state_to_json);
 }
 
+/* GET /cases/ID/events?since=T (contract 5.4): the events in result.h5
+ * with time > T (all without ?since), so a client that passes the last
+ * time it saw gets only what broke after; a step's events are written
+ * together, so none of that step is missed. A case without fracture, or
+ * not started, has none. */
+static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
+{
+    const char *text = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "since");
+    double since = -INFINITY;
+    if (text) {
+        char *end = NULL;
+        errno = 0;
+        since = strtod(text, &end);
+        if (!*text || *end || errno == ERANGE || !isfinite(since)) {
+            char detail[160];
+            snprintf(detail, sizeof detail, "?since= takes a finite time in seconds; not \"%.64s\"",
+                     text);
+            return http_reply_problem(conn, 400, "Bad request", detail, NULL);
+        }
+    }
+    fdem_event *events = NULL;
+    int count = 0, dimension = 0;
+    char err[700] = "";
+    if (io_read_events(c, since, &events, &count, &dimension, err, sizeof err) != 0)
+        return http_reply_problem(conn, 500, "Internal error", err, NULL);
+    if (!dimension) {
+        pthread_mutex_lock(&c->lock);
+        dimension = c->fig.counts.dimension ? c->fig.counts.dimension : 2;
+        pthread_mutex_unlock(&c->lock);
+    }
+    /* about 150 bytes of JSON tree per event, charged to the budget */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
+    json_t *o = events_to_json(events, count, dimension, text ? &since : NULL);
+    membudget_meter_end();
+    free(events);
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of these events would take the daemon "
+                                    "past its memory budget (--max-memory) now; ask for fewer "
+                                    "with ?since=", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
+}
+
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
 {
     char msg[1400] = "";
@@ -452,6 +505,8 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return route_state(conn, c);
     case ROUTE_CASE_FRAGMENTS:
         return route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, fragments_to_json);
+    case ROUTE_CASE_EVENTS:
+        return route_events(conn, c);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c);
     case ROUTE_CASE_RESULT_XDMF:

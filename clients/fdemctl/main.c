@@ -32,6 +32,7 @@ static const ctl_command ctl_commands[] = {
     {"wait",   cmd_wait,   "wait ID [--interval S]    follow progress; exit 0 iff finished"},
     {"state",  cmd_state,  "state ID [--fields LIST]  current state as JSON"},
     {"fragments", cmd_fragments, "fragments ID [--json]     fragments (mass, size, diameter...) and sieve curve"},
+    {"events", cmd_events, "events ID [--since T]     fracture events: time, joint, position, mode, energy"},
     {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
     {"extend", cmd_extend, "extend ID END [--start]   run a finished or paused case on to a later end"},
     {"clone",  cmd_clone,  "clone ID PATCH|- [--start] new case from a stored one + a JSON Merge Patch"},

@@ -266,6 +266,27 @@ class Client:
         """
         return self._json("GET", self._case_path(case_id, "/fragments"))
 
+    def events(self, case_id, since=None):
+        """The fracture events of the case: one per joint that broke, in the
+        order they broke (contract 5.4).
+
+        Args:
+            since: a time in seconds; only the events after it (time >
+                since) are returned, so passing the last time seen gives
+                only the new ones. None: all.
+        Returns:
+            {"dimension", "since", "count", "events": [{"time", "joint",
+            "position", "mode", "energy"}, ...]}: time the end of the step
+            the joint broke in, position its midpoint ([x, y] or [x, y,
+            z]), mode 1 tensile, 2 shear, 3 mixed, energy what it
+            dissipated (J per metre in 2D). The same rows as /events/* in
+            result.h5.
+        """
+        suffix = "/events"
+        if since is not None:
+            suffix += "?since=" + repr(float(since))
+        return self._json("GET", self._case_path(case_id, suffix))
+
     def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
         """Polls until the case is finished, failed or stopped.
 
