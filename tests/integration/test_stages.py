@@ -419,3 +419,35 @@ class ClientCommandTests(DaemonTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class ExtendFractureTests(DaemonTestCase):
+    """An extend that cuts through a crack's growth: the fracture events of
+    the continued run are those of the uninterrupted one, none twice, none
+    lost (the end checkpoint an extend resumes from holds no undrained
+    event, and the reopened file keeps only the events of joints broken
+    in it)."""
+
+    def events(self, case_id):
+        return self.d.json("GET", "/cases/%s/events" % case_id)[1]["events"]
+
+    def test_events_of_an_extended_fracturing_case_are_the_uninterrupted_ones(self):
+        # The bar's four joints break in one step near t = 52.7 us. Cut
+        # before it, and 0.3 us after it: between two snapshots, so the
+        # events are still in the engine when the end checkpoint is taken.
+        from test_events import pulled_bar
+        d = self.d
+        new_end = 2.5e-4
+        straight = d.create(pulled_bar(2, end=new_end), start=True)["id"]
+        d.wait_state(straight, "finished")
+        expected = self.events(straight)
+        self.assertEqual(len(expected), 4)
+        for old_end, before in ((5.2e-5, 0), (5.3e-5, 4)):
+            staged = d.create(pulled_bar(2, end=old_end), start=True)["id"]
+            d.wait_state(staged, "finished")
+            self.assertEqual(len(self.events(staged)), before, old_end)
+            status, _ = d.json("POST", "/cases/%s/extend" % staged, {"end": new_end})
+            self.assertEqual(status, 200)
+            d.json("POST", "/cases/%s/start" % staged)
+            d.wait_state(staged, "finished")
+            self.assertEqual(self.events(staged), expected, old_end)
