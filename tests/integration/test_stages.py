@@ -13,13 +13,11 @@ import os
 import signal
 import subprocess
 import sys
-import tempfile
 import unittest
 
-import h5py
 import numpy as np
 
-from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import SLOW, Daemon, DaemonTestCase, fetched_result, tiny_case
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -54,17 +52,9 @@ def staged_case_3d(name, end):
 
 def read_result(daemon, case_id):
     """Every /snapshots dataset and the root attribute `case`, from a download."""
-    status, _, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
-    assert status == 200, data[:200]
-    fd, path = tempfile.mkstemp(suffix=".h5")
-    with os.fdopen(fd, "wb") as f:
-        f.write(data)
-    try:
-        with h5py.File(path, "r") as f:
-            out = {name: f["/snapshots/" + name][...] for name in f["/snapshots"]}
-            out["case"] = json.loads(f.attrs["case"])
-    finally:
-        os.unlink(path)
+    with fetched_result(daemon, case_id) as f:
+        out = {name: f["/snapshots/" + name][...] for name in f["/snapshots"]}
+        out["case"] = json.loads(f.attrs["case"])
     return out
 
 
