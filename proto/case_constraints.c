@@ -15,7 +15,8 @@
 
 #include "case_internal.h"
 
-static const char *const constraint_keys[] = {"part", "box", "fix", "velocity", "force", NULL};
+static const char *const constraint_keys[] = {"part", "group", "box", "fix", "velocity", "force",
+                                              NULL};
 
 static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
                                  const char *ptr)
@@ -37,6 +38,17 @@ static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const 
     if (names) case_did_you_mean(doc, hint, sizeof hint, wanted, names, doc->part_count);
     free(names);
     case_problem(doc, ptr, "unknown part \"%.64s\"%s", wanted, hint);
+}
+
+/* {"part": P, "group": G}: the nodes of physical group G of gmsh part P. */
+static void constraint_read_group(case_doc *doc, case_constraint *c, const json_t *group,
+                                  const char *ptr)
+{
+    int count = 0;
+    if (case_group_vertices(doc, c->def.part, group, ptr, &c->vertices, &count) < 0) return;
+    c->def.select = FDEM_SELECT_VERTICES;
+    c->def.vertices = c->vertices;
+    c->def.vertex_count = count;
 }
 
 /* "[xmin, ymin, xmax, ymax]" or the 3D six. */
@@ -172,6 +184,11 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         if (selector == 0) constraint_read_part(doc, &c->def, s, at);
         else constraint_read_box(doc, &c->def, s, at);
     }
+    json_t *group = case_member(value, ptr, "group", at);
+    if (group && selector != 0)
+        case_problem(doc, at, "\"group\" names a physical group of a part: give \"part\" too");
+    else if (group)
+        constraint_read_group(doc, c, group, at);
     int action = constraint_pick(doc, value, ptr, actions, 3,
                                  "an action: \"fix\", \"velocity\" or \"force\"");
     if (action < 0) return;

@@ -204,8 +204,9 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
     const char *s = json_string_value(text);
     size_t n = json_string_length(text);
     int rc = kind->dimension == 3
-                 ? gmsh_read_tetrahedra(s, n, &part->tet_mesh, message, sizeof message)
-                 : gmsh_read(s, n, &part->mesh, message, sizeof message);
+                 ? gmsh_read_tetrahedra_grouped(s, n, &part->tet_mesh, &part->groups, message,
+                                                sizeof message)
+                 : gmsh_read_grouped(s, n, &part->mesh, &part->groups, message, sizeof message);
     if (rc < 0) {
         case_problem(doc, ptr, "%s", message);
         return;
