@@ -447,20 +447,28 @@ static int gmsh_read_sections(gmsh_reader *r)
 
 /* --------------------------------------------------------------- resolve */
 
-/* Sorts node indices by tag. qsort_r is a GNU extension and qsort would need
- * the nodes in a global, so a small merge sort it is. */
-static void gmsh_sort_by_tag(long *idx, long *tmp, long n, const gmsh_node *nodes)
+/* Sorts indices, stably, by `before`. qsort_r is a GNU extension and qsort
+ * would need the reader in a global, so a small merge sort it is. */
+typedef int (*gmsh_before_fn)(const gmsh_reader *r, long a, long b);
+
+static void gmsh_merge_sort(long *idx, long *tmp, long n, const gmsh_reader *r,
+                            gmsh_before_fn before)
 {
     if (n < 2) return;
     long half = n / 2;
-    gmsh_sort_by_tag(idx, tmp, half, nodes);
-    gmsh_sort_by_tag(idx + half, tmp, n - half, nodes);
+    gmsh_merge_sort(idx, tmp, half, r, before);
+    gmsh_merge_sort(idx + half, tmp, n - half, r, before);
     long i = 0, j = half, k = 0;
     while (i < half && j < n)
-        tmp[k++] = nodes[idx[j]].tag < nodes[idx[i]].tag ? idx[j++] : idx[i++];
+        tmp[k++] = before(r, idx[j], idx[i]) ? idx[j++] : idx[i++];
     while (i < half) tmp[k++] = idx[i++];
     while (j < n) tmp[k++] = idx[j++];
     memcpy(idx, tmp, (size_t)n * sizeof *idx);
+}
+
+static int gmsh_node_before(const gmsh_reader *r, long a, long b)
+{
+    return r->nodes[a].tag < r->nodes[b].tag;
 }
 
 long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, long long tag)
@@ -498,20 +506,6 @@ static int gmsh_element_before(const gmsh_reader *r, long a, long b)
     return a < b;
 }
 
-static void gmsh_sort_elements(long *idx, long *tmp, long n, const gmsh_reader *r)
-{
-    if (n < 2) return;
-    long half = n / 2;
-    gmsh_sort_elements(idx, tmp, half, r);
-    gmsh_sort_elements(idx + half, tmp, n - half, r);
-    long i = 0, j = half, k = 0;
-    while (i < half && j < n)
-        tmp[k++] = gmsh_element_before(r, idx[j], idx[i]) ? idx[j++] : idx[i++];
-    while (i < half) tmp[k++] = idx[i++];
-    while (j < n) tmp[k++] = idx[j++];
-    memcpy(idx, tmp, (size_t)n * sizeof *idx);
-}
-
 /* 2.2 writes an element once for each physical group it is in: every
  * repeat of a node set becomes the element of its first occurrence.
  * element_of[t] is the mesh index of kept element t; returns how many
@@ -527,7 +521,7 @@ static long gmsh_merge_repeats(const gmsh_reader *r, long *element_of)
         return -1;
     }
     for (long t = 0; t < m; t++) order[t] = t, element_of[t] = t;
-    gmsh_sort_elements(order, tmp, m, r);
+    gmsh_merge_sort(order, tmp, m, r, gmsh_element_before);
     long long prev[4], key[4];
     for (long i = 0; i < m; i++) {
         gmsh_element_key(r, order[i], key);
@@ -569,7 +563,7 @@ static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out, gmsh_groups *groups)
         goto done;
     }
     for (long i = 0; i < n; i++) sorted[i] = i;
-    gmsh_sort_by_tag(sorted, tmp, n, r->nodes);
+    gmsh_merge_sort(sorted, tmp, n, r, gmsh_node_before);
     for (long i = 1; i < n; i++)
         if (r->nodes[sorted[i]].tag == r->nodes[sorted[i - 1]].tag) {
             r->section = "$Nodes";

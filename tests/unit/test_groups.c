@@ -51,6 +51,22 @@ static void check_plane_group(const gmsh_group *group, const double *xyz, int no
               what);
 }
 
+/* Reads a test mesh of dimension dim (into mesh or tets) with its groups;
+ * 0, or -1 after a failed check. */
+static int read_groups(const char *path, int dim, fdem_mesh *mesh, fdem_tet_mesh *tets,
+                       gmsh_groups *g)
+{
+    size_t length = 0;
+    char *text = read_file(path, &length);
+    if (!text) return -1;
+    char message[256];
+    int rc = dim == 3 ? gmsh_read_tetrahedra_grouped(text, length, tets, g, message, sizeof message)
+                      : gmsh_read_grouped(text, length, mesh, g, message, sizeof message);
+    free(text);
+    CHECK(rc == 0, "%s: %s", path, message);
+    return rc;
+}
+
 /* Both formats, 2D: the surface groups partition the triangles (the
  * triangles 2.2 writes once per group are one each), "bar" holds them
  * all, the curve groups hold exactly the nodes on their lines and their
@@ -59,16 +75,9 @@ static void groups_2d(void)
 {
     int triangles[2] = {0, 0};
     for (int v = 0; v < 2; v++) {
-        size_t length = 0;
-        char *text = read_file(bar_files[v], &length);
-        if (!text) continue;
         fdem_mesh mesh;
         gmsh_groups g;
-        char message[256];
-        int rc = gmsh_read_grouped(text, length, &mesh, &g, message, sizeof message);
-        free(text);
-        CHECK(rc == 0, "%s: %s", bar_files[v], message);
-        if (rc) continue;
+        if (read_groups(bar_files[v], 2, &mesh, NULL, &g)) continue;
         triangles[v] = mesh.triangle_count;
         const gmsh_group *soft = named(&g, "soft", 2), *stiff = named(&g, "stiff", 2),
                          *bar = named(&g, "bar", 2);
@@ -106,16 +115,9 @@ static void groups_2d(void)
 static void groups_3d(void)
 {
     for (int v = 0; v < 2; v++) {
-        size_t length = 0;
-        char *text = read_file(cube_files[v], &length);
-        if (!text) continue;
         fdem_tet_mesh mesh;
         gmsh_groups g;
-        char message[256];
-        int rc = gmsh_read_tetrahedra_grouped(text, length, &mesh, &g, message, sizeof message);
-        free(text);
-        CHECK(rc == 0, "%s: %s", cube_files[v], message);
-        if (rc) continue;
+        if (read_groups(cube_files[v], 3, NULL, &mesh, &g)) continue;
         const gmsh_group *soft = named(&g, "soft", 3), *stiff = named(&g, "stiff", 3);
         CHECK(soft && stiff && soft->element_count + stiff->element_count == mesh.tet_count,
               "%s: the volume groups partition the %d tetrahedra", cube_files[v], mesh.tet_count);
@@ -293,15 +295,10 @@ static void joint_set_on_group(void)
                  load("{'interface': {'tensile_strength': 1e5, 'cohesion': 2e5}}"));
             fdem_model *m = build_or_report(doc);
             if (!m) continue;
-            size_t length = 0;
-            char *text = read_file(file, &length);
             gmsh_groups g = {0};
             fdem_mesh mesh = {0};
             fdem_tet_mesh tets = {0};
-            char message[256];
-            if (dim == 3) gmsh_read_tetrahedra_grouped(text, length, &tets, &g, message, 256);
-            else gmsh_read_grouped(text, length, &mesh, &g, message, 256);
-            free(text);
+            read_groups(file, dim, &mesh, &tets, &g);
             const gmsh_group *interface = named(&g, "interface", dim - 1);
             int on_set = 0, weak_off_plane = 0;
             for (int j = 0; j < m->joint_count; j++) {
