@@ -253,5 +253,5 @@ dump("jointed-block", {
     "constraints": [{"part": "block", "group": "base", "fix": ["y"]},
                     {"part": "block", "group": "corner", "fix": ["x"]},
                     {"part": "block", "group": "top", "velocity": [None, 0.01]}],
-    "time": {"end": 0.0018, "dt": "auto", "safety": 0.5},
+    "time": {"end": 0.0024, "dt": "auto", "safety": 0.5},
     "output": {"interval": 2e-5, "fields": ["position", "velocity", "stress", "damage"]}})
