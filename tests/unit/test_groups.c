@@ -407,5 +407,38 @@ static void weibull_reproducible(void)
     fdem_model_destroy(c);
 }
 
+/* examples/jointed-block.json to just past its peak: pulled across a set
+ * of joints at beta = 30 degrees, the block fails along the set when the
+ * normal stress on it, sigma cos^2(beta), reaches the set's tensile
+ * strength, 1 MPa (the shear on it, sigma sin cos, stays under the
+ * cohesion): peak sigma = 1.333 MPa to 3 %, far below the rock's 5 MPa, and
+ * every joint that broke is on the set. */
+static void jointed_block_example(void)
+{
+    size_t length = 0;
+    char *text = read_file("examples/jointed-block.json", &length);
+    if (!text) return;
+    json_error_t error;
+    json_t *doc = json_loadb(text, length, 0, &error);
+    free(text);
+    edit(doc, "/time/end", json_real(1.6e-3));
+    fdem_model *m = build_or_report(doc);
+    if (!m) return;
+    double peak = 0, width = 0.05, beta = M_PI / 6;
+    while (fdem_get_time(m) < 1.6e-3 && fdem_step(m, NULL) == 0)
+        peak = fmax(peak, fdem_constraint_forces(m)[2 * 2 + 1] / width);
+    int broken = 0, on_set = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        if (m->joint_damage[j] < 1) continue;
+        broken++;
+        on_set += m->joint_strengths[m->joint_strength_of[j]].tensile_strength == 1e6;
+    }
+    printf("  jointed block: peak %.4g MPa (f_t / cos^2 30 = %.4g MPa), %d broken joints, %d on "
+           "the set\n", peak / 1e6, 1e6 / (cos(beta) * cos(beta)) / 1e6, broken, on_set);
+    CHECK_REL(peak, 1e6 / (cos(beta) * cos(beta)), 0.03);
+    CHECK(broken > 0 && on_set == broken, "%d broken, %d on the set", broken, on_set);
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(groups_2d), T(groups_3d), T(group_selector), T(two_materials_bonded),
-           T(joint_set_on_group), T(weibull_statistics), T(weibull_reproducible))
+           T(joint_set_on_group), T(weibull_statistics), T(weibull_reproducible), T(jointed_block_example))
