@@ -185,10 +185,12 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         else constraint_read_box(doc, &c->def, s, at);
     }
     json_t *group = case_member(value, ptr, "group", at);
+    json_t *part = json_object_get(value, "part");
     if (group && selector != 0)
         case_problem(doc, at, "\"group\" names a physical group of a part: give \"part\" too");
-    else if (group)
-        constraint_read_group(doc, c, group, at);
+    else if (group && json_is_string(part) &&
+             case_names_find(doc->part_names, json_string_value(part)) >= 0)
+        constraint_read_group(doc, c, group, at); /* an unknown part is reported at "part" */
     int action = constraint_pick(doc, value, ptr, actions, 3,
                                  "an action: \"fix\", \"velocity\" or \"force\"");
     if (action < 0) return;
