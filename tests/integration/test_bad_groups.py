@@ -120,6 +120,10 @@ class BadGroupsTest(unittest.TestCase):
         self.refused(with_edit(["parts", 0, "discontinuities", "interface"], {}),
                      "/parts/0/discontinuities/interface", "at least one")
 
+    def test_joint_set_on_the_boundary(self):
+        self.refused(with_edit(["parts", 0, "discontinuities"], {"left": {"cohesion": 1e5}}),
+                     "/parts/0", "no interior edge")
+
     def test_group_selector(self):
         self.refused(with_edit(["constraints", 0, "group"], "top"),
                      "/constraints/0/group", "no physical group")
