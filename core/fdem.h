@@ -72,7 +72,6 @@ typedef struct fdem_fracture_params {
     double friction_angle;   /* degrees */
     double energy_I;         /* J/m^2 */
     double energy_II;        /* J/m^2 */
-    fdem_variation variation;
 } fdem_fracture_params;
 
 typedef struct fdem_material_def {
@@ -84,6 +83,7 @@ typedef struct fdem_material_def {
     double friction;/* Coulomb coefficient */
     int has_fracture;
     fdem_fracture_params fracture;
+    fdem_variation variation; /* of fracture's strengths; zero: none */
 } fdem_material_def;
 
 /* ------------------------------------------------------------------- meshes */
@@ -158,10 +158,12 @@ int fdem_set_element_materials(fdem_model *model, int part, const int32_t *mater
 /* Pre-existing discontinuities (contract 5.3): the joints of fracturing
  * part `part` that lie on one of `face_count` faces (vertex pairs in 2D,
  * triples in 3D, indices of the part's mesh as given, any order) take
- * `params` instead of their material's. Before finalize; a later set wins
- * where two overlap. Finalize fails when a set lies on no joint. */
+ * `params` (varied by `variation`, NULL: none) instead of their
+ * material's. Before finalize; a later set wins where two overlap.
+ * Finalize fails when a set lies on no joint. */
 int fdem_add_joint_set(fdem_model *model, int part, const fdem_fracture_params *params,
-                       const int32_t *faces, int face_count, fdem_error *err);
+                       const fdem_variation *variation, const int32_t *faces, int face_count,
+                       fdem_error *err);
 
 /* Initial velocity of every node of a part: `dimension` components in v
  * (the 2D form leaves vz out). */

@@ -68,9 +68,11 @@ static void face_key(const int32_t *vertices, int dim, int32_t key[3])
 }
 
 int fdem_add_joint_set(fdem_model *m, int part_index, const fdem_fracture_params *params,
-                       const int32_t *faces, int face_count, fdem_error *err)
+                       const fdem_variation *variation, const int32_t *faces, int face_count,
+                       fdem_error *err)
 {
     int k = m->joint_set_count;
+    fdem_variation none = {0, 0}, v = variation ? *variation : none;
     if (m->finalized || part_index < 0 || part_index >= m->part_count ||
         !m->parts[part_index].fracture) {
         model_error(err, FDEM_ITEM_PART, part_index,
@@ -82,7 +84,7 @@ int fdem_add_joint_set(fdem_model *m, int part_index, const fdem_fracture_params
     if (!(params->tensile_strength > 0) || !(params->cohesion > 0) ||
         !(params->energy_I > 0) || !(params->energy_II > 0) ||
         !(params->friction_angle >= 0 && params->friction_angle < 90) ||
-        !(params->variation.weibull_modulus >= 0) || !isfinite(params->variation.weibull_modulus)) {
+        !(v.weibull_modulus >= 0) || !isfinite(v.weibull_modulus)) {
         model_error(err, FDEM_ITEM_PART, part_index,
                     "joint set %d of part %d: strengths and energies must be > 0, the friction "
                     "angle in [0, 90) and the Weibull modulus finite and >= 0", k, part_index);
@@ -104,7 +106,7 @@ int fdem_add_joint_set(fdem_model *m, int part_index, const fdem_fracture_params
     for (int f = 0; f < face_count; f++)
         face_key(faces + (size_t)m->dim * (size_t)f, m->dim, keys + 3 * (size_t)f);
     qsort(keys, (size_t)face_count, 3 * sizeof(int32_t), face_compare);
-    m->joint_sets[k] = (joint_set){part_index, *params, keys, face_count};
+    m->joint_sets[k] = (joint_set){part_index, *params, v, keys, face_count};
     m->joint_set_count++;
     return k;
 }
@@ -137,6 +139,13 @@ static int joint_set_of(const fdem_model *m, int j)
 
 /* ------------------------------------------------------------ the table */
 
+/* The variation joint j's strengths take: its set's, else its material's. */
+static const fdem_variation *joint_variation(const fdem_model *m, int j, int set)
+{
+    if (set >= 0) return &m->joint_sets[set].variation;
+    return &m->materials[element_material(m, m->joint_elem[2 * j])].def.variation;
+}
+
 static joint_strength strength_of(const fdem_fracture_params *p)
 {
     return (joint_strength){p->tensile_strength, p->cohesion,
@@ -158,10 +167,7 @@ int joint_strengths_assign(fdem_model *m, fdem_error *err)
     for (int j = 0; ok && j < J; j++) {
         set_of[j] = S ? joint_set_of(m, j) : -1;
         if (set_of[j] >= 0) used[set_of[j]]++;
-        const fdem_fracture_params *p =
-            set_of[j] >= 0 ? &m->joint_sets[set_of[j]].params
-                           : &m->materials[element_material(m, m->joint_elem[2 * j])].def.fracture;
-        varied += p->variation.weibull_modulus > 0;
+        varied += joint_variation(m, j, set_of[j])->weibull_modulus > 0;
     }
     for (int k = 0; ok && k < S; k++)
         if (!used[k]) {
@@ -191,14 +197,13 @@ int joint_strengths_assign(fdem_model *m, fdem_error *err)
     int next = M + S;
     for (int j = 0; j < J; j++) {
         int mat = element_material(m, m->joint_elem[2 * j]);
-        const fdem_fracture_params *p =
-            set_of[j] >= 0 ? &m->joint_sets[set_of[j]].params : &m->materials[mat].def.fracture;
+        const fdem_variation *v = joint_variation(m, j, set_of[j]);
         int base = set_of[j] >= 0 ? M + set_of[j] : mat;
-        if (!(p->variation.weibull_modulus > 0)) {
+        if (!(v->weibull_modulus > 0)) {
             m->joint_strength_of[j] = base;
             continue;
         }
-        double factor = weibull_factor(p->variation.seed, (uint64_t)j, p->variation.weibull_modulus);
+        double factor = weibull_factor(v->seed, (uint64_t)j, v->weibull_modulus);
         m->joint_strengths[next] = m->joint_strengths[base];
         m->joint_strengths[next].tensile_strength *= factor;
         m->joint_strengths[next].cohesion *= factor;

@@ -59,6 +59,7 @@ typedef struct joint_strength {
 typedef struct joint_set {
     int part;
     fdem_fracture_params params;
+    fdem_variation variation;
     int32_t *faces;
     int face_count;
 } joint_set;

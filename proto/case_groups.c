@@ -132,7 +132,7 @@ static void read_discontinuities(case_doc *doc, case_part *part, const json_t *s
         case_joint_set *set = &part->joint_sets[part->joint_set_count];
         set->group = group_lookup(doc, part, name, part_mesh_dimension(doc) - 1, at);
         if (mat) set->params = mat->fracture;
-        case_read_fracture(doc, value, at, what, 0, &set->params);
+        case_read_fracture(doc, value, at, what, 0, &set->params, &set->variation);
         if (set->group >= 0 && part->groups.group[set->group].face_count == 0) {
             case_problem(doc, at, "the group \"%.64s\" has no %s of the mesh", name,
                          doc->dimension == 3 ? "3-node triangles" : "2-node lines");
@@ -223,7 +223,8 @@ int case_add_part_groups(case_doc *doc, fdem_model *model, int i)
     for (int k = 0; k < part->joint_set_count; k++) {
         const case_joint_set *set = &part->joint_sets[k];
         const gmsh_group *group = &part->groups.group[set->group];
-        if (fdem_add_joint_set(model, i, &set->params, group->faces, group->face_count, &err) < 0) {
+        if (fdem_add_joint_set(model, i, &set->params, &set->variation, group->faces,
+                               group->face_count, &err) < 0) {
             char sets[CASE_POINTER];
             pointer_join(sets, sizeof sets, base, "discontinuities");
             pointer_join(ptr, sizeof ptr, sets, group->name);

@@ -72,6 +72,7 @@ typedef struct case_part {
 typedef struct case_joint_set {
     int group;
     fdem_fracture_params params;
+    fdem_variation variation;
 } case_joint_set;
 
 typedef struct case_constraint {
@@ -179,10 +180,11 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
-/* case_materials.c: a fracture block; required = 0 lets keys be absent
- * (f keeps what it held) but wants at least one. */
+/* case_materials.c: a fracture block and its variation (zero when it has
+ * none); required = 0 lets keys be absent (f keeps what it held) but wants
+ * at least one. */
 void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, const char *what,
-                        int required, fdem_fracture_params *f);
+                        int required, fdem_fracture_params *f, fdem_variation *v);
 /* case_groups.c: a gmsh part's "materials" and "discontinuities" (after its
  * shape, material and fracture flag), a {"part", "group"} selector's nodes
  * (0 and a list the caller frees, or -1 after a problem at ptr), and the

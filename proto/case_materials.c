@@ -78,14 +78,14 @@ static void read_variation(case_doc *doc, const json_t *value, const char *ptr,
 }
 
 void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, const char *what,
-                        int required, fdem_fracture_params *f)
+                        int required, fdem_fracture_params *f, fdem_variation *v)
 {
     if (!case_expect_object(doc, value, ptr)) return;
     case_check_keys(doc, value, ptr, fracture_keys, what);
     char at[CASE_POINTER];
     json_t *variation = case_member(value, ptr, "variation", at);
-    f->variation = (fdem_variation){0, 0};
-    if (variation) read_variation(doc, variation, at, &f->variation);
+    *v = (fdem_variation){0, 0};
+    if (variation) read_variation(doc, variation, at, v);
     if (!required) { /* a joint set: what it leaves out is its material's */
         static const char *const keys[] = {"tensile_strength", "cohesion", "friction_angle",
                                            "energy_I", "energy_II"};
@@ -141,7 +141,8 @@ static void material_read(case_doc *doc, const char *name, const json_t *value,
         char fracture_what[128];
         snprintf(fracture_what, sizeof fracture_what, "the fracture block of %s", what);
         def->has_fracture = 1;
-        case_read_fracture(doc, fracture, fracture_ptr, fracture_what, 1, &def->fracture);
+        case_read_fracture(doc, fracture, fracture_ptr, fracture_what, 1, &def->fracture,
+                           &def->variation);
     }
 }
 
