@@ -14,6 +14,17 @@
  * pairs, the lists are added in thread order): the same bits on any thread
  * count.
  *
+ * Most candidate pairs are far from touching (coarse tetrahedra have loose
+ * bounding spheres: a sphere pile has ~25 candidates per element and well
+ * under one touching), so the per-step walk takes only the "near" pairs:
+ * no node has moved more than d = sqrt(max_disp2) since detection, so two
+ * boxes with a gap g at some step cannot overlap while every node stays
+ * within reach r of its detection place, if g > 2 (d + r). The near list
+ * holds the other pairs, in pair order, and is rebuilt when d passes r;
+ * a pair it leaves out has its boxes apart now and until then, exactly
+ * what the box test would have found, so its springs go at the rebuild as
+ * they would have gone that step: the same bits as walking every pair.
+ *
  * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
  * dimension's count of slots each (cs->slots), across steps, detections and
  * checkpoints (contact_history.c); a pair whose boxes part lets them go.
@@ -52,6 +63,11 @@ typedef struct contact_touches {
     double *force;
     size_t count, capacity;
 } contact_touches;
+
+/* How much farther the near list looks than the nodes have gone, as a
+ * fraction of the buffer: a rebuild every buffer/16 of travel (detection
+ * comes at buffer/2) against fewer pairs in the list. */
+#define NEAR_REACH_STEP 0.0625
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
 static inline int boxes_overlap(const double *a, const double *b, int dim)
@@ -113,6 +129,47 @@ static void contact_collect_active(contact_state *cs, int elem_count)
     for (int e = 0; e < elem_count; e++)
         if (cs->in_pair[e]) cs->active[count++] = e;
     cs->active_count = count;
+}
+
+/* The widest gap between two boxes along an axis (negative: they overlap
+ * on every axis). */
+static inline double boxes_gap(const double *a, const double *b, int dim)
+{
+    double gap = -INFINITY;
+    for (int d = 0; d < dim; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
+    return gap;
+}
+
+static void pair_springs_release(contact_state *cs, size_t k, int slots);
+
+/* The near list (see the top of this file) from this step's boxes, if a
+ * detection or a restore made it stale or the nodes have gone past its
+ * reach. Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(contact_state *cs, int dim)
+{
+    double d = sqrt(cs->max_disp2);
+    if (!cs->near_stale && d <= cs->near_reach) return 0;
+    if (cs->near_capacity < cs->pairs.count) {
+        size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
+        if (!n) return -1;
+        cs->near = n;
+        cs->near_capacity = cs->pairs.count;
+    }
+    double reach = d + NEAR_REACH_STEP * cs->buffer;
+    /* a hair over 2 (d + reach), so rounding in the gap or in d never
+     * leaves out a pair that could touch */
+    double limit = 2.0 * (d + reach) * (1 + 1e-9);
+    size_t width = 2 * (size_t)dim, count = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        const double *a = cs->box + width * (size_t)cs->pairs.a[k];
+        const double *b = cs->box + width * (size_t)cs->pairs.b[k];
+        if (boxes_gap(a, b, dim) <= limit) cs->near[count++] = k;
+        else pair_springs_release(cs, k, cs->slots); /* apart now and until the next rebuild */
+    }
+    cs->near_count = count;
+    cs->near_reach = reach;
+    cs->near_stale = 0;
+    return 0;
 }
 
 /* Force between two elements whose boxes overlap, both roles, into out
@@ -271,6 +328,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     if (pos != cs->pos_detect)
         memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
+    cs->near_stale = 1;
     cs->detections++;
     return 0;
 }
@@ -291,6 +349,7 @@ int contact_restore_detection(fdem_model *m)
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
     cs->pairs.count = 0;
+    cs->near_stale = 1;
     memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = 1;
     if (cs->need_detect) return 0; /* the next step detects anyway */
@@ -349,7 +408,7 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
-    free(cs->box); free(cs->active); free(cs->in_pair);
+    free(cs->box); free(cs->active); free(cs->in_pair); free(cs->near);
     for (int t = 0; t < cs->touch_lists; t++) {
         free(cs->touches[t].pair);
         free(cs->touches[t].force);
@@ -394,6 +453,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + 1);
     b += cs->record_capacity * sizeof(contact_record);
+    b += cs->near_capacity * sizeof(size_t);
     for (int t = 0; t < cs->touch_lists; t++)
         b += cs->touches[t].capacity * (sizeof(long) + sizeof(double) * (size_t)cs->pair_out);
     return b;
@@ -436,7 +496,8 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
 {
     contact_state *cs = &m->contact;
     int touching = 0;
-    for (size_t k = 0; k < cs->pairs.count; k++) {
+    for (size_t i = 0; i < cs->near_count; i++) {
+        size_t k = cs->near[i];
         double out[CONTACT_PAIR_OUT_MAX];
         if (pair_evaluate(m, k, h, out, D) <= 0) continue;
         contact_pair_scatter(m, cs->pairs.a[k], cs->pairs.b[k], out);
@@ -450,8 +511,8 @@ static int contact_pairs_forces_serial(fdem_model *m, double h)
     return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
 }
 
-/* The same on several threads: each takes a contiguous share of the pairs
- * and lists the ones that touched with their forces; the lists are then
+/* The same on several threads: each takes a contiguous share of the near
+ * pairs and lists the ones that touched with their forces; the lists are then
  * added in thread order, which is pair order. Every node's sum is formed in
  * the order the serial loop forms it: the same bits on any thread count.
  * Returns the number of pairs that touched, or -1 if a list could not grow
@@ -461,7 +522,8 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
                                                                      contact_touches *list, int D)
 {
     int touching = 0;
-    for (long k = begin; k < end; k++) {
+    for (long i = begin; i < end; i++) {
+        long k = (long)m->contact.near[i];
         double force[CONTACT_PAIR_OUT_MAX];
         if (pair_evaluate(m, (size_t)k, h, force, D) <= 0) continue;
         touching++;
@@ -473,7 +535,7 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
 static int contact_pairs_forces_threaded(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
-    long n = (long)cs->pairs.count;
+    long n = (long)cs->near_count;
     const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b;
     int touching = 0, failed = 0, used = 1;
     contact_touches *lists = cs->touches;
@@ -512,7 +574,7 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
 static int contact_pairs_forces(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
-    if (m->threads > 1 && cs->pairs.count >= CONTACT_THREADED_PAIRS &&
+    if (m->threads > 1 && cs->near_count >= CONTACT_THREADED_PAIRS &&
         contact_touch_lists(cs, m->threads) == 0) {
         /* a list that cannot grow has already moved some stick springs:
          * the step fails rather than run the pairs twice */
@@ -542,6 +604,7 @@ int contact_forces(fdem_model *m)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (cs->pairs.count) contact_boxes(m);
+    if (contact_near_refresh(cs, m->dim)) return -1;
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;
