@@ -14,6 +14,17 @@
  * pairs, the lists are added in thread order): the same bits on any thread
  * count.
  *
+ * Most candidate pairs are far from touching (coarse tetrahedra have loose
+ * bounding spheres: a sphere pile has ~25 candidates per element and well
+ * under one touching), so the per-step walk takes only the "near" pairs:
+ * no node has moved more than d = sqrt(max_disp2) since detection, so two
+ * boxes with a gap g at some step cannot overlap while every node stays
+ * within reach r of its detection place, if g > 2 (d + r). The near list
+ * holds the other pairs, in pair order, and is rebuilt when d passes r;
+ * a pair it leaves out has its boxes apart now and until then, exactly
+ * what the box test would have found, so its springs go at the rebuild as
+ * they would have gone that step: the same bits as walking every pair.
+ *
  * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
  * dimension's count of slots each (cs->slots), across steps, detections and
  * checkpoints (contact_history.c); a pair whose boxes part lets them go.
@@ -45,13 +56,55 @@ static const contact_kernel contact_kernels[2] = {
     {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153},
 };
 
-/* A thread's pairs that touched, in pair order, with their forces
- * (pair_out numbers each). */
-typedef struct contact_touches {
+/* Rows of numbers keyed by a candidate pair, in pair order. */
+typedef struct pair_rows {
     long *pair;
-    double *force;
+    double *row;
     size_t count, capacity;
+} pair_rows;
+
+/* A thread's share of the pairs: those that touched with their forces
+ * (pair_out numbers each), those whose springs the pool is to adopt
+ * (slots each) or let go. */
+typedef struct contact_touches {
+    pair_rows touched, adopt, release;
 } contact_touches;
+
+static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
+{
+    if (list->count == list->capacity) {
+        size_t cap = list->capacity ? 2 * list->capacity : 1024;
+        long *p = realloc(list->pair, cap * sizeof *p);
+        if (!p) return -1;
+        list->pair = p;
+        if (width) {
+            double *f = realloc(list->row, cap * (size_t)width * sizeof *f);
+            if (!f) return -1;
+            list->row = f;
+        }
+        list->capacity = cap;
+    }
+    list->pair[list->count] = pair;
+    if (width) memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
+    list->count++;
+    return 0;
+}
+
+static size_t pair_rows_bytes(const pair_rows *list, int width)
+{
+    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)width);
+}
+
+static void pair_rows_free(pair_rows *list)
+{
+    free(list->pair);
+    free(list->row);
+}
+
+/* How much farther the near list looks than the nodes have gone, as a
+ * fraction of the buffer: a rebuild every buffer/16 of travel (detection
+ * comes at buffer/2) against fewer pairs in the list. */
+#define NEAR_REACH_STEP 0.0625
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
 static inline int boxes_overlap(const double *a, const double *b, int dim)
@@ -115,6 +168,45 @@ static void contact_collect_active(contact_state *cs, int elem_count)
     cs->active_count = count;
 }
 
+/* The widest gap between two boxes along an axis (negative: they overlap
+ * on every axis). */
+static inline double boxes_gap(const double *a, const double *b, int dim)
+{
+    double gap = -INFINITY;
+    for (int d = 0; d < dim; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
+    return gap;
+}
+
+/* The near list (see the top of this file) from this step's boxes, if a
+ * detection or a restore made it stale or the nodes have gone past its
+ * reach. Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(contact_state *cs, int dim)
+{
+    double d = sqrt(cs->max_disp2);
+    if (!cs->near_stale && d <= cs->near_reach) return 0;
+    if (cs->near_capacity < cs->pairs.count) {
+        size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
+        if (!n) return -1;
+        cs->near = n;
+        cs->near_capacity = cs->pairs.count;
+    }
+    double reach = d + NEAR_REACH_STEP * cs->buffer;
+    /* a hair over 2 (d + reach), so rounding in the gap or in d never
+     * leaves out a pair that could touch */
+    double limit = 2.0 * (d + reach) * (1 + 1e-9);
+    size_t width = 2 * (size_t)dim, count = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        const double *a = cs->box + width * (size_t)cs->pairs.a[k];
+        const double *b = cs->box + width * (size_t)cs->pairs.b[k];
+        if (boxes_gap(a, b, dim) <= limit) cs->near[count++] = k;
+        else contact_springs_release(cs, k); /* apart now and until the next rebuild */
+    }
+    cs->near_count = count;
+    cs->near_reach = reach;
+    cs->near_stale = 0;
+    return 0;
+}
+
 /* Force between two elements whose boxes overlap, both roles, into out
  * (pair_out numbers); springs are the pair's stick springs (updated), h the
  * last step's size. The softer surface sets the penalty; friction is the
@@ -152,41 +244,39 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *ou
     m->friction_energy += out[2 * m->dim * m->elem_nodes];
 }
 
-/* A pair whose boxes no longer overlap lets its stick springs go. */
-static inline void pair_springs_release(contact_state *cs, size_t k, int slots)
-{
-    if (!cs->sprung[k]) return;
-    double *springs = cs->slip + (size_t)slots * k;
-    for (int s = 0; s < slots; s++) springs[s] = 0;
-    cs->sprung[k] = 0;
-}
-
-/* Notes whether pair k's springs hold anything after its evaluation. */
-static inline void pair_springs_mark(contact_state *cs, size_t k, int slots)
-{
-    const double *springs = cs->slip + (size_t)slots * k;
-    int any = 0;
-    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
-    cs->sprung[k] = (uint8_t)any;
-}
+/* What a pair's evaluation asks of the spring pool (contact_history.c):
+ * done at once on one thread, after the threads in pair order otherwise
+ * (the pool is shared; each pair's own set is not). */
+enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
 
 /* Candidate pair k this step: boxes apart, it lets its springs go (-1);
- * otherwise its force into out (pair_out numbers), 1 if it touched. D is a
+ * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
+ * without a set of springs is evaluated on fresh (zeros); *pool says
+ * whether fresh is to be adopted or the pair's set let go. D is a
  * constant where it is called, so each dimension's walk is compiled on
  * its own with the box and spring loops unrolled. */
 static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t k, double h,
-                                                               double *out, int D)
+                                                               double *out, double *fresh,
+                                                               int *pool, int D)
 {
     contact_state *cs = &m->contact;
     const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
     const size_t width = 2 * (size_t)D;
-    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k], set = cs->spring_of[k];
+    *pool = SPRINGS_KEPT;
     if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
-        pair_springs_release(cs, k, slots);
+        if (set >= 0) *pool = SPRINGS_RELEASE;
         return -1;
     }
-    int touched = contact_pair_force(m, a, b, h, cs->slip + (size_t)slots * k, out);
-    pair_springs_mark(cs, k, slots);
+    double *springs = fresh;
+    if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
+    else
+        for (int s = 0; s < slots; s++) fresh[s] = 0;
+    int touched = contact_pair_force(m, a, b, h, springs, out);
+    int any = 0;
+    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+    if (set < 0 && any) *pool = SPRINGS_ADOPT;
     return touched;
 }
 
@@ -271,6 +361,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     if (pos != cs->pos_detect)
         memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
+    cs->near_stale = 1;
     cs->detections++;
     return 0;
 }
@@ -291,6 +382,7 @@ int contact_restore_detection(fdem_model *m)
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
     cs->pairs.count = 0;
+    cs->near_stale = 1;
     memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = 1;
     if (cs->need_detect) return 0; /* the next step detects anyway */
@@ -349,14 +441,16 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->force);
-    free(cs->box); free(cs->active); free(cs->in_pair);
+    free(cs->box); free(cs->active); free(cs->in_pair); free(cs->near);
     for (int t = 0; t < cs->touch_lists; t++) {
-        free(cs->touches[t].pair);
-        free(cs->touches[t].force);
+        pair_rows_free(&cs->touches[t].touched);
+        pair_rows_free(&cs->touches[t].adopt);
+        pair_rows_free(&cs->touches[t].release);
     }
     free(cs->touches);
     free(cs->slip);
-    free(cs->sprung);
+    free(cs->spring_of);
+    free(cs->slip_free);
     free(cs->records);
     nbs_grid_free(&cs->grid);
     nbs_grid_3d_free(&cs->grid3);
@@ -386,35 +480,22 @@ double contact_stable_dt(const fdem_model *m)
     return dt;
 }
 
-/* The threaded runs' touch lists and the stick springs (slots doubles and
- * a flag per candidate pair, the records set aside across a detection):
- * in 3D the springs are 24 doubles a pair, the largest per-pair cost. */
+/* The threaded runs' lists, the stick springs (a set index per candidate
+ * pair, slots doubles per set in the pool: only pairs that touch hold a
+ * set), the records set aside across a detection and the near list. */
 size_t contact_memory_bytes(const contact_state *cs)
 {
     size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
-    b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + 1);
+    b += cs->pair_capacity * sizeof(int32_t);
+    b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
-    for (int t = 0; t < cs->touch_lists; t++)
-        b += cs->touches[t].capacity * (sizeof(long) + sizeof(double) * (size_t)cs->pair_out);
-    return b;
-}
-
-static int contact_touch_push(contact_touches *list, long pair, const double *force, int width)
-{
-    if (list->count == list->capacity) {
-        size_t cap = list->capacity ? 2 * list->capacity : 1024;
-        long *p = realloc(list->pair, cap * sizeof *p);
-        if (!p) return -1;
-        list->pair = p;
-        double *f = realloc(list->force, cap * (size_t)width * sizeof *f);
-        if (!f) return -1;
-        list->force = f;
-        list->capacity = cap;
+    b += cs->near_capacity * sizeof(size_t);
+    for (int t = 0; t < cs->touch_lists; t++) {
+        b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
+        b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
+        b += pair_rows_bytes(&cs->touches[t].release, 0);
     }
-    list->pair[list->count] = pair;
-    memcpy(list->force + list->count * (size_t)width, force, sizeof(double) * (size_t)width);
-    list->count++;
-    return 0;
+    return b;
 }
 
 /* One list per thread; 0, or -1 if they cannot be had. */
@@ -436,9 +517,13 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
 {
     contact_state *cs = &m->contact;
     int touching = 0;
-    for (size_t k = 0; k < cs->pairs.count; k++) {
-        double out[CONTACT_PAIR_OUT_MAX];
-        if (pair_evaluate(m, k, h, out, D) <= 0) continue;
+    for (size_t i = 0; i < cs->near_count; i++) {
+        size_t k = cs->near[i];
+        double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, k, h, out, fresh, &pool, D);
+        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, k);
+        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, k, fresh)) return -1;
+        if (touched <= 0) continue;
         contact_pair_scatter(m, cs->pairs.a[k], cs->pairs.b[k], out);
         touching++;
     }
@@ -450,8 +535,8 @@ static int contact_pairs_forces_serial(fdem_model *m, double h)
     return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
 }
 
-/* The same on several threads: each takes a contiguous share of the pairs
- * and lists the ones that touched with their forces; the lists are then
+/* The same on several threads: each takes a contiguous share of the near
+ * pairs and lists the ones that touched with their forces; the lists are then
  * added in thread order, which is pair order. Every node's sum is formed in
  * the order the serial loop forms it: the same bits on any thread count.
  * Returns the number of pairs that touched, or -1 if a list could not grow
@@ -460,12 +545,17 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
                                                                      long begin, long end,
                                                                      contact_touches *list, int D)
 {
+    const contact_state *cs = &m->contact;
     int touching = 0;
-    for (long k = begin; k < end; k++) {
-        double force[CONTACT_PAIR_OUT_MAX];
-        if (pair_evaluate(m, (size_t)k, h, force, D) <= 0) continue;
+    for (long i = begin; i < end; i++) {
+        long k = (long)cs->near[i];
+        double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, (size_t)k, h, force, fresh, &pool, D);
+        if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
+        if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
+        if (touched <= 0) continue;
         touching++;
-        if (contact_touch_push(list, k, force, m->contact.pair_out)) return -1;
+        if (pair_rows_push(&list->touched, k, force, cs->pair_out)) return -1;
     }
     return touching;
 }
@@ -473,7 +563,7 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
 static int contact_pairs_forces_threaded(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
-    long n = (long)cs->pairs.count;
+    long n = (long)cs->near_count;
     const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b;
     int touching = 0, failed = 0, used = 1;
     contact_touches *lists = cs->touches;
@@ -486,7 +576,7 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
 #endif
         if (t == 0) used = nt;
         contact_touches *list = &lists[t];
-        list->count = 0;
+        list->touched.count = list->adopt.count = list->release.count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
         int mine = m->dim == 3 ? pairs_forces_listed(m, h, begin, end, list, 3)
                                : pairs_forces_listed(m, h, begin, end, list, 2);
@@ -498,11 +588,19 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
         }
     }
     if (failed) return -1;
-    for (int t = 0; t < used; t++)
-        for (size_t i = 0; i < lists[t].count; i++) {
-            long k = lists[t].pair[i];
-            contact_pair_scatter(m, pa[k], pb[k], lists[t].force + i * (size_t)cs->pair_out);
+    for (int t = 0; t < used; t++) {
+        const pair_rows *touched = &lists[t].touched;
+        for (size_t i = 0; i < touched->count; i++) {
+            long k = touched->pair[i];
+            contact_pair_scatter(m, pa[k], pb[k], touched->row + i * (size_t)cs->pair_out);
         }
+        for (size_t i = 0; i < lists[t].release.count; i++)
+            contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
+        const pair_rows *adopt = &lists[t].adopt;
+        for (size_t i = 0; i < adopt->count; i++)
+            if (contact_springs_adopt(cs, (size_t)adopt->pair[i], adopt->row + i * (size_t)cs->slots))
+                return -1;
+    }
     return touching;
 }
 
@@ -512,7 +610,7 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
 static int contact_pairs_forces(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
-    if (m->threads > 1 && cs->pairs.count >= CONTACT_THREADED_PAIRS &&
+    if (m->threads > 1 && cs->near_count >= CONTACT_THREADED_PAIRS &&
         contact_touch_lists(cs, m->threads) == 0) {
         /* a list that cannot grow has already moved some stick springs:
          * the step fails rather than run the pairs twice */
@@ -542,6 +640,7 @@ int contact_forces(fdem_model *m)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (cs->pairs.count) contact_boxes(m);
+    if (contact_near_refresh(cs, m->dim)) return -1;
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;

@@ -5,10 +5,13 @@
  *
  * Friction with elastic stick needs to remember, per touching pair, how far
  * its surfaces have been sheared against each other (PHYSICS.md,
- * "Friction"). The history sits beside the candidate pair list (cs->slots
- * values a pair: 2D the three edges of each element as contactor, 3D the
- * three components for each of four faces), because that is
- * where the force loop walks. Detection rebuilds the pair list in an order
+ * "Friction"): cs->slots values (2D the three edges of each element as
+ * contactor, 3D the three components for each of four faces). Only pairs
+ * that touch have springs that hold anything, and they are a few in a
+ * hundred of the candidates (3D: 24 doubles a set against ~25 candidates
+ * per element), so a candidate pair carries an index into a pool of sets
+ * (-1 for none), and a set is handed out when a pair first holds a force
+ * and taken back when all its springs are zero again. Detection rebuilds the pair list in an order
  * of its own, so before it runs the pairs that hold some history are set
  * aside as records keyed by their two elements, and afterwards every new
  * pair looks its record up in a small open-addressing table. A checkpoint
@@ -32,19 +35,60 @@ static void pair_slots_oriented(const double *slip, int a, int b, int slots, dou
     }
 }
 
+/* Room for the set index of `pairs` candidate pairs. */
 int contact_history_reserve(contact_state *cs, size_t pairs)
 {
-    if (pairs <= cs->slip_capacity) return 0;
-    size_t cap = cs->slip_capacity ? cs->slip_capacity : 1024;
+    if (pairs <= cs->pair_capacity) return 0;
+    size_t cap = cs->pair_capacity ? cs->pair_capacity : 1024;
     while (cap < pairs) cap *= 2;
-    double *s = realloc(cs->slip, sizeof(double) * (size_t)cs->slots * cap);
-    if (!s) return -1;
-    cs->slip = s;
-    uint8_t *f = realloc(cs->sprung, cap);
+    int32_t *f = realloc(cs->spring_of, sizeof *f * cap);
     if (!f) return -1;
-    cs->sprung = f;
-    cs->slip_capacity = cap;
+    cs->spring_of = f;
+    cs->pair_capacity = cap;
     return 0;
+}
+
+/* A set of zeros from the pool: its index, or -1 when out of memory. */
+static int32_t springs_take(contact_state *cs)
+{
+    int32_t set;
+    if (cs->free_count) {
+        set = cs->slip_free[--cs->free_count];
+    } else {
+        if (cs->slip_count == cs->slip_capacity) {
+            size_t cap = cs->slip_capacity ? 2 * cs->slip_capacity : 256;
+            if (cap > INT32_MAX) return -1;
+            double *s = realloc(cs->slip, sizeof(double) * (size_t)cs->slots * cap);
+            if (!s) return -1;
+            cs->slip = s;
+            int32_t *f = realloc(cs->slip_free, sizeof *f * cap);
+            if (!f) return -1;
+            cs->slip_free = f;
+            cs->slip_capacity = cap;
+        }
+        set = (int32_t)cs->slip_count++;
+    }
+    memset(cs->slip + (size_t)cs->slots * (size_t)set, 0, sizeof(double) * (size_t)cs->slots);
+    return set;
+}
+
+/* Candidate pair `pair`, without a set so far, now holds these springs. */
+int contact_springs_adopt(contact_state *cs, size_t pair, const double *springs)
+{
+    int32_t set = springs_take(cs);
+    if (set < 0) return -1;
+    memcpy(cs->slip + (size_t)cs->slots * (size_t)set, springs, sizeof(double) * (size_t)cs->slots);
+    cs->spring_of[pair] = set;
+    return 0;
+}
+
+/* Candidate pair `pair` lets its springs go (if it held any). */
+void contact_springs_release(contact_state *cs, size_t pair)
+{
+    int32_t set = cs->spring_of[pair];
+    if (set < 0) return;
+    cs->slip_free[cs->free_count++] = set;
+    cs->spring_of[pair] = -1;
 }
 
 static int records_reserve(contact_state *cs, size_t count)
@@ -65,12 +109,12 @@ int contact_history_set_aside(contact_state *cs)
 {
     size_t n = cs->record_count;
     for (size_t k = 0; k < cs->pairs.count; k++)
-        n += cs->sprung[k];
+        n += contact_pair_sprung(cs, k);
     if (records_reserve(cs, n)) return -1;
     n = cs->record_count;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        if (!cs->sprung[k]) continue;
-        const double *slip = cs->slip + (size_t)cs->slots * k;
+        if (!contact_pair_sprung(cs, k)) continue;
+        const double *slip = cs->slip + (size_t)cs->slots * (size_t)cs->spring_of[k];
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
         contact_record *r = &cs->records[n++];
         r->lo = a < b ? a : b;
@@ -95,10 +139,9 @@ static inline uint64_t pair_hash(int32_t lo, int32_t hi)
 int contact_history_take_back(contact_state *cs)
 {
     if (contact_history_reserve(cs, cs->pairs.count)) return -1;
-    if (cs->pairs.count) {
-        memset(cs->slip, 0, sizeof(double) * (size_t)cs->slots * cs->pairs.count);
-        memset(cs->sprung, 0, cs->pairs.count);
-    }
+    /* every set was set aside: the pool starts empty */
+    cs->slip_count = cs->free_count = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) cs->spring_of[k] = -1;
     size_t n = cs->record_count;
     if (n == 0) return 0;
     size_t size = 16;
@@ -118,8 +161,12 @@ int contact_history_take_back(contact_state *cs)
         for (; table[i] >= 0; i = (i + 1) & (size - 1)) {
             const contact_record *r = &cs->records[table[i]];
             if (r->lo != lo || r->hi != hi) continue;
-            pair_slots_oriented(r->slip, a, b, cs->slots, cs->slip + (size_t)cs->slots * k);
-            cs->sprung[k] = 1;
+            double oriented[CONTACT_SLOTS_MAX];
+            pair_slots_oriented(r->slip, a, b, cs->slots, oriented);
+            if (contact_springs_adopt(cs, k, oriented)) {
+                free(table);
+                return -1;
+            }
             break;
         }
     }
@@ -140,7 +187,7 @@ size_t contact_history_checkpoint_size(const contact_state *cs)
 {
     size_t n = 0;
     for (size_t k = 0; k < cs->pairs.count; k++)
-        n += cs->sprung[k];
+        n += contact_pair_sprung(cs, k);
     return n * contact_record_bytes(cs);
 }
 
@@ -148,8 +195,8 @@ void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p)
 {
     size_t springs = sizeof(double) * (size_t)cs->slots;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        if (!cs->sprung[k]) continue;
-        const double *slip = cs->slip + (size_t)cs->slots * k;
+        if (!contact_pair_sprung(cs, k)) continue;
+        const double *slip = cs->slip + (size_t)cs->slots * (size_t)cs->spring_of[k];
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
         int32_t key[2] = {a < b ? a : b, a < b ? b : a};
         double oriented[CONTACT_SLOTS_MAX];

@@ -80,8 +80,10 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
 }
 
 /* Keeps the part of the polygon where lambda_k - lambda_j >= 0 (j < 0:
- * lambda_k >= 0) - Sutherland-Hodgman on an affine function. */
-static void clip_keep(clip_polygon *poly, int k, int j)
+ * lambda_k >= 0) - Sutherland-Hodgman on an affine function. Returns the
+ * clipped polygon: poly itself when the plane cuts nothing (most planes),
+ * else spare, written (so the caller swaps buffers instead of copying). */
+static clip_polygon *clip_keep(clip_polygon *poly, clip_polygon *spare, int k, int j)
 {
     int n = poly->count, inside = 0;
     double g[CLIP_MAX];
@@ -89,26 +91,22 @@ static void clip_keep(clip_polygon *poly, int k, int j)
         g[a] = poly->v[a].lambda[k] - (j >= 0 ? poly->v[a].lambda[j] : 0.0);
         inside += g[a] >= 0;
     }
-    if (inside == n) return; /* most planes cut nothing: no copy */
-    if (inside == 0) {
-        poly->count = 0;
-        return;
-    }
-    clip_polygon out;
-    out.count = 0;
+    if (inside == n) return poly;
+    clip_polygon *out = spare;
+    out->count = 0;
+    if (inside == 0) return out;
     for (int a = 0; a < n; a++) {
         const clip_vertex *p = &poly->v[a], *q = &poly->v[(a + 1) % n];
         double gp = g[a], gq = g[(a + 1) % n];
-        if (gp >= 0 && out.count < CLIP_MAX) out.v[out.count++] = *p;
-        if ((gp >= 0) != (gq >= 0) && out.count < CLIP_MAX) {
+        if (gp >= 0 && out->count < CLIP_MAX) out->v[out->count++] = *p;
+        if ((gp >= 0) != (gq >= 0) && out->count < CLIP_MAX) {
             double t = gp / (gp - gq);
-            clip_vertex *m = &out.v[out.count++];
+            clip_vertex *m = &out->v[out->count++];
             for (int i = 0; i < 3; i++) m->x[i] = p->x[i] + t * (q->x[i] - p->x[i]);
             for (int i = 0; i < 4; i++) m->lambda[i] = p->lambda[i] + t * (q->lambda[i] - p->lambda[i]);
         }
     }
-    poly->count = out.count;
-    memcpy(poly->v, out.v, sizeof(clip_vertex) * (size_t)out.count);
+    return out;
 }
 
 /* Integral of phi = 4 lambda_k over the polygon (*i0), its first moment
@@ -177,7 +175,7 @@ static int outside_one_face(const double (*lambda)[4], const int *which, int n)
 /* Face m (opposite contactor node m, whose corners have the coordinates
  * lambda in the target) clipped to the target: 1 and *ft if the potential
  * acts on it, 0 if not. */
-static int face_in_target(const double *pc[4], const double (*lambda)[4], int m,
+static int face_in_target(const double *const pc[4], const double (*lambda)[4], int m,
                           const bary_map *bt, face_touch *ft)
 {
     const int *fn = tet_face_nodes[m];
@@ -190,14 +188,16 @@ static int face_in_target(const double *pc[4], const double (*lambda)[4], int m,
         memcpy(face.v[v].lambda, lambda[fn[v]], sizeof face.v[v].lambda);
     }
     double i0 = 0, i1[3] = {0, 0, 0}, area = 0;
+    clip_polygon buffers[2];
     for (int k = 0; k < 4; k++) {
-        clip_polygon poly;
-        poly.count = 3;
-        memcpy(poly.v, face.v, sizeof(clip_vertex) * 3);
-        clip_keep(&poly, k, -1);
-        for (int j = 0; j < 4 && poly.count >= 3; j++)
-            if (j != k) clip_keep(&poly, j, k); /* lambda_j - lambda_k >= 0 */
-        if (poly.count >= 3) polygon_integrals(&poly, k, &i0, i1, &area);
+        /* the face itself until some plane cuts it; then two buffers in turn */
+        clip_polygon *poly = clip_keep(&face, &buffers[0], k, -1);
+        for (int j = 0; j < 4 && poly->count >= 3; j++) {
+            if (j == k) continue;
+            clip_polygon *spare = poly == &buffers[0] ? &buffers[1] : &buffers[0];
+            poly = clip_keep(poly, spare, j, k); /* lambda_j - lambda_k >= 0 */
+        }
+        if (poly->count >= 3) polygon_integrals(poly, k, &i0, i1, &area);
     }
     if (!(i0 > 0)) return 0;
     /* outward unit normal of the face: away from node m */
@@ -245,7 +245,7 @@ typedef struct tet_friction {
 } tet_friction;
 
 /* The target's smallest height, det / (largest |face cross product|). */
-static double tet_smallest_height_now(const double *pt[4], double det)
+static double tet_smallest_height_now(const double *const pt[4], double det)
 {
     double largest = 0;
     for (int m = 0; m < 4; m++) {
@@ -289,18 +289,26 @@ static void face_friction(const face_touch *ft, int m, double k_n, double f_n, t
     }
 }
 
+/* A tetrahedron's corner positions and barycentric map, worked out once
+ * a pair and used in both roles. */
+typedef struct tet_frame {
+    const double *p[4];
+    bary_map bary;
+} tet_frame;
+
+static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
+{
+    for (int v = 0; v < 4; v++) t->p[v] = pos + 3 * (size_t)n[v];
+    t->bary = bary_of(t->p);
+}
+
 /* One way, with friction when fr is not NULL (a face that does not touch
  * lets its spring go). */
-static double contact_one_way(const double *pos, const int32_t contactor[4],
-                              const int32_t target[4], double penalty, tet_friction *fr,
-                              double f_c[12], double f_t[12])
+static double contact_one_way(const tet_frame *contactor, const tet_frame *target,
+                              double penalty, tet_friction *fr, double f_c[12], double f_t[12])
 {
-    const double *pc[4], *pt[4];
-    for (int v = 0; v < 4; v++) {
-        pc[v] = pos + 3 * (size_t)contactor[v];
-        pt[v] = pos + 3 * (size_t)target[v];
-    }
-    bary_map bt = bary_of(pt);
+    const double *const *pc = contactor->p, *const *pt = target->p;
+    const bary_map bt = target->bary;
     if (!bt.valid) return 0.0;
     double lambda[4][4];
     static const int all[4] = {0, 1, 2, 3};
@@ -334,7 +342,10 @@ double tet_contact_one_way(const double *pos, const int32_t contactor[4],
                            const int32_t target[4], double penalty, double f_c[12],
                            double f_t[12])
 {
-    return contact_one_way(pos, contactor, target, penalty, NULL, f_c, f_t);
+    tet_frame c, t;
+    tet_frame_of(pos, contactor, &c);
+    tet_frame_of(pos, target, &t);
+    return contact_one_way(&c, &t, penalty, NULL, f_c, f_t);
 }
 
 double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4],
@@ -346,17 +357,12 @@ double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4
            tet_contact_one_way(pos, b, a, penalty, f_b, f_a);
 }
 
-static int tet_positive(const double *pos, const int32_t n[4])
-{
-    const double *p[4];
-    for (int v = 0; v < 4; v++) p[v] = pos + 3 * (size_t)n[v];
-    bary_map b = bary_of(p);
-    return b.valid && b.det > 0;
-}
-
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
-    if (!tet_positive(in->pos, in->node_a) || !tet_positive(in->pos, in->node_b)) {
+    tet_frame a, b;
+    tet_frame_of(in->pos, in->node_a, &a);
+    tet_frame_of(in->pos, in->node_b, &b);
+    if (!(a.bary.valid && a.bary.det > 0) || !(b.bary.valid && b.bary.det > 0)) {
         memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS); /* inverted: no potential */
         return 0;
     }
@@ -365,7 +371,7 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     tet_friction ab = {in->vel, in->node_a, in->node_b, in->friction, in->h, springs, dissipated};
     tet_friction ba = {in->vel, in->node_b, in->node_a, in->friction, in->h,
                        springs + TET_CONTACT_SLOTS / 2, dissipated};
-    double touched = contact_one_way(in->pos, in->node_a, in->node_b, in->penalty, &ab, out, out + 12);
-    touched += contact_one_way(in->pos, in->node_b, in->node_a, in->penalty, &ba, out + 12, out);
+    double touched = contact_one_way(&a, &b, in->penalty, &ab, out, out + 12);
+    touched += contact_one_way(&b, &a, in->penalty, &ba, out + 12, out);
     return touched > 0;
 }

@@ -691,8 +691,16 @@ size_t fdem_memory_estimate(long nodes, long elements, long joints)
 size_t fdem_memory_estimate_3d(long nodes, long elements, long joints)
 {
     size_t per_node = sizeof(double) * (3 * 5 + 2) + sizeof(int32_t) + 1;
+    /* spheres, boxes, body, NBS lists, then the candidate pairs: coarse
+     * tetrahedra have loose bounding spheres, and piles of them measure 25-50
+     * candidates per element. Each is two element ids and a spring-set index
+     * (12 bytes) with 4 for the near list and the lists' growth; a set of 24
+     * stick springs (196 bytes) is held only by pairs that touch, priced at
+     * one per 8 elements (piles measure one per 25-50). */
+    size_t per_pair = 2 * sizeof(int32_t) + sizeof(int32_t) + 4;
+    size_t per_set = sizeof(double) * 24 + sizeof(int32_t);
     size_t per_elem = sizeof(tet_hot) + sizeof(int32_t) * 5 + sizeof(double) * 12 + 1 +
-                      2 * 2 * sizeof(int32_t) * 6; /* spheres, boxes, body, NBS lists, ~6 pairs */
+                      50 * per_pair + per_set / 8;
     /* six nodes and two tetrahedra, damage, h, k and room; one face slot per
      * tetrahedron face once there are joints */
     size_t per_joint = sizeof(int32_t) * 8 + sizeof(double) * 8;

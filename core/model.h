@@ -131,13 +131,21 @@ typedef struct contact_state {
     int32_t *active;         /* the elements in some candidate pair, once each */
     int active_count;
     uint8_t *in_pair;        /* scratch per element for building active */
-    double *slip;            /* slots per candidate pair: the stick springs' force */
-    uint8_t *sprung;         /* per candidate pair: some spring is non-zero (so a pair out
-                                of reach, a detection or a checkpoint reads one byte, not
-                                all its springs) */
-    size_t slip_capacity;
+    /* Stick springs: a set of slots doubles only for the candidate pairs
+     * whose springs hold something (pairs that touch: a few in a hundred
+     * of the candidates), the rest share no memory (contact_history.c). */
+    double *slip;            /* the sets, slots doubles each */
+    int32_t *spring_of;      /* per candidate pair: its set, or -1 (all its springs zero) */
+    size_t pair_capacity;    /* of spring_of */
+    int32_t *slip_free;      /* sets let go, to be handed out again */
+    size_t slip_count, slip_capacity, free_count; /* sets handed out or freed, allocated, free */
     contact_record *records; /* history set aside across a detection or a restore */
     size_t record_count, record_capacity;
+    size_t *near;            /* candidate pairs whose boxes can overlap before max_disp2
+                                passes near_reach, in pair order (contact.c) */
+    size_t near_count, near_capacity;
+    double near_reach;       /* the list holds while sqrt(max_disp2) stays at or below this */
+    int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;           /* 2D detection */
@@ -321,6 +329,13 @@ size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick sp
 
 /* contact_history.c */
 int contact_history_reserve(contact_state *cs, size_t pairs);
+int contact_springs_adopt(contact_state *cs, size_t pair, const double *springs);
+void contact_springs_release(contact_state *cs, size_t pair);
+/* Some stick spring of candidate pair k holds a force. */
+static inline int contact_pair_sprung(const contact_state *cs, size_t k)
+{
+    return cs->spring_of[k] >= 0;
+}
 int contact_history_set_aside(contact_state *cs);
 int contact_history_take_back(contact_state *cs);
 size_t contact_history_checkpoint_size(const contact_state *cs);

@@ -455,7 +455,7 @@ static void two_threads_give_the_same_bits_with_contact(void)
 static long sprung_pairs(const fdem_model *m)
 {
     long n = 0;
-    for (size_t k = 0; k < m->contact.pairs.count; k++) n += m->contact.sprung[k];
+    for (size_t k = 0; k < m->contact.pairs.count; k++) n += contact_pair_sprung(&m->contact, k);
     return n;
 }
 
