@@ -1,7 +1,8 @@
 /*
  * test_fracture_3d.c - fracturing tetrahedral parts in the model: a joint
  * on every face shared by two tetrahedra (counted against the box mesh's
- * faces, oriented out of A, joining copies of one mesh vertex); an intact
+ * faces, oriented out of A, joining copies of one mesh vertex); the
+ * stable step of a jointed model within 2/omega_max of power iteration; an intact
  * fracturing bar vibrates with the period of the continuous one (4L/c);
  * a bar pulled apart at both ends breaks into pieces with the energy
  * balance closed, and 1 and 2 threads give the same bits.
@@ -11,6 +12,7 @@
 #include "check.h"
 #include "mesh_3d.h"
 #include "model.h"
+#include "power_iteration.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -156,6 +158,76 @@ static void intact_fracturing_bar_vibrates_like_continuum(void)
             100 * (stiff / continuous - 1), excess_soft / excess_stiff);
 }
 
+/* The stiffness of the whole model at rest (elements and intact joints),
+ * column by column from central differences of the engine's own forces;
+ * n = 3 x nodes, K row-major n x n, caller frees. */
+static double *assembled_stiffness(fdem_model *m, int with_elements)
+{
+    int n = 3 * m->node_count;
+    double *K = malloc(sizeof(double) * (size_t)n * (size_t)n), *fp = malloc(sizeof(double) * (size_t)n);
+    double step = 1e-9 * m->elem_h[0];
+    for (int j = 0; j < n; j++) {
+        for (int sign = 1; sign >= -1; sign -= 2) {
+            memcpy(m->pos, m->pos0, sizeof(double) * (size_t)n);
+            m->pos[j] += sign * step;
+            memset(m->force, 0, sizeof(double) * (size_t)n);
+            if (with_elements) element_forces(m);
+            joint_forces(m);
+            for (int i = 0; i < n; i++)
+                if (sign > 0) fp[i] = m->force[i];
+                else K[(size_t)n * i + j] = -(fp[i] - m->force[i]) / (2 * step);
+        }
+    }
+    memcpy(m->pos, m->pos0, sizeof(double) * (size_t)n);
+    free(fp);
+    return K;
+}
+
+/* The stable step of a jointed tetrahedral model against power iteration
+ * of M^-1 K of the whole model (elements and intact joints, from the
+ * engine's own forces), at three penalties. The joint estimate
+ * (joint_stable_dt_3d) must stay within 2 / omega_max (safe) and not fall
+ * below 0.4 of it: it takes 2 k A against the smallest of its six node
+ * masses, while Gershgorin gives about k A (a node's three faces, A / 3
+ * each, both sides) - a factor sqrt(2), and 0.9 on top, by design, with the
+ * faces of unequal area. The model's step (contact's 0.153 h sqrt(rho/p)
+ * governs a fracturing part) must be within 2 / omega_max too. */
+static void stable_step_bounds_the_fastest_jointed_mode(void)
+{
+    const double factors[3] = {1, 10, 100};
+    for (int t = 0; t < 3; t++) {
+        const double size[3] = {0.02, 0.01, 0.01};
+        const int div[3] = {2, 1, 1};
+        fdem_material_def mat = rock(1, 0);
+        mat.penalty = factors[t] * mat.young;
+        fdem_model *m = box_model(size, div, mat, 1);
+        build_finalize(m, 0.5);
+        int n = 3 * m->node_count;
+        double *K = assembled_stiffness(m, 1), *KJ = assembled_stiffness(m, 0);
+        double *mass = malloc(sizeof(double) * (size_t)n), *start = malloc(sizeof(double) * (size_t)n);
+        for (int i = 0; i < n; i++) {
+            mass[i] = m->mass[i / 3];
+            start[i] = 1.0 + 0.1 * (i % 7) * (i % 2 ? -1 : 1);
+        }
+        double exact = 2 / sqrt(largest_eigenvalue_over_mass(n, K, mass, start, 10000));
+        double joints_alone = 2 / sqrt(largest_eigenvalue_over_mass(n, KJ, mass, start, 10000));
+        double estimate = joint_stable_dt(m), taken = fdem_stable_dt(m);
+        CHECK(estimate <= exact && estimate >= 0.4 * exact,
+              "penalty %g E: joint estimate %.4g s against 2/omega_max %.4g s", factors[t],
+              estimate, exact);
+        CHECK(taken <= exact, "penalty %g E: step %.4g s above 2/omega_max %.4g s", factors[t],
+              taken, exact);
+        fprintf(stderr, "  penalty %3g E, %d joints: 2/omega_max %.4g s (joints alone %.4g s); "
+                "joint estimate %.3f of it, model step %.3f\n",
+                factors[t], m->joint_count, exact, joints_alone, estimate / exact, taken / exact);
+        free(K);
+        free(KJ);
+        free(mass);
+        free(start);
+        fdem_model_destroy(m);
+    }
+}
+
 /* A bar pulled at both ends at 5 m/s, as test_fragments' 2D bar. */
 static fdem_model *pulled_bar(int threads)
 {
@@ -225,5 +297,5 @@ static void two_threads_give_the_same_bits(void)
     fdem_model_destroy(b);
 }
 
-CHECK_MAIN(T(joints_on_interior_faces), T(intact_fracturing_bar_vibrates_like_continuum),
+CHECK_MAIN(T(joints_on_interior_faces), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
            T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits))
