@@ -5,7 +5,8 @@
  * stable step of a jointed model within 2/omega_max of power iteration; an intact
  * fracturing bar vibrates with the period of the continuous one (4L/c);
  * a bar pulled apart at both ends breaks into pieces with the energy
- * balance closed, and 1 and 2 threads give the same bits.
+ * balance closed, and 1 and 2 threads give the same bits, for that bar
+ * and for a fracturing block thrown at a slab (contact, friction, breakage).
  */
 #include "bar_period_3d.h"
 #include "build_model.h"
@@ -297,5 +298,82 @@ static void two_threads_give_the_same_bits(void)
     fdem_model_destroy(b);
 }
 
+/* A fracturing block (1296 tetrahedra, a joint on every interior face)
+ * thrown obliquely at a fixed steel slab under gravity: element forces,
+ * joints that break, contact with friction between the block and the slab
+ * and across broken faces, a support - every loop that threads. */
+static fdem_model *impact_model(int threads)
+{
+    fdem_error err = {0};
+    fdem_model *m = fdem_model_create();
+    fdem_material_def steel = {.density = 7800, .young = 2e11, .poisson = 0.3, .friction = 0.3};
+    fdem_material_def stone = rock(0, 0.05);
+    fdem_tet_mesh slab = {0}, block = {0};
+    const double slab_origin[3] = {-0.05, -0.05, -0.02}, slab_size[3] = {0.2, 0.2, 0.02};
+    const double block_origin[3] = {0, 0, 1e-4}, block_size[3] = {0.1, 0.1, 0.1};
+    const int slab_div[3] = {8, 8, 1}, block_div[3] = {6, 6, 6};
+    int ok = m && fdem_set_dimension(m, 3, &err) == 0 &&
+             fdem_tet_mesh_box(slab_origin, slab_size, slab_div, &slab, &err) == 0 &&
+             fdem_tet_mesh_box(block_origin, block_size, block_div, &block, &err) == 0 &&
+             fdem_add_material(m, &stone, &err) == 0 && fdem_add_material(m, &steel, &err) == 1 &&
+             fdem_add_part_3d(m, &block, 0, 1, &err) == 0 &&
+             fdem_add_part_3d(m, &slab, 1, 0, &err) == 1;
+    fdem_tet_mesh_free(&slab);
+    fdem_tet_mesh_free(&block);
+    if (!ok) build_die("impact", &err);
+    fdem_constraint_def fix = {0};
+    fix.select = FDEM_SELECT_PART;
+    fix.part = 1;
+    fix.kind = FDEM_CONSTRAINT_FIX;
+    fix.fix_x = fix.fix_y = fix.fix_z = 1;
+    const double v[3] = {0.5, 0.2, -3}, g[3] = {0, 0, -9.81};
+    if (fdem_add_constraint(m, &fix, &err) < 0 || fdem_set_part_velocity_v(m, 0, v, &err))
+        build_die("impact", &err);
+    fdem_set_gravity_v(m, g);
+    fdem_set_threads(m, threads);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+/* The impact on one and on two threads side by side, until joints have
+ * broken and the broken faces have been in contact for a while: the same
+ * bits (positions, velocities, damage, every energy account). */
+static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
+{
+    fdem_model *one = impact_model(1), *two = impact_model(2);
+    CHECK(fdem_get_threads(two) == 2, "threads %d", fdem_get_threads(two));
+    /* a fracturing part's tetrahedra share no node: one colour, several blocks */
+    CHECK(one->elem_plan.block_count >= 2 && one->joint_plan.color_count >= 2,
+          "the test needs planned loops: %d element blocks, %d joint colours",
+          one->elem_plan.block_count, one->joint_plan.color_count);
+    fdem_error err;
+    int steps = 0, after = 0;
+    while (after < 100 && steps < 20000) {
+        if (fdem_step(one, &err) || fdem_step(two, &err)) build_die("step", &err);
+        steps++;
+        after += fdem_get_counts(one).broken_joints > 0;
+    }
+    fdem_counts c1 = fdem_get_counts(one), c2 = fdem_get_counts(two);
+    CHECK(c1.broken_joints > 0, "no joint broke in %d steps", steps);
+    CHECK(c1.contacts > 0, "nothing touching after %d steps", steps);
+    CHECK(c1.broken_joints == c2.broken_joints, "broken %d vs %d", c1.broken_joints,
+          c2.broken_joints);
+    size_t bytes = sizeof(double) * 3 * (size_t)one->node_count;
+    CHECK(memcmp(one->pos, two->pos, bytes) == 0, "positions differ");
+    CHECK(memcmp(one->vel, two->vel, bytes) == 0, "velocities differ");
+    CHECK(memcmp(one->joint_damage, two->joint_damage, sizeof(double) * (size_t)one->joint_count) == 0,
+          "damage differs");
+    fdem_energy e1 = fdem_get_energy(one), e2 = fdem_get_energy(two);
+    CHECK(memcmp(&e1, &e2, sizeof e1) == 0, "energies differ: kinetic %.17g vs %.17g",
+          e1.kinetic, e2.kinetic);
+    fprintf(stderr, "  %d steps, %d tetrahedra, %d joints (%d broken), %d touching, %d element "
+            "blocks and %d joint colours, fracture %.3g J, friction %.3g J\n",
+            steps, c1.elements, c1.joints, c1.broken_joints, c1.contacts,
+            one->elem_plan.block_count, one->joint_plan.color_count, e1.fracture, e1.friction);
+    fdem_model_destroy(one);
+    fdem_model_destroy(two);
+}
+
 CHECK_MAIN(T(joints_on_interior_faces), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
-           T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits))
+           T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits),
+           T(fracturing_impact_on_two_threads_gives_the_bits_of_one))
