@@ -109,8 +109,35 @@ static void joints_on_interior_faces(void)
     fdem_model_destroy(m);
 }
 
-/* The first period of a fixed-free bar given an axial velocity. */
-static double bar_period(int fracture, double penalty_factor)
+/* The static excess compliance of the intact joints of a bar loaded
+ * along x, relative to the elements': under a uniform stress sigma along x
+ * a face of area A and normal n opens by sigma n_x n / k, which stores
+ * sigma^2 A n_x^2 / (2k) against the continuum's sigma^2 V / (2E), so the
+ * bar's stiffness falls by 1 + E sum(A n_x^2 / k) / V. */
+static double series_excess(const fdem_model *m, double young)
+{
+    double sum = 0, volume = 0;
+    for (int e = 0; e < m->elem_count; e++) volume += m->tet[e].volume0;
+    for (int j = 0; j < m->joint_count; j++) {
+        const int32_t *n = m->joint_node + 6 * j;
+        const double *x = m->pos0;
+        double e1[3], e2[3], N[3];
+        for (int c = 0; c < 3; c++) {
+            e1[c] = x[3 * n[1] + c] - x[3 * n[0] + c];
+            e2[c] = x[3 * n[2] + c] - x[3 * n[0] + c];
+        }
+        N[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        N[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        N[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        double twice_area = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+        sum += 0.5 * N[0] * N[0] / twice_area / m->joint_k[j];
+    }
+    return young * sum / volume;
+}
+
+/* The first period of a fixed-free bar given an axial velocity; *excess
+ * (when fracturing) gets series_excess of its joints. */
+static double bar_period(int fracture, double penalty_factor, double *excess)
 {
     const double L = 0.5, size[3] = {L, 0.05, 0.05};
     const int div[3] = {20, 1, 1};
@@ -122,6 +149,7 @@ static double bar_period(int fracture, double penalty_factor)
     fdem_error err;
     if (fdem_set_part_velocity_v(m, 0, v0, &err)) build_die("velocity", &err);
     build_finalize(m, 0.5);
+    if (excess) *excess = series_excess(m, mat.young);
     double period = 4 * L / sqrt(3e10 / 2700), u_max = 0.1 * period / 4;
     bar_crossing bar = {0, 0, -1, 0, 0};
     while (fdem_get_time(m) < 1.5 * period && bar.crossing < 0) {
@@ -133,30 +161,34 @@ static double bar_period(int fracture, double penalty_factor)
     return bar.crossing;
 }
 
-/* An intact joint is a penalty spring p/h per unit area in series with the
- * elements, so the bar's stiffness K falls to 1 / (1/K + c/p): the period
- * grows by (T/T_0)^2 - 1 = c K / p, inversely with the penalty. On this
- * mesh (a box cell cut into tetrahedra, several faces across the axis,
- * heights well below the cell) the default 10 E gives +12 % on the period
- * (2D: under 3 %), an open point for issue 13; at 100 E the bar vibrates
- * within 3 % of the continuous one. The excess (T/T_0)^2 - 1 falls about
- * tenfold (12.1: the series law is static, the first mode of a 20-element
- * chain is not quite); only its falling is held here. */
+/* An intact joint is a penalty spring k = p/h per unit area in series with
+ * the elements, so the bar's stiffness falls by 1 + series_excess and its
+ * period squared grows by that: (T/T_0)^2 - 1 = E sum(A n_x^2 / k) / V,
+ * which falls as 1/p. Measured: 0.258 against 0.245 at the default 10 E
+ * (+12 % on the period), 0.021 against 0.025 at 100 E (+1 %); the 2D bar
+ * of the same cells gives +8 % at 10 E by the same law (0.170 against
+ * 0.165): the 3D face network (each tetrahedron's four faces, heights well
+ * below the cell) holds 1.3-1.5 times the 2D joint area per volume, not a
+ * weaker joint (docs/physics.md, Three dimensions). The measured excess is
+ * held to the series law within 20 % (it is the static law, and the first
+ * mode of a 20-cell chain is not quite static). */
 static void intact_fracturing_bar_vibrates_like_continuum(void)
 {
-    double continuous = bar_period(0, 10), soft = bar_period(1, 10), stiff = bar_period(1, 100);
+    double soft_law, stiff_law;
+    double continuous = bar_period(0, 10, NULL), soft = bar_period(1, 10, &soft_law),
+           stiff = bar_period(1, 100, &stiff_law);
     double exact = 4 * 0.5 / sqrt(3e10 / 2700);
     CHECK_REL(continuous, exact, 0.03);
     CHECK_REL(stiff, continuous, 0.03);
     double excess_soft = soft * soft / (continuous * continuous) - 1;
     double excess_stiff = stiff * stiff / (continuous * continuous) - 1;
-    CHECK(excess_soft > 5 * excess_stiff && excess_stiff > 0,
-          "joint compliance does not fall with the penalty: %g at 10 E, %g at 100 E", excess_soft,
-          excess_stiff);
+    CHECK_REL(excess_soft, soft_law, 0.2);
+    CHECK_REL(excess_stiff, stiff_law, 0.2);
     fprintf(stderr, "  bar period: exact %.4g s, continuous %.4g s, fracturing %.4g s (%+.2f%%) "
-            "at penalty 10 E, %.4g s (%+.2f%%) at 100 E; compliance ratio %.3g\n",
+            "at penalty 10 E, %.4g s (%+.2f%%) at 100 E; (T/T0)^2 - 1 = %.4f and %.4f against "
+            "the series law's %.4f and %.4f\n",
             exact, continuous, soft, 100 * (soft / continuous - 1), stiff,
-            100 * (stiff / continuous - 1), excess_soft / excess_stiff);
+            100 * (stiff / continuous - 1), excess_soft, excess_stiff, soft_law, stiff_law);
 }
 
 /* The stiffness of the whole model at rest (elements and intact joints),
