@@ -31,6 +31,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "../tests/unit/joint_face_3d.h"
 #include "case.h"
 #include "model.h"
 
@@ -342,16 +343,7 @@ static double joint_angle(const fdem_model *m, int j, int split)
         double dx = fabs(p[2 * nd[1]] - p[2 * nd[0]]), dy = fabs(p[2 * nd[1] + 1] - p[2 * nd[0] + 1]);
         return atan2(dx, dy) * 180 / M_PI;
     }
-    const int32_t *nd = m->joint_node + 6 * (size_t)j;
-    double e1[3], e2[3], n[3];
-    for (int c = 0; c < 3; c++) {
-        e1[c] = p[3 * nd[1] + c] - p[3 * nd[0] + c];
-        e2[c] = p[3 * nd[2] + c] - p[3 * nd[0] + c];
-    }
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
-    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
-    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double n[3], len = joint_face_normal(p, m->joint_node + 6 * (size_t)j, n);
     if (split) return acos(fmin(1, fabs(n[0]) / len)) * 180 / M_PI;
     return asin(fmin(1, fabs(n[1]) / len)) * 180 / M_PI;
 }

@@ -33,6 +33,7 @@
 
 #include "case.h"
 #include "check.h"
+#include "joint_face_3d.h"
 #include "model.h"
 
 #define WINDOW 2e-6
@@ -155,18 +156,11 @@ static void joint_geometry(const fdem_model *m, int j, double *x, double *y, dou
     const double *p = m->pos0;
     if (m->dim == 3) {
         const int32_t *n = m->joint_node + 6 * (size_t)j;
-        double e1[3], e2[3], N[3];
-        for (int c = 0; c < 3; c++) {
-            e1[c] = p[3 * n[1] + c] - p[3 * n[0] + c];
-            e2[c] = p[3 * n[2] + c] - p[3 * n[0] + c];
-        }
-        N[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        N[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        N[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        *x = (p[3 * n[0]] + p[3 * n[1]] + p[3 * n[2]]) / 3;
-        *y = (p[3 * n[0] + 1] + p[3 * n[1] + 1] + p[3 * n[2] + 1]) / 3;
-        *angle_deg = acos(fmin(1, fabs(N[1]) / sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]))) *
-                     180 / M_PI;
+        double N[3], c[3], len = joint_face_normal(p, n, N);
+        joint_face_centre(p, n, c);
+        *x = c[0];
+        *y = c[1];
+        *angle_deg = acos(fmin(1, fabs(N[1]) / len)) * 180 / M_PI;
         return;
     }
     const int32_t *n = m->joint_node + 4 * j;
@@ -191,14 +185,7 @@ static void joint_slide_open(const fdem_model *m, int j, double *slid, double *o
         N[0] = -(p0[2 * n[1] + 1] - p0[2 * n[0] + 1]);
         N[1] = p0[2 * n[1]] - p0[2 * n[0]];
     } else {
-        double e1[3], e2[3];
-        for (int c = 0; c < 3; c++) {
-            e1[c] = p0[3 * n[1] + c] - p0[3 * n[0] + c];
-            e2[c] = p0[3 * n[2] + c] - p0[3 * n[0] + c];
-        }
-        N[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        N[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        N[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        joint_face_normal(p0, n, N);
     }
     double len = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
     double normal = (d[0] * N[0] + d[1] * N[1] + d[2] * N[2]) / len;

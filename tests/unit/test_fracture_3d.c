@@ -11,6 +11,7 @@
 #include "bar_period_3d.h"
 #include "build_model.h"
 #include "check.h"
+#include "joint_face_3d.h"
 #include "mesh_3d.h"
 #include "model.h"
 #include "power_iteration.h"
@@ -119,17 +120,7 @@ static double series_excess(const fdem_model *m, double young)
     double sum = 0, volume = 0;
     for (int e = 0; e < m->elem_count; e++) volume += m->tet[e].volume0;
     for (int j = 0; j < m->joint_count; j++) {
-        const int32_t *n = m->joint_node + 6 * j;
-        const double *x = m->pos0;
-        double e1[3], e2[3], N[3];
-        for (int c = 0; c < 3; c++) {
-            e1[c] = x[3 * n[1] + c] - x[3 * n[0] + c];
-            e2[c] = x[3 * n[2] + c] - x[3 * n[0] + c];
-        }
-        N[0] = e1[1] * e2[2] - e1[2] * e2[1];
-        N[1] = e1[2] * e2[0] - e1[0] * e2[2];
-        N[2] = e1[0] * e2[1] - e1[1] * e2[0];
-        double twice_area = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+        double N[3], twice_area = joint_face_normal(m->pos0, m->joint_node + 6 * j, N);
         sum += 0.5 * N[0] * N[0] / twice_area / m->joint_k[j];
     }
     return young * sum / volume;
