@@ -299,6 +299,28 @@ def brazilian_3d_table(runs):
                  zones(r["softening_at_peak"]), r["steps"], r["seconds"]), flush=True)
 
 
+def prism_3d_table(cells):
+    """examples/uniaxial-prism-3d.json with n x 2n x n box cells: peak
+    stress P/(W t) against Mohr-Coulomb, and against 2c/(1 - tan phi), the
+    Mohr-Coulomb strength of a plane at 45 degrees to the load, the nearest
+    a box mesh's faces come to the 30 degree plane (its faces lie at 0, 45
+    and 90 degrees to the axes)."""
+    with open(os.path.join(ROOT, "examples", "uniaxial-prism-3d.json")) as f:
+        shipped = json.load(f)
+    frac = shipped["materials"]["rock"]["fracture"]
+    phi = math.radians(frac["friction_angle"])
+    at_45 = 2 * frac["cohesion"] / (1 - math.tan(phi))
+    print("\n| cells across | tetrahedra (with platens) | peak / Mohr-Coulomb | peak / 45-degree plane | peak at | CPU |")
+    print("|---" * 6 + "|")
+    for n in cells:
+        doc = json.loads(json.dumps(shipped))
+        doc["parts"][0]["box"]["divisions"] = [n, 2 * n, n]
+        r = run("uniaxial", doc)
+        print("| %d | %d | %.3f | %.3f | %.3g ms | %.0f s |"
+              % (n, r["elements"], r["strength"] / r["reference"], r["strength"] / at_45,
+                 1e3 * r["peak_time"], r["seconds"]), flush=True)
+
+
 def run(kind, doc):
     out = subprocess.run([DRIVER, kind], input=json.dumps(doc), check=True, stdout=subprocess.PIPE,
                          text=True)
@@ -321,6 +343,8 @@ def main(groups):
         brazilian_3d_table([(24, 0.1), (24, 0.05), (24, 0.025), (24, 0.025, brittle),
                             (24, 0.025, arc_3d), (24, 0.025, {"penalty": 100}),
                             (32, 0.025), (40, 0.025), (48, 0.025), (40, 0.0125)])
+    if "prism3d" in groups:
+        prism_3d_table([3, 5])
     if "uniaxial" in groups:
         sizes = (3e-3, 2.5e-3, 2.2e-3, 2.1e-3, 2e-3, 1.95e-3, 1.9e-3, 1.8e-3, 1.5e-3, 1.25e-3,
                  1e-3, 0.7e-3)
@@ -331,4 +355,4 @@ def main(groups):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial", "brazilian3d"])
+    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial", "brazilian3d", "prism3d"])
