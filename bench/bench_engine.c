@@ -15,7 +15,10 @@
  *  5. the same elastic block in 3D (tetrahedra of a box mesh, 1e4 .. 1e6)
  *     with its bandwidth bound, and on 1 thread and every core;
  *  6. a pile of tetrahedral spheres dropped into a box, with contact: ns
- *     per element-step split over the stages, against the 3D elastic block.
+ *     per element-step split over the stages, against the 3D elastic block;
+ *  7. the fracturing block in 3D (every tetrahedron on its own nodes, a
+ *     joint on every interior face; 1e4, 1e5), as in 3 (goal: <= 4x the
+ *     same block without fracture).
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -271,46 +274,76 @@ static void bench_sphere_pile(void)
     printf("goal: the pile within 4x the elastic block per element-step (CPU time of both)\n");
 }
 
-/* A block vibrating at small strain (no joint breaks), fracturing or not. */
 /* A bench that broke joints would time the wrong thing: say so loudly. */
 #define CHECK_BROKEN(n) \
     do { \
         if (n) printf("           (!) %d joints broke: the figure above is not an intact block\n", n); \
     } while (0)
 
-static fdem_model *vibrating_block(int n, int fracture)
+/* The fracturing block in either dimension: one builder and one table, so
+ * the 2D and 3D figures are measured the same way and printed alike. */
+typedef struct fracture_kind {
+    const char *title;
+    int dim;
+    int sizes[3];         /* cells a side; 0: no such row */
+    double record_bytes;  /* hot element record */
+} fracture_kind;
+
+static const fracture_kind FRACTURE_2D = {
+    "Fracturing block: private nodes per triangle, a joint on every interior edge", 2,
+    {70, 224, 707}, sizeof(element_hot)}; /* 2 n^2 triangles: 1e4, 1e5, 1e6 */
+static const fracture_kind FRACTURE_3D = {
+    "Fracturing block 3D: private nodes per tetrahedron, a joint on every interior face", 3,
+    {12, 26, 0}, sizeof(tet_hot)}; /* 6 n^3 tetrahedra: 1e4, 1e5 */
+
+/* A unit block of n cells a side vibrating at small strain (no joint
+ * breaks), fracturing or not: damped rock, a 0.1 mm/s shear of the initial
+ * velocity field, so strains stay ~1e-9. */
+static fdem_model *vibrating_block(const fracture_kind *k, int n, int fracture)
 {
     fdem_model *m = fdem_model_create();
+    fdem_error err;
+    if (k->dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
     int mat = build_fracturing_rock(m, 0.1);
-    build_rectangle_part(m, mat, 0, 0, 1, 1, n, n, fracture);
-    /* a 0.1 mm/s shear of the initial velocity field: strains stay ~1e-9 */
+    if (k->dim == 2) {
+        build_rectangle_part(m, mat, 0, 0, 1, 1, n, n, fracture);
+    } else {
+        double origin[3] = {0, 0, 0}, size[3] = {1, 1, 1};
+        int div[3] = {n, n, n};
+        fdem_tet_mesh mesh = {0};
+        if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box mesh", &err);
+        int p = fdem_add_part_3d(m, &mesh, mat, fracture, &err);
+        fdem_tet_mesh_free(&mesh);
+        if (p < 0) build_die("box part", &err);
+    }
     build_finalize(m, 0.5);
-    for (int i = 0; i < m->node_count; i++) m->vel[2 * i] = 1e-4 * m->pos0[2 * i + 1];
+    for (int i = 0; i < m->node_count; i++)
+        m->vel[(size_t)k->dim * i] = 1e-4 * m->pos0[(size_t)k->dim * i + 1];
     return m;
 }
 
-static void bench_fracturing_block(double bandwidth_gbs)
+static void bench_fracturing_block(const fracture_kind *k, double bandwidth_gbs)
 {
-    printf("\n## Fracturing block: private nodes per triangle, a joint on every interior edge\n");
-    printf("%10s %8s %8s %14s %13s %9s %9s %9s %12s %10s %14s\n", "elements", "joints", "steps",
-           "ns/elem-step", "no-fracture", "forces%", "contact%", "integr%", "bytes/elem",
-           "bound ns", "pairs/el");
-    int sizes[] = {70, 224, 707}; /* 2 n^2 triangles: 1e4, 1e5, 1e6 */
-    for (int k = 0; k < 3; k++) {
-        double ns[2] = {0, 0};
+    printf("\n## %s\n", k->title);
+    printf("%10s %8s %7s %8s %14s %10s %13s %7s %9s %9s %9s %12s %10s %9s\n", "elements",
+           "joints", "j/elem", "steps", "ns/elem-step", "cpu ns", "no-frac cpu", "x cpu",
+           "forces%", "contact%", "integr%", "bytes/elem", "bound ns", "pairs/el");
+    for (int s = 0; s < 3 && k->sizes[s]; s++) {
+        double ns[2] = {0, 0}, cpu[2] = {0, 0};
         int steps = 0;
         fdem_stage_times before = {0};
         fdem_model *keep = NULL;
         for (int fracture = 0; fracture < 2; fracture++) {
-            fdem_model *m = vibrating_block(sizes[k], fracture);
+            fdem_model *m = vibrating_block(k, k->sizes[s], fracture);
             fdem_error err;
-            for (int s = 0; s < 3; s++) fdem_step(m, &err);
+            for (int w = 0; w < 3; w++) fdem_step(m, &err);
             if (fracture) before = fdem_get_stage_times(m);
             steps = (int)(2e7 / m->elem_count);
             if (steps < 10) steps = 10;
-            double t0 = now();
-            for (int s = 0; s < steps; s++) fdem_step(m, &err);
+            double t0 = now(), c0 = thread_cpu();
+            for (int w = 0; w < steps; w++) fdem_step(m, &err);
             ns[fracture] = (now() - t0) * 1e9 / ((double)steps * m->elem_count);
+            cpu[fracture] = (thread_cpu() - c0) * 1e9 / ((double)steps * m->elem_count);
             if (fracture) keep = m;
             else fdem_model_destroy(m);
         }
@@ -323,12 +356,14 @@ static void bench_fracturing_block(double bandwidth_gbs)
         double sum = t.elements + t.detection + t.contact + t.integration;
         fdem_counts c = fdem_get_counts(m);
         /* per element-step once the mesh is larger than cache: the element
-         * record (64), three private nodes' position, velocity and force
-         * (3 x 64, force written twice: elements, joints), inverse mass and
-         * dof flag (3 x 9), and 1.5 joints of 4 node ids + damage + size (40) */
-        double bytes = 64 + 3 * (64 + 9) + 1.5 * 40;
-        printf("%10d %8d %8d %14.1f %13.1f %9.1f %9.1f %9.1f %12.0f %10.1f %14.2f\n", c.elements,
-               c.joints, steps, ns[1], ns[0], 100 * t.elements / sum,
+         * record, D + 1 private nodes' position, velocity and force (force
+         * written twice: elements, joints; 8 D x 4), inverse mass and dof
+         * flag (9), and the joints of 2 D node ids + damage + size + k */
+        double D = k->dim, joints = (double)c.joints / c.elements;
+        double bytes = k->record_bytes + (D + 1) * (8 * D * 4 + 9) + joints * (8 * D + 24);
+        printf("%10d %8d %7.2f %8d %14.1f %10.1f %13.1f %7.2f %9.1f %9.1f %9.1f %12.0f %10.1f "
+               "%9.2f\n", c.elements, c.joints, joints, steps, ns[1], cpu[1], cpu[0],
+               cpu[1] / cpu[0], 100 * t.elements / sum,
                100 * (t.contact + t.detection) / sum, 100 * t.integration / sum,
                (double)fdem_memory_bytes(m) / c.elements, bytes / bandwidth_gbs,
                (double)c.contact_pairs / c.elements);
@@ -372,7 +407,7 @@ static void bench_threads(int rows_2d, int rows_3d)
            "threads ns", "speed-up");
     for (int fracture = 0; fracture < 2 && rows_2d; fracture++)
         for (int k = 0; k < 2; k++) {
-            fdem_model *m = vibrating_block(k ? 707 : 224, fracture);
+            fdem_model *m = vibrating_block(&FRACTURE_2D, k ? 707 : 224, fracture);
             thread_row(fracture ? "fracturing block (joints)" : "elastic block (shared nodes)", m,
                        fracture ? m->joint_plan.color_count : m->elem_plan.color_count, cores, 1e7);
             fdem_model_destroy(m);
@@ -394,7 +429,7 @@ static void bench_threads(int rows_2d, int rows_3d)
 }
 
 /* With no argument every section runs; otherwise only those named
- * (block, block3d, pile, pile3d, fracture, threads, threads3d), to iterate on one kernel. */
+ * (block, block3d, pile, pile3d, fracture, fracture3d, threads, threads3d), to iterate on one kernel. */
 static int wanted(int argc, char **argv, const char *name)
 {
     if (argc < 2) return 1;
@@ -411,7 +446,8 @@ int main(int argc, char **argv)
     if (wanted(argc, argv, "block3d")) bench_elastic_block(&BLOCK_3D, bw);
     if (wanted(argc, argv, "pile3d")) bench_sphere_pile();
     if (wanted(argc, argv, "pile")) bench_disc_pile();
-    if (wanted(argc, argv, "fracture")) bench_fracturing_block(bw);
+    if (wanted(argc, argv, "fracture")) bench_fracturing_block(&FRACTURE_2D, bw);
+    if (wanted(argc, argv, "fracture3d")) bench_fracturing_block(&FRACTURE_3D, bw);
     if (wanted(argc, argv, "threads") || wanted(argc, argv, "threads3d"))
         bench_threads(wanted(argc, argv, "threads"), wanted(argc, argv, "threads3d"));
     return 0;

@@ -169,6 +169,50 @@ dump("freefall-3d", {
     "gravity": [0, 0, -9.81],
     "time": {"end": 0.5, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
+# brazilian-disc.json's rock as a 10 mm thick cylinder (D = 50 mm, the
+# built-in cylinder: 24 edges round the rim, one layer through) between two
+# steel platen slabs closing at 0.1 m/s each; scripts/limits.py
+# (brazilian_3d_case) builds the same case at other meshes and speeds
+dump("brazilian-disc-3d", {
+    "name": "brazilian-disc-3d",
+    "dimension": 3,
+    "materials": {"rock": rock, "steel": steel},
+    "parts": [
+        {"name": "disc", "material": "rock", "fracture": True,
+         "cylinder": {"center": [0, 0, 0], "axis": "z", "radius": 0.025, "length": 0.01,
+                      "divisions": [24, 1]}},
+        {"name": "top", "material": "steel",
+         "box": {"origin": [-0.01, 0.025, -0.001], "size": [0.02, 0.004, 0.012],
+                 "divisions": [6, 1, 2]}},
+        {"name": "bottom", "material": "steel",
+         "box": {"origin": [-0.01, -0.029, -0.001], "size": [0.02, 0.004, 0.012],
+                 "divisions": [6, 1, 2]}}],
+    "constraints": [{"part": "top", "velocity": [0, -0.1, 0]},
+                    {"part": "bottom", "velocity": [0, 0.1, 0]}],
+    "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
+# uniaxial-compression.json's specimen extruded 25 mm along z (a square
+# prism, the load along y as in 2D), of the built-in box mesh (coarse: 3
+# cells across, so that it runs in about a minute and a half), between two
+# steel platen slabs wider than it on every side
+dump("uniaxial-prism-3d", {
+    "name": "uniaxial-prism-3d",
+    "dimension": 3,
+    "materials": {"rock": rock, "steel": steel},
+    "parts": [
+        {"name": "specimen", "material": "rock", "fracture": True,
+         "box": {"origin": [-0.0125, -0.025, 0], "size": [0.025, 0.05, 0.025],
+                 "divisions": [3, 6, 3]}},
+        {"name": "top", "material": "steel",
+         "box": {"origin": [-0.0175, 0.025, -0.005], "size": [0.035, 0.004, 0.035],
+                 "divisions": [4, 1, 4]}},
+        {"name": "bottom", "material": "steel",
+         "box": {"origin": [-0.0175, -0.029, -0.005], "size": [0.035, 0.004, 0.035],
+                 "divisions": [4, 1, 4]}}],
+    "constraints": [{"part": "top", "velocity": [0, -0.05, 0]},
+                    {"part": "bottom", "velocity": [0, 0.05, 0]}],
+    "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
 dump("collision-3d", {
     "name": "collision-3d",
     "dimension": 3,

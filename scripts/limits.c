@@ -9,10 +9,13 @@
  *                            static tip deflection is the mean over whole
  *                            periods of the free vibration about it, and the
  *                            period is read from the same record
- *   limits brazilian < CASE  peak platen force -> 2P/(pi D); when and where
+ *   limits brazilian < CASE  peak platen force -> 2P/(pi D) (3D: 2P/(pi D t)); when and where
  *                            joints first soften and break (centre or under
  *                            the platens)
- *   limits uniaxial < CASE   peak platen stress P/W, the same crack record
+ *   limits uniaxial < CASE   peak platen stress P/W (3D: P/(W t)), the same crack record
+ *
+ * Both dimensions: a 3D case (tetrahedra, joints on faces) is measured the
+ * same way, with the load along y and the thickness along z.
  *
  * Conventions shared with tests/unit/test_fracture.c: constraints 0 and 1
  * are the two platens, their force is averaged over 2 microsecond windows
@@ -28,6 +31,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "../tests/unit/joint_face_3d.h"
 #include "case.h"
 #include "model.h"
 
@@ -180,11 +184,17 @@ typedef struct crack_zones {
     int centre, between, platen;
 } crack_zones;
 
+/* The midpoint of joint j's face A (2D: its edge; 3D: its triangle) in
+ * the initial configuration, x and y (y: the load axis). */
 static void joint_midpoint(const fdem_model *m, int j, double *x, double *y)
 {
-    const int32_t *nd = m->joint_node + 4 * j;
-    *x = 0.5 * (m->pos0[2 * nd[0]] + m->pos0[2 * nd[1]]);
-    *y = 0.5 * (m->pos0[2 * nd[0] + 1] + m->pos0[2 * nd[1] + 1]);
+    const int D = m->dim, corners = D; /* an edge has 2 ends, a face 3 corners */
+    const int32_t *nd = m->joint_node + 2 * D * (size_t)j;
+    *x = *y = 0;
+    for (int i = 0; i < corners; i++) {
+        *x += m->pos0[D * nd[i]] / corners;
+        *y += m->pos0[D * nd[i] + 1] / corners;
+    }
 }
 
 /* D > 0 for level 0 (softening has begun), D >= level otherwise */
@@ -261,7 +271,7 @@ static int run_loaded(fdem_model *m, double end, double half, double expect, loa
         if (step_or_report(m)) return -1;
         const double *f = fdem_constraint_forces(m);
         double dt = fdem_get_dt(m);
-        sum += 0.5 * (fabs(f[1]) + fabs(f[3])) * dt;
+        sum += 0.5 * (fabs(f[1]) + fabs(f[m->dim + 1])) * dt; /* y of constraints 0, 1 */
         span += dt;
         if (span < WINDOW) continue;
         double mean = sum / span;
@@ -321,40 +331,56 @@ static void print_loaded(const char *kind, const case_info *info, const fdem_mod
     printf("\"broken_end\": %d, \"seconds\": %.3g}\n", m->broken_joints, r->seconds);
 }
 
+/* How far joint j's crack would run from the load (y) axis, in degrees: in
+ * 2D the angle of its edge to y; in 3D the angle of its face to y, or, for
+ * a split along the loaded diameter (`split`), the angle of its normal to
+ * x, so that faces lying across the disc's axis do not count. */
+static double joint_angle(const fdem_model *m, int j, int split)
+{
+    const double *p = m->pos0;
+    if (m->dim == 2) {
+        const int32_t *nd = m->joint_node + 4 * (size_t)j;
+        double dx = fabs(p[2 * nd[1]] - p[2 * nd[0]]), dy = fabs(p[2 * nd[1] + 1] - p[2 * nd[0] + 1]);
+        return atan2(dx, dy) * 180 / M_PI;
+    }
+    double n[3], len = joint_face_normal(p, m->joint_node + 6 * (size_t)j, n);
+    if (split) return acos(fmin(1, fabs(n[0]) / len)) * 180 / M_PI;
+    return asin(fmin(1, fabs(n[1]) / len)) * 180 / M_PI;
+}
+
 /* The share of joints near the middle of the specimen (|x|, |y| within
  * `reach`) whose direction lies within 10 degrees of `angle` from the load
- * (y) axis: a crack can only run along element edges, so a mesh with none
- * near the failure plane must be loaded further before it fails. */
+ * (y) axis: a crack can only run along element edges (faces in 3D), so a
+ * mesh with none near the failure plane must be loaded further before it
+ * fails. */
 static double oriented_share(const fdem_model *m, double reach, double angle)
 {
     int near = 0, oriented = 0;
     for (int j = 0; j < m->joint_count; j++) {
-        const int32_t *nd = m->joint_node + 4 * j;
-        const double *p = m->pos0;
         double x, y;
         joint_midpoint(m, j, &x, &y);
         if (fabs(x) > reach || fabs(y) > reach) continue;
-        double dx = fabs(p[2 * nd[1]] - p[2 * nd[0]]), dy = fabs(p[2 * nd[1] + 1] - p[2 * nd[0] + 1]);
-        double from_axis = atan2(dx, dy) * 180 / M_PI;
         near++;
-        oriented += fabs(from_axis - angle) <= 10;
+        oriented += fabs(joint_angle(m, j, angle == 0) - angle) <= 10;
     }
     return near ? (double)oriented / near : 0;
 }
 
-/* The specimen is part 0; its extent gives D (disc) or W x H (block). */
-static void specimen_extent(const fdem_model *m, double *width, double *height)
+/* The specimen is part 0; its extent gives D (disc) or W x H (block) and,
+ * in 3D, its thickness along z. */
+static void specimen_extent(const fdem_model *m, double *width, double *height, double *depth)
 {
     const part *p = &m->parts[0];
-    double xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
-    for (int i = p->node_begin; i < p->node_begin + p->node_count; i++) {
-        xmin = fmin(xmin, m->pos0[2 * i]);
-        xmax = fmax(xmax, m->pos0[2 * i]);
-        ymin = fmin(ymin, m->pos0[2 * i + 1]);
-        ymax = fmax(ymax, m->pos0[2 * i + 1]);
-    }
-    *width = xmax - xmin;
-    *height = ymax - ymin;
+    const int D = m->dim;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int i = p->node_begin; i < p->node_begin + p->node_count; i++)
+        for (int c = 0; c < D; c++) {
+            lo[c] = fmin(lo[c], m->pos0[D * i + c]);
+            hi[c] = fmax(hi[c], m->pos0[D * i + c]);
+        }
+    *width = hi[0] - lo[0];
+    *height = hi[1] - lo[1];
+    *depth = D == 3 ? hi[2] - lo[2] : 1; /* 2D: per metre of thickness */
 }
 
 static int run_fracture(const char *kind)
@@ -362,20 +388,20 @@ static int run_fracture(const char *kind)
     case_info info;
     fdem_model *m = load_case(&info);
     if (!m) return 1;
-    double width, height;
-    specimen_extent(m, &width, &height);
+    double width, height, depth;
+    specimen_extent(m, &width, &height, &depth);
     const material *rock = &m->materials[m->parts[0].material];
     double strength_per_force, reference, oriented;
     if (strcmp(kind, "brazilian") == 0) {
-        /* sigma_t = 2P/(pi D); the centre splits along the loaded diameter */
-        strength_per_force = 2 / (M_PI * width);
+        /* sigma_t = 2P/(pi D t); the centre splits along the loaded diameter */
+        strength_per_force = 2 / (M_PI * width * depth);
         reference = rock->def.fracture.tensile_strength;
         oriented = oriented_share(m, 0.25 * width, 0);
     } else {
         /* Mohr-Coulomb: failure planes at 45 - phi/2 degrees from the load */
         double c = rock->def.fracture.cohesion, phi_deg = rock->def.fracture.friction_angle;
         double phi = phi_deg * M_PI / 180;
-        strength_per_force = 1 / width;
+        strength_per_force = 1 / (width * depth);
         reference = 2 * c * cos(phi) / (1 - sin(phi));
         oriented = oriented_share(m, 0.5 * width, 45 - 0.5 * phi_deg);
     }

@@ -1,10 +1,11 @@
 #!/usr/bin/python3
 """limits.py - reruns the figures of "Known limitations and how to mesh" in
 docs/physics.md: how far constant-strain triangles are from beam theory in
-bending, and how the fracture examples' peaks move with the mesh.
+bending, and how the fracture examples' peaks move with the mesh (and, for
+the 3D Brazilian disc, with the platen speed, G_I and the joint penalty).
 
-    make limits                                  # everything, ~10 min of CPU on one core
-    LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian
+    make limits                                  # everything, ~25 min of CPU on one core
+    LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian brazilian3d
 
 It builds each case document (beams with the built-in rectangle; the
 Brazilian disc and uniaxial specimen exactly as examples/*.json, with only
@@ -227,6 +228,99 @@ def fracture_table(kind, runs, across):
                  zones(r["softening_at_peak"]), zones(r["damaged_at_peak"]), r["steps"], r["seconds"]), flush=True)
 
 
+# --------------------------------------------------------- 3D Brazilian disc
+# A rock cylinder (D = 50 mm, the 2D example's rock) between two steel
+# platens that close at `speed` each, meshed by the built-in cylinder with
+# `around` element edges round the rim and `along` layers through t (by
+# default as many as make the cells about cubic: around/4 cells across D).
+def brazilian_3d_case(around, speed=0.025, t=0.01, along=None, penalty=None, end=None):
+    R = 0.025
+    along = along or max(1, round(t * around / (4 * 2 * R)))
+    rock = {"density": 2700, "young": 3e10, "poisson": 0.3, "damping": 0.6, "friction": 0.3,
+            "fracture": {"tensile_strength": 1e6, "cohesion": 3e6, "friction_angle": 30,
+                         "energy_I": 10, "energy_II": 50}}
+    if penalty:
+        rock["penalty"] = penalty * rock["young"]
+    platen = lambda y: {"origin": [-0.01, y, -0.001], "size": [0.02, 0.004, t + 0.002],
+                        "divisions": [6, 1, along + 1]}
+    # the 2D example's end scaled by its speed: the load peaks near 0.7 ms at 0.025 m/s
+    end = end or 1.5e-3 * 0.025 / speed
+    return {
+        "name": "brazilian-3d-%d-%gmps" % (around, speed), "dimension": 3,
+        "materials": {"rock": rock,
+                      "steel": {"density": 7800, "young": 2e11, "poisson": 0.3, "friction": 0.3}},
+        "parts": [{"name": "disc", "material": "rock", "fracture": True,
+                   "cylinder": {"center": [0, 0, 0], "axis": "z", "radius": R, "length": t,
+                                "divisions": [around, along]}},
+                  {"name": "top", "material": "steel", "box": platen(R)},
+                  {"name": "bottom", "material": "steel", "box": platen(-R - 0.004)}],
+        "constraints": [{"part": "top", "velocity": [0, -speed, 0]},
+                        {"part": "bottom", "velocity": [0, speed, 0]}],
+        "time": {"end": end, "dt": "auto", "safety": 0.5}}
+
+
+def arc_3d(doc):
+    """As arc() in 2D: the disc's own rim nodes on two 15 degree arcs move at
+    the platens' speed, free sideways and along the axis; no platens."""
+    R = 0.025
+    half, low = R * math.sin(ARC / 2), R * math.cos(ARC / 2) - 1e-6
+    v = doc["constraints"][0]["velocity"][1]
+    doc["parts"] = doc["parts"][:1]
+    doc["constraints"] = [
+        {"box": [-half, low, -1, half, R + 1e-6, 1], "velocity": [None, v, None]},
+        {"box": [-half, -R - 1e-6, -1, half, -low, 1], "velocity": [None, -v, None]}]
+    doc["name"] += "-arc"
+
+
+def brazilian_3d_table(runs):
+    print("\n| divisions around | platen speed | tweaks | elements | joints | joints along the diameter | "
+          "2P/(pi D t) / f_t at the peak | peak at | at the first softening in the centre | "
+          "D > 0 at the peak | steps | CPU time |")
+    print("|---" * 12 + "|")
+    for around, speed, *tweaks in runs:
+        kw = {}
+        for tw in tweaks:
+            if isinstance(tw, dict):
+                kw.update(tw)
+        doc = brazilian_3d_case(around, speed, **kw)
+        for tw in tweaks:
+            if callable(tw):
+                tw(doc)
+        r = run("brazilian", doc)
+        centre = ("%.3f at %.3g ms" % (r["centre_onset_force"] / r["peak_force"] * r["strength"] / r["reference"],
+                                       1e3 * r["centre_onset_time"])) if r["centre_onset_time"] > 0 else "never"
+        names = " ".join([t.__name__ if callable(t) else ", ".join("%s %g" % kv for kv in t.items())
+                          for t in tweaks]) or "-"
+        if r["drop_time"] < 0:
+            names += " (the load never fell: the peak is a lower bound)"
+        print("| %d | %g m/s | %s | %d | %d | %.0f %% | %.3f | %.3g ms | %s | %s | %d | %.0f s |"
+              % (around, speed, names, r["elements"], r["joints"], 100 * r["oriented"],
+                 r["strength"] / r["reference"], 1e3 * r["peak_time"], centre,
+                 zones(r["softening_at_peak"]), r["steps"], r["seconds"]), flush=True)
+
+
+def prism_3d_table(cells):
+    """examples/uniaxial-prism-3d.json with n x 2n x n box cells: peak
+    stress P/(W t) against Mohr-Coulomb, and against 2c/(1 - tan phi), the
+    Mohr-Coulomb strength of a plane at 45 degrees to the load, the nearest
+    a box mesh's faces come to the 30 degree plane (its faces lie at 0, 45
+    and 90 degrees to the axes)."""
+    with open(os.path.join(ROOT, "examples", "uniaxial-prism-3d.json")) as f:
+        shipped = json.load(f)
+    frac = shipped["materials"]["rock"]["fracture"]
+    phi = math.radians(frac["friction_angle"])
+    at_45 = 2 * frac["cohesion"] / (1 - math.tan(phi))
+    print("\n| cells across | tetrahedra (with platens) | peak / Mohr-Coulomb | peak / 45-degree plane | peak at | CPU |")
+    print("|---" * 6 + "|")
+    for n in cells:
+        doc = json.loads(json.dumps(shipped))
+        doc["parts"][0]["box"]["divisions"] = [n, 2 * n, n]
+        r = run("uniaxial", doc)
+        print("| %d | %d | %.3f | %.3f | %.3g ms | %.0f s |"
+              % (n, r["elements"], r["strength"] / r["reference"], r["strength"] / at_45,
+                 1e3 * r["peak_time"], r["seconds"]), flush=True)
+
+
 def run(kind, doc):
     out = subprocess.run([DRIVER, kind], input=json.dumps(doc), check=True, stdout=subprocess.PIPE,
                          text=True)
@@ -243,6 +337,15 @@ def main(groups):
                                      (1e-3, delaunay, arc), (1e-3, delaunay),
                                      (2e-3, brittle), (1e-3, brittle),
                                      (2e-3, brittle, arc), (1e-3, brittle, arc)], 0.05)
+    if "brazilian3d" in groups:
+        # the speed series and the brittle, arc and stiff-joint variants on
+        # the shipped 24-edge disc, then finer meshes at the slow speed
+        brazilian_3d_table([(24, 0.1), (24, 0.05), (24, 0.025), (24, 0.025, brittle),
+                            (24, 0.025, arc_3d), (32, 0.025, arc_3d), (40, 0.025, arc_3d),
+                            (24, 0.025, {"penalty": 100}),
+                            (32, 0.025), (40, 0.025), (48, 0.025), (40, 0.0125)])
+    if "prism3d" in groups:
+        prism_3d_table([3, 5])
     if "uniaxial" in groups:
         sizes = (3e-3, 2.5e-3, 2.2e-3, 2.1e-3, 2e-3, 1.95e-3, 1.9e-3, 1.8e-3, 1.5e-3, 1.25e-3,
                  1e-3, 0.7e-3)
@@ -253,4 +356,4 @@ def main(groups):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial"])
+    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial", "brazilian3d", "prism3d"])

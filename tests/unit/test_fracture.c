@@ -33,6 +33,7 @@
 
 #include "case.h"
 #include "check.h"
+#include "joint_face_3d.h"
 #include "model.h"
 
 #define WINDOW 2e-6
@@ -103,7 +104,7 @@ static int run_loaded(fdem_model *m, double end, load_history *h)
             h->residual_after = fmax(h->residual_after, fabs(en.residual));
         }
         const double *f = fdem_constraint_forces(m);
-        double P = 0.5 * (fabs(f[1]) + fabs(f[3]));
+        double P = 0.5 * (fabs(f[1]) + fabs(f[m->dim + 1])); /* y of constraints 0 and 1 */
         double dt = fdem_get_dt(m);
         h->sum += P * dt;
         h->span += dt;
@@ -130,10 +131,10 @@ static int run_loaded(fdem_model *m, double end, load_history *h)
 static void energy_report(const char *name, const fdem_model *m, const load_history *h)
 {
     fdem_energy en = fdem_get_energy(m);
-    printf("  %s: work in %.4g J/m (%.4g at the peak): elastic %.4g, joint %.4g, fracture %.4g, "
+    printf("  %s: work in %.4g %s (%.4g at the peak): elastic %.4g, joint %.4g, fracture %.4g, "
            "contact %.4g, friction %.4g, damping %.4g, kinetic %.4g; worst residual %.3g %% of the "
            "work up to the peak, %.3g %% of all the work after it\n",
-           name, en.external_work, h->peak_work, en.elastic, en.joint, en.fracture, en.contact,
+           name, en.external_work, m->dim == 2 ? "J/m" : "J", h->peak_work, en.elastic, en.joint, en.fracture, en.contact,
            en.friction, en.damping, en.kinetic, 100 * h->residual_to_peak / h->peak_work,
            100 * h->residual_after / en.external_work);
     CHECK(h->residual_to_peak < 0.01 * h->peak_work, "energy residual %.3g %% of the work done",
@@ -147,34 +148,87 @@ static void energy_report(const char *name, const fdem_model *m, const load_hist
           -en.contact, en.external_work);
 }
 
-/* A joint's midpoint and direction in the initial configuration. */
+/* A joint's midpoint and direction in the initial configuration: the
+ * angle of its edge (2D) or face (3D) to the horizontal (x, or the x-z
+ * plane), 0 across the load, 90 along it. */
 static void joint_geometry(const fdem_model *m, int j, double *x, double *y, double *angle_deg)
 {
-    const int32_t *n = m->joint_node + 4 * j;
     const double *p = m->pos0;
+    if (m->dim == 3) {
+        const int32_t *n = m->joint_node + 6 * (size_t)j;
+        double N[3], c[3], len = joint_face_normal(p, n, N);
+        joint_face_centre(p, n, c);
+        *x = c[0];
+        *y = c[1];
+        *angle_deg = acos(fmin(1, fabs(N[1]) / len)) * 180 / M_PI;
+        return;
+    }
+    const int32_t *n = m->joint_node + 4 * j;
     *x = 0.5 * (p[2 * n[0]] + p[2 * n[1]]);
     *y = 0.5 * (p[2 * n[0] + 1] + p[2 * n[1] + 1]);
     double a = fabs(atan2(p[2 * n[1] + 1] - p[2 * n[0] + 1], p[2 * n[1]] - p[2 * n[0]])) * 180 / M_PI;
     *angle_deg = a > 90 ? 180 - a : a; /* 0 horizontal, 90 along the load */
 }
 
-static void brazilian_disc_splits_at_its_tensile_strength(void)
+/* How far face B of joint j has moved from face A (mean over its corners),
+ * split into sliding along the joint and opening across it, in the initial
+ * frame. */
+static void joint_slide_open(const fdem_model *m, int j, double *slid, double *opened)
+{
+    const int D = m->dim;
+    const int32_t *n = m->joint_node + 2 * D * (size_t)j;
+    const double *p = m->pos, *p0 = m->pos0;
+    double d[3] = {0, 0, 0}, N[3] = {0, 0, 0};
+    for (int i = 0; i < D; i++)
+        for (int c = 0; c < D; c++) d[c] += (p[D * n[D + i] + c] - p[D * n[i] + c]) / D;
+    if (D == 2) {
+        N[0] = -(p0[2 * n[1] + 1] - p0[2 * n[0] + 1]);
+        N[1] = p0[2 * n[1]] - p0[2 * n[0]];
+    } else {
+        joint_face_normal(p0, n, N);
+    }
+    double len = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    double normal = (d[0] * N[0] + d[1] * N[1] + d[2] * N[2]) / len;
+    *opened += fabs(normal);
+    *slid += sqrt(fmax(0, d[0] * d[0] + d[1] * d[1] + d[2] * d[2] - normal * normal));
+}
+
+/* The specimen's (part 0's) thickness: its extent along z in 3D; 1 in 2D,
+ * where forces are per metre. */
+static double specimen_thickness(const fdem_model *m)
+{
+    if (m->dim == 2) return 1;
+    const part *p = &m->parts[0];
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = p->node_begin; i < p->node_begin + p->node_count; i++) {
+        lo = fmin(lo, m->pos0[3 * i + 2]);
+        hi = fmax(hi, m->pos0[3 * i + 2]);
+    }
+    return hi - lo;
+}
+
+/* A disc of radius 25 mm (a cylinder along z in 3D) split between platens:
+ * 2P/(pi D t) at the peak between low and high times f_t, the damaged
+ * joints lining the loaded diameter from platen to platen. */
+static void brazilian_disc(const char *path, double low, double high)
 {
     case_info info;
-    fdem_model *m = load_example("examples/brazilian-disc.json", &info);
+    fdem_model *m = load_example(path, &info);
     if (!m) return;
-    const double R = 0.025, ft = 1e6;
+    const double R = 0.025, ft = 1e6, t = specimen_thickness(m);
     load_history h;
     if (run_loaded(m, info.end_time, &h)) {
         fdem_model_destroy(m);
         return;
     }
-    double sigma = 2 * h.peak / (M_PI * 2 * R);
-    printf("  brazilian: peak P %.4g N/m at %.3g ms -> 2P/(pi D) = %.4g MPa (%+.1f%% of f_t), "
+    double sigma = 2 * h.peak / (M_PI * 2 * R * t);
+    printf("  brazilian %dD: peak P %.4g N%s at %.3g ms -> 2P/(pi D%s) = %.4g MPa (%+.1f%% of f_t), "
            "fell below 30%% at %.3g ms, broken %d of %d joints, %d fragments\n",
-           h.peak, 1e3 * h.peak_time, sigma / 1e6, 100 * (sigma / ft - 1), 1e3 * h.drop_time,
-           m->broken_joints, m->joint_count, m->fragments);
-    CHECK_REL(sigma, ft, 0.15);
+           m->dim, h.peak, m->dim == 2 ? "/m" : "", 1e3 * h.peak_time, m->dim == 2 ? "" : " t",
+           sigma / 1e6, 100 * (sigma / ft - 1), 1e3 * h.drop_time, m->broken_joints,
+           m->joint_count, m->fragments);
+    CHECK(sigma >= low * ft && sigma <= high * ft, "2P/(pi D t) = %.4g f_t, not in [%g, %g]",
+          sigma / ft, low, high);
     energy_report("brazilian", m, &h);
 
     /* the crack: damaged joints within 0.2 R of the loaded (vertical)
@@ -192,8 +246,8 @@ static void brazilian_disc_splits_at_its_tensile_strength(void)
     }
     int reached = 0;
     for (int b = 0; b < 10; b++) reached += bins[b] > 0;
-    printf("  brazilian: %d damaged joints, %d near the loaded diameter, in %d of its 10 tenths:",
-           damaged, near, reached);
+    printf("  brazilian %dD: %d damaged joints, %d near the loaded diameter, in %d of its 10 tenths:",
+           m->dim, damaged, near, reached);
     for (int b = 0; b < 10; b++) printf(" %d", bins[b]);
     printf("\n");
     CHECK(reached >= 8, "the crack covers only %d tenths of the loaded diameter", reached);
@@ -202,19 +256,21 @@ static void brazilian_disc_splits_at_its_tensile_strength(void)
     fdem_model_destroy(m);
 }
 
-static void uniaxial_compression_fails_in_shear(void)
+/* A block 25 mm wide (and deep, in 3D) crushed between platens: the peak
+ * stress P/(W t) within `tolerance` of Mohr-Coulomb, a shear failure. */
+static void uniaxial_compression(const char *path, double tolerance)
 {
     case_info info;
-    fdem_model *m = load_example("examples/uniaxial-compression.json", &info);
+    fdem_model *m = load_example(path, &info);
     if (!m) return;
-    const double W = 0.025, c = 3e6, phi = 30 * M_PI / 180;
+    const double W = 0.025, c = 3e6, phi = 30 * M_PI / 180, t = specimen_thickness(m);
     double mohr_coulomb = 2 * c * cos(phi) / (1 - sin(phi));
     load_history h;
     if (run_loaded(m, info.end_time, &h)) {
         fdem_model_destroy(m);
         return;
     }
-    double ucs = h.peak / W;
+    double ucs = h.peak / (W * t);
     int inclined = 0, broken = 0;
     double slid = 0, opened = 0;
     for (int j = 0; j < m->joint_count; j++) {
@@ -223,22 +279,13 @@ static void uniaxial_compression_fails_in_shear(void)
         joint_geometry(m, j, &x, &y, &angle);
         broken++;
         inclined += angle >= 30 && angle <= 70;
-        /* where face B's midpoint now is relative to face A's, split along
-         * and across the joint's initial direction */
-        const int32_t *n = m->joint_node + 4 * j;
-        const double *p = m->pos, *p0 = m->pos0;
-        double tx = p0[2 * n[1]] - p0[2 * n[0]], ty = p0[2 * n[1] + 1] - p0[2 * n[0] + 1];
-        double L = hypot(tx, ty);
-        double dx = 0.5 * (p[2 * n[2]] + p[2 * n[3]] - p[2 * n[0]] - p[2 * n[1]]);
-        double dy = 0.5 * (p[2 * n[2] + 1] + p[2 * n[3] + 1] - p[2 * n[0] + 1] - p[2 * n[1] + 1]);
-        slid += fabs(dx * tx + dy * ty) / L;
-        opened += fabs(-dx * ty + dy * tx) / L;
+        joint_slide_open(m, j, &slid, &opened);
     }
-    printf("  uniaxial: peak %.4g MPa at %.3g ms (Mohr-Coulomb %.4g MPa, %+.1f%%), fell below 30%% at %.3g ms; "
+    printf("  uniaxial %dD: peak %.4g MPa at %.3g ms (Mohr-Coulomb %.4g MPa, %+.1f%%), fell below 30%% at %.3g ms; "
            "%d broken joints, %d at 30-70 deg; faces slid %.3g mm, opened %.3g mm in all\n",
-           ucs / 1e6, 1e3 * h.peak_time, mohr_coulomb / 1e6, 100 * (ucs / mohr_coulomb - 1),
+           m->dim, ucs / 1e6, 1e3 * h.peak_time, mohr_coulomb / 1e6, 100 * (ucs / mohr_coulomb - 1),
            1e3 * h.drop_time, broken, inclined, 1e3 * slid, 1e3 * opened);
-    CHECK_REL(ucs, mohr_coulomb, 0.25);
+    CHECK_REL(ucs, mohr_coulomb, tolerance);
     CHECK(broken >= 10, "only %d joints broke", broken);
     CHECK(inclined >= 0.6 * broken, "only %d of %d broken joints are inclined", inclined, broken);
     CHECK(slid > opened, "faces opened (%g) more than they slid (%g)", opened, slid);
@@ -246,4 +293,29 @@ static void uniaxial_compression_fails_in_shear(void)
     fdem_model_destroy(m);
 }
 
-CHECK_MAIN(T(brazilian_disc_splits_at_its_tensile_strength), T(uniaxial_compression_fails_in_shear))
+static void brazilian_disc_splits_at_its_tensile_strength(void)
+{
+    brazilian_disc("examples/brazilian-disc.json", 0.85, 1.15);
+}
+
+static void uniaxial_compression_fails_in_shear(void)
+{
+    uniaxial_compression("examples/uniaxial-compression.json", 0.25);
+}
+
+/* The 3D disc as shipped (24 edges round the rim, one layer, platens at
+ * 0.1 m/s each: a coarse, fast set-up a test can afford). Its peak is not
+ * f_t and must not be: the example's crack is very ductile (E G_I / f_t^2
+ * = 0.3 m, six diameters), so the load goes on rising after the centre has
+ * begun to soften (at 0.64 f_t here), and a fast platen adds inertia. make
+ * limits measured 1.49 f_t for this set-up, 1.30 at 0.025 m/s and 0.86
+ * with a tenth of G_I (docs/physics.md, "3D Brazilian disc"); the test
+ * holds the peak above f_t and below 1.6 f_t, with the split from platen
+ * to platen. */
+static void brazilian_disc_3d_splits_along_the_loaded_plane(void)
+{
+    brazilian_disc("examples/brazilian-disc-3d.json", 1.0, 1.6);
+}
+
+CHECK_MAIN(T(brazilian_disc_splits_at_its_tensile_strength), T(uniaxial_compression_fails_in_shear),
+           T(brazilian_disc_3d_splits_along_the_loaded_plane))

@@ -1,16 +1,20 @@
 /*
  * test_fracture_3d.c - fracturing tetrahedral parts in the model: a joint
  * on every face shared by two tetrahedra (counted against the box mesh's
- * faces, oriented out of A, joining copies of one mesh vertex); an intact
+ * faces, oriented out of A, joining copies of one mesh vertex); the
+ * stable step of a jointed model within 2/omega_max of power iteration; an intact
  * fracturing bar vibrates with the period of the continuous one (4L/c);
  * a bar pulled apart at both ends breaks into pieces with the energy
- * balance closed, and 1 and 2 threads give the same bits.
+ * balance closed, and 1 and 2 threads give the same bits, for that bar
+ * and for a fracturing block thrown at a slab (contact, friction, breakage).
  */
 #include "bar_period_3d.h"
 #include "build_model.h"
 #include "check.h"
+#include "joint_face_3d.h"
 #include "mesh_3d.h"
 #include "model.h"
+#include "power_iteration.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -106,8 +110,25 @@ static void joints_on_interior_faces(void)
     fdem_model_destroy(m);
 }
 
-/* The first period of a fixed-free bar given an axial velocity. */
-static double bar_period(int fracture, double penalty_factor)
+/* The static excess compliance of the intact joints of a bar loaded
+ * along x, relative to the elements': under a uniform stress sigma along x
+ * a face of area A and normal n opens by sigma n_x n / k, which stores
+ * sigma^2 A n_x^2 / (2k) against the continuum's sigma^2 V / (2E), so the
+ * bar's stiffness falls by 1 + E sum(A n_x^2 / k) / V. */
+static double series_excess(const fdem_model *m, double young)
+{
+    double sum = 0, volume = 0;
+    for (int e = 0; e < m->elem_count; e++) volume += m->tet[e].volume0;
+    for (int j = 0; j < m->joint_count; j++) {
+        double N[3], twice_area = joint_face_normal(m->pos0, m->joint_node + 6 * j, N);
+        sum += 0.5 * N[0] * N[0] / twice_area / m->joint_k[j];
+    }
+    return young * sum / volume;
+}
+
+/* The first period of a fixed-free bar given an axial velocity; *excess
+ * (when fracturing) gets series_excess of its joints. */
+static double bar_period(int fracture, double penalty_factor, double *excess)
 {
     const double L = 0.5, size[3] = {L, 0.05, 0.05};
     const int div[3] = {20, 1, 1};
@@ -119,6 +140,7 @@ static double bar_period(int fracture, double penalty_factor)
     fdem_error err;
     if (fdem_set_part_velocity_v(m, 0, v0, &err)) build_die("velocity", &err);
     build_finalize(m, 0.5);
+    if (excess) *excess = series_excess(m, mat.young);
     double period = 4 * L / sqrt(3e10 / 2700), u_max = 0.1 * period / 4;
     bar_crossing bar = {0, 0, -1, 0, 0};
     while (fdem_get_time(m) < 1.5 * period && bar.crossing < 0) {
@@ -130,30 +152,104 @@ static double bar_period(int fracture, double penalty_factor)
     return bar.crossing;
 }
 
-/* An intact joint is a penalty spring p/h per unit area in series with the
- * elements, so the bar's stiffness K falls to 1 / (1/K + c/p): the period
- * grows by (T/T_0)^2 - 1 = c K / p, inversely with the penalty. On this
- * mesh (a box cell cut into tetrahedra, several faces across the axis,
- * heights well below the cell) the default 10 E gives +12 % on the period
- * (2D: under 3 %), an open point for issue 13; at 100 E the bar vibrates
- * within 3 % of the continuous one. The excess (T/T_0)^2 - 1 falls about
- * tenfold (12.1: the series law is static, the first mode of a 20-element
- * chain is not quite); only its falling is held here. */
+/* An intact joint is a penalty spring k = p/h per unit area in series with
+ * the elements, so the bar's stiffness falls by 1 + series_excess and its
+ * period squared grows by that: (T/T_0)^2 - 1 = E sum(A n_x^2 / k) / V,
+ * which falls as 1/p. Measured: 0.258 against 0.245 at the default 10 E
+ * (+12 % on the period), 0.021 against 0.025 at 100 E (+1 %); the 2D bar
+ * of the same cells gives +8 % at 10 E by the same law (0.170 against
+ * 0.165): the 3D face network (each tetrahedron's four faces, heights well
+ * below the cell) holds 1.3-1.5 times the 2D joint area per volume, not a
+ * weaker joint (docs/physics.md, Three dimensions). The measured excess is
+ * held to the series law within 20 % (it is the static law, and the first
+ * mode of a 20-cell chain is not quite static). */
 static void intact_fracturing_bar_vibrates_like_continuum(void)
 {
-    double continuous = bar_period(0, 10), soft = bar_period(1, 10), stiff = bar_period(1, 100);
+    double soft_law, stiff_law;
+    double continuous = bar_period(0, 10, NULL), soft = bar_period(1, 10, &soft_law),
+           stiff = bar_period(1, 100, &stiff_law);
     double exact = 4 * 0.5 / sqrt(3e10 / 2700);
     CHECK_REL(continuous, exact, 0.03);
     CHECK_REL(stiff, continuous, 0.03);
     double excess_soft = soft * soft / (continuous * continuous) - 1;
     double excess_stiff = stiff * stiff / (continuous * continuous) - 1;
-    CHECK(excess_soft > 5 * excess_stiff && excess_stiff > 0,
-          "joint compliance does not fall with the penalty: %g at 10 E, %g at 100 E", excess_soft,
-          excess_stiff);
+    CHECK_REL(excess_soft, soft_law, 0.2);
+    CHECK_REL(excess_stiff, stiff_law, 0.2);
     fprintf(stderr, "  bar period: exact %.4g s, continuous %.4g s, fracturing %.4g s (%+.2f%%) "
-            "at penalty 10 E, %.4g s (%+.2f%%) at 100 E; compliance ratio %.3g\n",
+            "at penalty 10 E, %.4g s (%+.2f%%) at 100 E; (T/T0)^2 - 1 = %.4f and %.4f against "
+            "the series law's %.4f and %.4f\n",
             exact, continuous, soft, 100 * (soft / continuous - 1), stiff,
-            100 * (stiff / continuous - 1), excess_soft / excess_stiff);
+            100 * (stiff / continuous - 1), excess_soft, excess_stiff, soft_law, stiff_law);
+}
+
+/* The stiffness of the whole model at rest (elements and intact joints),
+ * column by column from central differences of the engine's own forces;
+ * n = 3 x nodes, K row-major n x n, caller frees. */
+static double *assembled_stiffness(fdem_model *m, int with_elements)
+{
+    int n = 3 * m->node_count;
+    double *K = malloc(sizeof(double) * (size_t)n * (size_t)n), *fp = malloc(sizeof(double) * (size_t)n);
+    double step = 1e-9 * m->elem_h[0];
+    for (int j = 0; j < n; j++) {
+        for (int sign = 1; sign >= -1; sign -= 2) {
+            memcpy(m->pos, m->pos0, sizeof(double) * (size_t)n);
+            m->pos[j] += sign * step;
+            memset(m->force, 0, sizeof(double) * (size_t)n);
+            if (with_elements) element_forces(m);
+            joint_forces(m);
+            for (int i = 0; i < n; i++)
+                if (sign > 0) fp[i] = m->force[i];
+                else K[(size_t)n * i + j] = -(fp[i] - m->force[i]) / (2 * step);
+        }
+    }
+    memcpy(m->pos, m->pos0, sizeof(double) * (size_t)n);
+    free(fp);
+    return K;
+}
+
+/* The stable step of a jointed tetrahedral model against power iteration
+ * of M^-1 K of the whole model (elements and intact joints, from the
+ * engine's own forces), at three penalties. The joint estimate
+ * (joint_stable_dt_3d) must stay within 2 / omega_max (safe) and not fall
+ * below 0.4 of it: it takes 2 k A against the smallest of its six node
+ * masses, while Gershgorin gives about k A (a node's three faces, A / 3
+ * each, both sides) - a factor sqrt(2), and 0.9 on top, by design, with the
+ * faces of unequal area. The model's step (contact's 0.153 h sqrt(rho/p)
+ * governs a fracturing part) must be within 2 / omega_max too. */
+static void stable_step_bounds_the_fastest_jointed_mode(void)
+{
+    const double factors[3] = {1, 10, 100};
+    for (int t = 0; t < 3; t++) {
+        const double size[3] = {0.02, 0.01, 0.01};
+        const int div[3] = {2, 1, 1};
+        fdem_material_def mat = rock(1, 0);
+        mat.penalty = factors[t] * mat.young;
+        fdem_model *m = box_model(size, div, mat, 1);
+        build_finalize(m, 0.5);
+        int n = 3 * m->node_count;
+        double *K = assembled_stiffness(m, 1), *KJ = assembled_stiffness(m, 0);
+        double *mass = malloc(sizeof(double) * (size_t)n), *start = malloc(sizeof(double) * (size_t)n);
+        for (int i = 0; i < n; i++) {
+            mass[i] = m->mass[i / 3];
+            start[i] = 1.0 + 0.1 * (i % 7) * (i % 2 ? -1 : 1);
+        }
+        double exact = 2 / sqrt(largest_eigenvalue_over_mass(n, K, mass, start, 10000));
+        double joints_alone = 2 / sqrt(largest_eigenvalue_over_mass(n, KJ, mass, start, 10000));
+        double estimate = joint_stable_dt(m), taken = fdem_stable_dt(m);
+        CHECK(estimate <= exact && estimate >= 0.4 * exact,
+              "penalty %g E: joint estimate %.4g s against 2/omega_max %.4g s", factors[t],
+              estimate, exact);
+        CHECK(taken <= exact, "penalty %g E: step %.4g s above 2/omega_max %.4g s", factors[t],
+              taken, exact);
+        fprintf(stderr, "  penalty %3g E, %d joints: 2/omega_max %.4g s (joints alone %.4g s); "
+                "joint estimate %.3f of it, model step %.3f\n",
+                factors[t], m->joint_count, exact, joints_alone, estimate / exact, taken / exact);
+        free(K);
+        free(KJ);
+        free(mass);
+        free(start);
+        fdem_model_destroy(m);
+    }
 }
 
 /* A bar pulled at both ends at 5 m/s, as test_fragments' 2D bar. */
@@ -225,5 +321,82 @@ static void two_threads_give_the_same_bits(void)
     fdem_model_destroy(b);
 }
 
-CHECK_MAIN(T(joints_on_interior_faces), T(intact_fracturing_bar_vibrates_like_continuum),
-           T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits))
+/* A fracturing block (1296 tetrahedra, a joint on every interior face)
+ * thrown obliquely at a fixed steel slab under gravity: element forces,
+ * joints that break, contact with friction between the block and the slab
+ * and across broken faces, a support - every loop that threads. */
+static fdem_model *impact_model(int threads)
+{
+    fdem_error err = {0};
+    fdem_model *m = fdem_model_create();
+    fdem_material_def steel = {.density = 7800, .young = 2e11, .poisson = 0.3, .friction = 0.3};
+    fdem_material_def stone = rock(0, 0.05);
+    fdem_tet_mesh slab = {0}, block = {0};
+    const double slab_origin[3] = {-0.05, -0.05, -0.02}, slab_size[3] = {0.2, 0.2, 0.02};
+    const double block_origin[3] = {0, 0, 1e-4}, block_size[3] = {0.1, 0.1, 0.1};
+    const int slab_div[3] = {8, 8, 1}, block_div[3] = {6, 6, 6};
+    int ok = m && fdem_set_dimension(m, 3, &err) == 0 &&
+             fdem_tet_mesh_box(slab_origin, slab_size, slab_div, &slab, &err) == 0 &&
+             fdem_tet_mesh_box(block_origin, block_size, block_div, &block, &err) == 0 &&
+             fdem_add_material(m, &stone, &err) == 0 && fdem_add_material(m, &steel, &err) == 1 &&
+             fdem_add_part_3d(m, &block, 0, 1, &err) == 0 &&
+             fdem_add_part_3d(m, &slab, 1, 0, &err) == 1;
+    fdem_tet_mesh_free(&slab);
+    fdem_tet_mesh_free(&block);
+    if (!ok) build_die("impact", &err);
+    fdem_constraint_def fix = {0};
+    fix.select = FDEM_SELECT_PART;
+    fix.part = 1;
+    fix.kind = FDEM_CONSTRAINT_FIX;
+    fix.fix_x = fix.fix_y = fix.fix_z = 1;
+    const double v[3] = {0.5, 0.2, -3}, g[3] = {0, 0, -9.81};
+    if (fdem_add_constraint(m, &fix, &err) < 0 || fdem_set_part_velocity_v(m, 0, v, &err))
+        build_die("impact", &err);
+    fdem_set_gravity_v(m, g);
+    fdem_set_threads(m, threads);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+/* The impact on one and on two threads side by side, until joints have
+ * broken and the broken faces have been in contact for a while: the same
+ * bits (positions, velocities, damage, every energy account). */
+static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
+{
+    fdem_model *one = impact_model(1), *two = impact_model(2);
+    CHECK(fdem_get_threads(two) == 2, "threads %d", fdem_get_threads(two));
+    /* a fracturing part's tetrahedra share no node: one colour, several blocks */
+    CHECK(one->elem_plan.block_count >= 2 && one->joint_plan.color_count >= 2,
+          "the test needs planned loops: %d element blocks, %d joint colours",
+          one->elem_plan.block_count, one->joint_plan.color_count);
+    fdem_error err;
+    int steps = 0, after = 0;
+    while (after < 100 && steps < 20000) {
+        if (fdem_step(one, &err) || fdem_step(two, &err)) build_die("step", &err);
+        steps++;
+        after += fdem_get_counts(one).broken_joints > 0;
+    }
+    fdem_counts c1 = fdem_get_counts(one), c2 = fdem_get_counts(two);
+    CHECK(c1.broken_joints > 0, "no joint broke in %d steps", steps);
+    CHECK(c1.contacts > 0, "nothing touching after %d steps", steps);
+    CHECK(c1.broken_joints == c2.broken_joints, "broken %d vs %d", c1.broken_joints,
+          c2.broken_joints);
+    size_t bytes = sizeof(double) * 3 * (size_t)one->node_count;
+    CHECK(memcmp(one->pos, two->pos, bytes) == 0, "positions differ");
+    CHECK(memcmp(one->vel, two->vel, bytes) == 0, "velocities differ");
+    CHECK(memcmp(one->joint_damage, two->joint_damage, sizeof(double) * (size_t)one->joint_count) == 0,
+          "damage differs");
+    fdem_energy e1 = fdem_get_energy(one), e2 = fdem_get_energy(two);
+    CHECK(memcmp(&e1, &e2, sizeof e1) == 0, "energies differ: kinetic %.17g vs %.17g",
+          e1.kinetic, e2.kinetic);
+    fprintf(stderr, "  %d steps, %d tetrahedra, %d joints (%d broken), %d touching, %d element "
+            "blocks and %d joint colours, fracture %.3g J, friction %.3g J\n",
+            steps, c1.elements, c1.joints, c1.broken_joints, c1.contacts,
+            one->elem_plan.block_count, one->joint_plan.color_count, e1.fracture, e1.friction);
+    fdem_model_destroy(one);
+    fdem_model_destroy(two);
+}
+
+CHECK_MAIN(T(joints_on_interior_faces), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
+           T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits),
+           T(fracturing_impact_on_two_threads_gives_the_bits_of_one))
