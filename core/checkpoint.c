@@ -246,6 +246,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         m->joint_energy = h.energy.joint;
         m->restored_energy = h.energy;
         m->restored_energy_valid = 1;
+        energy_gravity_restored(m, h.energy.gravity_work);
     }
     return 0;
 }

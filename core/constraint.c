@@ -1,7 +1,8 @@
 /*
  * constraint.c - boundary conditions: node selection by part or box, fixed
- * and prescribed-velocity components, forces shared over a node set, and the
- * total reaction of each constraint after every step.
+ * and prescribed-velocity components, forces shared over a node set, their
+ * amplitudes in time, and the total reaction of each constraint after every
+ * step (pressures and dashpots on boundary facets: boundary_load.c).
  *
  * A degree of freedom belongs to the last constraint (in case order) that
  * prescribes it, so overlapping selections are well defined and each
@@ -13,13 +14,14 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amplitude.h"
 #include "model.h"
 
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
 /* Box bounds: box[d] lower, box[D + d] upper, for D = m->dim. */
-static int constraint_selects(const fdem_model *m, const constraint *c, int node)
+int constraint_selects(const fdem_model *m, const constraint *c, int node)
 {
     if (c->def.select == FDEM_SELECT_PART) return m->node_part[node] == c->def.part;
     const double *b = c->def.box, *x = m->pos0 + (size_t)m->dim * (size_t)node;
@@ -38,6 +40,29 @@ static unsigned constraint_dofs(const fdem_model *m, const constraint *c)
     case FDEM_CONSTRAINT_VELOCITY:
         return (c->def.free_x ? 0u : 1u) | (c->def.free_y ? 0u : 2u) | (c->def.free_z ? 0u : z);
     default: return 0;
+    }
+}
+
+/* The values this step uses: forces, pressures and gravity at t_n, where
+ * the step evaluates forces, and prescribed velocities at velocity_time,
+ * the half step t_n + h/2 they are the velocity of (0 at finalize, for the
+ * velocity at t = 0). Without an amplitude the value is copied, not
+ * multiplied, so such a case keeps its arithmetic to the bit. */
+void constraint_set_time(fdem_model *m, double velocity_time)
+{
+    if (m->gravity_amplitude) {
+        double a = amplitude_at(m->gravity_amplitude, m->gravity_amplitude_count, m->time);
+        for (int d = 0; d < m->dim; d++) m->gravity[d] = m->gravity_base[d] * a;
+    }
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (!c->amplitude) {
+            memcpy(c->value_now, c->def.value, sizeof c->value_now);
+            continue;
+        }
+        double t = c->def.kind == FDEM_CONSTRAINT_VELOCITY ? velocity_time : m->time;
+        double a = amplitude_at(c->amplitude, c->def.amplitude_count, t);
+        for (int d = 0; d < 3; d++) c->value_now[d] = c->def.value[d] * a;
     }
 }
 
@@ -102,12 +127,12 @@ int constraint_select(fdem_model *m, fdem_error *err)
     /* Prescribed velocities hold from t = 0 on. */
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
-        if (c->def.kind == FDEM_CONSTRAINT_FORCE) continue;
+        if (c->def.kind != FDEM_CONSTRAINT_FIX && c->def.kind != FDEM_CONSTRAINT_VELOCITY) continue;
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
             int i = m->cnode[e];
             for (int d = 0; d < D; d++)
                 if (m->cdof[e] & (1u << d))
-                    m->vel[D * i + d] = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
+                    m->vel[D * i + d] = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->value_now[d];
         }
     }
     return 0;
@@ -120,10 +145,10 @@ void constraint_apply_forces(fdem_model *m)
         constraint *c = &m->constraints[k];
         if (c->def.kind != FDEM_CONSTRAINT_FORCE) continue;
         for (int d = 0; d < D; d++) {
-            double share = c->def.value[d] / c->entry_count;
+            double share = c->value_now[d] / c->entry_count;
             for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++)
                 m->force[(size_t)D * (size_t)m->cnode[e] + (size_t)d] += share;
-            c->force[d] = c->def.value[d];
+            c->force[d] = c->value_now[d];
         }
     }
 }
@@ -144,12 +169,14 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 for (int d = 0; d < D; d++) {
                     /* velocities were already advanced: v_old = v_new - a havg */
                     double a = (m->force[at + d] + (fc ? fc[at + d] : 0)) / m->mass[i] + m->gravity[d];
-                    power += c->def.value[d] / c->entry_count * (m->vel[at + d] - 0.5 * a * havg);
+                    power += c->value_now[d] / c->entry_count * (m->vel[at + d] - 0.5 * a * havg);
                 }
                 m->external_work += power * havg;
             }
             continue;
         }
+        if (c->def.kind != FDEM_CONSTRAINT_FIX && c->def.kind != FDEM_CONSTRAINT_VELOCITY)
+            continue; /* boundary loads: boundary_load.c */
         c->force[0] = c->force[1] = c->force[2] = 0;
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
             size_t i = (size_t)m->cnode[e], at = (size_t)D * i;
@@ -157,7 +184,7 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 if (!(m->cdof[e] & (1u << d))) continue;
                 double mass = m->mass[i];
                 double f = m->force[at + d] + (fc ? fc[at + d] : 0) + mass * m->gravity[d];
-                double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->def.value[d];
+                double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->value_now[d];
                 double v_old = m->vel[at + d];
                 double v_free = v_old + f / mass * havg;
                 double reaction = mass * (prescribed - v_free) / havg;

@@ -26,7 +26,10 @@
 #include <math.h>
 #include <string.h>
 
+#include "amplitude.h"
 #include "model.h"
+
+static void total_momentum(const fdem_model *m, double p[3]);
 
 /* Sum of m a . a over the free dofs at t = 0 for the forces in m->force
  * (and gravity): see energy_initial. */
@@ -53,7 +56,8 @@ static double initial_acceleration2(const fdem_model *m)
  * residual from the first step on. The first step's h is only known when
  * it is taken (fdem_step records it); a model restored from a checkpoint
  * takes its current dt. The forces at t = 0 are the elements' and the
- * applied ones (joints hold none; bodies start apart, so no contact). */
+ * applied ones, pressures included (joints hold none; bodies start apart,
+ * so no contact). */
 void energy_initial(fdem_model *m)
 {
     double kinetic = 0;
@@ -66,6 +70,7 @@ void energy_initial(fdem_model *m)
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     element_forces(m);
     constraint_apply_forces(m);
+    boundary_load_apply(m);
     m->initial_acceleration2 = initial_acceleration2(m);
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     if (m->elem_viscous)
@@ -73,6 +78,7 @@ void energy_initial(fdem_model *m)
                sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count);
     m->damping_work = 0;
     m->initial_energy = kinetic + m->elastic_energy;
+    if (m->gravity_amplitude) total_momentum(m, m->momentum);
 }
 
 /* Half the last step's power of the applied forces and reactions, times
@@ -87,14 +93,56 @@ static double constraints_last_half_step(const fdem_model *m)
             for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
                 const double *v = m->vel + (size_t)D * (size_t)m->cnode[e];
                 double p = 0;
-                for (int d = 0; d < D; d++) p += c->def.value[d] / c->entry_count * v[d];
+                for (int d = 0; d < D; d++) p += c->value_now[d] / c->entry_count * v[d];
                 power += p;
             }
         } else if (c->def.kind == FDEM_CONSTRAINT_VELOCITY) {
-            for (int d = 0; d < D; d++) power += c->force[d] * c->def.value[d];
+            for (int d = 0; d < D; d++) power += c->force[d] * c->value_now[d];
         }
     }
-    return 0.5 * m->havg_last * power;
+    return 0.5 * m->havg_last * power + boundary_load_last_half_step(m, 0);
+}
+
+/* Gravity times an amplitude is not a constant force, so its work is not
+ * M g . (centre of mass displacement): it is booked every step as any
+ * other force's, g . (P_old + P_new)/2 havg with P = sum m v over all nodes
+ * (prescribed ones too, as for a constant gravity). Only with an
+ * amplitude: the plain case keeps its exact formula. */
+static void total_momentum(const fdem_model *m, double p[3])
+{
+    const int D = m->dim;
+    p[0] = p[1] = p[2] = 0;
+    for (int i = 0; i < m->node_count; i++)
+        for (int d = 0; d < D; d++) p[d] += m->mass[i] * m->vel[(size_t)D * (size_t)i + (size_t)d];
+}
+
+void energy_gravity_step(fdem_model *m, double havg)
+{
+    if (!m->gravity_amplitude) return;
+    double p[3];
+    total_momentum(m, p);
+    for (int d = 0; d < m->dim; d++)
+        m->gravity_work_sum += m->gravity[d] * 0.5 * (m->momentum[d] + p[d]) * havg;
+    memcpy(m->momentum, p, sizeof p);
+}
+
+/* After a checkpoint is read: the sum that reports the stored gravity work. */
+void energy_gravity_restored(fdem_model *m, double gravity_work)
+{
+    if (!m->gravity_amplitude) return;
+    double a = amplitude_at(m->gravity_amplitude, m->gravity_amplitude_count, m->time - m->dt_prev);
+    for (int d = 0; d < m->dim; d++) m->gravity[d] = m->gravity_base[d] * a;
+    total_momentum(m, m->momentum);
+    double half = 0;
+    for (int d = 0; d < m->dim; d++) half += m->gravity[d] * m->momentum[d];
+    m->gravity_work_sum = gravity_work + 0.5 * m->havg_last * half;
+}
+
+static double gravity_work_of_amplitude(const fdem_model *m)
+{
+    double half = 0;
+    for (int d = 0; d < m->dim; d++) half += m->gravity[d] * m->momentum[d];
+    return m->gravity_work_sum - 0.5 * m->havg_last * half;
 }
 
 fdem_energy fdem_get_energy(const fdem_model *m)
@@ -128,8 +176,8 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     en.friction = m->friction_energy + m->joint_friction_energy;
     en.fracture = m->fracture_energy;
     en.contact = -(m->contact_work - 0.5 * havg * contact_power) - m->friction_energy;
-    en.damping = m->damping_work;
-    en.gravity_work = gravity_work;
+    en.damping = m->damping_work + boundary_load_last_half_step(m, 1);
+    en.gravity_work = m->gravity_amplitude ? gravity_work_of_amplitude(m) : gravity_work;
     en.external_work = m->external_work - constraints_last_half_step(m);
     en.residual = en.kinetic + en.elastic + en.joint + en.contact + en.friction + en.fracture +
                   en.damping - en.gravity_work - en.external_work - initial;

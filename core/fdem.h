@@ -156,6 +156,11 @@ int fdem_set_part_initial_stress(fdem_model *model, int part, const double *valu
 /* Gravity, `dimension` components in g (the 2D form leaves gz out). */
 void fdem_set_gravity(fdem_model *model, double gx, double gy);
 void fdem_set_gravity_v(fdem_model *model, const double *g);
+/* Gravity times a(t), a table as a constraint's amplitude (copied); count 0
+ * removes it. Returns 0, or -1 for a table that is not finite and
+ * increasing in time. */
+int fdem_set_gravity_amplitude(fdem_model *model, const double *pairs, int count,
+                               fdem_error *err);
 
 /* Node selection for a constraint: all nodes of a part, or every node whose
  * initial position lies in the box (inclusive): box[d] is the lower and
@@ -167,6 +172,9 @@ typedef enum fdem_constraint_kind {
     FDEM_CONSTRAINT_FIX,      /* fix_x / fix_y / fix_z */
     FDEM_CONSTRAINT_VELOCITY, /* prescribed velocity; free_x/_y/_z leave a component free */
     FDEM_CONSTRAINT_FORCE,    /* total force shared equally by the selected nodes */
+    FDEM_CONSTRAINT_PRESSURE, /* value[0] Pa on every boundary edge (face) whose nodes are all
+                                 selected, along the current inward normal (boundary_load.c) */
+    FDEM_CONSTRAINT_ABSORB,   /* Lysmer dashpots on the same boundary edges (faces) */
 } fdem_constraint_kind;
 
 typedef struct fdem_constraint_def {
@@ -177,6 +185,11 @@ typedef struct fdem_constraint_def {
     int fix_x, fix_y, fix_z;    /* FIX */
     double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness) */
     int free_x, free_y, free_z; /* VELOCITY: component left free (JSON null) */
+    /* VELOCITY, FORCE, PRESSURE: the value times a(t), piecewise linear through
+     * amplitude_count (t, a) pairs (times strictly increasing), held constant
+     * outside them; NULL (count 0) is a(t) = 1. fdem_add_constraint copies it. */
+    const double *amplitude;
+    int amplitude_count;
 } fdem_constraint_def;
 
 /* Returns the constraint index or -1 (e.g. a selection with no node).
@@ -234,9 +247,10 @@ typedef struct fdem_energy {
     double friction;      /* dissipated by Coulomb sliding of contacts and by the sigma_c tan(phi)
                              part of intact joints' shear strength (>= 0) */
     double fracture;      /* dissipated by joint softening and breaking (>= 0, never decreases) */
-    double damping;       /* dissipated by viscous damping (>= 0) */
+    double damping;       /* dissipated by viscous damping of elements and by absorbing
+                             boundaries' dashpots (>= 0) */
     double gravity_work;  /* work done by gravity */
-    double external_work; /* work of applied forces and constraint reactions */
+    double external_work; /* work of applied forces, pressures and constraint reactions */
     double residual;      /* the balance above */
 } fdem_energy;
 
@@ -317,8 +331,9 @@ void fdem_element_strain(const fdem_model *model, double *out);
 void fdem_element_principal_stress(const fdem_model *model, double *out);
 void fdem_principal_values(int dimension, const double *voigt, double *out);
 
-/* Total reaction (fix, velocity) or applied (force) force of each
- * constraint during the last step, `dimension` doubles per constraint. */
+/* Total reaction (fix, velocity), applied (force, pressure) or dashpot
+ * (absorb) force of each constraint during the last step, `dimension`
+ * doubles per constraint. */
 const double *fdem_constraint_forces(const fdem_model *model);
 
 /* Number of nodes selected by constraint c (valid after finalize). */

@@ -146,6 +146,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
     double t0 = stage_clock();
+    constraint_set_time(m, m->time + 0.5 * h);
     memset(m->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     element_forces(m);
     if (m->joint_count) {
@@ -165,8 +166,11 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double t2 = stage_clock();
     constraint_apply_forces(m);
+    boundary_load_apply(m);
     int bad = central_difference_step(m);
     constraint_enforce(m, h, havg);
+    boundary_load_account(m, havg);
+    energy_gravity_step(m, havg);
     m->times.integration += stage_clock() - t2;
     m->times.contact += t2 - t1; /* detection time is moved out in contact_forces */
     if (bad || !isfinite(m->elastic_energy)) {

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "amplitude.h"
 #include "mesh_3d.h"
 #include "model.h"
 
@@ -62,6 +63,9 @@ void fdem_model_destroy(fdem_model *m)
     free(m->pos0); free(m->mass); free(m->node_part); free(m->node_origin); free(m->dof_owned);
     free(m->elem); free(m->tet); free(m->elem_part); free(m->elem_node); free(m->elem_h);
     free(m->materials); free(m->parts); free(m->part_velocity);
+    for (int k = 0; k < m->constraint_count; k++) free(m->constraints[k].amplitude);
+    free(m->gravity_amplitude);
+    boundary_load_free(m);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
     free(m->joint_k); free(m->joint_material);
@@ -370,6 +374,38 @@ void fdem_set_gravity_v(fdem_model *m, const double *g)
 {
     m->gravity[2] = 0;
     for (int d = 0; d < m->dim; d++) m->gravity[d] = g[d];
+    memcpy(m->gravity_base, m->gravity, sizeof m->gravity_base);
+}
+
+/* A copy of an amplitude table, or NULL (with err filled) if it is bad. */
+static double *amplitude_copy(const double *pairs, int count, fdem_item_kind kind, int item,
+                              const char *what, fdem_error *err)
+{
+    int bad = count < 1 || !pairs ? -1 : amplitude_bad_pair(pairs, count);
+    if (bad) {
+        if (bad < 0)
+            model_error(err, kind, item, "%s: an amplitude needs at least one (t, a) pair", what);
+        else
+            model_error(err, kind, item,
+                        "%s: amplitude pair %d is not finite or its time does not exceed the "
+                        "time before it", what, bad - 1);
+        return NULL;
+    }
+    double *copy = malloc(sizeof(double) * 2 * (size_t)count);
+    if (!copy) model_error(err, kind, item, "%s: out of memory", what);
+    else memcpy(copy, pairs, sizeof(double) * 2 * (size_t)count);
+    return copy;
+}
+
+int fdem_set_gravity_amplitude(fdem_model *m, const double *pairs, int count, fdem_error *err)
+{
+    double *copy = NULL;
+    if (count > 0 && !(copy = amplitude_copy(pairs, count, FDEM_ITEM_NONE, -1, "gravity", err)))
+        return -1;
+    free(m->gravity_amplitude);
+    m->gravity_amplitude = copy;
+    m->gravity_amplitude_count = copy ? count : 0;
+    return 0;
 }
 
 void fdem_set_gravity(fdem_model *m, double gx, double gy)
@@ -406,12 +442,31 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
                     D == 3 ? "constraint %d fixes none of x, y, z" : "constraint %d fixes neither x nor y", k);
         return -1;
     }
+    int has_amplitude = def->amplitude != NULL || def->amplitude_count != 0;
+    if (has_amplitude && (def->kind == FDEM_CONSTRAINT_FIX || def->kind == FDEM_CONSTRAINT_ABSORB)) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    "constraint %d: an amplitude scales a velocity, force or pressure only", k);
+        return -1;
+    }
+    double *amplitude = NULL;
+    char what[32];
+    snprintf(what, sizeof what, "constraint %d", k);
+    if (has_amplitude &&
+        !(amplitude = amplitude_copy(def->amplitude, def->amplitude_count, FDEM_ITEM_CONSTRAINT,
+                                     k, what, err)))
+        return -1;
     if (grow((void **)&m->constraints, &m->constraint_capacity, k + 1, sizeof *m->constraints)) {
+        free(amplitude);
         model_error(err, FDEM_ITEM_CONSTRAINT, k, "out of memory");
         return -1;
     }
     memset(&m->constraints[k], 0, sizeof m->constraints[k]);
     m->constraints[k].def = *def;
+    m->constraints[k].amplitude = amplitude;
+    m->constraints[k].def.amplitude = amplitude;
+    m->constraints[k].def.amplitude_count = amplitude ? def->amplitude_count : 0;
+    if (def->kind == FDEM_CONSTRAINT_PRESSURE || def->kind == FDEM_CONSTRAINT_ABSORB)
+        m->constraints[k].def.value[1] = m->constraints[k].def.value[2] = 0;
     if (D == 2) { /* what a 2D caller left in the third component means nothing */
         constraint *c = &m->constraints[k];
         c->def.fix_z = 0;
@@ -492,7 +547,9 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     lump_masses(m);
     if (joint_prepare(m, err)) return -1;
     m->fragments = joint_fragment_count(m);
+    constraint_set_time(m, 0);
     if (constraint_select(m, err)) return -1;
+    if (boundary_load_select(m, err)) return -1;
     if (contact_init(m, err)) return -1;
     if (build_scatter_plans(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");

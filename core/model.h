@@ -65,7 +65,12 @@ typedef struct initial_stress_def {
 typedef struct constraint {
     fdem_constraint_def def;
     int entry_begin, entry_count;
-    double force[3];     /* reaction (fix, velocity) or applied (force) of the last step */
+    double force[3];     /* reaction (fix, velocity), applied (force, pressure) or dashpot
+                            (absorb) force of the last step */
+    double value_now[3]; /* def.value times the amplitude at the instant this step uses
+                            (constraint_set_time); def.value itself without an amplitude */
+    double *amplitude;   /* owned copy of def.amplitude (def.amplitude points here) */
+    int facet_begin, facet_count; /* PRESSURE, ABSORB: entries of model.bfacet_* */
 } constraint;
 
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
@@ -186,7 +191,22 @@ struct fdem_model {
     int broken_joints;
     int fragments;
 
-    double gravity[3];
+    double gravity[3];       /* this step's gravity: gravity_base times its amplitude */
+    double gravity_base[3];
+    double *gravity_amplitude; /* (t, a) pairs, NULL for a constant gravity */
+    int gravity_amplitude_count;
+    double gravity_work_sum; /* with a gravity amplitude: its work booked step by step */
+    double momentum[3];      /* with a gravity amplitude: sum m v after the last step */
+
+    /* boundary facets loaded by PRESSURE and ABSORB constraints
+     * (boundary_load.c): dim nodes per entry, ordered so that their area
+     * vector points out of the body, the element behind, and the force the
+     * last step put on each of its nodes (dim * dim per entry) */
+    int bfacet_count;
+    int32_t *bfacet_node;
+    int32_t *bfacet_elem;
+    double *bfacet_force;
+    double boundary_power_old[2]; /* this step's sum f . v_old: pressures, dashpots */
     double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
     int64_t step;
     double time;
@@ -308,6 +328,8 @@ int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, s
 size_t contact_record_bytes(const contact_state *cs); /* one record in a checkpoint */
 
 /* constraint.c */
+int constraint_selects(const fdem_model *m, const constraint *c, int node);
+void constraint_set_time(fdem_model *m, double velocity_time);
 int constraint_select(fdem_model *m, fdem_error *err);
 void constraint_apply_forces(fdem_model *m);
 void constraint_enforce(fdem_model *m, double h, double havg);
@@ -368,8 +390,17 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
                       double totals[SCATTER_SUMS]);
 void scatter_plan_free(scatter_plan *plan);
 
+/* boundary_load.c: pressures and absorbing dashpots on boundary facets */
+int boundary_load_select(fdem_model *m, fdem_error *err);
+void boundary_load_apply(fdem_model *m);
+void boundary_load_account(fdem_model *m, double havg);
+double boundary_load_last_half_step(const fdem_model *m, int absorb);
+void boundary_load_free(fdem_model *m);
+
 /* energy.c */
 void energy_initial(fdem_model *m);
+void energy_gravity_step(fdem_model *m, double havg);
+void energy_gravity_restored(fdem_model *m, double gravity_work);
 
 /* integrator.c */
 int central_difference_step(fdem_model *m);

@@ -21,7 +21,7 @@
 #define CASE_DEFAULT_SAFETY 0.5
 
 static const char *const top_keys[] = {
-    "name", "dimension", "materials", "parts", "constraints", "gravity", "time", "output",
+    "name", "dimension", "materials", "parts", "constraints", "gravity", "gravity_amplitude", "time", "output",
     NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
@@ -156,6 +156,13 @@ static void case_read_gravity(case_doc *doc, const json_t *gravity)
     if (gravity) case_read_vector(doc, gravity, "/gravity", doc->dimension, doc->gravity);
 }
 
+static void case_read_gravity_amplitude(case_doc *doc, const json_t *table)
+{
+    if (table)
+        doc->gravity_amplitude = case_read_amplitude(doc, table, "/gravity_amplitude",
+                                                     &doc->gravity_amplitude_count);
+}
+
 /* Pass 1 over the whole document. */
 static void case_read(case_doc *doc, const json_t *root)
 {
@@ -175,6 +182,7 @@ static void case_read(case_doc *doc, const json_t *root)
     json_t *constraints = json_object_get(root, "constraints");
     if (constraints) case_read_constraints(doc, constraints);
     case_read_gravity(doc, json_object_get(root, "gravity"));
+    case_read_gravity_amplitude(doc, json_object_get(root, "gravity_amplitude"));
     case_read_time(doc, json_object_get(root, "time"));
     case_read_output(doc, json_object_get(root, "output"));
 }
@@ -246,7 +254,10 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
          case_add_constraints(doc, model) == 0;
     if (ok) {
         fdem_set_gravity_v(model, doc->gravity);
-        ok = fdem_model_finalize(model, &err) == 0;
+        ok = fdem_set_gravity_amplitude(model, doc->gravity_amplitude,
+                                        doc->gravity_amplitude_count, &err) == 0;
+        if (!ok) case_engine_problem(doc, &err, "/gravity_amplitude");
+        ok = ok && fdem_model_finalize(model, &err) == 0;
         if (!ok) case_engine_problem(doc, &err, "");
     }
     ok = ok && case_check_selections(doc, model) && case_choose_dt(doc, model, info) == 0;
@@ -278,7 +289,9 @@ void case_doc_free(case_doc *doc)
     }
     free(doc->parts);
     free(doc->materials);
+    for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].amplitude);
     free(doc->constraints);
+    free(doc->gravity_amplitude);
     json_decref(doc->material_names);
     json_decref(doc->part_names);
 }

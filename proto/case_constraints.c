@@ -1,7 +1,9 @@
 /*
  * case_constraints.c - the "constraints" array of a case: each entry selects
  * nodes (a part by name, or a box of initial positions) and does one thing
- * to them (fix components, prescribe a velocity, apply a force).
+ * to them (fix components, prescribe a velocity, apply a force, press on or
+ * absorb waves through the boundary they span), a velocity, force or
+ * pressure optionally scaled by an "amplitude" table in time.
  *
  * Parts are read first, so a part selector is resolved to its index here and
  * a misspelt part name is reported with a suggestion. Whether a box selects
@@ -15,7 +17,9 @@
 
 #include "case_internal.h"
 
-static const char *const constraint_keys[] = {"part", "box", "fix", "velocity", "force", NULL};
+static const char *const constraint_keys[] = {"part",     "box",    "fix",       "velocity",
+                                              "force",    "pressure", "absorb", "amplitude",
+                                              NULL};
 
 static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
                                  const char *ptr)
@@ -153,10 +157,38 @@ static int constraint_pick(case_doc *doc, const json_t *value, const char *ptr,
     return -1;
 }
 
+/* "absorb": true; false is refused rather than ignored, since the constraint
+ * would then do nothing. */
+static void constraint_read_absorb(case_doc *doc, fdem_constraint_def *def, const json_t *a,
+                                   const char *ptr)
+{
+    def->kind = FDEM_CONSTRAINT_ABSORB;
+    int on = 0;
+    if (case_read_bool(doc, a, ptr, &on) && !on)
+        case_problem(doc, ptr, "\"absorb\": false does nothing; use true or leave the "
+                               "constraint out");
+}
+
+/* "amplitude" only scales a value: a velocity, force or pressure. */
+static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const json_t *value,
+                                      const char *ptr)
+{
+    char at[CASE_POINTER];
+    json_t *table = case_member(value, ptr, "amplitude", at);
+    if (!table) return;
+    if (c->def.kind == FDEM_CONSTRAINT_FIX || c->def.kind == FDEM_CONSTRAINT_ABSORB) {
+        case_problem(doc, at, "an amplitude scales a \"velocity\", \"force\" or \"pressure\", "
+                              "not %s", c->def.kind == FDEM_CONSTRAINT_FIX ? "\"fix\"" : "\"absorb\"");
+        return;
+    }
+    c->amplitude = case_read_amplitude(doc, table, at, &c->def.amplitude_count);
+    c->def.amplitude = c->amplitude;
+}
+
 static void constraint_read(case_doc *doc, case_constraint *c, int index, const json_t *value)
 {
     static const char *const selectors[] = {"part", "box"};
-    static const char *const actions[] = {"fix", "velocity", "force"};
+    static const char *const actions[] = {"fix", "velocity", "force", "pressure", "absorb"};
     char ptr[CASE_POINTER], at[CASE_POINTER], what[32];
     pointer_join_index(ptr, sizeof ptr, "/constraints", index);
     if (!case_expect_object(doc, value, ptr)) return;
@@ -172,18 +204,25 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         if (selector == 0) constraint_read_part(doc, &c->def, s, at);
         else constraint_read_box(doc, &c->def, s, at);
     }
-    int action = constraint_pick(doc, value, ptr, actions, 3,
-                                 "an action: \"fix\", \"velocity\" or \"force\"");
+    int action = constraint_pick(doc, value, ptr, actions, 5,
+                                 "an action: \"fix\", \"velocity\", \"force\", \"pressure\" "
+                                 "or \"absorb\"");
     if (action < 0) return;
     json_t *a = case_member(value, ptr, actions[action], at);
     if (action == 0) {
         constraint_read_fix(doc, &c->def, a, at);
     } else if (action == 1) {
         constraint_read_velocity(doc, &c->def, a, at);
-    } else {
+    } else if (action == 2) {
         c->def.kind = FDEM_CONSTRAINT_FORCE;
         case_read_vector(doc, a, at, doc->dimension, c->def.value);
+    } else if (action == 3) {
+        c->def.kind = FDEM_CONSTRAINT_PRESSURE;
+        case_read_number(doc, a, at, &c->def.value[0]);
+    } else {
+        constraint_read_absorb(doc, &c->def, a, at);
     }
+    constraint_read_amplitude(doc, c, value, ptr);
 }
 
 void case_read_constraints(case_doc *doc, const json_t *constraints)

@@ -66,6 +66,7 @@ typedef struct case_part {
 
 typedef struct case_constraint {
     fdem_constraint_def def;
+    double *amplitude;       /* def.amplitude points here (case_amplitude.c) */
 } case_constraint;
 
 typedef struct case_doc {
@@ -79,6 +80,8 @@ typedef struct case_doc {
     case_constraint *constraints;
     int constraint_count;
     double gravity[3];
+    double *gravity_amplitude; /* (t, a) pairs or NULL */
+    int gravity_amplitude_count;
     double end_time, dt, safety, interval;
     int dt_auto;
     unsigned fields;
@@ -86,6 +89,11 @@ typedef struct case_doc {
     json_t *part_names;      /* name -> index into parts */
     long typo_cells; /* edit-distance work spent on "did you mean" so far */
 } case_doc;
+
+/* case_amplitude.c: an amplitude table [[t, a], ...] at ptr, finite with
+ * strictly increasing times: the pairs (free() them) and their count, or
+ * NULL after adding a problem at the entry at fault. */
+double *case_read_amplitude(case_doc *doc, const json_t *value, const char *ptr, int *count);
 
 /* ------------------------------------------------- case_read.c: JSON values */
 

@@ -168,6 +168,54 @@ class BadInputTest(unittest.TestCase):
         self.assertIn("1e999", text)
         self.post(text.encode(), 400)
 
+    def with_constraint(self, constraint, **top):
+        case = tiny_case("loads", **top)
+        case["constraints"].append(constraint)
+        return case
+
+    def test_bad_amplitudes(self):
+        side = [-1, 0.099, 1, 1]  # the block's top edge
+        for table, pointer in [(3, "/constraints/1/amplitude"),
+                               ([], "/constraints/1/amplitude"),
+                               ([[0, 0, 1]], "/constraints/1/amplitude/0"),
+                               ([[0, 0], 5], "/constraints/1/amplitude/1"),
+                               ([[0, "x"]], "/constraints/1/amplitude/0/1"),
+                               ([[0, 0], [0, 1]], "/constraints/1/amplitude/1/0"),
+                               ([[0, 0], [1, 1], [0.5, 1]], "/constraints/1/amplitude/2/0")]:
+            for action in ({"force": [0, -1e3]}, {"pressure": 1e5}, {"velocity": [0, -1]}):
+                self.post(self.with_constraint(dict(box=side, amplitude=table, **action)), 422,
+                          pointer)
+        problem = self.post(self.with_constraint({"box": side, "fix": ["x"], "amplitude": [[0, 1]]}),
+                            422, "/constraints/1/amplitude")
+        self.assertIn("fix", json.dumps(problem))
+        self.post(self.with_constraint({"box": side, "absorb": True, "amplitude": [[0, 1]]}),
+                  422, "/constraints/1/amplitude")
+        self.post(tiny_case("g", gravity=[0, -9.81], gravity_amplitude=[[1, 0], [0, 1]]), 422,
+                  "/gravity_amplitude/1/0")
+        self.post(tiny_case("g", gravity=[0, -9.81], gravity_amplitude={"t": 1}), 422,
+                  "/gravity_amplitude")
+
+    def test_bad_pressure_and_absorb(self):
+        side = [-1, 0.099, 1, 1]
+        self.post(self.with_constraint({"box": side, "fix": ["x"], "pressure": 1e5}), 422,
+                  "/constraints/1", words=["exactly one"])
+        self.post(self.with_constraint({"box": side, "pressure": "high"}), 422,
+                  "/constraints/1/pressure")
+        self.post(self.with_constraint({"box": side, "pressure": [1e5, 0]}), 422,
+                  "/constraints/1/pressure")
+        self.post(self.with_constraint({"box": side, "absorb": 1}), 422, "/constraints/1/absorb")
+        self.post(self.with_constraint({"box": side, "absorb": "yes"}), 422,
+                  "/constraints/1/absorb")
+        self.post(self.with_constraint({"box": side, "absorb": False}), 422,
+                  "/constraints/1/absorb")
+        self.post(self.with_constraint({"box": side, "absorb": True, "pressure": 1}), 422,
+                  "/constraints/1")
+        # one interior node: no boundary edge has all its nodes selected
+        inner = [0.049, 0.049, 0.051, 0.051]
+        for action in ({"pressure": 1e5}, {"absorb": True}):
+            self.post(self.with_constraint(dict(box=inner, **action)), 422, "/constraints/1",
+                      words=["boundary edge"])
+
     def test_dt_above_stable(self):
         problem = self.post(edit(["time", "dt"], 1.0), 422, "/time/dt")
         self.assertIn("stable", json.dumps(problem).lower())
