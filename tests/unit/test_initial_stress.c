@@ -8,6 +8,9 @@
  *  - a block on rollers (each face held in its normal direction) under a
  *    uniform in-situ stress stays still, keeps its stress, and the rollers
  *    carry sigma . n times the face area;
+ *  - the same block held only by the matching boundary pressures stays
+ *    still (kinetic energy below 1e-6 of the elastic energy) with its
+ *    stress unchanged to 1 % (the issue's test);
  *  - a block whose in-situ stress grows with depth as gravity asks, on
  *    rollers at the sides and the base, stays still;
  *  - a free block released from its in-situ stress springs open, and the
@@ -181,25 +184,45 @@ static void rotation_carries_the_stress(void)
 
 /* ------------------------------------------------------------ equilibrium */
 
-/* A roller on the face of the block at coordinate `at` of `axis`: that
- * face's nodes held along the axis. */
-static int add_roller(fdem_model *m, const double size[3], int axis, double at)
+/* A constraint selecting the face of the block at coordinate `at` of `axis`. */
+static fdem_constraint_def face(const fdem_model *m, const double size[3], int axis, double at)
 {
     const int D = m->dim;
     fdem_constraint_def c = {0};
     c.select = FDEM_SELECT_BOX;
-    c.kind = FDEM_CONSTRAINT_FIX;
     for (int d = 0; d < D; d++) {
         c.box[d] = d == axis ? at - 1e-6 : -1e-6;
         c.box[D + d] = d == axis ? at + 1e-6 : size[d] + 1e-6;
     }
+    return c;
+}
+
+static int add_constraint(fdem_model *m, const fdem_constraint_def *c)
+{
+    fdem_error err;
+    int k = fdem_add_constraint(m, c, &err);
+    if (k < 0) build_die("constraint", &err);
+    return k;
+}
+
+/* A roller on a face: its nodes held along the axis. */
+static int add_roller(fdem_model *m, const double size[3], int axis, double at)
+{
+    fdem_constraint_def c = face(m, size, axis, at);
+    c.kind = FDEM_CONSTRAINT_FIX;
     c.fix_x = axis == 0;
     c.fix_y = axis == 1;
     c.fix_z = axis == 2;
-    fdem_error err;
-    int k = fdem_add_constraint(m, &c, &err);
-    if (k < 0) build_die("roller", &err);
-    return k;
+    return add_constraint(m, &c);
+}
+
+/* A pressure p (> 0 pushes into the body) on a face. */
+static int add_pressure(fdem_model *m, const double size[3], int axis, double at, double p)
+{
+    fdem_constraint_def c = face(m, size, axis, at);
+    c.kind = FDEM_CONSTRAINT_PRESSURE;
+    c.value[0] = p;
+    return add_constraint(m, &c);
 }
 
 /* Steps for `periods` of the block's slowest compression mode (height / c). */
@@ -255,6 +278,44 @@ static void rollers_hold_a_stressed_block(void)
                 if (d != a) area *= size[d];
             CHECK_REL(fdem_constraint_forces(m)[dim * far[a] + a], value[a] * area, 1e-6);
         }
+        free(before);
+        fdem_model_destroy(m);
+    }
+}
+
+/* The same block held by nothing but the pressures its stress asks for:
+ * p = -sigma_aa on both faces normal to axis a (contract 5.3 pressure). */
+static void pressures_hold_a_stressed_block(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        const double size[3] = {2, 1.5, 1};
+        const int div[3] = {8, 6, 4};
+        int pi;
+        fdem_model *m = block_model(dim, size, div, &pi);
+        const double v2[3] = {-10e6, -6e6, 0}, v3[6] = {-10e6, -6e6, -8e6, 0, 0, 0};
+        const double *value = dim == 2 ? v2 : v3;
+        set_stress(m, pi, value, NULL, 0);
+        for (int a = 0; a < dim; a++) {
+            add_pressure(m, size, a, 0, -value[a]);
+            add_pressure(m, size, a, size[a], -value[a]);
+        }
+        build_finalize(m, 0.5);
+        double *before = element_stresses(m), worst = 0, e0 = fdem_get_energy(m).elastic;
+        double c = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / RHO), t_end = 20 * size[0] / c;
+        fdem_error err;
+        while (fdem_get_time(m) < t_end) {
+            if (fdem_step(m, &err)) build_die("step", &err);
+            worst = fmax(worst, fabs(fdem_get_energy(m).residual) / e0);
+        }
+        fdem_energy en = fdem_get_energy(m);
+        CHECK(en.kinetic < 1e-6 * en.elastic, "%dD: kinetic %g J against elastic %g J", dim,
+              en.kinetic, en.elastic);
+        double change = stress_change(m, before);
+        CHECK(change < 0.01, "%dD: stress changed by %.3g %%", dim, 100 * change);
+        CHECK(worst < 1e-6, "%dD: energy residual %.3g of the elastic energy", dim, worst);
+        fprintf(stderr, "  %dD pressures: kinetic/elastic %.3g, stress change %.3g %%, worst "
+                        "residual %.3g of %.6g J\n", dim, en.kinetic / en.elastic, 100 * change,
+                worst, e0);
         free(before);
         fdem_model_destroy(m);
     }
@@ -366,5 +427,6 @@ static void zero_stress_steps_as_none(void)
 }
 
 CHECK_MAIN(T(stress_at_rest_is_the_given_field), T(rotation_carries_the_stress),
-           T(rollers_hold_a_stressed_block), T(gravity_column_stays_still),
+           T(rollers_hold_a_stressed_block), T(pressures_hold_a_stressed_block),
+           T(gravity_column_stays_still),
            T(released_block_closes_the_balance), T(zero_stress_steps_as_none))
