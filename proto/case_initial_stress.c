@@ -22,7 +22,8 @@ static const char *stress_layout(int dimension)
     return dimension == 3 ? "[sxx, syy, szz, syz, sxz, sxy]" : "[sxx, syy, sxy]";
 }
 
-/* An array of the dimension's stress components, each a finite number. */
+/* An array of the dimension's stress components, each a finite number; a
+ * wrong length is told with the layout it should have. */
 static int read_components(case_doc *doc, const json_t *value, const char *ptr, const char *unit,
                            double out[6])
 {
@@ -33,13 +34,7 @@ static int read_components(case_doc *doc, const json_t *value, const char *ptr, 
                      case_type_word(value), json_is_array(value) ? " of another length" : "");
         return 0;
     }
-    int ok = 1;
-    for (int k = 0; k < count; k++) {
-        char item[CASE_POINTER];
-        pointer_join_index(item, sizeof item, ptr, k);
-        ok &= case_read_number(doc, json_array_get(value, (size_t)k), item, &out[k]);
-    }
-    return ok;
+    return case_read_vector(doc, value, ptr, count, out);
 }
 
 void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,

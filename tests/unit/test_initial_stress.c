@@ -235,6 +235,35 @@ static void run_periods(fdem_model *m, double height, double periods)
         if (fdem_step(m, &err)) build_die("step", &err);
 }
 
+/* Steps to t_end; returns the worst |energy residual| / scale and sets
+ * *kinetic_max (when not NULL) to the largest kinetic energy seen. */
+static double run_watched(fdem_model *m, double t_end, double scale, double *kinetic_max)
+{
+    double worst = 0, kinetic = 0;
+    fdem_error err;
+    while (fdem_get_time(m) < t_end) {
+        if (fdem_step(m, &err)) build_die("step", &err);
+        fdem_energy en = fdem_get_energy(m);
+        worst = fmax(worst, fabs(en.residual) / scale);
+        kinetic = fmax(kinetic, en.kinetic);
+    }
+    if (kinetic_max) *kinetic_max = kinetic;
+    return worst;
+}
+
+/* The 2 x 1.5 (x 1) m block of the equilibrium tests under the uniform
+ * in-situ stress *value (principal along the axes). */
+static fdem_model *uniform_block(int dim, const double size[3], const double **value)
+{
+    static const double v2[3] = {-10e6, -6e6, 0}, v3[6] = {-10e6, -6e6, -8e6, 0, 0, 0};
+    const int div[3] = {8, 6, 4};
+    int pi;
+    fdem_model *m = block_model(dim, size, div, &pi);
+    *value = dim == 2 ? v2 : v3;
+    set_stress(m, pi, *value, NULL, 0);
+    return m;
+}
+
 /* Largest relative change of any element's stress against `want` (per element). */
 static double stress_change(const fdem_model *m, const double *want)
 {
@@ -251,13 +280,8 @@ static double stress_change(const fdem_model *m, const double *want)
 static void rollers_hold_a_stressed_block(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
-        const double size[3] = {2, 1.5, 1};
-        const int div[3] = {8, 6, 4};
-        int pi;
-        fdem_model *m = block_model(dim, size, div, &pi);
-        const double v2[3] = {-10e6, -6e6, 0}, v3[6] = {-10e6, -6e6, -8e6, 0, 0, 0};
-        const double *value = dim == 2 ? v2 : v3;
-        set_stress(m, pi, value, NULL, 0);
+        const double size[3] = {2, 1.5, 1}, *value;
+        fdem_model *m = uniform_block(dim, size, &value);
         int far[3];
         for (int a = 0; a < dim; a++) {
             add_roller(m, size, a, 0);
@@ -288,25 +312,16 @@ static void rollers_hold_a_stressed_block(void)
 static void pressures_hold_a_stressed_block(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
-        const double size[3] = {2, 1.5, 1};
-        const int div[3] = {8, 6, 4};
-        int pi;
-        fdem_model *m = block_model(dim, size, div, &pi);
-        const double v2[3] = {-10e6, -6e6, 0}, v3[6] = {-10e6, -6e6, -8e6, 0, 0, 0};
-        const double *value = dim == 2 ? v2 : v3;
-        set_stress(m, pi, value, NULL, 0);
+        const double size[3] = {2, 1.5, 1}, *value;
+        fdem_model *m = uniform_block(dim, size, &value);
         for (int a = 0; a < dim; a++) {
             add_pressure(m, size, a, 0, -value[a]);
             add_pressure(m, size, a, size[a], -value[a]);
         }
         build_finalize(m, 0.5);
-        double *before = element_stresses(m), worst = 0, e0 = fdem_get_energy(m).elastic;
-        double c = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / RHO), t_end = 20 * size[0] / c;
-        fdem_error err;
-        while (fdem_get_time(m) < t_end) {
-            if (fdem_step(m, &err)) build_die("step", &err);
-            worst = fmax(worst, fabs(fdem_get_energy(m).residual) / e0);
-        }
+        double *before = element_stresses(m), e0 = fdem_get_energy(m).elastic;
+        double c = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / RHO);
+        double worst = run_watched(m, 20 * size[0] / c, e0, NULL);
         fdem_energy en = fdem_get_energy(m);
         CHECK(en.kinetic < 1e-6 * en.elastic, "%dD: kinetic %g J against elastic %g J", dim,
               en.kinetic, en.elastic);
@@ -380,15 +395,8 @@ static void released_block_closes_the_balance(void)
         build_finalize(m, 0.5);
         const double e0 = m->initial_energy;
         CHECK_REL(e0, m->stress0_energy, 1e-9); /* at rest all is the in-situ stress's */
-        double worst = 0, kinetic_max = 0;
-        double c = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / RHO), t_end = 4 / c;
-        fdem_error err;
-        while (fdem_get_time(m) < t_end) {
-            if (fdem_step(m, &err)) build_die("step", &err);
-            fdem_energy en = fdem_get_energy(m);
-            worst = fmax(worst, fabs(en.residual) / e0);
-            kinetic_max = fmax(kinetic_max, en.kinetic);
-        }
+        double kinetic_max, c = sqrt(YOUNG * (1 - NU) / ((1 + NU) * (1 - 2 * NU)) / RHO);
+        double worst = run_watched(m, 4 / c, e0, &kinetic_max);
         /* the stress is released: most of its energy becomes motion */
         CHECK(kinetic_max > 0.5 * e0, "%dD: kinetic peaked at %g of %g J", dim, kinetic_max, e0);
         CHECK(worst < 1e-3, "%dD: residual %.3g of the in-situ energy", dim, worst);
