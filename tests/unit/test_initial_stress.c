@@ -29,23 +29,31 @@
 #define YOUNG 3e10
 #define NU 0.25
 
-/* A block [0, size] meshed with div cells a side (2D: triangles, 3D: tetrahedra). */
+/* A block part origin + [0, size] of material 0 meshed with div cells a
+ * side (2D: triangles, 3D: tetrahedra); returns the part. */
+static int add_block(fdem_model *m, const double origin[3], const double size[3],
+                     const int div[3])
+{
+    if (m->dim == 2)
+        return build_rectangle(m, 0, origin[0], origin[1], size[0], size[1], div[0], div[1]);
+    fdem_error err;
+    fdem_tet_mesh mesh = {0};
+    if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box", &err);
+    int p = fdem_add_part_3d(m, &mesh, 0, 0, &err);
+    fdem_tet_mesh_free(&mesh);
+    if (p < 0) build_die("box part", &err);
+    return p;
+}
+
+/* A model of one block [0, size]. */
 static fdem_model *block_model(int dim, const double size[3], const int div[3], int *part_out)
 {
     fdem_model *m = fdem_model_create();
     fdem_error err;
     if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
-    int mat = build_material(m, RHO, YOUNG, NU, 0, 0);
-    if (dim == 2) {
-        *part_out = build_rectangle(m, mat, 0, 0, size[0], size[1], div[0], div[1]);
-    } else {
-        const double origin[3] = {0, 0, 0};
-        fdem_tet_mesh mesh = {0};
-        if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box", &err);
-        *part_out = fdem_add_part_3d(m, &mesh, mat, 0, &err);
-        fdem_tet_mesh_free(&mesh);
-        if (*part_out < 0) build_die("box part", &err);
-    }
+    build_material(m, RHO, YOUNG, NU, 0, 0);
+    const double origin[3] = {0, 0, 0};
+    *part_out = add_block(m, origin, size, div);
     return m;
 }
 
@@ -434,7 +442,40 @@ static void zero_stress_steps_as_none(void)
     }
 }
 
+/* Two parts, one stressed and one not, split across the scatter plan's
+ * blocks: one thread and two give the same bits (the stressed runs are
+ * summed in block order like the rest). */
+static void threads_give_the_same_bits(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m[2];
+        for (int k = 0; k < 2; k++) {
+            const double size[3] = {1, 1, 1};
+            const int div[3] = {dim == 2 ? 40 : 10, dim == 2 ? 40 : 10, 10};
+            int pi;
+            const double beside[3] = {2, 0, 0};
+            m[k] = block_model(dim, size, div, &pi);
+            add_block(m[k], beside, size, div); /* unstressed */
+            const double value[6] = {-10e6, -6e6, -8e6, 1e6, 2e6, 3e6}, gradient[6] = {1e6};
+            set_stress(m[k], pi, value, gradient, 0.5);
+            fdem_set_threads(m[k], k + 1);
+            build_finalize(m[k], 0.5);
+        }
+        fdem_error err;
+        for (int s = 0; s < 50; s++)
+            for (int k = 0; k < 2; k++) fdem_step(m[k], &err);
+        size_t bytes = sizeof(double) * (size_t)dim * (size_t)m[0]->node_count;
+        fdem_energy e0 = fdem_get_energy(m[0]), e1 = fdem_get_energy(m[1]);
+        CHECK(memcmp(m[0]->pos, m[1]->pos, bytes) == 0, "%dD: positions differ", dim);
+        CHECK(memcmp(&e0, &e1, sizeof e0) == 0, "%dD: energies differ", dim);
+        CHECK(m[0]->elem_plan.color_count > 0, "%dD: the model fits one block", dim);
+        fdem_model_destroy(m[0]);
+        fdem_model_destroy(m[1]);
+    }
+}
+
 CHECK_MAIN(T(stress_at_rest_is_the_given_field), T(rotation_carries_the_stress),
            T(rollers_hold_a_stressed_block), T(pressures_hold_a_stressed_block),
            T(gravity_column_stays_still),
-           T(released_block_closes_the_balance), T(zero_stress_steps_as_none))
+           T(released_block_closes_the_balance), T(zero_stress_steps_as_none),
+           T(threads_give_the_same_bits))
