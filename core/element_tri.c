@@ -8,7 +8,9 @@
  * compressible neo-Hookean solid sigma = (mu/J)(B - I) + (lambda/J) ln J I,
  * B = F F^T: objective (a rigid rotation R gives B = I, so no stress) and
  * equal to plane-strain linear elasticity at small strain. Viscous damping
- * adds 2 eta D with D = sym([v][x]^-1).
+ * adds 2 eta D with D = sym([v][x]^-1); an in-situ pre-stress S0 adds
+ * F S0 F^T / J (initial_stress.c), in a second instance of the loop that
+ * only the elements of stressed parts run.
  *
  * Nodal forces come from edge tractions: the force on node a is
  * 1/2 sigma m_a, m_a the outward normal (scaled by length) of the edge
@@ -137,8 +139,8 @@ double element_log_near1(double J);
 double element_log_near1(double J) { return log_near1(J); }
 
 /* Half the stress of a deformation gradient (a b; c d) for Lame constants
- * 2 hlambda, 2 hmu; returns J (and 1/J as the law uses it in *invJ_out). *w gets the strain energy density per unit
- * initial area. Half, because nodal forces are 1/2 sigma m_a: scaling by a
+ * 2 hlambda, 2 hmu; returns J (and in *invJ_out the 1/J the law used).
+ * *w gets the strain energy density per unit initial area. Half, because nodal forces are 1/2 sigma m_a: scaling by a
  * power of two is exact, so this is bit for bit half of sigma and the 0.5
  * costs no multiplications per component. lambda ln J is shared by the
  * stress and the energy. */
