@@ -239,6 +239,66 @@ dump("sphere-pile", {
     "output": {"interval": 0.01, "fields": ["position", "velocity"]}})
 
 
+# A rock slope, 60 m wide, 30 m high behind a 45 degree face down to a 10 m
+# bench, meshed as 30 x 15 columns of 2 m (each quadrilateral split in two),
+# on a fixed base with rollers on both sides. Gravity is ramped as 1 - cos
+# over 0.6 s, eleven periods 4H/c_p of the slope's vertical mode (H = 30 m,
+# c_p = 2191 m/s): the slope settles with almost no kinetic energy, where
+# gravity switched on at once makes it ring with about its static elastic
+# energy.
+def slope_mesh(cols, rows, width, height):
+    nodes, triangles = [], []
+    for i in range(cols + 1):
+        x = width * i / cols
+        top = 30 if x <= 20 else (10 if x >= 40 else 30 - (x - 20))
+        for j in range(rows + 1):
+            nodes.append([round(x, 6), round(top * j / rows, 6)])
+    for i in range(cols):
+        for j in range(rows):
+            a, b = i * (rows + 1) + j, (i + 1) * (rows + 1) + j
+            if (i + j) % 2:
+                triangles += [[a, b, b + 1], [a, b + 1, a + 1]]
+            else:
+                triangles += [[a, b, a + 1], [a + 1, b, b + 1]]
+    return nodes, triangles
+
+
+nodes, triangles = slope_mesh(30, 15, 60, 30)
+ramp = [[round(0.6 * k / 20, 4), round(0.5 * (1 - math.cos(math.pi * k / 20)), 6)]
+        for k in range(21)]
+dump("slope-gravity-ramp", {
+    "name": "slope-gravity-ramp",
+    "materials": {"rock": {"density": 2500, "young": 1e10, "poisson": 0.25}},
+    "parts": [{"name": "slope", "material": "rock",
+               "mesh": {"nodes": nodes, "triangles": triangles}}],
+    "constraints": [{"box": [-1, -0.01, 61, 0.01], "fix": ["x", "y"]},
+                    {"box": [-0.01, -1, 0.01, 31], "fix": ["x"]},
+                    {"box": [59.99, -1, 60.01, 31], "fix": ["x"]}],
+    "gravity": [0, -9.81],
+    "gravity_amplitude": ramp,
+    "time": {"end": 0.9, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.01, "fields": ["position", "velocity", "stress"]}})
+
+
+# A plane P pulse along a 10 m bar (200 x 2 cells, every node held in y so
+# the wave is plane, c_p = 2191 m/s): a sin^2 pressure pulse of 1 MPa lasting
+# 1/c_p (1 m, 20 cells, long) enters at x = 0 and leaves through a Lysmer
+# boundary at x = 10 m. The run ends 1.5 transits after the pulse.
+c_p = math.sqrt(1e10 * 0.75 / (2500 * 1.25 * 0.5))
+tau = 1 / c_p
+pulse = [[float("%.6g" % (tau * k / 20)), round(math.sin(math.pi * k / 20) ** 2, 6)]
+         for k in range(21)]
+dump("wave-absorb", {
+    "name": "wave-absorb",
+    "materials": {"rock": {"density": 2500, "young": 1e10, "poisson": 0.25}},
+    "parts": [{"name": "bar", "material": "rock",
+               "rectangle": {"origin": [0, 0], "size": [10, 0.1], "divisions": [200, 2]}}],
+    "constraints": [{"box": [-1, -1, 11, 1], "fix": ["y"]},
+                    {"box": [-1, -1, 1e-6, 1], "pressure": 1e6, "amplitude": pulse},
+                    {"box": [9.999999, -1, 11, 1], "absorb": True}],
+    "time": {"end": float("%.4g" % (tau + 1.5 * 10 / c_p)), "dt": "auto", "safety": 0.5},
+    "output": {"interval": 1e-4, "fields": ["position", "velocity", "stress"]}})
+
 # In-situ stress (contract 5.3). A pressurised borehole: the plate of
 # borehole.geo starts under the in-situ stress sxx = -10, syy = -20 MPa
 # (compression negative), its edges carry the matching pressures and let
