@@ -3,7 +3,8 @@
  *
  * Only what stepping changes is stored (step, time, step sizes, positions,
  * velocities, joint damage, the last contact detection, the stick springs,
- * energy accumulators): the static model is rebuilt from the case document,
+ * energy accumulators, each joint's fracture account and the fracture
+ * events not drained yet): the static model is rebuilt from the case document,
  * so a checkpoint stays small and a model of another shape is detected by
  * its counts and refused. A model restored from a checkpoint steps on to the
  * same bits as the one that wrote it.
@@ -16,7 +17,7 @@
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
-#define CHECKPOINT_VERSION 3
+#define CHECKPOINT_VERSION 4
 
 /* Version 1 (fdemd 0.1): the header up to external_work, then positions,
  * velocities and damage. Read for cases stored by that version; they carry
@@ -47,10 +48,15 @@ typedef struct checkpoint_header {
     /* version 3: the friction of intact joints (0 from a version 2 file,
      * written before joints booked any) */
     double joint_friction_energy;
+    /* version 4: each joint's fracture account and the fracture events not
+     * drained yet follow the stick springs (events.c) */
+    int64_t pending_events;
 } checkpoint_header;
 
-/* The header of a version 2 file: everything before joint_friction_energy. */
+/* The header of a version 2 file: everything before joint_friction_energy;
+ * of a version 3 one, everything before pending_events. */
 #define CHECKPOINT_HEADER_V2 offsetof(checkpoint_header, joint_friction_energy)
+#define CHECKPOINT_HEADER_V3 offsetof(checkpoint_header, pending_events)
 
 static int checkpoint_has_detection(const fdem_model *m) { return m->contact.enabled; }
 
@@ -70,7 +76,8 @@ size_t fdem_checkpoint_size(const fdem_model *m)
 {
     return sizeof(checkpoint_header) +
            checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
-                                contact_history_checkpoint_size(&m->contact));
+                                contact_history_checkpoint_size(&m->contact)) +
+           events_checkpoint_size(m);
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
@@ -95,6 +102,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.dimension = m->dim;
     h.spring_records = (int64_t)(spring_bytes / contact_record_bytes(&m->contact));
     h.energy = fdem_get_energy(m);
+    h.pending_events = m->event_count;
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
     p += sizeof h;
@@ -115,6 +123,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
         p += vb;
     }
     contact_history_checkpoint_write(&m->contact, p);
+    events_checkpoint_write(m, p + spring_bytes);
     return 0;
 }
 
@@ -164,7 +173,9 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     if (h1.version == 1) {
         expected = header + checkpoint_body_size(m, 0, 0, 0);
     } else {
-        header = h1.version == 2 ? CHECKPOINT_HEADER_V2 : sizeof h;
+        header = h1.version == 2 ? CHECKPOINT_HEADER_V2
+               : h1.version == 3 ? CHECKPOINT_HEADER_V3
+                                 : sizeof h;
         if (size < header) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is truncated (%zu bytes)", size);
             return -1;
@@ -182,8 +193,15 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's contact section does not fit");
             return -1;
         }
+        if (h.pending_events < 0 || h.pending_events > m->joint_count) {
+            model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's fracture events do not fit");
+            return -1;
+        }
         expected = header + checkpoint_body_size(m, h.has_detection, h.has_viscous,
                                                  (size_t)h.spring_records * record_bytes);
+        if (h1.version >= 4)
+            expected += sizeof(double) * (size_t)m->joint_count +
+                        sizeof(fdem_event) * (size_t)h.pending_events;
     }
     if (size != expected) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,
@@ -195,6 +213,17 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     if (contact_history_checkpoint_read(&m->contact, springs, (size_t)h.spring_records,
                                         m->elem_count)) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's friction history is damaged");
+        return -1;
+    }
+    /* before version 4 no joint's account was kept: a joint damaged then
+     * reports only what it dissipates from now on when it breaks */
+    if (m->joint_count) memset(m->joint_fracture, 0, sizeof(double) * (size_t)m->joint_count);
+    m->event_count = 0;
+    if (h1.version >= 4 &&
+        events_checkpoint_read(m, springs + (size_t)h.spring_records *
+                                                contact_record_bytes(&m->contact),
+                               h.pending_events)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory restoring fracture events");
         return -1;
     }
     size_t nb = sizeof(double) * (size_t)m->dim * (size_t)m->node_count;

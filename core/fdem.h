@@ -205,7 +205,9 @@ int fdem_model_finalize(fdem_model *model, fdem_error *err);
 
 /* Largest stable step of the finalized model: the smallest of the elements'
  * dilatational-wave limit (reduced for damping) and the contact penalty
- * limit (only if some body can touch another). Multiply by a safety factor. */
+ * limit (only if some body can touch another). Multiply by a safety factor.
+ * Also set when finalize failed only at a constraint's node selection (so a
+ * caller can judge its dt in the same answer); 0 after any earlier failure. */
 double fdem_stable_dt(const fdem_model *model);
 
 /* Step size of the next step; may change between steps (central difference
@@ -314,6 +316,31 @@ int fdem_fragments(const fdem_model *model, fdem_fragment **out);
  * many it wrote (count distinct diameters). */
 int fdem_sieve_curve(const fdem_fragment *fragments, int count, double *diameter,
                      double *passing);
+
+/* Fracture events (contract 5.4): every joint that breaks is one event,
+ * kept by the model until drained. time is the end of the step it broke
+ * in (the first snapshot time that shows it broken), position its
+ * midpoint (the mean of its 2 dim nodes) at the start of that step, mode
+ * 1 tensile, 2 shear, 3 mixed (the opening's and the sliding's share of
+ * the damage at the point that broke it, docs/physics.md), energy what its
+ * damage growth dissipated from its first damage to the break: the events'
+ * energies sum to the fracture account of the broken joints. Events come
+ * in (step, joint) order whatever the thread count, and a checkpoint keeps
+ * those not drained. fdem_drain_events copies the oldest up to max into
+ * out, forgets them and returns how many; fdem_event_count says how many
+ * wait. fdem_joint_fracture_energy: each joint's fracture account so far
+ * (NULL when no joints); its sum is fdem_energy.fracture. */
+typedef struct fdem_event {
+    double time;
+    double position[3]; /* dimension components used */
+    double energy;
+    int32_t joint;
+    int8_t mode;
+} fdem_event;
+
+int fdem_event_count(const fdem_model *model);
+int fdem_drain_events(fdem_model *model, fdem_event *out, int max);
+const double *fdem_joint_fracture_energy(const fdem_model *model);
 
 /* Cauchy stress of every element into out[fdem_stress_components * elements]:
  * (sxx, syy, sxy) in 2D, (sxx, syy, szz, syz, sxz, sxy) in 3D. */

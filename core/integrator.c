@@ -151,6 +151,11 @@ int fdem_step(fdem_model *m, fdem_error *err)
     element_forces(m);
     if (m->joint_count) {
         int broke = joint_forces(m);
+        if (broke < 0) {
+            model_error(err, FDEM_ITEM_NONE, -1, "out of memory recording fracture events at "
+                        "step %lld", (long long)m->step + 1);
+            return -1;
+        }
         if (broke) {
             m->broken_joints += broke;
             m->fragments = joint_fragment_count(m);

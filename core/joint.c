@@ -147,14 +147,16 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     if (!m->joint_count) return 0;
     size_t J = (size_t)m->joint_count;
     m->joint_damage = calloc(J, sizeof(double));
+    m->joint_fracture = calloc(J, sizeof(double));
+    m->joint_broke = calloc(J, 1);
     m->joint_h = malloc(sizeof(double) * J);
     m->joint_k = malloc(sizeof(double) * J);
     m->joint_material = malloc(sizeof(int32_t) * J);
     int faces = m->dim + 1; /* an element's faces, so at most its joints */
     m->elem_joint = malloc(sizeof(int32_t) * (size_t)faces * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
-    if (!m->joint_damage || !m->joint_h || !m->elem_joint || !m->vertex_broken || !m->joint_k ||
-        !m->joint_material) {
+    if (!m->joint_damage || !m->joint_fracture || !m->joint_broke || !m->joint_h ||
+        !m->elem_joint || !m->vertex_broken || !m->joint_k || !m->joint_material) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
     }
@@ -336,6 +338,7 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
     double D = joint_points_damage(g, 2, *damage);
     double z_old = joint_softening(*damage), z = joint_softening(D);
     *damage = D;
+    if (D >= 1) e->broke = joint_points_mode(law, g, 2);
     double w = 0.5 * L; /* Gauss weight */
     fa0[0] = fa0[1] = fa1[0] = fa1[1] = 0;
     for (int i = 0; i < 2; i++) {
@@ -409,7 +412,7 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
         } else {
             /* a local, so that the loop's sums stay in registers */
             double inv_L = 1.0 / L;
-            joint_energy e = {0, 0, 0, 0};
+            joint_energy e = {0};
             const double *va0 = v + 2 * (size_t)n[0], *va1 = v + 2 * (size_t)n[1];
             const double *vb0 = v + 2 * (size_t)n[2], *vb1 = v + 2 * (size_t)n[3];
             double step0[2] = {h_last * (vb0[0] - va0[0]), h_last * (vb0[1] - va0[1])};
@@ -419,8 +422,10 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
             dissipated += e.dissipated;
             handed += e.handed;
             friction += e.friction;
+            m->joint_fracture[j] += e.dissipated;
             if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
                 m->joint_damage[j] = 1.0;
+                m->joint_broke[j] = (uint8_t)e.broke;
                 broke++;
                 continue;
             }
@@ -444,7 +449,9 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
 /* Adds the forces of every intact joint to m->force, sets the joints'
  * stored energy and adds what they dissipated to the fracture account (by
  * damage) and the friction account (by sliding against sigma_c tan(phi)).
- * Returns the number of joints that broke in this call. */
+ * Each joint that broke is one fracture event (events.c). Returns the
+ * number of joints that broke in this call, or -1 when there was no memory
+ * to record their events. */
 int joint_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
@@ -454,7 +461,9 @@ int joint_forces(fdem_model *m)
     m->fracture_energy += sums[2];
     m->joint_friction_energy += sums[4];
     m->contact_work -= sums[3]; /* what the contact of broken-shut faces now holds */
-    return (int)sums[0];
+    int broke = (int)sums[0];
+    if (broke && events_collect(m, broke)) return -1;
+    return broke;
 }
 
 /* ------------------------------------------------------------ fragments */

@@ -18,6 +18,8 @@
  *    dissipated and of the frictional work over the last step.
  *  - joint_point_elastic: the undamaged elastic test on unnormalised
  *    projections (both scaled by the same positive `scale`).
+ *  - joint_points_mode: how a joint that broke broke (tensile, shear or
+ *    mixed), from the point that broke it (docs/physics.md has the rule).
  * The law itself is described in joint.c's header.
  */
 #ifndef FDEM_JOINT_LAW_H
@@ -40,7 +42,16 @@ typedef struct joint_energy {
     double dissipated; /* by damage growth (fracture account) */
     double friction;   /* by the sigma_c tan(phi) part of the shear traction */
     double handed;     /* compression energy of a joint that broke shut */
+    int broke;         /* how the joint broke in this evaluation (JOINT_MODE_*), 0 if it holds */
 } joint_energy;
+
+/* Fracture modes of a joint that broke (contract 5.4, /events/mode). */
+enum { JOINT_MODE_TENSILE = 1, JOINT_MODE_SHEAR = 2, JOINT_MODE_MIXED = 3 };
+
+/* A break is tensile when the opening carries at least this share of
+ * D^2 = Dn^2 + Ds^2 at the point that broke it, shear when the sliding
+ * does, mixed otherwise. */
+#define JOINT_MODE_SHARE 0.9
 
 /* Munjiza's softening curve z(D), 1 at D <= 0, 0 at D >= 1. */
 double joint_softening(double D);
@@ -69,17 +80,44 @@ typedef struct joint_point {
     double D;              /* the damage its opening and sliding ask for */
 } joint_point;
 
+/* The opening and the sliding of point g beyond their elastic limits, each
+ * over its softening span: Dn and Ds, 1 at the critical opening (sliding)
+ * of a joint loaded in that mode alone. */
+static inline void joint_point_parts(const joint_law *law, const joint_point *g, double *dn,
+                                     double *ds)
+{
+    double k = law->k, ft = law->tensile_strength;
+    double dp = ft / k, sp = g->fs / k;
+    *dn = g->delta > dp ? (g->delta - dp) / softening_span(ft, dp, law->energy_I) : 0;
+    *ds = fabs(g->slide) > sp ? (fabs(g->slide) - sp) / softening_span(g->fs, sp, law->energy_II)
+                              : 0;
+}
+
 static inline void joint_point_measure(const joint_law *law, double delta, double slide,
                                        joint_point *g)
 {
-    double k = law->k, ft = law->tensile_strength;
     g->delta = delta;
     g->slide = slide;
-    g->fs = law->cohesion + (delta < 0 ? -k * delta * law->tan_phi : 0);
-    double dp = ft / k, sp = g->fs / k;
-    double dn = delta > dp ? (delta - dp) / softening_span(ft, dp, law->energy_I) : 0;
-    double ds = fabs(slide) > sp ? (fabs(slide) - sp) / softening_span(g->fs, sp, law->energy_II) : 0;
+    g->fs = law->cohesion + (delta < 0 ? -law->k * delta * law->tan_phi : 0);
+    double dn, ds;
+    joint_point_parts(law, g, &dn, &ds);
     g->D = sqrt(dn * dn + ds * ds);
+}
+
+/* The mode of a joint whose points g[0 .. count) broke it: that of the
+ * point asking for the most damage, by the share of its D^2 the opening
+ * (Dn^2) and the sliding (Ds^2) make up (JOINT_MODE_SHARE). */
+static inline int joint_points_mode(const joint_law *law, const joint_point *g, int count)
+{
+    int worst = 0;
+    for (int i = 1; i < count; i++)
+        if (g[i].D > g[worst].D) worst = i;
+    double dn, ds;
+    joint_point_parts(law, &g[worst], &dn, &ds);
+    double n2 = dn * dn, s2 = ds * ds;
+    if (n2 >= JOINT_MODE_SHARE * (n2 + s2)) return JOINT_MODE_TENSILE;
+    if (s2 >= JOINT_MODE_SHARE * (n2 + s2)) return JOINT_MODE_SHEAR;
+    return JOINT_MODE_MIXED;
 }
 
 /* The joint's damage after its points g[0 .. count) were measured: the

@@ -176,6 +176,7 @@ static void joint_tet_general(const joint_law *law, const double d[3][3],
     double D = joint_points_damage(g, 3, *damage);
     double z_old = joint_softening(*damage), z = joint_softening(D);
     *damage = D;
+    if (D >= 1) e->broke = joint_points_mode(law, g, 3);
     double w = area / 3;
     memset(fa, 0, 9 * sizeof(double));
     for (int p = 0; p < 3; p++) {
@@ -220,11 +221,12 @@ int joint_tet_forces(const joint_law *law, const double *pos, const double *vel,
     for (int i = 0; i < 3; i++)
         for (int c = 0; c < 3; c++) step[i][c] *= h_last;
     double n[3] = {N[0] / N_len, N[1] / N_len, N[2] / N_len};
-    joint_energy mine = {0, 0, 0, 0};
+    joint_energy mine = {0};
     joint_tet_general(law, d, step, n, area, damage, fa, &mine);
     e->dissipated += mine.dissipated;
     e->friction += mine.friction;
     e->handed += mine.handed;
+    e->broke = mine.broke;
     if (*damage >= 1.0) { /* broken within this call: it carries nothing from now on */
         memset(fa, 0, 9 * sizeof(double));
         return 0;

@@ -20,7 +20,8 @@
  *    is stored, and the function returns 0 (1 while it holds).
  *  - e gets the stored energy, the dissipation of damage growth, the
  *    frictional work over the last step (vel may be NULL: none) and, for a
- *    joint that broke shut, the compression energy contact takes over.
+ *    joint that broke shut, the compression energy contact takes over;
+ *    e->broke the mode of a break in this call (joint_points_mode).
  */
 #ifndef FDEM_JOINT_TET_H
 #define FDEM_JOINT_TET_H

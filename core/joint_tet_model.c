@@ -138,16 +138,24 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
 {
     double *f = m->force;
     int broke = 0;
-    joint_energy e = {0, 0, 0, 0};
+    double stored = 0, dissipated = 0, handed = 0, friction = 0;
     for (int j = begin; j < end; j++) {
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 6 * (size_t)j;
         const joint_law law = joint_law_of(&m->materials[m->joint_material[j]], m->joint_k[j]);
         double fa[9];
+        /* this joint's own, for its fracture account and its event */
+        joint_energy e = {0};
         int holds = joint_tet_forces(&law, m->pos, m->vel, m->dt_prev, n, &damage, fa, &e);
         m->joint_damage[j] = damage;
+        stored += e.stored;
+        dissipated += e.dissipated;
+        handed += e.handed;
+        friction += e.friction;
+        if (e.dissipated != 0) m->joint_fracture[j] += e.dissipated;
         if (!holds) {
+            m->joint_broke[j] = (uint8_t)e.broke;
             broke++;
             continue;
         }
@@ -158,8 +166,8 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
             }
     }
     sums[0] += broke;
-    sums[1] += e.stored;
-    sums[2] += e.dissipated;
-    sums[3] += e.handed;
-    sums[4] += e.friction;
+    sums[1] += stored;
+    sums[2] += dissipated;
+    sums[3] += handed;
+    sums[4] += friction;
 }

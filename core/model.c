@@ -71,6 +71,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_k); free(m->joint_material);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
     free(m->stress0_defs); free(m->elem_stress0);
+    free(m->joint_fracture); free(m->joint_broke); free(m->events);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     scatter_plan_free(&m->joint_plan);
@@ -547,9 +548,6 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     lump_masses(m);
     if (joint_prepare(m, err)) return -1;
     m->fragments = joint_fragment_count(m);
-    constraint_set_time(m, 0);
-    if (constraint_select(m, err)) return -1;
-    if (boundary_load_select(m, err)) return -1;
     if (contact_init(m, err)) return -1;
     if (build_scatter_plans(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
@@ -563,6 +561,11 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     }
     dt = fmin(dt, contact_stable_dt(m));
     m->stable_dt = fmin(dt, joint_stable_dt(m));
+    /* After the stable step, so a case refused for its constraints can
+     * still be told whether its dt would do (one answer, every problem). */
+    constraint_set_time(m, 0);
+    if (constraint_select(m, err)) return -1;
+    if (boundary_load_select(m, err)) return -1;
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;
@@ -675,9 +678,12 @@ size_t fdem_memory_bytes(const fdem_model *m)
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
                           : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     /* joints: 2 dim nodes and 2 elements; damage, h, k, material; elem_joint */
-    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 2 * sizeof(double));
+    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 3 * sizeof(double) + 1);
+    b += (size_t)m->event_capacity * sizeof(fdem_event);
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
+    /* boundary facets of pressures and dashpots: nodes, element, forces */
+    b += (size_t)m->bfacet_count * ((D + 1) * sizeof(int32_t) + D * D * sizeof(double));
     b += contact_memory_bytes(&m->contact);
     return b;
 }

@@ -188,8 +188,14 @@ struct fdem_model {
     int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
                                 refreshed at each contact detection */
+    double *joint_fracture;  /* per joint: what its damage growth dissipated so far (the
+                                fracture account joint by joint; its event's energy) */
+    uint8_t *joint_broke;    /* per joint: the mode of a break in this step's joint loop,
+                                0 otherwise; cleared as events_collect records it */
     int broken_joints;
     int fragments;
+    fdem_event *events;      /* fracture events not drained yet, in (step, joint) order */
+    int event_count, event_capacity;
 
     double gravity[3];       /* this step's gravity: gravity_base times its amplitude */
     double gravity_base[3];
@@ -361,6 +367,12 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
 int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 int joint_fragment_count(const fdem_model *m);
+/* events.c: the fracture events of the joints that broke in this step's
+ * joint loop (joint_broke), appended in joint order; -1 without memory */
+int events_collect(fdem_model *m, int broke);
+size_t events_checkpoint_size(const fdem_model *m);
+void events_checkpoint_write(const fdem_model *m, unsigned char *p);
+int events_checkpoint_read(fdem_model *m, const unsigned char *p, int64_t count);
 /* joint_tet_model.c: the 3D geometry of joints (6 nodes, a face each) */
 int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
                         fdem_error *err);

@@ -16,8 +16,6 @@
 
 #include "case_internal.h"
 
-#define CASE_MAX_SNAPSHOTS 1e6
-#define CASE_DEFAULT_SNAPSHOTS 100
 #define CASE_DEFAULT_SAFETY 0.5
 
 static const char *const top_keys[] = {
@@ -218,6 +216,14 @@ static int case_check_selections(case_doc *doc, const fdem_model *model)
     return ok;
 }
 
+void case_dt_problem(case_doc *doc, double stable, const char *whose)
+{
+    case_problem(doc, "/time/dt", "dt = %g s is above the stable time step of this model%s, "
+                                  "%.4g s; use at most that, or \"auto\" (%.4g s with safety "
+                                  "%g)", doc->dt, whose, stable, doc->safety * stable,
+                 doc->safety);
+}
+
 /* "auto" is safety x the stable step; a given dt must not exceed it. */
 static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
 {
@@ -227,10 +233,7 @@ static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
         return -1;
     }
     if (!doc->dt_auto && doc->dt > stable) {
-        case_problem(doc, "/time/dt", "dt = %g s is above the stable time step of this model, "
-                                      "%.4g s; use at most that, or \"auto\" (%.4g s with "
-                                      "safety %g)", doc->dt, stable, doc->safety * stable,
-                     doc->safety);
+        case_dt_problem(doc, stable, "");
         return -1;
     }
     double dt = doc->dt_auto ? doc->safety * stable : doc->dt;
@@ -250,8 +253,9 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
     fdem_error err = {0};
     int ok = fdem_set_dimension(model, doc->dimension, &err) == 0;
     if (!ok) case_engine_problem(doc, &err, "/dimension");
-    ok = ok && case_add_materials(doc, model) == 0 && case_add_parts(doc, model) == 0 &&
-         case_add_constraints(doc, model) == 0;
+    /* parts and constraints both, whatever the other finds (one answer) */
+    ok = ok && case_add_materials(doc, model) == 0;
+    ok = ok && (case_add_parts(doc, model) == 0) & (case_add_constraints(doc, model) == 0);
     if (ok) {
         fdem_set_gravity_v(model, doc->gravity);
         ok = fdem_set_gravity_amplitude(model, doc->gravity_amplitude,
@@ -259,8 +263,11 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
         if (!ok) case_engine_problem(doc, &err, "/gravity_amplitude");
         ok = ok && fdem_model_finalize(model, &err) == 0;
         if (!ok) case_engine_problem(doc, &err, "");
+        if (!ok && err.kind == FDEM_ITEM_CONSTRAINT && fdem_stable_dt(model) > 0)
+            case_choose_dt(doc, model, info);
     }
-    ok = ok && case_check_selections(doc, model) && case_choose_dt(doc, model, info) == 0;
+    /* Both checks, whatever the first finds: one answer names every problem. */
+    if (ok) ok = case_check_selections(doc, model) & (case_choose_dt(doc, model, info) == 0);
     if (!ok) {
         fdem_model_destroy(model);
         return NULL;
@@ -350,7 +357,9 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
     char **names = case_copy_names(&doc);
     json_decref(root);
     if (!names) case_problem(&doc, "", "out of memory");
-    if (out->count + out->dropped == before && gate && gate(gate_ctx, bytes) != 0) {
+    if (out->count + out->dropped != before)
+        case_probe_dt(&doc, before, memory_limit, gate, gate_ctx);
+    else if (gate && gate(gate_ctx, bytes) != 0) {
         snprintf(out->title, sizeof out->title, "Service unavailable");
         problems_add(out, 503, "", "the daemon has no memory to spare for this model now "
                                    "(--max-memory); try again later");

@@ -29,6 +29,10 @@ enum case_field {
 };
 
 #define CASE_MAX_PARTS 1024
+/* Snapshots a case may ask for, and how many an output.interval left out
+ * gives (interval = time.end / CASE_DEFAULT_SNAPSHOTS). */
+#define CASE_MAX_SNAPSHOTS 1e6
+#define CASE_DEFAULT_SNAPSHOTS 100
 
 typedef struct case_info {
     char name[128];

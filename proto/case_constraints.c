@@ -240,16 +240,20 @@ void case_read_constraints(case_doc *doc, const json_t *constraints)
         constraint_read(doc, &doc->constraints[i], i, json_array_get(constraints, (size_t)i));
 }
 
+/* Every constraint is checked even after one is refused (one answer names
+ * each); such a model is never finalized. */
 int case_add_constraints(case_doc *doc, fdem_model *model)
 {
+    int rc = 0;
     for (int i = 0; i < doc->constraint_count; i++) {
         fdem_error err = {0};
-        if (fdem_add_constraint(model, &doc->constraints[i].def, &err) != i) {
+        if (fdem_add_constraint(model, &doc->constraints[i].def, &err) < 0) {
             char ptr[CASE_POINTER];
             pointer_join_index(ptr, sizeof ptr, "/constraints", i);
+            if (err.kind == FDEM_ITEM_CONSTRAINT) err.item = i; /* not shifted by a refusal */
             case_engine_problem(doc, &err, ptr);
-            return -1;
+            rc = -1;
         }
     }
-    return 0;
+    return rc;
 }

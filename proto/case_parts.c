@@ -248,11 +248,12 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
     int index = part_add_mesh(doc, model, part, &err);
     fdem_mesh_free(&part->mesh); /* the engine keeps its own copy */
     fdem_tet_mesh_free(&part->tet_mesh);
-    if (index != i) {
+    if (index < 0) {
         case_mesh_problem(doc, i, &err, part_ptr);
         return -1;
     }
-    if (part->has_velocity && fdem_set_part_velocity_v(model, i, part->velocity, &err) < 0) {
+    /* `index` is i unless an earlier part was refused (case_add_parts) */
+    if (part->has_velocity && fdem_set_part_velocity_v(model, index, part->velocity, &err) < 0) {
         pointer_join(ptr, sizeof ptr, part_ptr, "velocity");
         case_problem(doc, ptr, "%s", err.message);
         return -1;
@@ -260,9 +261,12 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
     return case_add_initial_stress(doc, model, i);
 }
 
+/* Every part is meshed and checked even after one is refused, so that one
+ * answer names each bad mesh; such a model is never finalized. */
 int case_add_parts(case_doc *doc, fdem_model *model)
 {
+    int rc = 0;
     for (int i = 0; i < doc->part_count; i++)
-        if (part_add(doc, model, i) < 0) return -1;
-    return 0;
+        if (part_add(doc, model, i) < 0) rc = -1;
+    return rc;
 }

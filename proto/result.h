@@ -12,7 +12,11 @@
  *    marker, so a SWMR reader never sees a snapshot half written.
  *  - result_reopen() reopens a file left by a previous run (clearing the
  *    status flags a crash leaves, as `h5clear -s` does), drops snapshots
- *    whose step is after `keep_until_step` and resumes SWMR writing.
+ *    whose step is after `keep_until_step` and fracture events of joints
+ *    that are not broken in `model` (the model the run resumes from), and
+ *    resumes SWMR writing.
+ *  - /events (contract 5.4) follows the same commit discipline as
+ *    /snapshots, with /events/time as its marker (result_events.c).
  *  - Downloads while running: result_flush() on the I/O thread, then, with
  *    no append in between, any thread may copy the bytes with
  *    result_image_copy_step() (no HDF5 call; it clears the superblock's
@@ -21,8 +25,10 @@
  *    whether it is whole (a truncated or replaced file is refused).
  *  - xdmf_write() rewrites the XDMF2 sidecar atomically (temp + rename):
  *    a temporal collection with one grid per snapshot, Triangle topology
- *    and XY geometry (3D: Tetrahedron, XYZ) and attributes as HyperSlabs
- *    into the .h5 file.
+ *    and XY geometry (3D: Tetrahedron, XYZ); each snapshot's fields are
+ *    its /xdmf views once result_finish() made them (every ParaView XDMF
+ *    reader opens that), HyperSlabs into /snapshots before (the legacy
+ *    XDMF Reader only).
  *  - Both dimensions share one layout (contract 5.2); the root attribute
  *    `dimension` says which, and /mesh/triangles becomes /mesh/tetrahedra.
  */
@@ -45,10 +51,24 @@ result_file *result_create(const char *path, const fdem_model *model,
 result_file *result_create_described(const char *path, const fdem_model *model,
                                      const case_info *info, const char *document,
                                      size_t document_length, char *err, size_t errlen);
+/* Replaces the root attribute `case` of a closed result file (POST
+ * /cases/ID/extend rewrites the stored document); 0, or -1 with err. */
+int result_replace_document(const char *path, const char *text, size_t length, char *err,
+                            size_t errlen);
 result_file *result_reopen(const char *path, const fdem_model *model,
                            const case_info *info, int64_t keep_until_step,
                            char *err, size_t errlen);
 int result_append(result_file *f, const snapshot *s, char *err, size_t errlen);
+/* Appends fracture events to /events (result_events.c); the daemon appends
+ * a step's events before the snapshot after them. */
+int result_append_events(result_file *f, const fdem_event *events, int count, char *err,
+                         size_t errlen);
+/* The events with time > since of an open result file (f), or of the closed
+ * file at path (f NULL; a file written before events has none): *out
+ * (free() it) gets *count of them, *dimension the position width (0 for a
+ * file without /events). */
+int result_read_events(result_file *f, const char *path, double since, fdem_event **out,
+                       int *count, int *dimension, char *err, size_t errlen);
 int result_flush(result_file *f, char *err, size_t errlen);
 int result_check_file(const char *path, char *err, size_t errlen);
 /* Copies the next piece of bytes [done, size) of src to the same place in
@@ -61,6 +81,12 @@ int result_snapshot_count(const result_file *f);
 /* Simulated time of complete snapshot `index` (NAN when out of range). */
 double result_snapshot_time(const result_file *f, int index);
 int result_close(result_file *f);
+/* Ends SWMR writing and adds the /xdmf views (result_views.c) of every
+ * snapshot; `f` stays valid for xdmf_write() and must still be closed with
+ * result_close(). -1 with err on failure (the file keeps what it had). */
+int result_finish(result_file *f, const char *path, int dimension, char *err, size_t errlen);
+/* Snapshots that have /xdmf views; the sidecar names them directly. */
+int result_view_count(const result_file *f);
 
 /* h5_name is the .h5 file name as the .xdmf refers to it (same folder). */
 int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *model,

@@ -133,3 +133,30 @@ int result_describe(hid_t file, const char *text, size_t length, char *err, size
     json_decref(root);
     return rc;
 }
+
+int result_replace_document(const char *path, const char *text, size_t length, char *err,
+                            size_t errlen)
+{
+    h5_quiet();
+    hid_t fapl = file_access_latest(1);
+    hid_t file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : H5I_INVALID_HID;
+    if (fapl >= 0) H5Pclose(fapl);
+    if (file < 0) {
+        result_fail(err, errlen, "cannot open %s to store the new case document", path);
+        return -1;
+    }
+    int rc = -1;
+    if (!has_result_format(file))
+        snprintf(err, errlen, "%s is not an fdem result file", path);
+    else if (H5Aexists(file, "case") > 0 && H5Adelete(file, "case") < 0)
+        result_fail(err, errlen, "cannot remove the old root attribute \"case\" of %s", path);
+    else if (write_case_attribute(file, text, length) < 0)
+        result_fail(err, errlen, "cannot write the root attribute \"case\" of %s", path);
+    else
+        rc = 0;
+    if (H5Fclose(file) < 0 && rc == 0) {
+        result_fail(err, errlen, "closing %s after storing the case document failed", path);
+        rc = -1;
+    }
+    return rc;
+}

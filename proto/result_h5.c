@@ -235,7 +235,7 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
 
 /* ---------------------------------------------------------------- snapshots */
 
-static hid_t series_file_type(int kind)
+hid_t series_file_type(int kind)
 {
     return kind == SERIES_STEP       ? H5T_STD_I64LE
          : kind == SERIES_FRAGMENT   ? H5T_STD_I32LE
@@ -423,6 +423,7 @@ result_file *result_alloc(void)
     if (!f) return NULL;
     f->file = H5I_INVALID_HID;
     for (int k = 0; k < SERIES_COUNT; k++) f->ds[k].id = H5I_INVALID_HID;
+    for (int k = 0; k < EVENT_SERIES; k++) f->events[k] = H5I_INVALID_HID;
     return f;
 }
 
@@ -432,6 +433,8 @@ int result_release(result_file *f)
     int rc = 0;
     for (int k = 0; k < SERIES_COUNT; k++)
         if (f->ds[k].id >= 0 && H5Dclose(f->ds[k].id) < 0) rc = -1;
+    for (int k = 0; k < EVENT_SERIES; k++)
+        if (f->events[k] >= 0 && H5Dclose(f->events[k]) < 0) rc = -1;
     if (f->file >= 0 && H5Fclose(f->file) < 0) rc = -1;
     free(f->times);
     free(f);
@@ -497,6 +500,7 @@ result_file *result_create_described(const char *path, const fdem_model *model,
     if (result_describe(f->file, document, document_length, err, errlen) < 0) goto fail;
     series_layout(f->ds, model, info->fields);
     if (create_snapshot_series(f, err, errlen) < 0) goto fail;
+    if (events_create(f, fdem_get_dimension(model), err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;
     return f;
 fail:

@@ -45,12 +45,22 @@ typedef struct series {
     hsize_t row[2]; /* per-snapshot extent after the snapshot axis */
 } series;
 
+/* The /events datasets in append order: time, the commit marker, last
+ * (result_events.c). */
+enum event_series_kind { EVENT_JOINT, EVENT_POSITION, EVENT_MODE, EVENT_ENERGY, EVENT_TIME,
+                         EVENT_SERIES };
+extern const char *const event_series_names[EVENT_SERIES];
+
 struct result_file {
     hid_t file;
     series ds[SERIES_COUNT];
+    hid_t events[EVENT_SERIES];
+    hsize_t event_count;  /* complete events (= len(/events/time)) */
+    int event_dimension;
     int count;     /* complete snapshots (= len(/snapshots/time)) */
     double *times; /* the time of each of them, for the XDMF sidecar */
     int times_capacity;
+    int views;     /* snapshots with /xdmf views (result_views.c) */
 };
 
 /* "what: innermost HDF5 message" into err; clears the HDF5 error stack. */
@@ -65,6 +75,7 @@ int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
 hid_t series_mem_type(int kind);
+hid_t series_file_type(int kind);
 /* Which /snapshots datasets this model has, and their per-snapshot shape. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields);
 /* File access with the latest format (SWMR); optionally clearing the
@@ -76,6 +87,12 @@ int result_release(result_file *f);
  * /mesh/material_names; nothing when text is NULL (result_describe.c). */
 int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
 int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
+
+/* The /events group, empty, in a new file; in a reopened one, its events
+ * trimmed to those whose joints `model` has broken (result_events.c). Both
+ * before SWMR writing starts. */
+int events_create(result_file *f, int dimension, char *err, size_t errlen);
+int events_reopen(result_file *f, const fdem_model *model, char *err, size_t errlen);
 
 /* Creates /snapshots/<series_names[kind]> empty and extendible (result_h5.c). */
 int series_create(hid_t group, int kind, series *s);

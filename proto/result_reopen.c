@@ -7,7 +7,8 @@
  * clears the mark through the "clear_status_flags" file-access property
  * (the one `h5clear -s` sets), then trims every dataset to the committed
  * length (that of /snapshots/time, the commit marker) and to the last
- * checkpoint's step, and resumes SWMR writing (result_h5.c has the
+ * checkpoint's step, keeps the fracture events of the joints the resumed
+ * model has broken (result_events.c), and resumes SWMR writing (result_h5.c has the
  * discipline).
  */
 #include <errno.h>
@@ -201,6 +202,7 @@ result_file *result_reopen(const char *path, const fdem_model *model,
     hsize_t keep = 0;
     if (committed_snapshots(f, keep_until_step, &keep, err, errlen) < 0) goto fail;
     if (truncate_series(f, keep, err, errlen) < 0) goto fail;
+    if (events_reopen(f, model, err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;
     return f;
 fail:

@@ -9,29 +9,43 @@
  * the (S, ...) datasets, so the sidecar holds no numbers of its own and
  * stays small. One writer serves both dimensions through the xdmf_ctx.
  *
- * Choices ParaView dictates:
- *  - velocity is a Node "Vector" with 2 components; VTK's XDMF2 reader pads
- *    2-component vectors with z = 0, so glyphs work.
- *  - stress is written as Cell scalars stress_xx, stress_yy, stress_xy (3D:
- *    stress_xx, stress_yy, stress_zz, stress_yz, stress_xz, stress_xy),
- *    hyperslabs picking one component each, rather than a fake vector
- *    whose magnitude would mean nothing.
+ * Choices ParaView dictates (every XDMF reader of ParaView 5.11: the
+ * legacy XDMF Reader, Xdmf3ReaderS and Xdmf3ReaderT, without a message):
+ *  - a snapshot's fields are named through its /xdmf views (plain HDF
+ *    DataItems, result_views.c) once the file was finished; the Xdmf3
+ *    readers crash on HyperSlab DataItems, which remain only for the
+ *    snapshots of a case still running (legacy reader only).
+ *  - velocity is a Node "Vector" of 3 components (2D: z = 0 in the view).
+ *  - stress and strain are Cell "Tensor"s of 9 components, row-major
+ *    xx xy xz / yx yy yz / zx zy zz; a 2D tensor is the in-plane one (zz,
+ *    xz, yz read 0: /snapshots/stress does not hold the plane-strain zz).
+ *    Both reader families give the same 9 components ("Tensor6" would be
+ *    6 in one and 9 in the other).
+ *  - principal_stress is a Cell "Matrix" of `dimension` columns (a Matrix
+ *    keeps its width in both families; a 2D "Vector" would gain a z).
  *  - damage lives on joints, which are not cells of the element mesh: a
  *    second Temporal collection ("joints", present when the model has
- *    joints) draws each joint as its face A (columns a0, a1 of /mesh/joints
- *    as a line in 2D; a0, a1, a2 as a triangle in 3D) on the same moving
- *    nodes, with damage as its cell value. ParaView's reader turns the two
- *    collections into two blocks.
- *  - strain likewise (strain_xx ...), principal_stress as principal_stress_1
- *    (largest) ... and fragment (the fragment id of each element, an Int
- *    cell scalar in every grid).
- *  - node_part and element_part are static attributes from /mesh, handy for
- *    colouring bodies.
+ *    joints) draws each joint as its face A (/xdmf/joint_faces, columns
+ *    a0, a1 (3D: a0, a1, a2) of /mesh/joints: a line in 2D, a triangle in
+ *    3D) on the same moving nodes, with damage as its cell value.
+ *  - the energy series, the constraint forces and time are Grid (field
+ *    data) attributes of every grid: the whole series, one tuple per
+ *    snapshot (Dimensions "S 1", and "S C*dimension" for the forces, which
+ *    both families accept over the (S) and (S, C, dimension) datasets), so
+ *    ParaView's "Plot Data" draws them against time.
+ *  - fragment (the fragment id of each element, an Int cell scalar),
+ *    node_part and element_part (static, from /mesh) colour bodies.
+ *  - where the geometry still is a HyperSlab (a running case), so is the
+ *    topology (the whole of /mesh/triangles): the legacy reader caches a
+ *    grid whose topology is a plain DataItem and then logs "Cannot find
+ *    DataItem element in geometry xml, no caching possible" at every time
+ *    step whose geometry is not.
  *
  * The file is rewritten whole into path.tmp, synced, then renamed, so a
  * reader never sees a half-written sidecar.
  */
 #include "result.h"
+#include "result_internal.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -46,6 +60,8 @@ typedef struct xdmf_ctx {
     int corners;           /* nodes per element */
     int stress_components; /* 3 or 6 */
     int snapshots;
+    int views;             /* snapshots with /xdmf views */
+    long constraints;
     unsigned fields;
 } xdmf_ctx;
 
@@ -79,6 +95,21 @@ static void xdmf_mesh_item(const xdmf_ctx *x, const char *dims, const char *numb
             "        <DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
             "Format=\"HDF\">%s:/mesh/%s</DataItem>\n",
             dims, number_type, precision, x->h5, dataset);
+}
+
+/* The view of `field` of snapshot s (/xdmf/s/field, result_views.c). */
+static void xdmf_view_item(const xdmf_ctx *x, int s, const char *dims, const char *number_type,
+                           int precision, const char *field)
+{
+    fprintf(x->out,
+            "        <DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
+            "Format=\"HDF\">%s:/xdmf/%d/%s</DataItem>\n",
+            dims, number_type, precision, x->h5, s, field);
+}
+
+static int xdmf_has_view(const xdmf_ctx *x, int s)
+{
+    return s < x->views;
 }
 
 /* Row `s` of a (S, rows) /snapshots dataset of the given number type. */
@@ -124,7 +155,10 @@ static void xdmf_geometry(const xdmf_ctx *x, int s)
 {
     char dims[64];
     fprintf(x->out, "      <Geometry GeometryType=\"%s\">\n", x->dimension == 3 ? "XYZ" : "XY");
-    if (x->fields & CASE_FIELD_POSITION) {
+    if ((x->fields & CASE_FIELD_POSITION) && xdmf_has_view(x, s)) {
+        snprintf(dims, sizeof dims, "%ld %d", x->nodes, x->dimension);
+        xdmf_view_item(x, s, dims, "Float", 8, "position");
+    } else if (x->fields & CASE_FIELD_POSITION) {
         xdmf_row_item(x, s, x->nodes, x->dimension, -1, "position");
     } else {
         snprintf(dims, sizeof dims, "%ld %d", x->nodes, x->dimension);
@@ -134,11 +168,13 @@ static void xdmf_geometry(const xdmf_ctx *x, int s)
 }
 
 /* Face A of each joint: a line (a0, a1) in 2D, a triangle (a0, a1, a2) in
- * 3D, picked out of the (J, 2 * dimension) /mesh/joints. */
+ * 3D: /xdmf/joint_faces once the views exist, else picked out of the
+ * (J, 2 * dimension) /mesh/joints by a HyperSlab. */
 static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
 {
     long J = x->joints;
     int face = x->dimension, width = 2 * x->dimension;
+    char dims[64];
     fprintf(x->out, "    <Grid Name=\"joints %d\" GridType=\"Uniform\">\n", s);
     fprintf(x->out, "      <Time Value=\"%.17g\"/>\n", time);
     if (face == 2)
@@ -147,17 +183,25 @@ static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
     else
         fprintf(x->out, "      <Topology TopologyType=\"Triangle\" NumberOfElements=\"%ld\">\n",
                 J);
-    fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%ld %d\" "
-            "Type=\"HyperSlab\">\n", J, face);
-    fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" Format=\"XML\">"
-            "0 0  1 1  %ld %d</DataItem>\n", J, face);
-    fprintf(x->out, "          <DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" Precision=\"4\" "
-            "Format=\"HDF\">%s:/mesh/joints</DataItem>\n", J, width, x->h5);
-    fprintf(x->out, "        </DataItem>\n");
+    snprintf(dims, sizeof dims, "%ld %d", J, face);
+    if (xdmf_has_view(x, s)) {
+        fprintf(x->out, "        <DataItem Dimensions=\"%s\" NumberType=\"Int\" Precision=\"4\" "
+                "Format=\"HDF\">%s:/xdmf/joint_faces</DataItem>\n", dims, x->h5);
+    } else {
+        fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%s\" "
+                "Type=\"HyperSlab\">\n", dims);
+        fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" "
+                "Format=\"XML\">0 0  1 1  %ld %d</DataItem>\n", J, face);
+        fprintf(x->out, "          <DataItem Dimensions=\"%ld %d\" NumberType=\"Int\" "
+                "Precision=\"4\" Format=\"HDF\">%s:/mesh/joints</DataItem>\n", J, width, x->h5);
+        fprintf(x->out, "        </DataItem>\n");
+    }
     fprintf(x->out, "      </Topology>\n");
     xdmf_geometry(x, s);
     fprintf(x->out, "      <Attribute Name=\"damage\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
-    xdmf_scalar_row_item(x, s, J, "Float", 8, "damage");
+    snprintf(dims, sizeof dims, "%ld", J);
+    if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, "damage");
+    else xdmf_scalar_row_item(x, s, J, "Float", 8, "damage");
     fprintf(x->out, "      </Attribute>\n");
     fprintf(x->out, "    </Grid>\n");
 }
@@ -180,6 +224,44 @@ static void xdmf_cell_components(const xdmf_ctx *x, int s, const char *dataset, 
     }
 }
 
+/* An element field: its view (a Tensor of 9 or a Matrix of `width`
+ * columns) or, before the views exist, one HyperSlab scalar per column. */
+static void xdmf_cell_field(const xdmf_ctx *x, int s, const char *dataset, int width)
+{
+    if (!xdmf_has_view(x, s)) {
+        xdmf_cell_components(x, s, dataset, width);
+        return;
+    }
+    int tensor = width == x->stress_components;
+    char dims[64];
+    snprintf(dims, sizeof dims, "%ld %d", x->elements, tensor ? 9 : width);
+    fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Cell\">\n",
+            dataset, tensor ? "Tensor" : "Matrix");
+    xdmf_view_item(x, s, dims, "Float", 8, dataset);
+    fprintf(x->out, "      </Attribute>\n");
+}
+
+/* The whole series of the energies, time and constraint forces, one tuple
+ * per snapshot, as field data of the grid. */
+static void xdmf_series_attributes(const xdmf_ctx *x)
+{
+    for (int kind = SERIES_KINETIC; kind <= SERIES_TIME; kind++) {
+        fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
+                "Center=\"Grid\">\n", series_names[kind]);
+        fprintf(x->out, "        <DataItem Dimensions=\"%d 1\" NumberType=\"Float\" "
+                "Precision=\"8\" Format=\"HDF\">%s:/snapshots/%s</DataItem>\n", x->snapshots,
+                x->h5, series_names[kind]);
+        fprintf(x->out, "      </Attribute>\n");
+    }
+    if (x->constraints <= 0) return;
+    fprintf(x->out, "      <Attribute Name=\"constraint_force\" AttributeType=\"Matrix\" "
+            "Center=\"Grid\">\n");
+    fprintf(x->out, "        <DataItem Dimensions=\"%d %ld\" NumberType=\"Float\" "
+            "Precision=\"8\" Format=\"HDF\">%s:/snapshots/constraint_force</DataItem>\n",
+            x->snapshots, x->constraints * x->dimension, x->h5);
+    fprintf(x->out, "      </Attribute>\n");
+}
+
 static void xdmf_grid(const xdmf_ctx *x, int s, double time)
 {
     char dims[64];
@@ -190,7 +272,18 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     fprintf(x->out, "      <Topology TopologyType=\"%s\" NumberOfElements=\"%ld\">\n",
             solid ? "Tetrahedron" : "Triangle", x->elements);
     snprintf(dims, sizeof dims, "%ld %d", x->elements, x->corners);
-    xdmf_mesh_item(x, dims, "Int", 4, solid ? "tetrahedra" : "triangles");
+    const char *cells = solid ? "tetrahedra" : "triangles";
+    if ((x->fields & CASE_FIELD_POSITION) && !xdmf_has_view(x, s)) {
+        /* the whole of it, as a HyperSlab like the geometry (see the top) */
+        fprintf(x->out, "        <DataItem ItemType=\"HyperSlab\" Dimensions=\"%s\" "
+                "Type=\"HyperSlab\">\n", dims);
+        fprintf(x->out, "          <DataItem Dimensions=\"3 2\" NumberType=\"Int\" "
+                "Format=\"XML\">0 0  1 1  %s</DataItem>\n", dims);
+        fprintf(x->out, "  ");
+    }
+    xdmf_mesh_item(x, dims, "Int", 4, cells);
+    if ((x->fields & CASE_FIELD_POSITION) && !xdmf_has_view(x, s))
+        fprintf(x->out, "        </DataItem>\n");
     fprintf(x->out, "      </Topology>\n");
 
     xdmf_geometry(x, s);
@@ -198,19 +291,24 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     if (x->fields & CASE_FIELD_VELOCITY) {
         fprintf(x->out, "      <Attribute Name=\"velocity\" AttributeType=\"Vector\" "
                 "Center=\"Node\">\n");
-        xdmf_row_item(x, s, x->nodes, x->dimension, -1, "velocity");
+        snprintf(dims, sizeof dims, "%ld 3", x->nodes);
+        if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, "velocity");
+        else xdmf_row_item(x, s, x->nodes, x->dimension, -1, "velocity");
         fprintf(x->out, "      </Attribute>\n");
     }
     if (x->fields & CASE_FIELD_STRESS)
-        xdmf_cell_components(x, s, "stress", x->stress_components);
+        xdmf_cell_field(x, s, "stress", x->stress_components);
     if (x->fields & CASE_FIELD_STRAIN)
-        xdmf_cell_components(x, s, "strain", x->stress_components);
+        xdmf_cell_field(x, s, "strain", x->stress_components);
     if (x->fields & CASE_FIELD_PRINCIPAL_STRESS)
-        xdmf_cell_components(x, s, "principal_stress", x->dimension);
+        xdmf_cell_field(x, s, "principal_stress", x->dimension);
     fprintf(x->out, "      <Attribute Name=\"fragment\" AttributeType=\"Scalar\" "
             "Center=\"Cell\">\n");
-    xdmf_scalar_row_item(x, s, x->elements, "Int", 4, "fragment");
+    snprintf(dims, sizeof dims, "%ld", x->elements);
+    if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Int", 4, "fragment");
+    else xdmf_scalar_row_item(x, s, x->elements, "Int", 4, "fragment");
     fprintf(x->out, "      </Attribute>\n");
+    xdmf_series_attributes(x);
     fprintf(x->out, "      <Attribute Name=\"node_part\" AttributeType=\"Scalar\" "
             "Center=\"Node\">\n");
     snprintf(dims, sizeof dims, "%ld", x->nodes);
@@ -256,7 +354,8 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
                   .dimension = fdem_get_dimension(model),
                   .corners = fdem_nodes_per_element(model),
                   .stress_components = fdem_stress_components(model),
-                  .snapshots = result_snapshot_count(f), .fields = info->fields};
+                  .snapshots = result_snapshot_count(f), .views = result_view_count(f),
+                  .constraints = counts.constraints, .fields = info->fields};
     xml_escape(x.h5, sizeof x.h5, h5_name);
     char name[512];
     xml_escape(name, sizeof name, info->name[0] ? info->name : "fdem");

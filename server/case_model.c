@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "io_thread.h"
 #include "persist.h"
@@ -101,11 +102,20 @@ static case_model_rc case_model_parse(server_case *c, membudget_lease *lease, fd
     return rc;
 }
 
-static case_model_rc case_model_restore(server_case *c, fdem_model *model, char *err, size_t errlen)
+/* Restores checkpoint.bin, or when `resume` and an extended case has one,
+ * CASE_RESUME_CHECKPOINT (case_model.h). */
+static case_model_rc case_model_restore(server_case *c, fdem_model *model, int resume, char *err,
+                                        size_t errlen)
 {
     char path[1200], *ckpt = NULL;
     size_t size = 0;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", c->dir);
+    const char *name = CASE_CHECKPOINT;
+    c->resume_rows_until = -1;
+    snprintf(path, sizeof path, "%s/%s", c->dir, CASE_RESUME_CHECKPOINT);
+    int resuming = resume && access(path, F_OK) == 0;
+    if (resuming)
+        name = CASE_RESUME_CHECKPOINT;
+    snprintf(path, sizeof path, "%s/%s", c->dir, name);
     if (persist_read_file(path, &ckpt, &size, CASE_MODEL_MAX_CHECKPOINT) != 0) {
         pthread_mutex_lock(&c->lock);
         int started = c->fig.step != 0;
@@ -122,10 +132,20 @@ static case_model_rc case_model_restore(server_case *c, fdem_model *model, char 
     if (failed && case_model_out_of_memory(e.message))
         return CASE_MODEL_NO_MEMORY;
     if (failed) {
-        snprintf(err, errlen, "checkpoint.bin could not be restored: %s", e.message);
+        snprintf(err, errlen, "%s could not be restored: %s", name, e.message);
         return CASE_MODEL_BROKEN;
     }
+    if (resuming)
+        c->resume_rows_until = fdem_get_step(model) + 1; /* the old end's row */
     return CASE_MODEL_OK;
+}
+
+void case_model_forget_resume(server_case *c)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", c->dir, CASE_RESUME_CHECKPOINT);
+    if (unlink(path) == 0)
+        persist_fsync_dir(c->dir);
 }
 
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
@@ -150,14 +170,15 @@ fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lea
     return model;
 }
 
-case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_model **model,
-                               case_info *info, char *err, size_t errlen)
+static case_model_rc case_model_build_from(server_case *c, membudget_lease *lease,
+                                           fdem_model **model, case_info *info, int resume,
+                                           char *err, size_t errlen)
 {
     size_t held = lease->bytes;
     *model = NULL;
     case_model_rc rc = case_model_parse(c, lease, model, info, err, errlen);
     if (rc == CASE_MODEL_OK)
-        rc = case_model_restore(c, *model, err, errlen);
+        rc = case_model_restore(c, *model, resume, err, errlen);
     if (rc != CASE_MODEL_OK) {
         if (*model)
             fdem_model_destroy(*model);
@@ -172,6 +193,12 @@ case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_mode
     return CASE_MODEL_OK;
 }
 
+case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_model **model,
+                               case_info *info, char *err, size_t errlen)
+{
+    return case_model_build_from(c, lease, model, info, 1, err, errlen);
+}
+
 int case_model_attach(server_case *c, fdem_model *model, const case_info *info, int close_after,
                       char *err, size_t errlen)
 {
@@ -181,7 +208,8 @@ int case_model_attach(server_case *c, fdem_model *model, const case_info *info, 
     pthread_mutex_unlock(&c->model_lock);
     int64_t step = fdem_get_step(model);
     c->last_snapshot_step = c->last_checkpoint_step = step;
-    if (io_reopen(c, step, close_after, err, errlen) == 0)
+    int64_t keep = c->resume_rows_until > step ? c->resume_rows_until : step;
+    if (io_reopen(c, keep, close_after, err, errlen) == 0)
         return 0;
     fprintf(stderr, "fdemd: case %s: result.h5 could not be reopened (%s); starting a new one "
             "from the checkpoint\n", c->id, err);
@@ -214,7 +242,9 @@ snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *statu
     fdem_model *model = NULL;
     case_info info;
     char err[512] = "";
-    case_model_rc rc = case_model_build(c, &lease, &model, &info, err, sizeof err);
+    /* The state the case shows is its checkpoint.bin, also when an extend
+     * will resume it from the step before its old end. */
+    case_model_rc rc = case_model_build_from(c, &lease, &model, &info, 0, err, sizeof err);
     snapshot *s = NULL;
     if (rc == CASE_MODEL_OK) {
         s = snapshot_take(model, fields);

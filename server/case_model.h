@@ -12,6 +12,14 @@
  *    result file at the model's step (snapshots a crash left after the
  *    checkpoint are dropped); case_model_drop() closes the result file,
  *    frees the model and releases c->reserve.
+ *  - Extend (case_stages.c): the worker keeps, besides checkpoint.bin,
+ *    the state one step before the step it cut to land on time.end
+ *    (CASE_END_CHECKPOINT). Extending a finished case renames it to
+ *    CASE_RESUME_CHECKPOINT, and case_model_build() then resumes from it
+ *    (c->resume_rows_until: the end's row and those before it are kept),
+ *    so the run goes on on the step grid of an uninterrupted run; the
+ *    first checkpoint.bin written after it makes it go
+ *    (case_model_forget_resume).
  *  - case_model_state_from_disk() answers GET /state of a case that is not
  *    running from a temporary rebuild under the budget: the state of its
  *    last checkpoint, which for a paused, finished or stopped case is the
@@ -22,6 +30,10 @@
 
 #include "memory_budget.h"
 #include "registry.h"
+
+#define CASE_CHECKPOINT "checkpoint.bin"
+#define CASE_END_CHECKPOINT "checkpoint-end.bin"
+#define CASE_RESUME_CHECKPOINT "checkpoint-resume.bin"
 
 /* The largest case.json read back (the upload limit is far below it). */
 #define CASE_MODEL_MAX_DOCUMENT ((size_t)1 << 34)
@@ -58,6 +70,8 @@ case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_mode
 int case_model_attach(server_case *c, fdem_model *model, const case_info *info, int close_after,
                       char *err, size_t errlen);
 void case_model_drop(server_case *c);
+/* Removes CASE_RESUME_CHECKPOINT (a newer checkpoint.bin is durable). */
+void case_model_forget_resume(server_case *c);
 
 /* NULL with *status 503 (no memory now) or 409 (cannot be rebuilt). */
 snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *status);

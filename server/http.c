@@ -224,7 +224,7 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
     if (!cl) {
         if (routes_takes_body(r->route.kind, method)) {
             *rc = http_reply_problem(conn, 411, "Length required",
-                                     "POST /cases needs a Content-Length header", NULL);
+                                     "a POST with a body needs a Content-Length header", NULL);
             return 1;
         }
         return 0;

@@ -24,15 +24,19 @@
 #include "persist.h"
 
 typedef enum io_job_kind {
-    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_QUIT,
+    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_QUIT,
 } io_job_kind;
 
 typedef struct io_job {
     io_job_kind kind;
     server_case *c;
     snapshot *snap;
+    fdem_event *events;     /* IO_APPEND: written first; IO_EVENTS: the answer */
+    int event_count, dimension;
+    double since;           /* IO_EVENTS */
     void *ckpt;
     size_t ckpt_size;
+    const char *ckpt_name;     /* IO_APPEND: NULL = checkpoint.bin */
     int64_t keep_until_step;
     int close_after;
     /* completion, for jobs someone waits on */
@@ -85,13 +89,19 @@ static void io_write_xdmf(server_case *c, int force)
 }
 
 /* After a failed write no checkpoint may follow: a restart from it would
- * resume past the snapshot that was lost. */
-static void io_write_checkpoint(server_case *c, const void *ckpt, size_t size)
+ * resume past the snapshot that was lost. A new checkpoint.bin is later
+ * than the step an extended case resumes from, so the resume file goes
+ * (case_model.h). */
+static void io_write_checkpoint(server_case *c, const char *name, const void *ckpt, size_t size)
 {
     if (c->deleted || atomic_load(&c->io_failed))
         return;
-    if (persist_write_atomic(c->dir, "checkpoint.bin", ckpt, size) != 0)
-        case_record_io_failure(c, "checkpoint.bin", strerror(errno));
+    if (persist_write_atomic(c->dir, name, ckpt, size) != 0) {
+        case_record_io_failure(c, name, strerror(errno));
+        return;
+    }
+    if (strcmp(name, CASE_CHECKPOINT) == 0)
+        case_model_forget_resume(c);
 }
 
 /* Closes result.h5 after a failed write, so that what was committed stays
@@ -158,10 +168,26 @@ static void io_do_reopen(io_job *j)
     }
 }
 
+/* The snapshot an extended case writes at the step after its old end
+ * can lie at or (by a rounding) before that end's own row, and a restart
+ * can replay steps whose rows were kept: /snapshots/time only ever grows. */
+static int io_snapshot_is_new(const server_case *c, const snapshot *s)
+{
+    int count = result_snapshot_count(c->result);
+    return count == 0 || s->time > result_snapshot_time(c->result, count - 1);
+}
+
 static void io_do_append(io_job *j)
 {
     server_case *c = j->c;
-    if (j->snap && c->result && !c->deleted) {
+    if (j->event_count && c->result && !c->deleted) {
+        char err[256] = "";
+        if (result_append_events(c->result, j->events, j->event_count, err, sizeof err) != 0) {
+            case_record_io_failure(c, "result.h5", err);
+            io_close_after_failure(c);
+        }
+    }
+    if (j->snap && c->result && !c->deleted && io_snapshot_is_new(c, j->snap)) {
         char err[256] = "";
         if (result_append(c->result, j->snap, err, sizeof err) != 0) {
             case_record_io_failure(c, "result.h5", err);
@@ -172,7 +198,8 @@ static void io_do_append(io_job *j)
         }
     }
     if (j->ckpt && !atomic_load(&c->io_failed)) {
-        io_write_checkpoint(c, j->ckpt, j->ckpt_size);
+        io_write_checkpoint(c, j->ckpt_name ? j->ckpt_name : CASE_CHECKPOINT, j->ckpt,
+                            j->ckpt_size);
         if (!atomic_load(&c->io_failed))
             case_persist_status(c);
     }
@@ -182,13 +209,33 @@ static void io_do_append(io_job *j)
     pthread_mutex_unlock(&c->lock);
 }
 
+/* The document travels in j->ckpt (a text buffer). */
+static void io_do_describe(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    if (c->result) {
+        snprintf(j->err, sizeof j->err, "result.h5 is open for writing");
+        j->rc = -1;
+        return;
+    }
+    j->rc = result_replace_document(path, j->ckpt, j->ckpt_size, j->err, sizeof j->err);
+}
+
 static void io_do_close(io_job *j)
 {
     server_case *c = j->c;
     if (!c->result)
         return;
-    if (c->xdmf_dirty && !c->deleted)
+    if (!c->deleted && c->model) {
+        /* the views let every ParaView XDMF reader open the sidecar */
+        char path[1200], err[256] = "";
+        snprintf(path, sizeof path, "%s/result.h5", c->dir);
+        if (result_finish(c->result, path, fdem_get_dimension(c->model), err, sizeof err) != 0)
+            case_record_io_failure(c, "result.h5", err);
         io_write_xdmf(c, 1);
+    }
     if (result_close(c->result) != 0 && !c->deleted)
         case_record_io_failure(c, "result.h5", "its final flush failed (disk full or I/O error)");
     c->result = NULL;
@@ -237,6 +284,21 @@ static void io_do_fetch(io_job *j)
     j->rc = 0;
 }
 
+/* The events of the open file, or of the one on disk; none before it exists. */
+static void io_do_events(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+        j->rc = 0;
+        return;
+    }
+    j->rc = result_read_events(c->result, path, j->since, &j->events, &j->event_count,
+                               &j->dimension, j->err, sizeof j->err);
+}
+
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
  * checkpoint.bin and status.json, fsynced), a moving average over the
  * recent snapshot jobs: what a dry run charges per snapshot. */
@@ -282,6 +344,8 @@ static void io_run_job(io_job *j)
     case IO_APPEND: io_do_append(j); break;
     case IO_CLOSE: io_do_close(j); break;
     case IO_FETCH: io_do_fetch(j); break;
+    case IO_DESCRIBE: io_do_describe(j); break;
+    case IO_EVENTS: io_do_events(j); break;
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
@@ -292,6 +356,7 @@ static void io_job_free(io_job *j)
 {
     if (j->snap)
         snapshot_free(j->snap);
+    free(j->events);
     free(j->ckpt);
     if (j->c)
         case_release(j->c);
@@ -469,21 +534,60 @@ int io_reopen(server_case *c, int64_t keep_until_step, int close_after, char *er
     return rc;
 }
 
-void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size)
+static void io_queue_append(server_case *c, fdem_event *events, int event_count, snapshot *s,
+                            void *ckpt, size_t ckpt_size, const char *ckpt_name)
 {
     io_job *j = io_job_new(IO_APPEND, c);
     if (!j) {
+        free(events);
         snapshot_free(s);
         free(ckpt);
         return;
     }
+    j->events = events;
+    j->event_count = event_count;
     pthread_mutex_lock(&c->lock);
     c->io_pending++;
     pthread_mutex_unlock(&c->lock);
     j->snap = s;
     j->ckpt = ckpt;
     j->ckpt_size = ckpt_size;
+    j->ckpt_name = ckpt_name;
     io_enqueue(j);
+}
+
+void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s, void *ckpt,
+               size_t ckpt_size)
+{
+    io_queue_append(c, events, event_count, s, ckpt, ckpt_size, NULL);
+}
+
+void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,
+                               int event_count, void *ckpt, size_t ckpt_size)
+{
+    io_queue_append(c, events, event_count, NULL, ckpt, ckpt_size, name);
+}
+
+int io_replace_document(server_case *c, const char *text, size_t length, char *err,
+                        size_t errlen)
+{
+    io_job *j = io_job_new(IO_DESCRIBE, c);
+    char *copy = j ? malloc(length + 1) : NULL;
+    if (!copy) {
+        if (j)
+            io_job_free(j);
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    memcpy(copy, text, length);
+    copy[length] = '\0';
+    j->ckpt = copy;
+    j->ckpt_size = length;
+    int rc = io_run_and_wait(j);
+    if (rc != 0)
+        snprintf(err, errlen, "%s", j->err);
+    io_job_free(j);
+    return rc;
 }
 
 void io_close(server_case *c)
@@ -493,6 +597,30 @@ void io_close(server_case *c)
         return;
     io_run_and_wait(j);
     io_job_free(j);
+}
+
+int io_read_events(server_case *c, double since, fdem_event **out, int *count, int *dimension,
+                   char *err, size_t errlen)
+{
+    *out = NULL;
+    *count = 0;
+    io_job *j = io_job_new(IO_EVENTS, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    j->since = since;
+    int rc = io_run_and_wait(j);
+    if (rc == 0) {
+        *out = j->events;
+        *count = j->event_count;
+        *dimension = j->dimension;
+        j->events = NULL;
+    } else {
+        snprintf(err, errlen, "%s", j->err);
+    }
+    io_job_free(j);
+    return rc;
 }
 
 int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,

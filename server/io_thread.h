@@ -30,8 +30,25 @@ int io_create(server_case *c, snapshot *first, void *ckpt, size_t ckpt_size,
 /* result_reopen keeping steps <= keep_until_step, then xdmf. */
 int io_reopen(server_case *c, int64_t keep_until_step, int close_after,
               char *err, size_t errlen);
-/* Appends `s` (may be NULL) then writes `ckpt` (may be NULL) as checkpoint.bin. */
-void io_append(server_case *c, snapshot *s, void *ckpt, size_t ckpt_size);
+/* Appends the fracture events (may be NULL; malloc'd, taken over), then `s`
+ * (may be NULL), then writes `ckpt` (may be NULL) as checkpoint.bin: the
+ * events of the steps up to a snapshot are in result.h5 before it. */
+void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s, void *ckpt,
+               size_t ckpt_size);
+/* The case's fracture events with time > since from result.h5 (the open
+ * file of a running case, else the file on disk; none when there is no
+ * file yet): *out (free() it), *count, *dimension. -1 with the reason in
+ * err when the file cannot be read. */
+int io_read_events(server_case *c, double since, fdem_event **out, int *count, int *dimension,
+                   char *err, size_t errlen);
+/* Writes the events (as io_append), then `ckpt` as DIR/ID/<name> (a string
+ * literal), after the jobs queued before it; takes ownership, returns at once. */
+void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,
+                               int event_count, void *ckpt, size_t ckpt_size);
+/* Replaces the root attribute `case` of the closed result.h5 with `text`
+ * (extend); waits. 0, or -1 with err. */
+int io_replace_document(server_case *c, const char *text, size_t length, char *err,
+                        size_t errlen);
 void io_close(server_case *c);
 /* An open descriptor of result.h5 and its size. A finished file is checked
  * and served as it is (*held = 0). A file still being written was flushed

@@ -125,6 +125,7 @@ server_case *case_new(void)
     pthread_mutex_init(&c->persist_lock, NULL);
     c->last_snapshot_step = -1;
     c->last_checkpoint_step = -1;
+    c->resume_rows_until = -1;
     return c;
 }
 

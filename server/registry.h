@@ -107,6 +107,8 @@ typedef struct server_case {
                                   kept as found (so that, mended, the case comes back) */
 
     /* worker-private */
+    int64_t resume_rows_until; /* >= 0: resumed from the step before an extended case's
+                                  old end, whose row (this step) is kept (case_model.h) */
     double next_output;
     int64_t last_snapshot_step, last_checkpoint_step;
 } server_case;

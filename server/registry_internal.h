@@ -1,6 +1,6 @@
 /*
- * registry_internal.h - what registry.c, case_status.c and registry_load.c
- * share, and nothing else includes: building a case record, its state
+ * registry_internal.h - what registry.c, case_status.c, registry_load.c and
+ * case_stages.c share, and nothing else includes: building a case record, its state
  * names, the status object's durable write, and loading a stored case.
  */
 #ifndef FDEMD_REGISTRY_INTERNAL_H

@@ -136,7 +136,8 @@ static int case_check_stored(server_case *c)
             broken = 1;
         }
         case_finish_if_at_end(c);
-        case_publish_from_model(c);
+        if (c->resume_rows_until < 0) /* resumed before an old end: the status shows that end */
+            case_publish_from_model(c);
         case_model_drop(c);
     } else {
         fprintf(stderr, "fdemd: case %s: not checked at start-up (--max-memory is short); it "

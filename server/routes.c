@@ -9,12 +9,16 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "case_stages.h"
 #include "download.h"
+#include "events_json.h"
 #include "http.h"
 #include "io_thread.h"
 #include "memory_budget.h"
@@ -53,7 +57,8 @@ void routes_match(const char *url, route_match *out)
         {"start", ROUTE_CASE_START}, {"pause", ROUTE_CASE_PAUSE}, {"stop", ROUTE_CASE_STOP},
         {"case", ROUTE_CASE_DOCUMENT}, {"state", ROUTE_CASE_STATE},
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
-        {"fragments", ROUTE_CASE_FRAGMENTS},
+        {"fragments", ROUTE_CASE_FRAGMENTS}, {"extend", ROUTE_CASE_EXTEND},
+        {"clone", ROUTE_CASE_CLONE}, {"events", ROUTE_CASE_EVENTS},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
@@ -85,7 +90,8 @@ const char *routes_allowed(route_kind kind)
     switch (kind) {
     case ROUTE_CASES: return "GET, HEAD, POST";
     case ROUTE_CASE: return "GET, HEAD, DELETE";
-    case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP: return "POST";
+    case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
+    case ROUTE_CASE_EXTEND: case ROUTE_CASE_CLONE: return "POST";
     default: return "GET, HEAD";
     }
 }
@@ -102,7 +108,8 @@ int routes_method_allowed(route_kind kind, const char *method)
 
 int routes_takes_body(route_kind kind, const char *method)
 {
-    return kind == ROUTE_CASES && strcmp(method, "POST") == 0;
+    return (kind == ROUTE_CASES || kind == ROUTE_CASE_EXTEND || kind == ROUTE_CASE_CLONE) &&
+           strcmp(method, "POST") == 0;
 }
 
 /* ---------------------------------------------------------------- helpers */
@@ -153,10 +160,13 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const create[] = {"start", "dry_run", NULL};
     static const char *const list[] = {"state", NULL};
     static const char *const state[] = {"fields", NULL};
+    static const char *const events[] = {"since", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
-    return kind == ROUTE_CASE_STATE ? state : none;
+    if (kind == ROUTE_CASE_CLONE)
+        return create; /* a clone is made exactly as POST /cases makes a case */
+    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events : none;
 }
 
 typedef struct routes_query_check {
@@ -239,6 +249,23 @@ static enum MHD_Result route_list_cases(struct MHD_Connection *conn)
     return http_reply_json(conn, 200, json_pack("{s:o}", "cases", arr), NULL);
 }
 
+/* 400 (malformed JSON) or 422 (the problems of `what`) with the list. */
+static enum MHD_Result routes_reply_problems(struct MHD_Connection *conn, int status,
+                                             const problems *p, const char *what)
+{
+    char detail[640];
+    if (status == 400)
+        snprintf(detail, sizeof detail, "%s", p->count ? p->items[0].message : "the body is not valid JSON");
+    else if (p->dropped)
+        snprintf(detail, sizeof detail, "%d problems in the %s; the first %d are listed",
+                 p->count + p->dropped, what, p->count);
+    else
+        snprintf(detail, sizeof detail, "%d problem%s in the %s", p->count,
+                 p->count == 1 ? "" : "s", what);
+    const char *title = p->title[0] ? p->title : status == 400 ? "Malformed JSON" : "Invalid case";
+    return http_reply_problem(conn, (unsigned)status, title, detail, p);
+}
+
 static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char *body, size_t size)
 {
     int start = routes_flag(conn, "start");
@@ -274,17 +301,7 @@ static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char
     } else if (status == 503) {
         rc = http_reply_unavailable(conn, p.count ? p.items[0].message : "short of memory", &p);
     } else if (status == 400 || status == 422) {
-        char detail[640];
-        if (status == 400)
-            snprintf(detail, sizeof detail, "%s", p.count ? p.items[0].message : "the body is not valid JSON");
-        else if (p.dropped)
-            snprintf(detail, sizeof detail, "%d problems in the case; the first %d are listed",
-                     p.count + p.dropped, p.count);
-        else
-            snprintf(detail, sizeof detail, "%d problem%s in the case", p.count,
-                     p.count == 1 ? "" : "s");
-        const char *title = p.title[0] ? p.title : status == 400 ? "Malformed JSON" : "Invalid case";
-        rc = http_reply_problem(conn, (unsigned)status, title, detail, &p);
+        rc = routes_reply_problems(conn, status, &p, "case");
     } else {
         fprintf(stderr, "fdemd: storing a new case failed: %s\n", err);
         rc = http_reply_problem(conn, 500, "Internal error", err, NULL);
@@ -362,6 +379,55 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
     return route_snapshot_json(conn, c, fields, state_to_json);
 }
 
+/* GET /cases/ID/events?since=T (contract 5.4): the events in result.h5
+ * with time > T (all without ?since), so a client that passes the last
+ * time it saw gets only what broke after; a step's events are written
+ * together, so none of that step is missed. A case without fracture, or
+ * not started, has none. */
+static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
+{
+    const char *text = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "since");
+    double since = -INFINITY;
+    if (text) {
+        char *end = NULL;
+        errno = 0;
+        since = strtod(text, &end);
+        if (!*text || *end || errno == ERANGE || !isfinite(since)) {
+            char detail[160];
+            snprintf(detail, sizeof detail, "?since= takes a finite time in seconds; not \"%.64s\"",
+                     text);
+            return http_reply_problem(conn, 400, "Bad request", detail, NULL);
+        }
+    }
+    fdem_event *events = NULL;
+    int count = 0, dimension = 0;
+    char err[700] = "";
+    if (io_read_events(c, since, &events, &count, &dimension, err, sizeof err) != 0)
+        return http_reply_problem(conn, 500, "Internal error", err, NULL);
+    if (!dimension) {
+        pthread_mutex_lock(&c->lock);
+        dimension = c->fig.counts.dimension ? c->fig.counts.dimension : 2;
+        pthread_mutex_unlock(&c->lock);
+    }
+    /* about 150 bytes of JSON tree per event, charged to the budget */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
+    json_t *o = events_to_json(events, count, dimension, text ? &since : NULL);
+    membudget_meter_end();
+    free(events);
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of these events would take the daemon "
+                                    "past its memory budget (--max-memory) now; ask for fewer "
+                                    "with ?since=", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
+}
+
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
 {
     char msg[1400] = "";
@@ -373,8 +439,58 @@ static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
     return http_reply_problem(conn, 500, "Not deleted", msg, NULL);
 }
 
+static enum MHD_Result route_extend(struct MHD_Connection *conn, server_case *c, const char *body,
+                                    size_t size)
+{
+    problems p;
+    problems_init(&p);
+    char msg[640] = "";
+    int status = registry_extend(c, body, size, &p, msg, sizeof msg);
+    enum MHD_Result rc;
+    if (status == 0)
+        rc = http_reply_json(conn, 200, case_status_json(c), NULL);
+    else if (status == 404)
+        rc = routes_no_case(conn, c->id);
+    else if (status == 400 || status == 422)
+        rc = routes_reply_problems(conn, status, &p, "request");
+    else if (status == 409)
+        rc = http_reply_problem(conn, 409, "Conflict", msg, NULL);
+    else
+        rc = http_reply_problem(conn, 500, "Internal error", msg, NULL);
+    problems_free(&p);
+    return rc;
+}
+
+/* The patched document then goes the way of any POST /cases body. */
+static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, const char *body,
+                                   size_t size)
+{
+    problems p;
+    problems_init(&p);
+    int status = 0;
+    char err[640] = "";
+    size_t length = 0;
+    char *doc = registry_clone_document(c, body, size, &length, &p, &status, err, sizeof err);
+    membudget_lease *lease = membudget_request_lease();
+    enum MHD_Result rc;
+    if (!doc && status == 400)
+        rc = routes_reply_problems(conn, 400, &p, "patch");
+    else if (!doc && status == 404)
+        rc = routes_no_case(conn, c->id);
+    else if (!doc)
+        rc = http_reply_problem(conn, 500, "Internal error", err, NULL);
+    else if (lease && membudget_grow(lease, membudget_upload_cost(length)) != 0)
+        rc = http_reply_unavailable(conn, "parsing the patched case would take the daemon past "
+                                    "its memory budget (--max-memory) now; try again later", NULL);
+    else
+        rc = route_create_case(conn, doc, length);
+    free(doc);
+    problems_free(&p);
+    return rc;
+}
+
 static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, route_kind kind,
-                                  const char *method)
+                                  const char *method, const char *body, size_t body_size)
 {
     switch (kind) {
     case ROUTE_CASE:
@@ -389,10 +505,16 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return route_state(conn, c);
     case ROUTE_CASE_FRAGMENTS:
         return route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, fragments_to_json);
+    case ROUTE_CASE_EVENTS:
+        return route_events(conn, c);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c);
     case ROUTE_CASE_RESULT_XDMF:
         return routes_serve_file(conn, c, "result.xdmf", "application/xml");
+    case ROUTE_CASE_EXTEND:
+        return route_extend(conn, c, body, body_size);
+    case ROUTE_CASE_CLONE:
+        return route_clone(conn, c, body, body_size);
     default:
         return http_reply_problem(conn, 404, "Not found", "no such path", NULL);
     }
@@ -409,7 +531,7 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
     server_case *c = registry_find(m->id);
     if (!c)
         return routes_no_case(conn, m->id);
-    enum MHD_Result rc = route_case(conn, c, m->kind, method);
+    enum MHD_Result rc = route_case(conn, c, m->kind, method, body, body_size);
     case_release(c);
     return rc;
 }

@@ -114,6 +114,35 @@ static void worker_describe_failure(server_case *c, const fdem_error *err, doubl
     pthread_mutex_unlock(&c->lock);
 }
 
+/* The fracture events since the last call, for the next I/O job; taken
+ * before its checkpoint, which then holds none of them. Without memory
+ * they stay in the engine (and its checkpoint) for the next job. */
+static fdem_event *worker_drain_events(fdem_model *m, int *count)
+{
+    *count = fdem_event_count(m);
+    fdem_event *events = *count ? malloc(sizeof *events * (size_t)*count) : NULL;
+    if (!events) {
+        *count = 0;
+        return NULL;
+    }
+    *count = fdem_drain_events(m, events, *count);
+    return events;
+}
+
+/* The state before the step that is cut to land on time.end: an extend
+ * goes on from it, on the step grid of an uninterrupted run, instead of
+ * from the end (case_model.h). The events so far go to the file first,
+ * so the checkpoint holds none an extend would write twice. With
+ * model_lock held. */
+static void worker_keep_end_checkpoint(server_case *c)
+{
+    int event_count = 0;
+    fdem_event *events = worker_drain_events(c->model, &event_count);
+    size_t size = 0;
+    void *ckpt = case_checkpoint_take(c->model, &size);
+    io_write_named_checkpoint(c, CASE_END_CHECKPOINT, events, event_count, ckpt, size);
+}
+
 /* Runs steps until a command, the end time or a failure. */
 static worker_exit worker_loop(server_case *c, worker_clock *clk)
 {
@@ -141,6 +170,8 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
         double t0 = fdem_get_time(m);
         int cut = sizing_is_last_step(t0, dt, end);
         if (cut)
+            worker_keep_end_checkpoint(c);
+        if (cut)
             fdem_set_dt(m, end - t0);
         fdem_error err;
         memset(&err, 0, sizeof err);
@@ -157,6 +188,8 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
         snapshot *snap = NULL;
         void *ckpt = NULL;
         size_t ckpt_size = 0;
+        fdem_event *events = NULL;
+        int event_count = 0;
         if (done || t >= c->next_output - 1e-9 * dt) {
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
@@ -167,6 +200,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * last checkpoint and drops the rows after it); --checkpoint-every
          * makes progress between far-apart snapshots survive a crash too. */
         if (snap || now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
+            events = worker_drain_events(m, &event_count);
             ckpt = case_checkpoint_take(m, &ckpt_size);
             c->last_checkpoint_step = fdem_get_step(m);
             clk->last_checkpoint = now;
@@ -176,7 +210,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
         pthread_mutex_unlock(&c->model_lock);
 
         if (snap || ckpt) {
-            io_append(c, snap, ckpt, ckpt_size);
+            io_append(c, events, event_count, snap, ckpt, ckpt_size);
             worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
         }
         if (done)
@@ -193,7 +227,10 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
     snapshot *snap = NULL;
     void *ckpt = NULL;
     size_t ckpt_size = 0;
+    int event_count = 0;
     pthread_mutex_lock(&c->model_lock);
+    /* a failed case keeps the events up to its last step too */
+    fdem_event *events = worker_drain_events(c->model, &event_count);
     int64_t step = fdem_get_step(c->model);
     if (why == EXIT_STOP && step != c->last_snapshot_step) {
         snap = snapshot_take(c->model, c->info.fields);
@@ -205,8 +242,8 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
     }
     worker_publish(c, clk, worker_now(), 0);
     pthread_mutex_unlock(&c->model_lock);
-    if (snap || ckpt)
-        io_append(c, snap, ckpt, ckpt_size);
+    if (snap || ckpt || events)
+        io_append(c, events, event_count, snap, ckpt, ckpt_size);
     worker_wait_io(c, 0);
     io_close(c); /* a paused case keeps no file open either (case_model.h) */
 }

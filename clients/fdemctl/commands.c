@@ -49,7 +49,7 @@ static double status_number(json_t *obj, const char *key)
 }
 
 /* Reads a whole file (or stdin for "-") into a NUL-terminated buffer. */
-static char *read_all(const char *path, size_t *length)
+char *ctl_read_all(const char *path, size_t *length)
 {
     FILE *f = strcmp(path, "-") == 0 ? stdin : fopen(path, "rb");
     if (!f) {
@@ -182,7 +182,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
     }
 
     size_t length;
-    char *text = read_all(file[0], &length);
+    char *text = ctl_read_all(file[0], &length);
     if (!text) return CTL_FAIL;
     http_response r;
     const char *path = dry_run ? "/cases?dry_run=true" : start ? "/cases?start=true" : "/cases";

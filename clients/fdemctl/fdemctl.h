@@ -18,6 +18,7 @@
 
 #include <stddef.h>
 #include <stdio.h>
+#include <jansson.h>
 
 enum { CTL_OK = 0, CTL_FAIL = 1, CTL_USAGE = 2 };
 
@@ -87,6 +88,8 @@ static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_O
  * holds the exit code). The caller json_decref()s it. */
 struct json_t;
 struct json_t *ctl_get_status(const ctl_options *o, const char *id, int *code);
+/* A whole file (or stdin for "-"), NUL-terminated; NULL after saying why. */
+char *ctl_read_all(const char *path, size_t *length);
 
 /* --- commands --------------------------------------------------------- */
 
@@ -101,5 +104,13 @@ int cmd_state(const ctl_options *o, int argc, char **argv);
 int cmd_wait(const ctl_options *o, int argc, char **argv);
 int cmd_fetch(const ctl_options *o, int argc, char **argv);
 int cmd_fragments(const ctl_options *o, int argc, char **argv);
+int cmd_extend(const ctl_options *o, int argc, char **argv);    /* stages.c */
+int cmd_clone(const ctl_options *o, int argc, char **argv);
+/* fragments.c, shared with events.c: GET path and print the JSON object
+ * whose `key` is a list with print(), or pass it through as is (raw);
+ * `what` names the list in the message when the answer is not one. */
+int ctl_show_list(const ctl_options *o, const char *path, int raw, const char *key,
+                  const char *what, void (*print)(const json_t *body));
+int cmd_events(const ctl_options *o, int argc, char **argv);
 
 #endif

@@ -74,6 +74,12 @@ int cmd_fragments(const ctl_options *o, int argc, char **argv)
         fprintf(stderr, "fdemctl fragments: case id too long\n");
         return CTL_USAGE;
     }
+    return ctl_show_list(o, path, raw, "fragments", "a fragment list", print_fragments);
+}
+
+int ctl_show_list(const ctl_options *o, const char *path, int raw, const char *key,
+                  const char *what, void (*print)(const json_t *body))
+{
     http_response r;
     int code = ctl_call(o, "GET", path, NULL, 0, 200, &r);
     if (code) return code;
@@ -82,11 +88,11 @@ int cmd_fragments(const ctl_options *o, int argc, char **argv)
     if (raw) {
         fwrite(r.body, 1, r.length, stdout);
         if (r.length == 0 || r.body[r.length - 1] != '\n') fputc('\n', stdout);
-    } else if (!body || !json_is_array(json_object_get(body, "fragments"))) {
-        fprintf(stderr, "fdemctl fragments: the server's answer is not a fragment list\n");
+    } else if (!body || !json_is_array(json_object_get(body, key))) {
+        fprintf(stderr, "fdemctl: the server's answer to GET %s is not %s\n", path, what);
         code = CTL_FAIL;
     } else {
-        print_fragments(body);
+        print(body);
     }
     json_decref(body);
     http_response_free(&r);

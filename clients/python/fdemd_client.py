@@ -190,8 +190,45 @@ class Client:
         """Stops the case if needed and removes it and its files."""
         self._json("DELETE", self._case_path(case_id))
 
+    def extend(self, case_id, end, start=False):
+        """Runs a finished or paused case on to the later end time `end`
+        (POST /cases/ID/extend): the case becomes paused with the new end and
+        its results go on in the same result.h5 once started. Returns the
+        status (after the start, with start=True).
+
+        Raises:
+            FdemdError: 409 when the case is not finished or paused, or when
+                `end` is not beyond its current end; 422 for an end that is
+                not a finite number.
+        """
+        status = self._json("POST", self._case_path(case_id, "/extend"),
+                            json.dumps({"end": end}).encode("utf-8"))
+        return self.start(case_id) if start else status
+
+    def clone(self, case_id, patch, start=False):
+        """Creates a new case from the stored document of `case_id` with the
+        JSON Merge Patch (RFC 7396) `patch` applied, and returns its id
+        (POST /cases/ID/clone). In the patch an object merges, None (null)
+        removes a member, anything else replaces it, e.g.
+        ``{"name": "softer", "materials": {"rock": {"young": 1e9}}}``.
+
+        Args:
+            patch: a dict, bytes (its JSON text) or the path of a JSON file.
+            start: also start the new case.
+        Raises:
+            FdemdError: as submit() does, with pointers into the patched
+                document; 404 when `case_id` does not exist.
+        """
+        body = _case_body(patch)
+        path = self._case_path(case_id, "/clone" + ("?start=true" if start else ""))
+        status = self._json("POST", path, body)
+        if status.get("warning"):
+            warnings.warn("case %s: %s" % (status["id"], status["warning"]), stacklevel=2)
+        return status["id"]
+
     def case(self, case_id):
-        """The case document as uploaded, parsed."""
+        """The case document as stored (as uploaded; an extend rewrites
+        its time.end), parsed."""
         return self._json("GET", self._case_path(case_id, "/case"))
 
     def state(self, case_id, fields=None):
@@ -204,9 +241,10 @@ class Client:
         Returns:
             {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
             per node ([[x, y, z], ...] in 3D), stress and strain [[xx, yy,
-            xy], ...] per element (3D: xx, yy, zz, yz, xz, xy, contract 5.2;
-            strain is Green-Lagrange), principal_stress [[s1, s2], ...] (3D:
-            three) descending, damage per joint.
+            xy], ...] per element (3D: xx, yy, zz, yz, xz, xy; strain is
+            Green-Lagrange), principal_stress [[s1, s2], ...] (3D: three)
+            descending, damage per joint; docs/api.md, "GET
+            /cases/ID/state".
         """
         suffix = "/state"
         if fields:
@@ -227,6 +265,27 @@ class Client:
             fraction of fragments no larger than each diameter).
         """
         return self._json("GET", self._case_path(case_id, "/fragments"))
+
+    def events(self, case_id, since=None):
+        """The fracture events of the case: one per joint that broke, in the
+        order they broke (contract 5.4).
+
+        Args:
+            since: a time in seconds; only the events after it (time >
+                since) are returned, so passing the last time seen gives
+                only the new ones. None: all.
+        Returns:
+            {"dimension", "since", "count", "events": [{"time", "joint",
+            "position", "mode", "energy"}, ...]}: time the end of the step
+            the joint broke in, position its midpoint ([x, y] or [x, y,
+            z]), mode 1 tensile, 2 shear, 3 mixed, energy what it
+            dissipated (J per metre in 2D). The same rows as /events/* in
+            result.h5.
+        """
+        suffix = "/events"
+        if since is not None:
+            suffix += "?since=" + repr(float(since))
+        return self._json("GET", self._case_path(case_id, suffix))
 
     def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
         """Polls until the case is finished, failed or stopped.

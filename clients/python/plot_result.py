@@ -14,8 +14,12 @@ as its triangles, coloured by
             elasticity; the small-strain limit of the engine's material), so
                 svm = sqrt(((sxx - syy)^2 + (syy - szz)^2 + (szz - sxx)^2) / 2
                            + 3 * sxy^2).
-            nu comes from --poisson (default 0.25) or, per part, from the
-            materials of the case document given with --case.
+            nu is each part's material's "poisson", read from the case
+            document the file carries (root attribute `case`,
+            docs/results.md). --case CASE.json reads it from that
+            document instead, and --poisson NU uses NU for every element.
+            A file without the attribute (written before it existed)
+            needs one of the two.
   velocity  speed |v| per node from /snapshots/velocity.
   damage    every joint of /mesh/joints as a segment coloured by its damage
             (0 intact ... 1 broken) over the mesh in grey.
@@ -50,7 +54,7 @@ from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.tri import Triangulation  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-# Stress components as stored: 2D (sxx, syy, sxy); 3D (contract 5.2)
+# Stress components as stored: 2D (sxx, syy, sxy); 3D (docs/results.md)
 # (sxx, syy, szz, syz, sxz, sxy).
 COMPONENTS = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
 
@@ -85,14 +89,35 @@ def von_mises_3d(stress):
                    + 3.0 * (syz ** 2 + sxz ** 2 + sxy ** 2))
 
 
-def element_poisson(f, case_path, default_nu):
-    """Poisson's ratio per element: from the case's materials, else default."""
+class MissingMaterial(Exception):
+    """The file does not say which Poisson's ratio to use."""
+
+
+def case_document(f, case_path):
+    """The case: the --case file when given, else the one the result
+    carries (root attribute `case`); None when neither exists."""
+    if case_path:
+        with open(case_path) as c:
+            return json.load(c)
+    text = attr_text(f, "case")
+    return json.loads(text) if text else None
+
+
+def element_poisson(f, case_path=None, poisson=None):
+    """Poisson's ratio per element: `poisson` for all when given, else each
+    element's part's material in the case document (case_document())."""
     elements = f["/mesh/triangles"].shape[0]
-    if not case_path:
-        return np.full(elements, default_nu)
-    with open(case_path) as c:
-        case = json.load(c)
-    per_part = [case["materials"][p["material"]].get("poisson", default_nu) for p in case["parts"]]
+    if poisson is not None:
+        return np.full(elements, poisson)
+    case = case_document(f, case_path)
+    if case is None:
+        raise MissingMaterial("the file carries no case document (it predates the `case` "
+                              "attribute); give --poisson NU or --case CASE.json")
+    try:
+        per_part = [case["materials"][p["material"]]["poisson"] for p in case["parts"]]
+    except (KeyError, TypeError) as e:
+        raise MissingMaterial("the case document names no Poisson's ratio for every part "
+                              "(%s); give --poisson NU" % e) from None
     return np.asarray(per_part, dtype=float)[f["/mesh/element_part"][:]]
 
 
@@ -300,7 +325,7 @@ def plot_3d(f, args, field):
 
 
 def result_dimension(f):
-    """3 for a tetrahedral result (contract 5.2), else 2."""
+    """3 for a tetrahedral result (docs/results.md, "Three dimensions"), else 2."""
     return int(f.attrs.get("dimension", 3 if "/mesh/tetrahedra" in f else 2))
 
 
@@ -320,9 +345,11 @@ def main(argv=None):
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
     p.add_argument("--field", choices=sorted(DRAW), help="colouring (default stress if present)")
     p.add_argument("--snapshot", type=int, default=-1, help="index, negative from the end (-1)")
-    p.add_argument("--poisson", type=float, default=0.25,
-                   help="Poisson's ratio for the plane-strain szz (default 0.25)")
-    p.add_argument("--case", help="case JSON: take each part's Poisson's ratio from it")
+    p.add_argument("--poisson", type=float,
+                   help="Poisson's ratio for the plane-strain szz of every element "
+                        "(default: each part's material, from the case in the file)")
+    p.add_argument("--case", help="case JSON: take each part's Poisson's ratio from it "
+                                  "instead of from the case the file carries")
     p.add_argument("--component", choices=COMPONENTS[3],
                    help="colour by this stress component instead of von Mises "
                         "(2D: xx, yy, xy)")
@@ -334,6 +361,8 @@ def main(argv=None):
         plot(args)
     except (OSError, KeyError) as e:
         sys.exit("plot_result: cannot read %s: %s" % (args.result, e))
+    except MissingMaterial as e:
+        sys.exit("plot_result: %s: %s" % (args.result, e))
     print(args.output)
 
 

@@ -23,6 +23,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 FDEMD_BIN = os.environ.get("FDEMD_BIN", os.path.join(ROOT, "bin", "fdemd"))
 if not os.path.isabs(FDEMD_BIN):
     FDEMD_BIN = os.path.join(ROOT, FDEMD_BIN)
+FDEMCTL_BIN = os.environ.get("FDEMCTL_BIN", os.path.join(ROOT, "bin", "fdemctl"))
+if not os.path.isabs(FDEMCTL_BIN):
+    FDEMCTL_BIN = os.path.join(ROOT, FDEMCTL_BIN)
 # Sanitizer builds are several times slower; time limits scale with this.
 SLOW = 4.0 if "san" in os.path.basename(os.path.dirname(FDEMD_BIN)) else 1.0
 TERMINAL = ("finished", "stopped", "failed")

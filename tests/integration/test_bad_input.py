@@ -112,6 +112,23 @@ class BadInputTest(unittest.TestCase):
         self.post(degenerate_mesh_case(), 422, "/parts/1")
         self.post(out_of_range_mesh_case(), 422, "/parts/1")
 
+    def test_every_problem_in_one_answer(self):
+        """A dt above the stable step (found by building a model) comes in
+        the same 422 as a bad constraint, material and part (found while
+        reading), each at its own pointer."""
+        case = tiny_case("all-at-once")
+        case["materials"]["soft"] = {"density": -1, "young": 1e9, "poisson": 0.2}
+        case["parts"].append({"name": "soft", "material": "soft",
+                              "rectangle": {"origin": [0, 0.2], "size": [0.1, 0.1],
+                                            "divisions": [2, 2]}})
+        case["parts"].append({"name": "no-shape", "material": "rock"})
+        case["constraints"][0]["fix"] = ["x", "w"]
+        case["time"]["dt"] = 1e-3
+        problem = self.post(case, 422)
+        pointers = sorted(e["pointer"] for e in problem["errors"])
+        self.assertEqual(pointers, ["/constraints/0/fix/1", "/materials/soft/density",
+                                    "/parts/2", "/time/dt"], problem)
+
     def test_two_shapes_in_one_part(self):
         case = tiny_case("two")
         case["parts"][0]["disc"] = {"center": [0, 0], "radius": 0.05, "divisions": 16}

@@ -10,6 +10,7 @@ well under a minute.
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -432,6 +433,52 @@ class PlotTests(ClientTestCase):
         finally:
             self.client.delete(case_id)
 
+    def test_poisson_ratio_comes_from_the_file(self):
+        """von Mises takes each part's nu from the case document result.h5
+        carries (no longer 0.25 unless told); --case and --poisson override
+        it, and a file without the document asks for one of them."""
+        sys.path.insert(0, os.path.dirname(PLOT))
+        from plot_result import MissingMaterial, element_poisson
+        doc = quick_case("two-nu")
+        doc["materials"]["soft"] = dict(MATERIAL, poisson=0.4)
+        doc["materials"]["rock"]["poisson"] = 0.1
+        doc["parts"].append({"name": "top", "material": "soft",
+                             "rectangle": {"origin": [0, 0.2], "size": [0.1, 0.1],
+                                           "divisions": [1, 1]}})
+        case_id = self.client.submit(doc, start=True)
+        self.client.wait(case_id, interval=0.05, timeout=30 * SLOW)
+        h5, _ = self.client.fetch(case_id, os.path.join(self.work.name, "two-nu.h5"))
+        other = os.path.join(self.work.name, "other.json")
+        with open(other, "w") as f:
+            json.dump(dict(doc, materials={"rock": dict(MATERIAL, poisson=0.3),
+                                           "soft": dict(MATERIAL, poisson=0.35)}), f)
+        with h5py.File(h5, "r") as f:
+            part = f["/mesh/element_part"][:]
+            self.assertEqual(sorted(set(part)), [0, 1])
+            np.testing.assert_array_equal(element_poisson(f), np.where(part == 0, 0.1, 0.4))
+            np.testing.assert_array_equal(element_poisson(f, case_path=other),
+                                          np.where(part == 0, 0.3, 0.35))
+            np.testing.assert_array_equal(element_poisson(f, other, poisson=0.2), 0.2)
+        r = subprocess.run([PYTHON, PLOT, h5, "-o", os.path.join(self.work.name, "nu.png")],
+                           capture_output=True, text=True, timeout=60 * SLOW)
+        self.assert_png(r, os.path.join(self.work.name, "nu.png"))
+        # a file written before the `case` attribute existed
+        old = os.path.join(self.work.name, "old.h5")
+        shutil.copy(h5, old)
+        with h5py.File(old, "a") as f:
+            del f.attrs["case"]
+        with h5py.File(old, "r") as f, self.assertRaises(MissingMaterial):
+            element_poisson(f)
+        png = os.path.join(self.work.name, "old.png")
+        r = subprocess.run([PYTHON, PLOT, old, "-o", png], capture_output=True, text=True,
+                           timeout=60 * SLOW)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("--poisson", r.stderr)
+        self.assertFalse(os.path.exists(png))
+        r = subprocess.run([PYTHON, PLOT, old, "-o", png, "--poisson", "0.25"],
+                           capture_output=True, text=True, timeout=60 * SLOW)
+        self.assert_png(r, png)
+
     def test_damage_without_joints_is_a_clear_error(self):
         r, png = self.plot("--field", "damage")
         self.assertNotEqual(r.returncode, 0)
@@ -572,6 +619,29 @@ class Clients3DTests(ClientTestCase):
             self.assertIn("run3d.h5:/", f.read())
         with open(py_xdmf) as f:
             self.assertIn("py3d.h5:/", f.read())
+
+
+class DocReferenceTests(unittest.TestCase):
+    """Every doc the Python clients' docstrings and comments send a reader
+    to exists in the repository, with the section they name."""
+
+    def test_referenced_docs_exist(self):
+        import re
+        found = 0
+        for name in ("fdemd_client.py", "plot_result.py"):
+            with open(os.path.join(ROOT, "clients", "python", name)) as f:
+                text = " ".join(f.read().split())  # references may wrap lines
+            self.assertNotRegex(text, r"[Cc]ontract \d", "%s cites the spec, not a doc" % name)
+            for doc, section in re.findall(r"(docs/[\w-]+\.md)(?:, \"([^\"]+)\")?", text):
+                found += 1
+                path = os.path.join(ROOT, doc)
+                self.assertTrue(os.path.exists(path), "%s names %s" % (name, doc))
+                if section:
+                    with open(path) as f:
+                        headings = [line.lstrip("#").strip() for line in f
+                                    if line.startswith("#")]
+                    self.assertIn(section, headings, "%s names %s, %r" % (name, doc, section))
+        self.assertGreaterEqual(found, 3)
 
 
 class VonMisesTests(unittest.TestCase):

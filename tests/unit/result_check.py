@@ -189,6 +189,48 @@ def check_hyperslab(f, item, h5_name, s):
          f"hyperslab count {count.tolist()} vs Dimensions {dataitem_dims(item)}")
 
 
+def check_whole(f, item, h5_name, cells):
+    """A topology read through a HyperSlab that selects all of /mesh/<cells>."""
+    children = item.findall("DataItem")
+    need(len(children) == 2, "HyperSlab needs a selection and a source DataItem")
+    ds = check_hdf_item(f, children[1], h5_name)
+    need(ds.name == "/mesh/" + cells, f"topology HyperSlab reads {ds.name}")
+    sel = np.array(children[0].text.split(), dtype=int).reshape(3, -1)
+    need(sel.tolist() == [[0, 0], [1, 1], list(ds.shape)], f"topology selects {sel.tolist()}")
+
+
+# Row-major 3x3 tensor from the Voigt columns of /snapshots/stress.
+TENSOR = {2: [0, 2, None, 2, 1, None, None, None, None], 3: [0, 5, 4, 5, 1, 3, 4, 3, 2]}
+
+
+def check_view(f, path, s, dim):
+    """/xdmf/<s>/<field> shows row s of /snapshots/<field> as the sidecar
+    says: tensors 3x3 with the in-plane zeros, velocity with z = 0."""
+    _, group, snapshot, field = path.split("/")
+    need(group == "xdmf" and int(snapshot) == s, f"grid {s} names the view {path}")
+    got = f[path][()]
+    row = f["/snapshots/" + field][s]
+    if field in ("stress", "strain"):
+        want = np.array([row[:, k] if k is not None else np.zeros(len(row))
+                         for k in TENSOR[dim]]).T
+    elif field == "velocity":
+        want = np.zeros((len(row), 3))
+        want[:, :dim] = row
+    else:
+        want = row
+    need(got.shape == want.shape and np.array_equal(got, want), f"view {path} differs from its row")
+
+
+def check_series(f, item, h5_name, snapshots):
+    """A Grid attribute: the whole series, one tuple per snapshot."""
+    ref = item.text.strip()
+    need(ref.startswith(h5_name + ":/snapshots/"), f"series DataItem refers to {ref!r}")
+    ds = f[ref.split(":", 1)[1]]
+    dims = dataitem_dims(item)
+    need(len(dims) == 2 and dims[0] == snapshots == ds.shape[0] and
+         int(np.prod(dims)) == ds.size, f"series {ds.name} {dims} vs {ds.shape}")
+
+
 def check_xdmf(f, exp, xdmf_path, h5_name):
     root = ET.parse(xdmf_path).getroot()
     need(root.tag == "Xdmf" and root.get("Version") == "2.0", "not an XDMF 2.0 document")
@@ -209,22 +251,34 @@ def check_xdmf(f, exp, xdmf_path, h5_name):
         topo = grid.find("Topology")
         need(topo.get("TopologyType") == topology, f"topology is not {topology}")
         need(int(topo.get("NumberOfElements")) == n_elems, "NumberOfElements wrong")
-        check_hdf_item(f, topo.find("DataItem"), h5_name)
+        item = topo.find("DataItem")
+        if item.get("ItemType") == "HyperSlab":
+            check_whole(f, item, h5_name, cells)
+        else:
+            check_hdf_item(f, item, h5_name)
         geo = grid.find("Geometry")
         need(geo.get("GeometryType") == geometry, f"geometry is not {geometry}")
         item = geo.find("DataItem")
         if item.get("ItemType") == "HyperSlab":
             check_hyperslab(f, item, h5_name, s)
         else:
-            check_hdf_item(f, item, h5_name)
+            ds = check_hdf_item(f, item, h5_name)
+            if ds.name.startswith("/xdmf/"):
+                check_view(f, ds.name, s, dim)
         need(dataitem_dims(item) == (n_nodes, dim), f"geometry is not N x {dim}")
         attrs = {}
         for a in grid.findall("Attribute"):
             item = a.find("DataItem")
+            if a.get("Center") == "Grid":
+                check_series(f, item, h5_name, len(times))
+                attrs[a.get("Name")] = "Grid"
+                continue
             if item.get("ItemType") == "HyperSlab":
                 check_hyperslab(f, item, h5_name, s)
             else:
-                check_hdf_item(f, item, h5_name)
+                ds = check_hdf_item(f, item, h5_name)
+                if ds.name.startswith("/xdmf/"):
+                    check_view(f, ds.name, s, dim)
             rows = n_nodes if a.get("Center") == "Node" else n_elems
             need(dataitem_dims(item)[0] == rows, f"attribute {a.get('Name')} has wrong rows")
             attrs[a.get("Name")] = a.get("Center")

@@ -570,6 +570,65 @@ static void all_problems_are_collected(void)
     problems_free(&p);
 }
 
+/* Problems of independent sections come in one answer: a dt above the
+ * stable step (found only by building a model) beside a bad constraint,
+ * material and part (found while reading), and beside a constraint that
+ * selects nothing (found while building). */
+static void independent_problems_in_one_pass(void)
+{
+    json_t *doc = load(base_text);
+    edit(doc, "/time/dt", json_real(1e-3));
+    edit(doc, "/constraints/1/fix", load("['z']"));
+    edit(doc, "/materials/steel/poisson", json_real(0.5));
+    edit(doc, "/parts/2/material", json_string("granit"));
+    problems p;
+    case_info info;
+    fdem_model *m = build_json(doc, GiB, &info, &p);
+    CHECK(p.count == 4, "%d problems, want 4", p.count);
+    CHECK(has_problem(&p, "/time/dt", "stable time step of this model's valid parts"),
+          "no dt problem");
+    CHECK(has_problem(&p, "/constraints/1/fix/0", "\"x\" or \"y\""), "no constraint problem");
+    CHECK(has_problem(&p, "/materials/steel/poisson", "0.5"), "no material problem");
+    CHECK(has_problem(&p, "/parts/2/material", "granit"), "no part problem");
+    if (p.count != 4) dump_problems(&p);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+
+    /* a dt the valid parts allow is not called too large */
+    edit(doc, "/time/dt", json_real(1e-9));
+    m = build_json(doc, GiB, &info, &p);
+    CHECK(p.count == 3 && !has_problem(&p, "/time/dt", ""), "%d problems, want 3", p.count);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+    json_decref(doc);
+
+    /* the engine refuses two meshes: both are named */
+    doc = load(base_text);
+    edit(doc, "/parts/2/mesh/nodes", load("[[1, 0], [2, 0], [3, 0], [2, 1]]"));
+    edit(doc, "/parts/3", load("{'name': 'flat', 'material': 'rock', 'mesh': {'nodes': "
+                               "[[5, 5], [6, 6], [7, 7]], 'triangles': [[0, 1, 2]]}}"));
+    m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(p.count == 2 && has_problem(&p, "/parts/2/mesh/triangles/0", "") &&
+          has_problem(&p, "/parts/3/mesh/triangles/0", ""), "%d problems, want both meshes",
+          p.count);
+    if (p.count != 2) dump_problems(&p);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+
+    doc = load(base_text);
+    edit(doc, "/time/dt", json_real(1e-3));
+    edit(doc, "/constraints/1/box", load("[10, 10, 11, 11]"));
+    m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(p.count == 2 && has_problem(&p, "/constraints/1", "selects no node") &&
+          has_problem(&p, "/time/dt", "stable time step of this model,"),
+          "%d problems, want the selection and dt", p.count);
+    if (p.count != 2) dump_problems(&p);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+}
+
 static void pointer_escaping(void)
 {
     json_t *doc = load(base_text);
@@ -620,5 +679,6 @@ CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(constraint_errors), T(velocity_constraint_may_leave_a_component_free),
            T(time_errors), T(dt_above_stable_step), T(output_errors),
            T(absurd_divisions_are_refused_by_size), T(memory_estimate_is_not_low),
-           T(all_problems_are_collected), T(pointer_escaping), T(many_problems_are_capped),
+           T(all_problems_are_collected), T(independent_problems_in_one_pass),
+           T(pointer_escaping), T(many_problems_are_capped),
            T(parse_fields))

@@ -122,7 +122,7 @@ static void elastic_joint_integrates_its_traction(void)
     rotation(axis, 0.7, R);
     place_pair(R, shift, gap_mixed, pos);
     double damage = 0;
-    joint_energy e = {0, 0, 0, 0};
+    joint_energy e = {0};
     CHECK(joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e) == 1, "joint broke");
     CHECK(damage == 0, "an elastic joint was damaged: %g", damage);
     kernel_resultant(pos, fa, F, M);
@@ -159,7 +159,7 @@ static void damaged_open_joint_integrates_softened_traction(void)
     rotation(axis, -1.1, R);
     place_pair(R, shift, gap_open, pos);
     double damage = 0.4;
-    joint_energy e = {0, 0, 0, 0};
+    joint_energy e = {0};
     joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e);
     CHECK(damage == 0.4, "damage moved to %g", damage);
     CHECK(e.dissipated == 0, "dissipated %g without damage growth", e.dissipated);
@@ -185,7 +185,7 @@ static void rigid_motion_gives_no_force(void)
         for (int c = 0; c < 3; c++) vel[3 * i + c] += drift[c];
     }
     double damage = 0.3;
-    joint_energy e = {0, 0, 0, 0};
+    joint_energy e = {0};
     joint_tet_forces(&law, pos, vel, 1e-7, six, &damage, fa, &e);
     double largest = 0;
     for (int k = 0; k < 9; k++) largest = fmax(largest, fabs(fa[k]));
@@ -227,7 +227,7 @@ static void shut_part_forces_are_energy_gradient(void)
     rotation(axis, 0.9, R);
     for (int which = 0; which < 2; which++) {
         double pos[18], fa[9], damage = 0.5;
-        joint_energy e = {0, 0, 0, 0};
+        joint_energy e = {0};
         place_pair(R, shift, gaps[which], pos);
         joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e);
         CHECK(damage == 0.5, "damage moved to %g", damage);
@@ -237,7 +237,7 @@ static void shut_part_forces_are_energy_gradient(void)
             for (int side = 0; side < 2; side++) {
                 pos[9 + k] = keep + (side ? h : -h);
                 double D = 0.5;
-                joint_energy es = {0, 0, 0, 0};
+                joint_energy es = {0};
                 joint_tet_forces(&law, pos, NULL, 0, six, &D, f_unused, &es);
                 E[side] = es.stored;
             }
@@ -265,7 +265,7 @@ static double pull_apart(const double R[9], const double total_local[3], int ste
         for (int i = 0; i < 3; i++)
             for (int c = 0; c < 3; c++) gap[3 * i + c] = f * total_local[c];
         place_pair(R, shift, gap, pos);
-        joint_energy e = {0, 0, 0, 0};
+        joint_energy e = {0};
         joint_tet_forces(&law, pos, NULL, 0, six, damage, fa, &e);
         *dissipated += e.dissipated;
         *last_stored = e.stored;
@@ -327,7 +327,7 @@ static void sheared_under_compression_closes_the_balance(void)
     int steps = 40000;
     double h = 1.0; /* the step between evaluations: vel = increment / h */
     double damage = 0, work = 0, prev = 0, stored0 = 0, stored = 0;
-    joint_energy acc = {0, 0, 0, 0};
+    joint_energy acc = {0};
     for (int s = 0; s <= steps; s++) {
         double f = total * s / steps, gap[9];
         for (int i = 0; i < 3; i++) {
@@ -338,7 +338,7 @@ static void sheared_under_compression_closes_the_balance(void)
         place_pair(R, shift, gap, pos);
         for (int i = 0; i < 3; i++)
             for (int c = 0; c < 3; c++) vel[9 + 3 * i + c] = s ? world[c] * total / steps / h : 0;
-        joint_energy e = {0, 0, 0, 0};
+        joint_energy e = {0};
         joint_tet_forces(&law, pos, vel, h, six, &damage, fa, &e);
         acc.dissipated += e.dissipated;
         acc.friction += e.friction;

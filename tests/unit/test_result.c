@@ -209,6 +209,17 @@ static void run_check_xdmf(run *r, const char *xdmf_name, const char *h5_name,
     CHECK(run_checker(h5_name, json_name, "xdmf", extra) == 0, "%s", what);
 }
 
+/* Ends SWMR writing and adds the /xdmf views: every snapshot gets them. */
+static void run_finish(run *r, const char *h5_name)
+{
+    char h5[512];
+    tmp_path(h5, sizeof h5, h5_name);
+    CHECK(result_finish(r->file, h5, fdem_get_dimension(r->model), r->err, sizeof r->err) == 0,
+          "result_finish: %s", r->err);
+    CHECK(result_view_count(r->file) == result_snapshot_count(r->file), "views %d of %d",
+          result_view_count(r->file), result_snapshot_count(r->file));
+}
+
 /* ----------------------------------------------------------------- tests */
 
 static void test_result_layout_and_swmr_reads(void)
@@ -615,6 +626,8 @@ static void test_xdmf_matches_file(void)
         for (int i = 0; i < 3; i++) run_append(&r);
         expect_save(r.expect, "result.json");
         run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf with stress");
+        run_finish(&r, "result.h5");
+        run_check_xdmf(&r, "result.xdmf", "result.h5", "result.json", "xdmf with views");
     }
     run_end(&r);
     /* Without position the geometry is the initial mesh. */
@@ -639,6 +652,8 @@ static void test_result_3d_layout_and_xdmf(void)
         expect_save(r.expect, "solid.json");
         CHECK(run_checker("solid.h5", "solid.json", "swmr", NULL) == 0, "3D layout, swmr");
         run_check_xdmf(&r, "solid.xdmf", "solid.h5", "solid.json", "3D xdmf");
+        run_finish(&r, "solid.h5");
+        run_check_xdmf(&r, "solid.xdmf", "solid.h5", "solid.json", "3D xdmf with views");
         CHECK(result_close(r.file) == 0, "result_close");
         r.file = NULL;
         CHECK(run_checker("solid.h5", "solid.json", "plain", NULL) == 0, "3D, closed file");

@@ -1,0 +1,254 @@
+/*
+ * case_stages.c - extend and clone (case_stages.h): the two ways a case
+ * goes on past what its document first said.
+ *
+ * An extended case keeps its files: its document is rewritten with the
+ * new end (case.json, and the copy inside result.h5, so GET /case and the
+ * file's `case` attribute agree and a restart rebuilds it with the new
+ * end), and its next start appends to result.h5. A finished case resumes
+ * from the state one step before its old end (CASE_RESUME_CHECKPOINT, see
+ * case_model.h), not from the end: the last step of a run is cut to land
+ * on time.end, and going on from there would put every later step off the
+ * grid of an uninterrupted run. So the continued run is bit for bit the
+ * run that was asked for the new end from the start, and the row of the
+ * old end stays in the file as it was.
+ */
+#include "case_stages.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "case_model.h"
+#include "io_thread.h"
+#include "json_patch.h"
+#include "persist.h"
+#include "registry_internal.h"
+
+/* ---------------------------------------------------------------- reading */
+
+static json_t *stages_parse(const char *body, size_t size, size_t flags, problems *p)
+{
+    json_error_t e;
+    json_t *root = json_loadb(body, size, JSON_REJECT_DUPLICATES | flags, &e);
+    if (!root) {
+        snprintf(p->title, sizeof p->title, "Malformed JSON");
+        problems_add(p, 400, "", "line %d, column %d: %s", e.line, e.column, e.text);
+    }
+    return root;
+}
+
+/* The new end of {"end": t}: 0, or 400/422 with the problems in p. */
+static int stages_read_end(const char *body, size_t size, double *end, problems *p)
+{
+    json_t *root = stages_parse(body, size, 0, p);
+    if (!root)
+        return 400;
+    snprintf(p->title, sizeof p->title, "Invalid extend request");
+    if (!json_is_object(root)) {
+        problems_add(p, 422, "", "the body must be an object {\"end\": seconds}");
+        json_decref(root);
+        return 422;
+    }
+    const char *key;
+    json_t *v;
+    json_object_foreach(root, key, v) {
+        if (strcmp(key, "end") != 0) {
+            char pointer[256];
+            pointer_join(pointer, sizeof pointer, "", key);
+            problems_add(p, 422, pointer, "unknown member \"%.64s\"; extend takes {\"end\": seconds}",
+                         key);
+        }
+    }
+    v = json_object_get(root, "end");
+    if (!v)
+        problems_add(p, 422, "/end", "missing required \"end\" (the new end time in seconds)");
+    else if (!json_is_number(v))
+        problems_add(p, 422, "/end", "end must be a number of seconds");
+    else if (!isfinite(*end = json_number_value(v)))
+        problems_add(p, 422, "/end", "end must be finite");
+    json_decref(root);
+    return p->count ? 422 : 0;
+}
+
+/* The stored document of `c` as a tree, or NULL with err. */
+static json_t *stages_load_document(server_case *c, char *err, size_t errlen)
+{
+    char path[1200], *text = NULL;
+    size_t size = 0;
+    snprintf(path, sizeof path, "%s/case.json", c->dir);
+    if (persist_read_file(path, &text, &size, CASE_MODEL_MAX_DOCUMENT) != 0) {
+        snprintf(err, errlen, "the stored case.json could not be read: %s", strerror(errno));
+        return NULL;
+    }
+    json_t *doc = json_loadb(text, size, JSON_REJECT_DUPLICATES, NULL);
+    free(text);
+    if (!doc)
+        snprintf(err, errlen, "the stored case.json is not JSON");
+    return doc;
+}
+
+/* ---------------------------------------------------------------- extend */
+
+/* 0 when `c` may be extended now; 404, or 409 with a sentence. */
+static int stages_extendable(server_case *c, case_state *was, char *msg, size_t msglen)
+{
+    pthread_mutex_lock(&c->lock);
+    int status = 0;
+    *was = c->state;
+    if (atomic_load(&c->deleted)) {
+        status = 404;
+    } else if (c->state != CASE_FINISHED && c->state != CASE_PAUSED) {
+        snprintf(msg, msglen, "the case is %s; extend is allowed only when it is finished or "
+                 "paused%s", case_state_name(c->state),
+                 c->state == CASE_RUNNING || c->state == CASE_QUEUED ? " (pause it first)" : "");
+        status = 409;
+    } else if (c->worker_active) {
+        snprintf(msg, msglen, "the case is still winding down its last step; try again");
+        status = 409;
+    }
+    pthread_mutex_unlock(&c->lock);
+    return status;
+}
+
+/* `doc` with time.end = end, and output.interval pinned when it was left
+ * to its default. 0, or 409/422/500 with msg (422 also in p). */
+static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_t msglen)
+{
+    json_t *time = json_object_get(doc, "time");
+    double old_end = json_number_value(json_object_get(time, "end"));
+    if (!json_is_object(time) || !(old_end > 0)) {
+        snprintf(msg, msglen, "the stored case.json has no time.end");
+        return 500;
+    }
+    if (!(end > old_end)) {
+        snprintf(msg, msglen, "the new end %.17g s is not beyond the current end %.17g s",
+                 end, old_end);
+        return 409;
+    }
+    json_t *output = json_object_get(doc, "output");
+    if (!output) {
+        output = json_object();
+        json_object_set_new(doc, "output", output);
+    }
+    if (!json_is_object(output)) {
+        snprintf(msg, msglen, "the stored case.json has an output that is not an object");
+        return 500;
+    }
+    json_t *given = json_object_get(output, "interval");
+    double interval = json_is_number(given) ? json_number_value(given)
+                                            : old_end / CASE_DEFAULT_SNAPSHOTS;
+    if (end / interval > CASE_MAX_SNAPSHOTS) {
+        snprintf(p->title, sizeof p->title, "Invalid extend request");
+        problems_add(p, 422, "/end", "an end of %g s at the output interval of %g s would write "
+                     "%.3g snapshots; the limit is %.0f", end, interval, end / interval,
+                     CASE_MAX_SNAPSHOTS);
+        return 422;
+    }
+    if ((!given && json_object_set_new(output, "interval", json_real(interval)) != 0) ||
+        json_object_set_new(time, "end", json_real(end)) != 0) {
+        snprintf(msg, msglen, "out of memory rewriting the case document");
+        return 500;
+    }
+    return 0;
+}
+
+/* An extended finished case goes on from the step before its old end. */
+static int stages_keep_resume_point(server_case *c, char *msg, size_t msglen)
+{
+    char from[1200], to[1200];
+    snprintf(from, sizeof from, "%s/%s", c->dir, CASE_END_CHECKPOINT);
+    snprintf(to, sizeof to, "%s/%s", c->dir, CASE_RESUME_CHECKPOINT);
+    if (rename(from, to) != 0 && errno != ENOENT) {
+        snprintf(msg, msglen, "cannot keep %s: %s", CASE_END_CHECKPOINT, strerror(errno));
+        return -1;
+    }
+    persist_fsync_dir(c->dir);
+    return 0;
+}
+
+/* Rewrites the stored files for the new end; 0 or an HTTP status. */
+static int stages_store_extension(server_case *c, double end, case_state was, problems *p,
+                                  char *msg, size_t msglen)
+{
+    json_t *doc = stages_load_document(c, msg, msglen);
+    if (!doc)
+        return 500;
+    int status = stages_set_end(doc, end, p, msg, msglen);
+    size_t length = 0;
+    char *text = status == 0 ? json_dump_document(doc, &length) : NULL;
+    json_decref(doc);
+    if (status != 0)
+        return status;
+    char err[600] = "";
+    if (!text) {
+        snprintf(msg, msglen, "out of memory writing the case document");
+        status = 500;
+    } else if (persist_write_atomic(c->dir, "case.json", text, length) != 0) {
+        snprintf(msg, msglen, "cannot store case.json: %s", strerror(errno));
+        status = 500;
+    } else if (io_replace_document(c, text, length, err, sizeof err) != 0) {
+        case_record_io_failure(c, "result.h5", err);
+        snprintf(msg, msglen, "case.json has the new end, but result.h5 could not take it: %s", err);
+        status = 500;
+    } else if (was == CASE_FINISHED && stages_keep_resume_point(c, msg, msglen) != 0) {
+        status = 500;
+    }
+    free(text);
+    return status;
+}
+
+int registry_extend(server_case *c, const char *body, size_t size, problems *p, char *msg,
+                    size_t msglen)
+{
+    double end = 0;
+    int status = stages_read_end(body, size, &end, p);
+    if (status != 0)
+        return status;
+    pthread_mutex_lock(&c->ctl_lock);
+    case_state was;
+    double old_end = c->info.end_time;
+    status = stages_extendable(c, &was, msg, msglen);
+    if (status == 0)
+        status = stages_store_extension(c, end, was, p, msg, msglen);
+    if (status == 0) {
+        pthread_mutex_lock(&c->lock);
+        c->info.end_time = end;
+        c->state = CASE_PAUSED;
+        c->finished_at[0] = '\0';
+        pthread_mutex_unlock(&c->lock);
+        case_persist_status(c);
+        case_log(c, "extended from end = %.6g s to %.6g s (was %s); now paused, start it to go on",
+                 old_end, end, case_state_name(was));
+    }
+    pthread_mutex_unlock(&c->ctl_lock);
+    return status;
+}
+
+/* ----------------------------------------------------------------- clone */
+
+char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
+                              problems *p, int *status, char *err, size_t errlen)
+{
+    json_t *patch = stages_parse(body, size, JSON_DECODE_ANY, p);
+    if (!patch) {
+        *status = 400;
+        return NULL;
+    }
+    *status = 500;
+    json_t *doc = NULL;
+    if (atomic_load(&c->deleted))
+        *status = 404;
+    else
+        doc = stages_load_document(c, err, errlen);
+    json_t *patched = doc ? json_merge_patch(doc, patch) : NULL;
+    char *text = patched ? json_dump_document(patched, length) : NULL;
+    if (doc && !text)
+        snprintf(err, errlen, "out of memory patching the case document");
+    json_decref(patched);
+    json_decref(doc);
+    json_decref(patch);
+    return text;
+}

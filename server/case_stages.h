@@ -1,0 +1,32 @@
+/*
+ * case_stages.h - a case in stages (contract 5.3 "Continue and clone"):
+ * POST /cases/ID/extend runs a finished or paused case on to a later end
+ * in the same files; POST /cases/ID/clone makes a new case from a stored
+ * one and a JSON Merge Patch.
+ *
+ * Contract:
+ *  - registry_extend(): body {"end": t}. 0 when the case is now paused with
+ *    end t: case.json says time.end = t (and output.interval, when it was
+ *    left to its default, is pinned to the interval the case ran with, so
+ *    the snapshots go on at their pace), result.h5's root attribute `case`
+ *    is the same document, status.json has end_time t. Else 400/422 with
+ *    `p` (pointers into the body), 404, 409 (state, or t not beyond the
+ *    current end) or 500 with a sentence in msg.
+ *  - registry_clone_document(): the stored case.json of `c` with the patch
+ *    merged in (RFC 7396), as text to give to registry_create() (which then
+ *    validates it, with pointers into this patched document). NULL with
+ *    *status 400 (patch not JSON, in `p`), 404 or 500 (err).
+ */
+#ifndef FDEMD_CASE_STAGES_H
+#define FDEMD_CASE_STAGES_H
+
+#include <stddef.h>
+
+#include "registry.h"
+
+int registry_extend(server_case *c, const char *body, size_t size, problems *p, char *msg,
+                    size_t msglen);
+char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
+                              problems *p, int *status, char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,190 @@
+"""result.xdmf in every XDMF reader of ParaView 5.11 (the legacy "XDMF
+Reader" and Xdmf3ReaderS, Xdmf3ReaderT), 2D and 3D: no error or warning
+from VTK or HDF5, the time steps of /snapshots/time, and at the first and
+last step the same numbers as result.h5: node positions, velocity (3
+components), stress and strain as 3x3 tensors, principal stresses, joint
+damage, and the energy and constraint-force series as field data.
+
+Runs paraview_load.py under pvpython; skipped (saying so) where pvpython
+is not installed, as in CI."""
+import json
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+import h5py
+import numpy as np
+
+from fdemd_harness import Daemon, tiny_case
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PVPYTHON = shutil.which("pvpython")
+READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")
+VTK_TRIANGLE, VTK_TETRA = 5, 10
+FIELDS = ["position", "velocity", "stress", "strain", "principal_stress"]
+FRACTURE = {"tensile_strength": 1e6, "cohesion": 2e6, "friction_angle": 30,
+            "energy_I": 10, "energy_II": 50}
+# Row-major 3x3 tensor from the Voigt columns of /snapshots/stress
+TENSOR = {2: [0, 2, None, 2, 1, None, None, None, None], 3: [0, 5, 4, 5, 1, 3, 4, 3, 2]}
+
+
+def case_2d():
+    """A fracturing block hitting a fixed base: joints, damage, a reaction."""
+    case = tiny_case("pv-2d", end=0.002, divisions=(4, 4))
+    case["materials"]["rock"]["fracture"] = FRACTURE
+    case["parts"][0]["fracture"] = True
+    case["output"]["fields"] = FIELDS
+    return case
+
+
+def case_3d():
+    return {"name": "pv-3d", "dimension": 3,
+            "materials": {"rock": {"density": 2700, "young": 3e10, "poisson": 0.25,
+                                   "fracture": FRACTURE}},
+            "parts": [{"name": "body", "material": "rock", "fracture": True,
+                       "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1],
+                               "divisions": [2, 2, 2]}}],
+            "constraints": [{"box": [-1, -1, -0.001, 1, 1, 0.001], "fix": ["x", "y", "z"]}],
+            "gravity": [0, 0, -9.81], "time": {"end": 0.001},
+            "output": {"interval": 0.0002, "fields": FIELDS}}
+
+
+def tensor(voigt, dim):
+    return np.array([voigt[:, k] if k is not None else np.zeros(len(voigt))
+                     for k in TENSOR[dim]]).T
+
+
+def pad3(rows):
+    out = np.zeros((len(rows), 3))
+    out[:, :rows.shape[1]] = rows
+    return out
+
+
+@unittest.skipUnless(PVPYTHON, "pvpython is not installed (Debian: python3-paraview)")
+class ParaViewTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.mkdtemp(prefix="fdemd-pv-")
+        cls.d = Daemon().start()
+        cls.results = {}
+        for dim, case in ((2, case_2d()), (3, case_3d())):
+            st = cls.d.create(case, start=True)
+            st = cls.d.wait_state(st["id"], ("finished", "failed"), timeout=120)
+            assert st["state"] == "finished", st
+            folder = os.path.join(cls.tmp, str(dim))
+            os.makedirs(folder)
+            for name in ("result.h5", "result.xdmf"):
+                status, _, data = cls.d.request("GET", "/cases/%s/%s" % (st["id"], name))
+                assert status == 200, (name, status)
+                with open(os.path.join(folder, name), "wb") as f:
+                    f.write(data)
+            cls.results[dim] = folder
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.d.stop()
+        cls.d.close()
+        shutil.rmtree(cls.tmp, ignore_errors=True)
+
+    def load(self, reader, xdmf):
+        out = subprocess.run([PVPYTHON, os.path.join(HERE, "paraview_load.py"), reader, xdmf],
+                             capture_output=True, text=True, timeout=300)
+        self.assertEqual(out.returncode, 0, out.stderr[-3000:])
+        # loguru (VTK's errors and warnings) and HDF5-DIAG write to stderr
+        self.assertEqual(out.stderr.strip(), "", "%s printed:\n%s" % (reader, out.stderr[-3000:]))
+        got = json.loads(out.stdout.strip().splitlines()[-1])
+        self.assertEqual(got["messages"].strip(), "", reader)
+        return got
+
+    def check_grid(self, reader, f, block, s, dim):
+        where = "%s, snapshot %d" % (reader, s)
+        self.assertEqual(block["cell_type"], VTK_TETRA if dim == 3 else VTK_TRIANGLE, where)
+        self.assertEqual(block["cells"], f["/mesh/" + ("tetrahedra" if dim == 3 else
+                                                       "triangles")].shape[0], where)
+        points = np.array(block["points"])
+        np.testing.assert_array_equal(points, pad3(f["/snapshots/position"][s]), where)
+        cells, nodes = block["cell_data"], block["point_data"]
+        np.testing.assert_array_equal(np.array(nodes["velocity"]),
+                                      pad3(f["/snapshots/velocity"][s]), where)
+        for name in ("stress", "strain"):
+            self.assertEqual(len(cells[name][0]), 9, (where, name))
+            np.testing.assert_array_equal(np.array(cells[name]),
+                                          tensor(f["/snapshots/" + name][s], dim), where)
+        np.testing.assert_array_equal(np.array(cells["principal_stress"]),
+                                      f["/snapshots/principal_stress"][s], where)
+        np.testing.assert_array_equal(np.array(cells["fragment"])[:, 0],
+                                      f["/snapshots/fragment"][s], where)
+        # the series, one tuple per snapshot
+        series = block["field_data"]
+        for name in ("time", "kinetic_energy", "elastic_energy", "fracture_energy",
+                     "gravity_work"):
+            np.testing.assert_array_equal(np.array(series[name])[:, 0],
+                                          f["/snapshots/" + name][...], (where, name))
+        force = f["/snapshots/constraint_force"][...]
+        np.testing.assert_array_equal(np.array(series["constraint_force"]),
+                                      force.reshape(len(force), -1), where)
+
+    def check_joints(self, reader, f, block, s, dim):
+        where = "%s, joints, snapshot %d" % (reader, s)
+        self.assertEqual(block["cells"], f["/mesh/joints"].shape[0], where)
+        self.assertEqual(block["cell_type"], VTK_TRIANGLE if dim == 3 else 4, where)  # polyline
+        np.testing.assert_array_equal(np.array(block["cell_data"]["damage"])[:, 0],
+                                      f["/snapshots/damage"][s], where)
+
+    def check_reader(self, reader, dim):
+        folder = self.results[dim]
+        got = self.load(reader, os.path.join(folder, "result.xdmf"))
+        with h5py.File(os.path.join(folder, "result.h5"), "r") as f:
+            np.testing.assert_allclose(got["times"], f["/snapshots/time"][...], rtol=1e-15)
+            self.assertGreater(f["/mesh/joints"].shape[0], 0)
+            for step in got["steps"]:
+                s = step["index"]
+                grids, joints = step["blocks"]
+                self.check_grid(reader, f, grids, s, dim)
+                self.check_joints(reader, f, joints, s, dim)
+            # the case hit something: the last step is not the first
+            self.assertGreater(np.abs(f["/snapshots/stress"][-1]).max(), 0)
+
+    def test_running_case_in_the_legacy_reader(self):
+        """A copy fetched while the case runs has no views yet: its sidecar
+        uses HyperSlabs, which the legacy reader opens without a message
+        (docs/results.md says the Xdmf3 readers need a closed file)."""
+        case = tiny_case("pv-running", end=100.0, divisions=(3, 3), interval=1e-4)
+        st = self.d.create(case, start=True)
+        try:
+            self.d.wait(st["id"], lambda s: s["snapshots"] >= 4, what="4 snapshots")
+            folder = os.path.join(self.tmp, "running")
+            os.makedirs(folder)
+            for name in ("result.h5", "result.xdmf"):
+                status, _, data = self.d.request("GET", "/cases/%s/%s" % (st["id"], name))
+                self.assertEqual(status, 200)
+                with open(os.path.join(folder, name), "wb") as f:
+                    f.write(data)
+        finally:
+            self.d.json("POST", "/cases/%s/stop" % st["id"])
+        with open(os.path.join(folder, "result.xdmf")) as f:
+            self.assertIn('ItemType="HyperSlab"', f.read())
+        got = self.load("XDMFReader", os.path.join(folder, "result.xdmf"))
+        with h5py.File(os.path.join(folder, "result.h5"), "r") as f:
+            times = f["/snapshots/time"][...]
+            np.testing.assert_allclose(got["times"], times[:len(got["times"])], rtol=1e-15)
+            block = got["steps"][-1]["blocks"][0]
+            s = got["steps"][-1]["index"]
+            np.testing.assert_array_equal(np.array(block["points"]),
+                                          pad3(f["/snapshots/position"][s]))
+            np.testing.assert_array_equal(np.array(block["cell_data"]["stress_xy"])[:, 0],
+                                          f["/snapshots/stress"][s, :, 2])
+
+    def test_2d_in_every_reader(self):
+        for reader in READERS:  # (no subTest: run.py reports whole tests)
+            self.check_reader(reader, 2)
+
+    def test_3d_in_every_reader(self):
+        for reader in READERS:
+            self.check_reader(reader, 3)
+
+
+if __name__ == "__main__":
+    unittest.main()
