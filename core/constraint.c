@@ -1,8 +1,9 @@
 /*
- * constraint.c - boundary conditions: node selection by part or box, fixed
- * and prescribed-velocity components, forces shared over a node set, their
- * amplitudes in time, and the total reaction of each constraint after every
- * step (pressures and dashpots on boundary facets: boundary_load.c).
+ * constraint.c - boundary conditions: node selection by part, box or mesh
+ * vertices (a named group), fixed and prescribed-velocity components, forces
+ * shared over a node set, their amplitudes in time, and the total reaction
+ * of each constraint after every step (pressures and dashpots on boundary
+ * facets: boundary_load.c).
  *
  * A degree of freedom belongs to the last constraint (in case order) that
  * prescribes it, so overlapping selections are well defined and each
@@ -20,10 +21,40 @@
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+static int vertex_compare(const void *pa, const void *pb)
+{
+    int32_t a = *(const int32_t *)pa, b = *(const int32_t *)pb;
+    return (a > b) - (a < b);
+}
+
+/* A vertex selection's list is the caller's: keep a sorted copy, so
+ * selecting a node is a binary search. */
+int constraint_keep_vertices(constraint *c)
+{
+    if (c->def.select != FDEM_SELECT_VERTICES) {
+        c->def.vertices = NULL;
+        c->def.vertex_count = 0;
+        return 0;
+    }
+    size_t n = (size_t)c->def.vertex_count;
+    c->vertices = malloc(sizeof(int32_t) * n);
+    if (!c->vertices) return -1;
+    memcpy(c->vertices, c->def.vertices, sizeof(int32_t) * n);
+    qsort(c->vertices, n, sizeof(int32_t), vertex_compare);
+    c->def.vertices = c->vertices;
+    return 0;
+}
+
 /* Box bounds: box[d] lower, box[D + d] upper, for D = m->dim. */
 int constraint_selects(const fdem_model *m, const constraint *c, int node)
 {
     if (c->def.select == FDEM_SELECT_PART) return m->node_part[node] == c->def.part;
+    if (c->def.select == FDEM_SELECT_VERTICES) {
+        if (m->node_part[node] != c->def.part) return 0;
+        int32_t vertex = m->node_origin[node] - m->parts[c->def.part].node_begin;
+        return bsearch(&vertex, c->vertices, (size_t)c->def.vertex_count, sizeof(int32_t),
+                       vertex_compare) != NULL;
+    }
     const double *b = c->def.box, *x = m->pos0 + (size_t)m->dim * (size_t)node;
     int inside = 1;
     for (int d = 0; d < m->dim; d++) inside &= x[d] >= b[d] && x[d] <= b[m->dim + d];
@@ -71,7 +102,7 @@ int constraint_select(fdem_model *m, fdem_error *err)
     int total = 0;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
-        if (c->def.select == FDEM_SELECT_PART && (c->def.part < 0 || c->def.part >= m->part_count)) {
+        if (c->def.select != FDEM_SELECT_BOX && (c->def.part < 0 || c->def.part >= m->part_count)) {
             model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d selects part %d, which does not exist",
                         k, c->def.part);
             return -1;

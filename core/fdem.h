@@ -56,9 +56,19 @@ typedef struct fdem_error {
 
 /* ---------------------------------------------------------------- materials */
 
+/* Heterogeneity (contract 5.3): each joint's tensile strength and cohesion
+ * are the set's values times one factor drawn per joint from a Weibull law
+ * of mean 1 and this modulus (scale 1/Gamma(1 + 1/modulus)), from a
+ * counter-based generator keyed by seed and joint index, so a run does not
+ * depend on the thread count. modulus 0: no variation. */
+typedef struct fdem_variation {
+    double weibull_modulus;
+    uint64_t seed;
+} fdem_variation;
+
 typedef struct fdem_fracture_params {
-    double tensile_strength; /* Pa */
-    double cohesion;         /* Pa */
+    double tensile_strength; /* Pa (the mean when varied) */
+    double cohesion;         /* Pa (the mean when varied) */
     double friction_angle;   /* degrees */
     double energy_I;         /* J/m^2 */
     double energy_II;        /* J/m^2 */
@@ -73,6 +83,7 @@ typedef struct fdem_material_def {
     double friction;/* Coulomb coefficient */
     int has_fracture;
     fdem_fracture_params fracture;
+    fdem_variation variation; /* of fracture's strengths; zero: none */
 } fdem_material_def;
 
 /* ------------------------------------------------------------------- meshes */
@@ -136,6 +147,24 @@ int fdem_add_part(fdem_model *model, const fdem_mesh *mesh, int material,
 int fdem_add_part_3d(fdem_model *model, const fdem_tet_mesh *mesh, int material,
                      int fracture, fdem_error *err);
 
+/* Bonded materials (contract 5.3): material[t] becomes the material of
+ * element t of the part (in the order of the mesh given to fdem_add_part*);
+ * the part stays one body. Before finalize. In a fracturing part every
+ * material needs fracture parameters; a joint takes those of its first
+ * element's material (unless a joint set says otherwise). */
+int fdem_set_element_materials(fdem_model *model, int part, const int32_t *material,
+                               fdem_error *err);
+
+/* Pre-existing discontinuities (contract 5.3): the joints of fracturing
+ * part `part` that lie on one of `face_count` faces (vertex pairs in 2D,
+ * triples in 3D, indices of the part's mesh as given, any order) take
+ * `params` (varied by `variation`, NULL: none) instead of their
+ * material's. Before finalize; a later set wins where two overlap.
+ * Finalize fails when a set lies on no joint. */
+int fdem_add_joint_set(fdem_model *model, int part, const fdem_fracture_params *params,
+                       const fdem_variation *variation, const int32_t *faces, int face_count,
+                       fdem_error *err);
+
 /* Initial velocity of every node of a part: `dimension` components in v
  * (the 2D form leaves vz out). */
 int fdem_set_part_velocity(fdem_model *model, int part, double vx, double vy,
@@ -162,11 +191,18 @@ void fdem_set_gravity_v(fdem_model *model, const double *g);
 int fdem_set_gravity_amplitude(fdem_model *model, const double *pairs, int count,
                                fdem_error *err);
 
-/* Node selection for a constraint: all nodes of a part, or every node whose
+/* Node selection for a constraint: all nodes of a part, every node whose
  * initial position lies in the box (inclusive): box[d] is the lower and
  * box[dimension + d] the upper bound of axis d, so [xmin, ymin, xmax, ymax]
- * in 2D and [xmin, ymin, zmin, xmax, ymax, zmax] in 3D. */
-typedef enum fdem_select_kind { FDEM_SELECT_PART, FDEM_SELECT_BOX } fdem_select_kind;
+ * in 2D and [xmin, ymin, zmin, xmax, ymax, zmax] in 3D; or the nodes of
+ * `part` that stand for the listed vertices of its mesh (0-based, as given
+ * to fdem_add_part*; every copy of a vertex in a fracturing part), e.g. a
+ * named group of a gmsh file. */
+typedef enum fdem_select_kind {
+    FDEM_SELECT_PART,
+    FDEM_SELECT_BOX,
+    FDEM_SELECT_VERTICES,
+} fdem_select_kind;
 
 typedef enum fdem_constraint_kind {
     FDEM_CONSTRAINT_FIX,      /* fix_x / fix_y / fix_z */
@@ -179,8 +215,10 @@ typedef enum fdem_constraint_kind {
 
 typedef struct fdem_constraint_def {
     fdem_select_kind select;
-    int part;           /* FDEM_SELECT_PART */
+    int part;           /* FDEM_SELECT_PART, FDEM_SELECT_VERTICES */
     double box[6];      /* FDEM_SELECT_BOX: lower bounds, then upper bounds */
+    const int32_t *vertices; /* FDEM_SELECT_VERTICES: copied by fdem_add_constraint */
+    int vertex_count;
     fdem_constraint_kind kind;
     int fix_x, fix_y, fix_z;    /* FIX */
     double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness) */

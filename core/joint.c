@@ -144,19 +144,18 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
 /* Per-joint data derived at finalize: stiffness length, element map. */
 int joint_prepare(fdem_model *m, fdem_error *err)
 {
-    if (!m->joint_count) return 0;
+    if (!m->joint_count) return m->joint_set_count ? joint_strengths_assign(m, err) : 0;
     size_t J = (size_t)m->joint_count;
     m->joint_damage = calloc(J, sizeof(double));
     m->joint_fracture = calloc(J, sizeof(double));
     m->joint_broke = calloc(J, 1);
     m->joint_h = malloc(sizeof(double) * J);
     m->joint_k = malloc(sizeof(double) * J);
-    m->joint_material = malloc(sizeof(int32_t) * J);
     int faces = m->dim + 1; /* an element's faces, so at most its joints */
     m->elem_joint = malloc(sizeof(int32_t) * (size_t)faces * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
     if (!m->joint_damage || !m->joint_fracture || !m->joint_broke || !m->joint_h ||
-        !m->elem_joint || !m->vertex_broken || !m->joint_k || !m->joint_material) {
+        !m->elem_joint || !m->vertex_broken || !m->joint_k) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
     }
@@ -164,8 +163,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     for (int j = 0; j < m->joint_count; j++) {
         int ea = m->joint_elem[2 * j], eb = m->joint_elem[2 * j + 1];
         m->joint_h[j] = fmin(m->elem_h[ea], m->elem_h[eb]);
-        int mat = m->parts[m->elem_part[ea]].material;
-        m->joint_material[j] = mat;
+        int mat = element_material(m, ea);
         m->joint_k[j] = m->materials[mat].penalty / m->joint_h[j];
         for (int s = 0; s < 2; s++) {
             int e = m->joint_elem[2 * j + s];
@@ -176,7 +174,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
                 }
         }
     }
-    return 0;
+    return joint_strengths_assign(m, err);
 }
 
 /* Joint springs in series with the element: each face node feels about
@@ -372,14 +370,14 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
     const double *x = m->pos, *v = m->vel;
     const double h_last = m->dt_prev; /* x = x_before + h_last v: the last step */
     double *f = m->force;
-    const material *mats = m->materials;
+    const joint_strength *strengths = m->joint_strengths;
     int broke = 0;
     double stored = 0, dissipated = 0, handed = 0, friction = 0;
     for (int j = begin; j < end; j++) {
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 4 * j;
-        const joint_law law = joint_law_of(&mats[m->joint_material[j]], m->joint_k[j]);
+        const joint_law law = joint_law_of(&strengths[m->joint_strength_of[j]], m->joint_k[j]);
         const double k = law.k;
         const double *a0 = x + 2 * (size_t)n[0], *a1 = x + 2 * (size_t)n[1];
         const double *b0 = x + 2 * (size_t)n[2], *b1 = x + 2 * (size_t)n[3];

@@ -143,7 +143,7 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 6 * (size_t)j;
-        const joint_law law = joint_law_of(&m->materials[m->joint_material[j]], m->joint_k[j]);
+        const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
         double fa[9];
         /* this joint's own, for its fracture account and its event */
         joint_energy e = {0};

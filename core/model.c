@@ -63,12 +63,16 @@ void fdem_model_destroy(fdem_model *m)
     free(m->pos0); free(m->mass); free(m->node_part); free(m->node_origin); free(m->dof_owned);
     free(m->elem); free(m->tet); free(m->elem_part); free(m->elem_node); free(m->elem_h);
     free(m->materials); free(m->parts); free(m->part_velocity);
-    for (int k = 0; k < m->constraint_count; k++) free(m->constraints[k].amplitude);
+    for (int k = 0; k < m->constraint_count; k++) {
+        free(m->constraints[k].amplitude);
+        free(m->constraints[k].vertices);
+    }
     free(m->gravity_amplitude);
     boundary_load_free(m);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
-    free(m->joint_k); free(m->joint_material);
+    free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
+    joint_sets_free(m);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
@@ -344,6 +348,39 @@ int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_inde
     return failed ? -1 : k;
 }
 
+int fdem_set_element_materials(fdem_model *m, int part_index, const int32_t *material_of,
+                               fdem_error *err)
+{
+    if (m->finalized || part_index < 0 || part_index >= m->part_count) {
+        model_error(err, FDEM_ITEM_PART, part_index,
+                    m->finalized ? "the model is already finalized" : "part %d does not exist",
+                    part_index);
+        return -1;
+    }
+    const part *p = &m->parts[part_index];
+    for (int t = 0; t < p->elem_count; t++) {
+        int mat = material_of[t];
+        if (mat < 0 || mat >= m->material_count) {
+            model_error(err, FDEM_ITEM_PART, part_index,
+                        "element %d of part %d refers to material %d, which does not exist", t,
+                        part_index, mat);
+            return -1;
+        }
+        if (p->fracture && !m->materials[mat].def.has_fracture) {
+            model_error(err, FDEM_ITEM_MATERIAL, mat,
+                        "part %d fractures, so material %d of its element %d needs fracture "
+                        "parameters", part_index, mat, t);
+            return -1;
+        }
+    }
+    for (int t = 0; t < p->elem_count; t++) {
+        int e = p->elem_begin + t;
+        if (m->dim == 3) m->tet[e].material = material_of[t];
+        else m->elem[e].material = material_of[t];
+    }
+    return 0;
+}
+
 int fdem_set_part_velocity_v(fdem_model *m, int part_index, const double *v, fdem_error *err)
 {
     if (part_index < 0 || part_index >= m->part_count) {
@@ -443,6 +480,10 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
                     D == 3 ? "constraint %d fixes none of x, y, z" : "constraint %d fixes neither x nor y", k);
         return -1;
     }
+    if (def->select == FDEM_SELECT_VERTICES && (def->vertex_count < 1 || !def->vertices)) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d selects an empty list of vertices", k);
+        return -1;
+    }
     int has_amplitude = def->amplitude != NULL || def->amplitude_count != 0;
     if (has_amplitude && (def->kind == FDEM_CONSTRAINT_FIX || def->kind == FDEM_CONSTRAINT_ABSORB)) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k,
@@ -468,6 +509,11 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     m->constraints[k].def.amplitude_count = amplitude ? def->amplitude_count : 0;
     if (def->kind == FDEM_CONSTRAINT_PRESSURE || def->kind == FDEM_CONSTRAINT_ABSORB)
         m->constraints[k].def.value[1] = m->constraints[k].def.value[2] = 0;
+    if (constraint_keep_vertices(&m->constraints[k])) {
+        free(amplitude);
+        model_error(err, FDEM_ITEM_CONSTRAINT, k, "out of memory");
+        return -1;
+    }
     if (D == 2) { /* what a 2D caller left in the third component means nothing */
         constraint *c = &m->constraints[k];
         c->def.fix_z = 0;
@@ -681,6 +727,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 3 * sizeof(double) + 1);
     b += (size_t)m->event_capacity * sizeof(fdem_event);
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
+    b += (size_t)m->joint_strength_count * sizeof(joint_strength);
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);
     /* boundary facets of pressures and dashpots: nodes, element, forces */
     b += (size_t)m->bfacet_count * ((D + 1) * sizeof(int32_t) + D * D * sizeof(double));

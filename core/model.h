@@ -45,6 +45,25 @@ typedef struct tet_hot {
     double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
 } tet_hot;
 
+/* The cohesive constants a joint reads in the hot loop (joint_strength.c):
+ * one per material, one per joint set, one per joint whose strengths were
+ * drawn (Weibull variation). A joint holds an index into this table, so
+ * heterogeneity costs the joint loop nothing. */
+typedef struct joint_strength {
+    double tensile_strength, cohesion, tan_phi, energy_I, energy_II;
+} joint_strength;
+
+/* A pre-existing discontinuity of a fracturing part: the faces (mesh
+ * vertices of the part, dim per face, each sorted, the list sorted) whose
+ * joints take params. */
+typedef struct joint_set {
+    int part;
+    fdem_fracture_params params;
+    fdem_variation variation;
+    int32_t *faces;
+    int face_count;
+} joint_set;
+
 typedef struct part {
     int material;
     int fracture;
@@ -65,6 +84,7 @@ typedef struct initial_stress_def {
 typedef struct constraint {
     fdem_constraint_def def;
     int entry_begin, entry_count;
+    int32_t *vertices;   /* FDEM_SELECT_VERTICES: the owned, sorted copy def.vertices points to */
     double force[3];     /* reaction (fix, velocity), applied (force, pressure) or dashpot
                             (absorb) force of the last step */
     double value_now[3]; /* def.value times the amplitude at the instant this step uses
@@ -183,7 +203,11 @@ struct fdem_model {
     int32_t *joint_elem;     /* 2 per joint: elements A and B */
     double *joint_h;         /* smaller size of the two elements: sets the stiffness */
     double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
-    int32_t *joint_material; /* element A's material */
+    int32_t *joint_strength_of; /* index into joint_strengths */
+    joint_strength *joint_strengths;
+    int joint_strength_count;
+    joint_set *joint_sets;   /* fdem_add_joint_set, resolved at finalize */
+    int joint_set_count;
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
@@ -341,12 +365,11 @@ void constraint_apply_forces(fdem_model *m);
 void constraint_enforce(fdem_model *m, double h, double havg);
 
 /* joint.c (the cohesive law itself, joint_softening included: joint_law.h) */
-/* The cohesive constants of joint material mat at stiffness k. */
-static inline joint_law joint_law_of(const material *mat, double k)
+/* The cohesive constants of a joint of strength s at stiffness k. */
+static inline joint_law joint_law_of(const joint_strength *s, double k)
 {
-    const fdem_fracture_params *fp = &mat->def.fracture;
-    return (joint_law){k, fp->tensile_strength, fp->cohesion, mat->tan_phi, fp->energy_I,
-                       fp->energy_II};
+    return (joint_law){k, s->tensile_strength, s->cohesion, s->tan_phi, s->energy_I,
+                       s->energy_II};
 }
 /* The central-difference limit of a joint node of mass `mass` held by
  * stiffness k (all its joints, both faces), with a 0.9 margin. */
@@ -373,6 +396,12 @@ int events_collect(fdem_model *m, int broke);
 size_t events_checkpoint_size(const fdem_model *m);
 void events_checkpoint_write(const fdem_model *m, unsigned char *p);
 int events_checkpoint_read(fdem_model *m, const unsigned char *p, int64_t count);
+/* joint_strength.c: every joint's strength (material, joint set, variation) */
+int joint_strengths_assign(fdem_model *m, fdem_error *err);
+void joint_sets_free(fdem_model *m);
+double weibull_factor(uint64_t seed, uint64_t index, double modulus);
+/* constraint.c: the owned copy of a vertex selection */
+int constraint_keep_vertices(constraint *c);
 /* joint_tet_model.c: the 3D geometry of joints (6 nodes, a face each) */
 int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
                         fdem_error *err);

@@ -299,6 +299,27 @@ dump("wave-absorb", {
     "time": {"end": float("%.4g" % (tau + 1.5 * 10 / c_p)), "dt": "auto", "safety": 0.5},
     "output": {"interval": 1e-4, "fields": ["position", "velocity", "stress"]}})
 
+
+# ---------------------------------------------------------- joint sets
+# Contract 5.3: a joint set on a gmsh physical curve group of a fracturing
+# part, weaker than the rock around it.
+dump("jointed-block", {
+    "name": "jointed-block",
+    "materials": {"rock": {"density": 2500, "young": 1e10, "poisson": 0.2, "damping": 0.1,
+                           "fracture": {"tensile_strength": 5e6, "cohesion": 1.5e7,
+                                        "friction_angle": 30, "energy_I": 20,
+                                        "energy_II": 100}}},
+    "parts": [{"name": "block", "material": "rock", "fracture": True,
+               "gmsh": gmsh_text(os.path.join(OUT, "jointed-block.geo")),
+               "discontinuities": {"joints": {"tensile_strength": 1e6, "cohesion": 3e6,
+                                              "energy_I": 5, "energy_II": 25}}}],
+    "constraints": [{"part": "block", "group": "base", "fix": ["y"]},
+                    {"part": "block", "group": "corner", "fix": ["x"]},
+                    {"part": "block", "group": "top", "velocity": [None, 0.01]}],
+    "time": {"end": 0.0024, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 2e-5, "fields": ["position", "velocity", "stress", "damage"]}})
+
+
 # In-situ stress (contract 5.3). A pressurised borehole: the plate of
 # borehole.geo starts under the in-situ stress sxx = -10, syy = -20 MPa
 # (compression negative), its edges carry the matching pressures and let

@@ -293,7 +293,9 @@ void case_doc_free(case_doc *doc)
     for (int i = 0; i < doc->part_count; i++) {
         fdem_mesh_free(&doc->parts[i].mesh);
         fdem_tet_mesh_free(&doc->parts[i].tet_mesh);
+        case_part_groups_free(&doc->parts[i]);
     }
+    for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].vertices);
     free(doc->parts);
     free(doc->materials);
     for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].amplitude);

@@ -1,8 +1,9 @@
 /*
  * case_constraints.c - the "constraints" array of a case: each entry selects
- * nodes (a part by name, or a box of initial positions) and does one thing
- * to them (fix components, prescribe a velocity, apply a force, press on or
- * absorb waves through the boundary they span), a velocity, force or
+ * nodes (a part by name, a named group of a gmsh part, or a box of initial
+ * positions) and does one thing to them (fix components, prescribe a
+ * velocity, apply a force, press on or absorb waves through the boundary
+ * they span), a velocity, force or
  * pressure optionally scaled by an "amplitude" table in time.
  *
  * Parts are read first, so a part selector is resolved to its index here and
@@ -17,8 +18,9 @@
 
 #include "case_internal.h"
 
-static const char *const constraint_keys[] = {"part",     "box",    "fix",       "velocity",
-                                              "force",    "pressure", "absorb", "amplitude",
+static const char *const constraint_keys[] = {"part",     "group",  "box",    "fix",
+                                              "velocity", "force",  "pressure", "absorb",
+                                              "amplitude",
                                               NULL};
 
 static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
@@ -41,6 +43,17 @@ static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const 
     if (names) case_did_you_mean(doc, hint, sizeof hint, wanted, names, doc->part_count);
     free(names);
     case_problem(doc, ptr, "unknown part \"%.64s\"%s", wanted, hint);
+}
+
+/* {"part": P, "group": G}: the nodes of physical group G of gmsh part P. */
+static void constraint_read_group(case_doc *doc, case_constraint *c, const json_t *group,
+                                  const char *ptr)
+{
+    int count = 0;
+    if (case_group_vertices(doc, c->def.part, group, ptr, &c->vertices, &count) < 0) return;
+    c->def.select = FDEM_SELECT_VERTICES;
+    c->def.vertices = c->vertices;
+    c->def.vertex_count = count;
 }
 
 /* "[xmin, ymin, xmax, ymax]" or the 3D six. */
@@ -204,6 +217,13 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         if (selector == 0) constraint_read_part(doc, &c->def, s, at);
         else constraint_read_box(doc, &c->def, s, at);
     }
+    json_t *group = case_member(value, ptr, "group", at);
+    json_t *part = json_object_get(value, "part");
+    if (group && selector != 0)
+        case_problem(doc, at, "\"group\" names a physical group of a part: give \"part\" too");
+    else if (group && json_is_string(part) &&
+             case_names_find(doc->part_names, json_string_value(part)) >= 0)
+        constraint_read_group(doc, c, group, at); /* an unknown part is reported at "part" */
     int action = constraint_pick(doc, value, ptr, actions, 5,
                                  "an action: \"fix\", \"velocity\", \"force\", \"pressure\" "
                                  "or \"absorb\"");

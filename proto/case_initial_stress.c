@@ -66,12 +66,12 @@ void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *bloc
     part->has_stress0 = ok;
 }
 
-int case_add_initial_stress(case_doc *doc, fdem_model *model, int i)
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index)
 {
     const case_part *part = &doc->parts[i];
     if (!part->has_stress0) return 0;
     fdem_error err = {0};
-    if (fdem_set_part_initial_stress(model, i, part->stress0_value, part->stress0_gradient,
+    if (fdem_set_part_initial_stress(model, index, part->stress0_value, part->stress0_gradient,
                                      part->stress0_reference, &err) == 0)
         return 0;
     char base[CASE_POINTER], ptr[CASE_POINTER];

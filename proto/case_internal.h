@@ -18,6 +18,7 @@
 
 #include "case.h"
 #include "fdem.h"
+#include "gmsh.h"
 #include "mesh_3d.h"
 #include "problems.h"
 
@@ -62,11 +63,24 @@ typedef struct case_part {
     int has_stress0;         /* "initial_stress" read without a problem */
     double stress0_value[6], stress0_gradient[6], stress0_reference; /* stress layout, Pa */
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
+    gmsh_groups groups;      /* GMSH: its named physical groups */
+    int32_t *element_material; /* "materials": the material of each element, else NULL */
+    struct case_joint_set *joint_sets; /* "discontinuities" */
+    int joint_set_count;
 } case_part;
+
+/* A "discontinuities" entry: the group (index into the part's groups) and
+ * its parameters, the part material's where the entry leaves them out. */
+typedef struct case_joint_set {
+    int group;
+    fdem_fracture_params params;
+    fdem_variation variation;
+} case_joint_set;
 
 typedef struct case_constraint {
     fdem_constraint_def def;
     double *amplitude;       /* def.amplitude points here (case_amplitude.c) */
+    int32_t *vertices;       /* {"part", "group"}: the group's nodes, owned */
 } case_constraint;
 
 typedef struct case_doc {
@@ -176,11 +190,29 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
-/* case_initial_stress.c: a part's "initial_stress" (pass 1), and handing it
- * to the engine once part i exists (pass 3; 0, or -1 after a problem). */
+/* case_initial_stress.c: a part's "initial_stress" (pass 1), and handing
+ * document part i's to the engine once it is model part `index` (pass 3; 0,
+ * or -1 after a problem). */
 void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
                               const char *ptr);
-int case_add_initial_stress(case_doc *doc, fdem_model *model, int i);
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index);
+/* case_materials.c: a fracture block and its variation (zero when it has
+ * none); required = 0 lets keys be absent (f keeps what it held) but wants
+ * at least one. */
+void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, const char *what,
+                        int required, fdem_fracture_params *f, fdem_variation *v);
+/* case_groups.c: a gmsh part's "materials" and "discontinuities" (after its
+ * shape, material and fracture flag), a {"part", "group"} selector's nodes
+ * (0 and a list the caller frees, or -1 after a problem at ptr), and the
+ * groups' materials and joint sets given to the engine (pass 3). */
+void case_read_part_groups(case_doc *doc, case_part *part, const json_t *value,
+                           const char *ptr);
+int case_group_vertices(case_doc *doc, int part, const json_t *group, const char *ptr,
+                        int32_t **vertices, int *count);
+/* The groups' materials and joint sets of document part i, which is model
+ * part `index` (i unless an earlier part was refused). */
+int case_add_part_groups(case_doc *doc, fdem_model *model, int i, int index);
+void case_part_groups_free(case_part *part);
 
 /* ----------------------------------------------------- pass 2 and pass 3 */
 /* Adds a problem when the model would pass memory_limit; returns the estimate. */

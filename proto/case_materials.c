@@ -19,8 +19,9 @@ static const char *const material_keys[] = {
     "density", "young", "poisson", "damping", "penalty", "friction", "fracture", NULL,
 };
 static const char *const fracture_keys[] = {
-    "tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", NULL,
+    "tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", "variation", NULL,
 };
+static const char *const variation_keys[] = {"distribution", "modulus", "seed", NULL};
 
 /* Adds a problem at base/key when `ok` is false. */
 static void material_require(case_doc *doc, int ok, const char *base, const char *key,
@@ -45,22 +46,67 @@ static void material_read_poisson(case_doc *doc, const json_t *object, const cha
         case_problem(doc, ptr, "poisson must be in (-1, 0.5), got %g", *poisson);
 }
 
-static void material_read_fracture(case_doc *doc, const json_t *value, const char *ptr,
-                                   const char *what, fdem_fracture_params *f)
+/* "variation": {"distribution": "weibull", "modulus": m > 0, "seed": n}
+ * (seed an integer in [0, 2^53], exact in JSON; 0 when absent). */
+static void read_variation(case_doc *doc, const json_t *value, const char *ptr,
+                           fdem_variation *v)
+{
+    if (!case_expect_object(doc, value, ptr)) return;
+    case_check_keys(doc, value, ptr, variation_keys, "\"variation\"");
+    char at[CASE_POINTER];
+    json_t *distribution = case_member(value, ptr, "distribution", at);
+    if (!distribution)
+        case_problem(doc, ptr, "missing required \"distribution\": \"weibull\"");
+    else if (!json_is_string(distribution) ||
+             strcmp(json_string_value(distribution), "weibull") != 0)
+        case_problem(doc, at, "the only distribution is \"weibull\", got %s%.32s%s",
+                     json_is_string(distribution) ? "\"" : case_type_word(distribution),
+                     json_is_string(distribution) ? json_string_value(distribution) : "",
+                     json_is_string(distribution) ? "\"" : "");
+    double modulus = 0;
+    if (case_number_member(doc, value, ptr, "modulus", 1, &modulus)) {
+        if (!(modulus >= 0.5 && modulus <= 1000))
+            material_require(doc, 0, ptr, "modulus", "must be in [0.5, 1000] (the Weibull "
+                             "modulus: larger is less scatter)", modulus);
+        else
+            v->weibull_modulus = modulus;
+    }
+    json_t *seed = case_member(value, ptr, "seed", at);
+    long n = 0;
+    if (seed && case_read_integer(doc, seed, at, 0, 9007199254740992L, &n))
+        v->seed = (uint64_t)n;
+}
+
+void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, const char *what,
+                        int required, fdem_fracture_params *f, fdem_variation *v)
 {
     if (!case_expect_object(doc, value, ptr)) return;
     case_check_keys(doc, value, ptr, fracture_keys, what);
-    if (case_number_member(doc, value, ptr, "tensile_strength", 1, &f->tensile_strength))
+    char at[CASE_POINTER];
+    json_t *variation = case_member(value, ptr, "variation", at);
+    *v = (fdem_variation){0, 0};
+    if (variation) read_variation(doc, variation, at, v);
+    if (!required) { /* a joint set: what it leaves out is its material's */
+        static const char *const keys[] = {"tensile_strength", "cohesion", "friction_angle",
+                                           "energy_I", "energy_II"};
+        int given = 0;
+        for (int k = 0; k < 5; k++) given += json_object_get(value, keys[k]) != NULL;
+        if (!given && !variation)
+            case_problem(doc, ptr, "a joint set needs at least one fracture parameter "
+                                   "(tensile_strength, cohesion, friction_angle, energy_I, "
+                                   "energy_II or variation)");
+    }
+    if (case_number_member(doc, value, ptr, "tensile_strength", required, &f->tensile_strength))
         material_require(doc, f->tensile_strength > 0, ptr, "tensile_strength", "must be > 0",
                          f->tensile_strength);
-    if (case_number_member(doc, value, ptr, "cohesion", 1, &f->cohesion))
+    if (case_number_member(doc, value, ptr, "cohesion", required, &f->cohesion))
         material_require(doc, f->cohesion > 0, ptr, "cohesion", "must be > 0", f->cohesion);
-    if (case_number_member(doc, value, ptr, "friction_angle", 1, &f->friction_angle))
+    if (case_number_member(doc, value, ptr, "friction_angle", required, &f->friction_angle))
         material_require(doc, f->friction_angle >= 0 && f->friction_angle < 90, ptr,
                          "friction_angle", "must be in [0, 90) degrees", f->friction_angle);
-    if (case_number_member(doc, value, ptr, "energy_I", 1, &f->energy_I))
+    if (case_number_member(doc, value, ptr, "energy_I", required, &f->energy_I))
         material_require(doc, f->energy_I > 0, ptr, "energy_I", "must be > 0", f->energy_I);
-    if (case_number_member(doc, value, ptr, "energy_II", 1, &f->energy_II))
+    if (case_number_member(doc, value, ptr, "energy_II", required, &f->energy_II))
         material_require(doc, f->energy_II > 0, ptr, "energy_II", "must be > 0", f->energy_II);
 }
 
@@ -95,7 +141,8 @@ static void material_read(case_doc *doc, const char *name, const json_t *value,
         char fracture_what[128];
         snprintf(fracture_what, sizeof fracture_what, "the fracture block of %s", what);
         def->has_fracture = 1;
-        material_read_fracture(doc, fracture, fracture_ptr, fracture_what, &def->fracture);
+        case_read_fracture(doc, fracture, fracture_ptr, fracture_what, 1, &def->fracture,
+                           &def->variation);
     }
 }
 

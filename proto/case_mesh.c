@@ -193,6 +193,16 @@ void case_read_mesh(case_doc *doc, case_part *part, const json_t *mesh, const ch
 
 /* ---------------------------------------------------------------- gmsh */
 
+/* memmem without _GNU_SOURCE: does s[0 .. n) contain word? */
+static int text_contains(const char *s, size_t n, const char *word)
+{
+    size_t w = strlen(word);
+    for (const char *p = s; n >= w && (p = memchr(p, word[0], n - w + 1 - (size_t)(p - s)));
+         p++)
+        if (memcmp(p, word, w) == 0) return 1;
+    return 0;
+}
+
 void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const char *ptr)
 {
     if (!json_is_string(text)) {
@@ -203,9 +213,12 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
     char message[400];
     const char *s = json_string_value(text);
     size_t n = json_string_length(text);
+    /* only named groups can be used, so a file without names skips them */
+    gmsh_groups *groups = text_contains(s, n, "$PhysicalNames") ? &part->groups : NULL;
     int rc = kind->dimension == 3
-                 ? gmsh_read_tetrahedra(s, n, &part->tet_mesh, message, sizeof message)
-                 : gmsh_read(s, n, &part->mesh, message, sizeof message);
+                 ? gmsh_read_tetrahedra_grouped(s, n, &part->tet_mesh, groups, message,
+                                                sizeof message)
+                 : gmsh_read_grouped(s, n, &part->mesh, groups, message, sizeof message);
     if (rc < 0) {
         case_problem(doc, ptr, "%s", message);
         return;

@@ -21,7 +21,7 @@ const char *const case_shape_keys[CASE_SHAPE_KINDS] = {
 
 static const char *const part_keys[] = {
     "name", "material", "fracture", "velocity", "initial_stress", "rectangle", "disc", "mesh",
-    "gmsh", "box", "sphere", "cylinder", NULL,
+    "gmsh", "box", "sphere", "cylinder", "materials", "discontinuities", NULL,
 };
 
 /* The dimension a shape belongs to, 0 for both. */
@@ -175,6 +175,7 @@ static void part_read(case_doc *doc, case_part *part, int index, const json_t *v
     part_read_material(doc, part, value, ptr);
     part_read_flags(doc, part, value, ptr);
     part_read_shape(doc, part, value, ptr);
+    case_read_part_groups(doc, part, value, ptr);
 }
 
 /* Names must be unique because constraints select parts by name. */
@@ -253,12 +254,13 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
         return -1;
     }
     /* `index` is i unless an earlier part was refused (case_add_parts) */
+    if (case_add_part_groups(doc, model, i, index) < 0) return -1;
     if (part->has_velocity && fdem_set_part_velocity_v(model, index, part->velocity, &err) < 0) {
         pointer_join(ptr, sizeof ptr, part_ptr, "velocity");
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }
-    return case_add_initial_stress(doc, model, i);
+    return case_add_initial_stress(doc, model, i, index);
 }
 
 /* Every part is meshed and checked even after one is refused, so that one

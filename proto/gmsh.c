@@ -15,7 +15,7 @@
  * come in any order. The two dimensions differ only in the element type
  * kept (gmsh_kind) and whether z is read.
  */
-#include "gmsh.h"
+#include "gmsh_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -25,33 +25,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define GMSH_MAX_TOKENS 64 /* more than any element line we care about */
-#define GMSH_TOKEN_CHARS 64
-
-typedef struct gmsh_line {
-    const char *tokens[GMSH_MAX_TOKENS];
-    size_t lengths[GMSH_MAX_TOKENS];
-    int count; /* tokens found (capped at GMSH_MAX_TOKENS) */
-} gmsh_line;
-
-typedef struct gmsh_node {
-    long long tag;
-    double x, y, z;
-} gmsh_node;
-
-typedef struct gmsh_element {
-    long long tags[4];
-    int line;
-} gmsh_element;
-
-/* What one dimension keeps: the gmsh element type, its node count, the
- * coordinates read per node, and the words of its messages. */
-typedef struct gmsh_kind {
-    int type, nodes, dims;
-    const char *name;    /* "triangle" */
-    const char *missing; /* the message when the file has none */
-} gmsh_kind;
-
 static const gmsh_kind gmsh_triangles = {
     2, 3, 2, "triangle",
     "no 3-node triangles (element type 2) in $Elements; mesh the surfaces in 2D (gmsh -2)"};
@@ -59,24 +32,7 @@ static const gmsh_kind gmsh_tetrahedra = {
     4, 4, 3, "tetrahedron",
     "no 4-node tetrahedra (element type 4) in $Elements; mesh the volumes in 3D (gmsh -3)"};
 
-typedef struct gmsh_reader {
-    const char *p, *end;
-    int line;              /* number of the line last read, 1-based */
-    const char *section;   /* "$Nodes", ... for messages */
-    int version;           /* 22 or 41 once $MeshFormat was read, else 0 */
-    int seen_nodes, seen_elements;
-    const gmsh_kind *kind;
-    gmsh_node *nodes;
-    long node_count, node_capacity;
-    gmsh_element *elements;
-    long element_count, element_capacity;
-    char *message;
-    size_t message_size;
-    int failed;
-} gmsh_reader;
-
-__attribute__((format(printf, 2, 3)))
-static int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
+int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
 {
     if (r->failed) return -1;
     r->failed = 1;
@@ -100,7 +56,7 @@ static int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
 
 /* Reads the next line into `out` (tokens point into the buffer). Returns 0,
  * or -1 at the end of the buffer. */
-static int gmsh_next_line(gmsh_reader *r, gmsh_line *out)
+int gmsh_next_line(gmsh_reader *r, gmsh_line *out)
 {
     if (r->p >= r->end) return -1;
     const char *start = r->p;
@@ -126,7 +82,7 @@ static int gmsh_next_line(gmsh_reader *r, gmsh_line *out)
 }
 
 /* The next line, which must exist: a missing one means a truncated file. */
-static int gmsh_need_line(gmsh_reader *r, gmsh_line *out, const char *what)
+int gmsh_need_line(gmsh_reader *r, gmsh_line *out, const char *what)
 {
     if (gmsh_next_line(r, out) == 0) return 0;
     return gmsh_fail(r, "the file ends where %s was expected (truncated?)", what);
@@ -147,7 +103,7 @@ static int gmsh_token_copy(const gmsh_line *l, int i, char *buf)
     return 0;
 }
 
-static int gmsh_token_long(const gmsh_line *l, int i, long long *out)
+int gmsh_token_long(const gmsh_line *l, int i, long long *out)
 {
     char buf[GMSH_TOKEN_CHARS];
     if (gmsh_token_copy(l, i, buf) < 0) return -1;
@@ -171,7 +127,7 @@ static int gmsh_token_double(const gmsh_line *l, int i, double *out)
 }
 
 /* Reads `n` integers from the start of a line; names them in the message. */
-static int gmsh_line_longs(gmsh_reader *r, const gmsh_line *l, long long *out, int n,
+int gmsh_line_longs(gmsh_reader *r, const gmsh_line *l, long long *out, int n,
                            const char *what)
 {
     if (l->count < n) return gmsh_fail(r, "expected %s, found %d value(s)", what, l->count);
@@ -184,7 +140,7 @@ static int gmsh_line_longs(gmsh_reader *r, const gmsh_line *l, long long *out, i
 /* A declared count must be non-negative and fit in the rest of the buffer
  * (every item takes at least `min_bytes`), so a hostile header cannot make
  * us allocate more than the upload's size. */
-static int gmsh_check_count(gmsh_reader *r, long long count, long min_bytes, const char *what)
+int gmsh_check_count(gmsh_reader *r, long long count, long min_bytes, const char *what)
 {
     if (count < 0) return gmsh_fail(r, "negative number of %s (%lld)", what, count);
     long long room = (long long)(r->end - r->p) / min_bytes + 1;
@@ -196,7 +152,7 @@ static int gmsh_check_count(gmsh_reader *r, long long count, long min_bytes, con
 
 /* --------------------------------------------------------------- storage */
 
-static int gmsh_grow(void **items, long *capacity, long need, size_t item_size)
+int gmsh_grow(void **items, long *capacity, long need, size_t item_size)
 {
     if (need <= *capacity) return 0;
     long capacity_new = *capacity ? *capacity : 64;
@@ -350,10 +306,18 @@ static int gmsh_read_elements22(gmsh_reader *r)
         if (gmsh_need_line(r, &l, "an element") < 0) return -1;
         if (gmsh_line_longs(r, &l, head, 3, "\"number type number-of-tags ...\"") < 0)
             return -1;
-        if (head[1] != r->kind->type) continue;
+        int kept = head[1] == r->kind->type;
+        if (!kept && !r->want_groups) continue;
         if (head[2] < 0 || head[2] > GMSH_MAX_TOKENS)
             return gmsh_fail(r, "bad number of element tags (%lld)", head[2]);
-        if (gmsh_line_element(r, &l, 3 + (int)head[2]) < 0) return -1;
+        if (kept && gmsh_line_element(r, &l, 3 + (int)head[2]) < 0) return -1;
+        long long physical = 0; /* the first tag; 0: in no physical group */
+        if (r->want_groups && head[2] > 0 && gmsh_token_long(&l, 3, &physical) < 0)
+            return gmsh_fail(r, "element tag 1 is not an integer");
+        if (physical != 0 &&
+            gmsh_note_element(r, gmsh_type_dimension(head[1]), physical, &l, 3 + (int)head[2],
+                              kept ? r->element_count - 1 : -1) < 0)
+            return -1;
     }
     return 0;
 }
@@ -367,9 +331,15 @@ static int gmsh_read_element_block41(gmsh_reader *r, long long *total)
         return -1;
     long long n = head[3];
     if (gmsh_check_count(r, n, 4, "elements in the block") < 0) return -1;
+    int kept = head[2] == r->kind->type;
+    if (r->want_groups && (head[0] < 0 || head[0] > 3))
+        return gmsh_fail(r, "entity dimension %lld is not 0 to 3", head[0]);
     for (long long i = 0; i < n; i++) {
         if (gmsh_need_line(r, &l, "an element") < 0) return -1;
-        if (head[2] == r->kind->type && gmsh_line_element(r, &l, 1) < 0) return -1;
+        if (kept && gmsh_line_element(r, &l, 1) < 0) return -1;
+        if (r->want_groups && gmsh_note_element(r, (int)head[0], head[1], &l, 1,
+                                                kept ? r->element_count - 1 : -1) < 0)
+            return -1;
     }
     *total += n;
     return 0;
@@ -439,6 +409,16 @@ static int gmsh_read_section(gmsh_reader *r, const gmsh_line *l)
             return -1;
         return gmsh_expect_end(r, "$EndElements");
     }
+    if (r->want_groups && gmsh_token_is(l, 0, "$PhysicalNames")) {
+        r->section = "$PhysicalNames";
+        if (gmsh_read_physical_names(r) < 0) return -1;
+        return gmsh_expect_end(r, "$EndPhysicalNames");
+    }
+    if (r->want_groups && r->version == 41 && gmsh_token_is(l, 0, "$Entities")) {
+        r->section = "$Entities";
+        if (gmsh_read_entities(r) < 0) return -1;
+        return gmsh_expect_end(r, "$EndEntities");
+    }
     r->section = NULL;
     return gmsh_skip_section(r, l);
 }
@@ -467,23 +447,31 @@ static int gmsh_read_sections(gmsh_reader *r)
 
 /* --------------------------------------------------------------- resolve */
 
-/* Sorts node indices by tag. qsort_r is a GNU extension and qsort would need
- * the nodes in a global, so a small merge sort it is. */
-static void gmsh_sort_by_tag(long *idx, long *tmp, long n, const gmsh_node *nodes)
+/* Sorts indices, stably, by `before`. qsort_r is a GNU extension and qsort
+ * would need the reader in a global, so a small merge sort it is. */
+typedef int (*gmsh_before_fn)(const gmsh_reader *r, long a, long b);
+
+static void gmsh_merge_sort(long *idx, long *tmp, long n, const gmsh_reader *r,
+                            gmsh_before_fn before)
 {
     if (n < 2) return;
     long half = n / 2;
-    gmsh_sort_by_tag(idx, tmp, half, nodes);
-    gmsh_sort_by_tag(idx + half, tmp, n - half, nodes);
+    gmsh_merge_sort(idx, tmp, half, r, before);
+    gmsh_merge_sort(idx + half, tmp, n - half, r, before);
     long i = 0, j = half, k = 0;
     while (i < half && j < n)
-        tmp[k++] = nodes[idx[j]].tag < nodes[idx[i]].tag ? idx[j++] : idx[i++];
+        tmp[k++] = before(r, idx[j], idx[i]) ? idx[j++] : idx[i++];
     while (i < half) tmp[k++] = idx[i++];
     while (j < n) tmp[k++] = idx[j++];
     memcpy(idx, tmp, (size_t)n * sizeof *idx);
 }
 
-static long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, long long tag)
+static int gmsh_node_before(const gmsh_reader *r, long a, long b)
+{
+    return r->nodes[a].tag < r->nodes[b].tag;
+}
+
+long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, long long tag)
 {
     long lo = 0, hi = n - 1;
     while (lo <= hi) {
@@ -495,6 +483,60 @@ static long gmsh_find_tag(const long *sorted, long n, const gmsh_node *nodes, lo
     return -1;
 }
 
+/* Element t's node tags, ascending (a fourth of 0 for a triangle). */
+static void gmsh_element_key(const gmsh_reader *r, long t, long long key[4])
+{
+    int per = r->kind->nodes;
+    for (int k = 0; k < 4; k++) key[k] = k < per ? r->elements[t].tags[k] : 0;
+    for (int i = 1; i < per; i++)
+        for (int k = i; k > 0 && key[k - 1] > key[k]; k--) {
+            long long s = key[k];
+            key[k] = key[k - 1];
+            key[k - 1] = s;
+        }
+}
+
+static int gmsh_element_before(const gmsh_reader *r, long a, long b)
+{
+    long long ka[4], kb[4];
+    gmsh_element_key(r, a, ka);
+    gmsh_element_key(r, b, kb);
+    for (int k = 0; k < 4; k++)
+        if (ka[k] != kb[k]) return ka[k] < kb[k];
+    return a < b;
+}
+
+/* 2.2 writes an element once for each physical group it is in: every
+ * repeat of a node set becomes the element of its first occurrence.
+ * element_of[t] is the mesh index of kept element t; returns how many
+ * distinct elements there are, or -1 when out of memory. */
+static long gmsh_merge_repeats(const gmsh_reader *r, long *element_of)
+{
+    long m = r->element_count;
+    long *order = malloc((size_t)(m ? m : 1) * sizeof *order);
+    long *tmp = malloc((size_t)(m ? m : 1) * sizeof *tmp);
+    if (!order || !tmp) {
+        free(order);
+        free(tmp);
+        return -1;
+    }
+    for (long t = 0; t < m; t++) order[t] = t, element_of[t] = t;
+    gmsh_merge_sort(order, tmp, m, r, gmsh_element_before);
+    long long prev[4], key[4];
+    for (long i = 0; i < m; i++) {
+        gmsh_element_key(r, order[i], key);
+        if (i > 0 && memcmp(key, prev, sizeof key) == 0) element_of[order[i]] = element_of[order[i - 1]];
+        memcpy(prev, key, sizeof key);
+    }
+    long distinct = 0; /* first occurrences keep file order */
+    for (long t = 0; t < m; t++) element_of[t] = element_of[t] == t ? distinct++ : -1 - element_of[t];
+    for (long t = 0; t < m; t++)
+        if (element_of[t] < 0) element_of[t] = element_of[-1 - element_of[t]];
+    free(order);
+    free(tmp);
+    return distinct;
+}
+
 /* The resolved mesh in plain arrays: dims coordinates per node, the
  * kind's node count per element. */
 typedef struct gmsh_arrays {
@@ -504,7 +546,7 @@ typedef struct gmsh_arrays {
 } gmsh_arrays;
 
 /* Keeps only the nodes some element uses, renumbered in file order. */
-static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out)
+static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out, gmsh_groups *groups)
 {
     long n = r->node_count, m = r->element_count;
     const int per = r->kind->nodes, dims = r->kind->dims;
@@ -513,13 +555,15 @@ static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out)
     long *tmp = malloc((size_t)(n ? n : 1) * sizeof *tmp);
     long *file_index = malloc((size_t)m * per * sizeof *file_index);
     int32_t *renumber = malloc((size_t)(n ? n : 1) * sizeof *renumber);
+    long *element_of = malloc((size_t)(m ? m : 1) * sizeof *element_of);
     int rc = -1;
-    if (!sorted || !tmp || !file_index || !renumber) {
+    long distinct = element_of ? gmsh_merge_repeats(r, element_of) : -1;
+    if (!sorted || !tmp || !file_index || !renumber || distinct < 0) {
         gmsh_fail(r, "out of memory");
         goto done;
     }
     for (long i = 0; i < n; i++) sorted[i] = i;
-    gmsh_sort_by_tag(sorted, tmp, n, r->nodes);
+    gmsh_merge_sort(sorted, tmp, n, r, gmsh_node_before);
     for (long i = 1; i < n; i++)
         if (r->nodes[sorted[i]].tag == r->nodes[sorted[i - 1]].tag) {
             r->section = "$Nodes";
@@ -545,7 +589,7 @@ static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out)
     for (long i = 0; i < n; i++)
         if (renumber[i] == 0) renumber[i] = used++;
     out->coords = malloc((size_t)(used ? used : 1) * dims * sizeof *out->coords);
-    out->elements = malloc((size_t)m * per * sizeof *out->elements);
+    out->elements = malloc((size_t)distinct * per * sizeof *out->elements);
     if (!out->coords || !out->elements) {
         free(out->coords);
         free(out->elements);
@@ -558,44 +602,58 @@ static int gmsh_resolve(gmsh_reader *r, gmsh_arrays *out)
             double xyz[3] = {r->nodes[i].x, r->nodes[i].y, r->nodes[i].z};
             memcpy(out->coords + (size_t)dims * renumber[i], xyz, (size_t)dims * sizeof *xyz);
         }
-    for (long t = 0; t < per * m; t++) out->elements[t] = renumber[file_index[t]];
+    for (long t = 0; t < m; t++)
+        for (int k = 0; k < per; k++)
+            out->elements[per * element_of[t] + k] = renumber[file_index[per * t + k]];
     out->node_count = used;
-    out->element_count = (int)m;
+    out->element_count = (int)distinct;
     rc = 0;
+    if (groups && gmsh_resolve_groups(r, sorted, renumber, element_of, groups) < 0) {
+        free(out->coords);
+        free(out->elements);
+        memset(out, 0, sizeof *out);
+        rc = -1;
+    }
 done:
     free(sorted);
     free(tmp);
     free(file_index);
     free(renumber);
+    free(element_of);
     return rc;
 }
 
 static int gmsh_read_kind(const char *text, size_t length, const gmsh_kind *kind,
-                          gmsh_arrays *out, char *message, size_t message_size)
+                          gmsh_arrays *out, gmsh_groups *groups, char *message,
+                          size_t message_size)
 {
     char scratch[8];
     memset(out, 0, sizeof *out);
+    if (groups) memset(groups, 0, sizeof *groups);
     gmsh_reader r = {0};
     if (!text) text = "", length = 0;
     r.p = text;
     r.end = text + length;
     r.kind = kind;
+    r.want_groups = groups != NULL;
     r.message = message && message_size ? message : scratch;
     r.message_size = message && message_size ? message_size : sizeof scratch;
     r.message[0] = '\0';
     int rc = gmsh_read_sections(&r);
-    if (rc == 0) rc = gmsh_resolve(&r, out);
+    if (rc == 0) rc = gmsh_resolve(&r, out, groups);
     free(r.nodes);
     free(r.elements);
+    gmsh_reader_free_groups(&r);
     return rc;
 }
 
-int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
-              size_t message_size)
+int gmsh_read_grouped(const char *text, size_t length, fdem_mesh *out, gmsh_groups *groups,
+                      char *message, size_t message_size)
 {
     gmsh_arrays a;
     memset(out, 0, sizeof *out);
-    if (gmsh_read_kind(text, length, &gmsh_triangles, &a, message, message_size) != 0) return -1;
+    if (gmsh_read_kind(text, length, &gmsh_triangles, &a, groups, message, message_size) != 0)
+        return -1;
     out->xy = a.coords;
     out->tri = a.elements;
     out->node_count = a.node_count;
@@ -603,16 +661,28 @@ int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
     return 0;
 }
 
-int gmsh_read_tetrahedra(const char *text, size_t length, fdem_tet_mesh *out, char *message,
-                         size_t message_size)
+int gmsh_read_tetrahedra_grouped(const char *text, size_t length, fdem_tet_mesh *out,
+                                 gmsh_groups *groups, char *message, size_t message_size)
 {
     gmsh_arrays a;
     memset(out, 0, sizeof *out);
-    if (gmsh_read_kind(text, length, &gmsh_tetrahedra, &a, message, message_size) != 0)
+    if (gmsh_read_kind(text, length, &gmsh_tetrahedra, &a, groups, message, message_size) != 0)
         return -1;
     out->xyz = a.coords;
     out->tet = a.elements;
     out->node_count = a.node_count;
     out->tet_count = a.element_count;
     return 0;
+}
+
+int gmsh_read(const char *text, size_t length, fdem_mesh *out, char *message,
+              size_t message_size)
+{
+    return gmsh_read_grouped(text, length, out, NULL, message, message_size);
+}
+
+int gmsh_read_tetrahedra(const char *text, size_t length, fdem_tet_mesh *out, char *message,
+                         size_t message_size)
+{
+    return gmsh_read_tetrahedra_grouped(text, length, out, NULL, message, message_size);
 }

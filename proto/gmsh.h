@@ -12,8 +12,42 @@
 #define FDEM_GMSH_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "fdem.h"
 #include "mesh_3d.h"
+
+/* Physical groups (contract 5.3), read from $PhysicalNames and the
+ * elements' tags (2.2) or their entities' (4.1, $Entities). Only named
+ * groups are kept; several groups may share a name (in different
+ * dimensions). Node and element indices are those of the mesh read with
+ * them; an element in several groups (2.2 writes it once per group) is one
+ * element of the mesh. */
+#define GMSH_NAME 128
+
+typedef struct gmsh_group {
+    int dim;                 /* 0 points, 1 curves, 2 surfaces, 3 volumes */
+    char name[GMSH_NAME];
+    int32_t *nodes;          /* the mesh nodes of its elements, ascending */
+    int node_count;
+    int32_t *elements;       /* dim = the mesh's: its triangles (tetrahedra), ascending */
+    int element_count;
+    int32_t *faces;          /* dim = the mesh's - 1: its 2-node lines (3-node triangles) */
+    int face_count;
+} gmsh_group;
+
+typedef struct gmsh_groups {
+    gmsh_group *group;
+    int count;
+} gmsh_groups;
+
+void gmsh_groups_free(gmsh_groups *groups);
+
+/* gmsh_read and gmsh_read_tetrahedra, with the groups too (groups may be
+ * NULL: not wanted, as the two below). */
+int gmsh_read_grouped(const char *text, size_t length, fdem_mesh *out, gmsh_groups *groups,
+                      char *message, size_t message_size);
+int gmsh_read_tetrahedra_grouped(const char *text, size_t length, fdem_tet_mesh *out,
+                                 gmsh_groups *groups, char *message, size_t message_size);
 
 int gmsh_read(const char *text, size_t length, fdem_mesh *out,
               char *message, size_t message_size);

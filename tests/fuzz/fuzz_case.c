@@ -5,7 +5,7 @@
  * -malloc_limit_mb; the limit below keeps accepted models small so the
  * fuzzer spends its time on the parser, not on meshing).
  *
- * The same bytes also go to gmsh_read() directly: inside a case, gmsh text
+ * The same bytes also go to the gmsh reader (with its physical groups) directly: inside a case, gmsh text
  * sits in an escaped JSON string that mutations rarely keep valid, so the
  * reader gets its own raw-text coverage from the same run (the corpus holds
  * the .msh files of tests/data as they are).
@@ -35,11 +35,23 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     problems_free(&out);
 
     fdem_mesh mesh;
+    gmsh_groups groups;
     char message[256];
-    if (gmsh_read((const char *)data, size, &mesh, message, sizeof message) == 0) {
+    if (gmsh_read_grouped((const char *)data, size, &mesh, &groups, message, sizeof message) == 0) {
         if (mesh.node_count < 3 || mesh.triangle_count < 1) __builtin_trap();
         for (int i = 0; i < 3 * mesh.triangle_count; i++)
             if (mesh.tri[i] < 0 || mesh.tri[i] >= mesh.node_count) __builtin_trap();
+        /* every index a group holds is one of the mesh's */
+        for (int g = 0; g < groups.count; g++) {
+            const gmsh_group *k = &groups.group[g];
+            for (int i = 0; i < k->node_count; i++)
+                if (k->nodes[i] < 0 || k->nodes[i] >= mesh.node_count) __builtin_trap();
+            for (int i = 0; i < k->element_count; i++)
+                if (k->elements[i] < 0 || k->elements[i] >= mesh.triangle_count) __builtin_trap();
+            for (int i = 0; i < 2 * k->face_count; i++)
+                if (k->faces[i] < 0 || k->faces[i] >= mesh.node_count) __builtin_trap();
+        }
+        gmsh_groups_free(&groups);
         fdem_mesh_free(&mesh);
     } else if (strncmp(message, "gmsh", 4) != 0) {
         __builtin_trap(); /* every failure names where it happened */

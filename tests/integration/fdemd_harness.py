@@ -8,6 +8,7 @@ directory and talks HTTP to it (stdlib only), for the integration tests.
     d.start()               # same data directory: a restart
     d.close()               # kill if needed, remove the directory
 """
+import contextlib
 import http.client
 import json
 import os
@@ -46,6 +47,23 @@ def tiny_case(name="tiny", end=0.001, divisions=(10, 10), interval=None, young=3
     }
     case.update(extra)
     return case
+
+
+@contextlib.contextmanager
+def fetched_result(daemon, case_id):
+    """The case's result.h5 as GET /cases/ID/result.h5 serves it, open in
+    h5py (a temporary copy, removed on exit)."""
+    import h5py
+    status, _, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
+    assert status == 200, data[:200]
+    fd, path = tempfile.mkstemp(suffix=".h5")
+    with os.fdopen(fd, "wb") as f:
+        f.write(data)
+    try:
+        with h5py.File(path, "r") as f:
+            yield f
+    finally:
+        os.unlink(path)
 
 
 class Daemon:

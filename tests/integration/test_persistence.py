@@ -5,29 +5,18 @@ keep their results, and a corrupt case directory does not stop start-up."""
 import json
 import os
 import signal
-import tempfile
 import shutil
 import time
 import unittest
 
-import h5py
 import numpy as np
 
-from fdemd_harness import Daemon, tiny_case
+from fdemd_harness import Daemon, fetched_result, tiny_case
 
 
 def read_result(daemon, case_id):
-    status, headers, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
-    assert status == 200, data[:200]
-    fd, path = tempfile.mkstemp(suffix=".h5")
-    with os.fdopen(fd, "wb") as f:
-        f.write(data)
-    try:
-        with h5py.File(path, "r") as f:
-            out = {name: f["/snapshots/" + name][...] for name in ("time", "step", "position")}
-    finally:
-        os.unlink(path)
-    return out
+    with fetched_result(daemon, case_id) as f:
+        return {name: f["/snapshots/" + name][...] for name in ("time", "step", "position")}
 
 
 class PersistenceTest(unittest.TestCase):
