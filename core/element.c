@@ -19,22 +19,45 @@ int element_prepare(fdem_model *m, int e, fdem_error *err)
 
 double element_stable_dt(const fdem_model *m, int e)
 {
-    return m->dim == 3 ? tet_element_stable_dt(m, e) : tri_element_stable_dt(m, e);
+    double dt = m->dim == 3 ? tet_element_stable_dt(m, e) : tri_element_stable_dt(m, e);
+    return dt * initial_stress_dt_factor(m, e);
+}
+
+/* A block of a model with in-situ stress: each run of elements of one part
+ * goes through the kernel's loop with the pre-stress if the part has one,
+ * through the plain loop if not (elements of a part are contiguous), so an
+ * unstressed element costs what it costs in a model without any. */
+static void forces_by_stress_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    const int three = m->dim == 3;
+    for (int e = begin; e < end;) {
+        const part *p = &m->parts[m->elem_part[e]];
+        int stop = p->elem_begin + p->elem_count < end ? p->elem_begin + p->elem_count : end;
+        if (p->stressed)
+            (three ? tet_element_forces_range_stressed : tri_element_forces_range_stressed)(m, e, stop,
+                                                                                           sums);
+        else
+            (three ? tet_element_forces_range : tri_element_forces_range)(m, e, stop, sums);
+        e = stop;
+    }
 }
 
 /* Runs the element blocks through the model's scatter plan (threads side
  * by side within a colour). A block hands back the strain energy (sums[0])
  * and the power of the viscous stresses with the velocities before this
  * step (sums[1]) and of the last step's viscous stresses with the same
- * velocities (sums[2]); damping is booked with the step-averaged velocity
+ * velocities (sums[2]); the elastic energy adds what an in-situ stress held
+ * at t = 0 (initial_stress.c); damping is booked with the step-averaged velocity
  * like every work: this step's first half and the last step's second half
  * (energy.c). */
 void element_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
-    scatter_plan_run(&m->elem_plan, m, m->threads,
-                     m->dim == 3 ? tet_element_forces_range : tri_element_forces_range, sums);
-    m->elastic_energy = sums[0];
+    scatter_block_fn run = m->elem_stress0 ? forces_by_stress_runs
+                           : m->dim == 3   ? tet_element_forces_range
+                                           : tri_element_forces_range;
+    scatter_plan_run(&m->elem_plan, m, m->threads, run, sums);
+    m->elastic_energy = m->elem_stress0 ? sums[0] + m->stress0_energy : sums[0];
     m->damping_work -= 0.5 * (m->dt_prev + m->dt) * 0.5 * sums[1] + 0.5 * m->havg_last * sums[2];
 }
 

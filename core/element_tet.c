@@ -88,8 +88,8 @@ void tet_deformation(const double *pos, const int32_t node[4], const tet_geometr
 
 double tet_stress(const double F[9], double lambda, double mu, double sigma[6], double *J_out)
 {
-    double J;
-    double w = tet_kernel_stress(F, mu, lambda, 0.5 * mu, 0.5 * lambda, sigma, &J);
+    double J, invJ;
+    double w = tet_kernel_stress(F, mu, lambda, 0.5 * mu, 0.5 * lambda, sigma, &J, &invJ);
     if (J_out) *J_out = J;
     return w;
 }

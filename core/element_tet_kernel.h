@@ -17,13 +17,16 @@
  *    energy density per initial volume from hmu = mu/2, hlambda = lambda/2.
  *    Scaling the constants instead of the stress is free in a loop that
  *    loads them once per material. ln J by log_near1.h; below TET_J_MIN
- *    the law continues along its tangent.
+ *    the law continues along its tangent. J and the 1/J the law used come
+ *    back through the pointers.
+ *  - tet_kernel_prestress: adds scale F S0 F^T (an in-situ pre-stress S0
+ *    pushed forward) to a stress, returns S0 : E.
  *  - tet_kernel_rate: the symmetric part of sum_k (v_k - v_0) (x) c_k, which
  *    is det times the rate of deformation D (no division here).
  *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
  *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
  *    the other three: the four sum to zero exactly.
- *  - Each of edges, faces, gradient, stress and forces also exists as
+ *  - Each of edges, faces, gradient, stress, prestress and forces also exists as
  *    name_pair over tet_pair, two elements in the lanes of one SIMD
  *    register (element_tet_kernel_body.h is written once for both), with
  *    the same bits per element as the scalar one.

@@ -45,7 +45,8 @@ TET_KERNEL void TET_FN(tet_kernel_gradient)(const TET_T e[3][3], const TET_T xin
 }
 
 TET_KERNEL TET_T TET_FN(tet_kernel_stress)(const TET_T F[9], double smu, double slambda,
-                                           double hmu, double hlambda, TET_T s[6], TET_T *J_out)
+                                           double hmu, double hlambda, TET_T s[6], TET_T *J_out,
+                                           TET_T *invJ_out)
 {
     TET_T J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
               F[2] * (F[3] * F[7] - F[4] * F[6]);
@@ -66,6 +67,7 @@ TET_KERNEL TET_T TET_FN(tet_kernel_stress)(const TET_T F[9], double smu, double 
     s[4] = muJ * B02;
     s[5] = muJ * B01;
     *J_out = J;
+    *invJ_out = invJ;
     return hmu * (B00 + B11 + B22 - 3.0 - 2.0 * lnJ) + hlambda * lnJ * lnJ;
 }
 
@@ -80,4 +82,29 @@ TET_KERNEL void TET_FN(tet_kernel_forces)(const TET_T s[6], const TET_T c[3][3],
     }
     TET_UNROLL
     for (int i = 0; i < 3; i++) f[0][i] = -(f[1][i] + f[2][i] + f[3][i]);
+}
+
+/* s += scale F S0 F^T: the in-situ pre-stress S0 pushed forward (scale =
+ * 1/J, or 1/(6J) for the sixth stress); returns its strain energy density
+ * S0 : E = (tr(F S0 F^T) - tr S0) / 2 (initial_stress.c). */
+TET_KERNEL TET_T TET_FN(tet_kernel_prestress)(const TET_T F[9], TET_T scale, const TET_T S0[6],
+                                              TET_T s[6])
+{
+    const TET_T M[9] = {S0[0], S0[5], S0[4], S0[5], S0[1], S0[3], S0[4], S0[3], S0[2]};
+    TET_T FS[9];
+    TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        TET_UNROLL
+        for (int j = 0; j < 3; j++)
+            FS[3 * i + j] = F[3 * i] * M[j] + F[3 * i + 1] * M[3 + j] + F[3 * i + 2] * M[6 + j];
+    /* tau_ij = row i of F S0 . row j of F, in Voigt order */
+    static const int row[6] = {0, 1, 2, 1, 0, 0}, col[6] = {0, 1, 2, 2, 2, 1};
+    TET_T tau[6];
+    TET_UNROLL
+    for (int q = 0; q < 6; q++) {
+        int i = row[q], j = col[q];
+        tau[q] = FS[3 * i] * F[3 * j] + FS[3 * i + 1] * F[3 * j + 1] + FS[3 * i + 2] * F[3 * j + 2];
+        s[q] += scale * tau[q];
+    }
+    return 0.5 * (tau[0] + tau[1] + tau[2] - S0[0] - S0[1] - S0[2]);
 }

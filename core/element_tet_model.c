@@ -116,17 +116,27 @@ static inline void tet_scatter(double *f, const int32_t node[4], const double fa
     }
 }
 
-/* One element alone: the last of an odd range, or a pair of two materials. */
-static void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum)
+/* Element t's in-situ pre-stress (initial_stress.c). */
+static inline const double *tet_stress0(const fdem_model *m, const tet_hot *t)
+{
+    return m->elem_stress0 + 6 * (size_t)(t - m->tet);
+}
+
+/* One element alone: the last of an odd range, or a pair of two materials.
+ * `stressed` (a constant at each call) adds the element's pre-stress. */
+TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
+                               const int stressed)
 {
     const double *pos = m->pos;
     const int32_t *n = t->node;
-    double e[3][3], c[3][3], F[9], s[6], J;
+    double e[3][3], c[3][3], F[9], s[6], J, invJ;
     tet_kernel_edges(pos + 3 * (size_t)n[0], pos + 3 * (size_t)n[1], pos + 3 * (size_t)n[2],
                      pos + 3 * (size_t)n[3], e);
     tet_kernel_gradient(e, t->xinv, F);
     tet_constants_load(k, m->materials, t->material);
-    sum->energy += tet_kernel_stress(F, k->smu, k->slambda, k->hmu, k->hlambda, s, &J) * t->volume0;
+    double w = tet_kernel_stress(F, k->smu, k->slambda, k->hmu, k->hlambda, s, &J, &invJ);
+    if (stressed) w += tet_kernel_prestress(F, invJ * (1.0 / 6), tet_stress0(m, t), s);
+    sum->energy += w * t->volume0;
     double det = tet_kernel_faces(e, c);
     if (t->eta > 0) tet_damp(m, t, c, det, s, sum);
     double fa[4][3];
@@ -152,7 +162,8 @@ static inline void tet_damp_lane(const fdem_model *m, const tet_hot *t, int lane
 /* Two elements of one material side by side, in the lanes of tet_pair:
  * per element the same operations in the same order as tet_forces_one,
  * so the same bits; the sums and the scatter go element by element. */
-static void tet_forces_pair(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum)
+TET_KERNEL void tet_forces_pair(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
+                                const int stressed)
 {
     const double *pos = m->pos;
     const tet_hot *u = t + 1;
@@ -165,11 +176,18 @@ static void tet_forces_pair(fdem_model *m, const tet_hot *t, tet_constants *k, t
     }
     TET_UNROLL
     for (int q = 0; q < 9; q++) X[q] = (tet_pair){t->xinv[q], u->xinv[q]};
-    tet_pair e[3][3], c[3][3], F[9], s[6], J;
+    tet_pair e[3][3], c[3][3], F[9], s[6], J, invJ;
     tet_kernel_edges_pair(x[0], x[1], x[2], x[3], e);
     tet_kernel_gradient_pair(e, X, F);
     tet_constants_load(k, m->materials, t->material);
-    tet_pair w = tet_kernel_stress_pair(F, k->smu, k->slambda, k->hmu, k->hlambda, s, &J);
+    tet_pair w = tet_kernel_stress_pair(F, k->smu, k->slambda, k->hmu, k->hlambda, s, &J, &invJ);
+    if (stressed) {
+        const double *st = tet_stress0(m, t), *su = tet_stress0(m, u);
+        tet_pair S0[6];
+        TET_UNROLL
+        for (int q = 0; q < 6; q++) S0[q] = (tet_pair){st[q], su[q]};
+        w += tet_kernel_prestress_pair(F, invJ * (1.0 / 6), S0, s);
+    }
     tet_pair det = tet_kernel_faces_pair(e, c);
     if (t->eta > 0) tet_damp_lane(m, t, 0, c, det, s, sum);
     sum->energy += w[0] * t->volume0;
@@ -197,7 +215,8 @@ static void tet_forces_pair(fdem_model *m, const tet_hot *t, tet_constants *k, t
  *  - everything inline and unrolled, no per-element call or table lookup;
  *  - records prefetched ahead;
  *  - damping: one division, and its power from s : S directly. */
-void tet_element_forces_range(fdem_model *m, int begin, int end_index, double sums[SCATTER_SUMS])
+TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const int stressed,
+                               double sums[SCATTER_SUMS])
 {
     tet_sums sum = {0, 0, 0};
     tet_constants k = {.material = -1};
@@ -209,16 +228,28 @@ void tet_element_forces_range(fdem_model *m, int begin, int end_index, double su
         TET_PREFETCH_READ((const char *)ahead + 128);
         TET_PREFETCH_READ((const char *)ahead + 192);
         if (t[0].material == t[1].material) {
-            tet_forces_pair(m, t, &k, &sum);
+            tet_forces_pair(m, t, &k, &sum, stressed);
         } else {
-            tet_forces_one(m, t, &k, &sum);
-            tet_forces_one(m, t + 1, &k, &sum);
+            tet_forces_one(m, t, &k, &sum, stressed);
+            tet_forces_one(m, t + 1, &k, &sum, stressed);
         }
     }
-    if (t < end) tet_forces_one(m, t, &k, &sum);
+    if (t < end) tet_forces_one(m, t, &k, &sum, stressed);
     sums[0] += sum.energy;
     sums[1] += sum.power_now * (1.0 / 6);
     sums[2] += sum.power_prev * (1.0 / 6);
+}
+
+void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    tet_forces_run(m, begin, end, 0, sums);
+}
+
+/* The same loop for the elements of a part with an in-situ stress. */
+void tet_element_forces_range_stressed(fdem_model *m, int begin, int end,
+                                       double sums[SCATTER_SUMS])
+{
+    tet_forces_run(m, begin, end, 1, sums);
 }
 
 void tet_element_stress(const fdem_model *m, int e, double out[6])
@@ -226,11 +257,13 @@ void tet_element_stress(const fdem_model *m, int e, double out[6])
     const tet_hot *t = &m->tet[e];
     const double *pos = m->pos;
     const material *mat = &m->materials[t->material];
-    double ed[3][3], c[3][3], F[9], J;
+    double ed[3][3], c[3][3], F[9], J, invJ;
     tet_kernel_edges(pos + 3 * (size_t)t->node[0], pos + 3 * (size_t)t->node[1],
                      pos + 3 * (size_t)t->node[2], pos + 3 * (size_t)t->node[3], ed);
     tet_kernel_gradient(ed, t->xinv, F);
-    tet_kernel_stress(F, mat->mu, mat->lambda, 0.5 * mat->mu, 0.5 * mat->lambda, out, &J);
+    tet_kernel_stress(F, mat->mu, mat->lambda, 0.5 * mat->mu, 0.5 * mat->lambda, out, &J, &invJ);
+    if (m->elem_stress0 && m->parts[m->elem_part[e]].stressed)
+        tet_kernel_prestress(F, invJ, tet_stress0(m, t), out);
     double S[6], sv[6], det = tet_kernel_faces(ed, c);
     if (t->eta > 0 && tet_viscous(m->vel, t->node, c, det, t->eta, S, sv))
         for (int q = 0; q < 6; q++) out[q] += sv[q];

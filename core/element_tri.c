@@ -8,7 +8,9 @@
  * compressible neo-Hookean solid sigma = (mu/J)(B - I) + (lambda/J) ln J I,
  * B = F F^T: objective (a rigid rotation R gives B = I, so no stress) and
  * equal to plane-strain linear elasticity at small strain. Viscous damping
- * adds 2 eta D with D = sym([v][x]^-1).
+ * adds 2 eta D with D = sym([v][x]^-1); an in-situ pre-stress S0 adds
+ * F S0 F^T / J (initial_stress.c), in a second instance of the loop that
+ * only the elements of stressed parts run.
  *
  * Nodal forces come from edge tractions: the force on node a is
  * 1/2 sigma m_a, m_a the outward normal (scaled by length) of the edge
@@ -137,17 +139,18 @@ double element_log_near1(double J);
 double element_log_near1(double J) { return log_near1(J); }
 
 /* Half the stress of a deformation gradient (a b; c d) for Lame constants
- * 2 hlambda, 2 hmu; returns J. *w gets the strain energy density per unit
- * initial area. Half, because nodal forces are 1/2 sigma m_a: scaling by a
+ * 2 hlambda, 2 hmu; returns J (and in *invJ_out the 1/J the law used).
+ * *w gets the strain energy density per unit initial area. Half, because nodal forces are 1/2 sigma m_a: scaling by a
  * power of two is exact, so this is bit for bit half of sigma and the 0.5
  * costs no multiplications per component. lambda ln J is shared by the
  * stress and the energy. */
 static inline double neo_hookean_half(double a, double b, double c, double d, double hlambda,
-                                      double hmu, double hs[3], double *w)
+                                      double hmu, double hs[3], double *w, double *invJ_out)
 {
     double J = a * d - b * c;
     double lnJ, invJ;
     neo_hookean_log_inverse(J, J_MIN, &lnJ, &invJ);
+    *invJ_out = invJ;
     double B11 = a * a + b * b, B22 = c * c + d * d, B12 = a * c + b * d;
     double hmuJ = hmu * invJ, hl_lnJ = hlambda * lnJ, hvol = hl_lnJ * invJ;
     hs[0] = hmuJ * (B11 - 1) + hvol;
@@ -155,6 +158,22 @@ static inline double neo_hookean_half(double a, double b, double c, double d, do
     hs[2] = hmuJ * B12;
     *w = hmu * (B11 + B22 - 2 - 2 * lnJ) + hl_lnJ * lnJ;
     return J;
+}
+
+/* The in-situ pre-stress S0 (s0: xx, yy, xy) pushed forward by F = (a b;
+ * c d), F S0 F^T / J, times `scale` (1/2 for the half stress, with 1/J as
+ * the law takes it below J_MIN), added to hs; returns its strain energy
+ * density S0 : E = (tr(F S0 F^T) - tr S0) / 2 (initial_stress.c). */
+static inline double prestress_add(double a, double b, double c, double d, double scale,
+                                   const double s0[3], double hs[3])
+{
+    double r0 = a * s0[0] + b * s0[2], r1 = a * s0[2] + b * s0[1]; /* first row of F S0 */
+    double q0 = c * s0[0] + d * s0[2], q1 = c * s0[2] + d * s0[1]; /* second row */
+    double txx = r0 * a + r1 * b, tyy = q0 * c + q1 * d, txy = r0 * c + r1 * d;
+    hs[0] += scale * txx;
+    hs[1] += scale * tyy;
+    hs[2] += scale * txy;
+    return 0.5 * (txx + tyy - s0[0] - s0[1]);
 }
 
 /* The rate of deformation D = sym([v][x]^-1) of an element (current
@@ -234,10 +253,12 @@ static inline void edge_traction_forces(double *f, int n0, int n1, int n2, doubl
  *    the loop is too long per element for the hardware prefetcher's window
  *    to keep the record stream ahead of it (1e6 elements: ~17.5 -> ~15 ns
  *    per element-step). */
-void tri_element_forces_range(fdem_model *m, int begin, int end_index,
-                              double sums[SCATTER_SUMS])
+static inline __attribute__((always_inline)) void
+tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double sums[SCATTER_SUMS])
 {
     const double *pos = m->pos, *vel = m->vel;
+    /* stressed: this block's pre-stresses, walked alongside the records */
+    const double *stress0 = stressed ? m->elem_stress0 + 3 * (size_t)begin : NULL;
     double *f = m->force;
     /* this block's stored viscous stresses, walked alongside the records
      * (restrict: no other array of the loop lives there) */
@@ -262,8 +283,12 @@ void tri_element_forces_range(fdem_model *m, int begin, int end_index,
             hlambda = 0.5 * mats[cur_mat].lambda;
             hmu = 0.5 * mats[cur_mat].mu;
         }
-        double hs[3], w;
-        neo_hookean_half(a, b, c, d, hlambda, hmu, hs, &w);
+        double hs[3], w, invJ;
+        neo_hookean_half(a, b, c, d, hlambda, hmu, hs, &w, &invJ);
+        if (stressed) {
+            w += prestress_add(a, b, c, d, 0.5 * invJ, stress0, hs);
+            stress0 += 3;
+        }
         energy += w * el->area0;
         if (el->eta > 0) {
             /* Damping is booked with the step-averaged velocity, like every
@@ -288,6 +313,18 @@ void tri_element_forces_range(fdem_model *m, int begin, int end_index,
     sums[2] += power[1];
 }
 
+void tri_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    tri_forces(m, begin, end, 0, sums);
+}
+
+/* The same loop for the elements of a part with an in-situ stress. */
+void tri_element_forces_range_stressed(fdem_model *m, int begin, int end,
+                                       double sums[SCATTER_SUMS])
+{
+    tri_forces(m, begin, end, 1, sums);
+}
+
 void tri_element_stress(const fdem_model *m, int e, double out[3])
 {
     const element_hot *el = &m->elem[e];
@@ -300,8 +337,10 @@ void tri_element_stress(const fdem_model *m, int e, double out[3])
     double a = x1 * Xi[0] + x2 * Xi[2], b = x1 * Xi[1] + x2 * Xi[3];
     double c = y1 * Xi[0] + y2 * Xi[2], d = y1 * Xi[1] + y2 * Xi[3];
     const material *mat = &m->materials[el->material];
-    double w;
-    neo_hookean_half(a, b, c, d, 0.5 * mat->lambda, 0.5 * mat->mu, out, &w);
+    double w, invJ;
+    neo_hookean_half(a, b, c, d, 0.5 * mat->lambda, 0.5 * mat->mu, out, &w, &invJ);
+    if (m->elem_stress0 && m->parts[m->elem_part[e]].stressed)
+        prestress_add(a, b, c, d, 0.5 * invJ, m->elem_stress0 + 3 * (size_t)e, out);
     double det, D[3];
     if (el->eta > 0 && rate_of_deformation(m->vel, n0, n1, n2, x1, y1, x2, y2, &det, D))
         for (int k = 0; k < 3; k++) out[k] += el->eta * D[k];

@@ -31,7 +31,33 @@
 
 static void total_momentum(const fdem_model *m, double p[3]);
 
-/* Kinetic and elastic energy at t = 0: the reference of the balance. */
+/* Sum of m a . a over the free dofs at t = 0 for the forces in m->force
+ * (and gravity): see energy_initial. */
+static double initial_acceleration2(const fdem_model *m)
+{
+    const int D = m->dim;
+    double sum = 0;
+    for (int i = 0; i < m->node_count; i++)
+        for (int d = 0; d < D; d++) {
+            if (m->dof_owned[i] & (1u << d)) continue;
+            double a = m->force[(size_t)D * (size_t)i + (size_t)d] * m->inv_mass[i] + m->gravity[d];
+            sum += m->mass[i] * a * a;
+        }
+    return sum;
+}
+
+/* Kinetic and elastic energy at t = 0: the reference of the balance.
+ * Central difference starts with half a step, v(h/2) = v0 + a0 h/2, and
+ * what it conserves for a linear solid is 1/2 m v(t - h/2) . v(t + h/2) +
+ * U: at t = 0 that is the kinetic energy of v0 less m a0 . a0 h^2 / 8
+ * (v(-h/2) = v0 - a0 h/2). For a model that starts in equilibrium this is
+ * nothing; one that starts out of it (an in-situ stress without the
+ * matching boundary tractions) would otherwise carry it as a constant
+ * residual from the first step on. The first step's h is only known when
+ * it is taken (fdem_step records it); a model restored from a checkpoint
+ * takes its current dt. The forces at t = 0 are the elements' and the
+ * applied ones, pressures included (joints hold none; bodies start apart,
+ * so no contact). */
 void energy_initial(fdem_model *m)
 {
     double kinetic = 0;
@@ -43,6 +69,9 @@ void energy_initial(fdem_model *m)
     }
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     element_forces(m);
+    constraint_apply_forces(m);
+    boundary_load_apply(m);
+    m->initial_acceleration2 = initial_acceleration2(m);
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     if (m->elem_viscous)
         memset(m->elem_viscous, 0,
@@ -121,6 +150,11 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     if (m->restored_energy_valid) return m->restored_energy;
     fdem_energy en = {0};
     const double havg = m->havg_last, h = m->dt_prev;
+    /* v(t - h/2) from v(t + h/2): after the first (half) step, v(-h/2) of
+     * the scheme, as energy_initial takes it */
+    const double back = m->step == 1 ? h : havg;
+    const double h_first = m->first_dt > 0 ? m->first_dt : m->dt;
+    const double initial = m->initial_energy - 0.125 * h_first * h_first * m->initial_acceleration2;
     const double *fc = m->contact.enabled && !m->contact.force_is_zero ? m->contact.force : NULL;
     double contact_power = 0, gravity_work = 0;
     const int D = m->dim;
@@ -130,7 +164,7 @@ fdem_energy fdem_get_energy(const fdem_model *m)
             double v = m->vel[k], v_old = v;
             if (!(m->dof_owned[i] & (1u << d))) {
                 double f = m->force[k] + (fc ? fc[k] : 0);
-                v_old = v - (f * m->inv_mass[i] + m->gravity[d]) * havg;
+                v_old = v - (f * m->inv_mass[i] + m->gravity[d]) * back;
             }
             en.kinetic += 0.5 * m->mass[i] * v * v_old;
             gravity_work += m->mass[i] * m->gravity[d] * (m->pos[k] - v * h - m->pos0[k]);
@@ -146,6 +180,6 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     en.gravity_work = m->gravity_amplitude ? gravity_work_of_amplitude(m) : gravity_work;
     en.external_work = m->external_work - constraints_last_half_step(m);
     en.residual = en.kinetic + en.elastic + en.joint + en.contact + en.friction + en.fracture +
-                  en.damping - en.gravity_work - en.external_work - m->initial_energy;
+                  en.damping - en.gravity_work - en.external_work - initial;
     return en;
 }

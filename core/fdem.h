@@ -171,6 +171,17 @@ int fdem_set_part_velocity(fdem_model *model, int part, double vx, double vy,
                            fdem_error *err);
 int fdem_set_part_velocity_v(fdem_model *model, int part, const double *v, fdem_error *err);
 
+/* In-situ stress of a part (contract 5.3): its elements start, at t = 0,
+ * with the Cauchy stress value + gradient (h - reference), h the height of
+ * each element's initial centroid (y in 2D, z in 3D). value and gradient
+ * hold fdem_stress_components numbers in the layout of fdem_element_stress;
+ * gradient may be NULL (a uniform stress). Before finalize; a second call
+ * for the same part replaces the first. The stress is kept per element as a
+ * second Piola-Kirchhoff pre-stress S0 that the element carries as it
+ * deforms (sigma = F S0 F^T / J added to the elastic stress, docs/physics.md). */
+int fdem_set_part_initial_stress(fdem_model *model, int part, const double *value,
+                                 const double *gradient, double reference, fdem_error *err);
+
 /* Gravity, `dimension` components in g (the 2D form leaves gz out). */
 void fdem_set_gravity(fdem_model *model, double gx, double gy);
 void fdem_set_gravity_v(fdem_model *model, const double *g);
@@ -266,7 +277,9 @@ typedef struct fdem_energy {
     double kinetic;       /* 1/2 sum m v(t - h/2) . v(t + h/2): the central-difference kinetic
                              energy, which with the elastic energy the scheme conserves exactly
                              for a linear solid */
-    double elastic;       /* strain energy of all elements */
+    double elastic;       /* strain energy of all elements; with an in-situ stress S0 that
+                             of the total stress: the energy S0 holds at t = 0 (linear
+                             elastic) plus what it and the material gained since (S0 : E) */
     double joint;         /* elastic energy stored in intact joints */
     double contact;       /* minus the work of the contact forces, less what friction
                              dissipated: what the penalty (normal and stick) springs hold;

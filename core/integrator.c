@@ -182,6 +182,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
         report_non_finite(m, h, err);
         return -1;
     }
+    if (m->step == 0) m->first_dt = h;
     m->dt_prev = h;
     m->havg_last = havg;
     m->restored_energy_valid = 0;

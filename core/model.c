@@ -74,6 +74,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
+    free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
@@ -240,6 +241,7 @@ static int part_append(fdem_model *m, const double *coords, int node_count, cons
     part *p = &m->parts[k];
     p->material = material_index;
     p->fracture = fracture;
+    p->stressed = 0;
     p->node_begin = m->node_count;
     p->node_count = add_nodes;
     p->elem_begin = m->elem_count;
@@ -583,6 +585,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         if (element_prepare(m, e, err)) return -1;
         damped |= element_eta(m, e) > 0;
     }
+    if (initial_stress_prepare(m, err)) return -1;
     if (damped && !(m->elem_viscous = calloc((size_t)model_stress_comps(m) * (size_t)m->elem_count,
                                              sizeof(double)))) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
@@ -723,6 +726,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
+    if (m->elem_stress0) b += (size_t)m->elem_count * (size_t)model_stress_comps(m) * sizeof(double);
     if (m->contact.enabled) /* spheres (centre, radius), boxes (2 dim), body, piece */
         b += (size_t)m->elem_count * ((3 * D + 1) * sizeof(double) + 2 * sizeof(int32_t) + 1) +
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)

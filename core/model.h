@@ -67,9 +67,17 @@ typedef struct joint_set {
 typedef struct part {
     int material;
     int fracture;
+    int stressed;        /* has an in-situ stress (initial_stress.c) */
     int node_begin, node_count;
     int elem_begin, elem_count;
 } part;
+
+/* An in-situ stress as given for a part, until finalize evaluates it per
+ * element (initial_stress.c). */
+typedef struct initial_stress_def {
+    int part;
+    double value[6], gradient[6], reference;
+} initial_stress_def;
 
 /* One constraint after node selection. Its nodes are entries
  * [entry_begin, entry_begin + entry_count) of model.cnode / model.cdof. */
@@ -181,6 +189,13 @@ struct fdem_model {
     int part_count, part_capacity;
     part *parts;
     double *part_velocity;   /* 3 per part (2D uses 2), applied at finalize */
+    initial_stress_def *stress0_defs; /* in-situ stresses as given, one per part that has one */
+    int stress0_def_count;
+    double *elem_stress0;    /* stress_comps per element: the 2nd Piola-Kirchhoff pre-stress
+                                S0 (the in-situ Cauchy stress at t = 0); NULL when no part
+                                has one, zeros in the elements of parts without */
+    double stress0_energy;   /* sum of V0 S0 : C^-1 : S0 / 2: what the in-situ stress holds
+                                at t = 0, linear elastic (a constant of the elastic energy) */
 
     int constraint_count, constraint_capacity;
     constraint *constraints;
@@ -250,6 +265,8 @@ struct fdem_model {
     double damping_work;     /* energy dissipated by viscous damping */
     double external_work;
     double initial_energy;   /* kinetic + elastic at t = 0 */
+    double initial_acceleration2; /* sum of m a.a at t = 0 over free dofs (energy.c) */
+    double first_dt;         /* the first step's size, 0 before it or after a restore */
     double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
     double *elem_viscous;    /* stress_comps per element: the viscous half stress of the last step, whose
                                 work with the new velocities the next step books
@@ -298,6 +315,13 @@ static inline double element_eta(const fdem_model *m, int e)
     return m->dim == 3 ? m->tet[e].eta : m->elem[e].eta;
 }
 
+/* initial_stress.c: evaluates each stressed part's field at its elements'
+ * initial centroids into elem_stress0 and stress0_energy, marks the parts
+ * (0, or -1 out of memory); the stable step's factor for the geometric
+ * stiffness of a tensile pre-stress (1 for elements without) */
+int initial_stress_prepare(fdem_model *m, fdem_error *err);
+double initial_stress_dt_factor(const fdem_model *m, int e);
+
 /* element.c: the element stage of either dimension (prepare, stable step,
  * forces through the scatter plan, stress), calling the kernels below */
 int element_prepare(fdem_model *m, int e, fdem_error *err);
@@ -310,12 +334,16 @@ int element_of_node(const fdem_model *m, int node);
 void tri_element_prepare(fdem_model *m, int e);
 double tri_element_stable_dt(const fdem_model *m, int e);
 void tri_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+void tri_element_forces_range_stressed(fdem_model *m, int begin, int end,
+                                       double sums[SCATTER_SUMS]); /* with elem_stress0 */
 void tri_element_stress(const fdem_model *m, int e, double out[3]);
 
 /* element_tet_model.c: the tetrahedron kernel (element_tet.h) on the model */
 int tet_element_prepare(fdem_model *m, int e, fdem_error *err);
 double tet_element_stable_dt(const fdem_model *m, int e);
 void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+void tet_element_forces_range_stressed(fdem_model *m, int begin, int end,
+                                       double sums[SCATTER_SUMS]);
 void tet_element_stress(const fdem_model *m, int e, double out[6]);
 
 /* contact.c: the contact stage of both dimensions over the pair kernels of

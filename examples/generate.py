@@ -362,3 +362,54 @@ dump("jointed-block", {
                     {"part": "block", "group": "top", "velocity": [None, 0.01]}],
     "time": {"end": 0.0024, "dt": "auto", "safety": 0.5},
     "output": {"interval": 2e-5, "fields": ["position", "velocity", "stress", "damage"]}})
+
+
+# In-situ stress (contract 5.3). A pressurised borehole: the plate of
+# borehole.geo starts under the in-situ stress sxx = -10, syy = -20 MPa
+# (compression negative), its edges carry the matching pressures and let
+# waves out (absorb), the bore is drilled at t = 0 with 5 MPa of fluid in
+# it. Kirsch plus Lame give the hoop stress at the bore wall,
+# sxx + syy - 2 (sxx - syy) cos 2 theta + p: -45 MPa at theta = 0 and
+# -5 MPa at theta = 90 degrees.
+B = 2.0
+rock = {"density": 2600, "young": 2e10, "poisson": 0.25, "damping": 0.2}
+edges = [("x", [-B - 0.01, -B - 0.01, -B + 0.01, B + 0.01], 10e6),
+         ("x", [B - 0.01, -B - 0.01, B + 0.01, B + 0.01], 10e6),
+         ("y", [-B - 0.01, -B - 0.01, B + 0.01, -B + 0.01], 20e6),
+         ("y", [-B - 0.01, B - 0.01, B + 0.01, B + 0.01], 20e6)]
+dump("borehole", {
+    "name": "borehole",
+    "materials": {"rock": dict(rock)},
+    "parts": [{"name": "plate", "material": "rock",
+               "initial_stress": {"value": [-10e6, -20e6, 0]},
+               "gmsh": gmsh_text(os.path.join(OUT, "borehole.geo"))}],
+    "constraints": [{"box": box, "pressure": p} for _, box, p in edges] +
+                   [{"box": box, "absorb": True} for _, box, _ in edges] +
+                   [{"box": [-0.11, -0.11, 0.11, 0.11], "pressure": 5e6}],
+    "time": {"end": 0.002, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.0001, "fields": ["position", "stress"]}})
+
+
+# A tunnel excavated in a rock mass under the hydrostatic in-situ stress
+# -15 MPa: the opening of tunnel.geo starts held by a 15 MPa support
+# pressure equal to it (so the model starts in equilibrium), which is
+# taken away over 10 ms (amplitude 1 -> 0, slow against the 0.3 ms a wave
+# needs to cross the opening: quasi-static). The wall converges along the
+# elastic ground reaction line u = (P0 - p) a / (2 G) to 0.9375 mm, and the
+# hoop stress at the wall rises to 2 P0 - p = 30 MPa of compression.
+A = 1.0
+B = 20.0
+far = [[-B - 0.1, -B - 0.1, -B + 0.1, B + 0.1], [B - 0.1, -B - 0.1, B + 0.1, B + 0.1],
+       [-B - 0.1, -B - 0.1, B + 0.1, -B + 0.1], [-B - 0.1, B - 0.1, B + 0.1, B + 0.1]]
+dump("tunnel", {
+    "name": "tunnel",
+    "materials": {"rock": dict(rock)},
+    "parts": [{"name": "rock mass", "material": "rock",
+               "initial_stress": {"value": [-15e6, -15e6, 0]},
+               "gmsh": gmsh_text(os.path.join(OUT, "tunnel.geo"))}],
+    "constraints": [{"box": box, "pressure": 15e6} for box in far] +
+                   [{"box": box, "absorb": True} for box in far] +
+                   [{"box": [-A - 0.01, -A - 0.01, A + 0.01, A + 0.01], "pressure": 15e6,
+                     "amplitude": [[0, 1], [0.01, 0]]}],
+    "time": {"end": 0.015, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.0005, "fields": ["position", "stress"]}})

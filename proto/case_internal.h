@@ -60,6 +60,8 @@ typedef struct case_part {
     long divisions[3];       /* rectangle, box: per axis; disc, sphere: [0]; cylinder: 2 */
     fdem_mesh mesh;          /* 2D; MESH, GMSH: read in pass 1; others: pass 3 */
     fdem_tet_mesh tet_mesh;  /* 3D, the same */
+    int has_stress0;         /* "initial_stress" read without a problem */
+    double stress0_value[6], stress0_gradient[6], stress0_reference; /* stress layout, Pa */
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
     gmsh_groups groups;      /* GMSH: its named physical groups */
     int32_t *element_material; /* "materials": the material of each element, else NULL */
@@ -188,6 +190,12 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
+/* case_initial_stress.c: a part's "initial_stress" (pass 1), and handing
+ * document part i's to the engine once it is model part `index` (pass 3; 0,
+ * or -1 after a problem). */
+void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
+                              const char *ptr);
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index);
 /* case_materials.c: a fracture block and its variation (zero when it has
  * none); required = 0 lets keys be absent (f keeps what it held) but wants
  * at least one. */

@@ -20,8 +20,8 @@ const char *const case_shape_keys[CASE_SHAPE_KINDS] = {
 };
 
 static const char *const part_keys[] = {
-    "name", "material", "fracture", "velocity", "rectangle", "disc", "mesh", "gmsh", "box",
-    "sphere", "cylinder", "materials", "discontinuities", NULL,
+    "name", "material", "fracture", "velocity", "initial_stress", "rectangle", "disc", "mesh",
+    "gmsh", "box", "sphere", "cylinder", "materials", "discontinuities", NULL,
 };
 
 /* The dimension a shape belongs to, 0 for both. */
@@ -159,6 +159,8 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     json_t *velocity = case_member(value, ptr, "velocity", at);
     if (velocity)
         part->has_velocity = case_read_vector(doc, velocity, at, doc->dimension, part->velocity);
+    json_t *stress = case_member(value, ptr, "initial_stress", at);
+    if (stress) case_read_initial_stress(doc, part, stress, at);
 }
 
 static void part_read(case_doc *doc, case_part *part, int index, const json_t *value)
@@ -258,7 +260,7 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }
-    return 0;
+    return case_add_initial_stress(doc, model, i, index);
 }
 
 /* Every part is meshed and checked even after one is refused, so that one

@@ -151,6 +151,40 @@ class BadInputTest(unittest.TestCase):
         case["parts"][0]["gmsh"] = "$MeshFormat\nthis is not a mesh\n$EndMeshFormat\n\x01\x02"
         self.post(case, 422, "/parts/0")
 
+    def test_initial_stress(self):
+        def stressed(block, dimension=2):
+            if dimension == 3:
+                case = tiny_case("stress3d", dimension=3)
+                case["parts"][0] = {"name": "block", "material": "rock",
+                                    "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1],
+                                            "divisions": [2, 2, 2]}}
+                case["constraints"] = [{"box": [-1, -1, -0.001, 1, 1, 0.001], "fix": ["x", "y", "z"]}]
+            else:
+                case = tiny_case("stress")
+            case["parts"][0]["initial_stress"] = block
+            return case
+        at = "/parts/0/initial_stress"
+        self.post(stressed({"value": [-1e6, -2e6]}), 422, at + "/value", ["[sxx, syy, sxy]"])
+        self.post(stressed({"value": [-1e6, -2e6, 0]}, 3), 422, at + "/value",
+                  ["[sxx, syy, szz, syz, sxz, sxy]"])
+        self.post(stressed({"value": [-1e6, "big", 0]}), 422, at + "/value/1", ["number"])
+        self.post(stressed({"value": [-1e6, -2e6, None]}), 422, at + "/value/2")
+        self.post(stressed({"value": [0, 0, 0], "gradient": [0, 2.7e4]}), 422, at + "/gradient")
+        self.post(stressed({"value": [0, 0, 0], "gradient": [0, 2.7e4, 0]}), 422, at + "/gradient",
+                  ["reference"])
+        self.post(stressed({"value": [0, 0, 0], "reference": "top"}), 422, at + "/reference")
+        self.post(stressed({"value": [0, 0, 0], "gradiant": [0, 1, 0], "reference": 0}), 422,
+                  at + "/gradiant", ["gradient"])
+        self.post(stressed({"gradient": [0, 1, 0], "reference": 0}), 422, at, ["value"])
+        self.post(stressed([-1e6, -2e6, 0]), 422, at, ["object"])
+        # non-finite numbers never reach the case: the JSON parser refuses them
+        text = json.dumps(stressed({"value": [-1e6, -2e6, 0]})).replace("-2000000.0", "NaN")
+        self.assertIn("NaN", text)
+        self.post(text.encode(), 400)
+        text = json.dumps(stressed({"value": [-1e6, -2e6, 0]})).replace("-2000000.0", "-1e999")
+        self.assertIn("1e999", text)
+        self.post(text.encode(), 400)
+
     def with_constraint(self, constraint, **top):
         case = tiny_case("loads", **top)
         case["constraints"].append(constraint)

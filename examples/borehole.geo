@@ -1,0 +1,31 @@
+// Square plate with a circular borehole at its centre, for
+// examples/borehole.json: half-width B = 2 m, bore radius a = 0.1 m
+// (a/B = 1/20, so the plate's edges change the stress at the bore by
+// about (a/B)^2 = 0.25 %), elements of 5 mm on the bore growing to 0.25 m
+// at the edges.
+// gmsh -2 -format msh22 borehole.geo -o borehole.msh
+B = 2;
+a = 0.1;
+h_out = 0.25;
+h_bore = 0.005;
+Point(1) = {-B, -B, 0, h_out};
+Point(2) = {B, -B, 0, h_out};
+Point(3) = {B, B, 0, h_out};
+Point(4) = {-B, B, 0, h_out};
+Point(5) = {0, 0, 0, h_bore};
+Point(6) = {a, 0, 0, h_bore};
+Point(7) = {0, a, 0, h_bore};
+Point(8) = {-a, 0, 0, h_bore};
+Point(9) = {0, -a, 0, h_bore};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Circle(5) = {6, 5, 7};
+Circle(6) = {7, 5, 8};
+Circle(7) = {8, 5, 9};
+Circle(8) = {9, 5, 6};
+Curve Loop(1) = {1, 2, 3, 4};
+Curve Loop(2) = {5, 6, 7, 8};
+Plane Surface(1) = {1, 2};
+Physical Surface("rock") = {1};

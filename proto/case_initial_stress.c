@@ -1,0 +1,82 @@
+/*
+ * case_initial_stress.c - a part's "initial_stress" (contract 5.3): the
+ * in-situ stress its elements start with, {"value": [...], "gradient":
+ * [...], "reference": h}, read in pass 1 and handed to the engine with the
+ * part in pass 3.
+ *
+ * value and gradient hold the stress components in the layout of the
+ * `stress` output (2D: sxx, syy, sxy; 3D: sxx, syy, szz, syz, sxz, sxy);
+ * the gradient is per metre of height (y in 2D, z in 3D) and needs the
+ * reference height where value holds, since a gradient from an unstated
+ * height is a guess the user did not make.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "case_internal.h"
+
+static const char *const initial_stress_keys[] = {"value", "gradient", "reference", NULL};
+
+static const char *stress_layout(int dimension)
+{
+    return dimension == 3 ? "[sxx, syy, szz, syz, sxz, sxy]" : "[sxx, syy, sxy]";
+}
+
+/* An array of the dimension's stress components, each a finite number; a
+ * wrong length is told with the layout it should have. */
+static int read_components(case_doc *doc, const json_t *value, const char *ptr, const char *unit,
+                           double out[6])
+{
+    const int count = doc->dimension == 3 ? 6 : 3;
+    if (!json_is_array(value) || json_array_size(value) != (size_t)count) {
+        case_problem(doc, ptr, "expected an array of %s numbers %s (%s) for a %dD case, got %s%s",
+                     case_count_word(count), stress_layout(doc->dimension), unit, doc->dimension,
+                     case_type_word(value), json_is_array(value) ? " of another length" : "");
+        return 0;
+    }
+    return case_read_vector(doc, value, ptr, count, out);
+}
+
+void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
+                              const char *ptr)
+{
+    if (!case_expect_object(doc, block, ptr)) return;
+    case_check_keys(doc, block, ptr, initial_stress_keys, "\"initial_stress\"");
+    char at[CASE_POINTER];
+    int ok = 1;
+    json_t *value = case_member(block, ptr, "value", at);
+    if (!value) {
+        case_problem(doc, ptr, "missing required \"value\": the stress %s in Pa",
+                     stress_layout(doc->dimension));
+        ok = 0;
+    } else {
+        ok &= read_components(doc, value, at, "Pa", part->stress0_value);
+    }
+    json_t *gradient = case_member(block, ptr, "gradient", at);
+    if (gradient) {
+        ok &= read_components(doc, gradient, at, "Pa per metre of height",
+                              part->stress0_gradient);
+        if (!json_object_get(block, "reference")) {
+            case_problem(doc, at, "a \"gradient\" needs \"reference\": the height (%s) at which "
+                                  "\"value\" holds", doc->dimension == 3 ? "z" : "y");
+            ok = 0;
+        }
+    }
+    ok &= case_number_member(doc, block, ptr, "reference", 0, &part->stress0_reference);
+    part->has_stress0 = ok;
+}
+
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index)
+{
+    const case_part *part = &doc->parts[i];
+    if (!part->has_stress0) return 0;
+    fdem_error err = {0};
+    if (fdem_set_part_initial_stress(model, index, part->stress0_value, part->stress0_gradient,
+                                     part->stress0_reference, &err) == 0)
+        return 0;
+    char base[CASE_POINTER], ptr[CASE_POINTER];
+    pointer_join_index(base, sizeof base, "/parts", i);
+    pointer_join(ptr, sizeof ptr, base, "initial_stress");
+    case_problem(doc, ptr, "%s", err.message);
+    return -1;
+}
