@@ -268,7 +268,7 @@ class Client:
 
     def events(self, case_id, since=None):
         """The fracture events of the case: one per joint that broke, in the
-        order they broke (contract 5.4).
+        order they broke (docs/api.md, "GET /cases/ID/events").
 
         Args:
             since: a time in seconds; only the events after it (time >
