@@ -246,3 +246,16 @@ class DaemonTestCase(unittest.TestCase):
         cls.d.close()
         shutil.rmtree(cls.tmp, ignore_errors=True)
         assert code == 0, "fdemd exited %s on SIGTERM" % code
+
+    def run_case(self, case, timeout=60):
+        """Runs `case` to its end and downloads its result.h5 into the
+        scratch directory: (final status, path of the file)."""
+        st = self.d.create(case, start=True)
+        st = self.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=timeout)
+        self.assertEqual(st["state"], "finished", st.get("error"))
+        status, _, data = self.d.request("GET", "/cases/%s/result.h5" % st["id"])
+        self.assertEqual(status, 200)
+        path = os.path.join(self.tmp, st["id"] + ".h5")
+        with open(path, "wb") as f:
+            f.write(data)
+        return st, path

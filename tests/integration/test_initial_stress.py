@@ -57,21 +57,10 @@ def hoop_and_radial(s, theta):
 class InitialStressTest(DaemonTestCase):
     PREFIX = "fdemd-insitu-"
 
-    def run_case(self, case, timeout=120):
-        st = self.d.create(case, start=True)
-        st = self.d.wait_state(st["id"], ("finished", "failed"), timeout=timeout)
-        self.assertEqual(st["state"], "finished", st)
-        status, _, data = self.d.request("GET", "/cases/%s/result.h5" % st["id"])
-        self.assertEqual(status, 200)
-        path = os.path.join(self.tmp, st["id"] + ".h5")
-        with open(path, "wb") as f:
-            f.write(data)
-        return st, path
-
     def test_block_at_rest_shows_its_stress(self):
         for dimension in (2, 3):
             case, stress = block_case(dimension)
-            st, path = self.run_case(case)
+            st, path = self.run_case(case, timeout=120)
             with h5py.File(path, "r") as f:
                 s = f["/snapshots/stress"][...]
                 x, x0 = f["/snapshots/position"][...], f["/mesh/position0"][...]
@@ -90,7 +79,7 @@ class InitialStressTest(DaemonTestCase):
         sx, sy, _ = case["parts"][0]["initial_stress"]["value"]
         p = case["constraints"][-1]["pressure"]
         a = 0.1  # examples/borehole.geo
-        _, path = self.run_case(case)
+        _, path = self.run_case(case, timeout=120)
         with h5py.File(path, "r") as f:
             x0, tri = f["/mesh/position0"][...], f["/mesh/triangles"][...]
             s = f["/snapshots/stress"][-1]
@@ -114,7 +103,7 @@ class InitialStressTest(DaemonTestCase):
         case = example("tunnel")
         p0 = -case["parts"][0]["initial_stress"]["value"][0]
         a = 1.0  # examples/tunnel.geo
-        _, path = self.run_case(case)
+        _, path = self.run_case(case, timeout=120)
         with h5py.File(path, "r") as f:
             x0, tri = f["/mesh/position0"][...], f["/mesh/triangles"][...]
             x, s = f["/snapshots/position"][-1], f["/snapshots/stress"][-1]

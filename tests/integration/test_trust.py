@@ -12,7 +12,6 @@
 - a time.end below one step, and a density so high that the stable step
   exceeds time.end, end exactly at time.end with a snapshot there.
 """
-import os
 import time
 
 import h5py
@@ -44,17 +43,6 @@ def collision_case(interval, fields):
 
 class TrustworthyNumbers(DaemonTestCase):
     PREFIX = "fdemd-trust-"
-
-    def run_case(self, case):
-        st = self.d.create(case, start=True)
-        st = self.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=60)
-        self.assertEqual(st["state"], "finished", st.get("error"))
-        status, headers, data = self.d.request("GET", "/cases/%s/result.h5" % st["id"])
-        self.assertEqual(status, 200)
-        path = os.path.join(self.tmp, st["id"] + ".h5")
-        with open(path, "wb") as f:
-            f.write(data)
-        return st, path
 
     def test_output_interval_and_fields_leave_the_state_bit_identical(self):
         st1, p1 = self.run_case(collision_case(1e-4, ["position", "velocity"]))
