@@ -1,7 +1,8 @@
 /*
- * registry_internal.h - what registry.c, case_status.c, registry_load.c and
- * case_stages.c share, and nothing else includes: building a case record, its state
- * names, the status object's durable write, and loading a stored case.
+ * registry_internal.h - what registry.c, registry_create.c, case_status.c,
+ * registry_load.c and case_stages.c share, and nothing else includes:
+ * building a case record, its state names, the status object's durable
+ * write, admitting a stored case, and loading one.
  */
 #ifndef FDEMD_REGISTRY_INTERNAL_H
 #define FDEMD_REGISTRY_INTERNAL_H
@@ -12,6 +13,12 @@
 #include "registry.h"
 
 server_case *case_new(void);
+/* A fresh random case id (0), or -1 when the system has no randomness. */
+int id_generate(char out[CASE_ID_LEN + 1]);
+/* registry_create.c's last step: the stored case joins the list and starts
+ * (or queues) when `start`, its `cost` moved from `lease` to its reserve.
+ * -1 when the list cannot grow (the case is not listed). */
+int registry_admit(server_case *c, int start, membudget_lease *lease, size_t cost);
 int case_state_is_terminal(case_state s);
 void iso_time_now(char *out, size_t size);
 /* Figures of the case's model into its published figures. */
