@@ -147,28 +147,37 @@ class ParaViewTest(unittest.TestCase):
             # the case hit something: the last step is not the first
             self.assertGreater(np.abs(f["/snapshots/stress"][-1]).max(), 0)
 
+    def fetch_a_running_case(self, name, pause):
+        """result.h5, then result.xdmf, of a case that has taken 4
+        snapshots, fetched while it runs or after pausing it: the folder."""
+        case = tiny_case("pv-" + name, end=100.0, divisions=(3, 3), interval=1e-4)
+        st = self.d.create(case, start=True)
+        folder = os.path.join(self.tmp, name)
+        os.makedirs(folder)
+        try:
+            self.d.wait(st["id"], lambda s: s["snapshots"] >= 4, what="4 snapshots")
+            if pause:
+                self.d.json("POST", "/cases/%s/pause" % st["id"])
+                self.d.wait_state(st["id"], "paused")
+            for file in ("result.h5", "result.xdmf"):
+                status, _, data = self.d.request("GET", "/cases/%s/%s" % (st["id"], file))
+                self.assertEqual(status, 200)
+                with open(os.path.join(folder, file), "wb") as f:
+                    f.write(data)
+        finally:
+            self.d.json("POST", "/cases/%s/stop" % st["id"])
+        return folder
+
     def test_running_case_in_the_legacy_reader(self):
         """A copy fetched while the case runs has no views yet: its sidecar
         uses HyperSlabs, which the legacy reader opens without a message
         (docs/results.md says the Xdmf3 readers need a closed file)."""
-        case = tiny_case("pv-running", end=100.0, divisions=(3, 3), interval=1e-4)
-        st = self.d.create(case, start=True)
-        try:
-            self.d.wait(st["id"], lambda s: s["snapshots"] >= 4, what="4 snapshots")
-            folder = os.path.join(self.tmp, "running")
-            os.makedirs(folder)
-            # The legacy reader needs the sidecar to name exactly the rows
-            # the file holds (it crashes on one more or one fewer): the
-            # sidecar last, so it names what the file had; a snapshot
-            # appended between the two downloads still breaks it (rarely:
-            # docs/results.md tells users to pause first).
-            for name in ("result.h5", "result.xdmf"):
-                status, _, data = self.d.request("GET", "/cases/%s/%s" % (st["id"], name))
-                self.assertEqual(status, 200)
-                with open(os.path.join(folder, name), "wb") as f:
-                    f.write(data)
-        finally:
-            self.d.json("POST", "/cases/%s/stop" % st["id"])
+        # The legacy reader needs the sidecar to name exactly the rows the
+        # file holds (it crashes on one more or one fewer): the sidecar
+        # last, so it names what the file had; a snapshot appended between
+        # the two downloads still breaks it (rarely: docs/results.md tells
+        # users to pause first).
+        folder = self.fetch_a_running_case("running", pause=False)
         with open(os.path.join(folder, "result.xdmf")) as f:
             self.assertIn('ItemType="HyperSlab"', f.read())
         got = self.load("XDMFReader", os.path.join(folder, "result.xdmf"))
@@ -185,21 +194,7 @@ class ParaViewTest(unittest.TestCase):
     def test_paused_case_in_every_reader(self):
         """What docs/results.md tells a user who wants to look at a running
         case: pause it, and both files open in every reader."""
-        case = tiny_case("pv-paused", end=100.0, divisions=(3, 3), interval=1e-4)
-        st = self.d.create(case, start=True)
-        try:
-            self.d.wait(st["id"], lambda s: s["snapshots"] >= 4, what="4 snapshots")
-            self.d.json("POST", "/cases/%s/pause" % st["id"])
-            self.d.wait_state(st["id"], "paused")
-            folder = os.path.join(self.tmp, "paused")
-            os.makedirs(folder)
-            for name in ("result.xdmf", "result.h5"):
-                status, _, data = self.d.request("GET", "/cases/%s/%s" % (st["id"], name))
-                self.assertEqual(status, 200)
-                with open(os.path.join(folder, name), "wb") as f:
-                    f.write(data)
-        finally:
-            self.d.json("POST", "/cases/%s/stop" % st["id"])
+        folder = self.fetch_a_running_case("paused", pause=True)
         with h5py.File(os.path.join(folder, "result.h5"), "r") as f:
             times = f["/snapshots/time"][...]
         for reader in READERS:
