@@ -228,8 +228,11 @@ static void io_do_close(io_job *j)
     server_case *c = j->c;
     if (!c->result)
         return;
-    if (!c->deleted && c->model) {
-        /* the views let every ParaView XDMF reader open the sidecar */
+    if (!c->deleted && c->model && !atomic_load(&c->io_failed)) {
+        /* The views let every ParaView XDMF reader open the sidecar. Not
+         * after a failed write (a full disk): they grow the file, and a
+         * close that cannot flush leaves it flagged as open for writing,
+         * which h5py and the other readers then refuse. */
         char path[1200], err[256] = "";
         snprintf(path, sizeof path, "%s/result.h5", c->dir);
         if (result_finish(c->result, path, fdem_get_dimension(c->model), err, sizeof err) != 0)
