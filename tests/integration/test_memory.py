@@ -7,15 +7,13 @@ import json
 import os
 import signal
 import socket
-import tempfile
 import threading
 import time
 import unittest
 
-import h5py
 import numpy as np
 
-from fdemd_harness import Daemon, tiny_case, SLOW
+from fdemd_harness import SLOW, Daemon, fetched_result, tiny_case
 
 MiB = 1 << 20
 # ASan keeps freed memory in quarantine and maps shadow memory: RSS then says
@@ -246,17 +244,10 @@ class MemoryTest(unittest.TestCase):
         status, state = d.json("GET", "/cases/%s/state?fields=position,velocity" % case_id)
         self.assertEqual((status, state["step"]), (200, st["step"]))
         # The stop wrote its last snapshot at that step: the state is the same.
-        status, headers, data = d.request("GET", "/cases/%s/result.h5" % case_id)
-        fd, path = tempfile.mkstemp(suffix=".h5")
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        try:
-            with h5py.File(path, "r") as f:
-                self.assertEqual(f["/snapshots/step"][-1], st["step"])
-                np.testing.assert_array_equal(np.array(state["position"]), f["/snapshots/position"][-1])
-                np.testing.assert_array_equal(np.array(state["velocity"]), f["/snapshots/velocity"][-1])
-        finally:
-            os.unlink(path)
+        with fetched_result(d, case_id) as f:
+            self.assertEqual(f["/snapshots/step"][-1], st["step"])
+            np.testing.assert_array_equal(np.array(state["position"]), f["/snapshots/position"][-1])
+            np.testing.assert_array_equal(np.array(state["velocity"]), f["/snapshots/velocity"][-1])
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ import unittest
 
 import h5py
 
-from fdemd_harness import FDEMD_BIN, SLOW, Daemon, tiny_case
+from fdemd_harness import FDEMD_BIN, SLOW, Daemon, fetched_result, tiny_case
 
 
 def mount_tmpfs(test, size):
@@ -51,16 +51,8 @@ def daemon_on_tmpfs(test, size):
 
 def result_snapshots(daemon, case_id):
     """Downloads result.h5 and returns its /snapshots/time (must open)."""
-    status, headers, data = daemon.request("GET", "/cases/%s/result.h5" % case_id)
-    assert status == 200, (status, data[:300])
-    fd, path = tempfile.mkstemp(suffix=".h5")
-    with os.fdopen(fd, "wb") as f:
-        f.write(data)
-    try:
-        with h5py.File(path, "r") as f:
-            return f["/snapshots/time"][...], f["/snapshots/step"][...]
-    finally:
-        os.unlink(path)
+    with fetched_result(daemon, case_id) as f:
+        return f["/snapshots/time"][...], f["/snapshots/step"][...]
 
 
 class DiskFullTest(unittest.TestCase):
