@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 
 #include "case_model.h"
@@ -19,6 +20,25 @@
 #include "io_thread.h"
 #include "persist.h"
 #include "registry_internal.h"
+
+/* A case id: CASE_ID_LEN hex digits from the kernel's random source. */
+static int id_generate(char out[CASE_ID_LEN + 1])
+{
+    unsigned char raw[CASE_ID_LEN / 2];
+    size_t got = 0;
+    while (got < sizeof raw) {
+        ssize_t n = getrandom(raw + got, sizeof raw - got, 0);
+        if (n < 0) {
+            if (errno == EINTR)
+                continue;
+            return -1;
+        }
+        got += (size_t)n;
+    }
+    for (size_t i = 0; i < sizeof raw; i++)
+        snprintf(out + 2 * i, 3, "%02x", raw[i]);
+    return 0;
+}
 
 /* A new case is built in DIR/.tmp-ID and renamed into place once whole,
  * so a crash while storing it leaves nothing that start-up would list. */

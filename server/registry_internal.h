@@ -13,8 +13,6 @@
 #include "registry.h"
 
 server_case *case_new(void);
-/* A fresh random case id (0), or -1 when the system has no randomness. */
-int id_generate(char out[CASE_ID_LEN + 1]);
 /* registry_create.c's last step: the stored case joins the list and starts
  * (or queues) when `start`, its `cost` moved from `lease` to its reserve.
  * -1 when the list cannot grow (the case is not listed). */
