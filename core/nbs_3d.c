@@ -23,10 +23,16 @@
  *  - Layers are done in runs of consecutive layers, bottom-up, and rows of a
  *    layer likewise, exactly as the 2D rows are: the layer (row) just done
  *    stays mapped in its set as the layer (row) below the next one, so each
- *    element is mapped and unmapped once per level. The three rows of the
- *    layer below are not mapped to x-lists at all: their elements are
- *    walked against the x-lists of the row (the mask is symmetric), which
- *    needs no third set of heads.
+ *    element is mapped and unmapped once per level. The rows of the layer
+ *    below are not mapped to x-lists at all: their elements are walked
+ *    against the x-lists of the rows (the mask is symmetric), which needs
+ *    no third set of heads. With rows y and y-1 of the layer mapped, row
+ *    y-1 below meets both and row y below meets y-1, so each row below is
+ *    walked twice, not once for each of the three rows it meets.
+ *  - An element whose three (six) neighbouring cells are all empty is
+ *    skipped on one AND of their heads before its sphere is loaded, and a
+ *    hit is a branch (a few candidates in a hundred touch even in a
+ *    touching packing): sparse packings pay for the walk, not the tests.
  *  - Every table is a power of two >= 4 slots: at least one more than the
  *    cells it spans (an unfolded axis), or the fold. The neighbours v - 1
  *    and v + 1 are then one AND each and never branch on an edge: on an
@@ -350,18 +356,18 @@ static NBS_ALWAYS_INLINE void nbs3_trio_test(const nbs3_probe *p, int use_body, 
     nbs3_chain_test(p, use_body, b, t.up, o);
 }
 
-/* A row and what its mask reaches: the row is mapped to x-set `cur` (count
- * elements, known once mapped) while it is tested, the row below it (same
- * layer, held_count elements) is in x-set `held`, and below[0..2] are the
- * rows y-1, y, y+1 of the layer below. */
+/* A row in x-set `cur` (count elements, known once mapped) and the row
+ * below it in the same layer in x-set `held` (held_count elements). */
 typedef struct nbs3_row {
     int32_t list, count, held_count;
     int cur, held;
-    int32_t below[3];
 } nbs3_row;
 
-static NBS_ALWAYS_INLINE int nbs3_row_test(const nbs3_scan *s, int use_body, nbs3_row *row,
-                                           nbs_pairs *pairs)
+/* The row's own pass: mapping and testing in one, e meets the elements of
+ * its row mapped before it in cells x-1, x, x+1 (so each pair of the row
+ * once) and the held row's. The held set is empty when the row below is. */
+static NBS_ALWAYS_INLINE int nbs3_row_own(const nbs3_scan *s, int use_body, nbs3_row *row,
+                                          nbs_pairs *pairs)
 {
     nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
     const nbs3_probe p = nbs3_probe_of(s);
@@ -371,9 +377,6 @@ static NBS_ALWAYS_INLINE int nbs3_row_test(const nbs3_scan *s, int use_body, nbs
     const int32_t mask = (int32_t)p.xmask;
     const size_t held_count = (size_t)row->held_count;
     int32_t count = 0;
-    /* Mapping and testing in one pass: e meets the elements of its row
-     * mapped before it in cells x-1, x, x+1, so each pair of the row once.
-     * The held set is empty when the row below is. */
     for (int32_t e = row->list; e >= 0; e = row_next[e], count++) {
         double ex = p.cx[e];
         int32_t x = nbs3_probe_x(&p, ex);
@@ -388,23 +391,58 @@ static NBS_ALWAYS_INLINE int nbs3_row_test(const nbs3_scan *s, int use_body, nbs
         cur[x] = e;
     }
     row->count = count;
-    /* the layer below: each of its elements against the row's x-lists */
-    const size_t room_below = (size_t)count;
-    for (int k = 0; k < 3; k++)
-        for (int32_t j = row->below[k]; j >= 0; j = row_next[j]) {
-            double jx = p.cx[j];
-            nbs3_trio t = nbs3_trio_of(cur, nbs3_probe_x(&p, jx), mask);
-            if (nbs3_trio_and(t) < 0) continue;
-            if (nbs3_room(&o, room_below) != 0) return -1;
-            nbs3_trio_test(&p, use_body, nbs3_ball_of(&p, j, jx), t, &o);
-        }
     pairs->count = o.count;
     return 0;
 }
 
-static int nbs3_row_test_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs)
+/* A row of the layer below against one or two mapped rows of this layer
+ * (x-sets `one`, `two`; two < 0: only one): each of its elements against
+ * their x-lists. */
+static NBS_ALWAYS_INLINE int nbs3_row_cross(const nbs3_scan *s, int use_body, int32_t list,
+                                            int one, int two, size_t room, nbs_pairs *pairs)
 {
-    return s->body ? nbs3_row_test(s, 1, row, pairs) : nbs3_row_test(s, 0, row, pairs);
+    nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
+    const nbs3_probe p = nbs3_probe_of(s);
+    const int32_t *row_next = s->row_next;
+    const int32_t *set1 = s->cells[one], *set2 = s->cells[two < 0 ? one : two];
+    const int32_t mask = (int32_t)p.xmask;
+    for (int32_t j = list; j >= 0; j = row_next[j]) {
+        double jx = p.cx[j];
+        int32_t x = nbs3_probe_x(&p, jx);
+        nbs3_trio t1 = nbs3_trio_of(set1, x, mask);
+        int32_t any = nbs3_trio_and(t1);
+        nbs3_trio t2 = t1;
+        if (two >= 0) t2 = nbs3_trio_of(set2, x, mask), any &= nbs3_trio_and(t2);
+        if (any < 0) continue;
+        if (nbs3_room(&o, room) != 0) return -1;
+        nbs3_ball b = nbs3_ball_of(&p, j, jx);
+        nbs3_trio_test(&p, use_body, b, t1, &o);
+        if (two >= 0) nbs3_trio_test(&p, use_body, b, t2, &o);
+    }
+    pairs->count = o.count;
+    return 0;
+}
+
+static int nbs3_row_own_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs)
+{
+    return s->body ? nbs3_row_own(s, 1, row, pairs) : nbs3_row_own(s, 0, row, pairs);
+}
+
+static int nbs3_row_cross_any(const nbs3_scan *s, int32_t list, int one, int two, size_t room,
+                              nbs_pairs *pairs)
+{
+    if (two < 0)
+        return s->body ? nbs3_row_cross(s, 1, list, one, -1, room, pairs)
+                       : nbs3_row_cross(s, 0, list, one, -1, room, pairs);
+    return s->body ? nbs3_row_cross(s, 1, list, one, two, room, pairs)
+                   : nbs3_row_cross(s, 0, list, one, two, room, pairs);
+}
+
+/* An empty row of the layer below costs no call. */
+static inline int nbs3_cross(const nbs3_scan *s, int32_t list, int one, int two, size_t room,
+                             nbs_pairs *pairs)
+{
+    return list < 0 ? 0 : nbs3_row_cross_any(s, list, one, two, room, pairs);
 }
 
 /* The rows of a layer (its y-lists in set `cur`; the layer below in set
@@ -412,7 +450,14 @@ static int nbs3_row_test_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs
  * starts a run down to the lowest consecutive new row, then up while the
  * row above is new, the row just done held in its x-set as the row below
  * of the next. Done rows are marked old (-2 - head): they are still read
- * as neighbours, and are emptied when the layer is unmapped. */
+ * as neighbours, and are emptied when the layer is unmapped.
+ * The layer below: row y of this layer meets its rows y-1, y, y+1. With
+ * rows y (cur) and y-1 (held) mapped, its row y-1 is walked against both
+ * and its row y against held, so each row of the layer below is walked
+ * twice rather than three times; after the run's last row y, its rows y
+ * and y+1 against that row. A held row that was not done in this run (the
+ * run started above an old row) is another run's: its pairs with the layer
+ * below are that run's. */
 static int nbs3_layer_rows(const nbs3_scan *s, int32_t layer, int cur, int below,
                            nbs_pairs *pairs)
 {
@@ -430,22 +475,31 @@ static int nbs3_layer_rows(const nbs3_scan *s, int32_t layer, int cur, int below
         nbs3_row row = {.held = 1};
         int32_t held_list = nbs_row_list(rows[nbs3_down(y, ny)]);
         row.held_count = nbs3_row_map(s, row.held, held_list);
+        int held_ours = 0;
         for (;;) {
             int32_t head = rows[y];
             rows[y] = -2 - head;
             row.list = head;
             row.cur = 1 - row.held;
-            row.below[0] = nbs_row_list(low[nbs3_down(y, ny)]);
-            row.below[1] = nbs_row_list(low[y]);
-            row.below[2] = nbs_row_list(low[nbs3_up(y, ny)]);
-            if (nbs3_row_test_any(s, &row, pairs) != 0) return -1;
+            if (nbs3_row_own_any(s, &row, pairs) != 0) return -1;
+            int32_t low_down = nbs_row_list(low[nbs3_down(y, ny)]);
+            size_t room = (size_t)row.count + (held_ours ? (size_t)row.held_count : 0);
+            if (nbs3_cross(s, low_down, row.cur, held_ours ? row.held : -1, room, pairs) ||
+                (held_ours && nbs3_cross(s, nbs_row_list(low[y]), row.held, -1,
+                                                 (size_t)row.held_count, pairs)))
+                return -1;
             nbs3_row_unmap(s, row.held, held_list);
             row.held = row.cur;
             row.held_count = row.count;
             held_list = head;
+            held_ours = 1;
             y = nbs3_up(y, ny);
             if (rows[y] < 0) break; /* the run ends */
         }
+        size_t room = (size_t)row.held_count;
+        if (nbs3_cross(s, nbs_row_list(low[nbs3_down(y, ny)]), row.held, -1, room, pairs) ||
+            nbs3_cross(s, nbs_row_list(low[y]), row.held, -1, room, pairs))
+            return -1;
         nbs3_row_unmap(s, row.held, held_list);
     }
     return 0;
