@@ -23,14 +23,21 @@
  *  - Layers are done in runs of consecutive layers, bottom-up, and rows of a
  *    layer likewise, exactly as the 2D rows are: the layer (row) just done
  *    stays mapped in its set as the layer (row) below the next one, so each
- *    element is mapped and unmapped once per level. The three rows of the
- *    layer below are not mapped to x-lists at all: their elements are
- *    walked against the x-lists of the row (the mask is symmetric), which
- *    needs no third set of heads.
- *  - Every table has at least one slot more than the cells it spans (an
- *    unfolded axis) or is a folded power of two >= 4, so the neighbours
- *    v - 1 and v + 1 are one wrap-around compare each and never branch on
- *    an edge: on an unfolded axis the wrap lands on the always-empty slot.
+ *    element is mapped and unmapped once per level. The rows of the layer
+ *    below are not mapped to x-lists at all: their elements are walked
+ *    against the x-lists of the rows (the mask is symmetric), which needs
+ *    no third set of heads. With rows y and y-1 of the layer mapped, row
+ *    y-1 below meets both and row y below meets y-1, so each row below is
+ *    walked twice, not once for each of the three rows it meets.
+ *  - An element whose three (six) neighbouring cells are all empty is
+ *    skipped on one AND of their heads before its sphere is loaded, and a
+ *    hit is a branch (a few candidates in a hundred touch even in a
+ *    touching packing): sparse packings pay for the walk, not the tests.
+ *  - Every table is a power of two >= 4 slots: at least one more than the
+ *    cells it spans (an unfolded axis), or the fold. The neighbours v - 1
+ *    and v + 1 are then one AND each and never branch on an edge: on an
+ *    unfolded axis the wrap lands on an always-empty slot, and a cell
+ *    coordinate is the same truncation and AND on either kind of axis.
  *    Three consecutive slots are always distinct, so a folded pair of cells
  *    is still met once; folding only adds candidates, which the exact
  *    sphere test removes.
@@ -119,8 +126,8 @@ static void nbs3_reset_heads(nbs_grid_3d *g)
 
 typedef struct nbs3_axis {
     double lo;      /* smallest centre coordinate */
-    int64_t mask;   /* table - 1 when folded, all ones otherwise */
-    int32_t size;   /* table slots: cells spanned + 1, >= 3; or the fold */
+    int64_t mask;   /* size - 1 */
+    int32_t size;   /* table slots, a power of two >= 4: > cells spanned, or the fold */
 } nbs3_axis;
 
 typedef struct nbs3_bounds {
@@ -130,30 +137,32 @@ typedef struct nbs3_bounds {
 } nbs3_bounds;
 
 /* Extremes of the valid spheres. Whether every sphere is valid is decided
- * from a sum (finite only without NaN or infinity) and the extremes, so the
- * usual case runs the loop without a per-sphere test. */
+ * from one sum (finite only without NaN or infinity) and the extremes, so
+ * the usual case runs the loop without a per-sphere test. The axes are
+ * written out, each extreme keeps its own register (min/max in the order
+ * that compiles to one instruction) and the sum is one addition a sphere on
+ * its dependent chain: this loop was 38 instructions a sphere, a sixth of
+ * a sparse detection. */
 static nbs3_bounds nbs3_bounds_of(size_t n, const double *const c[3], const double *r)
 {
     nbs3_bounds b;
-    double rmin = DBL_MAX, sum = 0.0, sum_r = 0.0;
-    b.rmax = 0.0;
-    for (int a = 0; a < 3; a++) b.lo[a] = DBL_MAX, b.hi[a] = -DBL_MAX;
+    const double *cx = c[0], *cy = c[1], *cz = c[2];
+    double lx = DBL_MAX, ly = DBL_MAX, lz = DBL_MAX, hx = -DBL_MAX, hy = -DBL_MAX, hz = -DBL_MAX;
+    double rmin = DBL_MAX, rmax = 0.0, sum = 0.0;
     for (size_t i = 0; i < n; i++) {
-        for (int a = 0; a < 3; a++) {
-            double v = c[a][i];
-            b.lo[a] = v < b.lo[a] ? v : b.lo[a];
-            b.hi[a] = v > b.hi[a] ? v : b.hi[a];
-            sum += v;
-        }
-        rmin = r[i] < rmin ? r[i] : rmin;
-        b.rmax = r[i] > b.rmax ? r[i] : b.rmax;
-        sum_r += r[i];
+        double x = cx[i], y = cy[i], z = cz[i], ri = r[i];
+        lx = lx < x ? lx : x, hx = hx > x ? hx : x;
+        ly = ly < y ? ly : y, hy = hy > y ? hy : y;
+        lz = lz < z ? lz : z, hz = hz > z ? hz : z;
+        rmin = rmin < ri ? rmin : ri, rmax = rmax > ri ? rmax : ri;
+        sum += (x + y) + (z + ri);
     }
-    sum += sum_r;
+    b.lo[0] = lx, b.lo[1] = ly, b.lo[2] = lz;
+    b.hi[0] = hx, b.hi[1] = hy, b.hi[2] = hz;
+    b.rmax = rmax;
     b.valid = n;
-    b.all_valid = n > 0 && isfinite(sum) &&
-                  nbs3_sphere_valid(b.lo[0], b.lo[1], b.lo[2], rmin) &&
-                  nbs3_sphere_valid(b.hi[0], b.hi[1], b.hi[2], b.rmax);
+    b.all_valid = n > 0 && isfinite(sum) && nbs3_sphere_valid(lx, ly, lz, rmin) &&
+                  nbs3_sphere_valid(hx, hy, hz, rmax);
     if (b.all_valid) return b;
 
     b.rmax = 0.0;
@@ -171,9 +180,10 @@ static nbs3_bounds nbs3_bounds_of(size_t n, const double *const c[3], const doub
     return b;
 }
 
-/* One spare slot beyond the cells spanned, so that the wrap-around
- * neighbour of an edge cell is an empty slot; folded when that exceeds the
- * table of O(N). */
+/* At least one spare slot beyond the cells spanned, so that the wrap-around
+ * neighbour of an edge cell is an empty slot, rounded up to a power of two
+ * (at most doubling a table that is already O(N)); folded when the cells
+ * spanned exceed the table of O(N). */
 static nbs3_axis nbs3_axis_plan(double lo, double hi, double inv_cell, int32_t table)
 {
     nbs3_axis ax;
@@ -181,8 +191,8 @@ static nbs3_axis nbs3_axis_plan(double lo, double hi, double inv_cell, int32_t t
     int fold;
     nbs_axis_plan(hi - lo, inv_cell, table - 1, &spanned, &fold);
     ax.lo = lo;
-    ax.size = fold ? table : (spanned + 1 < 3 ? 3 : spanned + 1);
-    ax.mask = fold ? (int64_t)table - 1 : INT64_MAX;
+    ax.size = fold ? table : (int32_t)nbs_next_pow2((size_t)spanned + 1);
+    ax.mask = (int64_t)ax.size - 1;
     return ax;
 }
 
@@ -210,8 +220,9 @@ static inline int32_t nbs3_x(const nbs3_scan *s, int32_t j) { return nbs3_coord(
 static inline int32_t nbs3_y(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->ay, s->cy[j], s->inv); }
 static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->az, s->cz[j], s->inv); }
 
-static inline int32_t nbs3_down(int32_t v, int32_t size) { return v > 0 ? v - 1 : size - 1; }
-static inline int32_t nbs3_up(int32_t v, int32_t size) { return v < size - 1 ? v + 1 : 0; }
+/* neighbours on a table of a power of two slots */
+static inline int32_t nbs3_down(int32_t v, int32_t size) { return (v - 1) & (size - 1); }
+static inline int32_t nbs3_up(int32_t v, int32_t size) { return (v + 1) & (size - 1); }
 
 /* Layer `list` into y-set k, and out again (by looping over its elements). */
 static void nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
@@ -256,8 +267,8 @@ typedef struct nbs3_out {
     nbs_pairs *pairs;
 } nbs3_out;
 
-/* Makes room for `need` more pairs (one element's worst case plus the slot
- * written past the last), so the candidate loops need no capacity test. */
+/* Makes room for `need` more pairs (one element's worst case), so the
+ * candidate loops need no capacity test. */
 static inline int nbs3_room(nbs3_out *o, size_t need)
 {
     if (NBS_UNLIKELY(o->capacity - o->count < need)) {
@@ -270,89 +281,168 @@ static inline int nbs3_room(nbs3_out *o, size_t need)
     return 0;
 }
 
+/* What the candidate loops read, copied out of the scan: reached through
+ * a pointer, the scan's fields would be reloaded after every store to a
+ * list (an int32 store may alias them). */
+typedef struct nbs3_probe {
+    const double *cx, *cy, *cz, *r;
+    const int32_t *body, *cell_next;
+    double xlo, inv;
+    int64_t xmask;
+} nbs3_probe;
+
+static inline nbs3_probe nbs3_probe_of(const nbs3_scan *s)
+{
+    nbs3_probe p = {s->cx, s->cy, s->cz, s->r, s->body, s->cell_next, s->ax.lo, s->inv, s->ax.mask};
+    return p;
+}
+
+static inline int32_t nbs3_probe_x(const nbs3_probe *p, double x)
+{
+    return (int32_t)((int64_t)((x - p->xlo) * p->inv) & p->xmask);
+}
+
+/* The heads of the cells x-1, x, x+1 of an x-set. Cell heads are never in
+ * the old encoding, so the three are all empty exactly when their AND is
+ * negative: one branch skips an element with nothing to meet, and its
+ * sphere is loaded only when there is. */
+typedef struct nbs3_trio {
+    int32_t down, mid, up;
+} nbs3_trio;
+
+static inline nbs3_trio nbs3_trio_of(const int32_t *cells, int32_t x, int32_t mask)
+{
+    nbs3_trio t = {cells[(x - 1) & mask], cells[x], cells[(x + 1) & mask]};
+    return t;
+}
+
+static inline int32_t nbs3_trio_and(nbs3_trio t) { return t.down & t.mid & t.up; }
+
 /* An element's sphere, loaded once for all the cells it meets. */
 typedef struct nbs3_ball {
     double x, y, z, r;
     int32_t e;
 } nbs3_ball;
 
-static inline nbs3_ball nbs3_ball_of(const nbs3_scan *s, int32_t e)
+static inline nbs3_ball nbs3_ball_of(const nbs3_probe *p, int32_t e, double x)
 {
-    nbs3_ball b = {s->cx[e], s->cy[e], s->cz[e], s->r[e], e};
+    nbs3_ball b = {x, p->cy[e], p->cz[e], p->r[e], e};
     return b;
 }
 
-/* Tests a ball against one cell's list. The pair is always written and
- * the count advanced by the outcome: no mispredicted branch on a hit. */
-static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_scan *s, int use_body, nbs3_ball b,
+/* Tests a ball against one cell's list. A hit is rare (a few in a hundred
+ * candidates even in a touching packing), so it is a branch: cheaper than
+ * writing every candidate and advancing by the outcome. The caller has made
+ * room for the cell's pairs. */
+static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_probe *p, int use_body, nbs3_ball b,
                                               int32_t list, nbs3_out *o)
 {
-    const double *cx = s->cx, *cy = s->cy, *cz = s->cz, *r = s->r;
-    const int32_t *cell_next = s->cell_next;
+    const double *cx = p->cx, *cy = p->cy, *cz = p->cz, *r = p->r;
+    const int32_t *cell_next = p->cell_next;
     for (int32_t j = list; j >= 0; j = cell_next[j]) {
-        int hit = nbs_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j]);
-        if (use_body) hit &= !nbs_same_body(s->body, b.e, j);
+        if (!nbs_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j])) continue;
+        if (use_body && nbs_same_body(p->body, b.e, j)) continue;
         o->a[o->count] = b.e;
         o->b[o->count] = j;
-        o->count += (size_t)hit;
+        o->count++;
     }
 }
 
-/* A ball against the three cells x-1, x, x+1 of an x-set. */
-static NBS_ALWAYS_INLINE void nbs3_three_cells(const nbs3_scan *s, int use_body, nbs3_ball b,
-                                               const int32_t *cells, int32_t x, nbs3_out *o)
+static NBS_ALWAYS_INLINE void nbs3_trio_test(const nbs3_probe *p, int use_body, nbs3_ball b,
+                                             nbs3_trio t, nbs3_out *o)
 {
-    int32_t nx = s->ax.size;
-    nbs3_chain_test(s, use_body, b, cells[nbs3_down(x, nx)], o);
-    nbs3_chain_test(s, use_body, b, cells[x], o);
-    nbs3_chain_test(s, use_body, b, cells[nbs3_up(x, nx)], o);
+    nbs3_chain_test(p, use_body, b, t.down, o);
+    nbs3_chain_test(p, use_body, b, t.mid, o);
+    nbs3_chain_test(p, use_body, b, t.up, o);
 }
 
-/* A row and what its mask reaches: the row is mapped to x-set `cur` (count
- * elements, known once mapped) while it is tested, the row below it (same
- * layer, held_count elements) is in x-set `held`, and below[0..2] are the
- * rows y-1, y, y+1 of the layer below. */
+/* A row in x-set `cur` (count elements, known once mapped) and the row
+ * below it in the same layer in x-set `held` (held_count elements). */
 typedef struct nbs3_row {
     int32_t list, count, held_count;
     int cur, held;
-    int32_t below[3];
 } nbs3_row;
 
-static NBS_ALWAYS_INLINE int nbs3_row_test(const nbs3_scan *s, int use_body, nbs3_row *row,
-                                           nbs_pairs *pairs)
+/* The row's own pass: mapping and testing in one, e meets the elements of
+ * its row mapped before it in cells x-1, x, x+1 (so each pair of the row
+ * once) and the held row's. The held set is empty when the row below is. */
+static NBS_ALWAYS_INLINE int nbs3_row_own(const nbs3_scan *s, int use_body, nbs3_row *row,
+                                          nbs_pairs *pairs)
 {
     nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
-    int32_t *cur = s->cells[row->cur];
+    const nbs3_probe p = nbs3_probe_of(s);
+    const int32_t *row_next = s->row_next;
+    int32_t *cur = s->cells[row->cur], *cell_next = s->cell_next;
     const int32_t *held = s->cells[row->held];
-    int32_t *cell_next = s->cell_next;
+    const int32_t mask = (int32_t)p.xmask;
+    const size_t held_count = (size_t)row->held_count;
     int32_t count = 0;
-    /* Mapping and testing in one pass: e meets the elements of its row
-     * mapped before it in cells x-1, x, x+1, so each pair of the row once. */
-    for (int32_t e = row->list; e >= 0; e = s->row_next[e], count++) {
-        if (nbs3_room(&o, (size_t)count + (size_t)row->held_count + 1) != 0) return -1;
-        nbs3_ball b = nbs3_ball_of(s, e);
-        int32_t x = nbs3_coord(&s->ax, b.x, s->inv);
-        nbs3_three_cells(s, use_body, b, cur, x, &o);
-        if (row->held_count) nbs3_three_cells(s, use_body, b, held, x, &o);
-        cell_next[e] = cur[x];
+    for (int32_t e = row->list; e >= 0; e = row_next[e], count++) {
+        double ex = p.cx[e];
+        int32_t x = nbs3_probe_x(&p, ex);
+        nbs3_trio here = nbs3_trio_of(cur, x, mask), below = nbs3_trio_of(held, x, mask);
+        if ((nbs3_trio_and(here) & nbs3_trio_and(below)) >= 0) {
+            if (nbs3_room(&o, (size_t)count + held_count) != 0) return -1;
+            nbs3_ball b = nbs3_ball_of(&p, e, ex);
+            nbs3_trio_test(&p, use_body, b, here, &o);
+            nbs3_trio_test(&p, use_body, b, below, &o);
+        }
+        cell_next[e] = here.mid;
         cur[x] = e;
     }
     row->count = count;
-    /* the layer below: each of its elements against the row's x-lists */
-    const size_t room_below = (size_t)count + 1;
-    for (int k = 0; k < 3; k++)
-        for (int32_t j = row->below[k]; j >= 0; j = s->row_next[j]) {
-            if (nbs3_room(&o, room_below) != 0) return -1;
-            nbs3_ball b = nbs3_ball_of(s, j);
-            nbs3_three_cells(s, use_body, b, cur, nbs3_coord(&s->ax, b.x, s->inv), &o);
-        }
     pairs->count = o.count;
     return 0;
 }
 
-static int nbs3_row_test_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs)
+/* A row of the layer below against one or two mapped rows of this layer
+ * (x-sets `one`, `two`; two < 0: only one): each of its elements against
+ * their x-lists. */
+static NBS_ALWAYS_INLINE int nbs3_row_cross(const nbs3_scan *s, int use_body, int32_t list,
+                                            int one, int two, size_t room, nbs_pairs *pairs)
 {
-    return s->body ? nbs3_row_test(s, 1, row, pairs) : nbs3_row_test(s, 0, row, pairs);
+    nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
+    const nbs3_probe p = nbs3_probe_of(s);
+    const int32_t *row_next = s->row_next;
+    const int32_t *set1 = s->cells[one], *set2 = s->cells[two < 0 ? one : two];
+    const int32_t mask = (int32_t)p.xmask;
+    for (int32_t j = list; j >= 0; j = row_next[j]) {
+        double jx = p.cx[j];
+        int32_t x = nbs3_probe_x(&p, jx);
+        nbs3_trio t1 = nbs3_trio_of(set1, x, mask);
+        int32_t any = nbs3_trio_and(t1);
+        nbs3_trio t2 = t1;
+        if (two >= 0) t2 = nbs3_trio_of(set2, x, mask), any &= nbs3_trio_and(t2);
+        if (any < 0) continue;
+        if (nbs3_room(&o, room) != 0) return -1;
+        nbs3_ball b = nbs3_ball_of(&p, j, jx);
+        nbs3_trio_test(&p, use_body, b, t1, &o);
+        if (two >= 0) nbs3_trio_test(&p, use_body, b, t2, &o);
+    }
+    pairs->count = o.count;
+    return 0;
+}
+
+static int nbs3_row_own_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs)
+{
+    return s->body ? nbs3_row_own(s, 1, row, pairs) : nbs3_row_own(s, 0, row, pairs);
+}
+
+static int nbs3_row_cross_any(const nbs3_scan *s, int32_t list, int one, int two, size_t room,
+                              nbs_pairs *pairs)
+{
+    if (two < 0)
+        return s->body ? nbs3_row_cross(s, 1, list, one, -1, room, pairs)
+                       : nbs3_row_cross(s, 0, list, one, -1, room, pairs);
+    return s->body ? nbs3_row_cross(s, 1, list, one, two, room, pairs)
+                   : nbs3_row_cross(s, 0, list, one, two, room, pairs);
+}
+
+/* An empty row of the layer below costs no call. */
+static inline int nbs3_cross(const nbs3_scan *s, int32_t list, int one, int two, size_t room,
+                             nbs_pairs *pairs)
+{
+    return list < 0 ? 0 : nbs3_row_cross_any(s, list, one, two, room, pairs);
 }
 
 /* The rows of a layer (its y-lists in set `cur`; the layer below in set
@@ -360,7 +450,14 @@ static int nbs3_row_test_any(const nbs3_scan *s, nbs3_row *row, nbs_pairs *pairs
  * starts a run down to the lowest consecutive new row, then up while the
  * row above is new, the row just done held in its x-set as the row below
  * of the next. Done rows are marked old (-2 - head): they are still read
- * as neighbours, and are emptied when the layer is unmapped. */
+ * as neighbours, and are emptied when the layer is unmapped.
+ * The layer below: row y of this layer meets its rows y-1, y, y+1. With
+ * rows y (cur) and y-1 (held) mapped, its row y-1 is walked against both
+ * and its row y against held, so each row of the layer below is walked
+ * twice rather than three times; after the run's last row y, its rows y
+ * and y+1 against that row. A held row that was not done in this run (the
+ * run started above an old row) is another run's: its pairs with the layer
+ * below are that run's. */
 static int nbs3_layer_rows(const nbs3_scan *s, int32_t layer, int cur, int below,
                            nbs_pairs *pairs)
 {
@@ -378,22 +475,31 @@ static int nbs3_layer_rows(const nbs3_scan *s, int32_t layer, int cur, int below
         nbs3_row row = {.held = 1};
         int32_t held_list = nbs_row_list(rows[nbs3_down(y, ny)]);
         row.held_count = nbs3_row_map(s, row.held, held_list);
+        int held_ours = 0;
         for (;;) {
             int32_t head = rows[y];
             rows[y] = -2 - head;
             row.list = head;
             row.cur = 1 - row.held;
-            row.below[0] = nbs_row_list(low[nbs3_down(y, ny)]);
-            row.below[1] = nbs_row_list(low[y]);
-            row.below[2] = nbs_row_list(low[nbs3_up(y, ny)]);
-            if (nbs3_row_test_any(s, &row, pairs) != 0) return -1;
+            if (nbs3_row_own_any(s, &row, pairs) != 0) return -1;
+            int32_t low_down = nbs_row_list(low[nbs3_down(y, ny)]);
+            size_t room = (size_t)row.count + (held_ours ? (size_t)row.held_count : 0);
+            if (nbs3_cross(s, low_down, row.cur, held_ours ? row.held : -1, room, pairs) ||
+                (held_ours && nbs3_cross(s, nbs_row_list(low[y]), row.held, -1,
+                                                 (size_t)row.held_count, pairs)))
+                return -1;
             nbs3_row_unmap(s, row.held, held_list);
             row.held = row.cur;
             row.held_count = row.count;
             held_list = head;
+            held_ours = 1;
             y = nbs3_up(y, ny);
             if (rows[y] < 0) break; /* the run ends */
         }
+        size_t room = (size_t)row.held_count;
+        if (nbs3_cross(s, nbs_row_list(low[nbs3_down(y, ny)]), row.held, -1, room, pairs) ||
+            nbs3_cross(s, nbs_row_list(low[y]), row.held, -1, room, pairs))
+            return -1;
         nbs3_row_unmap(s, row.held, held_list);
     }
     return 0;
