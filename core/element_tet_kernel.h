@@ -26,10 +26,11 @@
  *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
  *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
  *    the other three: the four sum to zero exactly.
- *  - Each of edges, faces, gradient, stress, prestress and forces also exists as
- *    name_pair over tet_pair, two elements in the lanes of one SIMD
- *    register (element_tet_kernel_body.h is written once for both), with
- *    the same bits per element as the scalar one.
+ *  - tet_kernel_contract: s : S of two symmetric tensors in Voigt order.
+ *  - Each of edges, faces, gradient, stress, prestress, rate, contract and
+ *    forces also exists as name_pair over tet_pair, two elements in the
+ *    lanes of one SIMD register (element_tet_kernel_body.h is written once
+ *    for both), with the same bits per element as the scalar one.
  */
 #ifndef FDEM_ELEMENT_TET_KERNEL_H
 #define FDEM_ELEMENT_TET_KERNEL_H
@@ -84,30 +85,5 @@ static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ,
 #undef TET_T
 #undef TET_FN
 #undef TET_LOG_INVERSE
-
-TET_KERNEL void tet_kernel_rate(const double *v0, const double *v1, const double *v2,
-                                   const double *v3, const double c[3][3], double S[6])
-{
-    double dv[3][3];
-    tet_kernel_edges(v0, v1, v2, v3, dv);
-    double L[3][3];
-    TET_UNROLL
-    for (int i = 0; i < 3; i++)
-        TET_UNROLL
-        for (int j = 0; j < 3; j++)
-            L[i][j] = dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
-    S[0] = L[0][0];
-    S[1] = L[1][1];
-    S[2] = L[2][2];
-    S[3] = 0.5 * (L[1][2] + L[2][1]);
-    S[4] = 0.5 * (L[0][2] + L[2][0]);
-    S[5] = 0.5 * (L[0][1] + L[1][0]);
-}
-
-/* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */
-TET_KERNEL double tet_kernel_contract(const double s[6], const double S[6])
-{
-    return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
-}
 
 #endif /* FDEM_ELEMENT_TET_KERNEL_H */

@@ -108,3 +108,28 @@ TET_KERNEL TET_T TET_FN(tet_kernel_prestress)(const TET_T F[9], TET_T scale, con
     }
     return 0.5 * (tau[0] + tau[1] + tau[2] - S0[0] - S0[1] - S0[2]);
 }
+
+TET_KERNEL void TET_FN(tet_kernel_rate)(const TET_T *v0, const TET_T *v1, const TET_T *v2,
+                                        const TET_T *v3, const TET_T c[3][3], TET_T S[6])
+{
+    TET_T dv[3][3];
+    TET_FN(tet_kernel_edges)(v0, v1, v2, v3, dv);
+    TET_T L[3][3];
+    TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        TET_UNROLL
+        for (int j = 0; j < 3; j++)
+            L[i][j] = dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
+    S[0] = L[0][0];
+    S[1] = L[1][1];
+    S[2] = L[2][2];
+    S[3] = 0.5 * (L[1][2] + L[2][1]);
+    S[4] = 0.5 * (L[0][2] + L[2][0]);
+    S[5] = 0.5 * (L[0][1] + L[1][0]);
+}
+
+/* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */
+TET_KERNEL TET_T TET_FN(tet_kernel_contract)(const TET_T s[6], const TET_T S[6])
+{
+    return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
+}
