@@ -23,12 +23,13 @@
  *    pushed forward) to a stress, returns S0 : E.
  *  - tet_kernel_rate: the symmetric part of sum_k (v_k - v_0) (x) c_k, which
  *    is det times the rate of deformation D (no division here).
- *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
- *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
- *    the other three: the four sum to zero exactly.
+ *  - tet_kernel_face_loads: g_a = s c_a for a stress s already scaled by
+ *    1/6 and g_0 = g_1 + g_2 + g_3; the nodal forces are f_a = -g_a
+ *    (-V sigma grad N_a = -sigma c_a / 6) and f_0 = g_0: the four sum to
+ *    zero exactly. Unnegated, so a scatter subtracts and saves the signs.
  *  - tet_kernel_contract: s : S of two symmetric tensors in Voigt order.
  *  - Each of edges, faces, gradient, stress, prestress, rate, contract and
- *    forces also exists as name_pair over tet_pair, two elements in the
+ *    face_loads also exists as name_pair over tet_pair, two elements in the
  *    lanes of one SIMD register (element_tet_kernel_body.h is written once
  *    for both), with the same bits per element as the scalar one.
  */

@@ -105,15 +105,35 @@ static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double 
     for (int q = 0; q < 6; q++) prev[q] = sv[q];
 }
 
-static inline void tet_scatter(double *f, const int32_t node[4], const double fa[4][3])
+/* force[n] += or -= one node's load (x, y, z): x and y as one 16-byte
+ * vector, z alone. Every scatter writes the nodes this same way, so the
+ * next element's load of a node just stored forwards from the store. */
+static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add)
+{
+    double *fn = f + 3 * (size_t)n;
+    tet_pair old;
+    memcpy(&old, fn, sizeof old);
+    old = add ? old + xy : old - xy;
+    memcpy(fn, &old, sizeof old);
+    fn[2] = add ? fn[2] + z : fn[2] - z;
+}
+
+/* The forces of lane `lane` of g (tet_kernel_face_loads): f_0 = g_0 added,
+ * f_a = -g_a subtracted. */
+static inline void tet_scatter_lane(double *f, const int32_t node[4], const tet_pair g[4][3],
+                                    int lane)
 {
     TET_UNROLL
-    for (int a = 0; a < 4; a++) {
-        double *fn = f + 3 * (size_t)node[a];
-        fn[0] += fa[a][0];
-        fn[1] += fa[a][1];
-        fn[2] += fa[a][2];
-    }
+    for (int a = 0; a < 4; a++)
+        tet_scatter_node(f, node[a], (tet_pair){g[a][0][lane], g[a][1][lane]}, g[a][2][lane],
+                         a == 0);
+}
+
+static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3])
+{
+    TET_UNROLL
+    for (int a = 0; a < 4; a++)
+        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0);
 }
 
 /* Element t's in-situ pre-stress (initial_stress.c). */
@@ -139,9 +159,9 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     sum->energy += w * t->volume0;
     double det = tet_kernel_faces(e, c);
     if (t->eta > 0) tet_damp(m, t, c, det, s, sum);
-    double fa[4][3];
-    tet_kernel_forces(s, c, fa);
-    tet_scatter(m->force, n, fa);
+    double g[4][3];
+    tet_kernel_face_loads(s, c, g);
+    tet_scatter(m->force, n, g);
 }
 
 /* Lane `lane` of a pair's face vectors and sixth stress as scalars, the
@@ -235,14 +255,10 @@ TET_KERNEL void tet_forces_pair(fdem_model *m, const tet_hot *t, tet_constants *
     if (t->eta > 0 || u->eta > 0) tet_damp_pair(m, t, c, det, s, sum);
     sum->energy += w[0] * t->volume0;
     sum->energy += w[1] * u->volume0;
-    tet_pair fa[4][3];
-    tet_kernel_forces_pair(s, c, fa);
-    for (int lane = 0; lane < 2; lane++) {
-        double fl[4][3];
-        TET_UNROLL
-        for (int q = 0; q < 12; q++) fl[q / 3][q % 3] = fa[q / 3][q % 3][lane];
-        tet_scatter(m->force, (lane ? u : t)->node, fl);
-    }
+    tet_pair g[4][3];
+    tet_kernel_face_loads_pair(s, c, g);
+    tet_scatter_lane(m->force, t->node, g, 0);
+    tet_scatter_lane(m->force, u->node, g, 1);
 }
 
 /* The hot loop: one pass over the tetrahedron records, gathering four
