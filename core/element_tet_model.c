@@ -298,12 +298,30 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
     sums[2] += sum.power_prev * (1.0 / 6);
 }
 
+/* The loop is compiled twice, for the baseline x86-64 and for AVX2 (chosen
+ * once at load time by the CPU): the AVX encoding has three operands, which
+ * saves the many register copies two-operand SSE needs in this kernel (and
+ * 291 -> 238 instructions per undamped element-step, 3D block 26 -> 22
+ * CPU ns). AVX2 without FMA: every
+ * operation rounds as in the baseline (no contraction under -std=c11
+ * either), so both give the same bits. */
+#if defined(__x86_64__) && defined(__GNUC__) && defined(__has_attribute)
+#if __has_attribute(target_clones)
+#define TET_CLONES __attribute__((target_clones("avx2", "default")))
+#endif
+#endif
+#ifndef TET_CLONES
+#define TET_CLONES
+#endif
+
+TET_CLONES
 void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
     tet_forces_run(m, begin, end, 0, sums);
 }
 
 /* The same loop for the elements of a part with an in-situ stress. */
+TET_CLONES
 void tet_element_forces_range_stressed(fdem_model *m, int begin, int end,
                                        double sums[SCATTER_SUMS])
 {
