@@ -50,26 +50,36 @@
 #define TET_UNROLL
 #endif
 
-/* Two elements side by side: lane k of every number is element k's. */
+/* Two (four) elements side by side: lane k of every number is element
+ * k's. Quads are for the AVX2 loop only (element_tet_model.c). */
 typedef double tet_pair __attribute__((vector_size(16)));
+typedef double tet_quad __attribute__((vector_size(32)));
 
-/* ln J and 1/J of a pair: the series on both lanes in the usual case
- * (lane by lane, bit for bit what one element gets), the division as one
- * vector; the rare lane outside it through the scalar path. */
-static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ, tet_pair *invJ)
-{
-    tet_pair x = J - 1.0;
-    if (fabs(x[0]) <= LOG_SHORT_RANGE && fabs(x[1]) <= LOG_SHORT_RANGE) {
-        *lnJ = (tet_pair){log_short_series(x[0]), log_short_series(x[1])};
-        *invJ = 1.0 / J;
-        return;
+/* ln J and 1/J of a group of N lanes: log_short_series of log_near1.h on
+ * every lane as vector operations when all are in its range (the same
+ * operations per lane, so bit for bit what one element gets), the
+ * division as one vector; else lane by lane through the scalar path. */
+#define TET_LOG_INVERSE_LANES(T, N)                                                              \
+    static inline void tet_log_inverse_##T(T J, double j_min, T *lnJ, T *invJ)                  \
+    {                                                                                           \
+        T x = J - 1.0;                                                                          \
+        int near = 1;                                                                           \
+        for (int l = 0; l < N; l++) near &= fabs(x[l]) <= LOG_SHORT_RANGE;                      \
+        if (near) {                                                                             \
+            T x2 = x * x;                                                                       \
+            T q = (-1.0 / 2 + x * (1.0 / 3)) + x2 * (-1.0 / 4 + x * (1.0 / 5));                 \
+            *lnJ = x + x2 * q;                                                                  \
+            *invJ = 1.0 / J;                                                                    \
+            return;                                                                             \
+        }                                                                                       \
+        for (int l = 0; l < N; l++) {                                                           \
+            double ln, inv;                                                                     \
+            neo_hookean_log_inverse(J[l], j_min, &ln, &inv);                                    \
+            (*lnJ)[l] = ln;                                                                     \
+            (*invJ)[l] = inv;                                                                   \
+        }                                                                                       \
     }
-    double l0, l1, i0, i1;
-    neo_hookean_log_inverse(J[0], j_min, &l0, &i0);
-    neo_hookean_log_inverse(J[1], j_min, &l1, &i1);
-    *lnJ = (tet_pair){l0, l1};
-    *invJ = (tet_pair){i0, i1};
-}
+TET_LOG_INVERSE_LANES(tet_pair, 2)
 
 #define TET_T double
 #define TET_FN(name) name
@@ -81,10 +91,29 @@ static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ,
 
 #define TET_T tet_pair
 #define TET_FN(name) name##_pair
-#define TET_LOG_INVERSE tet_log_inverse_pair
+#define TET_LOG_INVERSE tet_log_inverse_tet_pair
 #include "element_tet_kernel_body.h"
 #undef TET_T
 #undef TET_FN
 #undef TET_LOG_INVERSE
+
+/* The quads exist only as AVX2 code (GCC on x86-64; TET_QUADS says so):
+ * 32-byte vectors are no baseline x86-64 argument. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define TET_QUADS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+TET_LOG_INVERSE_LANES(tet_quad, 4)
+#define TET_T tet_quad
+#define TET_FN(name) name##_quad
+#define TET_LOG_INVERSE tet_log_inverse_tet_quad
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
+#pragma GCC pop_options
+#else
+#define TET_QUADS 0
+#endif
 
 #endif /* FDEM_ELEMENT_TET_KERNEL_H */
