@@ -14,6 +14,19 @@
 #error "element_tet_lanes.h is included by element_tet_model.c only"
 #endif
 
+/* x[a][i] = component i of node a of each lane's element (xyz triples). */
+TET_KERNEL void TET_VFN(tet_gather_nodes)(const double *xyz, const tet_hot *t, TET_V x[4][3])
+{
+    const double *p[TET_N];
+    TET_UNROLL
+    for (int a = 0; a < 4; a++) {
+        TET_UNROLL
+        for (int l = 0; l < TET_N; l++) p[l] = xyz + 3 * (size_t)t[l].node[a];
+        TET_UNROLL
+        for (int i = 0; i < 3; i++) x[a][i] = TET_GATHER(p, i);
+    }
+}
+
 /* The forces of lane `lane` of g (tet_kernel_face_loads): f_0 = g_0 added,
  * f_a = -g_a subtracted. */
 TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], const TET_V g[4][3],
@@ -56,15 +69,8 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
             if (t[l].eta > 0) TET_VFN(tet_damp_lane)(m, t + l, l, c, det, s, sum);
         return;
     }
-    const double *vel = m->vel, *p[TET_N];
     TET_V v[4][3], S[6], sv[6], prev[6], eta2;
-    TET_UNROLL
-    for (int a = 0; a < 4; a++) {
-        TET_UNROLL
-        for (int l = 0; l < TET_N; l++) p[l] = vel + 3 * (size_t)t[l].node[a];
-        TET_UNROLL
-        for (int i = 0; i < 3; i++) v[a][i] = TET_GATHER(p, i);
-    }
+    TET_VFN(tet_gather_nodes)(m->vel, t, v);
     TET_VFN(tet_kernel_rate)(v[0], v[1], v[2], v[3], c, S);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) eta2[l] = 2 * t[l].eta;
@@ -97,15 +103,9 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
 TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_constants *k,
                                           tet_sums *sum, const int stressed)
 {
-    const double *pos = m->pos, *p[TET_N];
+    const double *p[TET_N];
     TET_V x[4][3], X[9];
-    TET_UNROLL
-    for (int a = 0; a < 4; a++) {
-        TET_UNROLL
-        for (int l = 0; l < TET_N; l++) p[l] = pos + 3 * (size_t)t[l].node[a];
-        TET_UNROLL
-        for (int i = 0; i < 3; i++) x[a][i] = TET_GATHER(p, i);
-    }
+    TET_VFN(tet_gather_nodes)(m->pos, t, x);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) p[l] = t[l].xinv;
     TET_UNROLL
