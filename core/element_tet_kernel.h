@@ -57,8 +57,9 @@ typedef double tet_quad __attribute__((vector_size(32)));
 
 /* ln J and 1/J of a group of N lanes: log_short_series of log_near1.h on
  * every lane as vector operations when all are in its range (the same
- * operations per lane, so bit for bit what one element gets), the
- * division as one vector; else lane by lane through the scalar path. */
+ * operations per lane, so bit for bit what one element gets: keep the
+ * expression that of log_short_series), the division as one vector; else
+ * lane by lane through the scalar path. */
 #define TET_LOG_INVERSE_LANES(T, N)                                                              \
     static inline void tet_log_inverse_##T(T J, double j_min, T *lnJ, T *invJ)                  \
     {                                                                                           \
