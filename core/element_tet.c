@@ -111,10 +111,11 @@ double tet_forces(const double *pos, const double *vel, const int32_t node[4],
                         node_at(vel, node[3]), c, S);
         for (int k = 0; k < 6; k++) sigma[k] += 2 * law->eta / det * S[k];
     }
-    double sixth[6], fa[4][3];
+    double sixth[6], load[4][3];
     for (int k = 0; k < 6; k++) sixth[k] = sigma[k] * (1.0 / 6);
-    tet_kernel_forces(sixth, c, fa);
-    memcpy(f, fa, sizeof fa);
+    tet_kernel_face_loads(sixth, c, load);
+    for (int i = 0; i < 3; i++) f[i] = load[0][i];
+    for (int q = 3; q < 12; q++) f[q] = -load[q / 3][q % 3];
     if (sigma_out) memcpy(sigma_out, sigma, sizeof sigma);
     return g->volume0 * w;
 }

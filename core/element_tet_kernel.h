@@ -23,13 +23,15 @@
  *    pushed forward) to a stress, returns S0 : E.
  *  - tet_kernel_rate: the symmetric part of sum_k (v_k - v_0) (x) c_k, which
  *    is det times the rate of deformation D (no division here).
- *  - tet_kernel_forces: f_a = -s c_a for a stress s already scaled by 1/6
- *    (f_a = -V sigma grad N_a = -sigma c_a / 6), node 0 minus the sum of
- *    the other three: the four sum to zero exactly.
- *  - Each of edges, faces, gradient, stress, prestress and forces also exists as
- *    name_pair over tet_pair, two elements in the lanes of one SIMD
- *    register (element_tet_kernel_body.h is written once for both), with
- *    the same bits per element as the scalar one.
+ *  - tet_kernel_face_loads: g_a = s c_a for a stress s already scaled by
+ *    1/6 and g_0 = g_1 + g_2 + g_3; the nodal forces are f_a = -g_a
+ *    (-V sigma grad N_a = -sigma c_a / 6) and f_0 = g_0: the four sum to
+ *    zero exactly. Unnegated, so a scatter subtracts and saves the signs.
+ *  - tet_kernel_contract: s : S of two symmetric tensors in Voigt order.
+ *  - Each of edges, faces, gradient, stress, prestress, rate, contract and
+ *    face_loads also exists as name_pair over tet_pair, two elements in the
+ *    lanes of one SIMD register (element_tet_kernel_body.h is written once
+ *    for both), with the same bits per element as the scalar one.
  */
 #ifndef FDEM_ELEMENT_TET_KERNEL_H
 #define FDEM_ELEMENT_TET_KERNEL_H
@@ -48,26 +50,37 @@
 #define TET_UNROLL
 #endif
 
-/* Two elements side by side: lane k of every number is element k's. */
+/* Two (four) elements side by side: lane k of every number is element
+ * k's. Quads are for the AVX2 loop only (element_tet_model.c). */
 typedef double tet_pair __attribute__((vector_size(16)));
+typedef double tet_quad __attribute__((vector_size(32)));
 
-/* ln J and 1/J of a pair: the series on both lanes in the usual case
- * (lane by lane, bit for bit what one element gets), the division as one
- * vector; the rare lane outside it through the scalar path. */
-static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ, tet_pair *invJ)
-{
-    tet_pair x = J - 1.0;
-    if (fabs(x[0]) <= LOG_SHORT_RANGE && fabs(x[1]) <= LOG_SHORT_RANGE) {
-        *lnJ = (tet_pair){log_short_series(x[0]), log_short_series(x[1])};
-        *invJ = 1.0 / J;
-        return;
+/* ln J and 1/J of a group of N lanes: log_short_series of log_near1.h on
+ * every lane as vector operations when all are in its range (the same
+ * operations per lane, so bit for bit what one element gets: keep the
+ * expression that of log_short_series), the division as one vector; else
+ * lane by lane through the scalar path. */
+#define TET_LOG_INVERSE_LANES(T, N)                                                              \
+    static inline void tet_log_inverse_##T(T J, double j_min, T *lnJ, T *invJ)                  \
+    {                                                                                           \
+        T x = J - 1.0;                                                                          \
+        int near = 1;                                                                           \
+        for (int l = 0; l < N; l++) near &= fabs(x[l]) <= LOG_SHORT_RANGE;                      \
+        if (near) {                                                                             \
+            T x2 = x * x;                                                                       \
+            T q = (-1.0 / 2 + x * (1.0 / 3)) + x2 * (-1.0 / 4 + x * (1.0 / 5));                 \
+            *lnJ = x + x2 * q;                                                                  \
+            *invJ = 1.0 / J;                                                                    \
+            return;                                                                             \
+        }                                                                                       \
+        for (int l = 0; l < N; l++) {                                                           \
+            double ln, inv;                                                                     \
+            neo_hookean_log_inverse(J[l], j_min, &ln, &inv);                                    \
+            (*lnJ)[l] = ln;                                                                     \
+            (*invJ)[l] = inv;                                                                   \
+        }                                                                                       \
     }
-    double l0, l1, i0, i1;
-    neo_hookean_log_inverse(J[0], j_min, &l0, &i0);
-    neo_hookean_log_inverse(J[1], j_min, &l1, &i1);
-    *lnJ = (tet_pair){l0, l1};
-    *invJ = (tet_pair){i0, i1};
-}
+TET_LOG_INVERSE_LANES(tet_pair, 2)
 
 #define TET_T double
 #define TET_FN(name) name
@@ -79,35 +92,29 @@ static inline void tet_log_inverse_pair(tet_pair J, double j_min, tet_pair *lnJ,
 
 #define TET_T tet_pair
 #define TET_FN(name) name##_pair
-#define TET_LOG_INVERSE tet_log_inverse_pair
+#define TET_LOG_INVERSE tet_log_inverse_tet_pair
 #include "element_tet_kernel_body.h"
 #undef TET_T
 #undef TET_FN
 #undef TET_LOG_INVERSE
 
-TET_KERNEL void tet_kernel_rate(const double *v0, const double *v1, const double *v2,
-                                   const double *v3, const double c[3][3], double S[6])
-{
-    double dv[3][3];
-    tet_kernel_edges(v0, v1, v2, v3, dv);
-    double L[3][3];
-    TET_UNROLL
-    for (int i = 0; i < 3; i++)
-        TET_UNROLL
-        for (int j = 0; j < 3; j++)
-            L[i][j] = dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
-    S[0] = L[0][0];
-    S[1] = L[1][1];
-    S[2] = L[2][2];
-    S[3] = 0.5 * (L[1][2] + L[2][1]);
-    S[4] = 0.5 * (L[0][2] + L[2][0]);
-    S[5] = 0.5 * (L[0][1] + L[1][0]);
-}
-
-/* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */
-TET_KERNEL double tet_kernel_contract(const double s[6], const double S[6])
-{
-    return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
-}
+/* The quads exist only as AVX2 code (GCC on x86-64; TET_QUADS says so):
+ * 32-byte vectors are no baseline x86-64 argument. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define TET_QUADS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+TET_LOG_INVERSE_LANES(tet_quad, 4)
+#define TET_T tet_quad
+#define TET_FN(name) name##_quad
+#define TET_LOG_INVERSE tet_log_inverse_tet_quad
+#include "element_tet_kernel_body.h"
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE
+#pragma GCC pop_options
+#else
+#define TET_QUADS 0
+#endif
 
 #endif /* FDEM_ELEMENT_TET_KERNEL_H */

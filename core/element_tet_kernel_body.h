@@ -71,17 +71,21 @@ TET_KERNEL TET_T TET_FN(tet_kernel_stress)(const TET_T F[9], double smu, double 
     return hmu * (B00 + B11 + B22 - 3.0 - 2.0 * lnJ) + hlambda * lnJ * lnJ;
 }
 
-TET_KERNEL void TET_FN(tet_kernel_forces)(const TET_T s[6], const TET_T c[3][3], TET_T f[4][3])
+/* g_a = s c_a (a = 1..3) and g_0 = g_1 + g_2 + g_3: the forces are f_a =
+ * -g_a and f_0 = g_0, left unnegated so that a scatter subtracts instead
+ * (x - g is x + (-g) exactly, and negation rounds symmetrically). */
+TET_KERNEL void TET_FN(tet_kernel_face_loads)(const TET_T s[6], const TET_T c[3][3],
+                                              TET_T g[4][3])
 {
     TET_UNROLL
     for (int a = 1; a <= 3; a++) {
         const TET_T *ca = c[a - 1];
-        f[a][0] = -(s[0] * ca[0] + s[5] * ca[1] + s[4] * ca[2]);
-        f[a][1] = -(s[5] * ca[0] + s[1] * ca[1] + s[3] * ca[2]);
-        f[a][2] = -(s[4] * ca[0] + s[3] * ca[1] + s[2] * ca[2]);
+        g[a][0] = s[0] * ca[0] + s[5] * ca[1] + s[4] * ca[2];
+        g[a][1] = s[5] * ca[0] + s[1] * ca[1] + s[3] * ca[2];
+        g[a][2] = s[4] * ca[0] + s[3] * ca[1] + s[2] * ca[2];
     }
     TET_UNROLL
-    for (int i = 0; i < 3; i++) f[0][i] = -(f[1][i] + f[2][i] + f[3][i]);
+    for (int i = 0; i < 3; i++) g[0][i] = g[1][i] + g[2][i] + g[3][i];
 }
 
 /* s += scale F S0 F^T: the in-situ pre-stress S0 pushed forward (scale =
@@ -107,4 +111,29 @@ TET_KERNEL TET_T TET_FN(tet_kernel_prestress)(const TET_T F[9], TET_T scale, con
         s[q] += scale * tau[q];
     }
     return 0.5 * (tau[0] + tau[1] + tau[2] - S0[0] - S0[1] - S0[2]);
+}
+
+TET_KERNEL void TET_FN(tet_kernel_rate)(const TET_T *v0, const TET_T *v1, const TET_T *v2,
+                                        const TET_T *v3, const TET_T c[3][3], TET_T S[6])
+{
+    TET_T dv[3][3];
+    TET_FN(tet_kernel_edges)(v0, v1, v2, v3, dv);
+    TET_T L[3][3];
+    TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        TET_UNROLL
+        for (int j = 0; j < 3; j++)
+            L[i][j] = dv[0][i] * c[0][j] + dv[1][i] * c[1][j] + dv[2][i] * c[2][j];
+    S[0] = L[0][0];
+    S[1] = L[1][1];
+    S[2] = L[2][2];
+    S[3] = 0.5 * (L[1][2] + L[2][1]);
+    S[4] = 0.5 * (L[0][2] + L[2][0]);
+    S[5] = 0.5 * (L[0][1] + L[1][0]);
+}
+
+/* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */
+TET_KERNEL TET_T TET_FN(tet_kernel_contract)(const TET_T s[6], const TET_T S[6])
+{
+    return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
 }
