@@ -133,21 +133,45 @@ double joint_stable_dt_3d(const fdem_model *m)
     return dt;
 }
 
-/* The 3D counterpart of joint.c's joint_forces_range, with the same sums. */
+/* Adds fa to face A's nodes and -fa to face B's. */
+static inline void joint_tet_scatter(double *f, const int32_t n[6], const double fa[9])
+{
+    for (int i = 0; i < 3; i++)
+        for (int c = 0; c < 3; c++) {
+            f[3 * (size_t)n[i] + c] += fa[3 * i + c];
+            f[3 * (size_t)n[3 + i] + c] -= fa[3 * i + c];
+        }
+}
+
+/* The 3D counterpart of joint.c's joint_forces_range, with the same sums.
+ * An undamaged joint surely inside its strengths takes joint_tet.h's inline
+ * path (the same bits as joint_tet_forces, without the call, the law per
+ * point or the bookkeeping); any other goes through joint_tet_forces. */
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
     double *f = m->force;
+    const double *pos = m->pos;
+    const joint_strength *strengths = m->joint_strengths;
     int broke = 0;
     double stored = 0, dissipated = 0, handed = 0, friction = 0;
     for (int j = begin; j < end; j++) {
         double damage = m->joint_damage[j];
         if (damage >= 1.0) continue;
         const int32_t *n = m->joint_node + 6 * (size_t)j;
-        const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
+        const joint_law law = joint_law_of(&strengths[m->joint_strength_of[j]], m->joint_k[j]);
         double fa[9];
+        if (damage == 0) {
+            double d[3][3], N[3];
+            double N_len = joint_tet_gaps(pos, n, d, N);
+            if (N_len > JOINT_TET_TINY_NORMAL && joint_tet_surely_elastic(&law, d)) {
+                stored += joint_tet_elastic_forces(law.k, 0.5 * N_len, d, fa);
+                joint_tet_scatter(f, n, fa);
+                continue;
+            }
+        }
         /* this joint's own, for its fracture account and its event */
         joint_energy e = {0};
-        int holds = joint_tet_forces(&law, m->pos, m->vel, m->dt_prev, n, &damage, fa, &e);
+        int holds = joint_tet_forces(&law, pos, m->vel, m->dt_prev, n, &damage, fa, &e);
         m->joint_damage[j] = damage;
         stored += e.stored;
         dissipated += e.dissipated;
@@ -159,11 +183,7 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
             broke++;
             continue;
         }
-        for (int i = 0; i < 3; i++)
-            for (int c = 0; c < 3; c++) {
-                f[3 * (size_t)n[i] + c] += fa[3 * i + c];
-                f[3 * (size_t)n[3 + i] + c] -= fa[3 * i + c];
-            }
+        joint_tet_scatter(f, n, fa);
     }
     sums[0] += broke;
     sums[1] += stored;
