@@ -42,64 +42,101 @@ int joint_tet_forces(const joint_law *law, const double *pos, const double *vel,
  * Nearly every joint in nearly every step is undamaged and far inside its
  * strengths. These pieces of joint_tet_forces are inline so the model's
  * joint loop can give such a joint its forces without the call, the
- * damage bookkeeping or the per-point law: joint_tet_gaps, then
+ * damage bookkeeping or the per-point law, one joint or two side by side
+ * (joint_tet_fast_body.h, written once for both): joint_tet_gaps, then
  * joint_tet_surely_elastic, then joint_tet_elastic_forces give the very
- * bits joint_tet_forces gives (it is built from the same three). */
+ * bits joint_tet_forces gives (it is built from the same three). Forced
+ * inline and unrolled, as element_tet_kernel.h's: gcc -O2 keeps the small
+ * loops, and the gaps and forces then go through memory, where wide loads
+ * of narrow stores stall on store forwarding. */
+#if defined(__GNUC__)
+#define JOINT_TET_INLINE static inline __attribute__((always_inline))
+#define JOINT_TET_UNROLL _Pragma("GCC unroll 16")
+#else
+#define JOINT_TET_INLINE static inline
+#define JOINT_TET_UNROLL
+#endif
 
-/* The gaps d_i = b_i - a_i at the corners and the unnormalised normal N of
- * the mean face (a + d/2); returns |N|, twice the face's area. */
-static inline double joint_tet_gaps(const double *pos, const int32_t node[6], double d[3][3],
-                                    double N[3])
-{
-    double mean[3][3];
-    for (int i = 0; i < 3; i++) {
-        const double *a = pos + 3 * (size_t)node[i], *b = pos + 3 * (size_t)node[3 + i];
-        vec3_sub(b, a, d[i]);
-        for (int c = 0; c < 3; c++) mean[i][c] = a[c] + 0.5 * d[i][c];
-    }
-    double e1[3], e2[3];
-    vec3_sub(mean[1], mean[0], e1);
-    vec3_sub(mean[2], mean[0], e2);
-    vec3_cross(e1, e2, N);
-    return sqrt(vec3_dot(N, N));
-}
-
-/* Far enough inside the strengths that rounding cannot matter (below). */
+/* Far enough inside the strengths that rounding cannot matter
+ * (joint_tet_surely_elastic). */
 #define JOINT_TET_SURE (1 - 1e-6)
-
-/* True when an undamaged joint's every point is surely elastic, decided
- * from the corner gaps alone: a point's gap g is a convex mix of them, so
- * |g| <= max |d_i|, and its opening and sliding are each at most |g|, while
- * the shear strength is at least the cohesion. So k max |d_i| below the
- * smaller of f_t and c passes joint_point_elastic at every point; the
- * margin JOINT_TET_SURE, far above the few roundings of that test, makes
- * it pass in floating point too. No sqrt, no normal; false (the point test
- * then decides) for anything else, NaN included. */
-static inline int joint_tet_surely_elastic(const joint_law *law, const double d[3][3])
-{
-    double ft = law->tensile_strength * JOINT_TET_SURE, c = law->cohesion * JOINT_TET_SURE;
-    if (!(ft >= 0 && c >= 0 && law->tan_phi >= 0)) return 0;
-    double limit = ft < c ? ft * ft : c * c, kk = law->k * law->k;
-    return kk * vec3_dot(d[0], d[0]) <= limit && kk * vec3_dot(d[1], d[1]) <= limit &&
-           kk * vec3_dot(d[2], d[2]) <= limit;
-}
-
-/* The faces' elastic forces fa, k d integrated exactly against the linear
- * shape functions; returns the stored energy 1/2 integral k |d|^2. */
-static inline double joint_tet_elastic_forces(double k, double area, const double d[3][3],
-                                              double fa[9])
-{
-    double s = k * area / 12, stored = 0;
-    for (int c = 0; c < 3; c++) {
-        double sum = d[0][c] + d[1][c] + d[2][c];
-        for (int i = 0; i < 3; i++) fa[3 * i + c] = s * (d[i][c] + sum);
-    }
-    for (int i = 0; i < 3; i++) stored += 0.5 * vec3_dot(fa + 3 * i, d[i]);
-    return stored;
-}
 
 /* The smallest |N| the fast path takes: far above where the projections
  * of the point test could underflow. */
 #define JOINT_TET_TINY_NORMAL 1e-100
+
+/* Two joints side by side: lane k of every number is joint k's; a
+ * comparison gives a lane of all bits set where it holds. */
+typedef double joint_pair __attribute__((vector_size(16)));
+typedef long long joint_pair_mask __attribute__((vector_size(16)));
+
+/* Lane by lane: sqrt rounds each lane as it rounds one number. */
+JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
+{
+    return (joint_pair){sqrt(x[0]), sqrt(x[1])};
+}
+
+#define JT_T double
+#define JT_MASK int
+#define JT_FN(name) name
+#define JT_SQRT sqrt
+#include "joint_tet_fast_body.h"
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+
+#define JT_T joint_pair
+#define JT_MASK joint_pair_mask
+#define JT_FN(name) name##_pair
+#define JT_SQRT joint_pair_sqrt
+#include "joint_tet_fast_body.h"
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+
+/* joint_tet_gaps_of for the joint of corners node[6] in pos. */
+JOINT_TET_INLINE double joint_tet_gaps(const double *pos, const int32_t node[6], double d[3][3],
+                                       double N[3])
+{
+    double a[3][3], b[3][3];
+    JOINT_TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        JOINT_TET_UNROLL
+        for (int c = 0; c < 3; c++) {
+            a[i][c] = pos[3 * (size_t)node[i] + c];
+            b[i][c] = pos[3 * (size_t)node[3 + i] + c];
+        }
+    return joint_tet_gaps_of(a, b, d, N);
+}
+
+/* The same for joints n0 (lane 0) and n1 (lane 1). */
+JOINT_TET_INLINE joint_pair joint_tet_gaps_pair(const double *pos, const int32_t n0[6],
+                                                const int32_t n1[6], joint_pair d[3][3],
+                                                joint_pair N[3])
+{
+    joint_pair a[3][3], b[3][3];
+    JOINT_TET_UNROLL
+    for (int i = 0; i < 3; i++)
+        JOINT_TET_UNROLL
+        for (int c = 0; c < 3; c++) {
+            a[i][c] = (joint_pair){pos[3 * (size_t)n0[i] + c], pos[3 * (size_t)n1[i] + c]};
+            b[i][c] = (joint_pair){pos[3 * (size_t)n0[3 + i] + c], pos[3 * (size_t)n1[3 + i] + c]};
+        }
+    return joint_tet_gaps_of_pair(a, b, d, N);
+}
+
+JOINT_TET_INLINE int joint_tet_surely_elastic(const joint_law *law, const double d[3][3])
+{
+    return joint_tet_surely_elastic_of(law->k, law->tensile_strength, law->cohesion, law->tan_phi,
+                                       d);
+}
+
+JOINT_TET_INLINE double joint_tet_elastic_forces(double k, double area, const double d[3][3],
+                                                 double fa[9])
+{
+    return joint_tet_elastic_forces_of(k, area, d, fa);
+}
 
 #endif /* FDEM_JOINT_TET_H */
