@@ -76,55 +76,39 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
     return (joint_pair){sqrt(x[0]), sqrt(x[1])};
 }
 
+/* Coordinate c of corner k (0-2 face A, 3-5 face B) of the joint(s). */
+#define JOINT_TET_AT(pos, n, k, c) (pos)[3 * (size_t)(n)[k] + (c)]
+
 #define JT_T double
 #define JT_MASK int
 #define JT_FN(name) name
 #define JT_SQRT sqrt
+#define JT_LOAD(pos, n0, n1, k, c) JOINT_TET_AT(pos, n0, k, c)
 #include "joint_tet_fast_body.h"
 #undef JT_T
 #undef JT_MASK
 #undef JT_FN
 #undef JT_SQRT
+#undef JT_LOAD
 
 #define JT_T joint_pair
 #define JT_MASK joint_pair_mask
 #define JT_FN(name) name##_pair
 #define JT_SQRT joint_pair_sqrt
+#define JT_LOAD(pos, n0, n1, k, c) \
+    ((joint_pair){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, n1, k, c)})
 #include "joint_tet_fast_body.h"
 #undef JT_T
 #undef JT_MASK
 #undef JT_FN
 #undef JT_SQRT
+#undef JT_LOAD
 
-/* joint_tet_gaps_of for the joint of corners node[6] in pos. */
+/* joint_tet_gaps_at for one joint, corners node[6]. */
 JOINT_TET_INLINE double joint_tet_gaps(const double *pos, const int32_t node[6], double d[3][3],
                                        double N[3])
 {
-    double a[3][3], b[3][3];
-    JOINT_TET_UNROLL
-    for (int i = 0; i < 3; i++)
-        JOINT_TET_UNROLL
-        for (int c = 0; c < 3; c++) {
-            a[i][c] = pos[3 * (size_t)node[i] + c];
-            b[i][c] = pos[3 * (size_t)node[3 + i] + c];
-        }
-    return joint_tet_gaps_of(a, b, d, N);
-}
-
-/* The same for joints n0 (lane 0) and n1 (lane 1). */
-JOINT_TET_INLINE joint_pair joint_tet_gaps_pair(const double *pos, const int32_t n0[6],
-                                                const int32_t n1[6], joint_pair d[3][3],
-                                                joint_pair N[3])
-{
-    joint_pair a[3][3], b[3][3];
-    JOINT_TET_UNROLL
-    for (int i = 0; i < 3; i++)
-        JOINT_TET_UNROLL
-        for (int c = 0; c < 3; c++) {
-            a[i][c] = (joint_pair){pos[3 * (size_t)n0[i] + c], pos[3 * (size_t)n1[i] + c]};
-            b[i][c] = (joint_pair){pos[3 * (size_t)n0[3 + i] + c], pos[3 * (size_t)n1[3 + i] + c]};
-        }
-    return joint_tet_gaps_of_pair(a, b, d, N);
+    return joint_tet_gaps_at(pos, node, node, d, N);
 }
 
 JOINT_TET_INLINE int joint_tet_surely_elastic(const joint_law *law, const double d[3][3])

@@ -8,23 +8,24 @@
  * element_tet_kernel_body.h does for tetrahedra.
  * Not a header of its own: include joint_tet.h.
  */
-#if !defined(JT_T) || !defined(JT_FN) || !defined(JT_SQRT)
+#if !defined(JT_T) || !defined(JT_FN) || !defined(JT_SQRT) || !defined(JT_LOAD)
 #error "include joint_tet.h, not this file"
 #endif
 
 /* The gaps d_i = b_i - a_i at the corners and the unnormalised normal N of
- * the mean face (a + d/2), from the corners a[i], b[i]; returns |N|, twice
- * the face's area. */
-JOINT_TET_INLINE JT_T JT_FN(joint_tet_gaps_of)(const JT_T a[3][3], const JT_T b[3][3],
-                                               JT_T d[3][3], JT_T N[3])
+ * the mean face (a + d/2) of joint n0 (and n1 in lane 1 of a pair; a
+ * single joint reads only n0); returns |N|, twice the face's area. */
+JOINT_TET_INLINE JT_T JT_FN(joint_tet_gaps_at)(const double *pos, const int32_t n0[6],
+                                               const int32_t n1[6], JT_T d[3][3], JT_T N[3])
 {
     JT_T mean[3][3];
     JOINT_TET_UNROLL
     for (int i = 0; i < 3; i++)
         JOINT_TET_UNROLL
         for (int c = 0; c < 3; c++) {
-            d[i][c] = b[i][c] - a[i][c];
-            mean[i][c] = a[i][c] + 0.5 * d[i][c];
+            JT_T a = JT_LOAD(pos, n0, n1, i, c), b = JT_LOAD(pos, n0, n1, 3 + i, c);
+            d[i][c] = b - a;
+            mean[i][c] = a + 0.5 * d[i][c];
         }
     JT_T e1[3], e2[3];
     JOINT_TET_UNROLL

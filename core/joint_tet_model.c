@@ -156,7 +156,7 @@ static int joint_pair_elastic(fdem_model *m, int j, double *stored)
     const joint_strength *s0 = &m->joint_strengths[m->joint_strength_of[j]];
     const joint_strength *s1 = &m->joint_strengths[m->joint_strength_of[j + 1]];
     joint_pair d[3][3], N[3];
-    joint_pair N_len = joint_tet_gaps_pair(m->pos, n0, n1, d, N);
+    joint_pair N_len = joint_tet_gaps_at_pair(m->pos, n0, n1, d, N);
     joint_pair k = {m->joint_k[j], m->joint_k[j + 1]};
     joint_pair_mask sure = joint_tet_surely_elastic_of_pair(
         k, (joint_pair){s0->tensile_strength, s1->tensile_strength},
