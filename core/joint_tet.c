@@ -59,20 +59,6 @@ static int joint_tet_elastic(const joint_law *law, const double d[3][3], const d
     return 1;
 }
 
-/* k d integrated exactly against the linear shape functions; returns the
- * stored energy 1/2 integral k |d|^2. */
-static double joint_tet_elastic_forces(double k, double area, const double d[3][3],
-                                       double fa[9])
-{
-    double s = k * area / 12, stored = 0;
-    for (int c = 0; c < 3; c++) {
-        double sum = d[0][c] + d[1][c] + d[2][c];
-        for (int i = 0; i < 3; i++) fa[3 * i + c] = s * (d[i][c] + sum);
-    }
-    for (int i = 0; i < 3; i++) stored += 0.5 * vec3_dot(fa + 3 * i, d[i]);
-    return stored;
-}
-
 /* ---------------------------------------------------------- compression */
 
 /* Adds k delta n N_i integrated over the sub-triangle with barycentric
@@ -198,17 +184,8 @@ int joint_tet_forces(const joint_law *law, const double *pos, const double *vel,
 {
     memset(fa, 0, 9 * sizeof(double));
     if (*damage >= 1.0) return 0;
-    double d[3][3], mean[3][3];
-    for (int i = 0; i < 3; i++) {
-        const double *a = node_at(pos, node[i]), *b = node_at(pos, node[3 + i]);
-        vec3_sub(b, a, d[i]);
-        for (int c = 0; c < 3; c++) mean[i][c] = a[c] + 0.5 * d[i][c];
-    }
-    double e1[3], e2[3], N[3];
-    vec3_sub(mean[1], mean[0], e1);
-    vec3_sub(mean[2], mean[0], e2);
-    vec3_cross(e1, e2, N);
-    double N_len = sqrt(vec3_dot(N, N)), area = 0.5 * N_len;
+    double d[3][3], N[3];
+    double N_len = joint_tet_gaps(pos, node, d, N), area = 0.5 * N_len;
     if (!(N_len > 0)) return 1; /* a face squashed flat carries nothing this step */
     if (*damage == 0 && joint_tet_elastic(law, d, N, N_len)) {
         e->stored += joint_tet_elastic_forces(law->k, area, d, fa);

@@ -29,9 +29,98 @@
 #include <stdint.h>
 
 #include "joint_law.h"
+#include "vec3.h"
+
+#include <math.h>
+#include <stddef.h>
 
 /* h_last: the last step, so that x - h_last v is where the nodes were. */
 int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
                      const int32_t node[6], double *damage, double fa[9], joint_energy *e);
+
+/* ------------------------------------------------ the intact fast path
+ * Nearly every joint in nearly every step is undamaged and far inside its
+ * strengths. These pieces of joint_tet_forces are inline so the model's
+ * joint loop can give such a joint its forces without the call, the
+ * damage bookkeeping or the per-point law, one joint or two side by side
+ * (joint_tet_fast_body.h, written once for both): joint_tet_gaps, then
+ * joint_tet_surely_elastic, then joint_tet_elastic_forces give the very
+ * bits joint_tet_forces gives (it is built from the same three). Forced
+ * inline and unrolled, as element_tet_kernel.h's: gcc -O2 keeps the small
+ * loops, and the gaps and forces then go through memory, where wide loads
+ * of narrow stores stall on store forwarding. */
+#if defined(__GNUC__)
+#define JOINT_TET_INLINE static inline __attribute__((always_inline))
+#define JOINT_TET_UNROLL _Pragma("GCC unroll 16")
+#else
+#define JOINT_TET_INLINE static inline
+#define JOINT_TET_UNROLL
+#endif
+
+/* Far enough inside the strengths that rounding cannot matter
+ * (joint_tet_surely_elastic). */
+#define JOINT_TET_SURE (1 - 1e-6)
+
+/* The smallest |N| the fast path takes: far above where the projections
+ * of the point test could underflow. */
+#define JOINT_TET_TINY_NORMAL 1e-100
+
+/* Two joints side by side: lane k of every number is joint k's; a
+ * comparison gives a lane of all bits set where it holds. */
+typedef double joint_pair __attribute__((vector_size(16)));
+typedef long long joint_pair_mask __attribute__((vector_size(16)));
+
+/* Lane by lane: sqrt rounds each lane as it rounds one number. */
+JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
+{
+    return (joint_pair){sqrt(x[0]), sqrt(x[1])};
+}
+
+/* Coordinate c of corner k (0-2 face A, 3-5 face B) of the joint(s). */
+#define JOINT_TET_AT(pos, n, k, c) (pos)[3 * (size_t)(n)[k] + (c)]
+
+#define JT_T double
+#define JT_MASK int
+#define JT_FN(name) name
+#define JT_SQRT sqrt
+#define JT_LOAD(pos, n0, n1, k, c) JOINT_TET_AT(pos, n0, k, c)
+#include "joint_tet_fast_body.h"
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+#undef JT_LOAD
+
+#define JT_T joint_pair
+#define JT_MASK joint_pair_mask
+#define JT_FN(name) name##_pair
+#define JT_SQRT joint_pair_sqrt
+#define JT_LOAD(pos, n0, n1, k, c) \
+    ((joint_pair){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, n1, k, c)})
+#include "joint_tet_fast_body.h"
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+#undef JT_LOAD
+
+/* joint_tet_gaps_at for one joint, corners node[6]. */
+JOINT_TET_INLINE double joint_tet_gaps(const double *pos, const int32_t node[6], double d[3][3],
+                                       double N[3])
+{
+    return joint_tet_gaps_at(pos, node, node, d, N);
+}
+
+JOINT_TET_INLINE int joint_tet_surely_elastic(const joint_law *law, const double d[3][3])
+{
+    return joint_tet_surely_elastic_of(law->k, law->tensile_strength, law->cohesion, law->tan_phi,
+                                       d);
+}
+
+JOINT_TET_INLINE double joint_tet_elastic_forces(double k, double area, const double d[3][3],
+                                                 double fa[9])
+{
+    return joint_tet_elastic_forces_of(k, area, d, fa);
+}
 
 #endif /* FDEM_JOINT_TET_H */

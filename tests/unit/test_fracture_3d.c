@@ -1,7 +1,8 @@
 /*
  * test_fracture_3d.c - fracturing tetrahedral parts in the model: a joint
  * on every face shared by two tetrahedra (counted against the box mesh's
- * faces, oriented out of A, joining copies of one mesh vertex); the
+ * faces, oriented out of A, joining copies of one mesh vertex); the joint
+ * loop's inline paths give each joint joint_tet_forces' bits; the
  * stable step of a jointed model within 2/omega_max of power iteration; an intact
  * fracturing bar vibrates with the period of the continuous one (4L/c);
  * a bar pulled apart at both ends breaks into pieces with the energy
@@ -11,6 +12,7 @@
 #include "bar_period_3d.h"
 #include "build_model.h"
 #include "check.h"
+#include "joint_tet.h"
 #include "joint_face_3d.h"
 #include "mesh_3d.h"
 #include "model.h"
@@ -108,6 +110,95 @@ static void joints_on_interior_faces(void)
           fdem_get_counts(m).fragments);
     fprintf(stderr, "  %d tetrahedra, %d joints\n", T, m->joint_count);
     fdem_model_destroy(m);
+}
+
+/* joint_forces_range_3d without its inline paths: joint_tet_forces for
+ * every joint, with the same sums. */
+static void reference_joint_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    double acc[5] = {0, 0, 0, 0, 0};
+    for (int j = begin; j < end; j++) {
+        if (m->joint_damage[j] >= 1.0) continue;
+        const int32_t *n = m->joint_node + 6 * (size_t)j;
+        const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
+        double fa[9];
+        joint_energy e = {0};
+        int holds = joint_tet_forces(&law, m->pos, m->vel, m->dt_prev, n, &m->joint_damage[j], fa, &e);
+        acc[1] += e.stored;
+        acc[2] += e.dissipated;
+        acc[3] += e.handed;
+        acc[4] += e.friction;
+        if (!holds) {
+            acc[0]++;
+            continue;
+        }
+        for (int i = 0; i < 3; i++)
+            for (int c = 0; c < 3; c++) {
+                m->force[3 * (size_t)n[i] + c] += fa[3 * i + c];
+                m->force[3 * (size_t)n[3 + i] + c] -= fa[3 * i + c];
+            }
+    }
+    for (int k = 0; k < 5; k++) sums[k] += acc[k];
+}
+
+/* A small fracturing box shaken: the tetrahedra whose index is a multiple
+ * of 3 by up to 3 f_t / k a coordinate (their joints beyond a strength),
+ * the others by 1/20 of that (joints far inside), every 7th joint already
+ * damaged. */
+static fdem_model *shaken_box(void)
+{
+    const double size[3] = {0.03, 0.03, 0.03};
+    const int div[3] = {3, 3, 3};
+    fdem_model *m = box_model(size, div, rock(0, 0.1), 1);
+    build_finalize(m, 0.5);
+    double limit = 1e6 / m->joint_k[0];
+    uint64_t state = 12345;
+    for (int e = 0; e < m->elem_count; e++)
+        for (int k = 0; k < 4; k++) {
+            int32_t node = m->tet[e].node[k];
+            for (int c = 0; c < 3; c++) {
+                state = state * 6364136223846793005ull + 1442695040888963407ull;
+                double u = (double)(state >> 11) * 0x1.0p-53 * 2 - 1;
+                m->pos[3 * node + c] += (e % 3 == 0 ? 3 : 0.15) * limit * u;
+                m->vel[3 * node + c] = 0.01 * u;
+            }
+        }
+    for (int j = 0; j < m->joint_count; j += 7) m->joint_damage[j] = 0.3;
+    return m;
+}
+
+/* The joint loop's inline paths (an undamaged joint surely inside its
+ * strengths, alone or two side by side) give every joint the bits
+ * joint_tet_forces gives it, whose physics test_joint_tet holds to closed
+ * forms: forces, damage and sums against the loop that calls
+ * joint_tet_forces for every joint, in the same planned order. */
+static void joint_loop_gives_the_bits_of_the_kernel(void)
+{
+    fdem_model *fast = shaken_box(), *reference = shaken_box();
+    double sums_fast[SCATTER_SUMS] = {0}, sums_reference[SCATTER_SUMS] = {0};
+    size_t bytes = sizeof(double) * 3 * (size_t)fast->node_count;
+    memset(fast->force, 0, bytes);
+    memset(reference->force, 0, bytes);
+    scatter_plan_run(&fast->joint_plan, fast, 1, joint_forces_range_3d, sums_fast);
+    scatter_plan_run(&reference->joint_plan, reference, 1, reference_joint_range, sums_reference);
+    int intact = 0, damaged = 0, broken = 0;
+    for (int j = 0; j < fast->joint_count; j++) {
+        double D = fast->joint_damage[j];
+        intact += D == 0;
+        damaged += D > 0 && D < 1;
+        broken += D >= 1;
+    }
+    CHECK(intact >= 10 && damaged >= 10, "the test needs both kinds: %d intact, %d damaged, "
+          "%d broken of %d joints", intact, damaged, broken, fast->joint_count);
+    CHECK(memcmp(fast->force, reference->force, bytes) == 0, "forces differ");
+    CHECK(memcmp(fast->joint_damage, reference->joint_damage,
+                 sizeof(double) * (size_t)fast->joint_count) == 0, "damage differs");
+    CHECK(memcmp(sums_fast, sums_reference, sizeof sums_fast) == 0,
+          "sums differ: stored %.17g vs %.17g", sums_fast[1], sums_reference[1]);
+    fprintf(stderr, "  %d joints: %d intact, %d damaged, %d broken\n", fast->joint_count, intact,
+            damaged, broken);
+    fdem_model_destroy(fast);
+    fdem_model_destroy(reference);
 }
 
 /* The static excess compliance of the intact joints of a bar loaded
@@ -397,6 +488,6 @@ static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
     fdem_model_destroy(two);
 }
 
-CHECK_MAIN(T(joints_on_interior_faces), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
+CHECK_MAIN(T(joints_on_interior_faces), T(joint_loop_gives_the_bits_of_the_kernel), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
            T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits),
            T(fracturing_impact_on_two_threads_gives_the_bits_of_one))
