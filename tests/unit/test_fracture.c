@@ -7,6 +7,9 @@
  *    degrees; between steel platens closing at 0.05 m/s): the peak platen force P
  *    per metre gives 2P/(pi D) within 15% of f_t; the damaged joints line
  *    the loaded diameter from platen to platen; the load falls after it.
+ *  - The same rock as a 3D cylinder: between platens (coarse, fast; a wide
+ *    band) and through loading arcs on a finer lattice, whose peak
+ *    2P/(pi D t) is within 15 % of f_t; both split along the loaded plane.
  *  - Uniaxial compression of a 25 x 50 mm specimen of the same rock: peak
  *    stress within 25% of Mohr-Coulomb's 2c cos(phi)/(1 - sin(phi)) (the
  *    joints' own envelope); the broken joints mostly lie at 30-70 degrees to
