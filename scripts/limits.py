@@ -341,7 +341,8 @@ def main(groups):
         # the speed series and the brittle, arc and stiff-joint variants on
         # the shipped 24-edge disc, then finer meshes at the slow speed
         brazilian_3d_table([(24, 0.1), (24, 0.05), (24, 0.025), (24, 0.025, brittle),
-                            (24, 0.025, arc_3d), (32, 0.025, arc_3d), (40, 0.025, arc_3d),
+                            (24, 0.025, arc_3d), (32, 0.025, arc_3d), (40, 0.025, arc_3d), (48, 0.025, arc_3d),
+                            (40, 0.025, arc_3d, brittle),
                             (24, 0.025, {"penalty": 100}),
                             (32, 0.025), (40, 0.025), (48, 0.025), (40, 0.0125)])
     if "prism3d" in groups:

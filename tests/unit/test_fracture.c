@@ -7,6 +7,9 @@
  *    degrees; between steel platens closing at 0.05 m/s): the peak platen force P
  *    per metre gives 2P/(pi D) within 15% of f_t; the damaged joints line
  *    the loaded diameter from platen to platen; the load falls after it.
+ *  - The same rock as a 3D cylinder: between platens (coarse, fast; a wide
+ *    band) and through loading arcs on a finer lattice, whose peak
+ *    2P/(pi D t) is within 15 % of f_t; both split along the loaded plane.
  *  - Uniaxial compression of a 25 x 50 mm specimen of the same rock: peak
  *    stress within 25% of Mohr-Coulomb's 2c cos(phi)/(1 - sin(phi)) (the
  *    joints' own envelope); the broken joints mostly lie at 30-70 degrees to
@@ -32,6 +35,7 @@
 #include <string.h>
 
 #include "case.h"
+#include "case_doc.h"
 #include "check.h"
 #include "joint_face_3d.h"
 #include "model.h"
@@ -56,12 +60,26 @@ static char *read_text(const char *path, size_t *length)
     return text;
 }
 
-static fdem_model *load_example(const char *path, case_info *info)
+/* The example at `path`, with the JSON at `pointer` replaced by `value`
+ * when both are given (a coarser mesh for the sanitizer build). */
+static fdem_model *load_example_edited(const char *path, const char *pointer, const char *value,
+                                       case_info *info)
 {
     size_t length = 0;
     char *text = read_text(path, &length);
     CHECK(text != NULL, "cannot read %s", path);
     if (!text) return NULL;
+    if (pointer && value) {
+        json_error_t error;
+        json_t *doc = json_loads(text, 0, &error);
+        CHECK(doc != NULL, "%s does not parse: %s", path, error.text);
+        free(text);
+        if (!doc) return NULL;
+        edit(doc, pointer, load(value));
+        text = json_dumps(doc, JSON_COMPACT);
+        length = strlen(text);
+        json_decref(doc);
+    }
     problems p;
     problems_init(&p);
     fdem_model *m = case_build(text, length, (size_t)1 << 31, info, &p);
@@ -69,6 +87,11 @@ static fdem_model *load_example(const char *path, case_info *info)
     problems_free(&p);
     free(text);
     return m;
+}
+
+static fdem_model *load_example(const char *path, case_info *info)
+{
+    return load_example_edited(path, NULL, NULL, info);
 }
 
 typedef struct load_history {
@@ -210,14 +233,13 @@ static double specimen_thickness(const fdem_model *m)
 /* A disc of radius 25 mm (a cylinder along z in 3D) split between platens:
  * 2P/(pi D t) at the peak between low and high times f_t, the damaged
  * joints lining the loaded diameter from platen to platen. */
-static void brazilian_disc(const char *path, double low, double high)
+static void brazilian_disc_model(fdem_model *m, const case_info *info, double low, double high)
 {
-    case_info info;
-    fdem_model *m = load_example(path, &info);
-    if (!m) return;
     const double R = 0.025, ft = 1e6, t = specimen_thickness(m);
     load_history h;
-    if (run_loaded(m, info.end_time, &h)) {
+    /* results are the same bits on any number of threads; CI has two cores */
+    fdem_set_threads(m, 2);
+    if (run_loaded(m, info->end_time, &h)) {
         fdem_model_destroy(m);
         return;
     }
@@ -254,6 +276,13 @@ static void brazilian_disc(const char *path, double low, double high)
     CHECK(near >= damaged / 2, "only %d of %d damaged joints are near the loaded diameter", near,
           damaged);
     fdem_model_destroy(m);
+}
+
+static void brazilian_disc(const char *path, double low, double high)
+{
+    case_info info;
+    fdem_model *m = load_example(path, &info);
+    if (m) brazilian_disc_model(m, &info, low, high);
 }
 
 /* A block 25 mm wide (and deep, in 3D) crushed between platens: the peak
@@ -317,5 +346,31 @@ static void brazilian_disc_3d_splits_along_the_loaded_plane(void)
     brazilian_disc("examples/brazilian-disc-3d.json", 1.0, 1.6);
 }
 
+/* The 3D disc that measures f_t (examples/brazilian-disc-3d-arc.json): 40
+ * edges round the rim (a 10 x 10 lattice across, two layers: 1200
+ * tetrahedra), loaded without platens through the rim nodes within a 15
+ * degree arc of each end of the loaded diameter, moved at 0.025 m/s and
+ * free sideways and along the axis. On this lattice the arc holds one row
+ * of nodes along the axis, so the load is the diametral line load that
+ * 2P/(pi D t) is the solution for. make limits measured 1.087 f_t here and
+ * 1.130 at 48 edges (docs/physics.md, "3D Brazilian disc"): within 15 %.
+ * The run takes minutes under ASan, so the sanitizer build (FDEM_SAN, set
+ * by the Makefile) runs the same set-up on the 24-edge, one-layer lattice
+ * and holds it to that mesh's band, [1.0, 1.6] f_t (measured 1.365), with
+ * the same split; the 15 % figure is checked by the normal build. */
+static void brazilian_disc_3d_through_arcs_peaks_at_its_tensile_strength(void)
+{
+    const char *path = "examples/brazilian-disc-3d-arc.json";
+    case_info info;
+#ifdef FDEM_SAN
+    fdem_model *m = load_example_edited(path, "/parts/0/cylinder/divisions", "[24, 1]", &info);
+    if (m) brazilian_disc_model(m, &info, 1.0, 1.6);
+#else
+    fdem_model *m = load_example(path, &info);
+    if (m) brazilian_disc_model(m, &info, 0.85, 1.15);
+#endif
+}
+
 CHECK_MAIN(T(brazilian_disc_splits_at_its_tensile_strength), T(uniaxial_compression_fails_in_shear),
-           T(brazilian_disc_3d_splits_along_the_loaded_plane))
+           T(brazilian_disc_3d_splits_along_the_loaded_plane),
+           T(brazilian_disc_3d_through_arcs_peaks_at_its_tensile_strength))
