@@ -13,16 +13,20 @@ status=0
 for t in "$BUILD"/tests/test_*; do
   [ -x "$t" ] || continue
   echo "== $(basename "$t")"
+  t0=$(date +%s)
   if ! "$t" 2>&1 | tee -a "$log"; then status=1; fi
   [ "${PIPESTATUS[0]}" -ne 0 ] && status=1
+  echo "   ($(basename "$t"): $(( $(date +%s) - t0 )) s)"
 done
 
 if [ "${UNIT_ONLY:-0}" != 1 ] && [ -d tests/integration ]; then
   echo "== integration"
+  t0=$(date +%s)
   if ! FDEMD_BIN="$BIN/fdemd" FDEMCTL_BIN="$BIN/fdemctl" "$PYTHON" tests/integration/run.py 2>&1 | tee -a "$log"; then
     status=1
   fi
   [ "${PIPESTATUS[0]}" -ne 0 ] && status=1
+  echo "   (integration: $(( $(date +%s) - t0 )) s)"
 fi
 
 passed=$(grep -c '^PASS ' "$log" || true)
