@@ -177,23 +177,52 @@ static inline double boxes_gap(const double *a, const double *b, int dim)
     return gap;
 }
 
-/* The near list (see the top of this file) from this step's boxes, if a
- * detection or a restore made it stale or the nodes have gone past its
- * reach. Returns 0, or -1 when out of memory. */
-static int contact_near_refresh(contact_state *cs, int dim)
+/* The largest squared node displacement since the near list was built. */
+static double near_moved2(const fdem_model *m)
 {
-    double d = sqrt(cs->max_disp2);
-    if (!cs->near_stale && d <= cs->near_reach) return 0;
+    const double *p = m->pos, *q = m->contact.pos_near;
+    long count = (long)m->dim * m->node_count;
+    double moved2 = 0;
+    if (m->dim == 3) {
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
+    schedule(static) reduction(max : moved2)
+        for (long i = 0; i < count; i += 3) {
+            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1], dz = p[i + 2] - q[i + 2];
+            moved2 = max2(moved2, dx * dx + dy * dy + dz * dz);
+        }
+    } else {
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
+    schedule(static) reduction(max : moved2)
+        for (long i = 0; i < count; i += 2) {
+            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1];
+            moved2 = max2(moved2, dx * dx + dy * dy);
+        }
+    }
+    return moved2;
+}
+
+/* The near list (see the top of this file) from this step's boxes, if a
+ * detection or a restore made it stale or some node has gone past its
+ * reach since it was built. Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
+        cs->near_count = 0;
+        return 0;
+    }
+    if (!cs->near_stale && near_moved2(m) <= cs->near_reach * cs->near_reach) return 0;
     if (cs->near_capacity < cs->pairs.count) {
         size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
         if (!n) return -1;
         cs->near = n;
         cs->near_capacity = cs->pairs.count;
     }
-    double reach = d + NEAR_REACH_STEP * cs->buffer;
-    /* a hair over 2 (d + reach), so rounding in the gap or in d never
-     * leaves out a pair that could touch */
-    double limit = 2.0 * (d + reach) * (1 + 1e-9);
+    double reach = NEAR_REACH_STEP * cs->buffer;
+    /* a hair over 2 reach, so rounding in the gap never leaves out a pair
+     * that could touch */
+    double limit = 2.0 * reach * (1 + 1e-9);
+    int dim = m->dim;
     size_t width = 2 * (size_t)dim, count = 0;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         const double *a = cs->box + width * (size_t)cs->pairs.a[k];
@@ -201,6 +230,7 @@ static int contact_near_refresh(contact_state *cs, int dim)
         if (boxes_gap(a, b, dim) <= limit) cs->near[count++] = k;
         else contact_springs_release(cs, k); /* apart now and until the next rebuild */
     }
+    memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_count = count;
     cs->near_reach = reach;
     cs->near_stale = 0;
@@ -410,13 +440,14 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->body = malloc(sizeof(int32_t) * E);
     cs->piece = malloc(sizeof(int32_t) * E);
     cs->pos_detect = malloc(sizeof(double) * D * N);
+    cs->pos_near = malloc(sizeof(double) * D * N);
     cs->force = calloc(D * N, sizeof(double));
     cs->force_is_zero = 1;
     cs->box = malloc(sizeof(double) * 2 * D * E);
     cs->active = malloc(sizeof(int32_t) * E);
     cs->in_pair = malloc(E);
     if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
-        !cs->pos_detect || !cs->force || !cs->box || !cs->active || !cs->in_pair) {
+        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -440,7 +471,7 @@ int contact_init(fdem_model *m, fdem_error *err)
 void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
-    free(cs->pos_detect); free(cs->force);
+    free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->box); free(cs->active); free(cs->in_pair); free(cs->near);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
@@ -640,7 +671,7 @@ int contact_forces(fdem_model *m)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (cs->pairs.count) contact_boxes(m);
-    if (contact_near_refresh(cs, m->dim)) return -1;
+    if (contact_near_refresh(m)) return -1;
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;

@@ -32,17 +32,27 @@
 
 #include "vec3.h"
 
-#define CLIP_MAX 12 /* a triangle clipped by 4 planes has at most 7 vertices */
+#define CLIP_MAX 12 /* a triangle clipped by 7 planes has at most 10 vertices */
 
-typedef struct clip_vertex {
-    double x[3];
-    double lambda[4];
-} clip_vertex;
-
-typedef struct clip_polygon {
-    clip_vertex v[CLIP_MAX];
+/* A polygon on a contactor face, its vertices given by w, their weights on
+ * the face's second and third corners (the first corner's is 1 - w[0] -
+ * w[1]): the face is the triangle (0,0), (1,0), (0,1) in w. The target's
+ * barycentric coordinates are affine along the face, so each clipping plane
+ * is an affine function of w and x is never needed. */
+typedef struct face_polygon {
+    double w[CLIP_MAX][2];
     int count;
-} clip_polygon;
+} face_polygon;
+
+/* An affine function of w on a face: c[0] + c[1] w[0] + c[2] w[1]. */
+typedef struct face_affine {
+    double c[3];
+} face_affine;
+
+static inline double affine_at(const face_affine *f, const double w[2])
+{
+    return f->c[0] + f->c[1] * w[0] + f->c[2] * w[1];
+}
 
 /* The target's barycentric map: lambda_{1..3} = rows . (x - x0). */
 typedef struct bary_map {
@@ -79,75 +89,144 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
-/* Keeps the part of the polygon where lambda_k - lambda_j >= 0 (j < 0:
- * lambda_k >= 0) - Sutherland-Hodgman on an affine function. Returns the
- * clipped polygon: poly itself when the plane cuts nothing (most planes),
- * else spare, written (so the caller swaps buffers instead of copying). */
-static clip_polygon *clip_keep(clip_polygon *poly, clip_polygon *spare, int k, int j)
+/* How many of the polygon's vertices are inside the plane g >= 0. */
+static int plane_inside(const face_polygon *poly, const face_affine *g)
 {
-    int n = poly->count, inside = 0;
-    double g[CLIP_MAX];
-    for (int a = 0; a < n; a++) {
-        g[a] = poly->v[a].lambda[k] - (j >= 0 ? poly->v[a].lambda[j] : 0.0);
-        inside += g[a] >= 0;
-    }
-    if (inside == n) return poly;
-    clip_polygon *out = spare;
-    out->count = 0;
-    if (inside == 0) return out;
-    for (int a = 0; a < n; a++) {
-        const clip_vertex *p = &poly->v[a], *q = &poly->v[(a + 1) % n];
-        double gp = g[a], gq = g[(a + 1) % n];
-        if (gp >= 0 && out->count < CLIP_MAX) out->v[out->count++] = *p;
-        if ((gp >= 0) != (gq >= 0) && out->count < CLIP_MAX) {
-            double t = gp / (gp - gq);
-            clip_vertex *m = &out->v[out->count++];
-            for (int i = 0; i < 3; i++) m->x[i] = p->x[i] + t * (q->x[i] - p->x[i]);
-            for (int i = 0; i < 4; i++) m->lambda[i] = p->lambda[i] + t * (q->lambda[i] - p->lambda[i]);
-        }
-    }
-    return out;
+    int inside = 0;
+    for (int a = 0; a < poly->count; a++) inside += affine_at(g, poly->w[a]) >= 0;
+    return inside;
 }
 
-/* Integral of phi = 4 lambda_k over the polygon (*i0), its first moment
- * (i1) and its area (*area), by a fan from vertex 0. */
-static void polygon_integrals(const clip_polygon *poly, int k, double *i0, double i1[3],
-                              double *area_sum)
+/* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
+ * vertices in, some out) - Sutherland-Hodgman - in out. */
+static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
 {
+    int n = poly->count, count = 0;
+    double depth[CLIP_MAX];
+    for (int a = 0; a < n; a++) depth[a] = affine_at(g, poly->w[a]);
+    for (int a = 0; a < n; a++) {
+        int b = a + 1 < n ? a + 1 : 0;
+        const double *u = poly->w[a], *v = poly->w[b];
+        if (depth[a] >= 0 && count < CLIP_MAX) {
+            out->w[count][0] = u[0];
+            out->w[count][1] = u[1];
+            count++;
+        }
+        if ((depth[a] >= 0) != (depth[b] >= 0) && count < CLIP_MAX) {
+            double t = depth[a] / (depth[a] - depth[b]);
+            out->w[count][0] = u[0] + t * (v[0] - u[0]);
+            out->w[count][1] = u[1] + t * (v[1] - u[1]);
+            count++;
+        }
+    }
+    out->count = count;
+}
+
+/* Which of the planes cut the polygon (some vertices in, some out): into
+ * cut, returning how many, or -1 if one of them has it all outside. */
+static int planes_cutting(const face_polygon *poly, const face_affine *planes, int count,
+                          const face_affine **cut)
+{
+    int cuts = 0;
+    for (int c = 0; c < count; c++) {
+        int inside = plane_inside(poly, &planes[c]);
+        if (inside == 0) return -1;
+        if (inside < poly->count) cut[cuts++] = &planes[c];
+    }
+    return cuts;
+}
+
+/* The polygon cut by the planes in turn, in one of the two buffers (poly
+ * itself when there is none). */
+static const face_polygon *clip_all(const face_polygon *poly, const face_affine *const *planes,
+                                    int count, face_polygon buffers[2])
+{
+    for (int c = 0; c < count && poly->count >= 3; c++) {
+        face_polygon *out = poly == &buffers[0] ? &buffers[1] : &buffers[0];
+        clip_keep(poly, out, planes[c]);
+        poly = out;
+    }
+    return poly;
+}
+
+/* The integral over the polygon of phi (sums[0]), its first moment in w
+ * (sums[1], sums[2]) and the polygon's area (sums[3]), in units of twice
+ * the face's area (the face has area 1/2 in w), by a fan from vertex 0:
+ * integral f = A (f_a + f_b + f_c)/3 and integral f w = A/12 (sum f_i w_i +
+ * sum f_i sum w_i) on each triangle. A clipped triangle keeps its turn, so
+ * the signed areas of the fan's triangles are their areas. */
+static void polygon_integrals(const face_polygon *poly, const face_affine *phi_of,
+                              double sums[4])
+{
+    const double *o = poly->w[0];
+    double phi_o = affine_at(phi_of, o), phi_p = affine_at(phi_of, poly->w[1]);
     for (int a = 1; a + 1 < poly->count; a++) {
-        const clip_vertex *v[3] = {&poly->v[0], &poly->v[a], &poly->v[a + 1]};
-        double u[3], w[3], n[3];
-        vec3_sub(v[1]->x, v[0]->x, u);
-        vec3_sub(v[2]->x, v[0]->x, w);
-        vec3_cross(u, w, n);
-        double area = 0.5 * sqrt(vec3_dot(n, n));
-        *area_sum += area;
-        double phi[3] = {4 * v[0]->lambda[k], 4 * v[1]->lambda[k], 4 * v[2]->lambda[k]};
-        double sum_phi = phi[0] + phi[1] + phi[2];
-        *i0 += area * sum_phi / 3.0;
-        for (int i = 0; i < 3; i++) {
-            double sum_x = v[0]->x[i] + v[1]->x[i] + v[2]->x[i];
-            double mixed = phi[0] * v[0]->x[i] + phi[1] * v[1]->x[i] + phi[2] * v[2]->x[i];
-            i1[i] += area / 12.0 * (mixed + sum_phi * sum_x);
+        const double *p = poly->w[a], *q = poly->w[a + 1];
+        double phi_q = affine_at(phi_of, q);
+        double area = 0.5 * ((p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]));
+        double sum_phi = phi_o + phi_p + phi_q;
+        sums[0] += area * sum_phi / 3.0;
+        for (int i = 0; i < 2; i++) {
+            double sum_w = o[i] + p[i] + q[i];
+            double mixed = phi_o * o[i] + phi_p * p[i] + phi_q * q[i];
+            sums[1 + i] += area / 12.0 * (mixed + sum_phi * sum_w);
         }
+        sums[3] += area;
+        phi_p = phi_q;
     }
 }
 
-/* Barycentric coordinates of x (in the plane) on the triangle a, b, c. */
-static void face_weights(const double *a, const double *b, const double *c, const double x[3],
-                         double w[3])
+/* The face clipped to the target (lambda_f >= 0, given as affine functions
+ * on the face), then to each of its sub-tetrahedra k (lambda_j - lambda_k
+ * >= 0, j != k: where lambda_k is the smallest, phi_t = 4 lambda_k is
+ * linear), the integrals (polygon_integrals) summed over the pieces. Only
+ * planes that cut are clipped by: a sub-tetrahedron with the face's part
+ * all outside one of its planes is passed over at once, and most are. */
+static void face_clipped_integrals(const face_affine lambda[4], double sums[4])
 {
-    double ab[3], ac[3], ax[3], n[3], t[3];
-    vec3_sub(b, a, ab);
-    vec3_sub(c, a, ac);
-    vec3_sub(x, a, ax);
-    vec3_cross(ab, ac, n);
-    double n2 = vec3_dot(n, n);
-    vec3_cross(ax, ac, t);
-    w[1] = vec3_dot(t, n) / n2;
-    vec3_cross(ab, ax, t);
-    w[2] = vec3_dot(t, n) / n2;
-    w[0] = 1.0 - w[1] - w[2];
+    static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
+    face_polygon inside[2], piece[2];
+    const face_affine *cut[4];
+    int cuts = planes_cutting(&face, lambda, 4, cut);
+    if (cuts < 0) return;
+    const face_polygon *part = clip_all(&face, cut, cuts, inside);
+    if (part->count < 3) return;
+    for (int k = 0; k < 4; k++) {
+        face_affine sub[3], phi;
+        for (int j = 0, c = 0; j < 4; j++) {
+            if (j == k) continue;
+            for (int i = 0; i < 3; i++) sub[c].c[i] = lambda[j].c[i] - lambda[k].c[i];
+            c++;
+        }
+        cuts = planes_cutting(part, sub, 3, cut);
+        if (cuts < 0) continue;
+        const face_polygon *piece_k = clip_all(part, cut, cuts, piece);
+        if (piece_k->count < 3) continue;
+        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[k].c[i];
+        polygon_integrals(piece_k, &phi, sums);
+    }
+}
+
+/* The plane of a face (corners' coordinates la, lb, lc in the target)
+ * has all four of the target's corners strictly on one side: the face
+ * misses the target. In the coordinates (lambda_1, lambda_2, lambda_3) the
+ * target's corners are 0 and the unit vectors, and the map from x is
+ * affine, so the sides are the signs of c . (e_v - la), c = (lb - la) x
+ * (lc - la). */
+static int face_plane_separates(const double la[4], const double lb[4], const double lc[4])
+{
+    double u[3], v[3], c[3];
+    vec3_sub(lb + 1, la + 1, u);
+    vec3_sub(lc + 1, la + 1, v);
+    vec3_cross(u, v, c);
+    double s = vec3_dot(c, la + 1);
+    double side[4] = {-s, c[0] - s, c[1] - s, c[2] - s};
+    int above = 0, below = 0;
+    for (int v_ = 0; v_ < 4; v_++) {
+        above += side[v_] > 0;
+        below += side[v_] < 0;
+    }
+    return above == 4 || below == 4;
 }
 
 /* One contactor face inside the target's potential: where and how hard the
@@ -160,47 +239,37 @@ typedef struct face_touch {
     double lt[4];       /* and its barycentric coordinates in t */
 } face_touch;
 
-/* Some face plane of the target has all n points (their coordinates
- * lambda) outside: they miss it. Most candidate pairs end here. */
-static int outside_one_face(const double (*lambda)[4], const int *which, int n)
+/* Which face planes of the target a point (its coordinates lambda) is
+ * outside of: bit j for lambda_j < 0. Points whose masks share a bit all
+ * miss the target on that side - most candidate pairs end there - and the
+ * test is an AND, without a branch per coordinate. */
+static inline unsigned outside_mask(const double lambda[4])
 {
-    for (int j = 0; j < 4; j++) {
-        int out = 1;
-        for (int v = 0; v < n && out; v++) out = lambda[which[v]][j] < 0;
-        if (out) return 1;
-    }
-    return 0;
+    return (unsigned)(lambda[0] < 0) | (unsigned)(lambda[1] < 0) << 1 |
+           (unsigned)(lambda[2] < 0) << 2 | (unsigned)(lambda[3] < 0) << 3;
 }
 
 /* Face m (opposite contactor node m, whose corners have the coordinates
  * lambda in the target) clipped to the target: 1 and *ft if the potential
  * acts on it, 0 if not. */
-static int face_in_target(const double *const pc[4], const double (*lambda)[4], int m,
-                          const bary_map *bt, face_touch *ft)
+static int face_in_target(const double *const pc[4], const double (*lambda)[4],
+                          const unsigned outside[4], int m, face_touch *ft)
 {
     const int *fn = tet_face_nodes[m];
-    if (outside_one_face(lambda, fn, 3)) return 0;
+    if (outside[fn[0]] & outside[fn[1]] & outside[fn[2]]) return 0;
+    const double *la = lambda[fn[0]], *lb = lambda[fn[1]], *lc = lambda[fn[2]];
+    if (face_plane_separates(la, lb, lc)) return 0;
+    face_affine along[4]; /* the target's lambda_i along the face */
+    for (int i = 0; i < 4; i++) {
+        along[i].c[0] = la[i];
+        along[i].c[1] = lb[i] - la[i];
+        along[i].c[2] = lc[i] - la[i];
+    }
+    double sums[4] = {0, 0, 0, 0};
+    face_clipped_integrals(along, sums);
+    if (!(sums[0] > 0)) return 0;
+    /* outward normal of the face, away from node m; |n| is twice its area */
     const double *a = pc[fn[0]], *b = pc[fn[1]], *c = pc[fn[2]];
-    clip_polygon face;
-    face.count = 3;
-    for (int v = 0; v < 3; v++) {
-        memcpy(face.v[v].x, pc[fn[v]], sizeof face.v[v].x);
-        memcpy(face.v[v].lambda, lambda[fn[v]], sizeof face.v[v].lambda);
-    }
-    double i0 = 0, i1[3] = {0, 0, 0}, area = 0;
-    clip_polygon buffers[2];
-    for (int k = 0; k < 4; k++) {
-        /* the face itself until some plane cuts it; then two buffers in turn */
-        clip_polygon *poly = clip_keep(&face, &buffers[0], k, -1);
-        for (int j = 0; j < 4 && poly->count >= 3; j++) {
-            if (j == k) continue;
-            clip_polygon *spare = poly == &buffers[0] ? &buffers[1] : &buffers[0];
-            poly = clip_keep(poly, spare, j, k); /* lambda_j - lambda_k >= 0 */
-        }
-        if (poly->count >= 3) polygon_integrals(poly, k, &i0, i1, &area);
-    }
-    if (!(i0 > 0)) return 0;
-    /* outward unit normal of the face: away from node m */
     double ab[3], ac[3], n[3], am[3];
     vec3_sub(b, a, ab);
     vec3_sub(c, a, ac);
@@ -209,15 +278,16 @@ static int face_in_target(const double *const pc[4], const double (*lambda)[4], 
     double len = sqrt(vec3_dot(n, n));
     if (!(len > 0)) return 0;
     double sign = vec3_dot(n, am) > 0 ? -1.0 : 1.0;
-    double point[3];
-    for (int i = 0; i < 3; i++) {
-        point[i] = i1[i] / i0;
-        ft->normal[i] = sign * n[i] / len;
-    }
-    ft->i0 = i0;
-    ft->area = area;
-    face_weights(a, b, c, point, ft->wf);
-    bary_at(bt, point, ft->lt);
+    for (int i = 0; i < 3; i++) ft->normal[i] = sign * n[i] / len;
+    ft->i0 = len * sums[0];
+    ft->area = len * sums[3];
+    /* the point of action: its weights on the face, and in t (affine in w) */
+    double w1 = sums[1] / sums[0], w2 = sums[2] / sums[0];
+    ft->wf[0] = 1.0 - w1 - w2;
+    ft->wf[1] = w1;
+    ft->wf[2] = w2;
+    for (int i = 1; i < 4; i++) ft->lt[i] = ft->wf[0] * la[i] + w1 * lb[i] + w2 * lc[i];
+    ft->lt[0] = 1.0 - ft->lt[1] - ft->lt[2] - ft->lt[3];
     return 1;
 }
 
@@ -311,16 +381,19 @@ static double contact_one_way(const tet_frame *contactor, const tet_frame *targe
     const bary_map bt = target->bary;
     if (!bt.valid) return 0.0;
     double lambda[4][4];
-    static const int all[4] = {0, 1, 2, 3};
-    for (int v = 0; v < 4; v++) bary_at(&bt, pc[v], lambda[v]);
-    if (outside_one_face((const double (*)[4])lambda, all, 4)) {
+    unsigned outside[4];
+    for (int v = 0; v < 4; v++) {
+        bary_at(&bt, pc[v], lambda[v]);
+        outside[v] = outside_mask(lambda[v]);
+    }
+    if (outside[0] & outside[1] & outside[2] & outside[3]) {
         if (fr) memset(fr->springs, 0, 12 * sizeof(double));
         return 0.0;
     }
     double total = 0, k_n = 0; /* 4 p / h_t, once some face needs it */
     for (int m = 0; m < 4; m++) {
         face_touch ft;
-        if (!face_in_target(pc, (const double (*)[4])lambda, m, &bt, &ft)) {
+        if (!face_in_target(pc, (const double (*)[4])lambda, outside, m, &ft)) {
             if (fr) memset(fr->springs + 3 * m, 0, 3 * sizeof(double));
             continue;
         }
