@@ -137,35 +137,36 @@ static inline void element_box(const fdem_model *m, int e, double *b)
     else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
 
-/* The current box of every element in some candidate pair. Most candidate
- * pairs do not touch (their bounding circles, inflated by the buffer,
- * overlap; their elements do not): the box test then reads two boxes
- * instead of two element records and their scattered nodes. */
-static void contact_boxes(fdem_model *m)
+/* The current box of each listed element: those in some candidate pair
+ * when the near list is rebuilt, else those in some near pair. Most
+ * candidate pairs do not touch (their bounding circles, inflated by the
+ * buffer, overlap; their elements do not): the box test then reads two
+ * boxes instead of two element records and their scattered nodes. */
+static void contact_boxes(fdem_model *m, const int32_t *list, int count)
 {
-    contact_state *cs = &m->contact;
-    const int32_t *active = cs->active;
-    double *box = cs->box;
-    int count = cs->active_count;
+    double *box = m->contact.box;
     size_t width = 2 * (size_t)m->dim;
 #pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
     schedule(static)
-    for (int k = 0; k < count; k++) element_box(m, active[k], box + width * (size_t)active[k]);
+    for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
 }
 
-/* The elements of the candidate pairs, once each and in element order (so
- * that contact_boxes walks the mesh forwards), for contact_boxes. */
-static void contact_collect_active(contact_state *cs, int elem_count)
+/* The elements of the candidate pairs which (all of them when which is
+ * NULL), once each and in element order (so that contact_boxes walks the
+ * mesh forwards), into list; returns how many. */
+static int contact_collect_elements(contact_state *cs, int elem_count, const size_t *which,
+                                    size_t count, int32_t *list)
 {
     memset(cs->in_pair, 0, (size_t)elem_count);
-    for (size_t k = 0; k < cs->pairs.count; k++) {
+    for (size_t i = 0; i < count; i++) {
+        size_t k = which ? which[i] : i;
         cs->in_pair[cs->pairs.a[k]] = 1;
         cs->in_pair[cs->pairs.b[k]] = 1;
     }
-    int count = 0;
+    int listed = 0;
     for (int e = 0; e < elem_count; e++)
-        if (cs->in_pair[e]) cs->active[count++] = e;
-    cs->active_count = count;
+        if (cs->in_pair[e]) list[listed++] = e;
+    return listed;
 }
 
 /* The widest gap between two boxes along an axis (negative: they overlap
@@ -201,17 +202,19 @@ static double near_moved2(const fdem_model *m)
     return moved2;
 }
 
-/* The near list (see the top of this file) from this step's boxes, if a
- * detection or a restore made it stale or some node has gone past its
- * reach since it was built. Returns 0, or -1 when out of memory. */
-static int contact_near_refresh(fdem_model *m)
+/* The near list is to be rebuilt: a detection or a restore made it stale,
+ * or some node has gone past its reach since it was built. */
+static int contact_near_due(const fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    return cs->near_stale || near_moved2(m) > cs->near_reach * cs->near_reach;
+}
+
+/* The near list (see the top of this file) and its elements from this
+ * step's boxes. Returns 0, or -1 when out of memory. */
+static int contact_near_rebuild(fdem_model *m)
 {
     contact_state *cs = &m->contact;
-    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
-        cs->near_count = 0;
-        return 0;
-    }
-    if (!cs->near_stale && near_moved2(m) <= cs->near_reach * cs->near_reach) return 0;
     if (cs->near_capacity < cs->pairs.count) {
         size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
         if (!n) return -1;
@@ -234,7 +237,27 @@ static int contact_near_refresh(fdem_model *m)
     cs->near_count = count;
     cs->near_reach = reach;
     cs->near_stale = 0;
+    cs->near_active_count =
+        contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
     return 0;
+}
+
+/* This step's boxes of the elements the near list needs, the list rebuilt
+ * first when due (from the boxes of every candidate pair's elements).
+ * Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
+        cs->near_count = 0;
+        return 0;
+    }
+    if (!contact_near_due(m)) {
+        contact_boxes(m, cs->near_active, cs->near_active_count);
+        return 0;
+    }
+    contact_boxes(m, cs->active, cs->active_count);
+    return contact_near_rebuild(m);
 }
 
 /* Force between two elements whose boxes overlap, both roles, into out
@@ -387,7 +410,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     if (failed) return -1;
     if (m->joint_count) contact_drop_joined(m);
     if (contact_history_take_back(cs)) return -1;
-    contact_collect_active(cs, m->elem_count);
+    cs->active_count = contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, cs->active);
     if (pos != cs->pos_detect)
         memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
@@ -445,9 +468,11 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->force_is_zero = 1;
     cs->box = malloc(sizeof(double) * 2 * D * E);
     cs->active = malloc(sizeof(int32_t) * E);
+    cs->near_active = malloc(sizeof(int32_t) * E);
     cs->in_pair = malloc(E);
     if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
-        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->in_pair) {
+        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active ||
+        !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -472,7 +497,7 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
-    free(cs->box); free(cs->active); free(cs->in_pair); free(cs->near);
+    free(cs->box); free(cs->active); free(cs->near_active); free(cs->in_pair); free(cs->near);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
@@ -670,7 +695,6 @@ int contact_forces(fdem_model *m)
     if (!cs->force_is_zero)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
-    if (cs->pairs.count) contact_boxes(m);
     if (contact_near_refresh(m)) return -1;
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
