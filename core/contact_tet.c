@@ -32,7 +32,10 @@
 
 #include "vec3.h"
 
-#define CLIP_MAX 12 /* a triangle clipped by 7 planes has at most 10 vertices */
+/* A cut adds at most one vertex: the face's triangle cut by the target's 4
+ * face planes, then split by at most 3 sub-tetrahedron planes, has at most
+ * 10. */
+#define CLIP_MAX 12
 
 /* A polygon on a contactor face, its vertices given by w, their weights on
  * the face's second and third corners (the first corner's is 1 - w[0] -
@@ -107,12 +110,12 @@ static void clip_keep(const face_polygon *poly, face_polygon *out, const face_af
     for (int a = 0; a < n; a++) {
         int b = a + 1 < n ? a + 1 : 0;
         const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0 && count < CLIP_MAX) {
+        if (depth[a] >= 0) {
             out->w[count][0] = u[0];
             out->w[count][1] = u[1];
             count++;
         }
-        if ((depth[a] >= 0) != (depth[b] >= 0) && count < CLIP_MAX) {
+        if ((depth[a] >= 0) != (depth[b] >= 0)) {
             double t = depth[a] / (depth[a] - depth[b]);
             out->w[count][0] = u[0] + t * (v[0] - u[0]);
             out->w[count][1] = u[1] + t * (v[1] - u[1]);
@@ -120,6 +123,38 @@ static void clip_keep(const face_polygon *poly, face_polygon *out, const face_af
         }
     }
     out->count = count;
+}
+
+/* Splits the polygon, with the depths of its vertices below a plane, into
+ * the parts above (depth >= 0) and below (depth <= 0) it, in one pass. */
+static void split_by(const face_polygon *poly, const double *depth, face_polygon *above,
+                     face_polygon *below)
+{
+    int n = poly->count, na = 0, nb = 0;
+    for (int a = 0; a < n; a++) {
+        int b = a + 1 < n ? a + 1 : 0;
+        const double *u = poly->w[a], *v = poly->w[b];
+        if (depth[a] >= 0) {
+            above->w[na][0] = u[0];
+            above->w[na][1] = u[1];
+            na++;
+        }
+        if (depth[a] <= 0) {
+            below->w[nb][0] = u[0];
+            below->w[nb][1] = u[1];
+            nb++;
+        }
+        if ((depth[a] > 0 && depth[b] < 0) || (depth[a] < 0 && depth[b] > 0)) {
+            double t = depth[a] / (depth[a] - depth[b]);
+            double x = u[0] + t * (v[0] - u[0]), y = u[1] + t * (v[1] - u[1]);
+            above->w[na][0] = below->w[nb][0] = x;
+            above->w[na][1] = below->w[nb][1] = y;
+            na++;
+            nb++;
+        }
+    }
+    above->count = na;
+    below->count = nb;
 }
 
 /* Which of the planes cut the polygon (some vertices in, some out): into
@@ -176,35 +211,66 @@ static void polygon_integrals(const face_polygon *poly, const face_affine *phi_o
     }
 }
 
+/* The candidates but the one at skip. */
+static int candidates_but(const int *cand, int count, int skip, int *rest)
+{
+    int kept = 0;
+    for (int c = 0; c < count; c++)
+        if (c != skip) rest[kept++] = cand[c];
+    return kept;
+}
+
+/* Adds to sums the integrals (polygon_integrals) of phi_t = 4 min lambda_k
+ * over the polygon, k among the candidates. phi_t is linear only where one
+ * lambda_k is the smallest (sub-tetrahedron k), so the polygon is split
+ * where two candidates i, j are equal: above lambda_i - lambda_j = 0, i is
+ * never the smallest, below j is not. A polygon on one side (most) is not
+ * cut, and the split yields both sides in one pass. */
+static void integrate_min(const face_polygon *poly, const face_affine lambda[4], const int *cand,
+                          int count, double sums[4])
+{
+    if (count == 1) {
+        face_affine phi;
+        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[cand[0]].c[i];
+        polygon_integrals(poly, &phi, sums);
+        return;
+    }
+    face_affine g;
+    for (int i = 0; i < 3; i++) g.c[i] = lambda[cand[0]].c[i] - lambda[cand[1]].c[i];
+    double depth[CLIP_MAX];
+    int above = 0, below = 0;
+    for (int a = 0; a < poly->count; a++) {
+        depth[a] = affine_at(&g, poly->w[a]);
+        above += depth[a] > 0;
+        below += depth[a] < 0;
+    }
+    int rest[3] = {0, 0, 0};
+    if (below == 0 || above == 0) { /* drop i (all above) or j (all below) */
+        int kept = candidates_but(cand, count, below == 0 ? 0 : 1, rest);
+        integrate_min(poly, lambda, rest, kept, sums);
+        return;
+    }
+    face_polygon part_above, part_below;
+    split_by(poly, depth, &part_above, &part_below);
+    int kept = candidates_but(cand, count, 0, rest);
+    if (part_above.count >= 3) integrate_min(&part_above, lambda, rest, kept, sums);
+    kept = candidates_but(cand, count, 1, rest);
+    if (part_below.count >= 3) integrate_min(&part_below, lambda, rest, kept, sums);
+}
+
 /* The face clipped to the target (lambda_f >= 0, given as affine functions
- * on the face), then to each of its sub-tetrahedra k (lambda_j - lambda_k
- * >= 0, j != k: where lambda_k is the smallest, phi_t = 4 lambda_k is
- * linear), the integrals (polygon_integrals) summed over the pieces. Only
- * planes that cut are clipped by: a sub-tetrahedron with the face's part
- * all outside one of its planes is passed over at once, and most are. */
+ * on the face; only by the planes that cut it), then the integrals of
+ * phi_t over it (integrate_min). */
 static void face_clipped_integrals(const face_affine lambda[4], double sums[4])
 {
     static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
-    face_polygon inside[2], piece[2];
+    static const int all[4] = {0, 1, 2, 3};
+    face_polygon inside[2];
     const face_affine *cut[4];
     int cuts = planes_cutting(&face, lambda, 4, cut);
     if (cuts < 0) return;
     const face_polygon *part = clip_all(&face, cut, cuts, inside);
-    if (part->count < 3) return;
-    for (int k = 0; k < 4; k++) {
-        face_affine sub[3], phi;
-        for (int j = 0, c = 0; j < 4; j++) {
-            if (j == k) continue;
-            for (int i = 0; i < 3; i++) sub[c].c[i] = lambda[j].c[i] - lambda[k].c[i];
-            c++;
-        }
-        cuts = planes_cutting(part, sub, 3, cut);
-        if (cuts < 0) continue;
-        const face_polygon *piece_k = clip_all(part, cut, cuts, piece);
-        if (piece_k->count < 3) continue;
-        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[k].c[i];
-        polygon_integrals(piece_k, &phi, sums);
-    }
+    if (part->count >= 3) integrate_min(part, lambda, all, 4, sums);
 }
 
 /* The plane of a face (corners' coordinates la, lb, lc in the target)
@@ -372,35 +438,43 @@ static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
     t->bary = bary_of(t->p);
 }
 
-/* One way, with friction when fr is not NULL (a face that does not touch
- * lets its spring go). */
-static double contact_one_way(const tet_frame *contactor, const tet_frame *target,
-                              double penalty, tet_friction *fr, double f_c[12], double f_t[12])
-{
-    const double *const *pc = contactor->p, *const *pt = target->p;
-    const bary_map bt = target->bary;
-    if (!bt.valid) return 0.0;
+/* A contactor's corners in the target: their barycentric coordinates and
+ * outside masks (outside_mask). */
+typedef struct corners_in {
     double lambda[4][4];
     unsigned outside[4];
+} corners_in;
+
+/* The contactor's corners in the target; 1 if they are all outside one of
+ * its face planes: that plane separates the two, no face of either touches
+ * the other, both ways. */
+static int corners_in_target(const tet_frame *contactor, const tet_frame *target, corners_in *ci)
+{
     for (int v = 0; v < 4; v++) {
-        bary_at(&bt, pc[v], lambda[v]);
-        outside[v] = outside_mask(lambda[v]);
+        bary_at(&target->bary, contactor->p[v], ci->lambda[v]);
+        ci->outside[v] = outside_mask(ci->lambda[v]);
     }
-    if (outside[0] & outside[1] & outside[2] & outside[3]) {
-        if (fr) memset(fr->springs, 0, 12 * sizeof(double));
-        return 0.0;
-    }
+    return (ci->outside[0] & ci->outside[1] & ci->outside[2] & ci->outside[3]) != 0;
+}
+
+/* One way, the contactor's corners in the target given, with friction when
+ * fr is not NULL (a face that does not touch lets its spring go). */
+static double contact_one_way(const tet_frame *contactor, const tet_frame *target,
+                              const corners_in *ci, double penalty, tet_friction *fr,
+                              double f_c[12], double f_t[12])
+{
+    const double *const *pc = contactor->p, *const *pt = target->p;
     double total = 0, k_n = 0; /* 4 p / h_t, once some face needs it */
     for (int m = 0; m < 4; m++) {
         face_touch ft;
-        if (!face_in_target(pc, (const double (*)[4])lambda, outside, m, &ft)) {
+        if (!face_in_target(pc, (const double (*)[4])ci->lambda, ci->outside, m, &ft)) {
             if (fr) memset(fr->springs + 3 * m, 0, 3 * sizeof(double));
             continue;
         }
         double f_n = penalty * ft.i0, force[3];
         for (int i = 0; i < 3; i++) force[i] = -f_n * ft.normal[i];
         if (fr && fr->mu > 0 && ft.area > 0) {
-            if (k_n == 0) k_n = 4 * penalty / tet_smallest_height_now(pt, bt.det);
+            if (k_n == 0) k_n = 4 * penalty / tet_smallest_height_now(pt, target->bary.det);
             face_friction(&ft, m, k_n, f_n, fr, force);
         } else if (fr) {
             memset(fr->springs + 3 * m, 0, 3 * sizeof(double));
@@ -418,7 +492,9 @@ double tet_contact_one_way(const double *pos, const int32_t contactor[4],
     tet_frame c, t;
     tet_frame_of(pos, contactor, &c);
     tet_frame_of(pos, target, &t);
-    return contact_one_way(&c, &t, penalty, NULL, f_c, f_t);
+    corners_in ci;
+    if (!t.bary.valid || corners_in_target(&c, &t, &ci)) return 0.0;
+    return contact_one_way(&c, &t, &ci, penalty, NULL, f_c, f_t);
 }
 
 double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4],
@@ -435,8 +511,11 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     tet_frame a, b;
     tet_frame_of(in->pos, in->node_a, &a);
     tet_frame_of(in->pos, in->node_b, &b);
-    if (!(a.bary.valid && a.bary.det > 0) || !(b.bary.valid && b.bary.det > 0)) {
-        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS); /* inverted: no potential */
+    corners_in a_in_b, b_in_a;
+    /* inverted: no potential; a face plane of either apart: no touch */
+    if (!(a.bary.valid && a.bary.det > 0) || !(b.bary.valid && b.bary.det > 0) ||
+        corners_in_target(&a, &b, &a_in_b) || corners_in_target(&b, &a, &b_in_a)) {
+        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
         return 0;
     }
     for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
@@ -444,7 +523,7 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     tet_friction ab = {in->vel, in->node_a, in->node_b, in->friction, in->h, springs, dissipated};
     tet_friction ba = {in->vel, in->node_b, in->node_a, in->friction, in->h,
                        springs + TET_CONTACT_SLOTS / 2, dissipated};
-    double touched = contact_one_way(&a, &b, in->penalty, &ab, out, out + 12);
-    touched += contact_one_way(&b, &a, in->penalty, &ba, out + 12, out);
+    double touched = contact_one_way(&a, &b, &a_in_b, in->penalty, &ab, out, out + 12);
+    touched += contact_one_way(&b, &a, &b_in_a, in->penalty, &ba, out + 12, out);
     return touched > 0;
 }
