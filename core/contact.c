@@ -151,6 +151,23 @@ static void contact_boxes(fdem_model *m, const int32_t *list, int count)
     for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
 }
 
+/* The same for the near pairs' elements whose boxes can touch another's:
+ * an element whose every near pair had a gap over near_apart keeps its
+ * box from before, which no pair reads (pair_evaluate). */
+static void contact_near_boxes(fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    const int32_t *list = cs->near_active;
+    const double *elem_gap = cs->elem_gap;
+    double *box = cs->box, apart = cs->near_apart;
+    size_t width = 2 * (size_t)m->dim;
+    int count = cs->near_active_count;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++)
+        if (elem_gap[list[k]] <= apart) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
 /* The elements of the candidate pairs which (all of them when which is
  * NULL), once each and in element order (so that contact_boxes walks the
  * mesh forwards), into list; returns how many. */
@@ -204,10 +221,17 @@ static double near_moved2(const fdem_model *m)
 
 /* The near list is to be rebuilt: a detection or a restore made it stale,
  * or some node has gone past its reach since it was built. */
-static int contact_near_due(const fdem_model *m)
+static int contact_near_due(fdem_model *m)
 {
-    const contact_state *cs = &m->contact;
-    return cs->near_stale || near_moved2(m) > cs->near_reach * cs->near_reach;
+    contact_state *cs = &m->contact;
+    if (cs->near_stale) return 1;
+    double moved2 = near_moved2(m);
+    if (moved2 > cs->near_reach * cs->near_reach) return 1;
+    /* boxes move by no more than their nodes: a gap over twice the
+     * farthest travel since the list was built is still open (a hair over
+     * it, for rounding) */
+    cs->near_apart = 2.0 * sqrt(moved2) * (1 + 1e-9);
+    return 0;
 }
 
 /* The near list (see the top of this file) and its elements from this
@@ -219,6 +243,9 @@ static int contact_near_rebuild(fdem_model *m)
         size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
         if (!n) return -1;
         cs->near = n;
+        double *g = realloc(cs->near_gap, sizeof *g * cs->pairs.count);
+        if (!g) return -1;
+        cs->near_gap = g;
         cs->near_capacity = cs->pairs.count;
     }
     double reach = NEAR_REACH_STEP * cs->buffer;
@@ -227,15 +254,23 @@ static int contact_near_rebuild(fdem_model *m)
     double limit = 2.0 * reach * (1 + 1e-9);
     int dim = m->dim;
     size_t width = 2 * (size_t)dim, count = 0;
+    for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        const double *a = cs->box + width * (size_t)cs->pairs.a[k];
-        const double *b = cs->box + width * (size_t)cs->pairs.b[k];
-        if (boxes_gap(a, b, dim) <= limit) cs->near[count++] = k;
-        else contact_springs_release(cs, k); /* apart now and until the next rebuild */
+        int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
+        double gap = boxes_gap(cs->box + width * (size_t)ea, cs->box + width * (size_t)eb, dim);
+        if (gap > limit) {
+            contact_springs_release(cs, k); /* apart now and until the next rebuild */
+            continue;
+        }
+        cs->near[count] = k;
+        cs->near_gap[count++] = gap;
+        cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
+        cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }
     memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_count = count;
     cs->near_reach = reach;
+    cs->near_apart = 0;
     cs->near_stale = 0;
     cs->near_active_count =
         contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
@@ -253,7 +288,7 @@ static int contact_near_refresh(fdem_model *m)
         return 0;
     }
     if (!contact_near_due(m)) {
-        contact_boxes(m, cs->near_active, cs->near_active_count);
+        contact_near_boxes(m);
         return 0;
     }
     contact_boxes(m, cs->active, cs->active_count);
@@ -308,15 +343,21 @@ enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
  * whether fresh is to be adopted or the pair's set let go. D is a
  * constant where it is called, so each dimension's walk is compiled on
  * its own with the box and spring loops unrolled. */
-static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t k, double h,
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t i, double h,
                                                                double *out, double *fresh,
                                                                int *pool, int D)
 {
     contact_state *cs = &m->contact;
     const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
     const size_t width = 2 * (size_t)D;
-    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k], set = cs->spring_of[k];
+    size_t k = cs->near[i];
+    int32_t set = cs->spring_of[k];
     *pool = SPRINGS_KEPT;
+    if (cs->near_gap[i] > cs->near_apart) { /* apart, boxes not even computed */
+        if (set >= 0) *pool = SPRINGS_RELEASE;
+        return -1;
+    }
+    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
     if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
         if (set >= 0) *pool = SPRINGS_RELEASE;
         return -1;
@@ -469,9 +510,10 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->box = malloc(sizeof(double) * 2 * D * E);
     cs->active = malloc(sizeof(int32_t) * E);
     cs->near_active = malloc(sizeof(int32_t) * E);
+    cs->elem_gap = malloc(sizeof(double) * E);
     cs->in_pair = malloc(E);
     if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
-        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active ||
+        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active || !cs->elem_gap ||
         !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
@@ -497,7 +539,8 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
-    free(cs->box); free(cs->active); free(cs->near_active); free(cs->in_pair); free(cs->near);
+    free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
+    free(cs->near); free(cs->near_gap);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
@@ -545,7 +588,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->pair_capacity * sizeof(int32_t);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
-    b += cs->near_capacity * sizeof(size_t);
+    b += cs->near_capacity * (sizeof(size_t) + sizeof(double));
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -576,7 +619,7 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
     for (size_t i = 0; i < cs->near_count; i++) {
         size_t k = cs->near[i];
         double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, k, h, out, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, i, h, out, fresh, &pool, D);
         if (pool == SPRINGS_RELEASE) contact_springs_release(cs, k);
         else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, k, fresh)) return -1;
         if (touched <= 0) continue;
@@ -606,7 +649,7 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     for (long i = begin; i < end; i++) {
         long k = (long)cs->near[i];
         double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, (size_t)k, h, force, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, (size_t)i, h, force, fresh, &pool, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
         if (touched <= 0) continue;
