@@ -92,14 +92,6 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
-/* How many of the polygon's vertices are inside the plane g >= 0. */
-static int plane_inside(const face_polygon *poly, const face_affine *g)
-{
-    int inside = 0;
-    for (int a = 0; a < poly->count; a++) inside += affine_at(g, poly->w[a]) >= 0;
-    return inside;
-}
-
 /* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
  * vertices in, some out) - Sutherland-Hodgman - in out. */
 static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
@@ -155,20 +147,6 @@ static void split_by(const face_polygon *poly, const double *depth, face_polygon
     }
     above->count = na;
     below->count = nb;
-}
-
-/* Which of the planes cut the polygon (some vertices in, some out): into
- * cut, returning how many, or -1 if one of them has it all outside. */
-static int planes_cutting(const face_polygon *poly, const face_affine *planes, int count,
-                          const face_affine **cut)
-{
-    int cuts = 0;
-    for (int c = 0; c < count; c++) {
-        int inside = plane_inside(poly, &planes[c]);
-        if (inside == 0) return -1;
-        if (inside < poly->count) cut[cuts++] = &planes[c];
-    }
-    return cuts;
 }
 
 /* The polygon cut by the planes in turn, in one of the two buffers (poly
@@ -259,16 +237,20 @@ static void integrate_min(const face_polygon *poly, const face_affine lambda[4],
 }
 
 /* The face clipped to the target (lambda_f >= 0, given as affine functions
- * on the face; only by the planes that cut it), then the integrals of
- * phi_t over it (integrate_min). */
-static void face_clipped_integrals(const face_affine lambda[4], double sums[4])
+ * on the face), then the integrals of phi_t over it (integrate_min). The
+ * planes that cut the face's triangle are those its corners' outside masks
+ * (outside_mask) name: one corner outside is enough, all three never are
+ * (face_in_target has let the face go then). */
+static void face_clipped_integrals(const face_affine lambda[4], unsigned corners_outside,
+                                   double sums[4])
 {
     static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
     static const int all[4] = {0, 1, 2, 3};
     face_polygon inside[2];
     const face_affine *cut[4];
-    int cuts = planes_cutting(&face, lambda, 4, cut);
-    if (cuts < 0) return;
+    int cuts = 0;
+    for (int f = 0; f < 4; f++)
+        if (corners_outside & 1u << f) cut[cuts++] = &lambda[f];
     const face_polygon *part = clip_all(&face, cut, cuts, inside);
     if (part->count >= 3) integrate_min(part, lambda, all, 4, sums);
 }
@@ -332,7 +314,7 @@ static int face_in_target(const double *const pc[4], const double (*lambda)[4],
         along[i].c[2] = lc[i] - la[i];
     }
     double sums[4] = {0, 0, 0, 0};
-    face_clipped_integrals(along, sums);
+    face_clipped_integrals(along, outside[fn[0]] | outside[fn[1]] | outside[fn[2]], sums);
     if (!(sums[0] > 0)) return 0;
     /* outward normal of the face, away from node m; |n| is twice its area */
     const double *a = pc[fn[0]], *b = pc[fn[1]], *c = pc[fn[2]];
