@@ -414,9 +414,14 @@ typedef struct tet_frame {
     bary_map bary;
 } tet_frame;
 
-static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
+static void tet_corners_of(const double *pos, const int32_t n[4], tet_frame *t)
 {
     for (int v = 0; v < 4; v++) t->p[v] = pos + 3 * (size_t)n[v];
+}
+
+static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
+{
+    tet_corners_of(pos, n, t);
     t->bary = bary_of(t->p);
 }
 
@@ -491,12 +496,21 @@ double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tet_frame a, b;
-    tet_frame_of(in->pos, in->node_a, &a);
-    tet_frame_of(in->pos, in->node_b, &b);
     corners_in a_in_b, b_in_a;
-    /* inverted: no potential; a face plane of either apart: no touch */
-    if (!(a.bary.valid && a.bary.det > 0) || !(b.bary.valid && b.bary.det > 0) ||
-        corners_in_target(&a, &b, &a_in_b) || corners_in_target(&b, &a, &b_in_a)) {
+    /* inverted: no potential; a face plane of either apart: no touch. b's
+     * map first, so that most pairs, apart by one of b's faces, never need
+     * a's. */
+    tet_frame_of(in->pos, in->node_b, &b);
+    int apart = !(b.bary.valid && b.bary.det > 0);
+    if (!apart) {
+        tet_corners_of(in->pos, in->node_a, &a);
+        apart = corners_in_target(&a, &b, &a_in_b);
+    }
+    if (!apart) {
+        a.bary = bary_of(a.p);
+        apart = !(a.bary.valid && a.bary.det > 0) || corners_in_target(&b, &a, &b_in_a);
+    }
+    if (apart) {
         memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
         return 0;
     }
