@@ -17,13 +17,16 @@
  * Most candidate pairs are far from touching (coarse tetrahedra have loose
  * bounding spheres: a sphere pile has ~25 candidates per element and well
  * under one touching), so the per-step walk takes only the "near" pairs:
- * no node has moved more than d = sqrt(max_disp2) since detection, so two
- * boxes with a gap g at some step cannot overlap while every node stays
- * within reach r of its detection place, if g > 2 (d + r). The near list
- * holds the other pairs, in pair order, and is rebuilt when d passes r;
+ * when the list is built every node's place is kept (pos_near), and two
+ * boxes with a gap g then cannot overlap while no node is farther than r
+ * from its kept place, if g > 2 r. The near list holds the other pairs,
+ * in pair order, with their gaps, and is rebuilt when some node passes r;
  * a pair it leaves out has its boxes apart now and until then, exactly
  * what the box test would have found, so its springs go at the rebuild as
  * they would have gone that step: the same bits as walking every pair.
+ * In the same way a near pair whose gap is over twice the farthest travel
+ * so far is apart without a look at its boxes, and only elements with such
+ * a pair closing get their box computed.
  *
  * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
  * dimension's count of slots each (cs->slots), across steps, detections and

@@ -1,14 +1,20 @@
 /*
  * contact_tet.c - potential contact between tetrahedra (contact_tet.h).
  *
- * Per contactor face the face triangle is clipped, in the target's
- * barycentric coordinates, to each sub-tetrahedron k of the target: the
- * region lambda_k >= 0 and lambda_j >= lambda_k (j != k), where phi_t =
- * 4 lambda_k is linear. The clipping carries lambda with each polygon
- * vertex (lambda is affine, so it interpolates exactly along a clipped
- * edge), and the integral of the linear phi over the polygon and its first
- * moment are exact fan sums: integral f = A (f_a + f_b + f_c)/3 and
- * integral f x = A/12 (sum f_i x_i + sum f_i sum x_i) on each triangle.
+ * Per contactor face the face triangle is clipped to the target and the
+ * target's phi_t = 4 min_k lambda_k integrated over what is left, in the
+ * face's own weights w (the face is the triangle (0,0), (1,0), (0,1)):
+ * lambda is affine along the face, so every plane is an affine function of
+ * w, a polygon vertex is two numbers, and the point of action comes out as
+ * weights on the face's nodes. phi_t is linear only on a sub-tetrahedron
+ * (lambda_k the smallest), so the clipped face is split where two
+ * candidate lambdas are equal until one candidate is left on each piece;
+ * on a piece the integral of the linear phi and its first moment are exact
+ * fan sums: integral f = A (f_a + f_b + f_c)/3 and integral f w = A/12
+ * (sum f_i w_i + sum f_i sum w_i) on each triangle. Most faces never get
+ * that far: cheap separating planes (a face plane of either tetrahedron
+ * with the other's corners all outside it, the face's own plane with the
+ * target's corners all on one side) end them first.
  *
  * It is also the tetrahedron pair kernel of the contact stage
  * (contact_pair.h), with Coulomb friction the way contact_tri.c has it for
@@ -92,29 +98,31 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
+/* Appends the vertex (x, y) to the polygon. */
+static inline void polygon_add(face_polygon *poly, double x, double y)
+{
+    poly->w[poly->count][0] = x;
+    poly->w[poly->count][1] = y;
+    poly->count++;
+}
+
 /* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
  * vertices in, some out) - Sutherland-Hodgman - in out. */
 static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
 {
-    int n = poly->count, count = 0;
+    int n = poly->count;
     double depth[CLIP_MAX];
     for (int a = 0; a < n; a++) depth[a] = affine_at(g, poly->w[a]);
+    out->count = 0;
     for (int a = 0; a < n; a++) {
         int b = a + 1 < n ? a + 1 : 0;
         const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) {
-            out->w[count][0] = u[0];
-            out->w[count][1] = u[1];
-            count++;
-        }
+        if (depth[a] >= 0) polygon_add(out, u[0], u[1]);
         if ((depth[a] >= 0) != (depth[b] >= 0)) {
             double t = depth[a] / (depth[a] - depth[b]);
-            out->w[count][0] = u[0] + t * (v[0] - u[0]);
-            out->w[count][1] = u[1] + t * (v[1] - u[1]);
-            count++;
+            polygon_add(out, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
         }
     }
-    out->count = count;
 }
 
 /* Splits the polygon, with the depths of its vertices below a plane, into
@@ -122,31 +130,20 @@ static void clip_keep(const face_polygon *poly, face_polygon *out, const face_af
 static void split_by(const face_polygon *poly, const double *depth, face_polygon *above,
                      face_polygon *below)
 {
-    int n = poly->count, na = 0, nb = 0;
+    int n = poly->count;
+    above->count = below->count = 0;
     for (int a = 0; a < n; a++) {
         int b = a + 1 < n ? a + 1 : 0;
         const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) {
-            above->w[na][0] = u[0];
-            above->w[na][1] = u[1];
-            na++;
-        }
-        if (depth[a] <= 0) {
-            below->w[nb][0] = u[0];
-            below->w[nb][1] = u[1];
-            nb++;
-        }
+        if (depth[a] >= 0) polygon_add(above, u[0], u[1]);
+        if (depth[a] <= 0) polygon_add(below, u[0], u[1]);
         if ((depth[a] > 0 && depth[b] < 0) || (depth[a] < 0 && depth[b] > 0)) {
             double t = depth[a] / (depth[a] - depth[b]);
             double x = u[0] + t * (v[0] - u[0]), y = u[1] + t * (v[1] - u[1]);
-            above->w[na][0] = below->w[nb][0] = x;
-            above->w[na][1] = below->w[nb][1] = y;
-            na++;
-            nb++;
+            polygon_add(above, x, y);
+            polygon_add(below, x, y);
         }
     }
-    above->count = na;
-    below->count = nb;
 }
 
 /* The polygon cut by the planes in turn, in one of the two buffers (poly
