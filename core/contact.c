@@ -17,13 +17,16 @@
  * Most candidate pairs are far from touching (coarse tetrahedra have loose
  * bounding spheres: a sphere pile has ~25 candidates per element and well
  * under one touching), so the per-step walk takes only the "near" pairs:
- * no node has moved more than d = sqrt(max_disp2) since detection, so two
- * boxes with a gap g at some step cannot overlap while every node stays
- * within reach r of its detection place, if g > 2 (d + r). The near list
- * holds the other pairs, in pair order, and is rebuilt when d passes r;
+ * when the list is built every node's place is kept (pos_near), and two
+ * boxes with a gap g then cannot overlap while no node is farther than r
+ * from its kept place, if g > 2 r. The near list holds the other pairs,
+ * in pair order, with their gaps, and is rebuilt when some node passes r;
  * a pair it leaves out has its boxes apart now and until then, exactly
  * what the box test would have found, so its springs go at the rebuild as
  * they would have gone that step: the same bits as walking every pair.
+ * In the same way a near pair whose gap is over twice the farthest travel
+ * so far is apart without a look at its boxes, and only elements with such
+ * a pair closing get their box computed.
  *
  * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
  * dimension's count of slots each (cs->slots), across steps, detections and
@@ -137,35 +140,53 @@ static inline void element_box(const fdem_model *m, int e, double *b)
     else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
 
-/* The current box of every element in some candidate pair. Most candidate
- * pairs do not touch (their bounding circles, inflated by the buffer,
- * overlap; their elements do not): the box test then reads two boxes
- * instead of two element records and their scattered nodes. */
-static void contact_boxes(fdem_model *m)
+/* The current box of each listed element: those in some candidate pair
+ * when the near list is rebuilt, else those in some near pair. Most
+ * candidate pairs do not touch (their bounding circles, inflated by the
+ * buffer, overlap; their elements do not): the box test then reads two
+ * boxes instead of two element records and their scattered nodes. */
+static void contact_boxes(fdem_model *m, const int32_t *list, int count)
 {
-    contact_state *cs = &m->contact;
-    const int32_t *active = cs->active;
-    double *box = cs->box;
-    int count = cs->active_count;
+    double *box = m->contact.box;
     size_t width = 2 * (size_t)m->dim;
 #pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
     schedule(static)
-    for (int k = 0; k < count; k++) element_box(m, active[k], box + width * (size_t)active[k]);
+    for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
 }
 
-/* The elements of the candidate pairs, once each and in element order (so
- * that contact_boxes walks the mesh forwards), for contact_boxes. */
-static void contact_collect_active(contact_state *cs, int elem_count)
+/* The same for the near pairs' elements whose boxes can touch another's:
+ * an element whose every near pair had a gap over near_apart keeps its
+ * box from before, which no pair reads (pair_evaluate). */
+static void contact_near_boxes(fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    const int32_t *list = cs->near_active;
+    const double *elem_gap = cs->elem_gap;
+    double *box = cs->box, apart = cs->near_apart;
+    size_t width = 2 * (size_t)m->dim;
+    int count = cs->near_active_count;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++)
+        if (elem_gap[list[k]] <= apart) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
+/* The elements of the candidate pairs which (all of them when which is
+ * NULL), once each and in element order (so that contact_boxes walks the
+ * mesh forwards), into list; returns how many. */
+static int contact_collect_elements(contact_state *cs, int elem_count, const size_t *which,
+                                    size_t count, int32_t *list)
 {
     memset(cs->in_pair, 0, (size_t)elem_count);
-    for (size_t k = 0; k < cs->pairs.count; k++) {
+    for (size_t i = 0; i < count; i++) {
+        size_t k = which ? which[i] : i;
         cs->in_pair[cs->pairs.a[k]] = 1;
         cs->in_pair[cs->pairs.b[k]] = 1;
     }
-    int count = 0;
+    int listed = 0;
     for (int e = 0; e < elem_count; e++)
-        if (cs->in_pair[e]) cs->active[count++] = e;
-    cs->active_count = count;
+        if (cs->in_pair[e]) list[listed++] = e;
+    return listed;
 }
 
 /* The widest gap between two boxes along an axis (negative: they overlap
@@ -177,34 +198,104 @@ static inline double boxes_gap(const double *a, const double *b, int dim)
     return gap;
 }
 
-/* The near list (see the top of this file) from this step's boxes, if a
- * detection or a restore made it stale or the nodes have gone past its
- * reach. Returns 0, or -1 when out of memory. */
-static int contact_near_refresh(contact_state *cs, int dim)
+/* The largest squared node displacement since the near list was built. */
+static double near_moved2(const fdem_model *m)
 {
-    double d = sqrt(cs->max_disp2);
-    if (!cs->near_stale && d <= cs->near_reach) return 0;
+    const double *p = m->pos, *q = m->contact.pos_near;
+    long count = (long)m->dim * m->node_count;
+    double moved2 = 0;
+    if (m->dim == 3) {
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
+    schedule(static) reduction(max : moved2)
+        for (long i = 0; i < count; i += 3) {
+            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1], dz = p[i + 2] - q[i + 2];
+            moved2 = max2(moved2, dx * dx + dy * dy + dz * dz);
+        }
+    } else {
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
+    schedule(static) reduction(max : moved2)
+        for (long i = 0; i < count; i += 2) {
+            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1];
+            moved2 = max2(moved2, dx * dx + dy * dy);
+        }
+    }
+    return moved2;
+}
+
+/* The near list is to be rebuilt: a detection or a restore made it stale,
+ * or some node has gone past its reach since it was built. */
+static int contact_near_due(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->near_stale) return 1;
+    double moved2 = near_moved2(m);
+    if (moved2 > cs->near_reach * cs->near_reach) return 1;
+    /* boxes move by no more than their nodes: a gap over twice the
+     * farthest travel since the list was built is still open (a hair over
+     * it, for rounding) */
+    cs->near_apart = 2.0 * sqrt(moved2) * (1 + 1e-9);
+    return 0;
+}
+
+/* The near list (see the top of this file) and its elements from this
+ * step's boxes. Returns 0, or -1 when out of memory. */
+static int contact_near_rebuild(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
     if (cs->near_capacity < cs->pairs.count) {
         size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
         if (!n) return -1;
         cs->near = n;
+        double *g = realloc(cs->near_gap, sizeof *g * cs->pairs.count);
+        if (!g) return -1;
+        cs->near_gap = g;
         cs->near_capacity = cs->pairs.count;
     }
-    double reach = d + NEAR_REACH_STEP * cs->buffer;
-    /* a hair over 2 (d + reach), so rounding in the gap or in d never
-     * leaves out a pair that could touch */
-    double limit = 2.0 * (d + reach) * (1 + 1e-9);
+    double reach = NEAR_REACH_STEP * cs->buffer;
+    /* a hair over 2 reach, so rounding in the gap never leaves out a pair
+     * that could touch */
+    double limit = 2.0 * reach * (1 + 1e-9);
+    int dim = m->dim;
     size_t width = 2 * (size_t)dim, count = 0;
+    for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
     for (size_t k = 0; k < cs->pairs.count; k++) {
-        const double *a = cs->box + width * (size_t)cs->pairs.a[k];
-        const double *b = cs->box + width * (size_t)cs->pairs.b[k];
-        if (boxes_gap(a, b, dim) <= limit) cs->near[count++] = k;
-        else contact_springs_release(cs, k); /* apart now and until the next rebuild */
+        int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
+        double gap = boxes_gap(cs->box + width * (size_t)ea, cs->box + width * (size_t)eb, dim);
+        if (gap > limit) {
+            contact_springs_release(cs, k); /* apart now and until the next rebuild */
+            continue;
+        }
+        cs->near[count] = k;
+        cs->near_gap[count++] = gap;
+        cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
+        cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }
+    memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_count = count;
     cs->near_reach = reach;
+    cs->near_apart = 0;
     cs->near_stale = 0;
+    cs->near_active_count =
+        contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
     return 0;
+}
+
+/* This step's boxes of the elements the near list needs, the list rebuilt
+ * first when due (from the boxes of every candidate pair's elements).
+ * Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
+        cs->near_count = 0;
+        return 0;
+    }
+    if (!contact_near_due(m)) {
+        contact_near_boxes(m);
+        return 0;
+    }
+    contact_boxes(m, cs->active, cs->active_count);
+    return contact_near_rebuild(m);
 }
 
 /* Force between two elements whose boxes overlap, both roles, into out
@@ -255,15 +346,21 @@ enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
  * whether fresh is to be adopted or the pair's set let go. D is a
  * constant where it is called, so each dimension's walk is compiled on
  * its own with the box and spring loops unrolled. */
-static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t k, double h,
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t i, double h,
                                                                double *out, double *fresh,
                                                                int *pool, int D)
 {
     contact_state *cs = &m->contact;
     const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
     const size_t width = 2 * (size_t)D;
-    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k], set = cs->spring_of[k];
+    size_t k = cs->near[i];
+    int32_t set = cs->spring_of[k];
     *pool = SPRINGS_KEPT;
+    if (cs->near_gap[i] > cs->near_apart) { /* apart, boxes not even computed */
+        if (set >= 0) *pool = SPRINGS_RELEASE;
+        return -1;
+    }
+    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
     if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
         if (set >= 0) *pool = SPRINGS_RELEASE;
         return -1;
@@ -357,7 +454,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     if (failed) return -1;
     if (m->joint_count) contact_drop_joined(m);
     if (contact_history_take_back(cs)) return -1;
-    contact_collect_active(cs, m->elem_count);
+    cs->active_count = contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, cs->active);
     if (pos != cs->pos_detect)
         memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
@@ -410,13 +507,17 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->body = malloc(sizeof(int32_t) * E);
     cs->piece = malloc(sizeof(int32_t) * E);
     cs->pos_detect = malloc(sizeof(double) * D * N);
+    cs->pos_near = malloc(sizeof(double) * D * N);
     cs->force = calloc(D * N, sizeof(double));
     cs->force_is_zero = 1;
     cs->box = malloc(sizeof(double) * 2 * D * E);
     cs->active = malloc(sizeof(int32_t) * E);
+    cs->near_active = malloc(sizeof(int32_t) * E);
+    cs->elem_gap = malloc(sizeof(double) * E);
     cs->in_pair = malloc(E);
     if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
-        !cs->pos_detect || !cs->force || !cs->box || !cs->active || !cs->in_pair) {
+        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active || !cs->elem_gap ||
+        !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -440,8 +541,9 @@ int contact_init(fdem_model *m, fdem_error *err)
 void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
-    free(cs->pos_detect); free(cs->force);
-    free(cs->box); free(cs->active); free(cs->in_pair); free(cs->near);
+    free(cs->pos_detect); free(cs->pos_near); free(cs->force);
+    free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
+    free(cs->near); free(cs->near_gap);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
@@ -489,7 +591,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->pair_capacity * sizeof(int32_t);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
-    b += cs->near_capacity * sizeof(size_t);
+    b += cs->near_capacity * (sizeof(size_t) + sizeof(double));
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -520,7 +622,7 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
     for (size_t i = 0; i < cs->near_count; i++) {
         size_t k = cs->near[i];
         double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, k, h, out, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, i, h, out, fresh, &pool, D);
         if (pool == SPRINGS_RELEASE) contact_springs_release(cs, k);
         else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, k, fresh)) return -1;
         if (touched <= 0) continue;
@@ -550,7 +652,7 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     for (long i = begin; i < end; i++) {
         long k = (long)cs->near[i];
         double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, (size_t)k, h, force, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, (size_t)i, h, force, fresh, &pool, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
         if (touched <= 0) continue;
@@ -639,8 +741,7 @@ int contact_forces(fdem_model *m)
     if (!cs->force_is_zero)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
-    if (cs->pairs.count) contact_boxes(m);
-    if (contact_near_refresh(cs, m->dim)) return -1;
+    if (contact_near_refresh(m)) return -1;
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;

@@ -1,14 +1,20 @@
 /*
  * contact_tet.c - potential contact between tetrahedra (contact_tet.h).
  *
- * Per contactor face the face triangle is clipped, in the target's
- * barycentric coordinates, to each sub-tetrahedron k of the target: the
- * region lambda_k >= 0 and lambda_j >= lambda_k (j != k), where phi_t =
- * 4 lambda_k is linear. The clipping carries lambda with each polygon
- * vertex (lambda is affine, so it interpolates exactly along a clipped
- * edge), and the integral of the linear phi over the polygon and its first
- * moment are exact fan sums: integral f = A (f_a + f_b + f_c)/3 and
- * integral f x = A/12 (sum f_i x_i + sum f_i sum x_i) on each triangle.
+ * Per contactor face the face triangle is clipped to the target and the
+ * target's phi_t = 4 min_k lambda_k integrated over what is left, in the
+ * face's own weights w (the face is the triangle (0,0), (1,0), (0,1)):
+ * lambda is affine along the face, so every plane is an affine function of
+ * w, a polygon vertex is two numbers, and the point of action comes out as
+ * weights on the face's nodes. phi_t is linear only on a sub-tetrahedron
+ * (lambda_k the smallest), so the clipped face is split where two
+ * candidate lambdas are equal until one candidate is left on each piece;
+ * on a piece the integral of the linear phi and its first moment are exact
+ * fan sums: integral f = A (f_a + f_b + f_c)/3 and integral f w = A/12
+ * (sum f_i w_i + sum f_i sum w_i) on each triangle. Most faces never get
+ * that far: cheap separating planes (a face plane of either tetrahedron
+ * with the other's corners all outside it, the face's own plane with the
+ * target's corners all on one side) end them first.
  *
  * It is also the tetrahedron pair kernel of the contact stage
  * (contact_pair.h), with Coulomb friction the way contact_tri.c has it for
@@ -32,17 +38,30 @@
 
 #include "vec3.h"
 
-#define CLIP_MAX 12 /* a triangle clipped by 4 planes has at most 7 vertices */
+/* A cut adds at most one vertex: the face's triangle cut by the target's 4
+ * face planes, then split by at most 3 sub-tetrahedron planes, has at most
+ * 10. */
+#define CLIP_MAX 12
 
-typedef struct clip_vertex {
-    double x[3];
-    double lambda[4];
-} clip_vertex;
-
-typedef struct clip_polygon {
-    clip_vertex v[CLIP_MAX];
+/* A polygon on a contactor face, its vertices given by w, their weights on
+ * the face's second and third corners (the first corner's is 1 - w[0] -
+ * w[1]): the face is the triangle (0,0), (1,0), (0,1) in w. The target's
+ * barycentric coordinates are affine along the face, so each clipping plane
+ * is an affine function of w and x is never needed. */
+typedef struct face_polygon {
+    double w[CLIP_MAX][2];
     int count;
-} clip_polygon;
+} face_polygon;
+
+/* An affine function of w on a face: c[0] + c[1] w[0] + c[2] w[1]. */
+typedef struct face_affine {
+    double c[3];
+} face_affine;
+
+static inline double affine_at(const face_affine *f, const double w[2])
+{
+    return f->c[0] + f->c[1] * w[0] + f->c[2] * w[1];
+}
 
 /* The target's barycentric map: lambda_{1..3} = rows . (x - x0). */
 typedef struct bary_map {
@@ -79,75 +98,180 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
-/* Keeps the part of the polygon where lambda_k - lambda_j >= 0 (j < 0:
- * lambda_k >= 0) - Sutherland-Hodgman on an affine function. Returns the
- * clipped polygon: poly itself when the plane cuts nothing (most planes),
- * else spare, written (so the caller swaps buffers instead of copying). */
-static clip_polygon *clip_keep(clip_polygon *poly, clip_polygon *spare, int k, int j)
+/* Appends the vertex (x, y) to the polygon. */
+static inline void polygon_add(face_polygon *poly, double x, double y)
 {
-    int n = poly->count, inside = 0;
-    double g[CLIP_MAX];
-    for (int a = 0; a < n; a++) {
-        g[a] = poly->v[a].lambda[k] - (j >= 0 ? poly->v[a].lambda[j] : 0.0);
-        inside += g[a] >= 0;
-    }
-    if (inside == n) return poly;
-    clip_polygon *out = spare;
+    poly->w[poly->count][0] = x;
+    poly->w[poly->count][1] = y;
+    poly->count++;
+}
+
+/* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
+ * vertices in, some out) - Sutherland-Hodgman - in out. */
+static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
+{
+    int n = poly->count;
+    double depth[CLIP_MAX];
+    for (int a = 0; a < n; a++) depth[a] = affine_at(g, poly->w[a]);
     out->count = 0;
-    if (inside == 0) return out;
     for (int a = 0; a < n; a++) {
-        const clip_vertex *p = &poly->v[a], *q = &poly->v[(a + 1) % n];
-        double gp = g[a], gq = g[(a + 1) % n];
-        if (gp >= 0 && out->count < CLIP_MAX) out->v[out->count++] = *p;
-        if ((gp >= 0) != (gq >= 0) && out->count < CLIP_MAX) {
-            double t = gp / (gp - gq);
-            clip_vertex *m = &out->v[out->count++];
-            for (int i = 0; i < 3; i++) m->x[i] = p->x[i] + t * (q->x[i] - p->x[i]);
-            for (int i = 0; i < 4; i++) m->lambda[i] = p->lambda[i] + t * (q->lambda[i] - p->lambda[i]);
+        int b = a + 1 < n ? a + 1 : 0;
+        const double *u = poly->w[a], *v = poly->w[b];
+        if (depth[a] >= 0) polygon_add(out, u[0], u[1]);
+        if ((depth[a] >= 0) != (depth[b] >= 0)) {
+            double t = depth[a] / (depth[a] - depth[b]);
+            polygon_add(out, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
         }
     }
-    return out;
 }
 
-/* Integral of phi = 4 lambda_k over the polygon (*i0), its first moment
- * (i1) and its area (*area), by a fan from vertex 0. */
-static void polygon_integrals(const clip_polygon *poly, int k, double *i0, double i1[3],
-                              double *area_sum)
+/* Splits the polygon, with the depths of its vertices below a plane, into
+ * the parts above (depth >= 0) and below (depth <= 0) it, in one pass. */
+static void split_by(const face_polygon *poly, const double *depth, face_polygon *above,
+                     face_polygon *below)
 {
+    int n = poly->count;
+    above->count = below->count = 0;
+    for (int a = 0; a < n; a++) {
+        int b = a + 1 < n ? a + 1 : 0;
+        const double *u = poly->w[a], *v = poly->w[b];
+        if (depth[a] >= 0) polygon_add(above, u[0], u[1]);
+        if (depth[a] <= 0) polygon_add(below, u[0], u[1]);
+        if ((depth[a] > 0 && depth[b] < 0) || (depth[a] < 0 && depth[b] > 0)) {
+            double t = depth[a] / (depth[a] - depth[b]);
+            double x = u[0] + t * (v[0] - u[0]), y = u[1] + t * (v[1] - u[1]);
+            polygon_add(above, x, y);
+            polygon_add(below, x, y);
+        }
+    }
+}
+
+/* The polygon cut by the planes in turn, in one of the two buffers (poly
+ * itself when there is none). */
+static const face_polygon *clip_all(const face_polygon *poly, const face_affine *const *planes,
+                                    int count, face_polygon buffers[2])
+{
+    for (int c = 0; c < count && poly->count >= 3; c++) {
+        face_polygon *out = poly == &buffers[0] ? &buffers[1] : &buffers[0];
+        clip_keep(poly, out, planes[c]);
+        poly = out;
+    }
+    return poly;
+}
+
+/* The integral over the polygon of phi (sums[0]), its first moment in w
+ * (sums[1], sums[2]) and the polygon's area (sums[3]), in units of twice
+ * the face's area (the face has area 1/2 in w), by a fan from vertex 0:
+ * integral f = A (f_a + f_b + f_c)/3 and integral f w = A/12 (sum f_i w_i +
+ * sum f_i sum w_i) on each triangle. A clipped triangle keeps its turn, so
+ * the signed areas of the fan's triangles are their areas. */
+static void polygon_integrals(const face_polygon *poly, const face_affine *phi_of,
+                              double sums[4])
+{
+    const double *o = poly->w[0];
+    double phi_o = affine_at(phi_of, o), phi_p = affine_at(phi_of, poly->w[1]);
     for (int a = 1; a + 1 < poly->count; a++) {
-        const clip_vertex *v[3] = {&poly->v[0], &poly->v[a], &poly->v[a + 1]};
-        double u[3], w[3], n[3];
-        vec3_sub(v[1]->x, v[0]->x, u);
-        vec3_sub(v[2]->x, v[0]->x, w);
-        vec3_cross(u, w, n);
-        double area = 0.5 * sqrt(vec3_dot(n, n));
-        *area_sum += area;
-        double phi[3] = {4 * v[0]->lambda[k], 4 * v[1]->lambda[k], 4 * v[2]->lambda[k]};
-        double sum_phi = phi[0] + phi[1] + phi[2];
-        *i0 += area * sum_phi / 3.0;
-        for (int i = 0; i < 3; i++) {
-            double sum_x = v[0]->x[i] + v[1]->x[i] + v[2]->x[i];
-            double mixed = phi[0] * v[0]->x[i] + phi[1] * v[1]->x[i] + phi[2] * v[2]->x[i];
-            i1[i] += area / 12.0 * (mixed + sum_phi * sum_x);
+        const double *p = poly->w[a], *q = poly->w[a + 1];
+        double phi_q = affine_at(phi_of, q);
+        double area = 0.5 * ((p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0]));
+        double sum_phi = phi_o + phi_p + phi_q;
+        sums[0] += area * sum_phi / 3.0;
+        for (int i = 0; i < 2; i++) {
+            double sum_w = o[i] + p[i] + q[i];
+            double mixed = phi_o * o[i] + phi_p * p[i] + phi_q * q[i];
+            sums[1 + i] += area / 12.0 * (mixed + sum_phi * sum_w);
         }
+        sums[3] += area;
+        phi_p = phi_q;
     }
 }
 
-/* Barycentric coordinates of x (in the plane) on the triangle a, b, c. */
-static void face_weights(const double *a, const double *b, const double *c, const double x[3],
-                         double w[3])
+/* The candidates but the one at skip. */
+static int candidates_but(const int *cand, int count, int skip, int *rest)
 {
-    double ab[3], ac[3], ax[3], n[3], t[3];
-    vec3_sub(b, a, ab);
-    vec3_sub(c, a, ac);
-    vec3_sub(x, a, ax);
-    vec3_cross(ab, ac, n);
-    double n2 = vec3_dot(n, n);
-    vec3_cross(ax, ac, t);
-    w[1] = vec3_dot(t, n) / n2;
-    vec3_cross(ab, ax, t);
-    w[2] = vec3_dot(t, n) / n2;
-    w[0] = 1.0 - w[1] - w[2];
+    int kept = 0;
+    for (int c = 0; c < count; c++)
+        if (c != skip) rest[kept++] = cand[c];
+    return kept;
+}
+
+/* Adds to sums the integrals (polygon_integrals) of phi_t = 4 min lambda_k
+ * over the polygon, k among the candidates. phi_t is linear only where one
+ * lambda_k is the smallest (sub-tetrahedron k), so the polygon is split
+ * where two candidates i, j are equal: above lambda_i - lambda_j = 0, i is
+ * never the smallest, below j is not. A polygon on one side (most) is not
+ * cut, and the split yields both sides in one pass. */
+static void integrate_min(const face_polygon *poly, const face_affine lambda[4], const int *cand,
+                          int count, double sums[4])
+{
+    if (count == 1) {
+        face_affine phi;
+        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[cand[0]].c[i];
+        polygon_integrals(poly, &phi, sums);
+        return;
+    }
+    face_affine g;
+    for (int i = 0; i < 3; i++) g.c[i] = lambda[cand[0]].c[i] - lambda[cand[1]].c[i];
+    double depth[CLIP_MAX];
+    int above = 0, below = 0;
+    for (int a = 0; a < poly->count; a++) {
+        depth[a] = affine_at(&g, poly->w[a]);
+        above += depth[a] > 0;
+        below += depth[a] < 0;
+    }
+    int rest[3] = {0, 0, 0};
+    if (below == 0 || above == 0) { /* drop i (all above) or j (all below) */
+        int kept = candidates_but(cand, count, below == 0 ? 0 : 1, rest);
+        integrate_min(poly, lambda, rest, kept, sums);
+        return;
+    }
+    face_polygon part_above, part_below;
+    split_by(poly, depth, &part_above, &part_below);
+    int kept = candidates_but(cand, count, 0, rest);
+    if (part_above.count >= 3) integrate_min(&part_above, lambda, rest, kept, sums);
+    kept = candidates_but(cand, count, 1, rest);
+    if (part_below.count >= 3) integrate_min(&part_below, lambda, rest, kept, sums);
+}
+
+/* The face clipped to the target (lambda_f >= 0, given as affine functions
+ * on the face), then the integrals of phi_t over it (integrate_min). The
+ * planes that cut the face's triangle are those its corners' outside masks
+ * (outside_mask) name: one corner outside is enough, all three never are
+ * (face_in_target has let the face go then). */
+static void face_clipped_integrals(const face_affine lambda[4], unsigned corners_outside,
+                                   double sums[4])
+{
+    static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
+    static const int all[4] = {0, 1, 2, 3};
+    face_polygon inside[2];
+    const face_affine *cut[4];
+    int cuts = 0;
+    for (int f = 0; f < 4; f++)
+        if (corners_outside & 1u << f) cut[cuts++] = &lambda[f];
+    const face_polygon *part = clip_all(&face, cut, cuts, inside);
+    if (part->count >= 3) integrate_min(part, lambda, all, 4, sums);
+}
+
+/* The plane of a face (corners' coordinates la, lb, lc in the target)
+ * has all four of the target's corners strictly on one side: the face
+ * misses the target. In the coordinates (lambda_1, lambda_2, lambda_3) the
+ * target's corners are 0 and the unit vectors, and the map from x is
+ * affine, so the sides are the signs of c . (e_v - la), c = (lb - la) x
+ * (lc - la). */
+static int face_plane_separates(const double la[4], const double lb[4], const double lc[4])
+{
+    double u[3], v[3], c[3];
+    vec3_sub(lb + 1, la + 1, u);
+    vec3_sub(lc + 1, la + 1, v);
+    vec3_cross(u, v, c);
+    double s = vec3_dot(c, la + 1);
+    double side[4] = {-s, c[0] - s, c[1] - s, c[2] - s};
+    int above = 0, below = 0;
+    for (int v_ = 0; v_ < 4; v_++) {
+        above += side[v_] > 0;
+        below += side[v_] < 0;
+    }
+    return above == 4 || below == 4;
 }
 
 /* One contactor face inside the target's potential: where and how hard the
@@ -160,47 +284,37 @@ typedef struct face_touch {
     double lt[4];       /* and its barycentric coordinates in t */
 } face_touch;
 
-/* Some face plane of the target has all n points (their coordinates
- * lambda) outside: they miss it. Most candidate pairs end here. */
-static int outside_one_face(const double (*lambda)[4], const int *which, int n)
+/* Which face planes of the target a point (its coordinates lambda) is
+ * outside of: bit j for lambda_j < 0. Points whose masks share a bit all
+ * miss the target on that side - most candidate pairs end there - and the
+ * test is an AND, without a branch per coordinate. */
+static inline unsigned outside_mask(const double lambda[4])
 {
-    for (int j = 0; j < 4; j++) {
-        int out = 1;
-        for (int v = 0; v < n && out; v++) out = lambda[which[v]][j] < 0;
-        if (out) return 1;
-    }
-    return 0;
+    return (unsigned)(lambda[0] < 0) | (unsigned)(lambda[1] < 0) << 1 |
+           (unsigned)(lambda[2] < 0) << 2 | (unsigned)(lambda[3] < 0) << 3;
 }
 
 /* Face m (opposite contactor node m, whose corners have the coordinates
  * lambda in the target) clipped to the target: 1 and *ft if the potential
  * acts on it, 0 if not. */
-static int face_in_target(const double *const pc[4], const double (*lambda)[4], int m,
-                          const bary_map *bt, face_touch *ft)
+static int face_in_target(const double *const pc[4], const double (*lambda)[4],
+                          const unsigned outside[4], int m, face_touch *ft)
 {
     const int *fn = tet_face_nodes[m];
-    if (outside_one_face(lambda, fn, 3)) return 0;
+    if (outside[fn[0]] & outside[fn[1]] & outside[fn[2]]) return 0;
+    const double *la = lambda[fn[0]], *lb = lambda[fn[1]], *lc = lambda[fn[2]];
+    if (face_plane_separates(la, lb, lc)) return 0;
+    face_affine along[4]; /* the target's lambda_i along the face */
+    for (int i = 0; i < 4; i++) {
+        along[i].c[0] = la[i];
+        along[i].c[1] = lb[i] - la[i];
+        along[i].c[2] = lc[i] - la[i];
+    }
+    double sums[4] = {0, 0, 0, 0};
+    face_clipped_integrals(along, outside[fn[0]] | outside[fn[1]] | outside[fn[2]], sums);
+    if (!(sums[0] > 0)) return 0;
+    /* outward normal of the face, away from node m; |n| is twice its area */
     const double *a = pc[fn[0]], *b = pc[fn[1]], *c = pc[fn[2]];
-    clip_polygon face;
-    face.count = 3;
-    for (int v = 0; v < 3; v++) {
-        memcpy(face.v[v].x, pc[fn[v]], sizeof face.v[v].x);
-        memcpy(face.v[v].lambda, lambda[fn[v]], sizeof face.v[v].lambda);
-    }
-    double i0 = 0, i1[3] = {0, 0, 0}, area = 0;
-    clip_polygon buffers[2];
-    for (int k = 0; k < 4; k++) {
-        /* the face itself until some plane cuts it; then two buffers in turn */
-        clip_polygon *poly = clip_keep(&face, &buffers[0], k, -1);
-        for (int j = 0; j < 4 && poly->count >= 3; j++) {
-            if (j == k) continue;
-            clip_polygon *spare = poly == &buffers[0] ? &buffers[1] : &buffers[0];
-            poly = clip_keep(poly, spare, j, k); /* lambda_j - lambda_k >= 0 */
-        }
-        if (poly->count >= 3) polygon_integrals(poly, k, &i0, i1, &area);
-    }
-    if (!(i0 > 0)) return 0;
-    /* outward unit normal of the face: away from node m */
     double ab[3], ac[3], n[3], am[3];
     vec3_sub(b, a, ab);
     vec3_sub(c, a, ac);
@@ -209,15 +323,16 @@ static int face_in_target(const double *const pc[4], const double (*lambda)[4], 
     double len = sqrt(vec3_dot(n, n));
     if (!(len > 0)) return 0;
     double sign = vec3_dot(n, am) > 0 ? -1.0 : 1.0;
-    double point[3];
-    for (int i = 0; i < 3; i++) {
-        point[i] = i1[i] / i0;
-        ft->normal[i] = sign * n[i] / len;
-    }
-    ft->i0 = i0;
-    ft->area = area;
-    face_weights(a, b, c, point, ft->wf);
-    bary_at(bt, point, ft->lt);
+    for (int i = 0; i < 3; i++) ft->normal[i] = sign * n[i] / len;
+    ft->i0 = len * sums[0];
+    ft->area = len * sums[3];
+    /* the point of action: its weights on the face, and in t (affine in w) */
+    double w1 = sums[1] / sums[0], w2 = sums[2] / sums[0];
+    ft->wf[0] = 1.0 - w1 - w2;
+    ft->wf[1] = w1;
+    ft->wf[2] = w2;
+    for (int i = 1; i < 4; i++) ft->lt[i] = ft->wf[0] * la[i] + w1 * lb[i] + w2 * lc[i];
+    ft->lt[0] = 1.0 - ft->lt[1] - ft->lt[2] - ft->lt[3];
     return 1;
 }
 
@@ -296,38 +411,54 @@ typedef struct tet_frame {
     bary_map bary;
 } tet_frame;
 
-static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
+static void tet_corners_of(const double *pos, const int32_t n[4], tet_frame *t)
 {
     for (int v = 0; v < 4; v++) t->p[v] = pos + 3 * (size_t)n[v];
+}
+
+static void tet_frame_of(const double *pos, const int32_t n[4], tet_frame *t)
+{
+    tet_corners_of(pos, n, t);
     t->bary = bary_of(t->p);
 }
 
-/* One way, with friction when fr is not NULL (a face that does not touch
- * lets its spring go). */
+/* A contactor's corners in the target: their barycentric coordinates and
+ * outside masks (outside_mask). */
+typedef struct corners_in {
+    double lambda[4][4];
+    unsigned outside[4];
+} corners_in;
+
+/* The contactor's corners in the target; 1 if they are all outside one of
+ * its face planes: that plane separates the two, no face of either touches
+ * the other, both ways. */
+static int corners_in_target(const tet_frame *contactor, const tet_frame *target, corners_in *ci)
+{
+    for (int v = 0; v < 4; v++) {
+        bary_at(&target->bary, contactor->p[v], ci->lambda[v]);
+        ci->outside[v] = outside_mask(ci->lambda[v]);
+    }
+    return (ci->outside[0] & ci->outside[1] & ci->outside[2] & ci->outside[3]) != 0;
+}
+
+/* One way, the contactor's corners in the target given, with friction when
+ * fr is not NULL (a face that does not touch lets its spring go). */
 static double contact_one_way(const tet_frame *contactor, const tet_frame *target,
-                              double penalty, tet_friction *fr, double f_c[12], double f_t[12])
+                              const corners_in *ci, double penalty, tet_friction *fr,
+                              double f_c[12], double f_t[12])
 {
     const double *const *pc = contactor->p, *const *pt = target->p;
-    const bary_map bt = target->bary;
-    if (!bt.valid) return 0.0;
-    double lambda[4][4];
-    static const int all[4] = {0, 1, 2, 3};
-    for (int v = 0; v < 4; v++) bary_at(&bt, pc[v], lambda[v]);
-    if (outside_one_face((const double (*)[4])lambda, all, 4)) {
-        if (fr) memset(fr->springs, 0, 12 * sizeof(double));
-        return 0.0;
-    }
     double total = 0, k_n = 0; /* 4 p / h_t, once some face needs it */
     for (int m = 0; m < 4; m++) {
         face_touch ft;
-        if (!face_in_target(pc, (const double (*)[4])lambda, m, &bt, &ft)) {
+        if (!face_in_target(pc, (const double (*)[4])ci->lambda, ci->outside, m, &ft)) {
             if (fr) memset(fr->springs + 3 * m, 0, 3 * sizeof(double));
             continue;
         }
         double f_n = penalty * ft.i0, force[3];
         for (int i = 0; i < 3; i++) force[i] = -f_n * ft.normal[i];
         if (fr && fr->mu > 0 && ft.area > 0) {
-            if (k_n == 0) k_n = 4 * penalty / tet_smallest_height_now(pt, bt.det);
+            if (k_n == 0) k_n = 4 * penalty / tet_smallest_height_now(pt, target->bary.det);
             face_friction(&ft, m, k_n, f_n, fr, force);
         } else if (fr) {
             memset(fr->springs + 3 * m, 0, 3 * sizeof(double));
@@ -345,7 +476,9 @@ double tet_contact_one_way(const double *pos, const int32_t contactor[4],
     tet_frame c, t;
     tet_frame_of(pos, contactor, &c);
     tet_frame_of(pos, target, &t);
-    return contact_one_way(&c, &t, penalty, NULL, f_c, f_t);
+    corners_in ci;
+    if (!t.bary.valid || corners_in_target(&c, &t, &ci)) return 0.0;
+    return contact_one_way(&c, &t, &ci, penalty, NULL, f_c, f_t);
 }
 
 double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4],
@@ -360,10 +493,22 @@ double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tet_frame a, b;
-    tet_frame_of(in->pos, in->node_a, &a);
+    corners_in a_in_b, b_in_a;
+    /* inverted: no potential; a face plane of either apart: no touch. b's
+     * map first, so that most pairs, apart by one of b's faces, never need
+     * a's. */
     tet_frame_of(in->pos, in->node_b, &b);
-    if (!(a.bary.valid && a.bary.det > 0) || !(b.bary.valid && b.bary.det > 0)) {
-        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS); /* inverted: no potential */
+    int apart = !(b.bary.valid && b.bary.det > 0);
+    if (!apart) {
+        tet_corners_of(in->pos, in->node_a, &a);
+        apart = corners_in_target(&a, &b, &a_in_b);
+    }
+    if (!apart) {
+        a.bary = bary_of(a.p);
+        apart = !(a.bary.valid && a.bary.det > 0) || corners_in_target(&b, &a, &b_in_a);
+    }
+    if (apart) {
+        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
         return 0;
     }
     for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
@@ -371,7 +516,7 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     tet_friction ab = {in->vel, in->node_a, in->node_b, in->friction, in->h, springs, dissipated};
     tet_friction ba = {in->vel, in->node_b, in->node_a, in->friction, in->h,
                        springs + TET_CONTACT_SLOTS / 2, dissipated};
-    double touched = contact_one_way(&a, &b, in->penalty, &ab, out, out + 12);
-    touched += contact_one_way(&b, &a, in->penalty, &ba, out + 12, out);
+    double touched = contact_one_way(&a, &b, &a_in_b, in->penalty, &ab, out, out + 12);
+    touched += contact_one_way(&b, &a, &b_in_a, in->penalty, &ba, out + 12, out);
     return touched > 0;
 }

@@ -722,7 +722,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
 {
     size_t b = sizeof *m, D = (size_t)m->dim;
     b += (size_t)m->node_capacity * (sizeof(double) * (D * 4 + 2) + sizeof(int32_t));
-    b += (size_t)m->node_count * (1 + (m->contact.enabled ? 2 * D * sizeof(double) : 0));
+    b += (size_t)m->node_count * (1 + (m->contact.enabled ? 3 * D * sizeof(double) : 0));
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
