@@ -227,12 +227,15 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 if (fc) m->contact_work += fc[at + d] * v_mid;
             }
             if (fc) {
-                double d2 = 0;
+                double d2 = 0, n2 = 0;
                 for (int d = 0; d < D; d++) {
                     double u = m->pos[at + d] - m->contact.pos_detect[at + d];
+                    double w = m->pos[at + d] - m->contact.pos_near[at + d];
                     d2 += u * u;
+                    n2 += w * w;
                 }
                 m->contact.max_disp2 = fmax(m->contact.max_disp2, d2);
+                m->contact.near_disp2 = fmax(m->contact.near_disp2, n2);
             }
         }
     }

@@ -198,37 +198,13 @@ static inline double boxes_gap(const double *a, const double *b, int dim)
     return gap;
 }
 
-/* The largest squared node displacement since the near list was built. */
-static double near_moved2(const fdem_model *m)
-{
-    const double *p = m->pos, *q = m->contact.pos_near;
-    long count = (long)m->dim * m->node_count;
-    double moved2 = 0;
-    if (m->dim == 3) {
-#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
-    schedule(static) reduction(max : moved2)
-        for (long i = 0; i < count; i += 3) {
-            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1], dz = p[i + 2] - q[i + 2];
-            moved2 = max2(moved2, dx * dx + dy * dy + dz * dz);
-        }
-    } else {
-#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 65536) \
-    schedule(static) reduction(max : moved2)
-        for (long i = 0; i < count; i += 2) {
-            double dx = p[i] - q[i], dy = p[i + 1] - q[i + 1];
-            moved2 = max2(moved2, dx * dx + dy * dy);
-        }
-    }
-    return moved2;
-}
-
 /* The near list is to be rebuilt: a detection or a restore made it stale,
  * or some node has gone past its reach since it was built. */
 static int contact_near_due(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (cs->near_stale) return 1;
-    double moved2 = near_moved2(m);
+    double moved2 = cs->near_disp2; /* the integrator's (central_difference_pass) */
     if (moved2 > cs->near_reach * cs->near_reach) return 1;
     /* boxes move by no more than their nodes: a gap over twice the
      * farthest travel since the list was built is still open (a hair over
@@ -271,6 +247,7 @@ static int contact_near_rebuild(fdem_model *m)
         cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }
     memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
+    cs->near_disp2 = 0;
     cs->near_count = count;
     cs->near_reach = reach;
     cs->near_apart = 0;
@@ -535,6 +512,9 @@ int contact_init(fdem_model *m, fdem_error *err)
     }
     cs->buffer = 0.4 * rmax;
     cs->need_detect = 1;
+    /* the integrator measures from here until the first near list */
+    memcpy(cs->pos_near, m->pos, sizeof(double) * D * N);
+    cs->near_disp2 = 0;
     return 0;
 }
 

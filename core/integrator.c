@@ -23,8 +23,9 @@
  * velocities: non-finite if and only if some value is (cheaper than a test
  * per value in the hot loop); it is accumulated as one add per node, so
  * that its dependency chain does not pace the loop. sums[1] gets the work
- * of the contact forces (times 2 / havg) and sums[SCATTER_MAX] the largest
- * squared displacement since the last detection. with_contact (contact is
+ * of the contact forces (times 2 / havg), sums[SCATTER_MAX] the largest
+ * squared displacement since the last detection and sums[SCATTER_MAX + 1]
+ * the largest since the near list was built (contact.c). with_contact (contact is
  * on: track displacements) and with_force (some contact force may be
  * non-zero) are constants at each call below, so the compiler emits each
  * loop without the loads and branches it does not need. */
@@ -38,12 +39,12 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
     const double *fc = m->contact.force;
-    const double *xd = m->contact.pos_detect;
-    double check = 0, max_disp2 = 0, contact_work = 0;
+    const double *xd = m->contact.pos_detect, *xn = m->contact.pos_near;
+    double check = 0, max_disp2 = 0, near_disp2 = 0, contact_work = 0;
     for (int i = begin; i < end; i++) {
         const size_t at = (size_t)D * (size_t)i;
         unsigned own = owned[i];
-        double pos_sum = 0, vel_sum = 0, work = 0, d2 = 0;
+        double pos_sum = 0, vel_sum = 0, work = 0, d2 = 0, n2 = 0;
         for (int d = 0; d < D; d++) {
             double fd = f[at + d], v_old = v[at + d];
             if (with_force) fd += fc[at + d];
@@ -61,17 +62,20 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
             pos_sum += pd;
             vel_sum += vd;
             if (with_contact) {
-                double u = pd - xd[at + d];
+                double u = pd - xd[at + d], w = pd - xn[at + d];
                 d2 += u * u;
+                n2 += w * w;
             }
         }
         check += pos_sum + vel_sum;
         if (with_force) contact_work += work;
         if (with_contact && d2 > max_disp2) max_disp2 = d2;
+        if (with_contact && n2 > near_disp2) near_disp2 = n2;
     }
     sums[0] += check;
     sums[1] += contact_work;
     if (max_disp2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = max_disp2;
+    if (near_disp2 > sums[SCATTER_MAX + 1]) sums[SCATTER_MAX + 1] = near_disp2;
 }
 
 #define CENTRAL_DIFFERENCE_PASSES(D)                                                              \
@@ -100,6 +104,7 @@ int central_difference_step(fdem_model *m)
     double havg = 0.5 * (m->dt_prev + m->dt);
     double sums[SCATTER_SUMS] = {0};
     sums[SCATTER_MAX] = m->contact.max_disp2;
+    sums[SCATTER_MAX + 1] = m->contact.near_disp2;
     const int three = m->dim == 3;
     scatter_block_fn pass = !m->contact.enabled
                                  ? (three ? central_difference_nodes_3 : central_difference_nodes_2)
@@ -108,6 +113,7 @@ int central_difference_step(fdem_model *m)
                                  : (three ? central_difference_contact_3 : central_difference_contact_2);
     scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
     m->contact.max_disp2 = sums[SCATTER_MAX];
+    m->contact.near_disp2 = sums[SCATTER_MAX + 1];
     m->contact_work += sums[1] * 0.5 * havg;
     return isfinite(sums[0]) ? 0 : -1;
 }

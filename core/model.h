@@ -94,8 +94,8 @@ typedef struct constraint {
 } constraint;
 
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
-#define SCATTER_SUMS 6
-#define SCATTER_MAX 5
+#define SCATTER_SUMS 7
+#define SCATTER_MAX 5 /* sums[SCATTER_MAX] and on are maxima, not sums */
 
 /* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
  * blocks of one colour share no node, so threads may run them side by side
@@ -154,6 +154,8 @@ typedef struct contact_state {
     size_t near_count, near_capacity;
     double near_reach;       /* the list holds while no node is farther than this from */
     double *pos_near;        /* its place when the list was built */
+    double near_disp2;       /* largest squared node displacement from pos_near since then
+                                (tracked by the integrator with max_disp2) */
     double *near_gap;        /* per near pair: its boxes' gap when the list was built */
     double near_apart;       /* this step, a near_gap over this is still open */
     int32_t *near_active;    /* the elements in some near pair, once each: their boxes */
@@ -432,8 +434,8 @@ void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTE
 /* scatter_plan.c: fn runs items [begin, end) of one block and may add into
  * node arrays. It starts from sums zeroed and leaves its block's partial
  * results there: sums[0 .. SCATTER_MAX - 1] are added, block by block in
- * block order, to the same totals; totals[SCATTER_MAX] becomes the largest
- * sums[SCATTER_MAX] (and what it held before, if larger). */
+ * block order, to the same totals; each totals[i] from SCATTER_MAX on
+ * becomes the largest sums[i] (and what it held before, if larger). */
 typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 /* Smallest blocks, and the block count aimed at above that: a node on the
  * border of two colours is loaded once per colour, so large meshes get

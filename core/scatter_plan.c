@@ -132,7 +132,8 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
 static inline void scatter_add_sums(double totals[SCATTER_SUMS], const double sum[SCATTER_SUMS])
 {
     for (int i = 0; i < SCATTER_MAX; i++) totals[i] += sum[i];
-    if (sum[SCATTER_MAX] > totals[SCATTER_MAX]) totals[SCATTER_MAX] = sum[SCATTER_MAX];
+    for (int i = SCATTER_MAX; i < SCATTER_SUMS; i++)
+        if (sum[i] > totals[i]) totals[i] = sum[i];
 }
 
 /* Runs block k of the colour-ordered list, leaving its partial sums in
