@@ -15,6 +15,15 @@
  * alike; libmicrohttpd reports each close through gate_closed(), which
  * runs before it closes the socket, so a descriptor number is never reused
  * while its slot is still counted.
+ *
+ * Why a connection over its address's limit waits a moment before its 503:
+ * every answer closes its connection, and a client that keeps N
+ * connections busy opens the next one as soon as it has read an answer,
+ * while the server side counts the old one until libmicrohttpd reports it
+ * done, a moment later. Refusing at once turned that moment into 503s for
+ * a client within its limit (9 % of the requests of 4 connections under
+ * --max-connections-per-ip 4), so such a connection waits, uncounted and
+ * unread, up to GATE_SLOT_GRACE for a slot of its address to free.
  */
 #define _GNU_SOURCE /* accept4, pipe2: the flags come with the descriptor, no race */
 #include "gate.h"
@@ -25,6 +34,7 @@
 #include <jansson.h>
 #include <poll.h>
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,6 +47,7 @@
 
 #define GATE_HEAD_MAX (32 * 1024) /* larger header blocks get 431 */
 #define GATE_MAX_SLOTS 65536      /* descriptors the gate can track */
+#define GATE_SLOT_GRACE 0.25      /* seconds an over-limit connection waits */
 
 typedef struct gate_slot {
     uint32_t ip;       /* network order */
@@ -52,13 +63,16 @@ typedef struct gate_ip {
 typedef struct gate_held {
     int fd;
     struct sockaddr_in addr;
-    double deadline;
+    double accepted;
+    double deadline;   /* whole headers by then; a waiting one: its 503 */
+    int waiting;       /* not counted yet: its address was at its limit */
 } gate_held;
 
 static struct {
     pthread_t thread;
     int running;
-    int listen_fd, wake[2];
+    int listen_fd, wake[2];   /* a byte on wake: stopping, or a slot freed */
+    atomic_int stopping;
     gate_limits limits;
     gate_hand_over hand_over;
     gate_held *held;          /* only the gate thread touches these two */
@@ -68,6 +82,7 @@ static struct {
     int slot_count;
     gate_ip *ips;             /* addresses with a connection, unordered */
     int ip_count, total;
+    int waiting;              /* held connections waiting for a slot */
 } gate = {.lock = PTHREAD_MUTEX_INITIALIZER, .listen_fd = -1, .wake = {-1, -1}};
 
 double gate_now(void)
@@ -86,7 +101,12 @@ static gate_ip *gate_find_ip(uint32_t ip)
     return NULL;
 }
 
-/* Counts a new connection; 0 when a limit refuses it (with the reason). */
+static const char GATE_PER_IP_FULL[] =
+    "your address has as many connections open as it may "
+    "(--max-connections-per-ip); close one or try again shortly";
+
+/* Counts a new connection; 0 when a limit refuses it (with the reason:
+ * GATE_PER_IP_FULL when it is its address's limit). */
 static int gate_admit(int fd, uint32_t ip, double now, const char **why)
 {
     int ok = 0;
@@ -95,8 +115,7 @@ static int gate_admit(int fd, uint32_t ip, double now, const char **why)
     if (fd >= gate.slot_count || gate.total >= gate.limits.total) {
         *why = "the daemon has as many connections open as it serves; try again shortly";
     } else if (entry && entry->count >= gate.limits.per_ip) {
-        *why = "your address has as many connections open as it may "
-               "(--max-connections-per-ip); close one or try again shortly";
+        *why = GATE_PER_IP_FULL;
     } else {
         if (!entry) {
             entry = &gate.ips[gate.ip_count++];
@@ -120,6 +139,7 @@ void gate_closed(int fd)
         gate.total--;
         gate_ip *entry = gate_find_ip(gate.slots[fd].ip);
         if (entry && --entry->count == 0) *entry = gate.ips[--gate.ip_count];
+        if (gate.waiting > 0) (void)!write(gate.wake[1], "", 1);
     }
     pthread_mutex_unlock(&gate.lock);
 }
@@ -184,7 +204,58 @@ static void gate_answer_and_close(int fd, int status, const char *title, const c
 
 static void gate_release(int index)
 {
+    if (gate.held[index].waiting) {
+        pthread_mutex_lock(&gate.lock);
+        gate.waiting--;
+        pthread_mutex_unlock(&gate.lock);
+    }
     gate.held[index] = gate.held[--gate.held_count];
+}
+
+/* Connections from `ip` waiting for a slot (an address may not park more
+ * than its limit, so the queue cannot be one client's to fill). */
+static int gate_waiting_from(uint32_t ip)
+{
+    int n = 0;
+    for (int i = 0; i < gate.held_count; i++)
+        n += gate.held[i].waiting && gate.held[i].addr.sin_addr.s_addr == ip;
+    return n;
+}
+
+/* Parks connection fd, refused for its address's limit, to wait for a
+ * slot; 0 when it may not wait either. */
+static int gate_park(int fd, const struct sockaddr_in *addr, double now)
+{
+    if (gate.held_count >= gate.limits.total ||
+        gate_waiting_from(addr->sin_addr.s_addr) >= gate.limits.per_ip)
+        return 0;
+    pthread_mutex_lock(&gate.lock);
+    gate.waiting++;
+    pthread_mutex_unlock(&gate.lock);
+    gate.held[gate.held_count++] = (gate_held){fd, *addr, now, now + GATE_SLOT_GRACE, 1};
+    return 1;
+}
+
+/* Counts the waiting connections whose address has a free slot again and
+ * refuses those whose grace has run out. */
+static void gate_admit_waiting(double now)
+{
+    for (int i = gate.held_count - 1; i >= 0; i--) {
+        gate_held *h = &gate.held[i];
+        if (!h->waiting) continue;
+        const char *why = NULL;
+        if (gate_admit(h->fd, h->addr.sin_addr.s_addr, h->accepted, &why)) {
+            pthread_mutex_lock(&gate.lock);
+            gate.waiting--;
+            pthread_mutex_unlock(&gate.lock);
+            h->waiting = 0;
+            h->deadline = h->accepted + gate.limits.timeout;
+        } else if (now >= h->deadline) {
+            int fd = h->fd;
+            gate_release(i);
+            gate_answer_and_close(fd, 503, "Too many connections", why);
+        }
+    }
 }
 
 /* Looks at what has arrived on held connection `index`; returns 1 when the
@@ -232,11 +303,12 @@ static void gate_accept_all(void)
         const char *why = NULL;
         if (addr.sin_family != AF_INET || gate.held_count >= gate.limits.total ||
             !gate_admit(fd, addr.sin_addr.s_addr, now, &why)) {
+            if (why == GATE_PER_IP_FULL && gate_park(fd, &addr, now)) continue;
             gate_answer_and_close(fd, 503, "Too many connections",
                                   why ? why : "too many connections are waiting for headers");
             continue;
         }
-        gate.held[gate.held_count++] = (gate_held){fd, addr, now + gate.limits.timeout};
+        gate.held[gate.held_count++] = (gate_held){fd, addr, now, now + gate.limits.timeout, 0};
     }
 }
 
@@ -247,7 +319,7 @@ static void gate_cut_late(double now)
              "the request headers did not arrive whole within %g s (--request-timeout)",
              gate.limits.timeout);
     for (int i = gate.held_count - 1; i >= 0; i--)
-        if (now >= gate.held[i].deadline) {
+        if (!gate.held[i].waiting && now >= gate.held[i].deadline) {
             int fd = gate.held[i].fd;
             gate_release(i);
             gate_answer_and_close(fd, 408, "Request timeout", detail);
@@ -268,17 +340,25 @@ static void *gate_main(void *arg)
         fds[0] = (struct pollfd){.fd = gate.wake[0], .events = POLLIN};
         fds[1] = (struct pollfd){.fd = gate.listen_fd, .events = POLLIN};
         for (int i = 0; i < gate.held_count; i++) {
-            fds[2 + i] = (struct pollfd){.fd = gate.held[i].fd, .events = POLLIN};
+            /* a waiting connection is not read before it is counted */
+            int fd = gate.held[i].waiting ? -1 : gate.held[i].fd;
+            fds[2 + i] = (struct pollfd){.fd = fd, .events = POLLIN};
             if (gate.held[i].deadline - now < wait) wait = gate.held[i].deadline - now;
         }
         int polled = gate.held_count;
         int ms = wait > 0 ? (int)(wait * 1000) + 1 : 0;
         if (poll(fds, (nfds_t)(2 + polled), ms) < 0 && errno != EINTR) break;
-        if (fds[0].revents) break;
+        if (fds[0].revents) {
+            char sink[256];
+            while (read(gate.wake[0], sink, sizeof sink) > 0)
+                ;
+        }
+        if (gate.stopping) break;
         /* backwards, since gate_release() moves the last entry into i */
         for (int i = polled - 1; i >= 0; i--)
             if (fds[2 + i].revents) gate_examine(i);
         gate_cut_late(gate_now());
+        gate_admit_waiting(gate_now());
         if (fds[1].revents) gate_accept_all();
     }
     free(fds);
@@ -296,12 +376,13 @@ int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_ove
         slots = (int)rl.rlim_cur;
     gate.limits = *limits;
     gate.hand_over = hand_over;
+    gate.stopping = 0;
     gate.listen_fd = listen_fd;
     gate.slots = calloc((size_t)slots, sizeof *gate.slots);
     gate.ips = calloc((size_t)limits->total, sizeof *gate.ips);
     gate.held = calloc((size_t)limits->total, sizeof *gate.held);
     gate.slot_count = slots;
-    if (!gate.slots || !gate.ips || !gate.held || pipe2(gate.wake, O_CLOEXEC) != 0 ||
+    if (!gate.slots || !gate.ips || !gate.held || pipe2(gate.wake, O_CLOEXEC | O_NONBLOCK) != 0 ||
         pthread_create(&gate.thread, NULL, gate_main, NULL) != 0) {
         fprintf(stderr, "fdemd: cannot start the connection gate: %s\n", strerror(errno));
         gate_stop();
@@ -314,15 +395,21 @@ int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_ove
 void gate_stop(void)
 {
     if (gate.running) {
-        (void)!write(gate.wake[1], "x", 1);
+        gate.stopping = 1;
+        (void)!write(gate.wake[1], "", 1);
         pthread_join(gate.thread, NULL);
         gate.running = 0;
     }
     for (int i = 0; i < gate.held_count; i++) close(gate.held[i].fd);
     gate.held_count = 0;
+    /* under the lock: gate_closed() may still run on libmicrohttpd's
+     * threads, and must not write to a reused descriptor number */
+    pthread_mutex_lock(&gate.lock);
+    gate.waiting = 0;
     for (int k = 0; k < 2; k++)
         if (gate.wake[k] >= 0) close(gate.wake[k]);
     gate.wake[0] = gate.wake[1] = -1;
+    pthread_mutex_unlock(&gate.lock);
     if (gate.listen_fd >= 0) close(gate.listen_fd);
     gate.listen_fd = -1;
     free(gate.held);

@@ -4,14 +4,16 @@
  *
  * Contract:
  *  - gate_start() takes a bound, listening socket and serves it on its own
- *    thread. Each accepted connection is refused at once (503) when its
- *    address already has `per_ip` connections, or the daemon `total`; it is
+ *    thread. Each accepted connection is refused (503) when the daemon has
+ *    `total` connections, or when its address has `per_ip` and none of
+ *    them closes within a quarter of a second (GATE_SLOT_GRACE); it is
  *    cut (408) when its header block is not whole `timeout` seconds after it
  *    was accepted; it is answered (400, 411, 413, 431) when the block frames
  *    its body ambiguously (http_frame.h). Every other connection is passed
  *    to `hand_over`, which owns the socket from then on.
  *  - The owner of a handed-over connection calls gate_closed(fd) before it
- *    closes the socket, so the per-address count stays true.
+ *    closes the socket, so the per-address count stays true; it may call it
+ *    earlier (once its one answer is sent), and a second call is a no-op.
  *  - gate_accepted_at(fd) is when that connection was accepted (monotonic
  *    seconds), so the whole-request deadline can be applied to the body.
  *  - gate_stop() stops accepting, closes held connections and joins.

@@ -367,8 +367,15 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
                            enum MHD_RequestTerminationCode toe)
 {
     (void)cls;
-    (void)conn;
     (void)toe;
+    /* The connection carries this one request (Connection: close), so it
+     * stops counting against its address now, not at libmicrohttpd's next
+     * clean-up pass: the client has its whole answer and may already be
+     * opening its next connection (gate.c). */
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (info)
+        gate_closed(info->connect_fd);
     http_request *r = *req_cls;
     if (r) {
         free(r->body);
