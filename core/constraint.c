@@ -99,7 +99,8 @@ void constraint_set_time(fdem_model *m, double velocity_time)
 
 int constraint_select(fdem_model *m, fdem_error *err)
 {
-    int total = 0;
+    int total = 0, empty = 0, first_empty = -1;
+    for (int k = 0; k < m->constraint_count; k++) m->constraints[k].entry_count = -1; /* not counted */
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.select != FDEM_SELECT_BOX && (c->def.part < 0 || c->def.part >= m->part_count)) {
@@ -109,14 +110,18 @@ int constraint_select(fdem_model *m, fdem_error *err)
         }
         int n = 0;
         for (int i = 0; i < m->node_count; i++) n += constraint_selects(m, c, i);
-        if (n == 0) {
-            model_error(err, FDEM_ITEM_CONSTRAINT, k,
-                        "constraint %d selects no node (check the box against the initial positions)", k);
-            return -1;
-        }
         c->entry_begin = total;
         c->entry_count = n;
         total += n;
+        if (n == 0 && empty++ == 0) first_empty = k;
+    }
+    /* every constraint counted first, so fdem_constraint_node_count()
+     * names each empty one to the caller, not only the first */
+    if (empty) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, first_empty,
+                    "constraint %d selects no node (check the box against the initial positions)%s",
+                    first_empty, empty > 1 ? "; other constraints select none either" : "");
+        return -1;
     }
     m->cnode = malloc(sizeof(int32_t) * (size_t)(total ? total : 1));
     m->cdof = malloc((size_t)(total ? total : 1));

@@ -401,7 +401,9 @@ void fdem_principal_values(int dimension, const double *voigt, double *out);
  * doubles per constraint. */
 const double *fdem_constraint_forces(const fdem_model *model);
 
-/* Number of nodes selected by constraint c (valid after finalize). */
+/* Number of nodes selected by constraint c: valid after finalize, and
+ * after a finalize that failed on a constraint selecting no node (then 0
+ * for each such one); -1 for a constraint finalize did not count. */
 int fdem_constraint_node_count(const fdem_model *model, int c);
 
 /* ------------------------------------------------------------- checkpoints */

@@ -262,7 +262,12 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
                                         doc->gravity_amplitude_count, &err) == 0;
         if (!ok) case_engine_problem(doc, &err, "/gravity_amplitude");
         ok = ok && fdem_model_finalize(model, &err) == 0;
-        if (!ok) case_engine_problem(doc, &err, "");
+        /* a constraint that selects nothing: name every such one */
+        if (!ok && err.kind == FDEM_ITEM_CONSTRAINT &&
+            fdem_constraint_node_count(model, err.item) == 0)
+            case_check_selections(doc, model);
+        else if (!ok)
+            case_engine_problem(doc, &err, "");
         if (!ok && err.kind == FDEM_ITEM_CONSTRAINT && fdem_stable_dt(model) > 0)
             case_choose_dt(doc, model, info);
     }

@@ -627,6 +627,19 @@ static void independent_problems_in_one_pass(void)
     if (p.count != 2) dump_problems(&p);
     if (m) fdem_model_destroy(m);
     problems_free(&p);
+
+    /* two constraints selecting nothing: both named in one answer */
+    doc = load(base_text);
+    edit(doc, "/constraints/1/box", load("[10, 10, 11, 11]"));
+    edit(doc, "/constraints/2/box", load("[20, 20, 21, 21]"));
+    m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(!m && p.count == 2 && has_problem(&p, "/constraints/1", "selects no node") &&
+              has_problem(&p, "/constraints/2", "selects no node"),
+          "%d problems, want /constraints/1 and /constraints/2", p.count);
+    if (p.count != 2) dump_problems(&p);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
 }
 
 static void pointer_escaping(void)
