@@ -124,7 +124,8 @@ typedef struct contact_state {
     int slots;               /* stick springs per pair */
     int pair_out;            /* numbers a pair evaluation hands back */
     double buffer;           /* added to circle diameters; re-detect after buffer/2 */
-    double max_disp2;        /* largest squared node displacement since detection */
+    double max_disp2;        /* bound of the squared node displacement since detection,
+                                exact once past the limit (integrator.c) */
     int need_detect;
     long detections;
     int touching;            /* pairs with non-zero force in the last step */
@@ -468,5 +469,11 @@ void energy_gravity_restored(fdem_model *m, double gravity_work);
 
 /* integrator.c */
 int central_difference_step(fdem_model *m);
+/* the travel since detection (contact.max_disp2, a bound; see integrator.c):
+ * grown by a step's largest squared node step, and whether some node is now
+ * farther than sqrt(limit2) from pos_detect (exact, read when the bound says
+ * it may be) */
+void contact_travel_step(fdem_model *m, double step2);
+int contact_travel_past(fdem_model *m, double limit2);
 
 #endif
