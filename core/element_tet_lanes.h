@@ -28,14 +28,14 @@ TET_KERNEL void TET_VFN(tet_gather_nodes)(const double *xyz, const tet_hot *t, T
 }
 
 /* The forces of lane `lane` of g (tet_kernel_face_loads): f_0 = g_0 added,
- * f_a = -g_a subtracted. */
+ * f_a = -g_a subtracted (`store`: tet_scatter_node). */
 TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], const TET_V g[4][3],
-                                          int lane)
+                                          int lane, const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
         tet_scatter_node(f, node[a], (tet_pair){g[a][0][lane], g[a][1][lane]}, g[a][2][lane],
-                         a == 0);
+                         a == 0, store);
 }
 
 /* Lane `lane` of a group's face vectors and sixth stress as scalars, the
@@ -101,7 +101,7 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
 
 /* TET_N elements t[0 .. TET_N-1] of one material. */
 TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_constants *k,
-                                          tet_sums *sum, const int stressed)
+                                          tet_sums *sum, const int stressed, const int store)
 {
     const double *p[TET_N];
     TET_V x[4][3], X[9];
@@ -133,5 +133,5 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
     TET_V g[4][3];
     TET_VFN(tet_kernel_face_loads)(s, c, g);
     TET_UNROLL
-    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l);
+    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l, store);
 }

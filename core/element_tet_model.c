@@ -109,22 +109,33 @@ static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double 
 
 /* force[n] += or -= one node's load (x, y, z): x and y as one 16-byte
  * vector, z alone. Every scatter writes the nodes this same way, so the
- * next element's load of a node just stored forwards from the store. */
-static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add)
+ * next element's load of a node just stored forwards from the store.
+ * `store` (a constant at each call: the element's part has nodes of its
+ * own, so this element is the first and only one to write them this step)
+ * starts from zero instead of reading the force: 0 + x and 0 - x are what
+ * the zeroed array gave, to the bit (signed zeros included), without the
+ * step having to zero it first or this loop reading it. */
+static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add,
+                                    const int store)
 {
     double *fn = f + 3 * (size_t)n;
-    tet_pair old;
-    memcpy(&old, fn, sizeof old);
+    tet_pair old = {0.0, 0.0};
+    double old_z = 0.0;
+    if (!store) {
+        memcpy(&old, fn, sizeof old);
+        old_z = fn[2];
+    }
     old = add ? old + xy : old - xy;
     memcpy(fn, &old, sizeof old);
-    fn[2] = add ? fn[2] + z : fn[2] - z;
+    fn[2] = add ? old_z + z : old_z - z;
 }
 
-static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3])
+static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3],
+                               const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
-        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0);
+        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0, store);
 }
 
 /* Element t's in-situ pre-stress (initial_stress.c). */
@@ -134,9 +145,10 @@ static inline const double *tet_stress0(const fdem_model *m, const tet_hot *t)
 }
 
 /* One element alone: the last of an odd range, or a pair of two materials.
- * `stressed` (a constant at each call) adds the element's pre-stress. */
+ * `stressed` (a constant at each call) adds the element's pre-stress;
+ * `store`: see tet_scatter_node. */
 TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
-                               const int stressed)
+                               const int stressed, const int store)
 {
     const double *pos = m->pos;
     const int32_t *n = t->node;
@@ -152,7 +164,7 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     if (t->eta > 0) tet_damp(m, t, c, det, s, sum);
     double g[4][3];
     tet_kernel_face_loads(s, c, g);
-    tet_scatter(m->force, n, g);
+    tet_scatter(m->force, n, g, store);
 }
 
 #define TET_V tet_pair
@@ -181,12 +193,14 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
 /* Four elements of one material: a call of its own, so that the baseline
  * loop, which never takes it, holds no AVX code. */
 static void tet_forces_quad(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
-                            int stressed)
+                            int stressed, int store)
 {
     if (stressed)
-        tet_forces_group_quad(m, t, k, sum, 1);
+        tet_forces_group_quad(m, t, k, sum, 1, store);
+    else if (store)
+        tet_forces_group_quad(m, t, k, sum, 0, 1);
     else
-        tet_forces_group_quad(m, t, k, sum, 0);
+        tet_forces_group_quad(m, t, k, sum, 0, 0);
 }
 #pragma GCC pop_options
 #endif
@@ -205,10 +219,11 @@ static void tet_forces_quad(fdem_model *m, const tet_hot *t, tet_constants *k, t
  *  - records prefetched ahead;
  *  - damping: one division, and its power from s : S directly. */
 TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const int stressed,
-                               const int quads, double sums[SCATTER_SUMS])
+                               const int store, const int quads, tet_constants *constants,
+                               tet_sums *sums)
 {
-    tet_sums sum = {0, 0, 0};
-    tet_constants k = {.material = -1};
+    tet_sums sum = *sums;
+    tet_constants k = *constants;
     const tet_hot *t = m->tet + begin, *end = m->tet + end_index;
     while (end - t >= 2) {
         const tet_hot *ahead = end - t > TET_PREFETCH + 3 ? t + TET_PREFETCH : t;
@@ -223,23 +238,22 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
             TET_PREFETCH_READ((const char *)ahead + 320);
             TET_PREFETCH_READ((const char *)ahead + 384);
             TET_PREFETCH_READ((const char *)ahead + 448);
-            tet_forces_quad(m, t, &k, &sum, stressed);
+            tet_forces_quad(m, t, &k, &sum, stressed, store);
             t += 4;
             continue;
         }
 #endif
         if (t[0].material == t[1].material) {
-            tet_forces_group_pair(m, t, &k, &sum, stressed);
+            tet_forces_group_pair(m, t, &k, &sum, stressed, store);
         } else {
-            tet_forces_one(m, t, &k, &sum, stressed);
-            tet_forces_one(m, t + 1, &k, &sum, stressed);
+            tet_forces_one(m, t, &k, &sum, stressed, store);
+            tet_forces_one(m, t + 1, &k, &sum, stressed, store);
         }
         t += 2;
     }
-    if (t < end) tet_forces_one(m, t, &k, &sum, stressed);
-    sums[0] += sum.energy;
-    sums[1] += sum.power_now * (1.0 / 6);
-    sums[2] += sum.power_prev * (1.0 / 6);
+    if (t < end) tet_forces_one(m, t, &k, &sum, stressed, store);
+    *sums = sum;
+    *constants = k;
 }
 
 /* The loop is compiled twice, for the baseline x86-64 (pairs in SSE2) and
@@ -253,41 +267,68 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
  * 300 instructions, 34.4 -> 27.4 ns. */
 #if TET_QUADS
 __attribute__((target("avx2"))) static void tet_forces_avx2(fdem_model *m, int begin, int end,
-                                                             int stressed,
-                                                             double sums[SCATTER_SUMS])
+                                                             int stressed, int store,
+                                                             tet_constants *k, tet_sums *sum)
 {
     if (stressed)
-        tet_forces_run(m, begin, end, 1, 1, sums);
+        tet_forces_run(m, begin, end, 1, store, 1, k, sum);
+    else if (store)
+        tet_forces_run(m, begin, end, 0, 1, 1, k, sum);
     else
-        tet_forces_run(m, begin, end, 0, 1, sums);
+        tet_forces_run(m, begin, end, 0, 0, 1, k, sum);
 }
 #endif
 
-static void tet_forces_dispatch(fdem_model *m, int begin, int end, int stressed,
-                                double sums[SCATTER_SUMS])
+/* A part with an in-situ stress is rare: its loop takes `store` as a
+ * variable (one variant fewer). */
+static void tet_forces_dispatch(fdem_model *m, int begin, int end, int stressed, int store,
+                                tet_constants *k, tet_sums *sum)
 {
 #if TET_QUADS
     if (__builtin_cpu_supports("avx2")) {
-        tet_forces_avx2(m, begin, end, stressed, sums);
+        tet_forces_avx2(m, begin, end, stressed, store, k, sum);
         return;
     }
 #endif
     if (stressed)
-        tet_forces_run(m, begin, end, 1, 0, sums);
+        tet_forces_run(m, begin, end, 1, store, 0, k, sum);
+    else if (store)
+        tet_forces_run(m, begin, end, 0, 1, 0, k, sum);
     else
-        tet_forces_run(m, begin, end, 0, 0, sums);
+        tet_forces_run(m, begin, end, 0, 0, 0, k, sum);
+}
+
+/* Elements [begin, end) run by run of one part: a part whose nodes are its
+ * elements' own (model_part_stores_forces) stores their forces, the others
+ * add to what the zeroed array holds (elements of a part are contiguous).
+ * One running sum over the whole range, whatever its runs, so the energy
+ * is added in the order it always was. */
+static void tet_forces_by_part(fdem_model *m, int begin, int end, int stressed,
+                               double sums[SCATTER_SUMS])
+{
+    tet_sums sum = {0, 0, 0};
+    tet_constants k = {.material = -1};
+    for (int e = begin; e < end;) {
+        const part *p = &m->parts[m->elem_part[e]];
+        int stop = p->elem_begin + p->elem_count < end ? p->elem_begin + p->elem_count : end;
+        tet_forces_dispatch(m, e, stop, stressed, model_part_stores_forces(m, p), &k, &sum);
+        e = stop;
+    }
+    sums[0] += sum.energy;
+    sums[1] += sum.power_now * (1.0 / 6);
+    sums[2] += sum.power_prev * (1.0 / 6);
 }
 
 void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    tet_forces_dispatch(m, begin, end, 0, sums);
+    tet_forces_by_part(m, begin, end, 0, sums);
 }
 
 /* The same loop for the elements of a part with an in-situ stress. */
 void tet_element_forces_range_stressed(fdem_model *m, int begin, int end,
                                        double sums[SCATTER_SUMS])
 {
-    tet_forces_dispatch(m, begin, end, 1, sums);
+    tet_forces_by_part(m, begin, end, 1, sums);
 }
 
 void tet_element_stress(const fdem_model *m, int e, double out[6])

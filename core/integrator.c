@@ -217,6 +217,25 @@ static void report_non_finite(fdem_model *m, double h, fdem_error *err)
                 (long long)m->step + 1, m->time + h, elem, node, h, m->stable_dt);
 }
 
+/* Zeroes the force of every node the element pass adds to; the nodes of
+ * parts whose elements store their forces (model_part_stores_forces) are
+ * left as they are, the pass overwrites them. Parts hold consecutive
+ * nodes, so this is a memset per run of such parts. */
+static void forces_clear(fdem_model *m)
+{
+    const size_t D = (size_t)m->dim;
+    int from = 0; /* the first node not zeroed yet */
+    for (int k = 0; k < m->part_count; k++) {
+        const part *p = &m->parts[k];
+        if (!model_part_stores_forces(m, p)) continue;
+        if (p->node_begin > from)
+            memset(m->force + D * (size_t)from, 0, sizeof(double) * D * (size_t)(p->node_begin - from));
+        from = p->node_begin + p->node_count;
+    }
+    if (m->node_count > from)
+        memset(m->force + D * (size_t)from, 0, sizeof(double) * D * (size_t)(m->node_count - from));
+}
+
 int fdem_step(fdem_model *m, fdem_error *err)
 {
     if (!m->finalized) {
@@ -226,7 +245,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
     double t0 = stage_clock();
     constraint_set_time(m, m->time + 0.5 * h);
-    memset(m->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    forces_clear(m);
     element_forces(m);
     if (m->joint_count) {
         int broke = joint_forces(m);

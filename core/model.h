@@ -313,6 +313,15 @@ static inline const int32_t *element_nodes(const fdem_model *m, int e)
     return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
 }
 
+/* A part whose elements' forces are stored, not added, at each step: a
+ * fracturing part in 3D, where every element has nodes of its own, so the
+ * step need not zero their forces first (element_tet_model.c; the triangle
+ * kernel adds everywhere). */
+static inline int model_part_stores_forces(const fdem_model *m, const part *p)
+{
+    return m->dim == 3 && p->fracture;
+}
+
 /* Initial area (2D) or volume (3D), set by element_prepare. */
 static inline double element_size0(const fdem_model *m, int e)
 {
