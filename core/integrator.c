@@ -72,6 +72,71 @@ central_difference_node(double *x, double *v, const double *f, const double *fc,
     if (with_force && n2 > *near2) *near2 = n2;
 }
 
+/* The same update for a node with no prescribed dof (nearly every node),
+ * x and y side by side in one 16-byte vector, z alone: per component the
+ * operations of central_difference_node in its order, so the same bits;
+ * the contact work and the near-list distance are added in its order too
+ * (they are results), the finiteness check and the step bound in any. */
+typedef double cd_pair __attribute__((vector_size(16)));
+
+static inline __attribute__((always_inline)) void
+central_difference_free_node(double *x, double *v, const double *f, const double *fc,
+                             const double *xn, double inv_mass, cd_pair gxy, double gz,
+                             double h, double havg, const int D, int with_contact,
+                             int with_force, cd_pair *check, double *check_z, double *work_sum,
+                             double *move2, double *near2)
+{
+    cd_pair fxy, vxy, xxy;
+    memcpy(&fxy, f, sizeof fxy);
+    memcpy(&vxy, v, sizeof vxy);
+    memcpy(&xxy, x, sizeof xxy);
+    cd_pair cxy = {0, 0};
+    if (with_force) {
+        memcpy(&cxy, fc, sizeof cxy);
+        fxy += cxy;
+    }
+    cd_pair vn = vxy + (fxy * inv_mass + gxy) * havg;
+    cd_pair pn = xxy + vn * h;
+    memcpy(v, &vn, sizeof vn);
+    memcpy(x, &pn, sizeof pn);
+    *check += pn + vn;
+    double vz = 0, pz = 0, z_old = 0, vz_old = 0;
+    if (D == 3) {
+        double fz = f[2];
+        if (with_force) fz += fc[2];
+        vz_old = v[2];
+        z_old = x[2];
+        vz = vz_old + (fz * inv_mass + gz) * havg;
+        pz = z_old + vz * h;
+        v[2] = vz;
+        x[2] = pz;
+        *check_z += pz + vz;
+    }
+    if (with_force) {
+        cd_pair wv = cxy * (vxy + vn);
+        double work = 0.0 + wv[0];
+        work += wv[1];
+        if (D == 3) work += fc[2] * (vz_old + vz);
+        *work_sum += work;
+    }
+    if (with_contact) {
+        cd_pair s = pn - xxy;
+        s *= s;
+        double s2 = s[0] + s[1];
+        if (D == 3) s2 += (pz - z_old) * (pz - z_old);
+        if (s2 > *move2) *move2 = s2;
+    }
+    if (with_force) {
+        cd_pair w;
+        memcpy(&w, xn, sizeof w);
+        w = pn - w;
+        w *= w;
+        double n2 = w[0] + w[1];
+        if (D == 3) n2 += (pz - xn[2]) * (pz - xn[2]);
+        if (n2 > *near2) *near2 = n2;
+    }
+}
+
 static inline __attribute__((always_inline)) void
 central_difference_pass(fdem_model *m, int begin, int end, const int D, int with_contact,
                         int with_force, double sums[SCATTER_SUMS])
@@ -82,20 +147,24 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
     const double *fc = m->contact.force, *xn = m->contact.pos_near;
+    const cd_pair gxy = {g[0], g[1]};
+    const double gz = D == 3 ? g[2] : 0;
+    cd_pair check_xy = {0, 0};
     double check = 0, move2 = 0, near2 = 0, contact_work = 0;
     for (int i = begin; i < end; i++) {
         const size_t at = (size_t)D * (size_t)i;
         unsigned own = owned[i];
         if (own == 0)
-            central_difference_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
-                                    with_force ? xn + at : NULL, inv_mass[i], g, h, havg, 0u, D, with_contact, with_force, &check,
-                                    &contact_work, &move2, &near2);
+            central_difference_free_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
+                                         with_force ? xn + at : NULL, inv_mass[i], gxy, gz, h,
+                                         havg, D, with_contact, with_force, &check_xy, &check,
+                                         &contact_work, &move2, &near2);
         else
             central_difference_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
                                     with_force ? xn + at : NULL, inv_mass[i], g, h, havg, own, D, with_contact, with_force, &check,
                                     &contact_work, &move2, &near2);
     }
-    sums[0] += check;
+    sums[0] += check + check_xy[0] + check_xy[1];
     sums[1] += contact_work;
     if (move2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = move2;
     if (near2 > sums[SCATTER_MAX + 1]) sums[SCATTER_MAX + 1] = near2;
