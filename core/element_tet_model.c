@@ -16,10 +16,22 @@
 
 #include "element_tet_kernel.h"
 #include "model.h"
+#if TET_QUADS
+#include <immintrin.h>
+#endif
 
 int tet_element_prepare(fdem_model *m, int e, fdem_error *err)
 {
     tet_hot *t = &m->tet[e];
+    /* the storing loop moves an element's four nodes as one block of
+     * twelve numbers (tet_gather_own_quad): part_append numbers them so */
+    if (model_part_stores_forces(m, &m->parts[m->elem_part[e]]))
+        for (int c = 1; c < 4; c++)
+            if (t->node[c] != t->node[0] + c) {
+                model_error(err, FDEM_ITEM_ELEMENT, e,
+                            "element %d of a fracturing part does not have consecutive nodes", e);
+                return -1;
+            }
     tet_geometry g;
     if (tet_prepare(m->pos0, t->node, &g)) {
         model_error(err, FDEM_ITEM_ELEMENT, e, "element %d has no positive volume", e);
@@ -171,11 +183,31 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
 #define TET_N 2
 #define TET_VFN(name) name##_pair
 #define TET_GATHER(p, i) ((tet_pair){(p)[0][i], (p)[1][i]})
+#define TET_GATHER_OWN(xyz, t, x) tet_gather_nodes_pair(xyz, t, x)
+#define TET_LOAD_SIX(rows, v)                                                                    \
+    do {                                                                                         \
+        for (int q_ = 0; q_ < 6; q_++) v[q_] = (tet_pair){(rows)[q_], (rows)[6 + q_]};          \
+    } while (0)
+#define TET_STORE_SIX(rows, v)                                                                   \
+    do {                                                                                         \
+        for (int q_ = 0; q_ < 6; q_++) {                                                         \
+            (rows)[q_] = v[q_][0];                                                               \
+            (rows)[6 + q_] = v[q_][1];                                                           \
+        }                                                                                        \
+    } while (0)
+#define TET_STORE_OWN(f, t, g)                                                                   \
+    do {                                                                                         \
+        for (int l_ = 0; l_ < 2; l_++) tet_scatter_lane_pair(f, (t)[l_].node, g, l_, 1);        \
+    } while (0)
 #include "element_tet_lanes.h"
 #undef TET_V
 #undef TET_N
 #undef TET_VFN
 #undef TET_GATHER
+#undef TET_GATHER_OWN
+#undef TET_STORE_OWN
+#undef TET_LOAD_SIX
+#undef TET_STORE_SIX
 
 #if TET_QUADS
 #pragma GCC push_options
@@ -184,11 +216,102 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
 #define TET_N 4
 #define TET_VFN(name) name##_quad
 #define TET_GATHER(p, i) ((tet_quad){(p)[0][i], (p)[1][i], (p)[2][i], (p)[3][i]})
+
+/* Four rows of four numbers, one per lane, turned into four vectors over
+ * the lanes (vector k holds number k of each row), and back: the same
+ * transpose. */
+TET_KERNEL void tet_transpose_quad(tet_quad r[4])
+{
+    __m256d t0 = _mm256_unpacklo_pd((__m256d)r[0], (__m256d)r[1]);
+    __m256d t1 = _mm256_unpackhi_pd((__m256d)r[0], (__m256d)r[1]);
+    __m256d t2 = _mm256_unpacklo_pd((__m256d)r[2], (__m256d)r[3]);
+    __m256d t3 = _mm256_unpackhi_pd((__m256d)r[2], (__m256d)r[3]);
+    r[0] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x20);
+    r[1] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x20);
+    r[2] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x31);
+    r[3] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
+/* tet_gather_nodes for four elements whose four nodes are consecutive:
+ * each element's twelve numbers are three rows of four, so three loads
+ * and a transpose per block of four numbers instead of 48 single ones. */
+TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, tet_quad x[4][3])
+{
+    tet_quad col[12];
+    TET_UNROLL
+    for (int k = 0; k < 3; k++) {
+        tet_quad *r = col + 4 * k;
+        TET_UNROLL
+        for (int l = 0; l < 4; l++)
+            memcpy(&r[l], xyz + 3 * (size_t)t[l].node[0] + 4 * k, sizeof r[l]);
+        tet_transpose_quad(r);
+    }
+    TET_UNROLL
+    for (int q = 0; q < 12; q++) x[q / 3][q % 3] = col[q];
+}
+
+/* The storing scatter (tet_scatter_node with store) of four such elements:
+ * 0 + g_0 and 0 - g_a as vectors, lane by lane what the scalar store
+ * gives, transposed back to rows and stored whole. */
+TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const tet_quad g[4][3])
+{
+    const tet_quad zero = {0.0, 0.0, 0.0, 0.0};
+    tet_quad row[12];
+    TET_UNROLL
+    for (int q = 0; q < 12; q++) row[q] = q < 3 ? zero + g[0][q] : zero - g[q / 3][q % 3];
+    TET_UNROLL
+    for (int k = 0; k < 3; k++) {
+        tet_quad *r = row + 4 * k;
+        tet_transpose_quad(r);
+        TET_UNROLL
+        for (int l = 0; l < 4; l++)
+            memcpy(f + 3 * (size_t)t[l].node[0] + 4 * k, &r[l], sizeof r[l]);
+    }
+}
+
+/* Six numbers a lane in four adjacent rows of six (24 numbers) as six
+ * vectors over the lanes, and back: a transpose of the first four of each
+ * row, and the last two of the rows paired across the lanes. */
+TET_KERNEL void tet_load_six_quad(const double *rows, tet_quad v[6])
+{
+    TET_UNROLL
+    for (int l = 0; l < 4; l++) memcpy(&v[l], rows + 6 * l, sizeof v[l]);
+    tet_transpose_quad(v);
+    __m256d p = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(rows + 4)),
+                                     _mm_loadu_pd(rows + 16), 1); /* rows 0, 2 */
+    __m256d q = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(rows + 10)),
+                                     _mm_loadu_pd(rows + 22), 1); /* rows 1, 3 */
+    v[4] = (tet_quad)_mm256_unpacklo_pd(p, q);
+    v[5] = (tet_quad)_mm256_unpackhi_pd(p, q);
+}
+
+TET_KERNEL void tet_store_six_quad(double *rows, const tet_quad v[6])
+{
+    tet_quad r[4] = {v[0], v[1], v[2], v[3]};
+    tet_transpose_quad(r);
+    TET_UNROLL
+    for (int l = 0; l < 4; l++) memcpy(rows + 6 * l, &r[l], sizeof r[l]);
+    __m256d p = _mm256_unpacklo_pd((__m256d)v[4], (__m256d)v[5]); /* rows 0, 2 */
+    __m256d q = _mm256_unpackhi_pd((__m256d)v[4], (__m256d)v[5]); /* rows 1, 3 */
+    _mm_storeu_pd(rows + 4, _mm256_castpd256_pd128(p));
+    _mm_storeu_pd(rows + 16, _mm256_extractf128_pd(p, 1));
+    _mm_storeu_pd(rows + 10, _mm256_castpd256_pd128(q));
+    _mm_storeu_pd(rows + 22, _mm256_extractf128_pd(q, 1));
+}
+
+#define TET_GATHER_OWN(xyz, t, x) tet_gather_own_quad(xyz, t, x)
+#define TET_STORE_OWN(f, t, g) tet_store_own_quad(f, t, g)
+#define TET_LOAD_SIX(rows, v) tet_load_six_quad(rows, v)
+#define TET_STORE_SIX(rows, v) tet_store_six_quad(rows, v)
 #include "element_tet_lanes.h"
 #undef TET_V
 #undef TET_N
 #undef TET_VFN
 #undef TET_GATHER
+#undef TET_GATHER_OWN
+#undef TET_STORE_OWN
+#undef TET_LOAD_SIX
+#undef TET_STORE_SIX
 
 /* Four elements of one material: a call of its own, so that the baseline
  * loop, which never takes it, holds no AVX code. */
