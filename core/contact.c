@@ -709,7 +709,7 @@ int contact_forces(fdem_model *m)
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
     double half = 0.5 * cs->buffer;
-    if (cs->need_detect || cs->max_disp2 > half * half) {
+    if (cs->need_detect || contact_travel_past(m, half * half)) {
         double t0 = stage_clock();
         if (contact_detect(m)) return -1;
         double spent = stage_clock() - t0;

@@ -61,7 +61,7 @@ typedef double tet_quad __attribute__((vector_size(32)));
  * expression that of log_short_series), the division as one vector; else
  * lane by lane through the scalar path. */
 #define TET_LOG_INVERSE_LANES(T, N)                                                              \
-    static inline void tet_log_inverse_##T(T J, double j_min, T *lnJ, T *invJ)                  \
+    TET_KERNEL void tet_log_inverse_##T(T J, double j_min, T *lnJ, T *invJ)                      \
     {                                                                                           \
         T x = J - 1.0;                                                                          \
         int near = 1;                                                                           \

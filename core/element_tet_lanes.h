@@ -9,8 +9,18 @@
  *   TET_V, TET_N        the vector type and its lane count
  *   TET_VFN(name)       name with the kernel's suffix (_pair, _quad)
  *   TET_GATHER(p, i)    the vector of p[lane][i] over the lanes
+ *   TET_GATHER_OWN(xyz, t, x), TET_STORE_OWN(f, t, g)
+ *                       tet_gather_nodes and the storing scatter for a group
+ *                       whose elements' nodes are their own and consecutive
+ *                       (model_part_stores_forces): whole rows moved and
+ *                       transposed, or the lane by lane way
+ *   TET_LOAD_SIX(rows, v), TET_STORE_SIX(rows, v)
+ *                       v[q] = the vector of rows[6 lane + q], q < 6, and
+ *                       back (the group's stored viscous stresses)
  */
-#if !defined(TET_V) || !defined(TET_N) || !defined(TET_VFN) || !defined(TET_GATHER)
+#if !defined(TET_V) || !defined(TET_N) || !defined(TET_VFN) || !defined(TET_GATHER) ||           \
+    !defined(TET_GATHER_OWN) || !defined(TET_STORE_OWN) || !defined(TET_LOAD_SIX) ||        \
+    !defined(TET_STORE_SIX)
 #error "element_tet_lanes.h is included by element_tet_model.c only"
 #endif
 
@@ -28,14 +38,14 @@ TET_KERNEL void TET_VFN(tet_gather_nodes)(const double *xyz, const tet_hot *t, T
 }
 
 /* The forces of lane `lane` of g (tet_kernel_face_loads): f_0 = g_0 added,
- * f_a = -g_a subtracted. */
+ * f_a = -g_a subtracted (`store`: tet_scatter_node). */
 TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], const TET_V g[4][3],
-                                          int lane)
+                                          int lane, const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
         tet_scatter_node(f, node[a], (tet_pair){g[a][0][lane], g[a][1][lane]}, g[a][2][lane],
-                         a == 0);
+                         a == 0, store);
 }
 
 /* Lane `lane` of a group's face vectors and sixth stress as scalars, the
@@ -59,7 +69,7 @@ static inline void TET_VFN(tet_damp_lane)(const fdem_model *m, const tet_hot *t,
  * order as one at a time would; else each lane through tet_damp_lane. */
 TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
                                         const TET_V c[3][3], TET_V det, TET_V s[6],
-                                        tet_sums *sum)
+                                        tet_sums *sum, const int store)
 {
     int all = 1;
     TET_UNROLL
@@ -70,21 +80,19 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
         return;
     }
     TET_V v[4][3], S[6], sv[6], prev[6], eta2;
-    TET_VFN(tet_gather_nodes)(m->vel, t, v);
+    if (store)
+        TET_GATHER_OWN(m->vel, t, v);
+    else
+        TET_VFN(tet_gather_nodes)(m->vel, t, v);
     TET_VFN(tet_kernel_rate)(v[0], v[1], v[2], v[3], c, S);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) eta2[l] = 2 * t[l].eta;
     TET_V scale = eta2 / det;
     /* the group's stored stresses are adjacent, 6 numbers each */
     double *stored = m->elem_viscous + 6 * (size_t)(t - m->tet);
-    const double *st[TET_N];
+    TET_LOAD_SIX(stored, prev);
     TET_UNROLL
-    for (int l = 0; l < TET_N; l++) st[l] = stored + 6 * l;
-    TET_UNROLL
-    for (int q = 0; q < 6; q++) {
-        sv[q] = scale * S[q];
-        prev[q] = TET_GATHER(st, q);
-    }
+    for (int q = 0; q < 6; q++) sv[q] = scale * S[q];
     TET_V now = TET_VFN(tet_kernel_contract)(sv, S), before = TET_VFN(tet_kernel_contract)(prev, S);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) {
@@ -92,20 +100,20 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
         sum->power_prev -= before[l];
     }
     TET_UNROLL
-    for (int q = 0; q < 6; q++) {
-        s[q] += sv[q] * (1.0 / 6);
-        TET_UNROLL
-        for (int l = 0; l < TET_N; l++) stored[6 * l + q] = sv[q][l];
-    }
+    for (int q = 0; q < 6; q++) s[q] += sv[q] * (1.0 / 6);
+    TET_STORE_SIX(stored, sv);
 }
 
 /* TET_N elements t[0 .. TET_N-1] of one material. */
 TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_constants *k,
-                                          tet_sums *sum, const int stressed)
+                                          tet_sums *sum, const int stressed, const int store)
 {
     const double *p[TET_N];
     TET_V x[4][3], X[9];
-    TET_VFN(tet_gather_nodes)(m->pos, t, x);
+    if (store)
+        TET_GATHER_OWN(m->pos, t, x);
+    else
+        TET_VFN(tet_gather_nodes)(m->pos, t, x);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) p[l] = t[l].xinv;
     TET_UNROLL
@@ -127,11 +135,15 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
     int damped = 0;
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) damped |= t[l].eta > 0;
-    if (damped) TET_VFN(tet_damp_group)(m, t, c, det, s, sum);
+    if (damped) TET_VFN(tet_damp_group)(m, t, c, det, s, sum, store);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) sum->energy += w[l] * t[l].volume0;
     TET_V g[4][3];
     TET_VFN(tet_kernel_face_loads)(s, c, g);
+    if (store) {
+        TET_STORE_OWN(m->force, t, g);
+        return;
+    }
     TET_UNROLL
-    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l);
+    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l, 0);
 }

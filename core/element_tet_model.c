@@ -16,10 +16,22 @@
 
 #include "element_tet_kernel.h"
 #include "model.h"
+#if TET_QUADS
+#include <immintrin.h>
+#endif
 
 int tet_element_prepare(fdem_model *m, int e, fdem_error *err)
 {
     tet_hot *t = &m->tet[e];
+    /* the storing loop moves an element's four nodes as one block of
+     * twelve numbers (tet_gather_own_quad): part_append numbers them so */
+    if (model_part_stores_forces(m, &m->parts[m->elem_part[e]]))
+        for (int c = 1; c < 4; c++)
+            if (t->node[c] != t->node[0] + c) {
+                model_error(err, FDEM_ITEM_ELEMENT, e,
+                            "element %d of a fracturing part does not have consecutive nodes", e);
+                return -1;
+            }
     tet_geometry g;
     if (tet_prepare(m->pos0, t->node, &g)) {
         model_error(err, FDEM_ITEM_ELEMENT, e, "element %d has no positive volume", e);
@@ -109,22 +121,33 @@ static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double 
 
 /* force[n] += or -= one node's load (x, y, z): x and y as one 16-byte
  * vector, z alone. Every scatter writes the nodes this same way, so the
- * next element's load of a node just stored forwards from the store. */
-static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add)
+ * next element's load of a node just stored forwards from the store.
+ * `store` (a constant at each call: the element's part has nodes of its
+ * own, so this element is the first and only one to write them this step)
+ * starts from zero instead of reading the force: 0 + x and 0 - x are what
+ * the zeroed array gave, to the bit (signed zeros included), without the
+ * step having to zero it first or this loop reading it. */
+static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add,
+                                    const int store)
 {
     double *fn = f + 3 * (size_t)n;
-    tet_pair old;
-    memcpy(&old, fn, sizeof old);
+    tet_pair old = {0.0, 0.0};
+    double old_z = 0.0;
+    if (!store) {
+        memcpy(&old, fn, sizeof old);
+        old_z = fn[2];
+    }
     old = add ? old + xy : old - xy;
     memcpy(fn, &old, sizeof old);
-    fn[2] = add ? fn[2] + z : fn[2] - z;
+    fn[2] = add ? old_z + z : old_z - z;
 }
 
-static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3])
+static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3],
+                               const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
-        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0);
+        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0, store);
 }
 
 /* Element t's in-situ pre-stress (initial_stress.c). */
@@ -134,9 +157,10 @@ static inline const double *tet_stress0(const fdem_model *m, const tet_hot *t)
 }
 
 /* One element alone: the last of an odd range, or a pair of two materials.
- * `stressed` (a constant at each call) adds the element's pre-stress. */
+ * `stressed` (a constant at each call) adds the element's pre-stress;
+ * `store`: see tet_scatter_node. */
 TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
-                               const int stressed)
+                               const int stressed, const int store)
 {
     const double *pos = m->pos;
     const int32_t *n = t->node;
@@ -152,18 +176,38 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     if (t->eta > 0) tet_damp(m, t, c, det, s, sum);
     double g[4][3];
     tet_kernel_face_loads(s, c, g);
-    tet_scatter(m->force, n, g);
+    tet_scatter(m->force, n, g, store);
 }
 
 #define TET_V tet_pair
 #define TET_N 2
 #define TET_VFN(name) name##_pair
 #define TET_GATHER(p, i) ((tet_pair){(p)[0][i], (p)[1][i]})
+#define TET_GATHER_OWN(xyz, t, x) tet_gather_nodes_pair(xyz, t, x)
+#define TET_LOAD_SIX(rows, v)                                                                    \
+    do {                                                                                         \
+        for (int q_ = 0; q_ < 6; q_++) v[q_] = (tet_pair){(rows)[q_], (rows)[6 + q_]};          \
+    } while (0)
+#define TET_STORE_SIX(rows, v)                                                                   \
+    do {                                                                                         \
+        for (int q_ = 0; q_ < 6; q_++) {                                                         \
+            (rows)[q_] = v[q_][0];                                                               \
+            (rows)[6 + q_] = v[q_][1];                                                           \
+        }                                                                                        \
+    } while (0)
+#define TET_STORE_OWN(f, t, g)                                                                   \
+    do {                                                                                         \
+        for (int l_ = 0; l_ < 2; l_++) tet_scatter_lane_pair(f, (t)[l_].node, g, l_, 1);        \
+    } while (0)
 #include "element_tet_lanes.h"
 #undef TET_V
 #undef TET_N
 #undef TET_VFN
 #undef TET_GATHER
+#undef TET_GATHER_OWN
+#undef TET_STORE_OWN
+#undef TET_LOAD_SIX
+#undef TET_STORE_SIX
 
 #if TET_QUADS
 #pragma GCC push_options
@@ -172,21 +216,114 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
 #define TET_N 4
 #define TET_VFN(name) name##_quad
 #define TET_GATHER(p, i) ((tet_quad){(p)[0][i], (p)[1][i], (p)[2][i], (p)[3][i]})
+
+/* Four rows of four numbers, one per lane, turned into four vectors over
+ * the lanes (vector k holds number k of each row), and back: the same
+ * transpose. */
+TET_KERNEL void tet_transpose_quad(tet_quad r[4])
+{
+    __m256d t0 = _mm256_unpacklo_pd((__m256d)r[0], (__m256d)r[1]);
+    __m256d t1 = _mm256_unpackhi_pd((__m256d)r[0], (__m256d)r[1]);
+    __m256d t2 = _mm256_unpacklo_pd((__m256d)r[2], (__m256d)r[3]);
+    __m256d t3 = _mm256_unpackhi_pd((__m256d)r[2], (__m256d)r[3]);
+    r[0] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x20);
+    r[1] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x20);
+    r[2] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x31);
+    r[3] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x31);
+}
+
+/* tet_gather_nodes for four elements whose four nodes are consecutive:
+ * each element's twelve numbers are three rows of four, so three loads
+ * and a transpose per block of four numbers instead of 48 single ones. */
+TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, tet_quad x[4][3])
+{
+    tet_quad col[12];
+    TET_UNROLL
+    for (int k = 0; k < 3; k++) {
+        tet_quad *r = col + 4 * k;
+        TET_UNROLL
+        for (int l = 0; l < 4; l++)
+            memcpy(&r[l], xyz + 3 * (size_t)t[l].node[0] + 4 * k, sizeof r[l]);
+        tet_transpose_quad(r);
+    }
+    TET_UNROLL
+    for (int q = 0; q < 12; q++) x[q / 3][q % 3] = col[q];
+}
+
+/* The storing scatter (tet_scatter_node with store) of four such elements:
+ * 0 + g_0 and 0 - g_a as vectors, lane by lane what the scalar store
+ * gives, transposed back to rows and stored whole. */
+TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const tet_quad g[4][3])
+{
+    const tet_quad zero = {0.0, 0.0, 0.0, 0.0};
+    tet_quad row[12];
+    TET_UNROLL
+    for (int q = 0; q < 12; q++) row[q] = q < 3 ? zero + g[0][q] : zero - g[q / 3][q % 3];
+    TET_UNROLL
+    for (int k = 0; k < 3; k++) {
+        tet_quad *r = row + 4 * k;
+        tet_transpose_quad(r);
+        TET_UNROLL
+        for (int l = 0; l < 4; l++)
+            memcpy(f + 3 * (size_t)t[l].node[0] + 4 * k, &r[l], sizeof r[l]);
+    }
+}
+
+/* Six numbers a lane in four adjacent rows of six (24 numbers) as six
+ * vectors over the lanes, and back: a transpose of the first four of each
+ * row, and the last two of the rows paired across the lanes. */
+TET_KERNEL void tet_load_six_quad(const double *rows, tet_quad v[6])
+{
+    TET_UNROLL
+    for (int l = 0; l < 4; l++) memcpy(&v[l], rows + 6 * l, sizeof v[l]);
+    tet_transpose_quad(v);
+    __m256d p = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(rows + 4)),
+                                     _mm_loadu_pd(rows + 16), 1); /* rows 0, 2 */
+    __m256d q = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(rows + 10)),
+                                     _mm_loadu_pd(rows + 22), 1); /* rows 1, 3 */
+    v[4] = (tet_quad)_mm256_unpacklo_pd(p, q);
+    v[5] = (tet_quad)_mm256_unpackhi_pd(p, q);
+}
+
+TET_KERNEL void tet_store_six_quad(double *rows, const tet_quad v[6])
+{
+    tet_quad r[4] = {v[0], v[1], v[2], v[3]};
+    tet_transpose_quad(r);
+    TET_UNROLL
+    for (int l = 0; l < 4; l++) memcpy(rows + 6 * l, &r[l], sizeof r[l]);
+    __m256d p = _mm256_unpacklo_pd((__m256d)v[4], (__m256d)v[5]); /* rows 0, 2 */
+    __m256d q = _mm256_unpackhi_pd((__m256d)v[4], (__m256d)v[5]); /* rows 1, 3 */
+    _mm_storeu_pd(rows + 4, _mm256_castpd256_pd128(p));
+    _mm_storeu_pd(rows + 16, _mm256_extractf128_pd(p, 1));
+    _mm_storeu_pd(rows + 10, _mm256_castpd256_pd128(q));
+    _mm_storeu_pd(rows + 22, _mm256_extractf128_pd(q, 1));
+}
+
+#define TET_GATHER_OWN(xyz, t, x) tet_gather_own_quad(xyz, t, x)
+#define TET_STORE_OWN(f, t, g) tet_store_own_quad(f, t, g)
+#define TET_LOAD_SIX(rows, v) tet_load_six_quad(rows, v)
+#define TET_STORE_SIX(rows, v) tet_store_six_quad(rows, v)
 #include "element_tet_lanes.h"
 #undef TET_V
 #undef TET_N
 #undef TET_VFN
 #undef TET_GATHER
+#undef TET_GATHER_OWN
+#undef TET_STORE_OWN
+#undef TET_LOAD_SIX
+#undef TET_STORE_SIX
 
 /* Four elements of one material: a call of its own, so that the baseline
  * loop, which never takes it, holds no AVX code. */
 static void tet_forces_quad(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
-                            int stressed)
+                            int stressed, int store)
 {
     if (stressed)
-        tet_forces_group_quad(m, t, k, sum, 1);
+        tet_forces_group_quad(m, t, k, sum, 1, store);
+    else if (store)
+        tet_forces_group_quad(m, t, k, sum, 0, 1);
     else
-        tet_forces_group_quad(m, t, k, sum, 0);
+        tet_forces_group_quad(m, t, k, sum, 0, 0);
 }
 #pragma GCC pop_options
 #endif
@@ -205,10 +342,11 @@ static void tet_forces_quad(fdem_model *m, const tet_hot *t, tet_constants *k, t
  *  - records prefetched ahead;
  *  - damping: one division, and its power from s : S directly. */
 TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const int stressed,
-                               const int quads, double sums[SCATTER_SUMS])
+                               const int store, const int quads, tet_constants *constants,
+                               tet_sums *sums)
 {
-    tet_sums sum = {0, 0, 0};
-    tet_constants k = {.material = -1};
+    tet_sums sum = *sums;
+    tet_constants k = *constants;
     const tet_hot *t = m->tet + begin, *end = m->tet + end_index;
     while (end - t >= 2) {
         const tet_hot *ahead = end - t > TET_PREFETCH + 3 ? t + TET_PREFETCH : t;
@@ -223,23 +361,22 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
             TET_PREFETCH_READ((const char *)ahead + 320);
             TET_PREFETCH_READ((const char *)ahead + 384);
             TET_PREFETCH_READ((const char *)ahead + 448);
-            tet_forces_quad(m, t, &k, &sum, stressed);
+            tet_forces_quad(m, t, &k, &sum, stressed, store);
             t += 4;
             continue;
         }
 #endif
         if (t[0].material == t[1].material) {
-            tet_forces_group_pair(m, t, &k, &sum, stressed);
+            tet_forces_group_pair(m, t, &k, &sum, stressed, store);
         } else {
-            tet_forces_one(m, t, &k, &sum, stressed);
-            tet_forces_one(m, t + 1, &k, &sum, stressed);
+            tet_forces_one(m, t, &k, &sum, stressed, store);
+            tet_forces_one(m, t + 1, &k, &sum, stressed, store);
         }
         t += 2;
     }
-    if (t < end) tet_forces_one(m, t, &k, &sum, stressed);
-    sums[0] += sum.energy;
-    sums[1] += sum.power_now * (1.0 / 6);
-    sums[2] += sum.power_prev * (1.0 / 6);
+    if (t < end) tet_forces_one(m, t, &k, &sum, stressed, store);
+    *sums = sum;
+    *constants = k;
 }
 
 /* The loop is compiled twice, for the baseline x86-64 (pairs in SSE2) and
@@ -253,41 +390,68 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
  * 300 instructions, 34.4 -> 27.4 ns. */
 #if TET_QUADS
 __attribute__((target("avx2"))) static void tet_forces_avx2(fdem_model *m, int begin, int end,
-                                                             int stressed,
-                                                             double sums[SCATTER_SUMS])
+                                                             int stressed, int store,
+                                                             tet_constants *k, tet_sums *sum)
 {
     if (stressed)
-        tet_forces_run(m, begin, end, 1, 1, sums);
+        tet_forces_run(m, begin, end, 1, store, 1, k, sum);
+    else if (store)
+        tet_forces_run(m, begin, end, 0, 1, 1, k, sum);
     else
-        tet_forces_run(m, begin, end, 0, 1, sums);
+        tet_forces_run(m, begin, end, 0, 0, 1, k, sum);
 }
 #endif
 
-static void tet_forces_dispatch(fdem_model *m, int begin, int end, int stressed,
-                                double sums[SCATTER_SUMS])
+/* A part with an in-situ stress is rare: its loop takes `store` as a
+ * variable (one variant fewer). */
+static void tet_forces_dispatch(fdem_model *m, int begin, int end, int stressed, int store,
+                                tet_constants *k, tet_sums *sum)
 {
 #if TET_QUADS
     if (__builtin_cpu_supports("avx2")) {
-        tet_forces_avx2(m, begin, end, stressed, sums);
+        tet_forces_avx2(m, begin, end, stressed, store, k, sum);
         return;
     }
 #endif
     if (stressed)
-        tet_forces_run(m, begin, end, 1, 0, sums);
+        tet_forces_run(m, begin, end, 1, store, 0, k, sum);
+    else if (store)
+        tet_forces_run(m, begin, end, 0, 1, 0, k, sum);
     else
-        tet_forces_run(m, begin, end, 0, 0, sums);
+        tet_forces_run(m, begin, end, 0, 0, 0, k, sum);
+}
+
+/* Elements [begin, end) run by run of one part: a part whose nodes are its
+ * elements' own (model_part_stores_forces) stores their forces, the others
+ * add to what the zeroed array holds (elements of a part are contiguous).
+ * One running sum over the whole range, whatever its runs, so the energy
+ * is added in the order it always was. */
+static void tet_forces_by_part(fdem_model *m, int begin, int end, int stressed,
+                               double sums[SCATTER_SUMS])
+{
+    tet_sums sum = {0, 0, 0};
+    tet_constants k = {.material = -1};
+    for (int e = begin; e < end;) {
+        const part *p = &m->parts[m->elem_part[e]];
+        int stop = p->elem_begin + p->elem_count < end ? p->elem_begin + p->elem_count : end;
+        tet_forces_dispatch(m, e, stop, stressed, model_part_stores_forces(m, p), &k, &sum);
+        e = stop;
+    }
+    sums[0] += sum.energy;
+    sums[1] += sum.power_now * (1.0 / 6);
+    sums[2] += sum.power_prev * (1.0 / 6);
 }
 
 void tet_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    tet_forces_dispatch(m, begin, end, 0, sums);
+    tet_forces_by_part(m, begin, end, 0, sums);
 }
 
 /* The same loop for the elements of a part with an in-situ stress. */
 void tet_element_forces_range_stressed(fdem_model *m, int begin, int end,
                                        double sums[SCATTER_SUMS])
 {
-    tet_forces_dispatch(m, begin, end, 1, sums);
+    tet_forces_by_part(m, begin, end, 1, sums);
 }
 
 void tet_element_stress(const fdem_model *m, int e, double out[6])

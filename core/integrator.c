@@ -23,12 +23,120 @@
  * velocities: non-finite if and only if some value is (cheaper than a test
  * per value in the hot loop); it is accumulated as one add per node, so
  * that its dependency chain does not pace the loop. sums[1] gets the work
- * of the contact forces (times 2 / havg), sums[SCATTER_MAX] the largest
- * squared displacement since the last detection and sums[SCATTER_MAX + 1]
- * the largest since the near list was built (contact.c). with_contact (contact is
- * on: track displacements) and with_force (some contact force may be
- * non-zero) are constants at each call below, so the compiler emits each
- * loop without the loads and branches it does not need. */
+ * of the contact forces (times 2 / havg). With contact on (with_contact)
+ * sums[SCATTER_MAX] gets the largest squared step of a node, new minus old
+ * position as computed (contact_travel_step makes a bound of it); with
+ * candidate pairs (with_force: some contact force may be non-zero, and the
+ * near list is in use) sums[SCATTER_MAX + 1] the largest squared
+ * displacement since the near list was built (contact.c). Both flags are
+ * constants at each call below, so the compiler emits each loop without
+ * the loads and branches it does not need. A node with no prescribed dof
+ * (nearly all) takes the branch-free path. */
+static inline __attribute__((always_inline)) void
+central_difference_node(double *x, double *v, const double *f, const double *fc,
+                        const double *xn, double inv_mass, const double *g, double h,
+                        double havg, unsigned own, const int D, int with_contact,
+                        int with_force, double *check, double *work_sum, double *move2,
+                        double *near2)
+{
+    double pos_sum = 0, vel_sum = 0, work = 0, s2 = 0, n2 = 0;
+#pragma GCC unroll 3
+    for (int d = 0; d < D; d++) {
+        double fd = f[d], v_old = v[d];
+        if (with_force) fd += fc[d];
+        double vd = v_old, p_old = x[d], pd = p_old;
+        if (!(own & (1u << d))) {
+            vd += (fd * inv_mass + g[d]) * havg;
+            pd += vd * h;
+            v[d] = vd;
+            x[d] = pd;
+            /* f . (v_old + v_new)/2 * havg is exactly what a force adds
+             * to the half-step kinetic energy, so the balance closes
+             * (constrained dofs: constraint_enforce). */
+            if (with_force) work += fc[d] * (v_old + vd);
+        }
+        pos_sum += pd;
+        vel_sum += vd;
+        if (with_contact) {
+            double s = pd - p_old;
+            s2 += s * s;
+        }
+        if (with_force) {
+            double w = pd - xn[d];
+            n2 += w * w;
+        }
+    }
+    *check += pos_sum + vel_sum;
+    if (with_force) *work_sum += work;
+    if (with_contact && s2 > *move2) *move2 = s2;
+    if (with_force && n2 > *near2) *near2 = n2;
+}
+
+/* The same update for a node with no prescribed dof (nearly every node),
+ * x and y side by side in one 16-byte vector, z alone: per component the
+ * operations of central_difference_node in its order, so the same bits;
+ * the contact work and the near-list distance are added in its order too
+ * (they are results), the finiteness check and the step bound in any. */
+typedef double cd_pair __attribute__((vector_size(16)));
+
+static inline __attribute__((always_inline)) void
+central_difference_free_node(double *x, double *v, const double *f, const double *fc,
+                             const double *xn, double inv_mass, cd_pair gxy, double gz,
+                             double h, double havg, const int D, int with_contact,
+                             int with_force, cd_pair *check, double *check_z, double *work_sum,
+                             double *move2, double *near2)
+{
+    cd_pair fxy, vxy, xxy;
+    memcpy(&fxy, f, sizeof fxy);
+    memcpy(&vxy, v, sizeof vxy);
+    memcpy(&xxy, x, sizeof xxy);
+    cd_pair cxy = {0, 0};
+    if (with_force) {
+        memcpy(&cxy, fc, sizeof cxy);
+        fxy += cxy;
+    }
+    cd_pair vn = vxy + (fxy * inv_mass + gxy) * havg;
+    cd_pair pn = xxy + vn * h;
+    memcpy(v, &vn, sizeof vn);
+    memcpy(x, &pn, sizeof pn);
+    *check += pn + vn;
+    double vz = 0, pz = 0, z_old = 0, vz_old = 0;
+    if (D == 3) {
+        double fz = f[2];
+        if (with_force) fz += fc[2];
+        vz_old = v[2];
+        z_old = x[2];
+        vz = vz_old + (fz * inv_mass + gz) * havg;
+        pz = z_old + vz * h;
+        v[2] = vz;
+        x[2] = pz;
+        *check_z += pz + vz;
+    }
+    if (with_force) {
+        cd_pair wv = cxy * (vxy + vn);
+        double work = 0.0 + wv[0];
+        work += wv[1];
+        if (D == 3) work += fc[2] * (vz_old + vz);
+        *work_sum += work;
+    }
+    if (with_contact) {
+        cd_pair s = pn - xxy;
+        s *= s;
+        double s2 = s[0] + s[1];
+        if (D == 3) s2 += (pz - z_old) * (pz - z_old);
+        if (s2 > *move2) *move2 = s2;
+    }
+    if (with_force) {
+        cd_pair w;
+        memcpy(&w, xn, sizeof w);
+        w = pn - w;
+        w *= w;
+        double n2 = w[0] + w[1];
+        if (D == 3) n2 += (pz - xn[2]) * (pz - xn[2]);
+        if (n2 > *near2) *near2 = n2;
+    }
+}
+
 static inline __attribute__((always_inline)) void
 central_difference_pass(fdem_model *m, int begin, int end, const int D, int with_contact,
                         int with_force, double sums[SCATTER_SUMS])
@@ -38,44 +146,28 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
     double *x = m->pos, *v = m->vel;
     const double *f = m->force, *inv_mass = m->inv_mass;
     const uint8_t *owned = m->dof_owned;
-    const double *fc = m->contact.force;
-    const double *xd = m->contact.pos_detect, *xn = m->contact.pos_near;
-    double check = 0, max_disp2 = 0, near_disp2 = 0, contact_work = 0;
+    const double *fc = m->contact.force, *xn = m->contact.pos_near;
+    const cd_pair gxy = {g[0], g[1]};
+    const double gz = D == 3 ? g[2] : 0;
+    cd_pair check_xy = {0, 0};
+    double check = 0, move2 = 0, near2 = 0, contact_work = 0;
     for (int i = begin; i < end; i++) {
         const size_t at = (size_t)D * (size_t)i;
         unsigned own = owned[i];
-        double pos_sum = 0, vel_sum = 0, work = 0, d2 = 0, n2 = 0;
-        for (int d = 0; d < D; d++) {
-            double fd = f[at + d], v_old = v[at + d];
-            if (with_force) fd += fc[at + d];
-            double vd = v_old, pd = x[at + d];
-            if (!(own & (1u << d))) {
-                vd += (fd * inv_mass[i] + g[d]) * havg;
-                pd += vd * h;
-                v[at + d] = vd;
-                x[at + d] = pd;
-                /* f . (v_old + v_new)/2 * havg is exactly what a force adds
-                 * to the half-step kinetic energy, so the balance closes
-                 * (constrained dofs: constraint_enforce). */
-                if (with_force) work += fc[at + d] * (v_old + vd);
-            }
-            pos_sum += pd;
-            vel_sum += vd;
-            if (with_contact) {
-                double u = pd - xd[at + d], w = pd - xn[at + d];
-                d2 += u * u;
-                n2 += w * w;
-            }
-        }
-        check += pos_sum + vel_sum;
-        if (with_force) contact_work += work;
-        if (with_contact && d2 > max_disp2) max_disp2 = d2;
-        if (with_contact && n2 > near_disp2) near_disp2 = n2;
+        if (own == 0)
+            central_difference_free_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
+                                         with_force ? xn + at : NULL, inv_mass[i], gxy, gz, h,
+                                         havg, D, with_contact, with_force, &check_xy, &check,
+                                         &contact_work, &move2, &near2);
+        else
+            central_difference_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
+                                    with_force ? xn + at : NULL, inv_mass[i], g, h, havg, own, D, with_contact, with_force, &check,
+                                    &contact_work, &move2, &near2);
     }
-    sums[0] += check;
+    sums[0] += check + check_xy[0] + check_xy[1];
     sums[1] += contact_work;
-    if (max_disp2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = max_disp2;
-    if (near_disp2 > sums[SCATTER_MAX + 1]) sums[SCATTER_MAX + 1] = near_disp2;
+    if (move2 > sums[SCATTER_MAX]) sums[SCATTER_MAX] = move2;
+    if (near2 > sums[SCATTER_MAX + 1]) sums[SCATTER_MAX + 1] = near2;
 }
 
 #define CENTRAL_DIFFERENCE_PASSES(D)                                                              \
@@ -103,7 +195,6 @@ int central_difference_step(fdem_model *m)
 {
     double havg = 0.5 * (m->dt_prev + m->dt);
     double sums[SCATTER_SUMS] = {0};
-    sums[SCATTER_MAX] = m->contact.max_disp2;
     sums[SCATTER_MAX + 1] = m->contact.near_disp2;
     const int three = m->dim == 3;
     scatter_block_fn pass = !m->contact.enabled
@@ -112,10 +203,61 @@ int central_difference_step(fdem_model *m)
                                  ? (three ? central_difference_tracked_3 : central_difference_tracked_2)
                                  : (three ? central_difference_contact_3 : central_difference_contact_2);
     scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
-    m->contact.max_disp2 = sums[SCATTER_MAX];
+    if (m->contact.enabled) contact_travel_step(m, sums[SCATTER_MAX]);
     m->contact.near_disp2 = sums[SCATTER_MAX + 1];
     m->contact_work += sums[1] * 0.5 * havg;
     return isfinite(sums[0]) ? 0 : -1;
+}
+
+/* How far the nodes have gone from pos_detect (the displacement-tracking
+ * protocol of contact detection, contact.c). Detection runs again at the
+ * first step after which some node is more than half the buffer from its
+ * place there. Measuring that exactly each step means reading the whole
+ * snapshot each step (24 bytes a node, a third of what the update itself
+ * moves); instead contact.max_disp2 holds a bound of the squared distance,
+ * grown each step by the largest step any node took (the triangle
+ * inequality), which costs nothing the update does not already hold in
+ * registers. Only when the bound passes the limit is the snapshot read
+ * (contact_travel_past) and the bound restarted from the exact figure, so
+ * detection runs exactly when the exact figure would have run it: the
+ * same pairs in the same order, the same bits.
+ *
+ * Rounding: each node's step is new minus old position as computed, so
+ * the true step is within a few units in the last place of it; the slack
+ * below is a thousand times those, and keeps the bound a bound. Nodes
+ * with a prescribed dof are measured exactly by constraint_enforce, which
+ * moves them after this. */
+#define TRAVEL_SLACK (1 + 1e-12)
+
+void contact_travel_step(fdem_model *m, double step2)
+{
+    double reach = sqrt(m->contact.max_disp2) + sqrt(step2);
+    m->contact.max_disp2 = reach * reach * TRAVEL_SLACK;
+}
+
+static void travel_exact_block(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    const size_t D = (size_t)m->dim;
+    const double *x = m->pos, *xd = m->contact.pos_detect;
+    double most = 0;
+    for (size_t k = D * (size_t)begin; k < D * (size_t)end; k += D) {
+        double d2 = 0;
+        for (size_t d = 0; d < D; d++) {
+            double u = x[k + d] - xd[k + d];
+            d2 += u * u;
+        }
+        if (d2 > most) most = d2;
+    }
+    if (most > sums[SCATTER_MAX]) sums[SCATTER_MAX] = most;
+}
+
+int contact_travel_past(fdem_model *m, double limit2)
+{
+    if (!(m->contact.max_disp2 > limit2)) return 0;
+    double sums[SCATTER_SUMS] = {0};
+    scatter_plan_run(&m->node_plan, m, m->threads, travel_exact_block, sums);
+    m->contact.max_disp2 = sums[SCATTER_MAX];
+    return sums[SCATTER_MAX] > limit2;
 }
 
 double stage_clock(void)
@@ -144,6 +286,25 @@ static void report_non_finite(fdem_model *m, double h, fdem_error *err)
                 (long long)m->step + 1, m->time + h, elem, node, h, m->stable_dt);
 }
 
+/* Zeroes the force of every node the element pass adds to; the nodes of
+ * parts whose elements store their forces (model_part_stores_forces) are
+ * left as they are, the pass overwrites them. Parts hold consecutive
+ * nodes, so this is a memset per run of such parts. */
+static void forces_clear(fdem_model *m)
+{
+    const size_t D = (size_t)m->dim;
+    int from = 0; /* the first node not zeroed yet */
+    for (int k = 0; k < m->part_count; k++) {
+        const part *p = &m->parts[k];
+        if (!model_part_stores_forces(m, p)) continue;
+        if (p->node_begin > from)
+            memset(m->force + D * (size_t)from, 0, sizeof(double) * D * (size_t)(p->node_begin - from));
+        from = p->node_begin + p->node_count;
+    }
+    if (m->node_count > from)
+        memset(m->force + D * (size_t)from, 0, sizeof(double) * D * (size_t)(m->node_count - from));
+}
+
 int fdem_step(fdem_model *m, fdem_error *err)
 {
     if (!m->finalized) {
@@ -153,7 +314,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
     double t0 = stage_clock();
     constraint_set_time(m, m->time + 0.5 * h);
-    memset(m->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    forces_clear(m);
     element_forces(m);
     if (m->joint_count) {
         int broke = joint_forces(m);

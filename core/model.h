@@ -124,7 +124,8 @@ typedef struct contact_state {
     int slots;               /* stick springs per pair */
     int pair_out;            /* numbers a pair evaluation hands back */
     double buffer;           /* added to circle diameters; re-detect after buffer/2 */
-    double max_disp2;        /* largest squared node displacement since detection */
+    double max_disp2;        /* bound of the squared node displacement since detection,
+                                exact once past the limit (integrator.c) */
     int need_detect;
     long detections;
     int touching;            /* pairs with non-zero force in the last step */
@@ -312,6 +313,15 @@ static inline const int32_t *element_nodes(const fdem_model *m, int e)
     return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
 }
 
+/* A part whose elements' forces are stored, not added, at each step: a
+ * fracturing part in 3D, where every element has nodes of its own, so the
+ * step need not zero their forces first (element_tet_model.c; the triangle
+ * kernel adds everywhere). */
+static inline int model_part_stores_forces(const fdem_model *m, const part *p)
+{
+    return m->dim == 3 && p->fracture;
+}
+
 /* Initial area (2D) or volume (3D), set by element_prepare. */
 static inline double element_size0(const fdem_model *m, int e)
 {
@@ -468,5 +478,11 @@ void energy_gravity_restored(fdem_model *m, double gravity_work);
 
 /* integrator.c */
 int central_difference_step(fdem_model *m);
+/* the travel since detection (contact.max_disp2, a bound; see integrator.c):
+ * grown by a step's largest squared node step, and whether some node is now
+ * farther than sqrt(limit2) from pos_detect (exact, read when the bound says
+ * it may be) */
+void contact_travel_step(fdem_model *m, double step2);
+int contact_travel_past(fdem_model *m, double limit2);
 
 #endif
