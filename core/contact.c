@@ -297,17 +297,18 @@ static int contact_near_refresh(fdem_model *m)
 
 /* Force between two elements whose boxes overlap, both roles, into out
  * (pair_out numbers); springs are the pair's stick springs (updated), h the
- * last step's size. The softer surface sets the penalty; friction is the
- * larger of the two, so giving it on one material is enough. Returns 1 if
- * they touched. Writes nothing in m. */
+ * last step's size, memo the walk's (contact_pair.h; NULL: none). The
+ * softer surface sets the penalty; friction is the larger of the two, so
+ * giving it on one material is enough. Returns 1 if they touched. Writes
+ * nothing in m. */
 static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
-                              double *out)
+                              double *out, contact_pair_memo *memo)
 {
     const material *ma = &m->materials[element_material(m, e1)];
     const material *mb = &m->materials[element_material(m, e2)];
     contact_pair_in in = {m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
                           min2(ma->penalty, mb->penalty),
-                          max2(ma->def.friction, mb->def.friction), h};
+                          max2(ma->def.friction, mb->def.friction), h, memo};
     return m->contact.kernel->pair_force(&in, springs, out);
 }
 
@@ -346,7 +347,8 @@ enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
  * unrolled. */
 static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, near_pair *np,
                                                                double h, double *out,
-                                                               double *fresh, int *pool, int D)
+                                                               double *fresh, int *pool,
+                                                               contact_pair_memo *memo, int D)
 {
     contact_state *cs = &m->contact;
     const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
@@ -367,7 +369,7 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
     else
         for (int s = 0; s < slots; s++) fresh[s] = 0;
-    int touched = contact_pair_force(m, a, b, h, springs, out);
+    int touched = contact_pair_force(m, a, b, h, springs, out, memo);
     int any = 0;
     for (int s = 0; s < slots; s++) any |= springs[s] != 0;
     if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
@@ -383,7 +385,8 @@ int contact_potential_force(fdem_model *m, int e1, int e2, double h)
     double b1[6] = {0}, b2[6] = {0}, out[CONTACT_PAIR_OUT_MAX], springs[CONTACT_SLOTS_MAX] = {0};
     element_box(m, e1, b1);
     element_box(m, e2, b2);
-    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out)) return 0;
+    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out, NULL))
+        return 0;
     contact_pair_scatter(m, e1, e2, out);
     return 1;
 }
@@ -620,11 +623,13 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
                                                                      int D)
 {
     contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
     int touching = 0;
     for (size_t i = 0; i < cs->near_count; i++) {
         near_pair *np = &cs->near[i];
         double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
         else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, np->pair, fresh)) return -1;
         if (touched <= 0) continue;
@@ -650,12 +655,14 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
                                                                      contact_touches *list, int D)
 {
     const contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
     int touching = 0;
     for (long i = begin; i < end; i++) {
         near_pair *np = &cs->near[i];
         long k = (long)np->pair;
         double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
         if (touched <= 0) continue;
