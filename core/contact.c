@@ -370,8 +370,11 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     else
         for (int s = 0; s < slots; s++) fresh[s] = 0;
     int touched = contact_pair_force(m, a, b, h, springs, out, memo);
+    /* a pair that did not touch has let every spring go (contact_pair.h):
+     * the springs are read only after a touch */
     int any = 0;
-    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (touched)
+        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
     if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
     if (set < 0 && any) *pool = SPRINGS_ADOPT;
     np->sprung = any;

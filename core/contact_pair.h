@@ -12,7 +12,8 @@
  *    contactor boundaries (edges, faces) of a against b, then those of b
  *    against a, the same count for each (so swapping the halves turns the
  *    pair (a, b) into (b, a)). A boundary that does not touch, or a pair
- *    without friction, leaves its springs at zero.
+ *    without friction, leaves its springs at zero: a pair that did not
+ *    touch has them all at zero.
  *  - It returns 1 if the pair touched; out then holds the forces on a's
  *    nodes (dim per node, node by node), then on b's, then the energy
  *    friction dissipated. It returns 0 if not (out is then undefined). An
