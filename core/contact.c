@@ -20,7 +20,10 @@
  * when the list is built every node's place is kept (pos_near), and two
  * boxes with a gap g then cannot overlap while no node is farther than r
  * from its kept place, if g > 2 r. The near list holds the other pairs,
- * in pair order, with their gaps, and is rebuilt when some node passes r;
+ * in pair order, each with its gap and what the walk reads of it (its
+ * elements, whether it holds springs: near_pair), so the walk streams one
+ * array instead of looking each pair up in the candidate arrays, and is
+ * rebuilt when some node passes r;
  * a pair it leaves out has its boxes apart now and until then, exactly
  * what the box test would have found, so its springs go at the rebuild as
  * they would have gone that step: the same bits as walking every pair.
@@ -33,6 +36,7 @@
  * checkpoints (contact_history.c); a pair whose boxes part lets them go.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #ifdef _OPENMP
@@ -104,6 +108,17 @@ static void pair_rows_free(pair_rows *list)
     free(list->row);
 }
 
+/* A near pair: what the per-step walk reads of a candidate pair, in one
+ * record. sprung mirrors contact_pair_sprung for the pair, kept by the walk
+ * as it lets springs go or adopts them, so a pair apart without springs
+ * (nearly all) reads nothing else. */
+typedef struct near_pair {
+    double gap;      /* its boxes' gap when the list was built */
+    uint32_t pair;   /* its index among the candidate pairs */
+    int32_t a, b;    /* its elements */
+    int32_t sprung;  /* some stick spring of it holds a force */
+} near_pair;
+
 /* How much farther the near list looks than the nodes have gone, as a
  * fraction of the buffer: a rebuild every buffer/16 of travel (detection
  * comes at buffer/2) against fewer pairs in the list. */
@@ -171,17 +186,16 @@ static void contact_near_boxes(fdem_model *m)
         if (elem_gap[list[k]] <= apart) element_box(m, list[k], box + width * (size_t)list[k]);
 }
 
-/* The elements of the candidate pairs which (all of them when which is
+/* The elements of the near pairs (of every candidate pair when near is
  * NULL), once each and in element order (so that contact_boxes walks the
  * mesh forwards), into list; returns how many. */
-static int contact_collect_elements(contact_state *cs, int elem_count, const size_t *which,
+static int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
                                     size_t count, int32_t *list)
 {
     memset(cs->in_pair, 0, (size_t)elem_count);
     for (size_t i = 0; i < count; i++) {
-        size_t k = which ? which[i] : i;
-        cs->in_pair[cs->pairs.a[k]] = 1;
-        cs->in_pair[cs->pairs.b[k]] = 1;
+        cs->in_pair[near ? near[i].a : cs->pairs.a[i]] = 1;
+        cs->in_pair[near ? near[i].b : cs->pairs.b[i]] = 1;
     }
     int listed = 0;
     for (int e = 0; e < elem_count; e++)
@@ -213,20 +227,26 @@ static int contact_near_due(fdem_model *m)
     return 0;
 }
 
+/* Room for one more near pair; 0, or -1 when out of memory. The list
+ * grows as it fills: it holds a tenth or so of the candidates. */
+static int near_reserve(contact_state *cs, size_t count)
+{
+    if (count < cs->near_capacity) return 0;
+    size_t cap = cs->near_capacity ? 2 * cs->near_capacity : 1024;
+    near_pair *n = realloc(cs->near, sizeof *n * cap);
+    if (!n) return -1;
+    cs->near = n;
+    cs->near_capacity = cap;
+    return 0;
+}
+
 /* The near list (see the top of this file) and its elements from this
- * step's boxes. Returns 0, or -1 when out of memory. */
+ * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
+ * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
 static int contact_near_rebuild(fdem_model *m)
 {
     contact_state *cs = &m->contact;
-    if (cs->near_capacity < cs->pairs.count) {
-        size_t *n = realloc(cs->near, sizeof *n * cs->pairs.count);
-        if (!n) return -1;
-        cs->near = n;
-        double *g = realloc(cs->near_gap, sizeof *g * cs->pairs.count);
-        if (!g) return -1;
-        cs->near_gap = g;
-        cs->near_capacity = cs->pairs.count;
-    }
+    if (cs->pairs.count > UINT32_MAX) return -1;
     double reach = NEAR_REACH_STEP * cs->buffer;
     /* a hair over 2 reach, so rounding in the gap never leaves out a pair
      * that could touch */
@@ -241,8 +261,8 @@ static int contact_near_rebuild(fdem_model *m)
             contact_springs_release(cs, k); /* apart now and until the next rebuild */
             continue;
         }
-        cs->near[count] = k;
-        cs->near_gap[count++] = gap;
+        if (near_reserve(cs, count)) return -1;
+        cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb, contact_pair_sprung(cs, k)};
         cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
         cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }
@@ -277,17 +297,18 @@ static int contact_near_refresh(fdem_model *m)
 
 /* Force between two elements whose boxes overlap, both roles, into out
  * (pair_out numbers); springs are the pair's stick springs (updated), h the
- * last step's size. The softer surface sets the penalty; friction is the
- * larger of the two, so giving it on one material is enough. Returns 1 if
- * they touched. Writes nothing in m. */
+ * last step's size, memo the walk's (contact_pair.h; NULL: none). The
+ * softer surface sets the penalty; friction is the larger of the two, so
+ * giving it on one material is enough. Returns 1 if they touched. Writes
+ * nothing in m. */
 static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
-                              double *out)
+                              double *out, contact_pair_memo *memo)
 {
     const material *ma = &m->materials[element_material(m, e1)];
     const material *mb = &m->materials[element_material(m, e2)];
     contact_pair_in in = {m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
                           min2(ma->penalty, mb->penalty),
-                          max2(ma->def.friction, mb->def.friction), h};
+                          max2(ma->def.friction, mb->def.friction), h, memo};
     return m->contact.kernel->pair_force(&in, springs, out);
 }
 
@@ -317,40 +338,46 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *ou
  * (the pool is shared; each pair's own set is not). */
 enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
 
-/* Candidate pair k this step: boxes apart, it lets its springs go (-1);
+/* Near pair np this step: boxes apart, it lets its springs go (-1);
  * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
  * without a set of springs is evaluated on fresh (zeros); *pool says
- * whether fresh is to be adopted or the pair's set let go. D is a
- * constant where it is called, so each dimension's walk is compiled on
- * its own with the box and spring loops unrolled. */
-static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, size_t i, double h,
-                                                               double *out, double *fresh,
-                                                               int *pool, int D)
+ * whether fresh is to be adopted or the pair's set let go (np->sprung
+ * says so at once). D is a constant where it is called, so each
+ * dimension's walk is compiled on its own with the box and spring loops
+ * unrolled. */
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, near_pair *np,
+                                                               double h, double *out,
+                                                               double *fresh, int *pool,
+                                                               contact_pair_memo *memo, int D)
 {
     contact_state *cs = &m->contact;
     const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
     const size_t width = 2 * (size_t)D;
-    size_t k = cs->near[i];
-    int32_t set = cs->spring_of[k];
+    int32_t a = np->a, b = np->b;
     *pool = SPRINGS_KEPT;
-    if (cs->near_gap[i] > cs->near_apart) { /* apart, boxes not even computed */
-        if (set >= 0) *pool = SPRINGS_RELEASE;
+    /* a gap over near_apart: apart, boxes not even computed this step */
+    if (np->gap > cs->near_apart ||
+        !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
+        if (np->sprung) {
+            *pool = SPRINGS_RELEASE;
+            np->sprung = 0;
+        }
         return -1;
     }
-    int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
-    if (!boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
-        if (set >= 0) *pool = SPRINGS_RELEASE;
-        return -1;
-    }
+    int32_t set = cs->spring_of[np->pair];
     double *springs = fresh;
     if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
     else
         for (int s = 0; s < slots; s++) fresh[s] = 0;
-    int touched = contact_pair_force(m, a, b, h, springs, out);
+    int touched = contact_pair_force(m, a, b, h, springs, out, memo);
+    /* a pair that did not touch has let every spring go (contact_pair.h):
+     * the springs are read only after a touch */
     int any = 0;
-    for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (touched)
+        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
     if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
     if (set < 0 && any) *pool = SPRINGS_ADOPT;
+    np->sprung = any;
     return touched;
 }
 
@@ -361,7 +388,8 @@ int contact_potential_force(fdem_model *m, int e1, int e2, double h)
     double b1[6] = {0}, b2[6] = {0}, out[CONTACT_PAIR_OUT_MAX], springs[CONTACT_SLOTS_MAX] = {0};
     element_box(m, e1, b1);
     element_box(m, e2, b2);
-    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out)) return 0;
+    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out, NULL))
+        return 0;
     contact_pair_scatter(m, e1, e2, out);
     return 1;
 }
@@ -523,7 +551,7 @@ void contact_free(contact_state *cs)
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
-    free(cs->near); free(cs->near_gap);
+    free(cs->near);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
@@ -571,7 +599,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->pair_capacity * sizeof(int32_t);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
-    b += cs->near_capacity * (sizeof(size_t) + sizeof(double));
+    b += cs->near_capacity * sizeof(near_pair);
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -598,15 +626,17 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
                                                                      int D)
 {
     contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
     int touching = 0;
     for (size_t i = 0; i < cs->near_count; i++) {
-        size_t k = cs->near[i];
+        near_pair *np = &cs->near[i];
         double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, i, h, out, fresh, &pool, D);
-        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, k);
-        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, k, fresh)) return -1;
+        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
+        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
+        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, np->pair, fresh)) return -1;
         if (touched <= 0) continue;
-        contact_pair_scatter(m, cs->pairs.a[k], cs->pairs.b[k], out);
+        contact_pair_scatter(m, np->a, np->b, out);
         touching++;
     }
     return touching;
@@ -628,11 +658,14 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
                                                                      contact_touches *list, int D)
 {
     const contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
     int touching = 0;
     for (long i = begin; i < end; i++) {
-        long k = (long)cs->near[i];
+        near_pair *np = &cs->near[i];
+        long k = (long)np->pair;
         double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, (size_t)i, h, force, fresh, &pool, D);
+        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
         if (touched <= 0) continue;

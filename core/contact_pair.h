@@ -12,24 +12,46 @@
  *    contactor boundaries (edges, faces) of a against b, then those of b
  *    against a, the same count for each (so swapping the halves turns the
  *    pair (a, b) into (b, a)). A boundary that does not touch, or a pair
- *    without friction, leaves its springs at zero.
+ *    without friction, leaves its springs at zero: a pair that did not
+ *    touch has them all at zero.
  *  - It returns 1 if the pair touched; out then holds the forces on a's
  *    nodes (dim per node, node by node), then on b's, then the energy
  *    friction dissipated. It returns 0 if not (out is then undefined). An
  *    inverted element has no potential: no force, springs let go.
  *  - Action equals reaction at one point per boundary: linear and angular
- *    momentum are conserved to round-off. Kernels write nothing else, so
- *    pairs can be evaluated side by side.
+ *    momentum are conserved to round-off. Kernels write nothing else (but
+ *    memo), so pairs can be evaluated side by side.
+ *  - memo (may be NULL) is what a kernel keeps from one call to the next
+ *    within one walk over the pairs: one thread, one step, positions that
+ *    do not move. The stage clears it (contact_pair_memo_clear) before the
+ *    walk. What a kernel takes from it is what it would have worked out
+ *    again, bit for bit.
  */
 #ifndef FDEM_CONTACT_PAIR_H
 #define FDEM_CONTACT_PAIR_H
 
 #include <stdint.h>
 
+/* An element meets the same few neighbours in pair after pair (the pairs
+ * come grouped by their first element, and neighbours by their second), so
+ * the tetrahedron kernel keeps elements' barycentric maps (a division per
+ * number) here, in slots chosen by the element. */
+#define CONTACT_MEMO_SLOTS 64
+typedef struct contact_pair_memo {
+    const int32_t *node[CONTACT_MEMO_SLOTS]; /* whose numbers a slot holds (its node list) */
+    double numbers[CONTACT_MEMO_SLOTS][14];
+} contact_pair_memo;
+
+static inline void contact_pair_memo_clear(contact_pair_memo *memo)
+{
+    for (int s = 0; s < CONTACT_MEMO_SLOTS; s++) memo->node[s] = 0;
+}
+
 typedef struct contact_pair_in {
     const double *pos, *vel;
     const int32_t *node_a, *node_b;
     double penalty, friction, h;
+    contact_pair_memo *memo;
 } contact_pair_in;
 
 /* Triangles: one tangential spring per edge, 3 edges x 2 roles; forces

@@ -490,22 +490,46 @@ double tet_contact_pair(const double *pos, const int32_t a[4], const int32_t b[4
            tet_contact_one_way(pos, b, a, penalty, f_b, f_a);
 }
 
+/* A tetrahedron's frame, its map kept in memo (contact_pair.h) for the
+ * next pairs it is in this walk: one slot per element, picked by a hash of
+ * its node list's address, which stands for the element. */
+static void tet_frame_memo(const double *pos, const int32_t n[4], contact_pair_memo *memo,
+                           tet_frame *t)
+{
+    _Static_assert(sizeof(bary_map) <= sizeof memo->numbers[0], "memo too small for a bary_map");
+    tet_corners_of(pos, n, t);
+    if (!memo) {
+        t->bary = bary_of(t->p);
+        return;
+    }
+    /* Fibonacci hashing: the top bits of the address times 2^64 / phi */
+    unsigned slot = (unsigned)(((uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15u) >> 58);
+    _Static_assert(CONTACT_MEMO_SLOTS == 64, "slot is 6 bits");
+    if (memo->node[slot] == n) {
+        memcpy(&t->bary, memo->numbers[slot], sizeof t->bary);
+        return;
+    }
+    t->bary = bary_of(t->p);
+    memo->node[slot] = n;
+    memcpy(memo->numbers[slot], &t->bary, sizeof t->bary);
+}
+
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tet_frame a, b;
     corners_in a_in_b, b_in_a;
-    /* inverted: no potential; a face plane of either apart: no touch. b's
-     * map first, so that most pairs, apart by one of b's faces, never need
-     * a's. */
-    tet_frame_of(in->pos, in->node_b, &b);
-    int apart = !(b.bary.valid && b.bary.det > 0);
+    /* inverted: no potential; a face plane of either apart: no touch. a's
+     * map first, most often kept from the last pair, so that most pairs,
+     * apart by one of a's faces, never look at b's. */
+    tet_frame_memo(in->pos, in->node_a, in->memo, &a);
+    int apart = !(a.bary.valid && a.bary.det > 0);
     if (!apart) {
-        tet_corners_of(in->pos, in->node_a, &a);
-        apart = corners_in_target(&a, &b, &a_in_b);
+        tet_corners_of(in->pos, in->node_b, &b);
+        apart = corners_in_target(&b, &a, &b_in_a);
     }
     if (!apart) {
-        a.bary = bary_of(a.p);
-        apart = !(a.bary.valid && a.bary.det > 0) || corners_in_target(&b, &a, &b_in_a);
+        tet_frame_memo(in->pos, in->node_b, in->memo, &b);
+        apart = !(b.bary.valid && b.bary.det > 0) || corners_in_target(&a, &b, &a_in_b);
     }
     if (apart) {
         memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);

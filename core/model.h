@@ -150,18 +150,18 @@ typedef struct contact_state {
     size_t slip_count, slip_capacity, free_count; /* sets handed out or freed, allocated, free */
     contact_record *records; /* history set aside across a detection or a restore */
     size_t record_count, record_capacity;
-    size_t *near;            /* candidate pairs whose boxes can overlap before some node
-                                moves near_reach from pos_near, in pair order (contact.c) */
+    struct near_pair *near;  /* candidate pairs whose boxes can overlap before some node
+                                moves near_reach from pos_near, in pair order, with what
+                                the walk reads of them (contact.c) */
     size_t near_count, near_capacity;
     double near_reach;       /* the list holds while no node is farther than this from */
     double *pos_near;        /* its place when the list was built */
     double near_disp2;       /* largest squared node displacement from pos_near since then
                                 (tracked by the integrator with max_disp2) */
-    double *near_gap;        /* per near pair: its boxes' gap when the list was built */
     double near_apart;       /* this step, a near_gap over this is still open */
     int32_t *near_active;    /* the elements in some near pair, once each: their boxes */
     int near_active_count;   /* are all a step needs while the list holds */
-    double *elem_gap;        /* per element: the smallest near_gap of its near pairs */
+    double *elem_gap;        /* per element: the smallest gap of its near pairs */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
