@@ -38,6 +38,15 @@
 int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
                      const int32_t node[6], double *damage, double fa[9], joint_energy *e);
 
+/* joint_tet_forces for a joint whose gaps d, normal N and |N| the caller
+ * already has from joint_tet_gaps (or a lane of joint_tet_gaps_at_pair:
+ * the same bits), so that a joint the fast path turned down does not
+ * compute them again. */
+int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const double N[3],
+                             double N_len, const double *vel, double h_last,
+                             const int32_t node[6], double *damage, double fa[9],
+                             joint_energy *e);
+
 /* ------------------------------------------------ the intact fast path
  * Nearly every joint in nearly every step is undamaged and far inside its
  * strengths. These pieces of joint_tet_forces are inline so the model's
