@@ -337,7 +337,7 @@ JOINT_TET_INLINE void joint_forces_loop(fdem_model *m, int begin, int end,
  * the three-operand AVX encoding drops the register copies two-operand SSE
  * needs. AVX2 without FMA, and no contraction under -std=c11: every
  * operation rounds as in the baseline, so both give the same bits. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(JOINT_NO_AVX2)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define JOINT_AVX2 1
 __attribute__((target("avx2"))) static void joint_forces_avx2(fdem_model *m, int begin, int end,
                                                                double sums[SCATTER_SUMS])
