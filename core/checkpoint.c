@@ -17,7 +17,7 @@
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
-#define CHECKPOINT_VERSION 4
+#define CHECKPOINT_VERSION 5
 
 /* Version 1 (fdemd 0.1): the header up to external_work, then positions,
  * velocities and damage. Read for cases stored by that version; they carry
@@ -49,7 +49,9 @@ typedef struct checkpoint_header {
      * written before joints booked any) */
     double joint_friction_energy;
     /* version 4: each joint's fracture account and the fracture events not
-     * drained yet follow the stick springs (events.c) */
+     * drained yet follow the stick springs (events.c). Version 5: the same
+     * layout; 3D joints are numbered by their tetrahedra (joint_tet_model.c),
+     * so an earlier file's 3D joint damage would land on other joints. */
     int64_t pending_events;
 } checkpoint_header;
 
@@ -184,6 +186,13 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         if ((h.dimension ? h.dimension : 2) != m->dim) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is of a %dD model; this one is %dD",
                         h.dimension ? h.dimension : 2, m->dim);
+            return -1;
+        }
+        if (h1.version < 5 && m->dim == 3 && m->joint_count) {
+            model_error(err, FDEM_ITEM_NONE, -1,
+                        "checkpoint is of an earlier fdemd that numbered the 3D joints in "
+                        "another order (version %u); run the case again from the start",
+                        h1.version);
             return -1;
         }
         size_t record_bytes = contact_record_bytes(&m->contact);

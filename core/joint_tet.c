@@ -182,10 +182,23 @@ static void joint_tet_general(const joint_law *law, const double d[3][3],
 int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
                      const int32_t node[6], double *damage, double fa[9], joint_energy *e)
 {
+    if (*damage >= 1.0) {
+        memset(fa, 0, 9 * sizeof(double));
+        return 0;
+    }
+    double d[3][3], N[3];
+    double N_len = joint_tet_gaps(pos, node, d, N);
+    return joint_tet_forces_of_gaps(law, d, N, N_len, vel, h_last, node, damage, fa, e);
+}
+
+int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const double N[3],
+                             double N_len, const double *vel, double h_last,
+                             const int32_t node[6], double *damage, double fa[9],
+                             joint_energy *e)
+{
     memset(fa, 0, 9 * sizeof(double));
     if (*damage >= 1.0) return 0;
-    double d[3][3], N[3];
-    double N_len = joint_tet_gaps(pos, node, d, N), area = 0.5 * N_len;
+    double area = 0.5 * N_len;
     if (!(N_len > 0)) return 1; /* a face squashed flat carries nothing this step */
     if (*damage == 0 && joint_tet_elastic(law, d, N, N_len)) {
         e->stored += joint_tet_elastic_forces(law->k, area, d, fa);

@@ -38,6 +38,15 @@
 int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
                      const int32_t node[6], double *damage, double fa[9], joint_energy *e);
 
+/* joint_tet_forces for a joint whose gaps d, normal N and |N| the caller
+ * already has from joint_tet_gaps (or a lane of joint_tet_gaps_at_pair:
+ * the same bits), so that a joint the fast path turned down does not
+ * compute them again. */
+int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const double N[3],
+                             double N_len, const double *vel, double h_last,
+                             const int32_t node[6], double *damage, double fa[9],
+                             joint_energy *e);
+
 /* ------------------------------------------------ the intact fast path
  * Nearly every joint in nearly every step is undamaged and far inside its
  * strengths. These pieces of joint_tet_forces are inline so the model's
@@ -103,6 +112,40 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #undef JT_FN
 #undef JT_SQRT
 #undef JT_LOAD
+
+/* Four joints side by side exist only as AVX2 code (GCC on x86-64;
+ * JOINT_TET_QUADS says so): 32-byte vectors are no baseline x86-64
+ * argument. The four are consecutive, corners n0, n0 + 6, n0 + 12 and
+ * n0 + 18 (n1 is not read). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define JOINT_TET_QUADS 1
+#pragma GCC push_options
+#pragma GCC target("avx2")
+typedef double joint_quad __attribute__((vector_size(32)));
+typedef long long joint_quad_mask __attribute__((vector_size(32)));
+
+JOINT_TET_INLINE joint_quad joint_quad_sqrt(joint_quad x)
+{
+    return (joint_quad){sqrt(x[0]), sqrt(x[1]), sqrt(x[2]), sqrt(x[3])};
+}
+
+#define JT_T joint_quad
+#define JT_MASK joint_quad_mask
+#define JT_FN(name) name##_quad
+#define JT_SQRT joint_quad_sqrt
+#define JT_LOAD(pos, n0, n1, k, c)                                                               \
+    ((joint_quad){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, (n0) + 6, k, c),               \
+                  JOINT_TET_AT(pos, (n0) + 12, k, c), JOINT_TET_AT(pos, (n0) + 18, k, c)})
+#include "joint_tet_fast_body.h"
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+#undef JT_LOAD
+#pragma GCC pop_options
+#else
+#define JOINT_TET_QUADS 0
+#endif
 
 /* joint_tet_gaps_at for one joint, corners node[6]. */
 JOINT_TET_INLINE double joint_tet_gaps(const double *pos, const int32_t node[6], double d[3][3],

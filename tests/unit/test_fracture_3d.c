@@ -20,6 +20,7 @@
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* build_fracturing_rock's rock, optionally too strong to break. */
 static fdem_material_def rock(int strong, double damping)
@@ -488,6 +489,30 @@ static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
     fdem_model_destroy(two);
 }
 
+/* A checkpoint of a 3D jointed model written before the joints were
+ * numbered by their tetrahedra (file version 4) would put each joint's
+ * damage on another joint: it is refused with a message, while the same
+ * bytes as version 5 are read back. */
+static void earlier_3d_joint_numbering_is_refused(void)
+{
+    const double size[3] = {0.03, 0.03, 0.03};
+    const int div[3] = {2, 2, 2};
+    fdem_model *m = box_model(size, div, rock(0, 0.1), 1);
+    build_finalize(m, 0.5);
+    size_t bytes = fdem_checkpoint_size(m);
+    unsigned char *buf = malloc(bytes);
+    CHECK(fdem_checkpoint_write(m, buf, bytes) == 0, "write");
+    fdem_error err;
+    CHECK(fdem_checkpoint_read(m, buf, bytes, &err) == 0, "version 5: %s", err.message);
+    uint32_t four = 4;
+    memcpy(buf + sizeof(uint32_t), &four, sizeof four);
+    CHECK(fdem_checkpoint_read(m, buf, bytes, &err) != 0, "a version 4 3D jointed checkpoint was read");
+    CHECK(strstr(err.message, "numbered the 3D joints") != NULL, "message: %s", err.message);
+    free(buf);
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(joints_on_interior_faces), T(joint_loop_gives_the_bits_of_the_kernel), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
            T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits),
-           T(fracturing_impact_on_two_threads_gives_the_bits_of_one))
+           T(fracturing_impact_on_two_threads_gives_the_bits_of_one),
+           T(earlier_3d_joint_numbering_is_refused))
