@@ -86,17 +86,11 @@ TET_LOG_INVERSE_LANES(tet_pair, 2)
 #define TET_FN(name) name
 #define TET_LOG_INVERSE neo_hookean_log_inverse
 #include "element_tet_kernel_body.h"
-#undef TET_T
-#undef TET_FN
-#undef TET_LOG_INVERSE
 
 #define TET_T tet_pair
 #define TET_FN(name) name##_pair
 #define TET_LOG_INVERSE tet_log_inverse_tet_pair
 #include "element_tet_kernel_body.h"
-#undef TET_T
-#undef TET_FN
-#undef TET_LOG_INVERSE
 
 /* The quads exist only as AVX2 code (GCC on x86-64; TET_QUADS says so):
  * 32-byte vectors are no baseline x86-64 argument. */
@@ -109,9 +103,6 @@ TET_LOG_INVERSE_LANES(tet_quad, 4)
 #define TET_FN(name) name##_quad
 #define TET_LOG_INVERSE tet_log_inverse_tet_quad
 #include "element_tet_kernel_body.h"
-#undef TET_T
-#undef TET_FN
-#undef TET_LOG_INVERSE
 #pragma GCC pop_options
 #else
 #define TET_QUADS 0

@@ -1,8 +1,9 @@
 /*
  * element_tet_kernel_body.h - the tetrahedron's per-element expressions,
- * written once over a number type TET_T and included twice by
- * element_tet_kernel.h: for double (one element) and for a pair of doubles
- * (two elements side by side in one SIMD register, TET_FN suffix _pair).
+ * written once over a number type TET_T and included by
+ * element_tet_kernel.h for double (one element), a pair of doubles (two
+ * elements side by side in one SIMD register, TET_FN suffix _pair) and, in
+ * AVX2 code, four (_quad).
  * Vector lanes round exactly as scalars do (IEEE, no contraction under
  * -std=c11), so a pair gives each element the bits it gets alone.
  * Not a header of its own: include element_tet_kernel.h.
@@ -137,3 +138,8 @@ TET_KERNEL TET_T TET_FN(tet_kernel_contract)(const TET_T s[6], const TET_T S[6])
 {
     return s[0] * S[0] + s[1] * S[1] + s[2] * S[2] + 2 * (s[3] * S[3] + s[4] * S[4] + s[5] * S[5]);
 }
+
+/* the parameters are this inclusion's alone: the next one defines its own */
+#undef TET_T
+#undef TET_FN
+#undef TET_LOG_INVERSE

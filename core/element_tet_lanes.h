@@ -147,3 +147,13 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l, 0);
 }
+
+/* the parameters are this inclusion's alone: the next one defines its own */
+#undef TET_V
+#undef TET_N
+#undef TET_VFN
+#undef TET_GATHER
+#undef TET_GATHER_OWN
+#undef TET_STORE_OWN
+#undef TET_LOAD_SIX
+#undef TET_STORE_SIX

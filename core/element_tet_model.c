@@ -200,14 +200,6 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
         for (int l_ = 0; l_ < 2; l_++) tet_scatter_lane_pair(f, (t)[l_].node, g, l_, 1);        \
     } while (0)
 #include "element_tet_lanes.h"
-#undef TET_V
-#undef TET_N
-#undef TET_VFN
-#undef TET_GATHER
-#undef TET_GATHER_OWN
-#undef TET_STORE_OWN
-#undef TET_LOAD_SIX
-#undef TET_STORE_SIX
 
 #if TET_QUADS
 #pragma GCC push_options
@@ -304,14 +296,6 @@ TET_KERNEL void tet_store_six_quad(double *rows, const tet_quad v[6])
 #define TET_LOAD_SIX(rows, v) tet_load_six_quad(rows, v)
 #define TET_STORE_SIX(rows, v) tet_store_six_quad(rows, v)
 #include "element_tet_lanes.h"
-#undef TET_V
-#undef TET_N
-#undef TET_VFN
-#undef TET_GATHER
-#undef TET_GATHER_OWN
-#undef TET_STORE_OWN
-#undef TET_LOAD_SIX
-#undef TET_STORE_SIX
 
 /* Four elements of one material: a call of its own, so that the baseline
  * loop, which never takes it, holds no AVX code. */

@@ -94,11 +94,6 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #define JT_SQRT sqrt
 #define JT_LOAD(pos, n0, n1, k, c) JOINT_TET_AT(pos, n0, k, c)
 #include "joint_tet_fast_body.h"
-#undef JT_T
-#undef JT_MASK
-#undef JT_FN
-#undef JT_SQRT
-#undef JT_LOAD
 
 #define JT_T joint_pair
 #define JT_MASK joint_pair_mask
@@ -107,11 +102,6 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #define JT_LOAD(pos, n0, n1, k, c) \
     ((joint_pair){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, n1, k, c)})
 #include "joint_tet_fast_body.h"
-#undef JT_T
-#undef JT_MASK
-#undef JT_FN
-#undef JT_SQRT
-#undef JT_LOAD
 
 /* Four joints side by side exist only as AVX2 code (GCC on x86-64;
  * JOINT_TET_QUADS says so): 32-byte vectors are no baseline x86-64
@@ -137,11 +127,6 @@ JOINT_TET_INLINE joint_quad joint_quad_sqrt(joint_quad x)
     ((joint_quad){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, (n0) + 6, k, c),               \
                   JOINT_TET_AT(pos, (n0) + 12, k, c), JOINT_TET_AT(pos, (n0) + 18, k, c)})
 #include "joint_tet_fast_body.h"
-#undef JT_T
-#undef JT_MASK
-#undef JT_FN
-#undef JT_SQRT
-#undef JT_LOAD
 #pragma GCC pop_options
 #else
 #define JOINT_TET_QUADS 0

@@ -1,9 +1,9 @@
 /*
  * joint_tet_fast_body.h - the intact, elastic 3D joint's expressions (the
  * fast path of joint_tet.h), written once over a number type JT_T and
- * included twice by joint_tet.h: for double (one joint) and for a pair of
- * doubles (two joints side by side in one SIMD register, JT_FN suffix
- * _pair). Lanes round exactly as scalars do (IEEE, no contraction under
+ * included by joint_tet.h for double (one joint), a pair of doubles (two
+ * joints side by side in one SIMD register, JT_FN suffix _pair) and, in
+ * AVX2 code, four (_quad). Lanes round exactly as scalars do (IEEE, no contraction under
  * -std=c11), so a pair gives each joint the bits it gets alone, as
  * element_tet_kernel_body.h does for tetrahedra.
  * Not a header of its own: include joint_tet.h.
@@ -80,3 +80,10 @@ JOINT_TET_INLINE JT_T JT_FN(joint_tet_elastic_forces_of)(JT_T k, JT_T area, cons
         stored += 0.5 * (fa[3 * i] * d[i][0] + fa[3 * i + 1] * d[i][1] + fa[3 * i + 2] * d[i][2]);
     return stored;
 }
+
+/* the parameters are this inclusion's alone: the next one defines its own */
+#undef JT_T
+#undef JT_MASK
+#undef JT_FN
+#undef JT_SQRT
+#undef JT_LOAD
