@@ -227,19 +227,6 @@ static int contact_near_due(fdem_model *m)
     return 0;
 }
 
-/* Room for one more near pair; 0, or -1 when out of memory. The list
- * grows as it fills: it holds a tenth or so of the candidates. */
-static int near_reserve(contact_state *cs, size_t count)
-{
-    if (count < cs->near_capacity) return 0;
-    size_t cap = cs->near_capacity ? 2 * cs->near_capacity : 1024;
-    near_pair *n = realloc(cs->near, sizeof *n * cap);
-    if (!n) return -1;
-    cs->near = n;
-    cs->near_capacity = cap;
-    return 0;
-}
-
 /* The near list (see the top of this file) and its elements from this
  * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
  * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
@@ -261,7 +248,10 @@ static int contact_near_rebuild(fdem_model *m)
             contact_springs_release(cs, k); /* apart now and until the next rebuild */
             continue;
         }
-        if (near_reserve(cs, count)) return -1;
+        /* the list grows as it fills: it holds a tenth or so of the candidates */
+        if (count == cs->near_capacity &&
+            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near, 1024))
+            return -1;
         cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb, contact_pair_sprung(cs, k)};
         cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
         cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);

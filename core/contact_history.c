@@ -38,14 +38,8 @@ static void pair_slots_oriented(const double *slip, int a, int b, int slots, dou
 /* Room for the set index of `pairs` candidate pairs. */
 int contact_history_reserve(contact_state *cs, size_t pairs)
 {
-    if (pairs <= cs->pair_capacity) return 0;
-    size_t cap = cs->pair_capacity ? cs->pair_capacity : 1024;
-    while (cap < pairs) cap *= 2;
-    int32_t *f = realloc(cs->spring_of, sizeof *f * cap);
-    if (!f) return -1;
-    cs->spring_of = f;
-    cs->pair_capacity = cap;
-    return 0;
+    return model_reserve((void **)&cs->spring_of, &cs->pair_capacity, pairs, sizeof *cs->spring_of,
+                         1024);
 }
 
 /* A set of zeros from the pool: its index, or -1 when out of memory. */

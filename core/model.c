@@ -32,6 +32,18 @@ void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt
     va_end(ap);
 }
 
+int model_reserve(void **array, size_t *capacity, size_t need, size_t size, size_t first)
+{
+    if (need <= *capacity) return 0;
+    size_t cap = *capacity ? *capacity : first;
+    while (cap < need) cap *= 2;
+    void *p = realloc(*array, cap * size);
+    if (!p) return -1;
+    *array = p;
+    *capacity = cap;
+    return 0;
+}
+
 /* Grows *array (element size `size`) to hold at least `need` items. */
 static int grow(void **array, int *capacity, int need, size_t size)
 {

@@ -299,6 +299,10 @@ double stage_clock(void);
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 
+/* Grows *array (items of `size` bytes) to hold at least `need`, doubling
+ * from `first`: 0, or -1 when out of memory (*array is then unchanged). */
+int model_reserve(void **array, size_t *capacity, size_t need, size_t size, size_t first);
+
 /* Stress components per element: 3 in 2D, 6 in 3D. */
 static inline int model_stress_comps(const fdem_model *m) { return m->dim == 3 ? 6 : 3; }
 
