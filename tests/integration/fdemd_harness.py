@@ -232,12 +232,14 @@ class Daemon:
 
 class DaemonTestCase(unittest.TestCase):
     """One daemon and one scratch directory shared by a class's tests; the
-    daemon must exit 0 on SIGTERM when the class is done."""
+    daemon must exit 0 on SIGTERM when the class is done. DAEMON_ARGS are
+    its command-line options."""
     PREFIX = "fdemd-test-"
+    DAEMON_ARGS = ()
 
     @classmethod
     def setUpClass(cls):
-        cls.d = Daemon().start()
+        cls.d = Daemon(args=cls.DAEMON_ARGS).start()
         cls.tmp = tempfile.mkdtemp(prefix=cls.PREFIX)
 
     @classmethod

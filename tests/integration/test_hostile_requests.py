@@ -11,7 +11,7 @@ import threading
 import time
 import unittest
 
-from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import SLOW, DaemonTestCase, tiny_case
 
 
 def raw_exchange(port, data, timeout=10.0, source="127.0.0.1"):
@@ -175,24 +175,15 @@ class FramingTest(DaemonTestCase):
             self.assertOneProblem(reply, 400, seconds)
 
 
-class BusyClientTest(unittest.TestCase):
+class BusyClientTest(DaemonTestCase):
     """A client within --max-connections-per-ip is always served: every
     answer closes its connection, and a client keeping all its allowed
     connections busy opens the next one the moment it has read an answer,
     before the daemon has finished counting the old one. Refusing that
     connection at once gave ~9 % 503s to 4 connections under a limit of 4."""
     PER_IP = 2
+    DAEMON_ARGS = ("--max-connections-per-ip", str(PER_IP))
     REQUESTS = 400  # per connection thread
-
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon(args=["--max-connections-per-ip", str(cls.PER_IP)]).start()
-
-    @classmethod
-    def tearDownClass(cls):
-        code, _ = cls.d.stop()
-        cls.d.close()
-        assert code == 0, "fdemd exited %s on SIGTERM" % code
 
     def test_a_client_using_all_its_connections_gets_no_503(self):
         statuses, lock = [], threading.Lock()
@@ -220,22 +211,12 @@ class BusyClientTest(unittest.TestCase):
                          (refused, len(statuses), sorted(set(statuses))))
 
 
-class SlowClientTest(unittest.TestCase):
+class SlowClientTest(DaemonTestCase):
     """Slowloris: clients that trickle a request must not hold connections
     past --request-timeout, nor more than --max-connections-per-ip each."""
     TIMEOUT = 2
     PER_IP = 4
-
-    @classmethod
-    def setUpClass(cls):
-        cls.d = Daemon(args=["--request-timeout", str(cls.TIMEOUT),
-                             "--max-connections-per-ip", str(cls.PER_IP)]).start()
-
-    @classmethod
-    def tearDownClass(cls):
-        code, _ = cls.d.stop()
-        cls.d.close()
-        assert code == 0, "fdemd exited %s on SIGTERM" % code
+    DAEMON_ARGS = ("--request-timeout", str(TIMEOUT), "--max-connections-per-ip", str(PER_IP))
 
     def connect(self, source="127.0.0.1"):
         s = socket.socket()
