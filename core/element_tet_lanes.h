@@ -38,14 +38,13 @@ TET_KERNEL void TET_VFN(tet_gather_nodes)(const double *xyz, const tet_hot *t, T
 }
 
 /* The forces of lane `lane` of g (tet_kernel_face_loads): f_0 = g_0 added,
- * f_a = -g_a subtracted (`store`: tet_scatter_node). */
+ * f_a = -g_a subtracted (`store`: vec3_scatter). */
 TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], const TET_V g[4][3],
                                           int lane, const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
-        tet_scatter_node(f, node[a], (tet_pair){g[a][0][lane], g[a][1][lane]}, g[a][2][lane],
-                         a == 0, store);
+        vec3_scatter(f, node[a], g[a][0][lane], g[a][1][lane], g[a][2][lane], a == 0, store);
 }
 
 /* Lane `lane` of a group's face vectors and sixth stress as scalars, the

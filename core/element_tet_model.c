@@ -16,6 +16,7 @@
 
 #include "element_tet_kernel.h"
 #include "model.h"
+#include "vec3.h"
 #if TET_QUADS
 #include <immintrin.h>
 #endif
@@ -119,35 +120,12 @@ static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double 
     for (int q = 0; q < 6; q++) prev[q] = sv[q];
 }
 
-/* force[n] += or -= one node's load (x, y, z): x and y as one 16-byte
- * vector, z alone. Every scatter writes the nodes this same way, so the
- * next element's load of a node just stored forwards from the store.
- * `store` (a constant at each call: the element's part has nodes of its
- * own, so this element is the first and only one to write them this step)
- * starts from zero instead of reading the force: 0 + x and 0 - x are what
- * the zeroed array gave, to the bit (signed zeros included), without the
- * step having to zero it first or this loop reading it. */
-static inline void tet_scatter_node(double *f, int32_t n, tet_pair xy, double z, const int add,
-                                    const int store)
-{
-    double *fn = f + 3 * (size_t)n;
-    tet_pair old = {0.0, 0.0};
-    double old_z = 0.0;
-    if (!store) {
-        memcpy(&old, fn, sizeof old);
-        old_z = fn[2];
-    }
-    old = add ? old + xy : old - xy;
-    memcpy(fn, &old, sizeof old);
-    fn[2] = add ? old_z + z : old_z - z;
-}
-
 static inline void tet_scatter(double *f, const int32_t node[4], const double g[4][3],
                                const int store)
 {
     TET_UNROLL
     for (int a = 0; a < 4; a++)
-        tet_scatter_node(f, node[a], (tet_pair){g[a][0], g[a][1]}, g[a][2], a == 0, store);
+        vec3_scatter(f, node[a], g[a][0], g[a][1], g[a][2], a == 0, store);
 }
 
 /* Element t's in-situ pre-stress (initial_stress.c). */
@@ -158,7 +136,7 @@ static inline const double *tet_stress0(const fdem_model *m, const tet_hot *t)
 
 /* One element alone: the last of an odd range, or a pair of two materials.
  * `stressed` (a constant at each call) adds the element's pre-stress;
- * `store`: see tet_scatter_node. */
+ * `store`: see vec3_scatter. */
 TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k, tet_sums *sum,
                                const int stressed, const int store)
 {
@@ -242,7 +220,7 @@ TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, tet_qua
     for (int q = 0; q < 12; q++) x[q / 3][q % 3] = col[q];
 }
 
-/* The storing scatter (tet_scatter_node with store) of four such elements:
+/* The storing scatter (vec3_scatter with store) of four such elements:
  * 0 + g_0 and 0 - g_a as vectors, lane by lane what the scalar store
  * gives, transposed back to rows and stored whole. */
 TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const tet_quad g[4][3])

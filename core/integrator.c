@@ -161,8 +161,9 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
                                          &contact_work, &move2, &near2);
         else
             central_difference_node(x + at, v + at, f + at, with_force ? fc + at : NULL,
-                                    with_force ? xn + at : NULL, inv_mass[i], g, h, havg, own, D, with_contact, with_force, &check,
-                                    &contact_work, &move2, &near2);
+                                    with_force ? xn + at : NULL, inv_mass[i], g, h, havg, own, D,
+                                    with_contact, with_force, &check, &contact_work, &move2,
+                                    &near2);
     }
     sums[0] += check + check_xy[0] + check_xy[1];
     sums[1] += contact_work;

@@ -8,7 +8,6 @@
  */
 #include <math.h>
 #include <stdlib.h>
-#include <string.h>
 
 #include "element_tet.h"
 #include "joint_tet.h"
@@ -169,26 +168,14 @@ double joint_stable_dt_3d(const fdem_model *m)
     return dt;
 }
 
-/* force[n] += (or -=) one node's load: x and y as one 16-byte vector, z
- * alone (element_tet_model.c's tet_scatter_node does the same): each lane
- * rounds as the scalar sum does, in fewer instructions. */
-JOINT_TET_INLINE void joint_scatter_node(double *f, int32_t n, const double load[3], const int add)
-{
-    double *fn = f + 3 * (size_t)n;
-    joint_pair old, xy = {load[0], load[1]};
-    memcpy(&old, fn, sizeof old);
-    old = add ? old + xy : old - xy;
-    memcpy(fn, &old, sizeof old);
-    fn[2] = add ? fn[2] + load[2] : fn[2] - load[2];
-}
-
 /* Adds fa to face A's nodes and -fa to face B's. */
 JOINT_TET_INLINE void joint_tet_scatter(double *f, const int32_t n[6], const double fa[9])
 {
     JOINT_TET_UNROLL
     for (int i = 0; i < 3; i++) {
-        joint_scatter_node(f, n[i], fa + 3 * i, 1);
-        joint_scatter_node(f, n[3 + i], fa + 3 * i, 0);
+        const double *load = fa + 3 * i;
+        vec3_scatter(f, n[i], load[0], load[1], load[2], 1, 0);
+        vec3_scatter(f, n[3 + i], load[0], load[1], load[2], 0, 0);
     }
 }
 
