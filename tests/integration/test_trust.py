@@ -91,7 +91,9 @@ class TrustworthyNumbers(DaemonTestCase):
         # worker cut every other step to half, and the alternating steps
         # blew this beam up within 81 steps
         case["output"]["interval"] = 1.5 * dt
-        st, path = self.run_case(case)
+        # ~3100 snapshots, each made durable (fsynced) before the next: the
+        # pace is the disk's, 7-21 s alone and over 60 s on a busy machine
+        st, path = self.run_case(case, timeout=240)
         with h5py.File(path, "r") as f:
             pos = f["/snapshots/position"][...]
             time = f["/snapshots/time"][...]
