@@ -138,6 +138,10 @@ int result_replace_document(const char *path, const char *text, size_t length, c
                             size_t errlen)
 {
     h5_quiet();
+    /* The attribute and the heap blocks around it: twice the text. */
+    if (result_reserve_room(path, (off_t)(2 * length + 65536), "store the new case document", err,
+                            errlen) != 0)
+        return -1;
     hid_t fapl = file_access_latest(1);
     hid_t file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : H5I_INVALID_HID;
     if (fapl >= 0) H5Pclose(fapl);

@@ -42,12 +42,16 @@
 #include "result_internal.h"
 
 #include <hdf5.h>
+#include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define CHUNK_SMALL_BYTES (8u * 1024u)
 #define CHUNK_MAX_BYTES (1024u * 1024u)
@@ -415,6 +419,26 @@ hid_t file_access_latest(int clear_status_flags)
 fail:
     H5Pclose(fapl);
     return H5I_INVALID_HID;
+}
+
+/* A reopened file grows when HDF5 closes it, and a close that cannot write
+ * leaves the file flagged as open for writing, which h5py and every other
+ * reader then refuse. So the room is allocated on disk first, past the end
+ * of the file: a full disk fails here, with the file untouched. HDF5 puts
+ * what it adds at its own end of allocation, inside that room, and trims
+ * the file back to that end when it closes. */
+int result_reserve_room(const char *path, off_t bytes, const char *what, char *err, size_t errlen)
+{
+    int fd = open(path, O_WRONLY | O_CLOEXEC);
+    struct stat st;
+    int rc = fd < 0 || fstat(fd, &st) != 0 ? errno : posix_fallocate(fd, st.st_size, bytes);
+    if (fd >= 0) close(fd);
+    if (rc != 0) {
+        snprintf(err, errlen, "cannot reserve %lld bytes in %s to %s: %s", (long long)bytes, path,
+                 what, strerror(rc));
+        return -1;
+    }
+    return 0;
 }
 
 result_file *result_alloc(void)

@@ -8,6 +8,7 @@
 #define FDEM_RESULT_INTERNAL_H
 
 #include <hdf5.h>
+#include <sys/types.h>
 
 #include "result.h"
 
@@ -81,6 +82,8 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
 /* File access with the latest format (SWMR); optionally clearing the
  * status flags a crashed writer left. */
 hid_t file_access_latest(int clear_status_flags);
+int result_reserve_room(const char *path, off_t bytes, const char *what, char *err,
+                        size_t errlen);
 result_file *result_alloc(void);
 int result_release(result_file *f);
 /* The root attribute `case` (the document) and /mesh/part_names,

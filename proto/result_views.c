@@ -171,6 +171,23 @@ static int views_add(hid_t file, const series *ds, int count, int dimension)
     return rc;
 }
 
+/* Room the views of `snapshots` more snapshots may take: measured at
+ * 550-880 bytes a view with its share of the snapshot's group, so 1 KiB
+ * each and for the group, and 64 KiB for /xdmf itself and joint_faces. */
+#define VIEW_ROOM_BYTES 1024
+#define VIEWS_FIXED_ROOM_BYTES 65536
+static off_t views_room(const series *ds, int snapshots, int dimension)
+{
+    off_t per_snapshot = VIEW_ROOM_BYTES;
+    for (int kind = 0; kind < SERIES_COUNT; kind++) {
+        view_shape v;
+        int width = ds[kind].rank == 3 ? (int)ds[kind].row[1] : 0;
+        if (ds[kind].rank >= 2 && view_shape_of(kind, width, dimension, &v))
+            per_snapshot += VIEW_ROOM_BYTES;
+    }
+    return VIEWS_FIXED_ROOM_BYTES + per_snapshot * (snapshots > 0 ? snapshots : 0);
+}
+
 int result_finish(result_file *f, const char *path, int dimension, char *err, size_t errlen)
 {
     h5_quiet();
@@ -180,12 +197,22 @@ int result_finish(result_file *f, const char *path, int dimension, char *err, si
             if (H5Dclose(f->ds[k].id) < 0) rc = -1;
             f->ds[k].id = H5I_INVALID_HID;
         }
+    /* The event datasets too: an open object keeps HDF5 from closing the
+     * file, and the views must go to a file closed and whole on disk. */
+    for (int k = 0; k < EVENT_SERIES; k++)
+        if (f->events[k] >= 0) {
+            if (H5Dclose(f->events[k]) < 0) rc = -1;
+            f->events[k] = H5I_INVALID_HID;
+        }
     if (f->file >= 0 && H5Fclose(f->file) < 0) rc = -1;
     f->file = H5I_INVALID_HID;
     if (rc != 0) {
         result_fail(err, errlen, "cannot close %s", path);
         return -1;
     }
+    if (result_reserve_room(path, views_room(f->ds, f->count - f->views, dimension),
+                            "add the /xdmf views", err, errlen) != 0)
+        return -1;
     hid_t fapl = file_access_latest(0);
     hid_t file = fapl >= 0 ? H5Fopen(path, H5F_ACC_RDWR, fapl) : H5I_INVALID_HID;
     if (fapl >= 0) H5Pclose(fapl);

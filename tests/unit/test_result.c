@@ -13,6 +13,7 @@
 #include <signal.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -603,6 +604,45 @@ static void test_result_check_file_refuses_damage(void)
     run_end(&r);
 }
 
+/* A disk that fills while result_finish adds the views must not leave the
+ * file flagged as open for writing (h5py and the other readers then refuse
+ * it): the views go only into room reserved on disk first, else nowhere.
+ * RLIMIT_FSIZE plays the full disk: a write past it fails with EFBIG as
+ * one past a full disk fails with ENOSPC. */
+static void test_result_finish_on_a_full_disk_keeps_the_file_readable(void)
+{
+    run r;
+    if (run_start(&r, 1, 1, 0, "fullfinish.h5") == 0) {
+        for (int i = 0; i < 40; i++) run_append(&r);
+        char path[512], err[512] = "";
+        tmp_path(path, sizeof path, "fullfinish.h5");
+        CHECK(result_flush(r.file, err, sizeof err) == 0, "flush: %s", err);
+        struct stat st;
+        CHECK(stat(path, &st) == 0, "stat");
+        struct rlimit old, tight;
+        CHECK(getrlimit(RLIMIT_FSIZE, &old) == 0, "getrlimit");
+        void (*was)(int) = signal(SIGXFSZ, SIG_IGN);
+        tight = old;
+        tight.rlim_cur = (rlim_t)st.st_size + 512;
+        CHECK(setrlimit(RLIMIT_FSIZE, &tight) == 0, "setrlimit");
+        int finished = result_finish(r.file, path, fdem_get_dimension(r.model), err, sizeof err);
+        int views = result_view_count(r.file);
+        int closed = result_close(r.file);
+        r.file = NULL;
+        CHECK(setrlimit(RLIMIT_FSIZE, &old) == 0, "setrlimit back");
+        signal(SIGXFSZ, was);
+        fprintf(stderr, "DBG finish %d err %s closed %d\n", finished, err, closed);
+        CHECK(finished < 0, "views added past the file size limit");
+        CHECK(strstr(err, "fullfinish.h5") && strstr(err, "/xdmf views"), "message: %s", err);
+        CHECK(views == 0, "views %d", views);
+        CHECK(closed == 0, "close after the refused views failed");
+        expect_save(r.expect, "fullfinish.json");
+        CHECK(run_checker("fullfinish.h5", "fullfinish.json", "plain", NULL) == 0,
+              "40 snapshots readable after a full disk");
+    }
+    run_end(&r);
+}
+
 static void test_result_minimal_fields_without_constraints(void)
 {
     run r;
@@ -732,6 +772,7 @@ int main(int argc, char **argv)
         T(test_result_check_file_refuses_damage), T(test_result_minimal_fields_without_constraints),
         T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),
         T(test_result_bad_input_is_an_error),
+        T(test_result_finish_on_a_full_disk_keeps_the_file_readable),
     };
     setup();
     int rc = check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
