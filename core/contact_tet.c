@@ -186,51 +186,59 @@ static void polygon_integrals(const face_polygon *poly, const face_affine *phi_o
     }
 }
 
-/* The candidates but the one at skip. */
-static int candidates_but(const int *cand, int count, int skip, int *rest)
+/* A list of up to four candidates (sub-tetrahedra, by the target face
+ * they stand on), four bits each, the first in the lowest. */
+typedef unsigned candidate_list;
+#define CANDIDATES_ALL 0x3210u
+
+static inline int candidate_first(candidate_list c) { return (int)(c & 15u); }
+static inline int candidate_second(candidate_list c) { return (int)(c >> 4 & 15u); }
+static inline candidate_list candidates_but_first(candidate_list c) { return c >> 4; }
+static inline candidate_list candidates_but_second(candidate_list c)
 {
-    int kept = 0;
-    for (int c = 0; c < count; c++)
-        if (c != skip) rest[kept++] = cand[c];
-    return kept;
+    return (c & 15u) | (c >> 8) << 4;
 }
 
 /* Adds to sums the integrals (polygon_integrals) of phi_t = 4 min lambda_k
- * over the polygon, k among the candidates. phi_t is linear only where one
- * lambda_k is the smallest (sub-tetrahedron k), so the polygon is split
- * where two candidates i, j are equal: above lambda_i - lambda_j = 0, i is
- * never the smallest, below j is not. A polygon on one side (most) is not
- * cut, and the split yields both sides in one pass. */
-static void integrate_min(const face_polygon *poly, const face_affine lambda[4], const int *cand,
-                          int count, double sums[4])
+ * over the polygon, k among the count candidates. phi_t is linear only
+ * where one lambda_k is the smallest (sub-tetrahedron k), so the polygon is
+ * split where the first two, i and j, are equal: above lambda_i - lambda_j
+ * = 0, i is never the smallest, below j is not. A polygon on one side
+ * (most) is not cut: that candidate is dropped and the loop goes on with
+ * the next two; a split recurses on both sides, which yields both in one
+ * pass. */
+static void integrate_min(const face_polygon *poly, const face_affine lambda[4],
+                          candidate_list cand, int count, double sums[4])
 {
-    if (count == 1) {
-        face_affine phi;
-        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[cand[0]].c[i];
-        polygon_integrals(poly, &phi, sums);
-        return;
+    for (; count > 1; count--) {
+        const face_affine *li = &lambda[candidate_first(cand)];
+        const face_affine *lj = &lambda[candidate_second(cand)];
+        face_affine g;
+        for (int i = 0; i < 3; i++) g.c[i] = li->c[i] - lj->c[i];
+        double depth[CLIP_MAX];
+        int above = 0, below = 0;
+        for (int a = 0; a < poly->count; a++) {
+            depth[a] = affine_at(&g, poly->w[a]);
+            above += depth[a] > 0;
+            below += depth[a] < 0;
+        }
+        if (below == 0) { /* i is nowhere the smallest */
+            cand = candidates_but_first(cand);
+        } else if (above == 0) { /* nor is j */
+            cand = candidates_but_second(cand);
+        } else {
+            face_polygon part_above, part_below;
+            split_by(poly, depth, &part_above, &part_below);
+            if (part_above.count >= 3)
+                integrate_min(&part_above, lambda, candidates_but_first(cand), count - 1, sums);
+            if (part_below.count >= 3)
+                integrate_min(&part_below, lambda, candidates_but_second(cand), count - 1, sums);
+            return;
+        }
     }
-    face_affine g;
-    for (int i = 0; i < 3; i++) g.c[i] = lambda[cand[0]].c[i] - lambda[cand[1]].c[i];
-    double depth[CLIP_MAX];
-    int above = 0, below = 0;
-    for (int a = 0; a < poly->count; a++) {
-        depth[a] = affine_at(&g, poly->w[a]);
-        above += depth[a] > 0;
-        below += depth[a] < 0;
-    }
-    int rest[3] = {0, 0, 0};
-    if (below == 0 || above == 0) { /* drop i (all above) or j (all below) */
-        int kept = candidates_but(cand, count, below == 0 ? 0 : 1, rest);
-        integrate_min(poly, lambda, rest, kept, sums);
-        return;
-    }
-    face_polygon part_above, part_below;
-    split_by(poly, depth, &part_above, &part_below);
-    int kept = candidates_but(cand, count, 0, rest);
-    if (part_above.count >= 3) integrate_min(&part_above, lambda, rest, kept, sums);
-    kept = candidates_but(cand, count, 1, rest);
-    if (part_below.count >= 3) integrate_min(&part_below, lambda, rest, kept, sums);
+    face_affine phi;
+    for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[candidate_first(cand)].c[i];
+    polygon_integrals(poly, &phi, sums);
 }
 
 /* The face clipped to the target (lambda_f >= 0, given as affine functions
@@ -242,14 +250,13 @@ static void face_clipped_integrals(const face_affine lambda[4], unsigned corners
                                    double sums[4])
 {
     static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
-    static const int all[4] = {0, 1, 2, 3};
     face_polygon inside[2];
     const face_affine *cut[4];
     int cuts = 0;
     for (int f = 0; f < 4; f++)
         if (corners_outside & 1u << f) cut[cuts++] = &lambda[f];
     const face_polygon *part = clip_all(&face, cut, cuts, inside);
-    if (part->count >= 3) integrate_min(part, lambda, all, 4, sums);
+    if (part->count >= 3) integrate_min(part, lambda, CANDIDATES_ALL, 4, sums);
 }
 
 /* The plane of a face (corners' coordinates la, lb, lc in the target)
