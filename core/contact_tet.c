@@ -98,31 +98,33 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
-/* Appends the vertex (x, y) to the polygon. */
-static inline void polygon_add(face_polygon *poly, double x, double y)
+/* Puts the vertex (x, y) at place k of w; returns the next place. The
+ * clipping loops keep their counts in locals, not in the polygon: a count
+ * read back from memory after every store was a fifth of their work. */
+static inline int vertex_put(double (*w)[2], int k, double x, double y)
 {
-    poly->w[poly->count][0] = x;
-    poly->w[poly->count][1] = y;
-    poly->count++;
+    w[k][0] = x;
+    w[k][1] = y;
+    return k + 1;
 }
 
 /* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
  * vertices in, some out) - Sutherland-Hodgman - in out. */
 static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
 {
-    int n = poly->count;
-    double depth[CLIP_MAX];
+    int n = poly->count, kept = 0;
+    double depth[CLIP_MAX + 1];
     for (int a = 0; a < n; a++) depth[a] = affine_at(g, poly->w[a]);
-    out->count = 0;
+    depth[n] = depth[0];
     for (int a = 0; a < n; a++) {
-        int b = a + 1 < n ? a + 1 : 0;
-        const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) polygon_add(out, u[0], u[1]);
-        if ((depth[a] >= 0) != (depth[b] >= 0)) {
-            double t = depth[a] / (depth[a] - depth[b]);
-            polygon_add(out, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
+        const double *u = poly->w[a], *v = poly->w[a + 1 < n ? a + 1 : 0];
+        if (depth[a] >= 0) kept = vertex_put(out->w, kept, u[0], u[1]);
+        if ((depth[a] >= 0) != (depth[a + 1] >= 0)) {
+            double t = depth[a] / (depth[a] - depth[a + 1]);
+            kept = vertex_put(out->w, kept, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
         }
     }
+    out->count = kept;
 }
 
 /* Splits the polygon, with the depths of its vertices below a plane, into
@@ -130,20 +132,21 @@ static void clip_keep(const face_polygon *poly, face_polygon *out, const face_af
 static void split_by(const face_polygon *poly, const double *depth, face_polygon *above,
                      face_polygon *below)
 {
-    int n = poly->count;
-    above->count = below->count = 0;
+    int n = poly->count, up = 0, down = 0;
     for (int a = 0; a < n; a++) {
         int b = a + 1 < n ? a + 1 : 0;
         const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) polygon_add(above, u[0], u[1]);
-        if (depth[a] <= 0) polygon_add(below, u[0], u[1]);
+        if (depth[a] >= 0) up = vertex_put(above->w, up, u[0], u[1]);
+        if (depth[a] <= 0) down = vertex_put(below->w, down, u[0], u[1]);
         if ((depth[a] > 0 && depth[b] < 0) || (depth[a] < 0 && depth[b] > 0)) {
             double t = depth[a] / (depth[a] - depth[b]);
             double x = u[0] + t * (v[0] - u[0]), y = u[1] + t * (v[1] - u[1]);
-            polygon_add(above, x, y);
-            polygon_add(below, x, y);
+            up = vertex_put(above->w, up, x, y);
+            down = vertex_put(below->w, down, x, y);
         }
     }
+    above->count = up;
+    below->count = down;
 }
 
 /* The polygon cut by the planes in turn, in one of the two buffers (poly
