@@ -351,11 +351,15 @@ static int face_in_target(const double *const pc[4], const double (*lambda)[4],
 static void face_force_apply(const face_touch *ft, int m, const double force[3], double f_c[12],
                              double f_t[12])
 {
+    /* in locals: the stores to f_c and f_t could alias them otherwise */
     const int *fn = tet_face_nodes[m];
+    const double f[3] = {force[0], force[1], force[2]};
+    const double wf[3] = {ft->wf[0], ft->wf[1], ft->wf[2]};
+    const double lt[4] = {ft->lt[0], ft->lt[1], ft->lt[2], ft->lt[3]};
     for (int v = 0; v < 3; v++)
-        for (int i = 0; i < 3; i++) f_c[3 * fn[v] + i] += ft->wf[v] * force[i];
+        for (int i = 0; i < 3; i++) f_c[3 * fn[v] + i] += wf[v] * f[i];
     for (int v = 0; v < 4; v++)
-        for (int i = 0; i < 3; i++) f_t[3 * v + i] -= ft->lt[v] * force[i];
+        for (int i = 0; i < 3; i++) f_t[3 * v + i] -= lt[v] * f[i];
 }
 
 /* What friction needs beyond the normal force: velocities, the contactor's
@@ -391,11 +395,13 @@ static void face_friction(const face_touch *ft, int m, double k_n, double f_n, t
                           double force[3])
 {
     const int *fn = tet_face_nodes[m];
-    const double *v = fr->vel, *n = ft->normal;
+    const double *n = ft->normal, *vc[3], *vt[4];
+    for (int c = 0; c < 3; c++) vc[c] = fr->vel + 3 * (size_t)fr->contactor[fn[c]];
+    for (int t = 0; t < 4; t++) vt[t] = fr->vel + 3 * (size_t)fr->target[t];
     double rel[3] = {0, 0, 0};
     for (int i = 0; i < 3; i++) {
-        for (int c = 0; c < 3; c++) rel[i] += ft->wf[c] * v[3 * (size_t)fr->contactor[fn[c]] + i];
-        for (int t = 0; t < 4; t++) rel[i] -= ft->lt[t] * v[3 * (size_t)fr->target[t] + i];
+        for (int c = 0; c < 3; c++) rel[i] += ft->wf[c] * vc[c][i];
+        for (int t = 0; t < 4; t++) rel[i] -= ft->lt[t] * vt[t][i];
     }
     double *spring = fr->springs + 3 * m;
     double rel_n = vec3_dot(rel, n), spring_n = vec3_dot(spring, n);
