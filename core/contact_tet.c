@@ -98,31 +98,33 @@ static void bary_at(const bary_map *m, const double x[3], double lambda[4])
     lambda[0] = 1.0 - lambda[1] - lambda[2] - lambda[3];
 }
 
-/* Appends the vertex (x, y) to the polygon. */
-static inline void polygon_add(face_polygon *poly, double x, double y)
+/* Puts the vertex (x, y) at place k of w; returns the next place. The
+ * clipping loops keep their counts in locals, not in the polygon: a count
+ * read back from memory after every store was a fifth of their work. */
+static inline int vertex_put(double (*w)[2], int k, double x, double y)
 {
-    poly->w[poly->count][0] = x;
-    poly->w[poly->count][1] = y;
-    poly->count++;
+    w[k][0] = x;
+    w[k][1] = y;
+    return k + 1;
 }
 
 /* Keeps the part of the polygon inside a plane g >= 0 that cuts it (some
  * vertices in, some out) - Sutherland-Hodgman - in out. */
 static void clip_keep(const face_polygon *poly, face_polygon *out, const face_affine *g)
 {
-    int n = poly->count;
-    double depth[CLIP_MAX];
+    int n = poly->count, kept = 0;
+    double depth[CLIP_MAX + 1];
     for (int a = 0; a < n; a++) depth[a] = affine_at(g, poly->w[a]);
-    out->count = 0;
+    depth[n] = depth[0];
     for (int a = 0; a < n; a++) {
-        int b = a + 1 < n ? a + 1 : 0;
-        const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) polygon_add(out, u[0], u[1]);
-        if ((depth[a] >= 0) != (depth[b] >= 0)) {
-            double t = depth[a] / (depth[a] - depth[b]);
-            polygon_add(out, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
+        const double *u = poly->w[a], *v = poly->w[a + 1 < n ? a + 1 : 0];
+        if (depth[a] >= 0) kept = vertex_put(out->w, kept, u[0], u[1]);
+        if ((depth[a] >= 0) != (depth[a + 1] >= 0)) {
+            double t = depth[a] / (depth[a] - depth[a + 1]);
+            kept = vertex_put(out->w, kept, u[0] + t * (v[0] - u[0]), u[1] + t * (v[1] - u[1]));
         }
     }
+    out->count = kept;
 }
 
 /* Splits the polygon, with the depths of its vertices below a plane, into
@@ -130,20 +132,21 @@ static void clip_keep(const face_polygon *poly, face_polygon *out, const face_af
 static void split_by(const face_polygon *poly, const double *depth, face_polygon *above,
                      face_polygon *below)
 {
-    int n = poly->count;
-    above->count = below->count = 0;
+    int n = poly->count, up = 0, down = 0;
     for (int a = 0; a < n; a++) {
         int b = a + 1 < n ? a + 1 : 0;
         const double *u = poly->w[a], *v = poly->w[b];
-        if (depth[a] >= 0) polygon_add(above, u[0], u[1]);
-        if (depth[a] <= 0) polygon_add(below, u[0], u[1]);
+        if (depth[a] >= 0) up = vertex_put(above->w, up, u[0], u[1]);
+        if (depth[a] <= 0) down = vertex_put(below->w, down, u[0], u[1]);
         if ((depth[a] > 0 && depth[b] < 0) || (depth[a] < 0 && depth[b] > 0)) {
             double t = depth[a] / (depth[a] - depth[b]);
             double x = u[0] + t * (v[0] - u[0]), y = u[1] + t * (v[1] - u[1]);
-            polygon_add(above, x, y);
-            polygon_add(below, x, y);
+            up = vertex_put(above->w, up, x, y);
+            down = vertex_put(below->w, down, x, y);
         }
     }
+    above->count = up;
+    below->count = down;
 }
 
 /* The polygon cut by the planes in turn, in one of the two buffers (poly
@@ -186,51 +189,59 @@ static void polygon_integrals(const face_polygon *poly, const face_affine *phi_o
     }
 }
 
-/* The candidates but the one at skip. */
-static int candidates_but(const int *cand, int count, int skip, int *rest)
+/* A list of up to four candidates (sub-tetrahedra, by the target face
+ * they stand on), four bits each, the first in the lowest. */
+typedef unsigned candidate_list;
+#define CANDIDATES_ALL 0x3210u
+
+static inline int candidate_first(candidate_list c) { return (int)(c & 15u); }
+static inline int candidate_second(candidate_list c) { return (int)(c >> 4 & 15u); }
+static inline candidate_list candidates_but_first(candidate_list c) { return c >> 4; }
+static inline candidate_list candidates_but_second(candidate_list c)
 {
-    int kept = 0;
-    for (int c = 0; c < count; c++)
-        if (c != skip) rest[kept++] = cand[c];
-    return kept;
+    return (c & 15u) | (c >> 8) << 4;
 }
 
 /* Adds to sums the integrals (polygon_integrals) of phi_t = 4 min lambda_k
- * over the polygon, k among the candidates. phi_t is linear only where one
- * lambda_k is the smallest (sub-tetrahedron k), so the polygon is split
- * where two candidates i, j are equal: above lambda_i - lambda_j = 0, i is
- * never the smallest, below j is not. A polygon on one side (most) is not
- * cut, and the split yields both sides in one pass. */
-static void integrate_min(const face_polygon *poly, const face_affine lambda[4], const int *cand,
-                          int count, double sums[4])
+ * over the polygon, k among the count candidates. phi_t is linear only
+ * where one lambda_k is the smallest (sub-tetrahedron k), so the polygon is
+ * split where the first two, i and j, are equal: above lambda_i - lambda_j
+ * = 0, i is never the smallest, below j is not. A polygon on one side
+ * (most) is not cut: that candidate is dropped and the loop goes on with
+ * the next two; a split recurses on both sides, which yields both in one
+ * pass. */
+static void integrate_min(const face_polygon *poly, const face_affine lambda[4],
+                          candidate_list cand, int count, double sums[4])
 {
-    if (count == 1) {
-        face_affine phi;
-        for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[cand[0]].c[i];
-        polygon_integrals(poly, &phi, sums);
-        return;
+    for (; count > 1; count--) {
+        const face_affine *li = &lambda[candidate_first(cand)];
+        const face_affine *lj = &lambda[candidate_second(cand)];
+        face_affine g;
+        for (int i = 0; i < 3; i++) g.c[i] = li->c[i] - lj->c[i];
+        double depth[CLIP_MAX];
+        int above = 0, below = 0;
+        for (int a = 0; a < poly->count; a++) {
+            depth[a] = affine_at(&g, poly->w[a]);
+            above += depth[a] > 0;
+            below += depth[a] < 0;
+        }
+        if (below == 0) { /* i is nowhere the smallest */
+            cand = candidates_but_first(cand);
+        } else if (above == 0) { /* nor is j */
+            cand = candidates_but_second(cand);
+        } else {
+            face_polygon part_above, part_below;
+            split_by(poly, depth, &part_above, &part_below);
+            if (part_above.count >= 3)
+                integrate_min(&part_above, lambda, candidates_but_first(cand), count - 1, sums);
+            if (part_below.count >= 3)
+                integrate_min(&part_below, lambda, candidates_but_second(cand), count - 1, sums);
+            return;
+        }
     }
-    face_affine g;
-    for (int i = 0; i < 3; i++) g.c[i] = lambda[cand[0]].c[i] - lambda[cand[1]].c[i];
-    double depth[CLIP_MAX];
-    int above = 0, below = 0;
-    for (int a = 0; a < poly->count; a++) {
-        depth[a] = affine_at(&g, poly->w[a]);
-        above += depth[a] > 0;
-        below += depth[a] < 0;
-    }
-    int rest[3] = {0, 0, 0};
-    if (below == 0 || above == 0) { /* drop i (all above) or j (all below) */
-        int kept = candidates_but(cand, count, below == 0 ? 0 : 1, rest);
-        integrate_min(poly, lambda, rest, kept, sums);
-        return;
-    }
-    face_polygon part_above, part_below;
-    split_by(poly, depth, &part_above, &part_below);
-    int kept = candidates_but(cand, count, 0, rest);
-    if (part_above.count >= 3) integrate_min(&part_above, lambda, rest, kept, sums);
-    kept = candidates_but(cand, count, 1, rest);
-    if (part_below.count >= 3) integrate_min(&part_below, lambda, rest, kept, sums);
+    face_affine phi;
+    for (int i = 0; i < 3; i++) phi.c[i] = 4 * lambda[candidate_first(cand)].c[i];
+    polygon_integrals(poly, &phi, sums);
 }
 
 /* The face clipped to the target (lambda_f >= 0, given as affine functions
@@ -242,14 +253,13 @@ static void face_clipped_integrals(const face_affine lambda[4], unsigned corners
                                    double sums[4])
 {
     static const face_polygon face = {{{0, 0}, {1, 0}, {0, 1}}, 3};
-    static const int all[4] = {0, 1, 2, 3};
     face_polygon inside[2];
     const face_affine *cut[4];
     int cuts = 0;
     for (int f = 0; f < 4; f++)
         if (corners_outside & 1u << f) cut[cuts++] = &lambda[f];
     const face_polygon *part = clip_all(&face, cut, cuts, inside);
-    if (part->count >= 3) integrate_min(part, lambda, all, 4, sums);
+    if (part->count >= 3) integrate_min(part, lambda, CANDIDATES_ALL, 4, sums);
 }
 
 /* The plane of a face (corners' coordinates la, lb, lc in the target)
@@ -341,11 +351,15 @@ static int face_in_target(const double *const pc[4], const double (*lambda)[4],
 static void face_force_apply(const face_touch *ft, int m, const double force[3], double f_c[12],
                              double f_t[12])
 {
+    /* in locals: the stores to f_c and f_t could alias them otherwise */
     const int *fn = tet_face_nodes[m];
+    const double f[3] = {force[0], force[1], force[2]};
+    const double wf[3] = {ft->wf[0], ft->wf[1], ft->wf[2]};
+    const double lt[4] = {ft->lt[0], ft->lt[1], ft->lt[2], ft->lt[3]};
     for (int v = 0; v < 3; v++)
-        for (int i = 0; i < 3; i++) f_c[3 * fn[v] + i] += ft->wf[v] * force[i];
+        for (int i = 0; i < 3; i++) f_c[3 * fn[v] + i] += wf[v] * f[i];
     for (int v = 0; v < 4; v++)
-        for (int i = 0; i < 3; i++) f_t[3 * v + i] -= ft->lt[v] * force[i];
+        for (int i = 0; i < 3; i++) f_t[3 * v + i] -= lt[v] * f[i];
 }
 
 /* What friction needs beyond the normal force: velocities, the contactor's
@@ -381,11 +395,13 @@ static void face_friction(const face_touch *ft, int m, double k_n, double f_n, t
                           double force[3])
 {
     const int *fn = tet_face_nodes[m];
-    const double *v = fr->vel, *n = ft->normal;
+    const double *n = ft->normal, *vc[3], *vt[4];
+    for (int c = 0; c < 3; c++) vc[c] = fr->vel + 3 * (size_t)fr->contactor[fn[c]];
+    for (int t = 0; t < 4; t++) vt[t] = fr->vel + 3 * (size_t)fr->target[t];
     double rel[3] = {0, 0, 0};
     for (int i = 0; i < 3; i++) {
-        for (int c = 0; c < 3; c++) rel[i] += ft->wf[c] * v[3 * (size_t)fr->contactor[fn[c]] + i];
-        for (int t = 0; t < 4; t++) rel[i] -= ft->lt[t] * v[3 * (size_t)fr->target[t] + i];
+        for (int c = 0; c < 3; c++) rel[i] += ft->wf[c] * vc[c][i];
+        for (int t = 0; t < 4; t++) rel[i] -= ft->lt[t] * vt[t][i];
     }
     double *spring = fr->springs + 3 * m;
     double rel_n = vec3_dot(rel, n), spring_n = vec3_dot(spring, n);

@@ -5,17 +5,20 @@
  * [+ friction] to 5 %); a box on a slab with gravity tilted 30 degrees
  * slides at g (sin 30 - mu cos 30) (to 5 %) with mu = 0.3, and with
  * mu = 0.7 > tan 30 stays put; a pile of spheres dropped into a box of
- * fixed slabs settles with no sphere through another; two threads give the
- * bits of one; a checkpoint holding stick springs restores to the same bits.
+ * fixed slabs settles with no sphere through another, and the near list
+ * it walks leaves out no touching pair; two threads give the bits of one; a
+ * checkpoint holding stick springs restores to the same bits.
  */
 #include "build_container_3d.h"
 #include "check.h"
+#include "contact_tet.h"
 #include "fdem.h"
 #include "mesh_3d.h"
 #include "model.h"
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 /* penalty 0: the default, 10 x young. */
 static fdem_material_def solid(double density, double young, double damping, double friction,
@@ -318,29 +321,23 @@ static double sphere_inscribed_radius(double R)
     return inscribed;
 }
 
-/* Eight spheres of radius R = 0.05 dropped into a box of fixed slabs, six
- * on the floor (3 x 2, 2 mm above it, 2 mm apart) and two above the
- * pockets between them, 1 cm higher than where they rest. By 0.25 s their
- * kinetic energy is below 5 % of gravity's work and less than half what it
- * was at 0.15 s; no two centres are closer than 0.9 x 2R, and no node of
- * one sphere is more than 0.05 R inside the sphere inscribed in another
- * (the coarse spheres are polyhedra whose faces come as close as 0.8 R to
- * the centre; a node resting on a face sits on that sphere). Soft (E =
- * 0.3 MPa, p = 1 MPa) for long steps; the penalty sets how far a vertex
- * of an upper sphere presses into a face under its weight, which grows as
- * p^(-1/3): measured 0.04 R inside the inscribed sphere at p = 0.3 MPa,
- * 0.01 R at 1 MPa, none at 3 MPa. */
-static void sphere_pile_settles_without_interpenetration(void)
+/* Eight spheres of radius R = 0.05 (8 divisions) over a 3 x 2 floor in a
+ * box of fixed slabs (sphere_pile_settles_without_interpenetration says
+ * where); their nodes are first[k] to end[k], X and Y the box. NULL if it
+ * could not be built (the failure is checked). */
+enum { PILE_SPHERES = 8 };
+static fdem_model *sphere_pile(double R, int first[PILE_SPHERES], int end[PILE_SPHERES],
+                               double *X, double *Y)
 {
     fdem_model *m = model_3d();
     int wall = add_material(m, solid(1000, 3e5, 0.1, 0.3, 1e6));
     int ball = add_material(m, solid(1000, 3e5, 0.3, 0.3, 1e6));
-    enum { SPHERES = 8 };
-    const double R = 0.05, pitch = 2 * R + 0.002, X = 3 * pitch, Y = 2 * pitch;
-    add_container(m, wall, X, Y, 0.25, 0.04);
-    int first[SPHERES], end[SPHERES];
+    const double pitch = 2 * R + 0.002;
+    *X = 3 * pitch;
+    *Y = 2 * pitch;
+    add_container(m, wall, *X, *Y, 0.25, 0.04);
     double rest = R + 0.002 + sqrt(4 * R * R - 0.5 * pitch * pitch); /* in a pocket */
-    for (int k = 0; k < SPHERES; k++) {
+    for (int k = 0; k < PILE_SPHERES; k++) {
         double c[3];
         if (k < 6) {
             c[0] = 0.5 * pitch + pitch * (k % 3);
@@ -355,7 +352,30 @@ static void sphere_pile_settles_without_interpenetration(void)
     }
     const double g[3] = {0, 0, -9.81};
     fdem_set_gravity_v(m, g);
-    if (finalize(m, 0.5)) return;
+    if (finalize(m, 0.5)) return NULL;
+    return m;
+}
+
+/* Eight spheres of radius R = 0.05 dropped into a box of fixed slabs, six
+ * on the floor (3 x 2, 2 mm above it, 2 mm apart) and two above the
+ * pockets between them, 1 cm higher than where they rest. By 0.25 s their
+ * kinetic energy is below 5 % of gravity's work and less than half what it
+ * was at 0.15 s; no two centres are closer than 0.9 x 2R, and no node of
+ * one sphere is more than 0.05 R inside the sphere inscribed in another
+ * (the coarse spheres are polyhedra whose faces come as close as 0.8 R to
+ * the centre; a node resting on a face sits on that sphere). Soft (E =
+ * 0.3 MPa, p = 1 MPa) for long steps; the penalty sets how far a vertex
+ * of an upper sphere presses into a face under its weight, which grows as
+ * p^(-1/3): measured 0.04 R inside the inscribed sphere at p = 0.3 MPa,
+ * 0.01 R at 1 MPa, none at 3 MPa. */
+static void sphere_pile_settles_without_interpenetration(void)
+{
+    enum { SPHERES = PILE_SPHERES };
+    const double R = 0.05;
+    int first[SPHERES], end[SPHERES];
+    double X, Y;
+    fdem_model *m = sphere_pile(R, first, end, &X, &Y);
+    if (!m) return;
     run_until(m, 0.15);
     double kinetic_before = fdem_get_energy(m).kinetic;
     run_until(m, 0.25);
@@ -391,6 +411,80 @@ static void sphere_pile_settles_without_interpenetration(void)
             "%d candidate pairs\n", closest, deepest, inscribed / R, en.kinetic / en.gravity_work,
             kinetic_before / en.gravity_work, (long long)fdem_get_step(m),
             fdem_get_counts(m).contact_pairs);
+    fdem_model_destroy(m);
+}
+
+/* Touching pairs among every candidate pair at the positions pos, each put
+ * to the kernel (tet_contact_pair) when the two boxes overlap. */
+static int touching_candidates(const fdem_model *m, const double *pos)
+{
+    const contact_state *cs = &m->contact;
+    int touching = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        const int32_t *na = m->tet[cs->pairs.a[k]].node, *nb = m->tet[cs->pairs.b[k]].node;
+        int apart = 0;
+        for (int d = 0; d < 3 && !apart; d++) {
+            double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+            for (int v = 0; v < 4; v++) {
+                lo[0] = fmin(lo[0], pos[3 * na[v] + d]), hi[0] = fmax(hi[0], pos[3 * na[v] + d]);
+                lo[1] = fmin(lo[1], pos[3 * nb[v] + d]), hi[1] = fmax(hi[1], pos[3 * nb[v] + d]);
+            }
+            apart = hi[0] < lo[1] || hi[1] < lo[0];
+        }
+        double fa[12], fb[12];
+        if (!apart && tet_contact_pair(pos, na, nb, 1.0, fa, fb) > 0) touching++;
+    }
+    return touching;
+}
+
+/* The walk takes only the near list (contact.c): candidate pairs whose boxes
+ * can overlap before some node travels the list's reach, a shorter reach in
+ * 3D, so the list is rebuilt often as the pile falls. What it leaves out
+ * must never touch: every 50th step of the settling pile (every 400th under
+ * the sanitizers) the pairs the step found touching are counted against
+ * every candidate pair at the positions the step starts from. A step that
+ * detects again (a new candidate list) is not compared. */
+static void near_list_misses_no_touching_pair(void)
+{
+    int first[PILE_SPHERES], end[PILE_SPHERES];
+    double X, Y;
+    fdem_model *m = sphere_pile(0.05, first, end, &X, &Y);
+    if (!m) return;
+#ifdef FDEM_SAN
+    const int every = 400;
+#else
+    const int every = 50;
+#endif
+    size_t bytes = sizeof(double) * 3 * (size_t)m->node_count;
+    double *start = malloc(bytes), *kept = calloc(1, bytes); /* kept: the list's pos_near */
+    fdem_error err = {0};
+    int compared = 0, busiest = 0, rebuilds = 0;
+    for (int s = 0; s < 2500 && start && kept; s++) {
+        long detections = m->contact.detections;
+        int check = s % every == 0 && m->contact.pairs.count > 0;
+        if (check) memcpy(start, m->pos, bytes);
+        if (fdem_step(m, &err)) {
+            CHECK(0, "step %d: %s", s, err.message);
+            break;
+        }
+        if (memcmp(kept, m->contact.pos_near, bytes)) {
+            memcpy(kept, m->contact.pos_near, bytes);
+            rebuilds++;
+        }
+        if (!check || m->contact.detections != detections) continue;
+        int expected = touching_candidates(m, start);
+        CHECK(m->contact.touching == expected, "step %d: %d pairs touched, %d candidates touch", s,
+              m->contact.touching, expected);
+        busiest = expected > busiest ? expected : busiest;
+        compared++;
+    }
+    CHECK(compared >= 2500 / every / 2, "only %d steps compared", compared);
+    CHECK(busiest > 20, "at most %d touching pairs: nothing to miss", busiest);
+    CHECK(rebuilds > 2500 / every, "the near list was rebuilt %d times only", rebuilds);
+    fprintf(stderr, "  near list: %d steps compared, up to %d touching pairs, %d rebuilds\n",
+            compared, busiest, rebuilds);
+    free(start);
+    free(kept);
     fdem_model_destroy(m);
 }
 
@@ -484,5 +578,6 @@ CHECK_MAIN(T(boxes_colliding_conserve_momentum_and_energy),
            T(box_slides_down_tilted_slab_with_friction),
            T(box_sticks_on_slab_below_friction_angle),
            T(sphere_pile_settles_without_interpenetration),
+           T(near_list_misses_no_touching_pair),
            T(two_threads_give_the_same_bits_with_contact),
            T(restored_model_steps_on_to_the_same_bits_with_springs))
