@@ -224,13 +224,17 @@ static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(
 static inline int32_t nbs3_down(int32_t v, int32_t size) { return (v - 1) & (size - 1); }
 static inline int32_t nbs3_up(int32_t v, int32_t size) { return (v + 1) & (size - 1); }
 
-/* Layer `list` into y-set k, and out again (by looping over its elements). */
+/* Layer `list` into y-set k, and out again (by looping over its elements).
+ * Mapping also puts each element's x in its x-link, dead until its row is
+ * mapped: every walk of a row then reads x beside the row link it has just
+ * loaded instead of converting the centre on its chain of dependent loads
+ * (row link, centre, x, heads), and nbs3_row_unmap puts it back. */
 static void nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->rows[k];
     for (int32_t j = list; j >= 0; j = s->layer_next[j]) {
         int32_t y = nbs3_y(s, j);
-        s->next[j].row = heads[y];
+        s->next[j] = (nbs_next_3d){heads[y], nbs3_x(s, j)};
         heads[y] = j;
     }
 }
@@ -241,14 +245,6 @@ static void nbs3_layer_unmap(const nbs3_scan *s, int k, int32_t list)
     for (int32_t j = list; j >= 0; j = s->layer_next[j]) heads[nbs3_y(s, j)] = NBS_EMPTY;
 }
 
-/* The x of each element of a layer not done yet, kept in its x-link, as
- * nbs3_row_unmap leaves it: the layer below the first of a run that has
- * wrapped round a folded axis, where every slot is a layer. */
-static void nbs3_layer_keep_x(const nbs3_scan *s, int32_t list)
-{
-    for (int32_t j = list; j >= 0; j = s->layer_next[j]) s->next[j].cell = nbs3_x(s, j);
-}
-
 /* Row `list` into x-set k (head insertion: an element's link leads to the
  * elements of its cell mapped before it); returns the row's element count. */
 static int32_t nbs3_row_map(const nbs3_scan *s, int k, int32_t list)
@@ -256,18 +252,15 @@ static int32_t nbs3_row_map(const nbs3_scan *s, int k, int32_t list)
     int32_t *heads = s->cells[k], count = 0;
     for (int32_t j = list, after; j >= 0; j = after, count++) {
         after = s->next[j].row; /* read before the store beside it */
-        int32_t x = nbs3_x(s, j);
+        int32_t x = s->next[j].cell;
         s->next[j].cell = heads[x];
         heads[x] = j;
     }
     return count;
 }
 
-/* Out of x-set k again. An element's x-link is dead from here on, so it
- * keeps the element's x: the next layer's walks of this one read it there
- * instead of converting the centre again, which takes that conversion off
- * their chain of dependent loads (row link, centre, x, heads): 12-15 % of a
- * detection at density 1, where each element is walked twice so. */
+/* Out of x-set k again, its x-links holding x again (nbs3_layer_map) for
+ * the next layer's walks of this row. */
 static void nbs3_row_unmap(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->cells[k];
@@ -399,8 +392,8 @@ static NBS_ALWAYS_INLINE int nbs3_row_own(const nbs3_scan *s, int use_body, nbs3
     int32_t count = 0;
     for (int32_t e = row->list, after; e >= 0; e = after, count++) {
         after = next[e].row; /* read before the store beside it */
+        int32_t x = next[e].cell; /* nbs3_layer_map */
         double ex = p.cx[e];
-        int32_t x = nbs3_probe_x(&p, ex);
         nbs3_trio here = nbs3_trio_of(cur, x, mask), below = nbs3_trio_of(held, x, mask);
         if ((nbs3_trio_and(here) & nbs3_trio_and(below)) >= 0) {
             if (nbs3_room(&o, (size_t)count + held_count) != 0) return -1;
@@ -428,7 +421,7 @@ static NBS_ALWAYS_INLINE int nbs3_row_cross(const nbs3_scan *s, int use_body, in
     const int32_t *set1 = s->cells[one], *set2 = s->cells[two < 0 ? one : two];
     const int32_t mask = (int32_t)p.xmask;
     for (int32_t j = list; j >= 0; j = next[j].row) {
-        int32_t x = next[j].cell; /* its x, kept (nbs3_row_unmap) */
+        int32_t x = next[j].cell; /* nbs3_row_unmap */
         nbs3_trio t1 = nbs3_trio_of(set1, x, mask);
         int32_t any = nbs3_trio_and(t1);
         nbs3_trio t2 = t1;
@@ -543,10 +536,8 @@ static int nbs3_layers_detect(const nbs3_scan *s, size_t n, int all_valid, nbs_p
             z = zb;
         }
         int held = 1;
-        int32_t below = layers[nbs3_down(z, nz)];
-        int32_t held_list = nbs_row_list(below);
+        int32_t held_list = nbs_row_list(layers[nbs3_down(z, nz)]);
         nbs3_layer_map(s, held, held_list);
-        if (below >= 0) nbs3_layer_keep_x(s, held_list); /* new: a wrapped fold */
         for (;;) {
             int32_t head = layers[z];
             layers[z] = -2 - head;

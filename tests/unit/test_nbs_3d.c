@@ -460,10 +460,10 @@ static void test_nbs3_reuse(void)
 
 /* A run that wraps round a folded z-axis starts above a layer not done
  * yet, and the walks of its first layer read each element's x from the
- * x-links of that layer, which only a done layer holds (nbs3_row_unmap):
- * it must get them first. Four spheres fold z onto 4 slots, every one a
- * layer; sphere 0's is the layer below the run's first, and it touches
- * sphere 1 above it. The grid is reused, so that a stale x from the first
+ * x-links of that layer, which must hold them although none of its rows
+ * has been through an x-set yet. Four spheres fold z onto 4 slots, every
+ * one a layer; sphere 0's is the layer below the run's first, and it
+ * touches sphere 1 above it. The grid is reused, so that a stale x from the first
  * detection (sphere 0 two cells away in x) would lose the pair. */
 static void test_nbs3_wrapped_run(void)
 {
