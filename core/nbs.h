@@ -76,7 +76,9 @@ size_t nbs_memory_bytes(const nbs_grid *grid, const nbs_pairs *pairs);
  *    against the row's x-lists. Only non-empty layers and rows are visited,
  *    by looping over elements; lists are cleared the same way.
  *  - Integer RAM is exactly 3N + nz + 2nx + 2ny (nbs_integers_3d) plus the
- *    pair list: no integer coordinates are stored, they are recomputed.
+ *    pair list: no integer coordinates are stored beside the lists (an
+ *    element's x waits in its x-link while that link is unused), they are
+ *    recomputed.
  *    Axes are folded like the 2D ones, so RAM is O(N) whatever the extent
  *    and never O(nx * ny * nz).
  */

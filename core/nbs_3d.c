@@ -14,7 +14,14 @@
  *  - Integer RAM is exactly the book's 3N + nz + 2nx + 2ny: integer
  *    coordinates are not stored (that would be 3N more) but recomputed from
  *    the centre when needed - a subtract, a multiply and a convert, cheaper
- *    than the memory traffic of storing them at 1e6 elements.
+ *    than the memory traffic of storing them at 1e6 elements. The one
+ *    exception costs no memory: an element's x-link is unused from the
+ *    mapping of its layer to the mapping of its row, and again once the
+ *    row is out, and holds its x then (nbs3_layer_map): the walks read it
+ *    beside the row link instead of converting on their chain of loads.
+ *  - The y- and x-links of an element are side by side (nbs_next_3d):
+ *    as two page-aligned arrays a store to one and the next load from the
+ *    other stalled as 4 KiB aliases.
  *  - Half mask: an element meets the elements of its row mapped before it
  *    in cells x-1 .. x+1 (the row is mapped and tested in one pass), the
  *    cells (x-1 .. x+1, y-1, z) and the nine cells (x-1 .. x+1, y-1 .. y+1,
