@@ -5,8 +5,8 @@
  * Owns: integerising bounding spheres onto a grid of cell size d (the
  * largest diameter), the three levels of singly connected lists of the book
  * (z-layers: layer_head / layer_next; y-lists of a layer and the layer below
- * it: two sets of row heads / row_next; x-lists of a row and the row below
- * it: two sets of cell heads / cell_next), the half contact mask in 3D, and
+ * it: two sets of row heads / next.row; x-lists of a row and the row below
+ * it: two sets of cell heads / next.cell), the half contact mask in 3D, and
  * the all-pairs reference. What it shares with the 2D detector (pair list,
  * padding, folding, the old-list encoding) is in nbs_internal.h.
  *
@@ -14,7 +14,14 @@
  *  - Integer RAM is exactly the book's 3N + nz + 2nx + 2ny: integer
  *    coordinates are not stored (that would be 3N more) but recomputed from
  *    the centre when needed - a subtract, a multiply and a convert, cheaper
- *    than the memory traffic of storing them at 1e6 elements.
+ *    than the memory traffic of storing them at 1e6 elements. The one
+ *    exception costs no memory: an element's x-link is unused from the
+ *    mapping of its layer to the mapping of its row, and again once the
+ *    row is out, and holds its x then (nbs3_layer_map): the walks read it
+ *    beside the row link instead of converting on their chain of loads.
+ *  - The y- and x-links of an element are side by side (nbs_next_3d):
+ *    as two page-aligned arrays a store to one and the next load from the
+ *    other stalled as 4 KiB aliases.
  *  - Half mask: an element meets the elements of its row mapped before it
  *    in cells x-1 .. x+1 (the row is mapped and tested in one pass), the
  *    cells (x-1 .. x+1, y-1, z) and the nine cells (x-1 .. x+1, y-1 .. y+1,
@@ -68,9 +75,9 @@ void nbs_grid_3d_init(nbs_grid_3d *grid)
 
 void nbs_grid_3d_free(nbs_grid_3d *grid)
 {
-    int32_t *arrays[] = {grid->layer_head, grid->layer_next, grid->row_head,
-                         grid->row_next, grid->cell_head, grid->cell_next};
+    int32_t *arrays[] = {grid->layer_head, grid->layer_next, grid->row_head, grid->cell_head};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
+    free(grid->next);
     nbs_grid_3d_init(grid);
 }
 
@@ -103,9 +110,10 @@ static int nbs3_reserve(nbs_grid_3d *g, size_t n, int32_t nx, int32_t ny, int32_
 {
     if (n > g->n_capacity) {
         size_t cap = n > 2 * g->n_capacity ? n : 2 * g->n_capacity;
-        if (nbs_grow_array(&g->layer_next, cap) || nbs_grow_array(&g->row_next, cap) ||
-            nbs_grow_array(&g->cell_next, cap))
-            return -1;
+        if (nbs_grow_array(&g->layer_next, cap)) return -1;
+        nbs_next_3d *next = realloc(g->next, cap * sizeof *next);
+        if (!next) return -1;
+        g->next = next;
         g->n_capacity = cap;
     }
     if (nbs3_grow_heads(&g->layer_head, &g->nz_capacity, (size_t)nz, 1) ||
@@ -205,9 +213,8 @@ typedef struct nbs3_scan {
     const int32_t *body;
     double inv;
     nbs3_axis ax, ay, az;
-    int32_t *layer_head, *layer_next;
-    int32_t *rows[2], *row_next;
-    int32_t *cells[2], *cell_next;
+    int32_t *layer_head, *layer_next, *rows[2], *cells[2];
+    nbs_next_3d *next;
 } nbs3_scan;
 
 /* x >= lo, so truncation is floor */
@@ -224,13 +231,17 @@ static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(
 static inline int32_t nbs3_down(int32_t v, int32_t size) { return (v - 1) & (size - 1); }
 static inline int32_t nbs3_up(int32_t v, int32_t size) { return (v + 1) & (size - 1); }
 
-/* Layer `list` into y-set k, and out again (by looping over its elements). */
+/* Layer `list` into y-set k, and out again (by looping over its elements).
+ * Mapping also puts each element's x in its x-link, dead until its row is
+ * mapped: every walk of a row then reads x beside the row link it has just
+ * loaded instead of converting the centre on its chain of dependent loads
+ * (row link, centre, x, heads), and nbs3_row_unmap puts it back. */
 static void nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->rows[k];
     for (int32_t j = list; j >= 0; j = s->layer_next[j]) {
         int32_t y = nbs3_y(s, j);
-        s->row_next[j] = heads[y];
+        s->next[j] = (nbs_next_3d){heads[y], nbs3_x(s, j)};
         heads[y] = j;
     }
 }
@@ -246,18 +257,26 @@ static void nbs3_layer_unmap(const nbs3_scan *s, int k, int32_t list)
 static int32_t nbs3_row_map(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->cells[k], count = 0;
-    for (int32_t j = list; j >= 0; j = s->row_next[j], count++) {
-        int32_t x = nbs3_x(s, j);
-        s->cell_next[j] = heads[x];
+    for (int32_t j = list, after; j >= 0; j = after, count++) {
+        after = s->next[j].row; /* read before the store beside it */
+        int32_t x = s->next[j].cell;
+        s->next[j].cell = heads[x];
         heads[x] = j;
     }
     return count;
 }
 
+/* Out of x-set k again, its x-links holding x again (nbs3_layer_map) for
+ * the next layer's walks of this row. */
 static void nbs3_row_unmap(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->cells[k];
-    for (int32_t j = list; j >= 0; j = s->row_next[j]) heads[nbs3_x(s, j)] = NBS_EMPTY;
+    for (int32_t j = list, after; j >= 0; j = after) {
+        after = s->next[j].row; /* read before the store beside it */
+        int32_t x = nbs3_x(s, j);
+        heads[x] = NBS_EMPTY;
+        s->next[j].cell = x;
+    }
 }
 
 /* The pair list in locals the compiler can keep in registers. */
@@ -286,14 +305,15 @@ static inline int nbs3_room(nbs3_out *o, size_t need)
  * list (an int32 store may alias them). */
 typedef struct nbs3_probe {
     const double *cx, *cy, *cz, *r;
-    const int32_t *body, *cell_next;
+    const int32_t *body;
+    const nbs_next_3d *next;
     double xlo, inv;
     int64_t xmask;
 } nbs3_probe;
 
 static inline nbs3_probe nbs3_probe_of(const nbs3_scan *s)
 {
-    nbs3_probe p = {s->cx, s->cy, s->cz, s->r, s->body, s->cell_next, s->ax.lo, s->inv, s->ax.mask};
+    nbs3_probe p = {s->cx, s->cy, s->cz, s->r, s->body, s->next, s->ax.lo, s->inv, s->ax.mask};
     return p;
 }
 
@@ -338,8 +358,8 @@ static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_probe *p, int use_body,
                                               int32_t list, nbs3_out *o)
 {
     const double *cx = p->cx, *cy = p->cy, *cz = p->cz, *r = p->r;
-    const int32_t *cell_next = p->cell_next;
-    for (int32_t j = list; j >= 0; j = cell_next[j]) {
+    const nbs_next_3d *next = p->next;
+    for (int32_t j = list; j >= 0; j = next[j].cell) {
         if (!nbs_spheres_touch(b.x, b.y, b.z, b.r, cx[j], cy[j], cz[j], r[j])) continue;
         if (use_body && nbs_same_body(p->body, b.e, j)) continue;
         o->a[o->count] = b.e;
@@ -371,15 +391,16 @@ static NBS_ALWAYS_INLINE int nbs3_row_own(const nbs3_scan *s, int use_body, nbs3
 {
     nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
     const nbs3_probe p = nbs3_probe_of(s);
-    const int32_t *row_next = s->row_next;
-    int32_t *cur = s->cells[row->cur], *cell_next = s->cell_next;
+    nbs_next_3d *next = s->next;
+    int32_t *cur = s->cells[row->cur];
     const int32_t *held = s->cells[row->held];
     const int32_t mask = (int32_t)p.xmask;
     const size_t held_count = (size_t)row->held_count;
     int32_t count = 0;
-    for (int32_t e = row->list; e >= 0; e = row_next[e], count++) {
+    for (int32_t e = row->list, after; e >= 0; e = after, count++) {
+        after = next[e].row; /* read before the store beside it */
+        int32_t x = next[e].cell; /* nbs3_layer_map */
         double ex = p.cx[e];
-        int32_t x = nbs3_probe_x(&p, ex);
         nbs3_trio here = nbs3_trio_of(cur, x, mask), below = nbs3_trio_of(held, x, mask);
         if ((nbs3_trio_and(here) & nbs3_trio_and(below)) >= 0) {
             if (nbs3_room(&o, (size_t)count + held_count) != 0) return -1;
@@ -387,7 +408,7 @@ static NBS_ALWAYS_INLINE int nbs3_row_own(const nbs3_scan *s, int use_body, nbs3
             nbs3_trio_test(&p, use_body, b, here, &o);
             nbs3_trio_test(&p, use_body, b, below, &o);
         }
-        cell_next[e] = here.mid;
+        next[e].cell = here.mid;
         cur[x] = e;
     }
     row->count = count;
@@ -403,19 +424,18 @@ static NBS_ALWAYS_INLINE int nbs3_row_cross(const nbs3_scan *s, int use_body, in
 {
     nbs3_out o = {pairs->a, pairs->b, pairs->count, pairs->capacity, pairs};
     const nbs3_probe p = nbs3_probe_of(s);
-    const int32_t *row_next = s->row_next;
+    const nbs_next_3d *next = s->next;
     const int32_t *set1 = s->cells[one], *set2 = s->cells[two < 0 ? one : two];
     const int32_t mask = (int32_t)p.xmask;
-    for (int32_t j = list; j >= 0; j = row_next[j]) {
-        double jx = p.cx[j];
-        int32_t x = nbs3_probe_x(&p, jx);
+    for (int32_t j = list; j >= 0; j = next[j].row) {
+        int32_t x = next[j].cell; /* nbs3_row_unmap */
         nbs3_trio t1 = nbs3_trio_of(set1, x, mask);
         int32_t any = nbs3_trio_and(t1);
         nbs3_trio t2 = t1;
         if (two >= 0) t2 = nbs3_trio_of(set2, x, mask), any &= nbs3_trio_and(t2);
         if (any < 0) continue;
         if (nbs3_room(&o, room) != 0) return -1;
-        nbs3_ball b = nbs3_ball_of(&p, j, jx);
+        nbs3_ball b = nbs3_ball_of(&p, j, p.cx[j]);
         nbs3_trio_test(&p, use_body, b, t1, &o);
         if (two >= 0) nbs3_trio_test(&p, use_body, b, t2, &o);
     }
@@ -585,13 +605,12 @@ int nbs_detect_3d(nbs_grid_3d *grid, size_t n, const double *cx, const double *c
     grid->cell = cell;
 
     s.layer_head = grid->layer_head;
-    s.layer_next = grid->layer_next;
     s.rows[0] = grid->row_head;
     s.rows[1] = grid->row_head + grid->ny_capacity;
-    s.row_next = grid->row_next;
     s.cells[0] = grid->cell_head;
     s.cells[1] = grid->cell_head + grid->nx_capacity;
-    s.cell_next = grid->cell_next;
+    s.layer_next = grid->layer_next;
+    s.next = grid->next;
 
     nbs3_layers_build(&s, n, b.all_valid);
     if (nbs3_layers_detect(&s, n, b.all_valid, pairs) != 0) {

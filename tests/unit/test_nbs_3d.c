@@ -458,6 +458,37 @@ static void test_nbs3_reuse(void)
     nbs_pairs_free(&want);
 }
 
+/* A run that wraps round a folded z-axis starts above a layer not done
+ * yet, and the walks of its first layer read each element's x from the
+ * x-links of that layer, which must hold them although none of its rows
+ * has been through an x-set yet. Four spheres fold z onto 4 slots, every
+ * one a layer; sphere 0's is the layer below the run's first, and it
+ * touches sphere 1 above it. The grid is reused, so that a stale x from the first
+ * detection (sphere 0 two cells away in x) would lose the pair. */
+static void test_nbs3_wrapped_run(void)
+{
+    spheres s = spheres_new(4);
+    double x[4] = {1.2, 3.3, 0.0, 3.3}, z[4] = {1.5, 2.2, 0.0, 7.5}; /* z cells 1, 2, 0, 7 */
+    for (int i = 0; i < 4; i++) s.p[0][i] = x[i], s.p[1][i] = 0.0, s.p[2][i] = z[i], s.r[i] = 0.5;
+    nbs_grid_3d g;
+    nbs_pairs got, want;
+    nbs_grid_3d_init(&g);
+    nbs_pairs_init(&got);
+    nbs_pairs_init(&want);
+    for (int round = 0; round < 2; round++) {
+        if (round) s.p[0][0] = 3.3; /* now on top of sphere 1, 0.7 below it */
+        CHECK(detect(&g, &s, 0, &got) == 0, "wrapped run: detect failed");
+        CHECK(g.nz == 4, "wrapped run: %d z slots, want the fold 4", g.nz);
+        nbs_detect_brute_3d(s.n, s.p[0], s.p[1], s.p[2], s.r, NULL, &want);
+        CHECK(want.count == (size_t)round, "wrapped run: brute finds %zu pairs", want.count);
+        check_same_pairs(round ? "wrapped run, reused" : "wrapped run", &got, &want);
+    }
+    nbs_grid_3d_free(&g);
+    nbs_pairs_free(&got);
+    nbs_pairs_free(&want);
+    spheres_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -472,6 +503,7 @@ int main(int argc, char **argv)
         {"test_nbs3_invalid_spheres", test_nbs3_invalid_spheres},
         {"test_nbs3_integer_ram", test_nbs3_integer_ram},
         {"test_nbs3_reuse", test_nbs3_reuse},
+        {"test_nbs3_wrapped_run", test_nbs3_wrapped_run},
     };
     return check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }
