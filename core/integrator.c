@@ -16,6 +16,7 @@
 #include <time.h>
 
 #include "model.h"
+#include "quad.h"
 
 /* The central difference update of nodes [begin, end), for every dof no
  * constraint owns, in D = 2 or 3 components (a constant at each call, so
@@ -137,13 +138,10 @@ central_difference_free_node(double *x, double *v, const double *f, const double
     }
 }
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define CD_QUADS 1
+#if FDEM_QUADS
 #include <immintrin.h>
 #pragma GCC push_options
 #pragma GCC target("avx2")
-typedef double cd_quad __attribute__((vector_size(32)));
-typedef long long cd_quad_index __attribute__((vector_size(32)));
 
 /* The free update of four consecutive 3D nodes with no prescribed dof and
  * no contact force, their twelve numbers as three vectors (x0 y0 z0 x1,
@@ -153,18 +151,18 @@ typedef long long cd_quad_index __attribute__((vector_size(32)));
  * each node's squared step is summed (x + y) + z as there. */
 static inline __attribute__((always_inline)) void
 central_difference_quad(double *x, double *v, const double *f, const double *inv_mass,
-                        const cd_quad g[3], double h, double havg, const int with_contact,
-                        cd_quad *check, double *move2)
+                        const fdem_quad g[3], double h, double havg, const int with_contact,
+                        fdem_quad *check, double *move2)
 {
-    cd_quad xo[3], vn[3], pn[3];
-    const cd_quad im = (cd_quad)_mm256_loadu_pd(inv_mass);
-    const cd_quad ims[3] = {__builtin_shuffle(im, (cd_quad_index){0, 0, 0, 1}),
-                            __builtin_shuffle(im, (cd_quad_index){1, 1, 2, 2}),
-                            __builtin_shuffle(im, (cd_quad_index){2, 3, 3, 3})};
+    fdem_quad xo[3], vn[3], pn[3];
+    const fdem_quad im = (fdem_quad)_mm256_loadu_pd(inv_mass);
+    const fdem_quad ims[3] = {__builtin_shuffle(im, (fdem_quad_mask){0, 0, 0, 1}),
+                            __builtin_shuffle(im, (fdem_quad_mask){1, 1, 2, 2}),
+                            __builtin_shuffle(im, (fdem_quad_mask){2, 3, 3, 3})};
 #pragma GCC unroll 3
     for (int k = 0; k < 3; k++) {
-        cd_quad fk = (cd_quad)_mm256_loadu_pd(f + 4 * k), vk = (cd_quad)_mm256_loadu_pd(v + 4 * k);
-        xo[k] = (cd_quad)_mm256_loadu_pd(x + 4 * k);
+        fdem_quad fk = (fdem_quad)_mm256_loadu_pd(f + 4 * k), vk = (fdem_quad)_mm256_loadu_pd(v + 4 * k);
+        xo[k] = (fdem_quad)_mm256_loadu_pd(x + 4 * k);
         vn[k] = vk + (fk * ims[k] + g[k]) * havg;
         pn[k] = xo[k] + vn[k] * h;
         _mm256_storeu_pd(v + 4 * k, (__m256d)vn[k]);
@@ -172,20 +170,20 @@ central_difference_quad(double *x, double *v, const double *f, const double *inv
         *check += pn[k] + vn[k];
     }
     if (!with_contact) return;
-    cd_quad q[3];
+    fdem_quad q[3];
 #pragma GCC unroll 3
     for (int k = 0; k < 3; k++) {
         q[k] = pn[k] - xo[k];
         q[k] *= q[k];
     }
     /* the squares by component: sx = q0[0] q0[3] q1[2] q2[1], sy, sz */
-    cd_quad a = __builtin_shuffle(q[0], q[1], (cd_quad_index){0, 3, 6, 1});
-    cd_quad b = __builtin_shuffle(q[0], q[1], (cd_quad_index){1, 4, 7, 2});
-    cd_quad sx = __builtin_shuffle(a, q[2], (cd_quad_index){0, 1, 2, 5});
-    cd_quad sy = __builtin_shuffle(b, q[2], (cd_quad_index){0, 1, 2, 6});
-    cd_quad sz = __builtin_shuffle(__builtin_shuffle(q[0], q[1], (cd_quad_index){2, 5, 0, 0}),
-                                   q[2], (cd_quad_index){0, 1, 4, 7});
-    cd_quad s2 = (sx + sy) + sz;
+    fdem_quad a = __builtin_shuffle(q[0], q[1], (fdem_quad_mask){0, 3, 6, 1});
+    fdem_quad b = __builtin_shuffle(q[0], q[1], (fdem_quad_mask){1, 4, 7, 2});
+    fdem_quad sx = __builtin_shuffle(a, q[2], (fdem_quad_mask){0, 1, 2, 5});
+    fdem_quad sy = __builtin_shuffle(b, q[2], (fdem_quad_mask){0, 1, 2, 6});
+    fdem_quad sz = __builtin_shuffle(__builtin_shuffle(q[0], q[1], (fdem_quad_mask){2, 5, 0, 0}),
+                                   q[2], (fdem_quad_mask){0, 1, 4, 7});
+    fdem_quad s2 = (sx + sy) + sz;
 #pragma GCC unroll 4
     for (int l = 0; l < 4; l++)
         if (s2[l] > *move2) *move2 = s2[l];
@@ -200,11 +198,11 @@ static int central_difference_quads(fdem_model *m, int begin, int end, int with_
 {
     const double h = m->dt, havg = 0.5 * (m->dt_prev + m->dt);
     const double *g = m->gravity, *f = m->force, *inv_mass = m->inv_mass;
-    const cd_quad gq[3] = {{g[0], g[1], g[2], g[0]}, {g[1], g[2], g[0], g[1]},
+    const fdem_quad gq[3] = {{g[0], g[1], g[2], g[0]}, {g[1], g[2], g[0], g[1]},
                            {g[2], g[0], g[1], g[2]}};
     double *x = m->pos, *v = m->vel;
     const uint8_t *owned = m->dof_owned;
-    cd_quad sum = {0, 0, 0, 0};
+    fdem_quad sum = {0, 0, 0, 0};
     double most = *move2; /* in a register, not re-read past the stores */
     int i = begin;
     for (; end - i >= 4; i += 4) {
@@ -224,8 +222,6 @@ static int central_difference_quads(fdem_model *m, int begin, int end, int with_
     return i;
 }
 #pragma GCC pop_options
-#else
-#define CD_QUADS 0
 #endif
 
 static inline __attribute__((always_inline)) void
@@ -242,11 +238,11 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
     const double gz = D == 3 ? g[2] : 0;
     cd_pair check_xy = {0, 0};
     double check = 0, move2 = 0, near2 = 0, contact_work = 0;
-#if CD_QUADS
+#if FDEM_QUADS
     const int quads = D == 3 && !with_force && __builtin_cpu_supports("avx2");
 #endif
     for (int i = begin; i < end; i++) {
-#if CD_QUADS
+#if FDEM_QUADS
         if (quads && end - i >= 4) {
             int stop = central_difference_quads(m, i, end, with_contact, &check, &move2);
             if (stop > i) {

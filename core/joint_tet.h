@@ -29,6 +29,7 @@
 #include <stdint.h>
 
 #include "joint_law.h"
+#include "quad.h"
 #include "vec3.h"
 
 #include <math.h>
@@ -104,32 +105,27 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #include "joint_tet_fast_body.h"
 
 /* Four joints side by side exist only as AVX2 code (GCC on x86-64;
- * JOINT_TET_QUADS says so): 32-byte vectors are no baseline x86-64
+ * FDEM_QUADS says so, quad.h): 32-byte vectors are no baseline x86-64
  * argument. The four are consecutive, corners n0, n0 + 6, n0 + 12 and
  * n0 + 18 (n1 is not read). */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define JOINT_TET_QUADS 1
+#if FDEM_QUADS
 #pragma GCC push_options
 #pragma GCC target("avx2")
-typedef double joint_quad __attribute__((vector_size(32)));
-typedef long long joint_quad_mask __attribute__((vector_size(32)));
 
-JOINT_TET_INLINE joint_quad joint_quad_sqrt(joint_quad x)
+JOINT_TET_INLINE fdem_quad joint_quad_sqrt(fdem_quad x)
 {
-    return (joint_quad){sqrt(x[0]), sqrt(x[1]), sqrt(x[2]), sqrt(x[3])};
+    return (fdem_quad){sqrt(x[0]), sqrt(x[1]), sqrt(x[2]), sqrt(x[3])};
 }
 
-#define JT_T joint_quad
-#define JT_MASK joint_quad_mask
+#define JT_T fdem_quad
+#define JT_MASK fdem_quad_mask
 #define JT_FN(name) name##_quad
 #define JT_SQRT joint_quad_sqrt
 #define JT_LOAD(pos, n0, n1, k, c)                                                               \
-    ((joint_quad){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, (n0) + 6, k, c),               \
+    ((fdem_quad){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, (n0) + 6, k, c),               \
                   JOINT_TET_AT(pos, (n0) + 12, k, c), JOINT_TET_AT(pos, (n0) + 18, k, c)})
 #include "joint_tet_fast_body.h"
 #pragma GCC pop_options
-#else
-#define JOINT_TET_QUADS 0
 #endif
 
 /* joint_tet_gaps_at for one joint, corners node[6]. */

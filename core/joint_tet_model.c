@@ -287,7 +287,7 @@ JOINT_TET_INLINE void joint_pair_undamaged(fdem_model *m, int j, joint_totals *t
     }
 }
 
-#if JOINT_TET_QUADS
+#if FDEM_QUADS
 /* Joints j .. j + 3, all undamaged, when all four are surely elastic:
  * their forces added and their stored energy booked, joint by joint in
  * order; returns 0, having touched nothing, otherwise. A call of its own,
@@ -296,7 +296,7 @@ __attribute__((target("avx2"))) static int joint_quad_elastic(fdem_model *m, int
                                                               joint_totals *t)
 {
     const int32_t *n = m->joint_node + 6 * (size_t)j;
-    joint_quad k, ft, c, tan_phi;
+    fdem_quad k, ft, c, tan_phi;
     JOINT_TET_UNROLL
     for (int l = 0; l < 4; l++) {
         const joint_strength *s = &m->joint_strengths[m->joint_strength_of[j + l]];
@@ -305,13 +305,13 @@ __attribute__((target("avx2"))) static int joint_quad_elastic(fdem_model *m, int
         c[l] = s->cohesion;
         tan_phi[l] = s->tan_phi;
     }
-    joint_quad d[3][3], N[3];
-    joint_quad N_len = joint_tet_gaps_at_quad(m->pos, n, n, d, N);
-    joint_quad_mask sure = joint_tet_surely_elastic_of_quad(k, ft, c, tan_phi, d);
+    fdem_quad d[3][3], N[3];
+    fdem_quad N_len = joint_tet_gaps_at_quad(m->pos, n, n, d, N);
+    fdem_quad_mask sure = joint_tet_surely_elastic_of_quad(k, ft, c, tan_phi, d);
     sure &= N_len > JOINT_TET_TINY_NORMAL;
     if (!(sure[0] && sure[1] && sure[2] && sure[3])) return 0;
-    joint_quad fa[9];
-    joint_quad e = joint_tet_elastic_forces_of_quad(k, 0.5 * N_len, d, fa);
+    fdem_quad fa[9];
+    fdem_quad e = joint_tet_elastic_forces_of_quad(k, 0.5 * N_len, d, fa);
     JOINT_TET_UNROLL
     for (int l = 0; l < 4; l++) {
         double f[9];
@@ -342,7 +342,7 @@ JOINT_TET_INLINE void joint_forces_loop(fdem_model *m, int begin, int end,
             joint_prefetch_face_a(m, j + JOINT_PREFETCH_AHEAD + 1);
         }
         if (damage[j] == 0 && damage[j + 1] == 0) {
-#if JOINT_TET_QUADS
+#if FDEM_QUADS
             if (quads && j + 3 < end && damage[j + 2] == 0 && damage[j + 3] == 0 &&
                 joint_quad_elastic(m, j, &t)) {
                 if (j + JOINT_PREFETCH_AHEAD + 3 < end) {
@@ -377,7 +377,7 @@ JOINT_TET_INLINE void joint_forces_loop(fdem_model *m, int begin, int end,
  * (callgrind; CPU ns per joint, interleaved runs on a busy 2-core machine):
  * pairs in AVX 252 -> 213 instructions, 21.8 -> 20.7 ns at 1e4 joints;
  * quads 20.3 -> 17.5 ns at 1e4, 25.4 -> 23.8 at 1e5. */
-#if JOINT_TET_QUADS
+#if FDEM_QUADS
 __attribute__((target("avx2"))) static void joint_forces_avx2(fdem_model *m, int begin, int end,
                                                                double sums[SCATTER_SUMS])
 {
@@ -387,7 +387,7 @@ __attribute__((target("avx2"))) static void joint_forces_avx2(fdem_model *m, int
 
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-#if JOINT_TET_QUADS
+#if FDEM_QUADS
     if (__builtin_cpu_supports("avx2")) {
         joint_forces_avx2(m, begin, end, sums);
         return;
