@@ -38,6 +38,7 @@
 
 #include "element_tet.h"
 #include "log_near1.h"
+#include "quad.h"
 
 /* Forced inline, and the small loops fully unrolled (gcc -O2 keeps some as
  * loops): otherwise F, the stress and the forces go through memory, and
@@ -50,10 +51,9 @@
 #define TET_UNROLL
 #endif
 
-/* Two (four) elements side by side: lane k of every number is element
- * k's. Quads are for the AVX2 loop only (element_tet_model.c). */
+/* Two (four: quad.h's fdem_quad, for the AVX2 loop only) elements side by
+ * side: lane k of every number is element k's. */
 typedef double tet_pair __attribute__((vector_size(16)));
-typedef double tet_quad __attribute__((vector_size(32)));
 
 /* ln J and 1/J of a group of N lanes: log_short_series of log_near1.h on
  * every lane as vector operations when all are in its range (the same
@@ -92,20 +92,17 @@ TET_LOG_INVERSE_LANES(tet_pair, 2)
 #define TET_LOG_INVERSE tet_log_inverse_tet_pair
 #include "element_tet_kernel_body.h"
 
-/* The quads exist only as AVX2 code (GCC on x86-64; TET_QUADS says so):
- * 32-byte vectors are no baseline x86-64 argument. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define TET_QUADS 1
+/* The quads exist only as AVX2 code (GCC on x86-64; FDEM_QUADS says so,
+ * quad.h): 32-byte vectors are no baseline x86-64 argument. */
+#if FDEM_QUADS
 #pragma GCC push_options
 #pragma GCC target("avx2")
-TET_LOG_INVERSE_LANES(tet_quad, 4)
-#define TET_T tet_quad
+TET_LOG_INVERSE_LANES(fdem_quad, 4)
+#define TET_T fdem_quad
 #define TET_FN(name) name##_quad
-#define TET_LOG_INVERSE tet_log_inverse_tet_quad
+#define TET_LOG_INVERSE tet_log_inverse_fdem_quad
 #include "element_tet_kernel_body.h"
 #pragma GCC pop_options
-#else
-#define TET_QUADS 0
 #endif
 
 #endif /* FDEM_ELEMENT_TET_KERNEL_H */

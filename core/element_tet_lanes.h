@@ -1,7 +1,7 @@
 /*
  * element_tet_lanes.h - a group of TET_N tetrahedra of one material side by
  * side in the lanes of the vector type TET_V, written once and included by
- * element_tet_model.c for pairs (tet_pair, SSE2) and quads (tet_quad, the
+ * element_tet_model.c for pairs (tet_pair, SSE2) and quads (fdem_quad, the
  * AVX2 loop). Per element the same operations in the same order as
  * tet_forces_one, so the same bits whatever the group; the sums and the
  * scatter go element by element in element order. Not a header of its

@@ -17,7 +17,7 @@
 #include "element_tet_kernel.h"
 #include "model.h"
 #include "vec3.h"
-#if TET_QUADS
+#if FDEM_QUADS
 #include <immintrin.h>
 #endif
 
@@ -179,38 +179,38 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     } while (0)
 #include "element_tet_lanes.h"
 
-#if TET_QUADS
+#if FDEM_QUADS
 #pragma GCC push_options
 #pragma GCC target("avx2")
-#define TET_V tet_quad
+#define TET_V fdem_quad
 #define TET_N 4
 #define TET_VFN(name) name##_quad
-#define TET_GATHER(p, i) ((tet_quad){(p)[0][i], (p)[1][i], (p)[2][i], (p)[3][i]})
+#define TET_GATHER(p, i) ((fdem_quad){(p)[0][i], (p)[1][i], (p)[2][i], (p)[3][i]})
 
 /* Four rows of four numbers, one per lane, turned into four vectors over
  * the lanes (vector k holds number k of each row), and back: the same
  * transpose. */
-TET_KERNEL void tet_transpose_quad(tet_quad r[4])
+TET_KERNEL void tet_transpose_quad(fdem_quad r[4])
 {
     __m256d t0 = _mm256_unpacklo_pd((__m256d)r[0], (__m256d)r[1]);
     __m256d t1 = _mm256_unpackhi_pd((__m256d)r[0], (__m256d)r[1]);
     __m256d t2 = _mm256_unpacklo_pd((__m256d)r[2], (__m256d)r[3]);
     __m256d t3 = _mm256_unpackhi_pd((__m256d)r[2], (__m256d)r[3]);
-    r[0] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x20);
-    r[1] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x20);
-    r[2] = (tet_quad)_mm256_permute2f128_pd(t0, t2, 0x31);
-    r[3] = (tet_quad)_mm256_permute2f128_pd(t1, t3, 0x31);
+    r[0] = (fdem_quad)_mm256_permute2f128_pd(t0, t2, 0x20);
+    r[1] = (fdem_quad)_mm256_permute2f128_pd(t1, t3, 0x20);
+    r[2] = (fdem_quad)_mm256_permute2f128_pd(t0, t2, 0x31);
+    r[3] = (fdem_quad)_mm256_permute2f128_pd(t1, t3, 0x31);
 }
 
 /* tet_gather_nodes for four elements whose four nodes are consecutive:
  * each element's twelve numbers are three rows of four, so three loads
  * and a transpose per block of four numbers instead of 48 single ones. */
-TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, tet_quad x[4][3])
+TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, fdem_quad x[4][3])
 {
-    tet_quad col[12];
+    fdem_quad col[12];
     TET_UNROLL
     for (int k = 0; k < 3; k++) {
-        tet_quad *r = col + 4 * k;
+        fdem_quad *r = col + 4 * k;
         TET_UNROLL
         for (int l = 0; l < 4; l++)
             memcpy(&r[l], xyz + 3 * (size_t)t[l].node[0] + 4 * k, sizeof r[l]);
@@ -223,15 +223,15 @@ TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, tet_qua
 /* The storing scatter (vec3_scatter with store) of four such elements:
  * 0 + g_0 and 0 - g_a as vectors, lane by lane what the scalar store
  * gives, transposed back to rows and stored whole. */
-TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const tet_quad g[4][3])
+TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const fdem_quad g[4][3])
 {
-    const tet_quad zero = {0.0, 0.0, 0.0, 0.0};
-    tet_quad row[12];
+    const fdem_quad zero = {0.0, 0.0, 0.0, 0.0};
+    fdem_quad row[12];
     TET_UNROLL
     for (int q = 0; q < 12; q++) row[q] = q < 3 ? zero + g[0][q] : zero - g[q / 3][q % 3];
     TET_UNROLL
     for (int k = 0; k < 3; k++) {
-        tet_quad *r = row + 4 * k;
+        fdem_quad *r = row + 4 * k;
         tet_transpose_quad(r);
         TET_UNROLL
         for (int l = 0; l < 4; l++)
@@ -242,7 +242,7 @@ TET_KERNEL void tet_store_own_quad(double *f, const tet_hot *t, const tet_quad g
 /* Six numbers a lane in four adjacent rows of six (24 numbers) as six
  * vectors over the lanes, and back: a transpose of the first four of each
  * row, and the last two of the rows paired across the lanes. */
-TET_KERNEL void tet_load_six_quad(const double *rows, tet_quad v[6])
+TET_KERNEL void tet_load_six_quad(const double *rows, fdem_quad v[6])
 {
     TET_UNROLL
     for (int l = 0; l < 4; l++) memcpy(&v[l], rows + 6 * l, sizeof v[l]);
@@ -251,13 +251,13 @@ TET_KERNEL void tet_load_six_quad(const double *rows, tet_quad v[6])
                                      _mm_loadu_pd(rows + 16), 1); /* rows 0, 2 */
     __m256d q = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(rows + 10)),
                                      _mm_loadu_pd(rows + 22), 1); /* rows 1, 3 */
-    v[4] = (tet_quad)_mm256_unpacklo_pd(p, q);
-    v[5] = (tet_quad)_mm256_unpackhi_pd(p, q);
+    v[4] = (fdem_quad)_mm256_unpacklo_pd(p, q);
+    v[5] = (fdem_quad)_mm256_unpackhi_pd(p, q);
 }
 
-TET_KERNEL void tet_store_six_quad(double *rows, const tet_quad v[6])
+TET_KERNEL void tet_store_six_quad(double *rows, const fdem_quad v[6])
 {
-    tet_quad r[4] = {v[0], v[1], v[2], v[3]};
+    fdem_quad r[4] = {v[0], v[1], v[2], v[3]};
     tet_transpose_quad(r);
     TET_UNROLL
     for (int l = 0; l < 4; l++) memcpy(rows + 6 * l, &r[l], sizeof r[l]);
@@ -316,7 +316,7 @@ TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const in
         TET_PREFETCH_READ((const char *)ahead + 64);
         TET_PREFETCH_READ((const char *)ahead + 128);
         TET_PREFETCH_READ((const char *)ahead + 192);
-#if TET_QUADS
+#if FDEM_QUADS
         if (quads && end - t >= 4 && t[0].material == t[1].material &&
             t[0].material == t[2].material && t[0].material == t[3].material) {
             TET_PREFETCH_READ((const char *)ahead + 256);
@@ -364,7 +364,7 @@ TET_KERNEL void tet_forces_variant(fdem_model *m, int begin, int end, int stress
         tet_forces_run(m, begin, end, 0, 0, quads, k, sum);
 }
 
-#if TET_QUADS
+#if FDEM_QUADS
 __attribute__((target("avx2"))) static void tet_forces_avx2(fdem_model *m, int begin, int end,
                                                              int stressed, int store,
                                                              tet_constants *k, tet_sums *sum)
@@ -376,7 +376,7 @@ __attribute__((target("avx2"))) static void tet_forces_avx2(fdem_model *m, int b
 static void tet_forces_dispatch(fdem_model *m, int begin, int end, int stressed, int store,
                                 tet_constants *k, tet_sums *sum)
 {
-#if TET_QUADS
+#if FDEM_QUADS
     if (__builtin_cpu_supports("avx2")) {
         tet_forces_avx2(m, begin, end, stressed, store, k, sum);
         return;

@@ -1,8 +1,9 @@
 /*
  * quad.h - the four-wide double vector of the AVX2 loops.
  *
- * The free update of the integrator and the joint loop each have a variant
- * that carries four items in one 32-byte register, compiled under
+ * The tetrahedron loop, the joint loop and the integrator's free update
+ * each have a variant that carries four items in one 32-byte register,
+ * compiled under
  * #pragma GCC target("avx2") and chosen at run time. Such vectors are
  * GCC's vector extension on x86-64 only: FDEM_QUADS is 1 where they exist
  * and 0 elsewhere, where only the baseline loops are built. Lane k of a
