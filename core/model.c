@@ -44,16 +44,14 @@ int model_reserve(void **array, size_t *capacity, size_t need, size_t size, size
     return 0;
 }
 
-/* Grows *array (element size `size`) to hold at least `need` items. */
+/* model_reserve for the build-phase arrays (materials, parts,
+ * constraints), whose counts are int. */
 static int grow(void **array, int *capacity, int need, size_t size)
 {
     if (need <= *capacity) return 0;
-    int cap = *capacity ? *capacity : 16;
-    while (cap < need) cap = cap > INT32_MAX / 2 ? need : cap * 2;
-    void *p = realloc(*array, (size_t)cap * size);
-    if (!p) return -1;
-    *array = p;
-    *capacity = cap;
+    size_t cap = (size_t)*capacity;
+    if (model_reserve(array, &cap, (size_t)need, size, 16)) return -1;
+    *capacity = cap > INT32_MAX ? INT32_MAX : (int)cap;
     return 0;
 }
 
