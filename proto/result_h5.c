@@ -452,14 +452,27 @@ result_file *result_alloc(void)
 }
 
 /* Closes every handle; returns -1 if HDF5 reported a failure. */
-int result_release(result_file *f)
+int result_close_handles(result_file *f)
 {
     int rc = 0;
     for (int k = 0; k < SERIES_COUNT; k++)
-        if (f->ds[k].id >= 0 && H5Dclose(f->ds[k].id) < 0) rc = -1;
+        if (f->ds[k].id >= 0) {
+            if (H5Dclose(f->ds[k].id) < 0) rc = -1;
+            f->ds[k].id = H5I_INVALID_HID;
+        }
     for (int k = 0; k < EVENT_SERIES; k++)
-        if (f->events[k] >= 0 && H5Dclose(f->events[k]) < 0) rc = -1;
+        if (f->events[k] >= 0) {
+            if (H5Dclose(f->events[k]) < 0) rc = -1;
+            f->events[k] = H5I_INVALID_HID;
+        }
     if (f->file >= 0 && H5Fclose(f->file) < 0) rc = -1;
+    f->file = H5I_INVALID_HID;
+    return rc;
+}
+
+int result_release(result_file *f)
+{
+    int rc = result_close_handles(f);
     free(f->times);
     free(f);
     return rc;

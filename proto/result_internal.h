@@ -85,6 +85,9 @@ hid_t file_access_latest(int clear_status_flags);
 int result_reserve_room(const char *path, off_t bytes, const char *what, char *err,
                         size_t errlen);
 result_file *result_alloc(void);
+/* Closes every HDF5 handle of f and marks it closed; -1 if HDF5 reported
+ * a failure. result_release also frees f. */
+int result_close_handles(result_file *f);
 int result_release(result_file *f);
 /* The root attribute `case` (the document) and /mesh/part_names,
  * /mesh/material_names; nothing when text is NULL (result_describe.c). */

@@ -67,6 +67,14 @@ static int view_shape_of(int kind, int width, int dimension, view_shape *v)
     return 1;
 }
 
+/* The view of this file's series `kind` (a per-snapshot array, rank 2 or
+ * 3): 0 when it has none. */
+static int series_view(const series *ds, int kind, int dimension, view_shape *v)
+{
+    int width = ds[kind].rank == 3 ? (int)ds[kind].row[1] : 0;
+    return ds[kind].rank >= 2 && view_shape_of(kind, width, dimension, v);
+}
+
 /* Maps destination column k (or the whole 1-D row) of `vspace` to row s
  * of the source. */
 static int view_map(hid_t dcpl, hid_t vspace, hid_t sspace, const char *source, int s,
@@ -161,9 +169,7 @@ static int views_add(hid_t file, const series *ds, int count, int dimension)
         if (group < 0) rc = -1;
         for (int kind = 0; rc == 0 && kind < SERIES_COUNT; kind++) {
             view_shape v;
-            int width = ds[kind].rank == 3 ? (int)ds[kind].row[1] : 0;
-            if (ds[kind].rank >= 2 && view_shape_of(kind, width, dimension, &v))
-                rc = view_create(group, ds, &v, s);
+            if (series_view(ds, kind, dimension, &v)) rc = view_create(group, ds, &v, s);
         }
         if (group >= 0 && H5Gclose(group) < 0) rc = -1;
     }
@@ -181,9 +187,7 @@ static off_t views_room(const series *ds, int snapshots, int dimension)
     off_t per_snapshot = VIEW_ROOM_BYTES;
     for (int kind = 0; kind < SERIES_COUNT; kind++) {
         view_shape v;
-        int width = ds[kind].rank == 3 ? (int)ds[kind].row[1] : 0;
-        if (ds[kind].rank >= 2 && view_shape_of(kind, width, dimension, &v))
-            per_snapshot += VIEW_ROOM_BYTES;
+        if (series_view(ds, kind, dimension, &v)) per_snapshot += VIEW_ROOM_BYTES;
     }
     return VIEWS_FIXED_ROOM_BYTES + per_snapshot * (snapshots > 0 ? snapshots : 0);
 }
@@ -192,20 +196,10 @@ int result_finish(result_file *f, const char *path, int dimension, char *err, si
 {
     h5_quiet();
     int rc = f->file >= 0 && H5Fflush(f->file, H5F_SCOPE_LOCAL) < 0 ? -1 : 0;
-    for (int k = 0; k < SERIES_COUNT; k++)
-        if (f->ds[k].id >= 0) {
-            if (H5Dclose(f->ds[k].id) < 0) rc = -1;
-            f->ds[k].id = H5I_INVALID_HID;
-        }
-    /* The event datasets too: an open object keeps HDF5 from closing the
-     * file, and the views must go to a file closed and whole on disk. */
-    for (int k = 0; k < EVENT_SERIES; k++)
-        if (f->events[k] >= 0) {
-            if (H5Dclose(f->events[k]) < 0) rc = -1;
-            f->events[k] = H5I_INVALID_HID;
-        }
-    if (f->file >= 0 && H5Fclose(f->file) < 0) rc = -1;
-    f->file = H5I_INVALID_HID;
+    /* Every handle, the event datasets too: an open object keeps HDF5
+     * from closing the file, and the views must go to a file closed and
+     * whole on disk. */
+    if (result_close_handles(f) != 0) rc = -1;
     if (rc != 0) {
         result_fail(err, errlen, "cannot close %s", path);
         return -1;
