@@ -307,19 +307,13 @@ typedef struct nbs3_probe {
     const double *cx, *cy, *cz, *r;
     const int32_t *body;
     const nbs_next_3d *next;
-    double xlo, inv;
     int64_t xmask;
 } nbs3_probe;
 
 static inline nbs3_probe nbs3_probe_of(const nbs3_scan *s)
 {
-    nbs3_probe p = {s->cx, s->cy, s->cz, s->r, s->body, s->next, s->ax.lo, s->inv, s->ax.mask};
+    nbs3_probe p = {s->cx, s->cy, s->cz, s->r, s->body, s->next, s->ax.mask};
     return p;
-}
-
-static inline int32_t nbs3_probe_x(const nbs3_probe *p, double x)
-{
-    return (int32_t)((int64_t)((x - p->xlo) * p->inv) & p->xmask);
 }
 
 /* The heads of the cells x-1, x, x+1 of an x-set. Cell heads are never in
