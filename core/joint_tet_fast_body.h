@@ -3,9 +3,9 @@
  * fast path of joint_tet.h), written once over a number type JT_T and
  * included by joint_tet.h for double (one joint), a pair of doubles (two
  * joints side by side in one SIMD register, JT_FN suffix _pair) and, in
- * AVX2 code, four (_quad). Lanes round exactly as scalars do (IEEE, no contraction under
- * -std=c11), so a pair gives each joint the bits it gets alone, as
- * element_tet_kernel_body.h does for tetrahedra.
+ * AVX2 code, four (_quad). Lanes round exactly as scalars do (IEEE, no
+ * contraction under -std=c11), so a pair or a quad gives each joint the
+ * bits it gets alone, as element_tet_kernel_body.h does for tetrahedra.
  * Not a header of its own: include joint_tet.h.
  */
 #if !defined(JT_T) || !defined(JT_FN) || !defined(JT_SQRT) || !defined(JT_LOAD)
