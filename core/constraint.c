@@ -189,6 +189,78 @@ void constraint_apply_forces(fdem_model *m)
     }
 }
 
+/* What constraint_enforce accumulates over its entries, kept in locals:
+ * through m, every store to a velocity or position (a double) could alias
+ * the sums, so the compiler reloaded and stored them at every dof (67
+ * instructions an element-step of the sphere pile, whose container is
+ * fixed). The sums are formed in the same order as before: the same bits. */
+typedef struct enforce_sums {
+    double external_work, contact_work, max_disp2, near_disp2;
+} enforce_sums;
+
+/* fmax's result (the other when one is NaN) without its libm call */
+static inline double enforce_max(double most, double v)
+{
+    return v > most || most != most ? v : most;
+}
+
+/* The prescribed dofs of one node (velocity `prescribed`, 0 when fixed)
+ * into the support's reaction `reaction_sum`, with their work, and the
+ * node's travel since the contact lists were built. D and with_contact
+ * are constants at each call, so the loops unroll and fc's test goes. */
+static inline __attribute__((always_inline)) void
+enforce_node(fdem_model *m, size_t i, unsigned own, const double *prescribed, double h,
+             double havg, const int D, const int with_contact, double *reaction_sum,
+             enforce_sums *s)
+{
+    const size_t at = (size_t)D * i;
+    const double *fc = m->contact.force;
+    double *x = m->pos + at, *v = m->vel + at;
+    const double mass = m->mass[i];
+#pragma GCC unroll 3
+    for (int d = 0; d < D; d++) {
+        if (!(own & (1u << d))) continue;
+        double f = m->force[at + d] + (with_contact ? fc[at + d] : 0) + mass * m->gravity[d];
+        double v_old = v[d];
+        double v_free = v_old + f / mass * havg;
+        double reaction = mass * (prescribed[d] - v_free) / havg;
+        reaction_sum[d] += reaction;
+        v[d] = prescribed[d];
+        x[d] += prescribed[d] * h;
+        double v_mid = 0.5 * (v_old + prescribed[d]) * havg;
+        s->external_work += reaction * v_mid;
+        if (with_contact) s->contact_work += fc[at + d] * v_mid;
+    }
+    if (!with_contact) return;
+    const double *xd = m->contact.pos_detect + at, *xn = m->contact.pos_near + at;
+    double d2 = 0, n2 = 0;
+#pragma GCC unroll 3
+    for (int d = 0; d < D; d++) {
+        double u = x[d] - xd[d];
+        double w = x[d] - xn[d];
+        d2 += u * u;
+        n2 += w * w;
+    }
+    s->max_disp2 = enforce_max(s->max_disp2, d2);
+    s->near_disp2 = enforce_max(s->near_disp2, n2);
+}
+
+static void enforce_entries(fdem_model *m, const constraint *c, const double *prescribed,
+                            double h, double havg, double *reaction_sum, enforce_sums *s)
+{
+    const int end = c->entry_begin + c->entry_count, with_contact = m->contact.enabled;
+    for (int e = c->entry_begin; e < end; e++) {
+        size_t i = (size_t)m->cnode[e];
+        unsigned own = m->cdof[e];
+        if (m->dim == 3)
+            with_contact ? enforce_node(m, i, own, prescribed, h, havg, 3, 1, reaction_sum, s)
+                         : enforce_node(m, i, own, prescribed, h, havg, 3, 0, reaction_sum, s);
+        else
+            with_contact ? enforce_node(m, i, own, prescribed, h, havg, 2, 1, reaction_sum, s)
+                         : enforce_node(m, i, own, prescribed, h, havg, 2, 0, reaction_sum, s);
+    }
+}
+
 /* Integrates the prescribed dofs (skipped by the free update) and the work
  * of every constraint during this step. total_force(i, d) is the step's
  * force on dof d of node i from every source except the support. */
@@ -196,6 +268,8 @@ void constraint_enforce(fdem_model *m, double h, double havg)
 {
     const double *fc = m->contact.enabled ? m->contact.force : NULL;
     const int D = m->dim;
+    enforce_sums s = {m->external_work, m->contact_work, m->contact.max_disp2,
+                      m->contact.near_disp2};
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.kind == FDEM_CONSTRAINT_FORCE) {
@@ -207,41 +281,20 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                     double a = (m->force[at + d] + (fc ? fc[at + d] : 0)) / m->mass[i] + m->gravity[d];
                     power += c->value_now[d] / c->entry_count * (m->vel[at + d] - 0.5 * a * havg);
                 }
-                m->external_work += power * havg;
+                s.external_work += power * havg;
             }
             continue;
         }
         if (c->def.kind != FDEM_CONSTRAINT_FIX && c->def.kind != FDEM_CONSTRAINT_VELOCITY)
             continue; /* boundary loads: boundary_load.c */
-        c->force[0] = c->force[1] = c->force[2] = 0;
-        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-            size_t i = (size_t)m->cnode[e], at = (size_t)D * i;
-            for (int d = 0; d < D; d++) {
-                if (!(m->cdof[e] & (1u << d))) continue;
-                double mass = m->mass[i];
-                double f = m->force[at + d] + (fc ? fc[at + d] : 0) + mass * m->gravity[d];
-                double prescribed = c->def.kind == FDEM_CONSTRAINT_FIX ? 0.0 : c->value_now[d];
-                double v_old = m->vel[at + d];
-                double v_free = v_old + f / mass * havg;
-                double reaction = mass * (prescribed - v_free) / havg;
-                c->force[d] += reaction;
-                m->vel[at + d] = prescribed;
-                m->pos[at + d] += prescribed * h;
-                double v_mid = 0.5 * (v_old + prescribed) * havg;
-                m->external_work += reaction * v_mid;
-                if (fc) m->contact_work += fc[at + d] * v_mid;
-            }
-            if (fc) {
-                double d2 = 0, n2 = 0;
-                for (int d = 0; d < D; d++) {
-                    double u = m->pos[at + d] - m->contact.pos_detect[at + d];
-                    double w = m->pos[at + d] - m->contact.pos_near[at + d];
-                    d2 += u * u;
-                    n2 += w * w;
-                }
-                m->contact.max_disp2 = fmax(m->contact.max_disp2, d2);
-                m->contact.near_disp2 = fmax(m->contact.near_disp2, n2);
-            }
-        }
+        static const double fixed[3] = {0, 0, 0};
+        double reaction[3] = {0, 0, 0};
+        enforce_entries(m, c, c->def.kind == FDEM_CONSTRAINT_FIX ? fixed : c->value_now, h, havg,
+                        reaction, &s);
+        for (int d = 0; d < 3; d++) c->force[d] = reaction[d];
     }
+    m->external_work = s.external_work;
+    m->contact_work = s.contact_work;
+    m->contact.max_disp2 = s.max_disp2;
+    m->contact.near_disp2 = s.near_disp2;
 }
