@@ -59,8 +59,10 @@ typedef struct fdem_error {
 /* Heterogeneity (contract 5.3): each joint's tensile strength and cohesion
  * are the set's values times one factor drawn per joint from a Weibull law
  * of mean 1 and this modulus (scale 1/Gamma(1 + 1/modulus)), from a
- * counter-based generator keyed by seed and joint index, so a run does not
- * depend on the thread count. modulus 0: no variation. */
+ * counter-based generator keyed by the seed, the part and the joint's face
+ * (its mesh vertices), so a run depends neither on the thread count nor on
+ * the order of the mesh's elements or of the joints. modulus 0: no
+ * variation. */
 typedef struct fdem_variation {
     double weibull_modulus;
     uint64_t seed;

@@ -10,11 +10,17 @@
  * holding the very numbers the material holds, so its results do not
  * change by a bit.
  *
- * The draws are counter-based: joint j of a set with seed s takes the j-th
- * output of a splitmix64 stream started at s, a pure function of (s, j).
+ * The draws are counter-based: the joint on face F (its mesh vertices) of
+ * part p, varied with seed s, takes the output of a splitmix64 stream
+ * started at s at an index hashed from (p, F), a pure function of (s, p, F).
  * So a model owns no generator state, the draws do not depend on the order
- * or the thread that makes them, and rebuilding a case from its document
- * (as a restart does) gives every joint the same strength.
+ * or the thread that makes them, rebuilding a case from its document (as a
+ * restart does) gives every joint the same strength, and neither the order
+ * in which a mesh lists its elements nor the order in which the engine
+ * numbers its joints moves a strength to another face. Keyed by the joint
+ * index, as they were until 2026-11-24, the draws followed the numbering,
+ * and the 3D joints' renumbering for speed had silently given a seed
+ * another strength field.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -119,15 +125,35 @@ void joint_sets_free(fdem_model *m)
     m->joint_set_count = 0;
 }
 
-/* The set joint j lies on (the last that names its face), or -1. */
-static int joint_set_of(const fdem_model *m, int j)
+/* Joint j's part and face: the part's mesh vertices of its side A, sorted
+ * (face_key), the same whatever element or copy they were reached from. */
+static int joint_face(const fdem_model *m, int j, int32_t key[3])
 {
     int part_index = m->elem_part[m->joint_elem[2 * j]];
     int begin = m->parts[part_index].node_begin;
     const int32_t *n = m->joint_node + 2 * (size_t)m->dim * (size_t)j;
-    int32_t vertices[3], key[3];
+    int32_t vertices[3];
     for (int i = 0; i < m->dim; i++) vertices[i] = m->node_origin[n[i]] - begin;
     face_key(vertices, m->dim, key);
+    return part_index;
+}
+
+/* The index of joint j's draw: its part and face hashed through splitmix64
+ * (a chain of outputs, each seeded with the one before), so that faces
+ * that share vertices draw independently. */
+static uint64_t joint_draw_index(const fdem_model *m, int j)
+{
+    int32_t key[3];
+    uint64_t h = splitmix64_at(0, (uint64_t)joint_face(m, j, key));
+    for (int i = 0; i < 3; i++) h = splitmix64_at(h, (uint64_t)(uint32_t)key[i]);
+    return h;
+}
+
+/* The set joint j lies on (the last that names its face), or -1. */
+static int joint_set_of(const fdem_model *m, int j)
+{
+    int32_t key[3];
+    int part_index = joint_face(m, j, key);
     for (int k = m->joint_set_count - 1; k >= 0; k--) {
         const joint_set *s = &m->joint_sets[k];
         if (s->part == part_index &&
@@ -203,7 +229,7 @@ int joint_strengths_assign(fdem_model *m, fdem_error *err)
             m->joint_strength_of[j] = base;
             continue;
         }
-        double factor = weibull_factor(v->seed, (uint64_t)j, v->weibull_modulus);
+        double factor = weibull_factor(v->seed, joint_draw_index(m, j), v->weibull_modulus);
         m->joint_strengths[next] = m->joint_strengths[base];
         m->joint_strengths[next].tensile_strength *= factor;
         m->joint_strengths[next].cohesion *= factor;

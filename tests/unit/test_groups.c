@@ -18,6 +18,7 @@
 #include "case_doc.h"
 #include "check.h"
 #include "gmsh.h"
+#include "mesh_3d.h"
 #include "model.h"
 #include "read_file.h"
 
@@ -407,6 +408,134 @@ static void weibull_reproducible(void)
     fdem_model_destroy(c);
 }
 
+/* A joint's face and drawn tensile strength, for comparing two models
+ * whose joints are numbered differently. */
+typedef struct face_strength {
+    int32_t vertex[3]; /* the part's mesh vertices of side A, sorted (2D: third -1) */
+    double strength;
+} face_strength;
+
+static int face_strength_compare(const void *pa, const void *pb)
+{
+    const face_strength *a = pa, *b = pb;
+    for (int i = 0; i < 3; i++)
+        if (a->vertex[i] != b->vertex[i]) return a->vertex[i] < b->vertex[i] ? -1 : 1;
+    return 0;
+}
+
+/* Every joint of a one-part model as (face, strength), sorted by face. */
+static face_strength *faces_and_strengths(const fdem_model *m)
+{
+    face_strength *out = calloc((size_t)m->joint_count, sizeof *out);
+    int D = m->dim;
+    for (int j = 0; out && j < m->joint_count; j++) {
+        int32_t *v = out[j].vertex;
+        v[2] = -1;
+        for (int i = 0; i < D; i++) v[i] = m->node_origin[m->joint_node[2 * D * j + i]];
+        for (int i = 1; i < D; i++)
+            for (int k = i; k > 0 && v[k - 1] > v[k]; k--) {
+                int32_t t = v[k];
+                v[k] = v[k - 1];
+                v[k - 1] = t;
+            }
+        out[j].strength = m->joint_strengths[m->joint_strength_of[j]].tensile_strength;
+    }
+    if (out) qsort(out, (size_t)m->joint_count, sizeof *out, face_strength_compare);
+    return out;
+}
+
+/* One fracturing part of Weibull-varied rock (modulus 5, seed 7) on a mesh
+ * whose elements are listed in reverse order when `reversed`, each with its
+ * nodes rotated, in 2D (a rectangle) or 3D (a box). */
+static fdem_model *varied_part(int dim, int reversed)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err;
+    fdem_material_def d = {.density = 2700, .young = 3e10, .poisson = 0.25, .has_fracture = 1,
+                           .fracture = {1e6, 3e6, 30, 10, 50}, .variation = {5, 7}};
+    int ok = fdem_set_dimension(m, dim, &err) == 0;
+    int mat = ok ? fdem_add_material(m, &d, &err) : -1;
+    ok = mat >= 0;
+    if (ok && dim == 2) {
+        fdem_mesh mesh;
+        ok = fdem_mesh_rectangle(0, 0, 1, 1, 6, 6, &mesh, &err) == 0;
+        for (int t = 0; ok && reversed && t < mesh.triangle_count / 2; t++) {
+            int32_t *a = mesh.tri + 3 * t, *b = mesh.tri + 3 * (mesh.triangle_count - 1 - t);
+            for (int i = 0; i < 3; i++) {
+                int32_t x = a[i];
+                a[i] = b[i];
+                b[i] = x;
+            }
+        }
+        for (int t = 0; ok && reversed && t < mesh.triangle_count; t++) {
+            int32_t *n = mesh.tri + 3 * t, first = n[0];
+            n[0] = n[1], n[1] = n[2], n[2] = first;
+        }
+        ok = ok && fdem_add_part(m, &mesh, mat, 1, &err) >= 0;
+        if (ok) fdem_mesh_free(&mesh);
+    } else if (ok) {
+        fdem_tet_mesh mesh;
+        const double origin[3] = {0, 0, 0}, size[3] = {1, 1, 1};
+        const int div[3] = {3, 3, 3};
+        ok = fdem_tet_mesh_box(origin, size, div, &mesh, &err) == 0;
+        for (int t = 0; ok && reversed && t < mesh.tet_count / 2; t++) {
+            int32_t *a = mesh.tet + 4 * t, *b = mesh.tet + 4 * (mesh.tet_count - 1 - t);
+            for (int i = 0; i < 4; i++) {
+                int32_t x = a[i];
+                a[i] = b[i];
+                b[i] = x;
+            }
+        }
+        for (int t = 0; ok && reversed && t < mesh.tet_count; t++) {
+            int32_t *n = mesh.tet + 4 * t, first = n[0]; /* an even permutation keeps the sign */
+            n[0] = n[1], n[1] = n[2], n[2] = first;
+        }
+        ok = ok && fdem_add_part_3d(m, &mesh, mat, 1, &err) >= 0;
+        if (ok) fdem_tet_mesh_free(&mesh);
+    }
+    if (!ok || fdem_model_finalize(m, &err)) {
+        CHECK(0, "varied part (%dD): %s", dim, err.message);
+        fdem_model_destroy(m);
+        return NULL;
+    }
+    return m;
+}
+
+/* A face keeps its strength whatever order the mesh lists its elements in
+ * (and so whatever order the engine numbers its joints in): the draws are
+ * keyed by the face, not by the joint's index. Keyed by the index, 268 of
+ * the 270 faces of the reversed 3D mesh drew another strength (3D joints
+ * are numbered by their tetrahedra); the 2D joints, numbered by their
+ * edges' vertices, kept theirs either way. */
+static void weibull_follows_faces(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *a = varied_part(dim, 0), *b = varied_part(dim, 1);
+        if (!a || !b) {
+            fdem_model_destroy(a);
+            fdem_model_destroy(b);
+            return;
+        }
+        int J = a->joint_count, moved = 0, varied = 0;
+        face_strength *fa = faces_and_strengths(a), *fb = faces_and_strengths(b);
+        CHECK(J == b->joint_count && J > 50, "%d and %d joints", J, b->joint_count);
+        for (int j = 0; fa && fb && j < J && J == b->joint_count; j++) {
+            CHECK(face_strength_compare(&fa[j], &fb[j]) == 0, "%dD: the two meshes' faces differ",
+                  dim);
+            moved += fa[j].strength != fb[j].strength;
+            varied += fa[j].strength != 1e6;
+        }
+        printf("  %dD: %d joints, %d varied, %d with another strength after the elements were "
+               "reversed\n", dim, J, varied, moved);
+        CHECK(varied == J, "%d of %d joints drew no factor", J - varied, J);
+        CHECK(moved == 0, "%d of %d faces changed strength", moved, J);
+        free(fa);
+        free(fb);
+        fdem_model_destroy(a);
+        fdem_model_destroy(b);
+    }
+}
+
 /* examples/jointed-block.json to just past its peak: pulled across a set
  * of joints at beta = 30 degrees, the block fails along the set when the
  * normal stress on it, sigma cos^2(beta), reaches the set's tensile
@@ -441,4 +570,5 @@ static void jointed_block_example(void)
 }
 
 CHECK_MAIN(T(groups_2d), T(groups_3d), T(group_selector), T(two_materials_bonded),
-           T(joint_set_on_group), T(weibull_statistics), T(weibull_reproducible), T(jointed_block_example))
+           T(joint_set_on_group), T(weibull_statistics), T(weibull_reproducible),
+           T(weibull_follows_faces), T(jointed_block_example))
