@@ -444,6 +444,25 @@ static face_strength *faces_and_strengths(const fdem_model *m)
     return out;
 }
 
+/* Lists `count` elements of `per` nodes in reverse order, each with its
+ * first three nodes rotated (an even permutation: a tetrahedron keeps the
+ * sign of its volume). */
+static void reverse_elements(int32_t *nodes, int count, int per)
+{
+    for (int t = 0; t < count / 2; t++) {
+        int32_t *a = nodes + per * t, *b = nodes + per * (count - 1 - t);
+        for (int i = 0; i < per; i++) {
+            int32_t x = a[i];
+            a[i] = b[i];
+            b[i] = x;
+        }
+    }
+    for (int t = 0; t < count; t++) {
+        int32_t *n = nodes + per * t, first = n[0];
+        n[0] = n[1], n[1] = n[2], n[2] = first;
+    }
+}
+
 /* One fracturing part of Weibull-varied rock (modulus 5, seed 7) on a mesh
  * whose elements are listed in reverse order when `reversed`, each with its
  * nodes rotated, in 2D (a rectangle) or 3D (a box). */
@@ -459,18 +478,7 @@ static fdem_model *varied_part(int dim, int reversed)
     if (ok && dim == 2) {
         fdem_mesh mesh;
         ok = fdem_mesh_rectangle(0, 0, 1, 1, 6, 6, &mesh, &err) == 0;
-        for (int t = 0; ok && reversed && t < mesh.triangle_count / 2; t++) {
-            int32_t *a = mesh.tri + 3 * t, *b = mesh.tri + 3 * (mesh.triangle_count - 1 - t);
-            for (int i = 0; i < 3; i++) {
-                int32_t x = a[i];
-                a[i] = b[i];
-                b[i] = x;
-            }
-        }
-        for (int t = 0; ok && reversed && t < mesh.triangle_count; t++) {
-            int32_t *n = mesh.tri + 3 * t, first = n[0];
-            n[0] = n[1], n[1] = n[2], n[2] = first;
-        }
+        if (ok && reversed) reverse_elements(mesh.tri, mesh.triangle_count, 3);
         ok = ok && fdem_add_part(m, &mesh, mat, 1, &err) >= 0;
         if (ok) fdem_mesh_free(&mesh);
     } else if (ok) {
@@ -478,18 +486,7 @@ static fdem_model *varied_part(int dim, int reversed)
         const double origin[3] = {0, 0, 0}, size[3] = {1, 1, 1};
         const int div[3] = {3, 3, 3};
         ok = fdem_tet_mesh_box(origin, size, div, &mesh, &err) == 0;
-        for (int t = 0; ok && reversed && t < mesh.tet_count / 2; t++) {
-            int32_t *a = mesh.tet + 4 * t, *b = mesh.tet + 4 * (mesh.tet_count - 1 - t);
-            for (int i = 0; i < 4; i++) {
-                int32_t x = a[i];
-                a[i] = b[i];
-                b[i] = x;
-            }
-        }
-        for (int t = 0; ok && reversed && t < mesh.tet_count; t++) {
-            int32_t *n = mesh.tet + 4 * t, first = n[0]; /* an even permutation keeps the sign */
-            n[0] = n[1], n[1] = n[2], n[2] = first;
-        }
+        if (ok && reversed) reverse_elements(mesh.tet, mesh.tet_count, 4);
         ok = ok && fdem_add_part_3d(m, &mesh, mat, 1, &err) >= 0;
         if (ok) fdem_tet_mesh_free(&mesh);
     }
