@@ -397,7 +397,8 @@ static void thread_row(const char *name, fdem_model *m, int colours, int cores, 
            one / many);
 }
 
-/* The 2D rows (blocks, then disc piles) and/or the 3D elastic block. */
+/* The 2D rows (blocks, then disc piles) and/or the 3D ones (elastic block, fracturing
+ * block, sphere pile). */
 static void bench_threads(int rows_2d, int rows_3d)
 {
     int cores = (int)sysconf(_SC_NPROCESSORS_ONLN);
@@ -426,6 +427,15 @@ static void bench_threads(int rows_2d, int rows_3d)
         thread_row("elastic block 3D (tets)", m, m->elem_plan.color_count, cores, 1e7);
         fdem_model_destroy(m);
     }
+    if (!rows_3d) return;
+    fdem_model *block = vibrating_block(&FRACTURE_3D, FRACTURE_3D.sizes[1], 1);
+    thread_row("fracturing block 3D (joints)", block, block->joint_plan.color_count, cores, 1e7);
+    fdem_model_destroy(block);
+    fdem_model *pile = sphere_pile(6, 6, 4);
+    fdem_error err;
+    for (int s = 0; s < 400; s++) fdem_step(pile, &err); /* into contact, as above */
+    thread_row("sphere pile 3D (contact)", pile, pile->elem_plan.color_count, cores, 5e6);
+    fdem_model_destroy(pile);
 }
 
 /* With no argument every section runs; otherwise only those named
