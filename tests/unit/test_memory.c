@@ -27,14 +27,15 @@ typedef struct memory_case {
 } memory_case;
 
 static const memory_case memory_cases[] = {
-    {"examples/incline.json", 2000},          /* sliding block: sprung pairs */
-    {"examples/collision.json", 2000},        /* two bodies, first capacities */
-    {"examples/disc-pile.json", 1000},        /* 2D pile */
-    {"examples/tunnel.json", 100},            /* no contact, loaded facets */
-    {"examples/jointed-block.json", 300},     /* 2D fracture */
-    {"examples/uniaxial-compression.json", 300},
-    {"examples/collision-3d.json", 1000},     /* 3D contact */
-    {"examples/uniaxial-prism-3d.json", 200}, /* 3D fracture: densest pair lists */
+    {"examples/incline.json", 2000},              /* sliding block: sprung pairs */
+    {"examples/collision.json", 2000},            /* two bodies, first capacities */
+    {"examples/disc-pile.json", 2000},            /* 2D pile */
+    {"examples/tunnel.json", 200},                /* no contact, loaded facets */
+    {"examples/jointed-block.json", 2000},        /* 2D fracture */
+    {"examples/uniaxial-compression.json", 2000}, /* 2D fracture under platens */
+    {"examples/collision-3d.json", 2000},         /* 3D contact */
+    {"examples/sphere-pile.json", 500},           /* 3D pile */
+    {"examples/uniaxial-prism-3d.json", 1000},    /* 3D fracture: densest pair lists */
 };
 
 /* Not absurdly high: the bundled examples measure 1.0-2.7 at 2000 steps,
@@ -104,6 +105,23 @@ static void estimate_holds_each_example(void)
     }
 }
 
+/* On two threads a 3D fracturing model also holds each thread's touch
+ * lists: the estimate plus fdem_memory_per_thread() a thread, what the
+ * daemon charges, covers it. */
+static void threads_add_their_touch_lists(void)
+{
+    fdem_model *m = memory_build("examples/uniaxial-prism-3d.json");
+    if (!m) return;
+    fdem_set_threads(m, 2);
+    double peak = (double)memory_peak(m, 300);
+    double priced = gated_estimate + 2.0 * (double)fdem_memory_per_thread(3);
+    printf("  two threads: estimate %.0f + threads %.0f, peak %.0f\n", gated_estimate,
+           priced - gated_estimate, peak);
+    CHECK(priced >= peak, "estimated %.0f bytes with two threads, holds %.0f", priced, peak);
+    CHECK(gated_estimate < peak, "the two threads' lists (peak %.0f) were not exercised", peak);
+    fdem_model_destroy(m);
+}
+
 /* fdem_memory_bytes() against the allocator's own count (glibc mallinfo2;
  * the sanitizers' allocator keeps its own books, so only the plain build
  * checks it). What the model holds once built and stepped: within 3% and
@@ -135,4 +153,5 @@ static void memory_bytes_counts_the_heap(void)
 #endif
 }
 
-CHECK_MAIN(T(estimate_holds_each_example), T(memory_bytes_counts_the_heap))
+CHECK_MAIN(T(estimate_holds_each_example), T(threads_add_their_touch_lists),
+           T(memory_bytes_counts_the_heap))
