@@ -734,23 +734,26 @@ int fdem_constraint_node_count(const fdem_model *m, int c)
  * (tests/unit/test_memory.c holds the estimate against the examples). */
 
 /* What one dimension's records weigh, and its contact lists' capacities per
- * contact element: the raw NBS list (before the pairs of joined elements
- * are dropped), the kept pairs' spring_of, the near pairs walked each step,
- * stick-spring sets and the records detection sets them aside in. */
+ * contact element: candidate pairs kept, the near pairs walked each step,
+ * stick-spring sets and the records detection sets them aside in; and per
+ * joint the raw NBS list's extra pairs of joined elements, held at each
+ * detection until they are dropped (contact_drop_joined). */
 typedef struct memory_figures {
     size_t D, elem_nodes, stress_comps, hot, slots;
-    double raw_pairs, kept_pairs, near_pairs, spring_sets, records;
+    double kept_pairs, near_pairs, spring_sets, records, joined_pairs;
 } memory_figures;
 
-/* Capacities measured per element (2000 steps): 2D raw 8.1 (jointed-block,
- * at detection), kept 1.25 and near 1.25 (disc-pile), near 0.8
- * (brazilian-disc), sets 0.2 (brazilian-disc); 3D raw 63.5, kept 31.8,
- * near 7.9, sets 2.0 (uniaxial-prism-3d), records 0.24 (sphere-pile).
- * Smaller models sit on the first capacities (memory_fixed). */
+/* Capacities measured (valgrind massif for the raw list, which is fitted
+ * after each detection), per element: 2D kept 1.25 and near 1.25
+ * (disc-pile), sets 0.2 (brazilian-disc); 3D kept 31.8, near 7.9, sets 2.0
+ * (uniaxial-prism-3d), kept 30 and records 0.24 (sphere-pile); per joint,
+ * the raw list: 2D 16.1 (uniaxial-compression; brazilian-disc 9.3,
+ * jointed-block 5.5), 3D 62 (brazilian-disc-3d-arc; prism 58.7). Smaller
+ * models sit on the first capacities (memory_fixed). */
 static const memory_figures memory_2d = {2, 3, 3, sizeof(element_hot), TRI_CONTACT_SLOTS,
-                                         10, 2, 2, 0.5, 0.25};
+                                         2, 2, 0.5, 0.25, 17};
 static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_SLOTS,
-                                         64, 32, 8, 2, 0.5};
+                                         32, 8, 2, 0.5, 64};
 
 /* pos, vel, force, pos0 (dim each), mass, inv_mass; node_part, node_origin;
  * dof_owned and a constraint entry (node, dofs); a quarter of a loaded
@@ -774,13 +777,13 @@ static size_t memory_element(const memory_figures *f, int joints)
 
 /* Detection arrays (centre and radius, box, elem_gap; body, piece, active,
  * near_active; in_pair; the NBS grid's heads, 12 bytes measured in 3D, 40
- * in 2D) and the pair lists at their capacities: a raw pair is two element
- * ids, spring_of one, a near_pair 24 bytes, a set slots doubles and a
+ * in 2D) and the pair lists at their capacities: a kept pair is two element
+ * ids and its spring_of, a near_pair 24 bytes, a set slots doubles and a
  * free-list slot, a record a contact_record. */
 static size_t memory_contact_element(const memory_figures *f)
 {
     double set = (double)(f->slots * sizeof(double) + sizeof(int32_t));
-    double lists = f->raw_pairs * 2 * sizeof(int32_t) + f->kept_pairs * sizeof(int32_t) +
+    double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
     return (3 * f->D + 2) * sizeof(double) + 4 * sizeof(int32_t) + 1 + 10 * sizeof(int32_t) +
@@ -788,12 +791,14 @@ static size_t memory_contact_element(const memory_figures *f)
 }
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;
- * joint_strength_of, a strength record of its own (varied strengths), and
- * its fracture event (in a list that grows by doubling) */
+ * joint_strength_of, a strength record of its own (varied strengths), its
+ * fracture event (in a list that grows by doubling), and the raw NBS
+ * list's pairs of joined elements (two element ids each) */
 static size_t memory_joint(const memory_figures *f)
 {
     return (2 * f->D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 + sizeof(int32_t) +
-           sizeof(joint_strength) + 2 * sizeof(fdem_event);
+           sizeof(joint_strength) + 2 * sizeof(fdem_event) +
+           (size_t)(f->joined_pairs * 2 * sizeof(int32_t));
 }
 
 /* The model record, parts, materials and constraints (a few KB), the event
@@ -809,13 +814,25 @@ static size_t memory_fixed(const memory_figures *f, int contact)
     return b;
 }
 
+/* Finalize's scratch, freed before the first step: the scatter plans'
+ * colour mask (a uint64_t a node) and, with pressures or dashpots, every
+ * element facet's sorted key (20 bytes) twice over (qsort's merge buffer):
+ * tunnel's model peaks at 1.7 times what it holds after. A model with
+ * contact builds them while its pair lists are still small, within what
+ * memory_contact_element prices for those. */
+static size_t memory_finalize(const memory_figures *f, long nodes, long elements)
+{
+    return (size_t)nodes * sizeof(uint64_t) + (size_t)elements * (f->D + 1) * 2 * 5 * sizeof(int32_t);
+}
+
 static size_t memory_estimate(const memory_figures *f, long nodes, long elements, long joints,
                               int parts)
 {
     int contact = parts > 1 || joints > 0;
     size_t elem = memory_element(f, joints > 0) + (contact ? memory_contact_element(f) : 0);
     return memory_fixed(f, contact) + (size_t)nodes * memory_node(f, contact, joints > 0) +
-           (size_t)elements * elem + (size_t)joints * memory_joint(f);
+           (size_t)elements * elem + (size_t)joints * memory_joint(f) +
+           (contact ? 0 : memory_finalize(f, nodes, elements));
 }
 
 size_t fdem_memory_estimate(long nodes, long elements, long joints, int parts)
