@@ -7,7 +7,9 @@
  * fdem_memory_bytes() - the figure users read as the case's memory and the
  * one the estimate is held against here - must count what the model
  * allocated. Bundled examples, 2D and 3D, with and without contact and
- * fracture, are built as the daemon builds them and stepped.
+ * fracture, are built as the daemon builds them and stepped. Peaks inside
+ * a step (the raw pair list at detection) and finalize's scratch are not
+ * seen here; valgrind massif measured them (core/model.c, memory priced).
  */
 #include <malloc.h>
 #include <stdio.h>
@@ -38,10 +40,10 @@ static const memory_case memory_cases[] = {
     {"examples/uniaxial-prism-3d.json", 1000},    /* 3D fracture: densest pair lists */
 };
 
-/* Not absurdly high: the bundled examples measure 1.0-2.7 at 2000 steps,
- * up to 4.4 for collision-3d whose two bodies barely touch; a small model
+/* Not absurdly high: between steps the examples here hold 1/1.5 to 1/2.5
+ * of it, collision-3d (two bodies that barely touch) 1/3.8; a small model
  * sits on fixed first capacities of the contact lists (~100-200 KB). */
-#define MEMORY_ESTIMATE_MAX_RATIO 5.0
+#define MEMORY_ESTIMATE_MAX_RATIO 4.5
 
 static double gated_estimate;
 
