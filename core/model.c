@@ -723,10 +723,11 @@ int fdem_constraint_node_count(const fdem_model *m, int c)
 
 /* ------------------------------------------------------- memory, priced
  *
- * fdem_memory_estimate*() must be an upper bound of what fdem_memory_bytes()
- * reports once a model has stepped long enough for its contacts to develop:
- * the daemon admits a case on it, and a low figure is an OOM kill on a loaded
- * server. Counts are all it knows, so whatever a case may or may not have
+ * fdem_memory_estimate*() must be an upper bound of a model's peak: what
+ * fdem_memory_bytes() reports once it has stepped long enough for its
+ * contacts to develop, and the scratch of finalize and of each detection
+ * (measured with valgrind massif). The daemon admits a case on it, and a
+ * low figure is an OOM kill on a loaded server. Counts are all it knows, so whatever a case may or may not have
  * (in-situ stress, damping, varied joint strengths, broken joints) is priced
  * as if it had it. The figures name the arrays they pay for; the contact
  * lists grow by doubling, so they are priced at the largest capacity per
