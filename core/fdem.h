@@ -432,16 +432,25 @@ typedef struct fdem_stage_times {
 
 fdem_stage_times fdem_get_stage_times(const fdem_model *model);
 
-/* Bytes the engine holds for this model (for memory limits and bench). */
+/* Bytes the engine holds for this model now: every array it allocated,
+ * at its capacity (for memory limits, the status and bench). */
 size_t fdem_memory_bytes(const fdem_model *model);
 
-/* Estimated bytes a model with this many nodes, elements and joints will
- * need once finalized (to reject oversized cases before building them). */
-size_t fdem_memory_estimate(long nodes, long elements, long joints);
-size_t fdem_memory_estimate_3d(long nodes, long elements, long joints);
+/* An upper bound of fdem_memory_bytes() of a model with this many nodes,
+ * elements, joints and parts once it has stepped (contacts developed), on
+ * one thread: to reject oversized cases before building them. What the
+ * counts cannot tell (in-situ stress, damping, varied joint strengths,
+ * every joint broken) is priced as present; contact when parts > 1 or
+ * joints > 0; finalize's scratch too. The bundled examples' real peaks
+ * (valgrind massif, 2000 steps) are 0.26-0.98 of it: 0.5-0.7 for the large
+ * 2D and 3D fracturing ones, less for small or sparse-contact ones. */
+size_t fdem_memory_estimate(long nodes, long elements, long joints, int parts);
+size_t fdem_memory_estimate_3d(long nodes, long elements, long joints, int parts);
 /* The estimate of the counts' dimension (a dimension of 0, as in counts
  * stored before 3D, is 2). */
 size_t fdem_memory_estimate_of(const fdem_counts *counts);
+/* What each thread beyond the first may add (its contact touch lists). */
+size_t fdem_memory_per_thread(int dimension);
 
 #ifdef __cplusplus
 }

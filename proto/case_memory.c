@@ -85,13 +85,15 @@ static void memory_part_counts(case_part *part, int dimension)
     }
 }
 
-static double memory_bytes(int dimension, double nodes, double elements, double joints)
+static double memory_bytes(int dimension, double nodes, double elements, double joints,
+                           int parts)
 {
     double largest = fmax(nodes, fmax(elements, joints));
     double scale = largest > MEMORY_EXACT_COUNT ? largest / MEMORY_EXACT_COUNT : 1;
     long n = (long)(nodes / scale), e = (long)(elements / scale);
     long j = (long)(joints / scale);
-    size_t bytes = dimension == 3 ? fdem_memory_estimate_3d(n, e, j) : fdem_memory_estimate(n, e, j);
+    size_t bytes = dimension == 3 ? fdem_memory_estimate_3d(n, e, j, parts)
+                                 : fdem_memory_estimate(n, e, j, parts);
     return (double)bytes * scale;
 }
 
@@ -128,7 +130,7 @@ double case_check_memory(case_doc *doc, size_t memory_limit)
         elements += doc->parts[i].elements;
         joints += doc->parts[i].joints;
     }
-    double bytes = memory_bytes(doc->dimension, nodes, elements, joints);
+    double bytes = memory_bytes(doc->dimension, nodes, elements, joints, doc->part_count);
     char need[32], limit[32], counts[96];
     memory_format(bytes, need, sizeof need);
     memory_describe(nodes, elements, joints, counts, sizeof counts);

@@ -45,7 +45,8 @@ typedef enum case_model_rc {
 } case_model_rc;
 
 /* What holding a model of about `estimate` bytes (fdem_memory_estimate)
- * is charged: the model and one checkpoint copy on its way to disk. */
+ * is charged: the model, one checkpoint copy on its way to disk, and the
+ * contact lists of each thread it runs on. */
 size_t case_model_cost(double estimate);
 /* The same from the counts the case last published. */
 size_t case_model_cost_of(server_case *c);

@@ -536,7 +536,7 @@ static void memory_estimate_is_not_low(void)
     if (m) {
         fdem_counts c = fdem_get_counts(m);
         /* joints: one per interior edge of the fracturing disc, at most 1.5 per triangle */
-        size_t priced = fdem_memory_estimate(c.nodes, c.elements, c.joints);
+        size_t priced = fdem_memory_estimate_of(&c);
         size_t limit = smallest_accepted_limit(doc);
         CHECK(limit >= priced, "accepted at %zu bytes, the real counts price at %zu", limit,
               priced);

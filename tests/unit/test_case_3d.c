@@ -475,7 +475,7 @@ static void memory_estimate_3d_is_not_low(void)
         problems_free(&p);
         if (m) {
             fdem_counts c = fdem_get_counts(m);
-            size_t priced = fdem_memory_estimate_3d(c.nodes, c.elements, c.joints);
+            size_t priced = fdem_memory_estimate_of(&c);
             size_t limit = smallest_accepted_limit(doc);
             CHECK(limit >= priced, "%s accepted at %zu bytes, the real counts price at %zu",
                   shapes[s][0], limit, priced);
