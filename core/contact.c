@@ -90,7 +90,7 @@ typedef struct contact_touches {
 static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
 {
     if (list->count == list->capacity) {
-        size_t cap = list->capacity ? 2 * list->capacity : 1024;
+        size_t cap = list->capacity ? 2 * list->capacity : CONTACT_FIRST_ROWS;
         long *p = realloc(list->pair, cap * sizeof *p);
         if (!p) return -1;
         list->pair = p;
@@ -255,7 +255,8 @@ static int contact_near_rebuild(fdem_model *m)
         }
         /* the list grows as it fills: it holds a tenth or so of the candidates */
         if (count == cs->near_capacity &&
-            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near, 1024))
+            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near,
+                          CONTACT_FIRST_ROWS))
             return -1;
         cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb, contact_pair_sprung(cs, k)};
         cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);

@@ -39,7 +39,7 @@ static void pair_slots_oriented(const double *slip, int a, int b, int slots, dou
 int contact_history_reserve(contact_state *cs, size_t pairs)
 {
     return model_reserve((void **)&cs->spring_of, &cs->pair_capacity, pairs, sizeof *cs->spring_of,
-                         1024);
+                         CONTACT_FIRST_ROWS);
 }
 
 /* A set of zeros from the pool: its index, or -1 when out of memory. */
@@ -50,7 +50,7 @@ static int32_t springs_take(contact_state *cs)
         set = cs->slip_free[--cs->free_count];
     } else {
         if (cs->slip_count == cs->slip_capacity) {
-            size_t cap = cs->slip_capacity ? 2 * cs->slip_capacity : 256;
+            size_t cap = cs->slip_capacity ? 2 * cs->slip_capacity : CONTACT_FIRST_SETS;
             if (cap > INT32_MAX) return -1;
             double *s = realloc(cs->slip, sizeof(double) * (size_t)cs->slots * cap);
             if (!s) return -1;
@@ -88,7 +88,7 @@ void contact_springs_release(contact_state *cs, size_t pair)
 static int records_reserve(contact_state *cs, size_t count)
 {
     if (count <= cs->record_capacity) return 0;
-    size_t cap = cs->record_capacity ? cs->record_capacity : 256;
+    size_t cap = cs->record_capacity ? cs->record_capacity : CONTACT_FIRST_SETS;
     while (cap < count) cap *= 2;
     contact_record *r = realloc(cs->records, sizeof *r * cap);
     if (!r) return -1;

@@ -449,7 +449,8 @@ size_t fdem_memory_estimate_3d(long nodes, long elements, long joints, int parts
 /* The estimate of the counts' dimension (a dimension of 0, as in counts
  * stored before 3D, is 2). */
 size_t fdem_memory_estimate_of(const fdem_counts *counts);
-/* What each thread beyond the first may add (its contact touch lists). */
+/* What each thread of a case run on more than one may add (its contact
+ * touch lists, one per thread, the first's included). */
 size_t fdem_memory_per_thread(int dimension);
 
 #ifdef __cplusplus

@@ -804,14 +804,16 @@ static size_t memory_joint(const memory_figures *f)
 
 /* The model record, parts, materials and constraints (a few KB), the event
  * list's first 64; with contact the first capacities of the lists that grow
- * by doubling: 1024 raw pairs, 1024 spring_of, 1024 near_pair, 256 spring
- * sets and 256 records, and the NBS grid's row and cell tables */
+ * by doubling (raw pairs, spring_of and near pairs; spring sets and
+ * records), and the NBS grid's row and cell tables */
 static size_t memory_fixed(const memory_figures *f, int contact)
 {
     size_t b = sizeof(fdem_model) + 8192 + 64 * sizeof(fdem_event);
     if (contact)
-        b += 1024 * (2 * sizeof(int32_t) + sizeof(int32_t) + sizeof(double) + 4 * sizeof(int32_t)) +
-             256 * (f->slots * sizeof(double) + sizeof(int32_t) + sizeof(contact_record)) + 16384;
+        b += NBS_FIRST_PAIRS * 2 * sizeof(int32_t) +
+             CONTACT_FIRST_ROWS * (sizeof(int32_t) + sizeof(double) + 4 * sizeof(int32_t)) +
+             CONTACT_FIRST_SETS * (f->slots * sizeof(double) + sizeof(int32_t) + sizeof(contact_record)) +
+             16384;
     return b;
 }
 
@@ -853,14 +855,14 @@ size_t fdem_memory_estimate_of(const fdem_counts *n)
                : fdem_memory_estimate(n->nodes, n->elements, n->joints, n->parts);
 }
 
-/* A thread's touch lists hold at least 1024 rows of each kind once the
- * pairs run threaded (contact.c pair_rows_push): pairs touched with their
- * forces, springs adopted, springs released. */
+/* A thread's touch lists hold at least CONTACT_FIRST_ROWS rows of each kind
+ * once the pairs run threaded (contact.c pair_rows_push): pairs touched with
+ * their forces, springs adopted, springs released. */
 size_t fdem_memory_per_thread(int dimension)
 {
     size_t out = dimension == 3 ? TET_PAIR_OUT : TRI_PAIR_OUT;
     size_t slots = dimension == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
-    return 1024 * (3 * sizeof(long) + (out + slots) * sizeof(double));
+    return CONTACT_FIRST_ROWS * (3 * sizeof(long) + (out + slots) * sizeof(double));
 }
 
 static size_t scatter_plan_bytes(const scatter_plan *p)

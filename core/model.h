@@ -118,6 +118,13 @@ typedef struct contact_record {
     double slip[CONTACT_SLOTS_MAX];
 } contact_record;
 
+/* First capacities of the contact lists that grow by doubling (pair and
+ * touch rows, near pairs, spring indices; stick-spring sets and records):
+ * a model with contact holds them however few its pairs, and the memory
+ * estimate prices them (model.c, memory_fixed and fdem_memory_per_thread). */
+#define CONTACT_FIRST_ROWS 1024
+#define CONTACT_FIRST_SETS 256
+
 typedef struct contact_state {
     int enabled;             /* some pair of elements can ever touch */
     const struct contact_kernel *kernel; /* the dimension's pair kernel (contact.c) */

@@ -29,6 +29,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* A pair list's first capacity (it grows by doubling): the memory estimate
+ * prices it for every model with contact. */
+#define NBS_FIRST_PAIRS 1024
+
 typedef struct nbs_pairs {
     int32_t *a, *b;   /* pair k is (a[k], b[k]) */
     size_t count, capacity;

@@ -60,7 +60,7 @@ static inline int nbs_same_body(const int32_t *body, int32_t i, int32_t j)
 static inline int nbs_pairs_grow(nbs_pairs *pairs, size_t want)
 {
     if (want <= pairs->capacity) return 0;
-    size_t cap = pairs->capacity ? pairs->capacity : 1024;
+    size_t cap = pairs->capacity ? pairs->capacity : NBS_FIRST_PAIRS;
     while (cap < want) cap *= 2;
     int32_t *a = realloc(pairs->a, cap * sizeof *a);
     if (!a) return -1;
