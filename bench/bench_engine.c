@@ -410,7 +410,7 @@ static void bench_threads(int rows_2d, int rows_3d)
         for (int k = 0; k < 2; k++) {
             fdem_model *m = vibrating_block(&FRACTURE_2D, k ? 707 : 224, fracture);
             thread_row(fracture ? "fracturing block (joints)" : "elastic block (shared nodes)", m,
-                       fracture ? m->joint_plan.color_count : m->elem_plan.color_count, cores, 1e7);
+                       m->elem_plan.color_count, cores, 1e7);
             fdem_model_destroy(m);
         }
     int dims[][2] = {{20, 20}, {60, 60}};
@@ -429,7 +429,7 @@ static void bench_threads(int rows_2d, int rows_3d)
     }
     if (!rows_3d) return;
     fdem_model *block = vibrating_block(&FRACTURE_3D, FRACTURE_3D.sizes[1], 1);
-    thread_row("fracturing block 3D (joints)", block, block->joint_plan.color_count, cores, 1e7);
+    thread_row("fracturing block 3D (joints)", block, block->elem_plan.color_count, cores, 1e7);
     fdem_model_destroy(block);
     fdem_model *pile = sphere_pile(6, 6, 4);
     fdem_error err;

@@ -352,11 +352,12 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
     if (D >= 1) e->handed += squeezed; /* broken shut: its overlap goes on as contact */
 }
 
-/* Adds the forces of intact joints [begin, end) to m->force, counts in
- * sums[0] those that broke in this call, and adds their stored energy to
- * sums[1], what their damage growth dissipated to sums[2], the compression
- * energy of those that broke shut to sums[3] and the frictional work of
- * their sliding in the last step to sums[4].
+/* Joint j's forces on face A (fa: a0 then a1; face B takes their
+ * negatives), its damage and its share of the running sums t (joints that
+ * broke, stored energy, what damage growth dissipated, the compression
+ * energy of those that broke shut, the frictional work of their sliding in
+ * the last step). Returns 0 when it adds nothing: broken before or now, or
+ * its face is degenerate.
  *
  * Nearly every joint in nearly every step is undamaged and elastic at both
  * Gauss points. There the traction is k (delta n + s t) = k d: the penalty
@@ -365,83 +366,99 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
  *   f_a0 = L k (2 d0 + d1) / 6,   f_a1 = L k (d0 + 2 d1) / 6,
  * the same forces as the Gauss-point sum, without unit vectors, tractions or
  * the damage bookkeeping. Only the elastic test needs the projections. */
-static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+static inline __attribute__((always_inline)) int joint_evaluate_2d(fdem_model *m, int j,
+                                                                    joint_totals *t,
+                                                                    double fa[4])
 {
     const double *x = m->pos, *v = m->vel;
     const double h_last = m->dt_prev; /* x = x_before + h_last v: the last step */
+    double damage = m->joint_damage[j];
+    if (damage >= 1.0) return 0;
+    const int32_t *n = m->joint_node + 4 * j;
+    const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
+    const double k = law.k;
+    const double *a0 = x + 2 * (size_t)n[0], *a1 = x + 2 * (size_t)n[1];
+    const double *b0 = x + 2 * (size_t)n[2], *b1 = x + 2 * (size_t)n[3];
+    double d0[2] = {b0[0] - a0[0], b0[1] - a0[1]}, d1[2] = {b1[0] - a1[0], b1[1] - a1[1]};
+    /* mean face tangent, length L: A's edge plus half the gap change */
+    double tx = (a1[0] - a0[0]) + 0.5 * (d1[0] - d0[0]);
+    double ty = (a1[1] - a0[1]) + 0.5 * (d1[1] - d0[1]);
+    double L2 = tx * tx + ty * ty;
+    if (!(L2 > 0)) return 0;
+    double L = sqrt(L2);
+    double *fa0 = fa, *fa1 = fa + 2;
+    int elastic = 0;
+    if (damage == 0) {
+        double g0x = (1 - gauss[0]) * d0[0] + gauss[0] * d1[0];
+        double g0y = (1 - gauss[0]) * d0[1] + gauss[0] * d1[1];
+        double g1x = (1 - gauss[1]) * d0[0] + gauss[1] * d1[0];
+        double g1y = (1 - gauss[1]) * d0[1] + gauss[1] * d1[1];
+        /* (tx, ty) has length L, normal (ty, -tx): projections are L x */
+        elastic = joint_point_elastic(&law, L, g0x * ty - g0y * tx, g0x * tx + g0y * ty) &&
+                  joint_point_elastic(&law, L, g1x * ty - g1y * tx, g1x * tx + g1y * ty);
+    }
+    if (elastic) {
+        double s = L * k * (1.0 / 6);
+        fa0[0] = s * (2 * d0[0] + d1[0]);
+        fa0[1] = s * (2 * d0[1] + d1[1]);
+        fa1[0] = s * (d0[0] + 2 * d1[0]);
+        fa1[1] = s * (d0[1] + 2 * d1[1]);
+        /* 1/2 integral of k |d|^2 along the face, exact for linear d */
+        t->stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
+        return 1;
+    }
+    double inv_L = 1.0 / L;
+    joint_energy e = {0};
+    const double *va0 = v + 2 * (size_t)n[0], *va1 = v + 2 * (size_t)n[1];
+    const double *vb0 = v + 2 * (size_t)n[2], *vb1 = v + 2 * (size_t)n[3];
+    double step0[2] = {h_last * (vb0[0] - va0[0]), h_last * (vb0[1] - va0[1])};
+    double step1[2] = {h_last * (vb1[0] - va1[0]), h_last * (vb1[1] - va1[1])};
+    joint_forces_general(&law, d0, d1, step0, step1, tx * inv_L, ty * inv_L, L, &damage, fa0, fa1,
+                         &e);
+    t->dissipated += e.dissipated;
+    t->handed += e.handed;
+    t->friction += e.friction;
+    m->joint_fracture[j] += e.dissipated;
+    if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
+        m->joint_damage[j] = 1.0;
+        m->joint_broke[j] = (uint8_t)e.broke;
+        t->broke++;
+        return 0;
+    }
+    t->stored += e.stored;
+    m->joint_damage[j] = damage;
+    return 1;
+}
+
+/* Adds the forces of intact joints [begin, end) to m->force, continuing
+ * the running sums (joint_totals) in sums. */
+void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
     double *f = m->force;
-    const joint_strength *strengths = m->joint_strengths;
-    int broke = 0;
-    double stored = 0, dissipated = 0, handed = 0, friction = 0;
+    /* a local, so that the loop's sums stay in registers */
+    joint_totals t = joint_totals_load(sums);
     for (int j = begin; j < end; j++) {
-        double damage = m->joint_damage[j];
-        if (damage >= 1.0) continue;
+        double fa[4];
+        if (!joint_evaluate_2d(m, j, &t, fa)) continue;
         const int32_t *n = m->joint_node + 4 * j;
-        const joint_law law = joint_law_of(&strengths[m->joint_strength_of[j]], m->joint_k[j]);
-        const double k = law.k;
-        const double *a0 = x + 2 * (size_t)n[0], *a1 = x + 2 * (size_t)n[1];
-        const double *b0 = x + 2 * (size_t)n[2], *b1 = x + 2 * (size_t)n[3];
-        double d0[2] = {b0[0] - a0[0], b0[1] - a0[1]}, d1[2] = {b1[0] - a1[0], b1[1] - a1[1]};
-        /* mean face tangent, length L: A's edge plus half the gap change */
-        double tx = (a1[0] - a0[0]) + 0.5 * (d1[0] - d0[0]);
-        double ty = (a1[1] - a0[1]) + 0.5 * (d1[1] - d0[1]);
-        double L2 = tx * tx + ty * ty;
-        if (!(L2 > 0)) continue;
-        double L = sqrt(L2);
-        double fa0[2], fa1[2];
-        int elastic = 0;
-        if (damage == 0) {
-            double g0x = (1 - gauss[0]) * d0[0] + gauss[0] * d1[0];
-            double g0y = (1 - gauss[0]) * d0[1] + gauss[0] * d1[1];
-            double g1x = (1 - gauss[1]) * d0[0] + gauss[1] * d1[0];
-            double g1y = (1 - gauss[1]) * d0[1] + gauss[1] * d1[1];
-            /* (tx, ty) has length L, normal (ty, -tx): projections are L x */
-            elastic = joint_point_elastic(&law, L, g0x * ty - g0y * tx, g0x * tx + g0y * ty) &&
-                      joint_point_elastic(&law, L, g1x * ty - g1y * tx, g1x * tx + g1y * ty);
-        }
-        if (elastic) {
-            double s = L * k * (1.0 / 6);
-            fa0[0] = s * (2 * d0[0] + d1[0]);
-            fa0[1] = s * (2 * d0[1] + d1[1]);
-            fa1[0] = s * (d0[0] + 2 * d1[0]);
-            fa1[1] = s * (d0[1] + 2 * d1[1]);
-            /* 1/2 integral of k |d|^2 along the face, exact for linear d */
-            stored += 0.5 * ((fa0[0] * d0[0] + fa0[1] * d0[1]) + (fa1[0] * d1[0] + fa1[1] * d1[1]));
-        } else {
-            /* a local, so that the loop's sums stay in registers */
-            double inv_L = 1.0 / L;
-            joint_energy e = {0};
-            const double *va0 = v + 2 * (size_t)n[0], *va1 = v + 2 * (size_t)n[1];
-            const double *vb0 = v + 2 * (size_t)n[2], *vb1 = v + 2 * (size_t)n[3];
-            double step0[2] = {h_last * (vb0[0] - va0[0]), h_last * (vb0[1] - va0[1])};
-            double step1[2] = {h_last * (vb1[0] - va1[0]), h_last * (vb1[1] - va1[1])};
-            joint_forces_general(&law, d0, d1, step0, step1, tx * inv_L, ty * inv_L, L, &damage,
-                                 fa0, fa1, &e);
-            dissipated += e.dissipated;
-            handed += e.handed;
-            friction += e.friction;
-            m->joint_fracture[j] += e.dissipated;
-            if (damage >= 1.0) { /* broken within this step: it carries nothing from now on */
-                m->joint_damage[j] = 1.0;
-                m->joint_broke[j] = (uint8_t)e.broke;
-                broke++;
-                continue;
-            }
-            stored += e.stored;
-            m->joint_damage[j] = damage;
-        }
         double *ga0 = f + 2 * (size_t)n[0], *ga1 = f + 2 * (size_t)n[1];
         double *gb0 = f + 2 * (size_t)n[2], *gb1 = f + 2 * (size_t)n[3];
-        ga0[0] += fa0[0]; ga0[1] += fa0[1];
-        ga1[0] += fa1[0]; ga1[1] += fa1[1];
-        gb0[0] -= fa0[0]; gb0[1] -= fa0[1];
-        gb1[0] -= fa1[0]; gb1[1] -= fa1[1];
+        ga0[0] += fa[0]; ga0[1] += fa[1];
+        ga1[0] += fa[2]; ga1[1] += fa[3];
+        gb0[0] -= fa[0]; gb0[1] -= fa[1];
+        gb1[0] -= fa[2]; gb1[1] -= fa[3];
     }
-    sums[0] += broke;
-    sums[1] += stored;
-    sums[2] += dissipated;
-    sums[3] += handed;
-    sums[4] += friction;
+    joint_totals_store(&t, sums);
+}
+
+/* Joint j alone, its face A forces handed back (joint_one_fn). */
+int joint_forces_one_2d(fdem_model *m, int j, double sums[SCATTER_SUMS],
+                        double fa[JOINT_FACE_VALUES])
+{
+    joint_totals t = joint_totals_load(sums);
+    int live = joint_evaluate_2d(m, j, &t, fa);
+    joint_totals_store(&t, sums);
+    return live;
 }
 
 /* Adds the forces of every intact joint to m->force, sets the joints'
@@ -453,8 +470,8 @@ static void joint_forces_range(fdem_model *m, int begin, int end, double sums[SC
 int joint_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
-    scatter_plan_run(&m->joint_plan, m, m->threads,
-                     m->dim == 3 ? joint_forces_range_3d : joint_forces_range, sums);
+    if (m->dim == 3) joint_sweep_run(m, joint_forces_range_3d, joint_forces_one_3d, sums);
+    else joint_sweep_run(m, joint_forces_range_2d, joint_forces_one_2d, sums);
     m->joint_energy = sums[1];
     m->fracture_energy += sums[2];
     m->joint_friction_energy += sums[4];

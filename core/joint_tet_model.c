@@ -202,20 +202,15 @@ JOINT_TET_INLINE void joint_prefetch_face_a(const fdem_model *m, int j)
 #endif
 }
 
-/* The loop's running totals, joint by joint in joint order. */
-typedef struct joint_totals {
-    int broke;
-    double stored, dissipated, handed, friction;
-} joint_totals;
-
 /* Joint j (not broken) through joint_tet_forces, from the gaps the loop
- * already has: its damage, fracture account, break and forces booked. */
-static void joint_through_kernel(fdem_model *m, int j, const double d[3][3], const double N[3],
-                                 double N_len, joint_totals *t)
+ * already has: its damage, fracture account and break booked, its face A
+ * forces in fa. Returns 0 when it broke (nothing to add). */
+static int joint_through_kernel(fdem_model *m, int j, const double d[3][3], const double N[3],
+                                double N_len, joint_totals *t, double fa[9])
 {
     const int32_t *n = m->joint_node + 6 * (size_t)j;
     const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
-    double damage = m->joint_damage[j], fa[9];
+    double damage = m->joint_damage[j];
     /* this joint's own, for its fracture account and its event */
     joint_energy e = {0};
     int holds = joint_tet_forces_of_gaps(&law, d, N, N_len, m->vel, m->dt_prev, n, &damage, fa, &e);
@@ -228,29 +223,44 @@ static void joint_through_kernel(fdem_model *m, int j, const double d[3][3], con
     if (!holds) {
         m->joint_broke[j] = (uint8_t)e.broke;
         t->broke++;
-        return;
+        return 0;
     }
-    joint_tet_scatter(m->force, n, fa);
+    return 1;
 }
 
 /* Joint j alone: the inline path when it is undamaged and surely elastic,
- * else the kernel; nothing when it is broken. */
-static void joint_alone(fdem_model *m, int j, joint_totals *t)
+ * else the kernel; its face A forces in fa, 0 when it adds nothing
+ * (broken). */
+static int joint_alone_forces(fdem_model *m, int j, joint_totals *t, double fa[9])
 {
     double damage = m->joint_damage[j];
-    if (damage >= 1.0) return;
+    if (damage >= 1.0) return 0;
     const int32_t *n = m->joint_node + 6 * (size_t)j;
     const joint_strength *s = &m->joint_strengths[m->joint_strength_of[j]];
     double d[3][3], N[3], k = m->joint_k[j];
     double N_len = joint_tet_gaps(m->pos, n, d, N);
     if (damage == 0 && N_len > JOINT_TET_TINY_NORMAL &&
         joint_tet_surely_elastic_of(k, s->tensile_strength, s->cohesion, s->tan_phi, d)) {
-        double fa[9];
         t->stored += joint_tet_elastic_forces(k, 0.5 * N_len, d, fa);
-        joint_tet_scatter(m->force, n, fa);
-        return;
+        return 1;
     }
-    joint_through_kernel(m, j, d, N, N_len, t);
+    return joint_through_kernel(m, j, d, N, N_len, t, fa);
+}
+
+static void joint_alone(fdem_model *m, int j, joint_totals *t)
+{
+    double fa[9];
+    if (joint_alone_forces(m, j, t, fa)) joint_tet_scatter(m->force, m->joint_node + 6 * (size_t)j, fa);
+}
+
+/* Joint j alone, its face A forces handed back (joint_one_fn). */
+int joint_forces_one_3d(fdem_model *m, int j, double sums[SCATTER_SUMS],
+                        double fa[JOINT_FACE_VALUES])
+{
+    joint_totals t = joint_totals_load(sums);
+    int live = joint_alone_forces(m, j, &t, fa);
+    joint_totals_store(&t, sums);
+    return live;
 }
 
 /* Joints j and j + 1, both undamaged, side by side: each lane surely
@@ -280,10 +290,11 @@ JOINT_TET_INLINE void joint_pair_undamaged(fdem_model *m, int j, joint_totals *t
             t->stored += e[lane];
             continue;
         }
-        double dl[3][3], Nl[3];
+        double dl[3][3], Nl[3], f[9];
         for (int q = 0; q < 9; q++) dl[q / 3][q % 3] = d[q / 3][q % 3][lane];
         for (int c = 0; c < 3; c++) Nl[c] = N[c][lane];
-        joint_through_kernel(m, j + lane, dl, Nl, N_len[lane], t);
+        if (joint_through_kernel(m, j + lane, dl, Nl, N_len[lane], t, f))
+            joint_tet_scatter(m->force, lane ? n1 : n0, f);
     }
 }
 
@@ -324,7 +335,7 @@ __attribute__((target("avx2"))) static int joint_quad_elastic(fdem_model *m, int
 }
 #endif
 
-/* The 3D counterpart of joint.c's joint_forces_range, with the same sums.
+/* The 3D counterpart of joint.c's joint_forces_range_2d, with the same sums.
  * Undamaged joints surely inside their strengths take joint_tet.h's inline
  * path, four (quads, in the AVX2 loop) or two at a time where they are
  * undamaged: the same bits as joint_tet_forces, without the call, the law
@@ -334,7 +345,7 @@ JOINT_TET_INLINE void joint_forces_loop(fdem_model *m, int begin, int end,
                                         double sums[SCATTER_SUMS], const int quads)
 {
     const double *damage = m->joint_damage;
-    joint_totals t = {0, 0, 0, 0, 0};
+    joint_totals t = joint_totals_load(sums);
     int j = begin;
     for (; j + 1 < end; j += 2) {
         if (j + JOINT_PREFETCH_AHEAD + 1 < end) {
@@ -360,11 +371,7 @@ JOINT_TET_INLINE void joint_forces_loop(fdem_model *m, int begin, int end,
         }
     }
     if (j < end) joint_alone(m, j, &t);
-    sums[0] += t.broke;
-    sums[1] += t.stored;
-    sums[2] += t.dissipated;
-    sums[3] += t.handed;
-    sums[4] += t.friction;
+    joint_totals_store(&t, sums);
 }
 
 /* The loop is compiled twice, for the baseline x86-64 (pairs) and for AVX2

@@ -88,7 +88,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
-    scatter_plan_free(&m->joint_plan);
+    joint_sweep_free(&m->joint_sweep);
     scatter_plan_free(&m->node_plan);
     free(m);
 }
@@ -588,11 +588,7 @@ static int build_scatter_plans(fdem_model *m)
                            scatter_block_size(m->elem_count, SCATTER_BLOCK_ELEMENTS), first,
                            stride, m->elem_nodes, m->node_count))
         return -1;
-    if (m->joint_count &&
-        scatter_plan_build(&m->joint_plan, m->joint_count,
-                           scatter_block_size(m->joint_count, SCATTER_BLOCK_JOINTS),
-                           m->joint_node, 2 * m->dim, 2 * m->dim, m->node_count))
-        return -1;
+    if (joint_sweep_init(&m->joint_sweep, m->joint_count)) return -1;
     return scatter_plan_build_disjoint(&m->node_plan, m->node_count,
                                        scatter_block_size(m->node_count, SCATTER_BLOCK_NODES));
 }
@@ -769,11 +765,12 @@ static size_t memory_node(const memory_figures *f, int contact, int joints)
 }
 
 /* hot record, elem_node, elem_part, elem_h, elem_viscous and elem_stress0
- * (stress_comps each); with joints elem_joint (a slot per face) */
+ * (stress_comps each); with joints elem_joint (a slot per face) and the
+ * byte the joint sweep's cut needs while it finds each element's owner */
 static size_t memory_element(const memory_figures *f, int joints)
 {
     return f->hot + (f->elem_nodes + 1) * sizeof(int32_t) + sizeof(double) +
-           2 * f->stress_comps * sizeof(double) + (joints ? (f->D + 1) * sizeof(int32_t) : 0);
+           2 * f->stress_comps * sizeof(double) + (joints ? (f->D + 1) * sizeof(int32_t) + 1 : 0);
 }
 
 /* Detection arrays (centre and radius, box, elem_gap; body, piece, active,
@@ -793,13 +790,16 @@ static size_t memory_contact_element(const memory_figures *f)
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;
  * joint_strength_of, a strength record of its own (varied strengths), its
- * fracture event (in a list that grows by doubling), and the raw NBS
- * list's pairs of joined elements (two element ids each) */
+ * fracture event (in a list that grows by doubling), the raw NBS list's
+ * pairs of joined elements (two element ids each), and on several threads
+ * the joint sweep's slots, at most one per 8 joints (a face's forces, its
+ * joint and face, a flag; its joint's id and two slot ids) */
 static size_t memory_joint(const memory_figures *f)
 {
+    size_t slot = JOINT_FACE_VALUES * sizeof(double) + 4 * sizeof(int32_t) + 1;
     return (2 * f->D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 + sizeof(int32_t) +
            sizeof(joint_strength) + 2 * sizeof(fdem_event) +
-           (size_t)(f->joined_pairs * 2 * sizeof(int32_t));
+           (size_t)(f->joined_pairs * 2 * sizeof(int32_t)) + (slot + 7) / 8;
 }
 
 /* The model record, parts, materials and constraints (a few KB), the event
@@ -907,7 +907,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
          (size_t)m->material_capacity * sizeof(material);
     /* boundary facets of pressures and dashpots: nodes, element, forces */
     b += (size_t)m->bfacet_count * ((D + 1) * sizeof(int32_t) + D * D * sizeof(double));
-    b += scatter_plan_bytes(&m->elem_plan) + scatter_plan_bytes(&m->joint_plan) +
+    b += scatter_plan_bytes(&m->elem_plan) + joint_sweep_bytes(&m->joint_sweep) +
          scatter_plan_bytes(&m->node_plan);
     b += contact_memory_bytes(&m->contact);
     return b;

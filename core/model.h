@@ -97,7 +97,7 @@ typedef struct constraint {
 #define SCATTER_SUMS 7
 #define SCATTER_MAX 5 /* sums[SCATTER_MAX] and on are maxima, not sums */
 
-/* Blocks of consecutive items (elements, joints, nodes) grouped by colour:
+/* Blocks of consecutive items (elements, nodes) grouped by colour:
  * blocks of one colour share no node, so threads may run them side by side
  * and add into node arrays without races (scatter_plan.c). */
 typedef struct scatter_plan {
@@ -107,6 +107,55 @@ typedef struct scatter_plan {
     int32_t *block_order;    /* block indices, colour by colour */
     double *block_sum;       /* SCATTER_SUMS partials per block, totalled in block order */
 } scatter_plan;
+
+/* The joint loop's plan (joint_sweep.c). Every node's joint forces are
+ * added in joint order on any thread count: one thread walks the joints in
+ * order; T threads walk T contiguous ranges of them side by side, each
+ * adding only into the elements it owns (those whose first joint is its
+ * own) and setting aside the forces on the faces of elements an earlier
+ * range owns (slots), which their owners add after a barrier. The energy
+ * sums are formed per fixed block of joints, in joint order, and totalled
+ * in block order, as scatter_plan_run does. */
+typedef struct joint_sweep {
+    int threads;          /* the thread count the ranges were cut for; 0: none yet */
+    int block_size, block_count;
+    double *block_sum;    /* SCATTER_SUMS per block */
+    int ranges;           /* 1: the whole loop on one thread */
+    int32_t *range_block; /* ranges + 1: each range's first block */
+    int32_t *cross_begin; /* ranges + 1 offsets into cross_joint */
+    int32_t *cross_joint; /* per range, in joint order: its joints with a slot */
+    int32_t *cross_slot;  /* 2 per cross joint: the slot of face A's and B's forces, or -1 */
+    int32_t *slot_begin;  /* ranges + 1: slots by the range owning their face */
+    int32_t *slot_face;   /* per slot: 2 joint + face (0 A, 1 B); joint order within a range */
+    double *slot_force;   /* JOINT_FACE_VALUES per slot */
+    uint8_t *slot_live;   /* the joint held in this step: its forces are to be added */
+} joint_sweep;
+
+/* What a joint adds to one face's nodes: dim nodes of dim components. */
+#define JOINT_FACE_VALUES 9
+
+/* A joint loop's running sums, sums[0 .. 4] of its block: joints that
+ * broke, energy stored, dissipated by damage, handed to contact by joints
+ * that broke shut, and frictional work. A loop starts from what its block
+ * holds and writes back what it reached (joint_sweep.c needs that). */
+typedef struct joint_totals {
+    int broke;
+    double stored, dissipated, handed, friction;
+} joint_totals;
+
+static inline joint_totals joint_totals_load(const double sums[SCATTER_SUMS])
+{
+    return (joint_totals){(int)sums[0], sums[1], sums[2], sums[3], sums[4]};
+}
+
+static inline void joint_totals_store(const joint_totals *t, double sums[SCATTER_SUMS])
+{
+    sums[0] = t->broke;
+    sums[1] = t->stored;
+    sums[2] = t->dissipated;
+    sums[3] = t->handed;
+    sums[4] = t->friction;
+}
 
 /* Stick-spring history of one pair of elements lo < hi (contact_history.c):
  * the tangential springs of lo's contactor boundaries against hi, then of
@@ -297,7 +346,8 @@ struct fdem_model {
     /* threads for the per-step loops; the plans fix the summation order so
      * that the result does not depend on the thread count */
     int threads;
-    scatter_plan elem_plan, joint_plan, node_plan;
+    scatter_plan elem_plan, node_plan;
+    joint_sweep joint_sweep;
 };
 
 double stage_clock(void);
@@ -433,6 +483,9 @@ int joint_fan_holds(const fdem_model *m, int a, int b);
 int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int b);
 int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
+void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+int joint_forces_one_2d(fdem_model *m, int j, double sums[SCATTER_SUMS],
+                        double fa[JOINT_FACE_VALUES]);
 int joint_fragment_count(const fdem_model *m);
 /* events.c: the fracture events of the joints that broke in this step's
  * joint loop (joint_broke), appended in joint order; -1 without memory */
@@ -451,6 +504,8 @@ int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int t
                         fdem_error *err);
 double joint_stable_dt_3d(const fdem_model *m);
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+int joint_forces_one_3d(fdem_model *m, int j, double sums[SCATTER_SUMS],
+                        double fa[JOINT_FACE_VALUES]);
 
 /* scatter_plan.c: fn runs items [begin, end) of one block and may add into
  * node arrays. It starts from sums zeroed and leaves its block's partial
@@ -474,6 +529,27 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
 void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_block_fn fn,
                       double totals[SCATTER_SUMS]);
 void scatter_plan_free(scatter_plan *plan);
+/* One block's partial results into the totals, as the comment on
+ * scatter_block_fn says. */
+static inline void scatter_sums_add(double totals[SCATTER_SUMS], const double sum[SCATTER_SUMS])
+{
+    for (int i = 0; i < SCATTER_MAX; i++) totals[i] += sum[i];
+    for (int i = SCATTER_MAX; i < SCATTER_SUMS; i++)
+        if (sum[i] > totals[i]) totals[i] = sum[i];
+}
+
+/* joint_sweep.c. A joint loop (range_fn) continues the running sums it is
+ * handed, so that a block walked in several pieces sums as if in one;
+ * one_fn computes joint j alike but hands back face A's share fa (face A
+ * gets +fa, face B -fa) instead of adding it, returning 0 when nothing is
+ * to be added (the joint is broken or degenerate). */
+typedef int (*joint_one_fn)(fdem_model *m, int j, double sums[SCATTER_SUMS],
+                            double fa[JOINT_FACE_VALUES]);
+int joint_sweep_init(joint_sweep *s, int joint_count);
+void joint_sweep_free(joint_sweep *s);
+void joint_sweep_run(fdem_model *m, scatter_block_fn range_fn, joint_one_fn one_fn,
+                     double totals[SCATTER_SUMS]);
+size_t joint_sweep_bytes(const joint_sweep *s);
 
 /* boundary_load.c: pressures and absorbing dashpots on boundary facets */
 int boundary_load_select(fdem_model *m, fdem_error *err);

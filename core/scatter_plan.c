@@ -1,8 +1,9 @@
 /*
  * scatter_plan.c - lets several threads run a loop that adds into node
- * arrays (element forces, joint forces) with no locks and no atomics.
+ * arrays (element forces) with no locks and no atomics. (The joint loop
+ * has a plan of its own, joint_sweep.c, that keeps joint order.)
  *
- * Items (elements, joints) are cut into blocks of consecutive items. Blocks
+ * Items (elements, nodes) are cut into blocks of consecutive items. Blocks
  * that share no node get the same colour, greedily in block order, using a
  * 64-bit mask per node of the colours already touching it. A step then runs
  * the colours one after another and the blocks of one colour side by side:
@@ -128,14 +129,6 @@ int scatter_plan_build_disjoint(scatter_plan *plan, int item_count, int block_si
     return 0;
 }
 
-/* One block's partial results into the totals (SCATTER_SUMS in model.h). */
-static inline void scatter_add_sums(double totals[SCATTER_SUMS], const double sum[SCATTER_SUMS])
-{
-    for (int i = 0; i < SCATTER_MAX; i++) totals[i] += sum[i];
-    for (int i = SCATTER_MAX; i < SCATTER_SUMS; i++)
-        if (sum[i] > totals[i]) totals[i] = sum[i];
-}
-
 /* Runs block k of the colour-ordered list, leaving its partial sums in
  * block_sum. */
 static inline void scatter_run_block(scatter_plan *plan, fdem_model *m, scatter_block_fn fn,
@@ -155,7 +148,7 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
     if (plan->color_count == 0) { /* unplanned: every item, in order, on this thread */
         double sum[SCATTER_SUMS] = {0};
         if (plan->item_count > 0) fn(m, 0, plan->item_count, sum);
-        scatter_add_sums(totals, sum);
+        scatter_sums_add(totals, sum);
         return;
     }
     if (threads > 1 && plan->block_count > 1) {
@@ -169,6 +162,6 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
         for (int k = 0; k < plan->block_count; k++) scatter_run_block(plan, m, fn, k);
     }
     for (int b = 0; b < plan->block_count; b++) { /* block order: the same bits for any T */
-        scatter_add_sums(totals, &plan->block_sum[SCATTER_SUMS * (size_t)b]);
+        scatter_sums_add(totals, &plan->block_sum[SCATTER_SUMS * (size_t)b]);
     }
 }

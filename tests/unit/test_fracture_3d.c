@@ -180,8 +180,8 @@ static void joint_loop_gives_the_bits_of_the_kernel(void)
     size_t bytes = sizeof(double) * 3 * (size_t)fast->node_count;
     memset(fast->force, 0, bytes);
     memset(reference->force, 0, bytes);
-    scatter_plan_run(&fast->joint_plan, fast, 1, joint_forces_range_3d, sums_fast);
-    scatter_plan_run(&reference->joint_plan, reference, 1, reference_joint_range, sums_reference);
+    joint_forces_range_3d(fast, 0, fast->joint_count, sums_fast);
+    reference_joint_range(reference, 0, reference->joint_count, sums_reference);
     int intact = 0, damaged = 0, broken = 0;
     for (int j = 0; j < fast->joint_count; j++) {
         double D = fast->joint_damage[j];
@@ -458,9 +458,9 @@ static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
     fdem_model *one = impact_model(1), *two = impact_model(2);
     CHECK(fdem_get_threads(two) == 2, "threads %d", fdem_get_threads(two));
     /* a fracturing part's tetrahedra share no node: one colour, several blocks */
-    CHECK(one->elem_plan.block_count >= 2 && one->joint_plan.color_count >= 2,
-          "the test needs planned loops: %d element blocks, %d joint colours",
-          one->elem_plan.block_count, one->joint_plan.color_count);
+    CHECK(one->elem_plan.block_count >= 2 && one->joint_sweep.block_count >= 2,
+          "the test needs planned loops: %d element blocks, %d joint blocks",
+          one->elem_plan.block_count, one->joint_sweep.block_count);
     fdem_error err;
     int steps = 0, after = 0;
     while (after < 100 && steps < 20000) {
@@ -481,10 +481,15 @@ static void fracturing_impact_on_two_threads_gives_the_bits_of_one(void)
     fdem_energy e1 = fdem_get_energy(one), e2 = fdem_get_energy(two);
     CHECK(memcmp(&e1, &e2, sizeof e1) == 0, "energies differ: kinetic %.17g vs %.17g",
           e1.kinetic, e2.kinetic);
+    /* two ranges of joints, and faces set aside for the other range's owner */
+    const joint_sweep *s2 = &two->joint_sweep;
+    CHECK(s2->ranges == 2 && s2->slot_begin[2] > 0, "joint ranges %d with %d slots", s2->ranges,
+          s2->slot_begin[s2->ranges]);
     fprintf(stderr, "  %d steps, %d tetrahedra, %d joints (%d broken), %d touching, %d element "
-            "blocks and %d joint colours, fracture %.3g J, friction %.3g J\n",
+            "blocks, %d joint ranges with %d slots, fracture %.3g J, friction %.3g J\n",
             steps, c1.elements, c1.joints, c1.broken_joints, c1.contacts,
-            one->elem_plan.block_count, one->joint_plan.color_count, e1.fracture, e1.friction);
+            one->elem_plan.block_count, s2->ranges, s2->slot_begin[s2->ranges], e1.fracture,
+            e1.friction);
     fdem_model_destroy(one);
     fdem_model_destroy(two);
 }

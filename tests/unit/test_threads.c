@@ -113,10 +113,10 @@ static void impact_on_one_and_two_threads(int fracture)
     fdem_model *one = impact_model(1, fracture), *two = impact_model(2, fracture);
     CHECK(fdem_get_threads(two) == 2, "threads %d", fdem_get_threads(two));
     /* private nodes: a fracturing part's element blocks share no node */
-    CHECK(fracture ? one->elem_plan.color_count >= 1 && one->joint_plan.color_count >= 2
+    CHECK(fracture ? one->elem_plan.color_count >= 1 && one->joint_sweep.block_count >= 2
                    : one->elem_plan.color_count >= 2,
-          "the test needs planned loops with colours: %d element, %d joint colours",
-          one->elem_plan.color_count, one->joint_plan.color_count);
+          "the test needs planned loops: %d element colours, %d joint blocks",
+          one->elem_plan.color_count, one->joint_sweep.block_count);
     fdem_error err;
     int steps = 0, touched = 0;
     while (steps < 600 || !touched || (fracture && fdem_get_counts(one).broken_joints == 0)) {
@@ -135,9 +135,13 @@ static void impact_on_one_and_two_threads(int fracture)
     fdem_energy e1 = fdem_get_energy(one), e2 = fdem_get_energy(two);
     CHECK(memcmp(&e1, &e2, sizeof e1) == 0, "energies differ: kinetic %.17g vs %.17g",
           e1.kinetic, e2.kinetic);
-    fprintf(stderr, "  %d steps, %d elements, %d joints (%d broken), %d element and %d joint colours\n",
-            steps, c1.elements, c1.joints, c1.broken_joints, one->elem_plan.color_count,
-            one->joint_plan.color_count);
+    const joint_sweep *s2 = &two->joint_sweep;
+    int slots = s2->slot_begin ? s2->slot_begin[s2->ranges] : 0;
+    CHECK(!fracture || (s2->ranges == 2 && slots > 0), "joint ranges %d with %d slots",
+          s2->ranges, slots);
+    fprintf(stderr, "  %d steps, %d elements, %d joints (%d broken), %d element colours, %d joint "
+            "ranges with %d slots\n", steps, c1.elements, c1.joints, c1.broken_joints,
+            one->elem_plan.color_count, s2->ranges, slots);
     fdem_model_destroy(one);
     fdem_model_destroy(two);
 }
