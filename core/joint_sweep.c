@@ -230,7 +230,9 @@ static void sweep_cross_joint(fdem_model *m, joint_sweep *s, size_t c, joint_one
                               double sums[SCATTER_SUMS])
 {
     double fa[JOINT_FACE_VALUES];
-    int j = s->cross_joint[c], live = one_fn(m, j, sums, fa);
+    joint_totals t = joint_totals_load(sums);
+    int j = s->cross_joint[c], live = one_fn(m, j, &t, fa);
+    joint_totals_store(&t, sums);
     for (int face = 0; face < 2; face++) {
         int slot = s->cross_slot[2 * c + face];
         if (slot >= 0) {

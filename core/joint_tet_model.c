@@ -230,8 +230,8 @@ static int joint_through_kernel(fdem_model *m, int j, const double d[3][3], cons
 
 /* Joint j alone: the inline path when it is undamaged and surely elastic,
  * else the kernel; its face A forces in fa, 0 when it adds nothing
- * (broken). */
-static int joint_alone_forces(fdem_model *m, int j, joint_totals *t, double fa[9])
+ * (broken). The joint sweep's joint_one_fn. */
+int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES])
 {
     double damage = m->joint_damage[j];
     if (damage >= 1.0) return 0;
@@ -250,17 +250,7 @@ static int joint_alone_forces(fdem_model *m, int j, joint_totals *t, double fa[9
 static void joint_alone(fdem_model *m, int j, joint_totals *t)
 {
     double fa[9];
-    if (joint_alone_forces(m, j, t, fa)) joint_tet_scatter(m->force, m->joint_node + 6 * (size_t)j, fa);
-}
-
-/* Joint j alone, its face A forces handed back (joint_one_fn). */
-int joint_forces_one_3d(fdem_model *m, int j, double sums[SCATTER_SUMS],
-                        double fa[JOINT_FACE_VALUES])
-{
-    joint_totals t = joint_totals_load(sums);
-    int live = joint_alone_forces(m, j, &t, fa);
-    joint_totals_store(&t, sums);
-    return live;
+    if (joint_forces_one_3d(m, j, t, fa)) joint_tet_scatter(m->force, m->joint_node + 6 * (size_t)j, fa);
 }
 
 /* Joints j and j + 1, both undamaged, side by side: each lane surely

@@ -484,8 +484,7 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
 int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
-int joint_forces_one_2d(fdem_model *m, int j, double sums[SCATTER_SUMS],
-                        double fa[JOINT_FACE_VALUES]);
+int joint_forces_one_2d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES]);
 int joint_fragment_count(const fdem_model *m);
 /* events.c: the fracture events of the joints that broke in this step's
  * joint loop (joint_broke), appended in joint order; -1 without memory */
@@ -504,8 +503,7 @@ int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int t
                         fdem_error *err);
 double joint_stable_dt_3d(const fdem_model *m);
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
-int joint_forces_one_3d(fdem_model *m, int j, double sums[SCATTER_SUMS],
-                        double fa[JOINT_FACE_VALUES]);
+int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES]);
 
 /* scatter_plan.c: fn runs items [begin, end) of one block and may add into
  * node arrays. It starts from sums zeroed and leaves its block's partial
@@ -540,10 +538,11 @@ static inline void scatter_sums_add(double totals[SCATTER_SUMS], const double su
 
 /* joint_sweep.c. A joint loop (range_fn) continues the running sums it is
  * handed, so that a block walked in several pieces sums as if in one;
- * one_fn computes joint j alike but hands back face A's share fa (face A
- * gets +fa, face B -fa) instead of adding it, returning 0 when nothing is
- * to be added (the joint is broken or degenerate). */
-typedef int (*joint_one_fn)(fdem_model *m, int j, double sums[SCATTER_SUMS],
+ * one_fn computes joint j alike, continuing the running sums t, but hands
+ * back face A's share fa (face A gets +fa, face B -fa) instead of adding
+ * it, returning 0 when nothing is to be added (the joint is broken or
+ * degenerate). */
+typedef int (*joint_one_fn)(fdem_model *m, int j, joint_totals *t,
                             double fa[JOINT_FACE_VALUES]);
 int joint_sweep_init(joint_sweep *s, int joint_count);
 void joint_sweep_free(joint_sweep *s);
