@@ -399,33 +399,49 @@ static void bench_fracturing_block(const fracture_kind *k, double bandwidth_gbs)
                goal);
 }
 
-/* ns per element-step on `threads` threads: the best of three runs of
- * `steps` steps (a shared machine's neighbours only ever slow a run). */
-static double time_steps(fdem_model *m, int threads, int steps)
+/* One model on 1 thread and its twin (built and stepped alike) on `cores`:
+ * ns per element-step, the best of three runs each, the runs interleaved so
+ * that both go through the same states (their results are bit-identical).
+ * Timing one model on 1 thread and then on `cores` would measure the second
+ * later in its run: a pile still settling costs more per step as its
+ * contacts grow, which read as a 1.38x speed-up where the same states give
+ * 1.6x. Destroys both. */
+static void thread_row(const char *name, fdem_model *one, fdem_model *many, int colours,
+                       int cores, double work)
 {
+    int steps = (int)(work / one->elem_count);
+    if (steps < 10) steps = 10;
     fdem_error err;
-    fdem_set_threads(m, threads);
-    for (int s = 0; s < 3; s++) fdem_step(m, &err);
-    double best = INFINITY;
+    fdem_set_threads(one, 1);
+    fdem_set_threads(many, cores);
+    for (int s = 0; s < 3; s++) {
+        fdem_step(one, &err);
+        fdem_step(many, &err);
+    }
+    double best_one = INFINITY, best_many = INFINITY;
     for (int rep = 0; rep < 3; rep++) {
         double t0 = now();
-        for (int s = 0; s < steps; s++) fdem_step(m, &err);
-        best = fmin(best, now() - t0);
+        for (int s = 0; s < steps; s++) fdem_step(one, &err);
+        double t1 = now();
+        for (int s = 0; s < steps; s++) fdem_step(many, &err);
+        best_one = fmin(best_one, t1 - t0);
+        best_many = fmin(best_many, now() - t1);
     }
-    return best * 1e9 / ((double)steps * m->elem_count);
+    double scale = 1e9 / ((double)steps * one->elem_count);
+    printf("%-28s %10d %8d %12.1f %12.1f %9.2f\n", name, one->elem_count, colours,
+           best_one * scale, best_many * scale, best_one / best_many);
+    fdem_model_destroy(one);
+    fdem_model_destroy(many);
 }
 
-static void thread_row(const char *name, fdem_model *m, int colours, int cores, double work)
+/* Steps a model `steps` steps (into contact) and returns it. */
+static fdem_model *stepped(fdem_model *m, int steps)
 {
-    int steps = (int)(work / m->elem_count);
-    if (steps < 10) steps = 10;
-    double one = time_steps(m, 1, steps), many = time_steps(m, cores, steps);
-    printf("%-28s %10d %8d %12.1f %12.1f %9.2f\n", name, m->elem_count, colours, one, many,
-           one / many);
+    fdem_error err;
+    for (int s = 0; s < steps; s++) fdem_step(m, &err);
+    return m;
 }
 
-/* The 2D rows (blocks, then disc piles) and/or the 3D ones (elastic block, fracturing
- * block, sphere pile). */
 static void bench_threads(int rows_2d, int rows_3d)
 {
     int cores = (int)sysconf(_SC_NPROCESSORS_ONLN);
@@ -435,34 +451,30 @@ static void bench_threads(int rows_2d, int rows_3d)
            "threads ns", "speed-up");
     for (int fracture = 0; fracture < 2 && rows_2d; fracture++)
         for (int k = 0; k < 2; k++) {
-            fdem_model *m = vibrating_block(&FRACTURE_2D, k ? 707 : 224, fracture);
-            thread_row(fracture ? "fracturing block (joints)" : "elastic block (shared nodes)", m,
-                       m->elem_plan.color_count, cores, 1e7);
-            fdem_model_destroy(m);
+            fdem_model *one = vibrating_block(&FRACTURE_2D, k ? 707 : 224, fracture);
+            fdem_model *many = vibrating_block(&FRACTURE_2D, k ? 707 : 224, fracture);
+            thread_row(fracture ? "fracturing block (joints)" : "elastic block (shared nodes)", one,
+                       many, one->elem_plan.color_count, cores, 1e7);
         }
     int dims[][2] = {{20, 20}, {60, 60}};
-    for (int k = 0; k < 2 && rows_2d; k++) {
-        fdem_model *m = build_disc_pile(dims[k][0], dims[k][1]);
-        fdem_error err;
-        for (int s = 0; s < 300; s++) fdem_step(m, &err); /* into contact, as above */
-        thread_row("disc pile (contact)", m, m->elem_plan.color_count, cores, 5e6);
-        fdem_model_destroy(m);
+    for (int k = 0; k < 2 && rows_2d; k++) { /* into contact, as above */
+        fdem_model *one = stepped(build_disc_pile(dims[k][0], dims[k][1]), 300);
+        fdem_model *many = stepped(build_disc_pile(dims[k][0], dims[k][1]), 300);
+        thread_row("disc pile (contact)", one, many, one->elem_plan.color_count, cores, 5e6);
     }
     long sizes_3d[] = {100000, 1000000};
     for (int k = 0; k < 2 && rows_3d; k++) {
-        fdem_model *m = elastic_block(&BLOCK_3D, sizes_3d[k]);
-        thread_row("elastic block 3D (tets)", m, m->elem_plan.color_count, cores, 1e7);
-        fdem_model_destroy(m);
+        fdem_model *one = elastic_block(&BLOCK_3D, sizes_3d[k]);
+        fdem_model *many = elastic_block(&BLOCK_3D, sizes_3d[k]);
+        thread_row("elastic block 3D (tets)", one, many, one->elem_plan.color_count, cores, 1e7);
     }
     if (!rows_3d) return;
-    fdem_model *block = vibrating_block(&FRACTURE_3D, FRACTURE_3D.sizes[1], 1);
-    thread_row("fracturing block 3D (joints)", block, block->elem_plan.color_count, cores, 1e7);
-    fdem_model_destroy(block);
-    fdem_model *pile = sphere_pile(6, 6, 4);
-    fdem_error err;
-    for (int s = 0; s < 400; s++) fdem_step(pile, &err); /* into contact, as above */
-    thread_row("sphere pile 3D (contact)", pile, pile->elem_plan.color_count, cores, 5e6);
-    fdem_model_destroy(pile);
+    fdem_model *one = vibrating_block(&FRACTURE_3D, FRACTURE_3D.sizes[1], 1);
+    fdem_model *many = vibrating_block(&FRACTURE_3D, FRACTURE_3D.sizes[1], 1);
+    thread_row("fracturing block 3D (joints)", one, many, one->elem_plan.color_count, cores, 1e7);
+    one = stepped(sphere_pile(6, 6, 4), 400); /* into contact, as above */
+    many = stepped(sphere_pile(6, 6, 4), 400);
+    thread_row("sphere pile 3D (contact)", one, many, one->elem_plan.color_count, cores, 5e6);
 }
 
 /* With no argument every section runs; otherwise only those named
