@@ -103,6 +103,26 @@ static double block_bytes_moved(const block_kind *k, const fdem_model *m)
     return k->record_bytes + (double)m->node_count / m->elem_count * (8 * D * (1 + 2 + 4) + 9);
 }
 
+/* Wall and CPU ns per element-step of the best of three runs of `steps`
+ * steps: a shared machine's neighbours only ever slow a run. */
+typedef struct step_time {
+    double wall, cpu;
+} step_time;
+
+static step_time best_of_three(fdem_model *m, int steps)
+{
+    fdem_error err;
+    double best = INFINITY, best_cpu = INFINITY;
+    for (int rep = 0; rep < 3; rep++) {
+        double t0 = now(), c0 = thread_cpu();
+        for (int s = 0; s < steps; s++) fdem_step(m, &err);
+        best_cpu = fmin(best_cpu, thread_cpu() - c0);
+        best = fmin(best, now() - t0);
+    }
+    double scale = 1e9 / ((double)steps * m->elem_count);
+    return (step_time){best * scale, best_cpu * scale};
+}
+
 static void bench_elastic_block(const block_kind *k, double bandwidth_gbs)
 {
     printf("\n## %s\n", k->title);
@@ -116,15 +136,8 @@ static void bench_elastic_block(const block_kind *k, double bandwidth_gbs)
         if (steps < 20) steps = 20;
         fdem_error err;
         for (int w = 0; w < 3; w++) fdem_step(m, &err); /* warm up caches and pages */
-        /* best of three runs: a shared machine's neighbours only slow a run */
-        double best = INFINITY, best_cpu = INFINITY;
-        for (int rep = 0; rep < 3; rep++) {
-            double t0 = now(), c0 = thread_cpu();
-            for (int i = 0; i < steps; i++) fdem_step(m, &err);
-            best_cpu = fmin(best_cpu, thread_cpu() - c0);
-            best = fmin(best, now() - t0);
-        }
-        double ns = best * 1e9 / ((double)steps * E), cpu = best_cpu * 1e9 / ((double)steps * E);
+        step_time t = best_of_three(m, steps);
+        double ns = t.wall, cpu = t.cpu;
         double bytes = block_bytes_moved(k, m), bound = bytes / bandwidth_gbs;
         printf("%10d %8d %14.1f %10.1f %12.0f %14.0f %14.1f %10.2f\n", E, steps, ns, cpu,
                (double)fdem_memory_bytes(m) / E, bytes, bound, ns / bound);
@@ -230,14 +243,7 @@ static double elastic_block_3d_cpu(int E)
     fdem_error err;
     fdem_model *block = elastic_block(&BLOCK_3D, E);
     for (int s = 0; s < 3; s++) fdem_step(block, &err);
-    int block_steps = (int)(1e7 / block->elem_count) + 20;
-    double block_cpu = INFINITY;
-    for (int rep = 0; rep < 3; rep++) {
-        double c0 = thread_cpu();
-        for (int s = 0; s < block_steps; s++) fdem_step(block, &err);
-        block_cpu = fmin(block_cpu, thread_cpu() - c0);
-    }
-    double elastic = block_cpu * 1e9 / ((double)block_steps * block->elem_count);
+    double elastic = best_of_three(block, (int)(1e7 / block->elem_count) + 20).cpu;
     fdem_model_destroy(block);
     return elastic;
 }
@@ -260,18 +266,11 @@ static void bench_sphere_pile(void)
         int steps = (int)(2e6 / E);
         if (steps < 20) steps = 20;
         fdem_stage_times before = fdem_get_stage_times(m);
-        double best = INFINITY, best_cpu = INFINITY;
-        for (int rep = 0; rep < 3; rep++) {
-            double t0 = now(), c0 = thread_cpu();
-            for (int s = 0; s < steps; s++) fdem_step(m, &err);
-            best_cpu = fmin(best_cpu, thread_cpu() - c0);
-            best = fmin(best, now() - t0);
-        }
+        step_time t = best_of_three(m, steps);
         fdem_stage_times after = fdem_get_stage_times(m);
         double fe = after.elements - before.elements, de = after.detection - before.detection;
         double co = after.contact - before.contact, in = after.integration - before.integration;
-        double sum = fe + de + co + in, ns = best * 1e9 / ((double)steps * E);
-        double cpu = best_cpu * 1e9 / ((double)steps * E);
+        double sum = fe + de + co + in, ns = t.wall, cpu = t.cpu;
         fdem_counts c = fdem_get_counts(m);
 
         double elastic = elastic_block_3d_cpu(E);
@@ -351,18 +350,11 @@ static void bench_fracturing_block(const fracture_kind *k, double bandwidth_gbs)
             if (fracture) before = fdem_get_stage_times(m);
             steps = (int)(2e7 / m->elem_count);
             if (steps < 10) steps = 10;
-            /* best of three runs, as the other tables: a shared machine's
-             * neighbours only slow a run (one run of the 1e5 block read
-             * 65 to 74 ns within minutes) */
-            double best = INFINITY, best_cpu = INFINITY;
-            for (int rep = 0; rep < 3; rep++) {
-                double t0 = now(), c0 = thread_cpu();
-                for (int w = 0; w < steps; w++) fdem_step(m, &err);
-                best_cpu = fmin(best_cpu, thread_cpu() - c0);
-                best = fmin(best, now() - t0);
-            }
-            ns[fracture] = best * 1e9 / ((double)steps * m->elem_count);
-            cpu[fracture] = best_cpu * 1e9 / ((double)steps * m->elem_count);
+            /* best of three, as the other tables (one run of the 1e5 block
+             * read 65 to 74 ns within minutes) */
+            step_time t = best_of_three(m, steps);
+            ns[fracture] = t.wall;
+            cpu[fracture] = t.cpu;
             if (fracture) keep = m;
             else fdem_model_destroy(m);
         }
