@@ -126,10 +126,37 @@ static void one_thread_walks_in_joint_order(int dim)
     fdem_model_destroy(plain);
 }
 
+/* The thread count changed between passes (a case resumed with another
+ * --threads): the sweep is cut again each time, and the forces stay those
+ * of one thread pass after pass. */
+static void changing_threads_between_passes_keeps_the_bits(int dim)
+{
+    fdem_model *one = shaken_block(dim), *varied = shaken_block(dim);
+    const int threads[] = {2, 1, 3, 2};
+    for (int pass = 0; pass < 4; pass++) {
+        fdem_set_threads(varied, threads[pass]);
+        double sums_one[SCATTER_SUMS] = {0}, sums[SCATTER_SUMS] = {0};
+        joint_pass(one, sums_one);
+        joint_pass(varied, sums);
+        CHECK(varied->joint_sweep.ranges == threads[pass], "%dD pass %d: %d ranges for %d threads",
+              dim, pass, varied->joint_sweep.ranges, threads[pass]);
+        size_t bytes = sizeof(double) * (size_t)dim * (size_t)one->node_count;
+        CHECK(memcmp(one->force, varied->force, bytes) == 0 &&
+                  memcmp(sums_one, sums, sizeof sums) == 0,
+              "%dD pass %d on %d threads: forces or sums differ", dim, pass, threads[pass]);
+    }
+    fdem_model_destroy(one);
+    fdem_model_destroy(varied);
+}
+
+static void changing_threads_keeps_the_bits_2d(void) { changing_threads_between_passes_keeps_the_bits(2); }
+static void changing_threads_keeps_the_bits_3d(void) { changing_threads_between_passes_keeps_the_bits(3); }
+
 static void threads_give_the_bits_of_one_2d(void) { threads_give_the_bits_of_one(2); }
 static void threads_give_the_bits_of_one_3d(void) { threads_give_the_bits_of_one(3); }
 static void one_thread_walks_in_joint_order_2d(void) { one_thread_walks_in_joint_order(2); }
 static void one_thread_walks_in_joint_order_3d(void) { one_thread_walks_in_joint_order(3); }
 
 CHECK_MAIN(T(threads_give_the_bits_of_one_2d), T(threads_give_the_bits_of_one_3d),
-           T(one_thread_walks_in_joint_order_2d), T(one_thread_walks_in_joint_order_3d))
+           T(one_thread_walks_in_joint_order_2d), T(one_thread_walks_in_joint_order_3d),
+           T(changing_threads_keeps_the_bits_2d), T(changing_threads_keeps_the_bits_3d))
