@@ -237,7 +237,9 @@ static void sweep_cross_joint(fdem_model *m, joint_sweep *s, size_t c, joint_one
         int slot = s->cross_slot[2 * c + face];
         if (slot >= 0) {
             s->slot_live[slot] = (uint8_t)live;
-            if (live) memcpy(s->slot_force + JOINT_FACE_VALUES * (size_t)slot, fa, sizeof fa);
+            if (live) /* dim x dim values: a 2D joint sets only the first four */
+                memcpy(s->slot_force + JOINT_FACE_VALUES * (size_t)slot, fa,
+                       sizeof(double) * (size_t)(m->dim * m->dim));
         } else if (live) {
             face_add(m, j, face, fa);
         }
