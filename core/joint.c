@@ -352,20 +352,6 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
     if (D >= 1) e->handed += squeezed; /* broken shut: its overlap goes on as contact */
 }
 
-/* Joint j's forces on face A (fa: a0 then a1; face B takes their
- * negatives), its damage and its share of the running sums t (joints that
- * broke, stored energy, what damage growth dissipated, the compression
- * energy of those that broke shut, the frictional work of their sliding in
- * the last step). Returns 0 when it adds nothing: broken before or now, or
- * its face is degenerate.
- *
- * Nearly every joint in nearly every step is undamaged and elastic at both
- * Gauss points. There the traction is k (delta n + s t) = k d: the penalty
- * acts on the whole relative displacement, whatever the face's direction,
- * and the two-point rule integrates the linear d exactly:
- *   f_a0 = L k (2 d0 + d1) / 6,   f_a1 = L k (d0 + 2 d1) / 6,
- * the same forces as the Gauss-point sum, without unit vectors, tractions or
- * the damage bookkeeping. Only the elastic test needs the projections. */
 typedef struct joint_view_2d {
     const double *x, *v;
     double h_last; /* x = x_before + h_last v: the last step */
@@ -407,6 +393,20 @@ static __attribute__((noinline)) double joint_softening_2d(const fdem_model *m,
     return damage;
 }
 
+/* Joint j's forces on face A (fa: a0 then a1; face B takes their
+ * negatives), its damage and its share of the running sums t (joints that
+ * broke, stored energy, what damage growth dissipated, the compression
+ * energy of those that broke shut, the frictional work of their sliding in
+ * the last step). Returns 0 when it adds nothing: broken before or now, or
+ * its face is degenerate.
+ *
+ * Nearly every joint in nearly every step is undamaged and elastic at both
+ * Gauss points. There the traction is k (delta n + s t) = k d: the penalty
+ * acts on the whole relative displacement, whatever the face's direction,
+ * and the two-point rule integrates the linear d exactly:
+ *   f_a0 = L k (2 d0 + d1) / 6,   f_a1 = L k (d0 + 2 d1) / 6,
+ * the same forces as the Gauss-point sum, without unit vectors, tractions or
+ * the damage bookkeeping. Only the elastic test needs the projections. */
 static inline __attribute__((always_inline)) int joint_evaluate_2d(fdem_model *m,
                                                                     const joint_view_2d *w, int j,
                                                                     joint_totals *t,

@@ -39,18 +39,44 @@
 
 #include "model.h"
 
-void joint_sweep_free(joint_sweep *s)
+/* Frees a cut's joint and slot lists. */
+static void sweep_drop_lists(joint_sweep *s)
 {
-    free(s->block_sum);
-    free(s->range_block);
-    free(s->cross_begin);
     free(s->cross_joint);
     free(s->cross_slot);
-    free(s->slot_begin);
     free(s->slot_face);
     free(s->slot_force);
     free(s->slot_live);
+    s->cross_joint = s->cross_slot = s->slot_face = NULL;
+    s->slot_force = NULL;
+    s->slot_live = NULL;
+}
+
+void joint_sweep_free(joint_sweep *s)
+{
+    sweep_drop_lists(s);
+    free(s->block_sum);
+    free(s->range_block);
+    free(s->cross_begin);
+    free(s->slot_begin);
     memset(s, 0, sizeof *s);
+}
+
+/* The serial walk: one range of every block, no slot (keeps the blocks). */
+static void sweep_serial(joint_sweep *s)
+{
+    sweep_drop_lists(s);
+    s->ranges = 1;
+    s->range_block[0] = 0;
+    s->range_block[1] = s->block_count;
+    s->cross_begin[0] = s->cross_begin[1] = 0;
+    s->slot_begin[0] = s->slot_begin[1] = 0;
+}
+
+/* Joint index where block b begins (b = block_count: the end). */
+static int block_first_joint(const joint_sweep *s, int joint_count, int b)
+{
+    return (long)b * s->block_size < joint_count ? b * s->block_size : joint_count;
 }
 
 /* The fixed blocks and the serial walk; 0, or -1 without memory. */
@@ -62,15 +88,13 @@ int joint_sweep_init(joint_sweep *s, int joint_count)
     s->block_count = (joint_count + s->block_size - 1) / s->block_size;
     s->block_sum = calloc(SCATTER_SUMS * (size_t)s->block_count, sizeof *s->block_sum);
     s->range_block = malloc(2 * sizeof *s->range_block);
-    s->cross_begin = calloc(2, sizeof *s->cross_begin);
-    s->slot_begin = calloc(2, sizeof *s->slot_begin);
+    s->cross_begin = malloc(2 * sizeof *s->cross_begin);
+    s->slot_begin = malloc(2 * sizeof *s->slot_begin);
     if (!s->block_sum || !s->range_block || !s->cross_begin || !s->slot_begin) {
         joint_sweep_free(s);
         return -1;
     }
-    s->ranges = 1;
-    s->range_block[0] = 0;
-    s->range_block[1] = s->block_count;
+    sweep_serial(s);
     return 0;
 }
 
@@ -81,24 +105,6 @@ size_t joint_sweep_bytes(const joint_sweep *s)
     return SCATTER_SUMS * (size_t)s->block_count * sizeof(double) +
            3 * ((size_t)s->ranges + 1) * sizeof(int32_t) + cross * 3 * sizeof(int32_t) +
            slots * (sizeof(int32_t) + JOINT_FACE_VALUES * sizeof(double) + 1);
-}
-
-/* Back to the serial walk (keeps the blocks). */
-static void sweep_serial(joint_sweep *s)
-{
-    free(s->cross_joint);
-    free(s->cross_slot);
-    free(s->slot_face);
-    free(s->slot_force);
-    free(s->slot_live);
-    s->cross_joint = s->cross_slot = s->slot_face = NULL;
-    s->slot_force = NULL;
-    s->slot_live = NULL;
-    s->ranges = 1;
-    s->range_block[0] = 0;
-    s->range_block[1] = s->block_count;
-    s->cross_begin[0] = s->cross_begin[1] = 0;
-    s->slot_begin[0] = s->slot_begin[1] = 0;
 }
 
 /* Whether every joint touches only nodes of its two elements, the premise
@@ -134,8 +140,8 @@ static int sweep_cut(const fdem_model *m, joint_sweep *s, int ranges, uint8_t *o
     memset(slot_count, 0, sizeof *slot_count * ((size_t)ranges + 1));
     long slots = 0;
     for (int r = 0; r < ranges; r++) {
-        int end = range_block[r + 1] * s->block_size < J ? range_block[r + 1] * s->block_size : J;
-        for (int j = range_block[r] * s->block_size; j < end; j++) {
+        int end = block_first_joint(s, J, range_block[r + 1]);
+        for (int j = block_first_joint(s, J, range_block[r]); j < end; j++) {
             int crossing = 0;
             for (int face = 0; face < 2; face++) {
                 int e = m->joint_elem[2 * j + face];
@@ -170,8 +176,8 @@ static int sweep_cut(const fdem_model *m, joint_sweep *s, int ranges, uint8_t *o
     memcpy(fill, slot_count, sizeof *fill * (size_t)ranges);
     size_t c = 0;
     for (int r = 0; r < ranges; r++) {
-        int end = range_block[r + 1] * s->block_size < J ? range_block[r + 1] * s->block_size : J;
-        for (int j = range_block[r] * s->block_size; j < end; j++) {
+        int end = block_first_joint(s, J, range_block[r + 1]);
+        for (int j = block_first_joint(s, J, range_block[r]); j < end; j++) {
             int slot[2] = {-1, -1};
             for (int face = 0; face < 2; face++) {
                 int e = m->joint_elem[2 * j + face];
@@ -256,7 +262,7 @@ static void sweep_range(fdem_model *m, joint_sweep *s, int r, scatter_block_fn r
     for (int b = s->range_block[r]; b < s->range_block[r + 1]; b++) {
         double *sum = s->block_sum + SCATTER_SUMS * (size_t)b;
         for (int i = 0; i < SCATTER_SUMS; i++) sum[i] = 0;
-        int j = b * s->block_size, end = J - j > s->block_size ? j + s->block_size : J;
+        int j = block_first_joint(s, J, b), end = block_first_joint(s, J, b + 1);
         while (j < end) {
             int stop = c < c_end && s->cross_joint[c] < end ? s->cross_joint[c] : end;
             if (stop > j) range_fn(m, j, stop, sum);

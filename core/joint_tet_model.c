@@ -250,7 +250,8 @@ int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_F
 static void joint_alone(fdem_model *m, int j, joint_totals *t)
 {
     double fa[9];
-    if (joint_forces_one_3d(m, j, t, fa)) joint_tet_scatter(m->force, m->joint_node + 6 * (size_t)j, fa);
+    if (joint_forces_one_3d(m, j, t, fa))
+        joint_tet_scatter(m->force, m->joint_node + 6 * (size_t)j, fa);
 }
 
 /* Joints j and j + 1, both undamaged, side by side: each lane surely
