@@ -7,10 +7,12 @@
 #ifndef FDEM_BUILD_MODEL_H
 #define FDEM_BUILD_MODEL_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "fdem.h"
+#include "mesh_3d.h"
 
 static inline void build_die(const char *what, const fdem_error *err)
 {
@@ -60,6 +62,32 @@ static inline int build_rectangle_part(fdem_model *m, int mat, double x, double 
     fdem_mesh_free(&mesh);
     if (p < 0) build_die("rectangle part", &err);
     return p;
+}
+
+/* A box part from the origin in the model's dimension: 2D size[0] x
+ * size[1] in div[0] x div[1] squares of two triangles, 3D size in div
+ * cubes of six tetrahedra; fracture != 0 puts a joint on every interior
+ * edge or face. */
+static inline int build_box_part(fdem_model *m, int mat, int dim, const double size[3],
+                                 const int div[3], int fracture)
+{
+    if (dim == 2) return build_rectangle_part(m, mat, 0, 0, size[0], size[1], div[0], div[1], fracture);
+    const double origin[3] = {0, 0, 0};
+    fdem_tet_mesh mesh = {0};
+    fdem_error err = {0};
+    if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box mesh", &err);
+    int p = fdem_add_part_3d(m, &mesh, mat, fracture, &err);
+    fdem_tet_mesh_free(&mesh);
+    if (p < 0) build_die("box part", &err);
+    return p;
+}
+
+/* Reproducible noise for tests: the next number of a 64-bit linear
+ * congruential state (Knuth's MMIX constants), uniform in [-1, 1). */
+static inline double build_uniform(uint64_t *state)
+{
+    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
+    return (double)(*state >> 11) * 0x1.0p-53 * 2 - 1;
 }
 
 static inline int build_rectangle(fdem_model *m, int mat, double x, double y, double w, double h,

@@ -34,17 +34,9 @@ static inline fdem_model *pulled_bar(int dimension, int threads, double speed)
     fdem_error err = {0};
     if (!m || fdem_set_dimension(m, dimension, &err)) build_die("dimension", &err);
     int rock = build_fracturing_rock(m, 0.1);
-    if (dimension == 2) {
-        build_rectangle_part(m, rock, 0, 0, 0.1, 0.01, 20, 2, 1);
-    } else {
-        const double origin[3] = {0, 0, 0}, size[3] = {0.1, 0.01, 0.01};
-        const int div[3] = {10, 1, 1};
-        fdem_tet_mesh mesh = {0};
-        int ok = fdem_tet_mesh_box(origin, size, div, &mesh, &err) == 0 &&
-                 fdem_add_part_3d(m, &mesh, rock, 1, &err) >= 0;
-        fdem_tet_mesh_free(&mesh);
-        if (!ok) build_die("box", &err);
-    }
+    const double size[3] = {0.1, 0.01, 0.01};
+    const int div_2d[3] = {20, 2, 0}, div_3d[3] = {10, 1, 1};
+    build_box_part(m, rock, dimension, size, dimension == 2 ? div_2d : div_3d, 1);
     pulled_bar_end(m, 0, -speed);
     pulled_bar_end(m, 0.1, speed);
     fdem_set_threads(m, threads);

@@ -37,15 +37,10 @@ static fdem_model *box_model(const double size[3], const int div[3], fdem_materi
                              int fracture)
 {
     fdem_error err = {0};
-    fdem_tet_mesh mesh = {0};
-    const double origin[3] = {0, 0, 0};
     fdem_model *m = fdem_model_create();
-    int ok = m && fdem_set_dimension(m, 3, &err) == 0 &&
-             fdem_tet_mesh_box(origin, size, div, &mesh, &err) == 0 &&
-             fdem_add_material(m, &mat, &err) == 0 &&
-             fdem_add_part_3d(m, &mesh, 0, fracture, &err) == 0;
-    fdem_tet_mesh_free(&mesh);
-    if (!ok) build_die("box", &err);
+    if (!m || fdem_set_dimension(m, 3, &err) || fdem_add_material(m, &mat, &err) != 0)
+        build_die("box", &err);
+    build_box_part(m, 0, 3, size, div, fracture);
     return m;
 }
 
@@ -158,8 +153,7 @@ static fdem_model *shaken_box(void)
         for (int k = 0; k < 4; k++) {
             int32_t node = m->tet[e].node[k];
             for (int c = 0; c < 3; c++) {
-                state = state * 6364136223846793005ull + 1442695040888963407ull;
-                double u = (double)(state >> 11) * 0x1.0p-53 * 2 - 1;
+                double u = build_uniform(&state);
                 m->pos[3 * node + c] += (e % 3 == 0 ? 3 : 0.15) * limit * u;
                 m->vel[3 * node + c] = 0.01 * u;
             }

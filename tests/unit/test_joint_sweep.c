@@ -17,14 +17,7 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "mesh_3d.h"
 #include "model.h"
-
-static double next_uniform(uint64_t *state) /* in [-1, 1) */
-{
-    *state = *state * 6364136223846793005ull + 1442695040888963407ull;
-    return (double)(*state >> 11) * 0x1.0p-53 * 2 - 1;
-}
 
 /* A fracturing block of some 3000 elements (three or more joint blocks):
  * 2D 40 x 40 squares of two triangles, 3D 8^3 cubes of six tetrahedra. */
@@ -34,26 +27,18 @@ static fdem_model *shaken_block(int dim)
     fdem_error err = {0};
     if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
     int mat = build_fracturing_rock(m, 0.1);
-    if (dim == 2) {
-        build_rectangle_part(m, mat, 0, 0, 0.4, 0.4, 40, 40, 1);
-    } else {
-        const double origin[3] = {0, 0, 0}, size[3] = {0.08, 0.08, 0.08};
-        const int div[3] = {8, 8, 8};
-        fdem_tet_mesh mesh = {0};
-        if (fdem_tet_mesh_box(origin, size, div, &mesh, &err) ||
-            fdem_add_part_3d(m, &mesh, mat, 1, &err) < 0)
-            build_die("box", &err);
-        fdem_tet_mesh_free(&mesh);
-    }
+    const double size_2d[3] = {0.4, 0.4, 0}, size_3d[3] = {0.08, 0.08, 0.08};
+    const int div_2d[3] = {40, 40, 0}, div_3d[3] = {8, 8, 8};
+    build_box_part(m, mat, dim, dim == 2 ? size_2d : size_3d, dim == 2 ? div_2d : div_3d, 1);
     build_finalize(m, 0.5);
     /* gaps around the tensile strength: most joints elastic, some past it,
      * a few (the nodes moved 2000 times as far) past the softening span */
     double limit = 1e6 / m->joint_k[0];
     uint64_t state = 2024;
     for (int i = 0; i < dim * m->node_count; i++) {
-        m->pos[i] += (i % 149 == 0 ? 2000 : i % 5 == 0 ? 2 : 0.2) * limit * next_uniform(&state);
-        m->vel[i] = 0.01 * next_uniform(&state);
-        m->force[i] = 1e3 * next_uniform(&state);
+        m->pos[i] += (i % 149 == 0 ? 2000 : i % 5 == 0 ? 2 : 0.2) * limit * build_uniform(&state);
+        m->vel[i] = 0.01 * build_uniform(&state);
+        m->force[i] = 1e3 * build_uniform(&state);
     }
     for (int j = 0; j < m->joint_count; j += 11) m->joint_damage[j] = 0.4;
     return m;
