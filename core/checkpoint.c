@@ -258,6 +258,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
     if (m->joint_count) m->fragments = joint_fragment_count(m);
     memset(m->force, 0, nb);
+    m->fixed_valid = 0; /* computed again from the restored positions: the same bits */
     if (h1.version == 1 || !h.has_detection) {
         m->contact.need_detect = 1;
     } else {

@@ -23,17 +23,20 @@ double element_stable_dt(const fdem_model *m, int e)
     return dt * initial_stress_dt_factor(m, e);
 }
 
-/* A block of a model with in-situ stress: each run of elements of one part
- * goes through the kernel's loop with the pre-stress if the part has one,
- * through the plain loop if not (elements of a part are contiguous), so an
- * unstressed element costs what it costs in a model without any. */
-static void forces_by_stress_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+/* A block part run by part run (elements of a part are contiguous): a
+ * part with an in-situ stress through the kernel's loop with the
+ * pre-stress, a fixed part whose forces are kept (fixed_part.c) not at
+ * all, the rest through the plain loop, so a model without either pays
+ * nothing for them. */
+static void forces_by_part_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    const int three = m->dim == 3;
+    const int three = m->dim == 3, kept = fixed_parts_kept(m);
     for (int e = begin; e < end;) {
         const part *p = &m->parts[m->elem_part[e]];
         int stop = p->elem_begin + p->elem_count < end ? p->elem_begin + p->elem_count : end;
-        if (p->stressed)
+        if (kept && p->fixed)
+            ; /* fixed_parts_forces */
+        else if (p->stressed)
             (three ? tet_element_forces_range_stressed : tri_element_forces_range_stressed)(m, e, stop,
                                                                                            sums);
         else
@@ -46,18 +49,21 @@ static void forces_by_stress_runs(fdem_model *m, int begin, int end, double sums
  * by side within a colour). A block hands back the strain energy (sums[0])
  * and the power of the viscous stresses with the velocities before this
  * step (sums[1]) and of the last step's viscous stresses with the same
- * velocities (sums[2]); the elastic energy adds what an in-situ stress held
- * at t = 0 (initial_stress.c); damping is booked with the step-averaged velocity
+ * velocities (sums[2]); the elastic energy adds what the fixed parts'
+ * elements hold (fixed_part.c) and what an in-situ stress held at t = 0
+ * (initial_stress.c); damping is booked with the step-averaged velocity
  * like every work: this step's first half and the last step's second half
  * (energy.c). */
 void element_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
-    scatter_block_fn run = m->elem_stress0 ? forces_by_stress_runs
-                           : m->dim == 3   ? tet_element_forces_range
-                                           : tri_element_forces_range;
+    const int kept = fixed_parts_kept(m);
+    scatter_block_fn run = m->elem_stress0 || kept ? forces_by_part_runs
+                           : m->dim == 3           ? tet_element_forces_range
+                                                   : tri_element_forces_range;
     scatter_plan_run(&m->elem_plan, m, m->threads, run, sums);
-    m->elastic_energy = m->elem_stress0 ? sums[0] + m->stress0_energy : sums[0];
+    double elastic = kept ? sums[0] + fixed_parts_forces(m) : sums[0];
+    m->elastic_energy = m->elem_stress0 ? elastic + m->stress0_energy : elastic;
     m->damping_work -= 0.5 * (m->dt_prev + m->dt) * 0.5 * sums[1] + 0.5 * m->havg_last * sums[2];
 }
 

@@ -83,7 +83,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
     free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
-    free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous);
+    free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     contact_free(&m->contact);
@@ -647,6 +647,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     constraint_set_time(m, 0);
     if (constraint_select(m, err)) return -1;
     if (boundary_load_select(m, err)) return -1;
+    if (fixed_parts_prepare(m, err)) return -1;
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;
@@ -753,14 +754,15 @@ static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_S
                                          32, 8, 2, 0.5, 64};
 
 /* pos, vel, force, pos0 (dim each), mass, inv_mass; node_part, node_origin;
- * dof_owned and a constraint entry (node, dofs); a quarter of a loaded
+ * a fixed part's kept force (dim; fixed_part.c); dof_owned and a constraint
+ * entry (node, dofs); a quarter of a loaded
  * boundary facet (nodes, element, dim x dim forces; tunnel measures 0.15 a
  * node); with contact pos_detect, pos_near and the contact force (dim
  * each); with joints vertex_broken */
 static size_t memory_node(const memory_figures *f, int contact, int joints)
 {
     size_t facet = (f->D + 1) * sizeof(int32_t) + f->D * f->D * sizeof(double);
-    return sizeof(double) * (4 * f->D + 2) + 2 * sizeof(int32_t) + 1 + sizeof(int32_t) + 1 +
+    return sizeof(double) * (5 * f->D + 2) + 2 * sizeof(int32_t) + 1 + sizeof(int32_t) + 1 +
            facet / 4 + (contact ? 3 * f->D * sizeof(double) : 0) + (joints ? 1 : 0);
 }
 
@@ -883,6 +885,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);
+    for (int k = 0; k < m->part_count && m->fixed_force; k++) /* fixed_part.c */
+        if (m->parts[k].fixed) b += sizeof(double) * D * (size_t)m->parts[k].node_count;
     size_t stress = (size_t)m->elem_count * (size_t)model_stress_comps(m) * sizeof(double);
     if (m->elem_stress0) b += stress;
     if (m->elem_viscous) b += stress;

@@ -68,6 +68,7 @@ typedef struct part {
     int material;
     int fracture;
     int stressed;        /* has an in-situ stress (initial_stress.c) */
+    int fixed;           /* held still as a whole: its element forces are kept (fixed_part.c) */
     int node_begin, node_count;
     int elem_begin, elem_count;
 } part;
@@ -261,6 +262,11 @@ struct fdem_model {
                                 has one, zeros in the elements of parts without */
     double stress0_energy;   /* sum of V0 S0 : C^-1 : S0 / 2: what the in-situ stress holds
                                 at t = 0, linear elastic (a constant of the elastic energy) */
+    int fixed_parts;         /* parts with part.fixed (fixed_part.c) */
+    int fixed_valid;         /* fixed_force and fixed_energy are this model's */
+    double *fixed_force;     /* dim per node of the fixed parts, part after part: their
+                                elements' forces, the same every step from the second on */
+    double fixed_energy;     /* those elements' strain energy */
 
     int constraint_count, constraint_capacity;
     constraint *constraints;
@@ -408,6 +414,13 @@ double element_stable_dt(const fdem_model *m, int e);
 void element_forces(fdem_model *m);
 void element_stress_one(const fdem_model *m, int e, double *out);
 int element_of_node(const fdem_model *m, int node);
+
+/* fixed_part.c: parts held still as a whole, whose element forces are
+ * computed once and kept (element.c skips their elements from the second
+ * step on: fixed_parts_kept) */
+int fixed_parts_prepare(fdem_model *m, fdem_error *err);
+static inline int fixed_parts_kept(const fdem_model *m) { return m->fixed_parts && m->step >= 1; }
+double fixed_parts_forces(fdem_model *m);
 
 /* element_tri.c: the triangle kernel */
 void tri_element_prepare(fdem_model *m, int e);

@@ -64,15 +64,16 @@ static inline int build_rectangle_part(fdem_model *m, int mat, double x, double 
     return p;
 }
 
-/* A box part from the origin in the model's dimension: 2D size[0] x
+/* A box part origin + [0, size] in the model's dimension: 2D size[0] x
  * size[1] in div[0] x div[1] squares of two triangles, 3D size in div
  * cubes of six tetrahedra; fracture != 0 puts a joint on every interior
  * edge or face. */
-static inline int build_box_part(fdem_model *m, int mat, int dim, const double size[3],
-                                 const int div[3], int fracture)
+static inline int build_box_at(fdem_model *m, int mat, int dim, const double origin[3],
+                               const double size[3], const int div[3], int fracture)
 {
-    if (dim == 2) return build_rectangle_part(m, mat, 0, 0, size[0], size[1], div[0], div[1], fracture);
-    const double origin[3] = {0, 0, 0};
+    if (dim == 2)
+        return build_rectangle_part(m, mat, origin[0], origin[1], size[0], size[1], div[0], div[1],
+                                    fracture);
     fdem_tet_mesh mesh = {0};
     fdem_error err = {0};
     if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box mesh", &err);
@@ -80,6 +81,14 @@ static inline int build_box_part(fdem_model *m, int mat, int dim, const double s
     fdem_tet_mesh_free(&mesh);
     if (p < 0) build_die("box part", &err);
     return p;
+}
+
+/* The same box from the origin. */
+static inline int build_box_part(fdem_model *m, int mat, int dim, const double size[3],
+                                 const int div[3], int fracture)
+{
+    const double origin[3] = {0, 0, 0};
+    return build_box_at(m, mat, dim, origin, size, div, fracture);
 }
 
 /* Reproducible noise for tests: the next number of a 64-bit linear

@@ -34,15 +34,7 @@
 static int add_block(fdem_model *m, const double origin[3], const double size[3],
                      const int div[3])
 {
-    if (m->dim == 2)
-        return build_rectangle(m, 0, origin[0], origin[1], size[0], size[1], div[0], div[1]);
-    fdem_error err;
-    fdem_tet_mesh mesh = {0};
-    if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box", &err);
-    int p = fdem_add_part_3d(m, &mesh, 0, 0, &err);
-    fdem_tet_mesh_free(&mesh);
-    if (p < 0) build_die("box part", &err);
-    return p;
+    return build_box_at(m, 0, m->dim, origin, size, div, 0);
 }
 
 /* A model of one block [0, size]. */
