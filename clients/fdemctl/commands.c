@@ -183,7 +183,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
 
     size_t length;
     char *text = ctl_read_all(file[0], &length);
-    if (!text) return CTL_FAIL;
+    if (!text) return CTL_USAGE;
     http_response r;
     const char *path = dry_run ? "/cases?dry_run=true" : start ? "/cases?start=true" : "/cases";
     int code = ctl_call(o, "POST", path, text, length, dry_run ? 200 : 201, &r);

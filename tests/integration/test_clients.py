@@ -167,8 +167,10 @@ class FdemctlTests(ClientTestCase):
         self.assertIn("400", r.stderr)
 
     def test_submit_missing_file(self):
+        # A file the user mistyped is a usage error (2), not a refusal by
+        # the server (1): a script must be able to tell the two apart.
         r = self.ctl("submit", "/nonexistent/case.json")
-        self.assertNotEqual(r.returncode, 0)
+        self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn("/nonexistent/case.json", r.stderr)
 
     def test_list_shows_every_case(self):

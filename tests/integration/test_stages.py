@@ -382,7 +382,7 @@ class ClientCommandTests(DaemonTestCase):
         r = self.ctl("clone", source, "-", stdin='{"name": "piped"}')
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(self.d.status(r.stdout.strip())["name"], "piped")
-        self.assertEqual(self.ctl("clone", source, "missing.json").returncode, 1)
+        self.assertEqual(self.ctl("clone", source, "missing.json").returncode, 2)
         self.assertEqual(self.ctl("clone", "0123456789abcdef", path).returncode, 1)
         self.assertEqual(self.ctl("clone", "--help").returncode, 0)
 
