@@ -164,6 +164,21 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertEqual(faces.shape[0], 6)
         self.assertNotIn((1, 2, 3), [tuple(sorted(f)) for f in faces])
 
+    def test_an_intact_joint_hides_its_two_faces_and_a_broken_one_shows_them(self):
+        # Two tetrahedra of a fracturing part: each on its own nodes (0-3 and
+        # 4-7), the face 1 2 3 of the first joined to the face 5 6 7 of the
+        # second. While the joint holds the body is one solid whose surface
+        # has six faces; once it breaks, the two crack faces are surface too.
+        tets = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+        joints = np.array([[1, 2, 3, 5, 6, 7]])
+        self.assertEqual(boundary_faces(tets)[0].shape[0], 8)
+        faces, element = boundary_faces(tets, held_joints=joints)
+        self.assertEqual(faces.shape[0], 6)
+        drawn = [tuple(sorted(f)) for f in faces]
+        self.assertNotIn((1, 2, 3), drawn)
+        self.assertNotIn((5, 6, 7), drawn)
+        self.assertEqual(boundary_faces(tets, held_joints=joints[:0])[0].shape[0], 8)
+
     def test_stress_plot(self):
         self.assert_drawn(*self.plot(self.h5))
 
@@ -235,6 +250,57 @@ class DaemonResultTests(Plot3DTestCase):
 
     def test_velocity_plot(self):
         self.assert_drawn(*self.plot(self.h5, "--field", "velocity"))
+
+
+class FracturingResultTests(Plot3DTestCase):
+    """A fracturing box the real daemon stepped: every tetrahedron has its
+    own four nodes, so each face is used by one tetrahedron only and the
+    faces inside the body are told by the joints that hold them. The plot
+    must draw the box's surface, not every face of every tetrahedron (which
+    the painter's algorithm then shows through the surface)."""
+
+    DIVISIONS = (2, 1, 1)
+
+    @classmethod
+    def setUpClass(cls):
+        cls.daemon = fdemd_harness.Daemon().start()
+        cls.client = Client("http://127.0.0.1:%d" % cls.daemon.port)
+        cls.results = tempfile.TemporaryDirectory(prefix="plot3d-fracture-")
+        case = {"name": "fracturing-box-3d", "dimension": 3,
+                "materials": {"rock": {"density": 2000, "young": 1e8, "poisson": 0.25,
+                                       "fracture": {"tensile_strength": 1e6, "cohesion": 2e6,
+                                                    "friction_angle": 30, "energy_I": 10,
+                                                    "energy_II": 50}}},
+                "parts": [{"name": "block", "material": "rock", "fracture": True,
+                           "box": {"size": [0.2, 0.1, 0.1], "divisions": list(cls.DIVISIONS)}}],
+                "time": {"end": 1e-4},
+                "output": {"interval": 1e-4, "fields": ["position", "velocity", "stress"]}}
+        case_id = cls.client.submit(case, start=True)
+        cls.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
+        cls.h5, _ = cls.client.fetch(case_id, os.path.join(cls.results.name, "fracturing.h5"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.stop()
+        cls.daemon.close()
+        cls.results.cleanup()
+
+    def test_the_plot_draws_the_surface_of_the_unbroken_box(self):
+        from plot_result import surface_of_snapshot
+        with h5py.File(self.h5, "r") as f:
+            nodes, tets = f["/mesh/position0"][:], f["/mesh/tetrahedra"][:]
+            self.assertEqual(len(np.unique(tets)), 4 * tets.shape[0])
+            self.assertFalse(np.any(f["/snapshots/damage"][-1] >= 1))
+            faces, element = surface_of_snapshot(f, -1)
+        self.assertEqual(faces.shape[0], analytic_boundary_faces(self.DIVISIONS))
+        low, high = nodes.min(axis=0), nodes.max(axis=0)
+        corners = nodes[faces]
+        on_a_side = np.any(np.all(np.isclose(corners, low), axis=1)
+                           | np.all(np.isclose(corners, high), axis=1), axis=1)
+        self.assertTrue(np.all(on_a_side))
+
+    def test_stress_plot(self):
+        self.assert_drawn(*self.plot(self.h5))
 
 
 class VonMises3DTests(unittest.TestCase):
