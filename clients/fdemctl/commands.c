@@ -69,10 +69,11 @@ char *ctl_read_all(const char *path, size_t *length)
         n += got;
         if (got == 0) break;
     }
-    int failed = ferror(f);
+    int failed = ferror(f), read_errno = errno;
     if (f != stdin) fclose(f);
     if (!data || failed) {
-        fprintf(stderr, "fdemctl: cannot read %s%s\n", path, data ? "" : " (out of memory)");
+        fprintf(stderr, "fdemctl: cannot read %s: %s\n", path,
+                data ? strerror(read_errno) : "out of memory");
         free(data);
         return NULL;
     }

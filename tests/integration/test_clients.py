@@ -173,6 +173,13 @@ class FdemctlTests(ClientTestCase):
         self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn("/nonexistent/case.json", r.stderr)
 
+    def test_submit_a_directory_says_why(self):
+        # fopen() takes a directory on Linux; the read then fails, and the
+        # user is told the reason, not only that it failed.
+        r = self.ctl("submit", os.path.join(ROOT, "examples"))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("examples: Is a directory", r.stderr)
+
     def test_list_shows_every_case(self):
         a = self.submit(quick_case("listed-a"))
         b = self.submit(quick_case("listed-b"))
