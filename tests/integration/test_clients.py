@@ -243,6 +243,19 @@ class FdemctlTests(ClientTestCase):
         self.assertNotIn("\r", r.stdout)     # not a terminal: plain lines
         self.assertIn("finished", r.stdout.splitlines()[-1])
 
+    def test_wait_on_a_case_nobody_started_says_so_and_keeps_waiting(self):
+        # A user who submitted without --start would otherwise watch
+        # "created 0.0%" forever. wait still waits (someone may start the
+        # case), but says once, on stderr, what the case is waiting for.
+        case_id = self.submit(quick_case("never-started"))
+        with self.assertRaises(subprocess.TimeoutExpired) as cm:
+            self.ctl("wait", case_id, "--interval", "0.1", timeout=2)
+        stderr = cm.exception.stderr or b""
+        stderr = stderr.decode() if isinstance(stderr, bytes) else stderr
+        self.assertIn("case %s is created" % case_id, stderr)
+        self.assertIn("fdemctl start %s" % case_id, stderr)
+        self.assertEqual(stderr.count("fdemctl start"), 1)
+
     def test_wait_stopped_exits_1(self):
         case_id = self.submit(long_case("to-stop"), "--start")
         self.client.stop(case_id)
