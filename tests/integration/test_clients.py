@@ -383,6 +383,15 @@ class PythonClientTests(ClientTestCase):
         self.assertIn("/parts/0/material", pointers)
         self.assertIn("/parts/0/material", str(e.exception))
 
+    def test_wait_on_a_case_nobody_started_warns_once(self):
+        # As fdemctl wait: a created case does not move by itself; the
+        # client keeps waiting (up to its timeout) but says why, once.
+        case_id = self.client.submit(quick_case("py-never-started"))
+        with self.assertWarnsRegex(UserWarning, "case %s is created: .*start" % case_id) as cm:
+            with self.assertRaises(TimeoutError):
+                self.client.wait(case_id, interval=0.05, timeout=0.5)
+        self.assertEqual(len(cm.warnings), 1)
+
     def test_wait_raises_on_a_stopped_case_when_asked(self):
         case_id = self.client.submit(long_case("py-stop"), start=True)
         self.assertEqual(self.client.stop(case_id)["state"], "stopped")
