@@ -332,10 +332,13 @@ class TokenTests(ClientTestCase):
         self.assertEqual(self.ctl("status", case_id).returncode, 0)
 
     def test_missing_or_wrong_token_is_401(self):
-        for token in ("", "wrong"):      # "" = FDEMD_TOKEN unset
-            r = self.ctl("list", token=token)
+        # The detail tells the two user mistakes apart: no token sent (set
+        # FDEMD_TOKEN) and a token that is not the daemon's.
+        for token, says in (("", "set FDEMD_TOKEN"), ("wrong", "does not match")):
+            r = self.ctl("list", token=token)      # "" = FDEMD_TOKEN unset
             self.assertEqual(r.returncode, 1, token)
             self.assertIn("401", r.stderr)
+            self.assertIn(says, r.stderr)
 
     def test_health_needs_no_token(self):
         self.assertEqual(Client(self.url, token="").health()["status"], "ok")
