@@ -212,7 +212,10 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         return 1;
     }
     if (r->route.kind == ROUTE_NONE) {
-        *rc = http_reply_problem(conn, 404, "Not found", "no such path", NULL);
+        *rc = http_reply_problem(conn, 404, "Not found",
+                                 r->route.bad_id ? "no such path: a case id is 16 lowercase "
+                                                   "hexadecimal digits (GET /cases lists them)"
+                                                 : "no such path", NULL);
         return 1;
     }
     if (!routes_method_allowed(r->route.kind, method)) {
