@@ -53,7 +53,8 @@ static double sizing_snapshots(const case_info *info, double t0, double dt, doub
 {
     double interval = sizing_output_interval(info);
     double last_start = t0 + (steps - 1) * dt + 1e-9 * dt;
-    double inside = floor(last_start / interval * (1 + 1e-12)) - floor(t0 / interval * (1 + 1e-12) + 1e-9);
+    double done_before = floor(t0 / interval * (1 + 1e-12) + 1e-9);
+    double inside = floor(last_start / interval * (1 + 1e-12)) - done_before;
     if (!(inside > 0))
         inside = 0;
     if (inside > steps - 1)
