@@ -84,16 +84,21 @@ static void dump_jansson(dump_buffer *b, const json_t *v)
     free(s);
 }
 
+void format_shortest_real(char *out, size_t size, double x)
+{
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(out, size, "%.*g", digits, x);
+        if (strtod(out, NULL) == x)
+            break;
+    }
+}
+
 /* The fewest significant digits that read back to x; ".0" keeps a whole
  * real a real, as jansson does. */
 static void dump_real(dump_buffer *b, double x)
 {
     char s[40];
-    for (int digits = 1; digits <= 17; digits++) {
-        snprintf(s, sizeof s, "%.*g", digits, x);
-        if (strtod(s, NULL) == x)
-            break;
-    }
+    format_shortest_real(s, sizeof s, x);
     if (!strpbrk(s, ".eE"))
         strcat(s, ".0");
     dump_str(b, s);

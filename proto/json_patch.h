@@ -21,5 +21,8 @@
 
 json_t *json_merge_patch(const json_t *target, const json_t *patch);
 char *json_dump_document(const json_t *doc, size_t *length);
+/* x with the fewest significant digits ("%.*g") that read back to x, for
+ * numbers a person reads in a message (0.0004, not 0.00040000000000000002). */
+void format_shortest_real(char *out, size_t size, double x);
 
 #endif

@@ -44,14 +44,18 @@ double sizing_output_interval(const case_info *info)
     return interval > 0 ? interval : 1.0;
 }
 
-/* Snapshot 0, one at the first step at or after each output time before
- * the end (several output times inside one step give one snapshot), and
- * the one at the end. */
-static double sizing_snapshots(const case_info *info, double steps)
+/* Snapshot 0, one at the first step at or after each output time (several
+ * output times inside one step give one snapshot), and the one at the end.
+ * An output time after the start of the last step, which is cut to land on
+ * time.end, is the end's snapshot: only those up to that start count, with
+ * the worker's tolerance of 1e-9 dt. */
+static double sizing_snapshots(const case_info *info, double t0, double dt, double steps)
 {
     double interval = sizing_output_interval(info);
-    double inside = ceil(info->end_time / interval * (1 - 1e-12)) - 1;
-    if (inside < 0)
+    double last_start = t0 + (steps - 1) * dt + 1e-9 * dt;
+    double done_before = floor(t0 / interval * (1 + 1e-12) + 1e-9);
+    double inside = floor(last_start / interval * (1 + 1e-12)) - done_before;
+    if (!(inside > 0))
         inside = 0;
     if (inside > steps - 1)
         inside = steps > 1 ? steps - 1 : 0;
@@ -119,7 +123,7 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->joints = c.joints;
     out->dt = fdem_get_dt(model);
     out->steps = sizing_steps_to_end(fdem_get_time(model), info->end_time, out->dt);
-    out->snapshots = sizing_snapshots(info, out->steps);
+    out->snapshots = sizing_snapshots(info, fdem_get_time(model), out->dt, out->steps);
     out->memory_bytes = (double)case_model_cost(model_bytes);
     out->result_bytes = sizing_result_bytes(model, info, out->snapshots);
     fdem_set_threads(model, threads);

@@ -124,8 +124,11 @@ static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_
         return 500;
     }
     if (!(end > old_end)) {
-        snprintf(msg, msglen, "the new end %.17g s is not beyond the current end %.17g s",
-                 end, old_end);
+        char new_text[40], old_text[40];
+        format_shortest_real(new_text, sizeof new_text, end);
+        format_shortest_real(old_text, sizeof old_text, old_end);
+        snprintf(msg, msglen, "the new end %s s is not beyond the current end %s s", new_text,
+                 old_text);
         return 409;
     }
     json_t *output = json_object_get(doc, "output");

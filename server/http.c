@@ -173,23 +173,27 @@ static int http_token_equal(const char *given, size_t given_len, const char *wan
     return diff == 0;
 }
 
-static int http_authorized(struct MHD_Connection *conn)
+/* NULL when the request may pass, else why not: the detail of its 401,
+ * which tells a user who sent no token from one who sent the wrong one. */
+static const char *http_unauthorized_reason(struct MHD_Connection *conn)
 {
     if (!http_cfg->token)
-        return 1;
+        return NULL;
     const char *h = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_AUTHORIZATION);
     if (!h || strncasecmp(h, "Bearer ", 7) != 0)
-        return 0;
+        return "this daemon needs an Authorization: Bearer <token> header "
+               "(fdemctl and the Python client: set FDEMD_TOKEN)";
     h += 7;
     while (*h == ' ')
         h++;
-    return http_token_equal(h, strlen(h), http_cfg->token);
+    if (!http_token_equal(h, strlen(h), http_cfg->token))
+        return "the bearer token does not match this daemon's --token";
+    return NULL;
 }
 
-static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn)
+static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn, const char *reason)
 {
-    struct MHD_Response *resp = http_problem_response(
-        401, "Unauthorized", "this daemon needs an Authorization: Bearer <token> header", NULL);
+    struct MHD_Response *resp = http_problem_response(401, "Unauthorized", reason, NULL);
     if (resp)
         MHD_add_response_header(resp, MHD_HTTP_HEADER_WWW_AUTHENTICATE, "Bearer realm=\"fdemd\"");
     return http_queue(conn, 401, resp);
@@ -202,12 +206,16 @@ static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn)
 static int http_check_headers(struct MHD_Connection *conn, const char *method, http_request *r,
                               enum MHD_Result *rc)
 {
-    if (r->route.kind != ROUTE_HEALTH && !http_authorized(conn)) {
-        *rc = http_reply_unauthorized(conn);
+    const char *unauthorized = r->route.kind != ROUTE_HEALTH ? http_unauthorized_reason(conn) : NULL;
+    if (unauthorized) {
+        *rc = http_reply_unauthorized(conn, unauthorized);
         return 1;
     }
     if (r->route.kind == ROUTE_NONE) {
-        *rc = http_reply_problem(conn, 404, "Not found", "no such path", NULL);
+        *rc = http_reply_problem(conn, 404, "Not found",
+                                 r->route.bad_id ? "no such path: a case id is 16 lowercase "
+                                                   "hexadecimal digits (GET /cases lists them)"
+                                                 : "no such path", NULL);
         return 1;
     }
     if (!routes_method_allowed(r->route.kind, method)) {

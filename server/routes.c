@@ -71,7 +71,11 @@ void routes_match(const char *url, route_match *out)
         out->kind = ROUTE_CASES;
         return;
     }
-    if (!id_is_valid(seg[1]) || n > 3)
+    if (!id_is_valid(seg[1])) {
+        out->bad_id = 1;
+        return;
+    }
+    if (n > 3)
         return;
     if (n == 2) {
         out->kind = ROUTE_CASE;

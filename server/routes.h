@@ -24,6 +24,7 @@ typedef enum route_kind {
 typedef struct route_match {
     route_kind kind;
     char id[CASE_ID_LEN + 1]; /* "" unless the path names a valid id */
+    int bad_id;               /* /cases/X... with an X that is not an id (its 404 says so) */
 } route_match;
 
 void routes_match(const char *url, route_match *out);

@@ -69,10 +69,11 @@ char *ctl_read_all(const char *path, size_t *length)
         n += got;
         if (got == 0) break;
     }
-    int failed = ferror(f);
+    int failed = ferror(f), read_errno = errno;
     if (f != stdin) fclose(f);
     if (!data || failed) {
-        fprintf(stderr, "fdemctl: cannot read %s%s\n", path, data ? "" : " (out of memory)");
+        fprintf(stderr, "fdemctl: cannot read %s: %s\n", path,
+                data ? strerror(read_errno) : "out of memory");
         free(data);
         return NULL;
     }
@@ -183,7 +184,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
 
     size_t length;
     char *text = ctl_read_all(file[0], &length);
-    if (!text) return CTL_FAIL;
+    if (!text) return CTL_USAGE;
     http_response r;
     const char *path = dry_run ? "/cases?dry_run=true" : start ? "/cases?start=true" : "/cases";
     int code = ctl_call(o, "POST", path, text, length, dry_run ? 200 : 201, &r);

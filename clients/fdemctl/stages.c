@@ -106,7 +106,7 @@ int cmd_clone(const ctl_options *o, int argc, char **argv)
     }
     size_t length;
     char *patch = ctl_read_all(args[1], &length);
-    if (!patch) return CTL_FAIL;
+    if (!patch) return CTL_USAGE;
     http_response r;
     int code = ctl_call(o, "POST", path, patch, length, 201, &r);
     free(patch);

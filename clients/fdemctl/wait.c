@@ -120,6 +120,17 @@ static int wait_verdict(const char *id, json_t *s, const wait_progress *p)
     return CTL_FAIL;
 }
 
+/* A created or paused case does not move until someone starts it; wait
+ * keeps waiting (another client may), but says so once per such state, so
+ * a user who forgot --start is not left watching 0.0 % in silence. */
+static void wait_hint_idle(FILE *tty, const char *id, const char *state, int drawn)
+{
+    if (strcmp(state, "created") != 0 && strcmp(state, "paused") != 0) return;
+    if (tty == stderr && drawn) fputc('\n', stderr);
+    fprintf(stderr, "fdemctl: case %s is %s: it does not run until it is started "
+                    "(fdemctl start %s); waiting\n", id, state, id);
+}
+
 static int wait_is_terminal(const char *state)
 {
     return strcmp(state, "finished") == 0 || strcmp(state, "failed") == 0 ||
@@ -160,6 +171,8 @@ int cmd_wait(const ctl_options *o, int argc, char **argv)
             return code;
         }
         wait_progress p = wait_read(s);
+        if (strcmp(p.state, last_state) != 0)
+            wait_hint_idle(tty, id[0], p.state, last_step >= 0);
         if (tty) {
             wait_draw_bar(tty, &p);
         } else if (p.step != last_step || strcmp(p.state, last_state) != 0) {

@@ -302,12 +302,20 @@ class Client:
             the final status object.
         """
         deadline = None if timeout is None else time.monotonic() + timeout
+        last_state = None
         while True:
             s = self.status(case_id)
             if callback is not None:
                 callback(s)
             if s.get("state") in TERMINAL_STATES:
                 break
+            if s.get("state") in ("created", "paused") and s.get("state") != last_state:
+                # It will not move until someone starts it: keep waiting
+                # (another client may), but say why, once per such state.
+                warnings.warn("case %s is %s: it does not run until it is started "
+                              "(Client.start(%r)); waiting" % (case_id, s["state"], case_id),
+                              stacklevel=2)
+            last_state = s.get("state")
             if deadline is not None and time.monotonic() > deadline:
                 raise TimeoutError("case %s still %s after %g s" % (case_id, s.get("state"), timeout))
             time.sleep(interval)

@@ -26,7 +26,8 @@ as its triangles, coloured by
 
 A 3D result (root attribute dimension = 3, /mesh/tetrahedra) is drawn as
 the boundary faces of its tetrahedral mesh (faces of exactly one
-tetrahedron) in an equal-aspect perspective view (--view ELEV,AZIM), each
+tetrahedron and of no joint still holding: a broken joint's faces show the
+crack) in an equal-aspect perspective view (--view ELEV,AZIM), each
 face coloured by its tetrahedron's von Mises stress, exact from the six
 components (xx, yy, zz, yz, xz, xy) of /snapshots/stress, or by the mean
 speed of its three nodes for --field velocity. Only the surface is drawn:
@@ -242,13 +243,23 @@ def plot_2d(f, args, field):
 TET_FACES = np.array([[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]])
 
 
-def boundary_faces(tetrahedra):
-    """The faces used by exactly one tetrahedron.
+def _face_keys(faces):
+    """One comparable key per face, whatever the order of its three nodes."""
+    rows = np.ascontiguousarray(np.sort(faces, axis=1).astype(np.int64))
+    return rows.view(np.dtype((np.void, rows.dtype.itemsize * 3))).ravel()
+
+
+def boundary_faces(tetrahedra, held_joints=None):
+    """The faces used by exactly one tetrahedron and held by no joint.
 
     Returns (faces (F, 3) node indices, outward, and element (F,) the
     tetrahedron each belongs to). A face shared by two tetrahedra is inside
     the body; one of a single tetrahedron is on its surface (or on a crack
-    or contact surface between parts, which have their own nodes).
+    or contact surface between parts, which have their own nodes). In a
+    fracturing part every tetrahedron has its own nodes, so its inner faces
+    are told apart by held_joints, the (K, 6) rows of /mesh/joints still
+    holding: both faces of each are inside the body; a broken joint's two
+    faces are crack surfaces and are drawn.
     """
     tetrahedra = np.asarray(tetrahedra, dtype=np.int64)
     faces = tetrahedra[:, TET_FACES].reshape(-1, 3)
@@ -256,7 +267,18 @@ def boundary_faces(tetrahedra):
     _, first, uses = np.unique(np.sort(faces, axis=1), axis=0,
                                return_index=True, return_counts=True)
     once = np.sort(first[uses == 1])
+    if held_joints is not None and len(held_joints):
+        held = np.asarray(held_joints).reshape(-1, 3)
+        once = once[~np.isin(_face_keys(faces[once]), _face_keys(held))]
     return faces[once], element[once]
+
+
+def surface_of_snapshot(f, s):
+    """The boundary faces of snapshot s: joints with damage below 1 hold."""
+    held = None
+    if "/mesh/joints" in f and "/snapshots/damage" in f:
+        held = f["/mesh/joints"][:][f["/snapshots/damage"][s] < 1.0]
+    return boundary_faces(f["/mesh/tetrahedra"][:], held)
 
 
 def face_stress(f, s, element, args):
@@ -299,7 +321,7 @@ def plot_3d(f, args, field):
         sys.exit("plot_result: --field damage is drawn for 2D results only")
     s, count = snapshot_index(f, args.snapshot)
     xyz, where = snapshot_positions(f, s)
-    faces, element = boundary_faces(f["/mesh/tetrahedra"][:])
+    faces, element = surface_of_snapshot(f, s)
     if field == "stress":
         values, label, cmap = face_stress(f, s, element, args)
     else:

@@ -221,6 +221,14 @@ class ApiTest(unittest.TestCase):
             problem = json.loads(data)
             self.assertEqual((problem["type"], problem["status"]), ("about:blank", 404))
             self.assertEqual(problem["errors"], [])
+        # A mistyped id (a user's copy-paste cut short, upper case) is told
+        # what an id looks like, not only "no such path".
+        for path in ("/cases/xyz", "/cases/0123456789ABCDEF", "/cases/0123456789abcde/state"):
+            detail = json.loads(self.d.request("GET", path)[2])["detail"]
+            self.assertIn("a case id is 16 lowercase hexadecimal digits", detail, path)
+        for path in ("/nope", "/health/x", "/cases/0123456789abcdef/what"):
+            detail = json.loads(self.d.request("GET", path)[2])["detail"]
+            self.assertNotIn("case id", detail, path)
         case_id = self.d.create(tiny_case("methods"))["id"]
         for method, path, allow in (("DELETE", "/cases", "GET, HEAD, POST"),
                                     ("PUT", "/cases/" + case_id, "GET, HEAD, DELETE"),

@@ -167,9 +167,18 @@ class FdemctlTests(ClientTestCase):
         self.assertIn("400", r.stderr)
 
     def test_submit_missing_file(self):
+        # A file the user mistyped is a usage error (2), not a refusal by
+        # the server (1): a script must be able to tell the two apart.
         r = self.ctl("submit", "/nonexistent/case.json")
-        self.assertNotEqual(r.returncode, 0)
+        self.assertEqual(r.returncode, 2, r.stderr)
         self.assertIn("/nonexistent/case.json", r.stderr)
+
+    def test_submit_a_directory_says_why(self):
+        # fopen() takes a directory on Linux; the read then fails, and the
+        # user is told the reason, not only that it failed.
+        r = self.ctl("submit", os.path.join(ROOT, "examples"))
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("examples: Is a directory", r.stderr)
 
     def test_list_shows_every_case(self):
         a = self.submit(quick_case("listed-a"))
@@ -233,6 +242,19 @@ class FdemctlTests(ClientTestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertNotIn("\r", r.stdout)     # not a terminal: plain lines
         self.assertIn("finished", r.stdout.splitlines()[-1])
+
+    def test_wait_on_a_case_nobody_started_says_so_and_keeps_waiting(self):
+        # A user who submitted without --start would otherwise watch
+        # "created 0.0%" forever. wait still waits (someone may start the
+        # case), but says once, on stderr, what the case is waiting for.
+        case_id = self.submit(quick_case("never-started"))
+        with self.assertRaises(subprocess.TimeoutExpired) as cm:
+            self.ctl("wait", case_id, "--interval", "0.1", timeout=2)
+        stderr = cm.exception.stderr or b""
+        stderr = stderr.decode() if isinstance(stderr, bytes) else stderr
+        self.assertIn("case %s is created" % case_id, stderr)
+        self.assertIn("fdemctl start %s" % case_id, stderr)
+        self.assertEqual(stderr.count("fdemctl start"), 1)
 
     def test_wait_stopped_exits_1(self):
         case_id = self.submit(long_case("to-stop"), "--start")
@@ -310,10 +332,13 @@ class TokenTests(ClientTestCase):
         self.assertEqual(self.ctl("status", case_id).returncode, 0)
 
     def test_missing_or_wrong_token_is_401(self):
-        for token in ("", "wrong"):      # "" = FDEMD_TOKEN unset
-            r = self.ctl("list", token=token)
+        # The detail tells the two user mistakes apart: no token sent (set
+        # FDEMD_TOKEN) and a token that is not the daemon's.
+        for token, says in (("", "set FDEMD_TOKEN"), ("wrong", "does not match")):
+            r = self.ctl("list", token=token)      # "" = FDEMD_TOKEN unset
             self.assertEqual(r.returncode, 1, token)
             self.assertIn("401", r.stderr)
+            self.assertIn(says, r.stderr)
 
     def test_health_needs_no_token(self):
         self.assertEqual(Client(self.url, token="").health()["status"], "ok")
@@ -360,6 +385,15 @@ class PythonClientTests(ClientTestCase):
         pointers = [p["pointer"] for p in e.exception.errors]
         self.assertIn("/parts/0/material", pointers)
         self.assertIn("/parts/0/material", str(e.exception))
+
+    def test_wait_on_a_case_nobody_started_warns_once(self):
+        # As fdemctl wait: a created case does not move by itself; the
+        # client keeps waiting (up to its timeout) but says why, once.
+        case_id = self.client.submit(quick_case("py-never-started"))
+        with self.assertWarnsRegex(UserWarning, "case %s is created: .*start" % case_id) as cm:
+            with self.assertRaises(TimeoutError):
+                self.client.wait(case_id, interval=0.05, timeout=0.5)
+        self.assertEqual(len(cm.warnings), 1)
 
     def test_wait_raises_on_a_stopped_case_when_asked(self):
         case_id = self.client.submit(long_case("py-stop"), start=True)

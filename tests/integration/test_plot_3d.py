@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
 import fdemd_harness  # noqa: E402
 from fdemd_client import Client, FdemdError  # noqa: E402
-from plot_result import TET_FACES, boundary_faces, von_mises_3d  # noqa: E402
+from plot_result import TET_FACES, boundary_faces, surface_of_snapshot, von_mises_3d  # noqa: E402
 
 PLOT = os.path.join(ROOT, "clients", "python", "plot_result.py")
 PYTHON = "/usr/bin/python3"
@@ -118,10 +118,11 @@ class Plot3DTestCase(unittest.TestCase):
         colours = np.unique((pixels[inked] * 255).astype(np.uint8), axis=0)
         self.assertGreater(colours.shape[0], 50)
 
-    def assert_surface_of_box(self, nodes, tets, divisions):
-        """The boundary faces of a box mesh: the analytic count, each face
+    def assert_surface_of_box(self, nodes, tets, divisions, surface=None):
+        """The boundary faces of a box mesh (surface: the (faces, element)
+        to check, else boundary_faces(tets)): the analytic count, each face
         on the box's surface, facing out, and taken from its own element."""
-        faces, element = boundary_faces(tets)
+        faces, element = surface if surface is not None else boundary_faces(tets)
         self.assertEqual(faces.shape[0], analytic_boundary_faces(divisions))
         low, high = nodes.min(axis=0), nodes.max(axis=0)
         corners = nodes[faces]
@@ -164,6 +165,21 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertEqual(faces.shape[0], 6)
         self.assertNotIn((1, 2, 3), [tuple(sorted(f)) for f in faces])
 
+    def test_an_intact_joint_hides_its_two_faces_and_a_broken_one_shows_them(self):
+        # Two tetrahedra of a fracturing part: each on its own nodes (0-3 and
+        # 4-7), the face 1 2 3 of the first joined to the face 5 6 7 of the
+        # second. While the joint holds the body is one solid whose surface
+        # has six faces; once it breaks, the two crack faces are surface too.
+        tets = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+        joints = np.array([[1, 2, 3, 5, 6, 7]])
+        self.assertEqual(boundary_faces(tets)[0].shape[0], 8)
+        faces, element = boundary_faces(tets, held_joints=joints)
+        self.assertEqual(faces.shape[0], 6)
+        drawn = [tuple(sorted(f)) for f in faces]
+        self.assertNotIn((1, 2, 3), drawn)
+        self.assertNotIn((5, 6, 7), drawn)
+        self.assertEqual(boundary_faces(tets, held_joints=joints[:0])[0].shape[0], 8)
+
     def test_stress_plot(self):
         self.assert_drawn(*self.plot(self.h5))
 
@@ -190,18 +206,44 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertIn("out of range", r.stderr)
 
 
-class DaemonResultTests(Plot3DTestCase):
-    """A box the real daemon stepped: its mesh (mirrored Kuhn cells, not the
-    layout above) has the same analytic boundary, and the plot draws it."""
+class DaemonRunTestCase(Plot3DTestCase):
+    """Runs cls.case() on a real daemon once per class; self.h5 is the
+    fetched result."""
 
-    DIVISIONS = (3, 2, 2)
+    @classmethod
+    def case(cls):
+        raise NotImplementedError
 
     @classmethod
     def setUpClass(cls):
         cls.daemon = fdemd_harness.Daemon().start()
         cls.client = Client("http://127.0.0.1:%d" % cls.daemon.port)
         cls.results = tempfile.TemporaryDirectory(prefix="plot3d-daemon-")
-        case = {"name": "box-3d", "dimension": 3,
+        case = cls.case()
+        try:
+            case_id = cls.client.submit(case, start=True)
+        except FdemdError as e:
+            cls.tearDownClass()
+            raise AssertionError("the daemon refused %s: %s %s" % (case["name"], e, e.errors))
+        cls.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
+        cls.h5, _ = cls.client.fetch(case_id, os.path.join(cls.results.name, "result.h5"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.daemon.stop()
+        cls.daemon.close()
+        cls.results.cleanup()
+
+
+class DaemonResultTests(DaemonRunTestCase):
+    """A box the real daemon stepped: its mesh (mirrored Kuhn cells, not the
+    layout above) has the same analytic boundary, and the plot draws it."""
+
+    DIVISIONS = (3, 2, 2)
+
+    @classmethod
+    def case(cls):
+        return {"name": "box-3d", "dimension": 3,
                 "materials": {"rock": {"density": 2000, "young": 1e8, "poisson": 0.25}},
                 "parts": [{"name": "block", "material": "rock",
                            "box": {"origin": [0, 0, 0], "size": [0.3, 0.2, 0.2],
@@ -210,19 +252,6 @@ class DaemonResultTests(Plot3DTestCase):
                 "constraints": [{"box": [-1e-6, -1, -1, 1e-6, 1, 1], "fix": ["x", "y", "z"]}],
                 "time": {"end": 0.002},
                 "output": {"interval": 0.001, "fields": ["position", "velocity", "stress"]}}
-        try:
-            case_id = cls.client.submit(case, start=True)
-        except FdemdError as e:
-            cls.tearDownClass()
-            raise AssertionError("the daemon refused a 3D box: %s %s" % (e, e.errors))
-        cls.client.wait(case_id, interval=0.05, timeout=60 * SLOW)
-        cls.h5, _ = cls.client.fetch(case_id, os.path.join(cls.results.name, "box3d.h5"))
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.daemon.stop()
-        cls.daemon.close()
-        cls.results.cleanup()
 
     def test_boundary_faces_of_the_daemons_box(self):
         with h5py.File(self.h5, "r") as f:
@@ -235,6 +264,39 @@ class DaemonResultTests(Plot3DTestCase):
 
     def test_velocity_plot(self):
         self.assert_drawn(*self.plot(self.h5, "--field", "velocity"))
+
+
+class FracturingResultTests(DaemonRunTestCase):
+    """A fracturing box the real daemon stepped: every tetrahedron has its
+    own four nodes, so each face is used by one tetrahedron only and the
+    faces inside the body are told by the joints that hold them. The plot
+    must draw the box's surface, not every face of every tetrahedron (which
+    the painter's algorithm then shows through the surface)."""
+
+    DIVISIONS = (2, 1, 1)
+
+    @classmethod
+    def case(cls):
+        return {"name": "fracturing-box-3d", "dimension": 3,
+                "materials": {"rock": {"density": 2000, "young": 1e8, "poisson": 0.25,
+                                       "fracture": {"tensile_strength": 1e6, "cohesion": 2e6,
+                                                    "friction_angle": 30, "energy_I": 10,
+                                                    "energy_II": 50}}},
+                "parts": [{"name": "block", "material": "rock", "fracture": True,
+                           "box": {"size": [0.2, 0.1, 0.1], "divisions": list(cls.DIVISIONS)}}],
+                "time": {"end": 1e-4},
+                "output": {"interval": 1e-4, "fields": ["position", "velocity", "stress"]}}
+
+    def test_the_plot_draws_the_surface_of_the_unbroken_box(self):
+        with h5py.File(self.h5, "r") as f:
+            nodes, tets = f["/mesh/position0"][:], f["/mesh/tetrahedra"][:]
+            self.assertEqual(len(np.unique(tets)), 4 * tets.shape[0])
+            self.assertFalse(np.any(f["/snapshots/damage"][-1] >= 1))
+            surface = surface_of_snapshot(f, -1)
+        self.assert_surface_of_box(nodes, tets, self.DIVISIONS, surface)
+
+    def test_stress_plot(self):
+        self.assert_drawn(*self.plot(self.h5))
 
 
 class VonMises3DTests(unittest.TestCase):

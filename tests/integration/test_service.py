@@ -177,6 +177,16 @@ class ServiceTest(DaemonTestCase):
         self.assertEqual(st["step"], 1235)
         self.assertEqual(z["steps"], 1235)
 
+    def test_dry_run_snapshots_when_an_output_time_falls_in_the_cut_last_step(self):
+        # Full steps of 1 us end at 1.234 ms, the cut one at 1.2345 ms; the
+        # third output time, 1.23426 ms, lies inside that cut step, so the
+        # end snapshot stands for it: 0, two outputs, the end = 4 (the dry
+        # run counted 5, one per output time before the end).
+        case = tiny_case("cut-output", end=0.0012345, interval=0.00041142)
+        case["time"]["dt"] = 1e-6
+        z, st = self.assert_dry_run_matches_the_run(case)
+        self.assertEqual(st["snapshots"], 4)
+
     def test_dry_run_memory_and_result_scale_with_the_mesh(self):
         small = self.d.json("POST", "/cases?dry_run=true", tiny_case("s", divisions=(10, 10)))[1]
         large = self.d.json("POST", "/cases?dry_run=true", tiny_case("l", divisions=(40, 40)))[1]

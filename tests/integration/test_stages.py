@@ -149,6 +149,10 @@ class ExtendTests(DaemonTestCase, StagesCheck):
         status, problem = d.json("POST", "/cases/%s/extend" % case_id, {"end": OLD_END})
         self.assertEqual(status, 409)
         self.assertIn("not beyond the current end", problem["detail"])
+        # The ends read as the user wrote them (api.md's example), not as
+        # 17 digits (0.00040000000000000002).
+        self.assertIn("the new end %r s is not beyond the current end %r s" % (OLD_END, OLD_END),
+                      problem["detail"])
         status, problem = d.json("POST", "/cases/%s/extend" % case_id, {"end": OLD_END / 2})
         self.assertEqual(status, 409)
         running = d.create(tiny_case("running", end=1e3), start=True)["id"]
@@ -382,7 +386,7 @@ class ClientCommandTests(DaemonTestCase):
         r = self.ctl("clone", source, "-", stdin='{"name": "piped"}')
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertEqual(self.d.status(r.stdout.strip())["name"], "piped")
-        self.assertEqual(self.ctl("clone", source, "missing.json").returncode, 1)
+        self.assertEqual(self.ctl("clone", source, "missing.json").returncode, 2)
         self.assertEqual(self.ctl("clone", "0123456789abcdef", path).returncode, 1)
         self.assertEqual(self.ctl("clone", "--help").returncode, 0)
 
