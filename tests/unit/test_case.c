@@ -380,6 +380,9 @@ static void explicit_mesh_errors(void)
     expect_variant("/parts/2/mesh/nodes/4", "[5, 5]", "/parts/2/mesh/nodes/4",
                    "not used by any triangle");
     expect_variant("/parts/2/mesh/triangles", NULL, "/parts/2/mesh", "\"triangles\"");
+    /* a repeated triangle (in any order) would double its mass and stiffness */
+    expect_variant("/parts/2/mesh/triangles/2", "[2, 1, 3]", "/parts/2/mesh/triangles/2",
+                   "same nodes as triangle 1");
 }
 
 static void gmsh_errors(void)

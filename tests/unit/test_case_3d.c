@@ -397,6 +397,9 @@ static void explicit_mesh_errors(void)
          "at least 4 nodes"},
         {"/tetrahedra", NULL, "/parts/0/mesh", "missing required \"tetrahedra\""},
         {"/triangles", "[[0, 1, 2]]", "/parts/0/mesh/triangles", "unknown key \"triangles\""},
+        /* a repeated tetrahedron (in any order) would double its mass and stiffness */
+        {"/tetrahedra/2", "[3, 2, 1, 0]", "/parts/0/mesh/tetrahedra/2",
+         "same nodes as tetrahedron 0"},
     };
     expect_shape_edits("mesh", two_tets, bad, sizeof bad / sizeof bad[0]);
 }
