@@ -276,6 +276,28 @@ static void two_parts_build_or_wait_for_contact(void)
     problems_free(&p);
 }
 
+/* A second body placed into the block is refused at its part, whether it
+ * reaches in partly or sits exactly on the block; one just touching it
+ * builds (the lid above, flush on the top face). */
+static void bodies_overlapping_at_start(void)
+{
+    const char *lid = "{'name': 'lid', 'material': 'rock', 'box': {'origin': [0, 0, 0.3], "
+                      "'size': [0.1, 0.2, 0.1], 'divisions': [2, 3, 1]}}";
+    json_t *doc = load(base3d);
+    edit(doc, "/parts/1", load(lid));
+    case_info info;
+    fdem_model *m = build_ok(doc, &info);
+    if (m) fdem_model_destroy(m);
+    doc = load(base3d);
+    edit(doc, "/parts/1", load(lid));
+    edit(doc, "/parts/1/box/origin/2", json_real(0.25));
+    expect_doc(doc, GiB, 422, "/parts/1", "part 1 overlaps part 0 at the start");
+    doc = load(base3d);
+    edit(doc, "/parts/1", load("{'name': 'twin', 'material': 'rock', 'box': {'origin': [0, 0, 0],"
+                               " 'size': [0.1, 0.2, 0.3], 'divisions': [2, 3, 4]}}"));
+    expect_doc(doc, GiB, 422, "/parts/1", "overlaps part 0");
+}
+
 /* ------------------------------------------------------------- problems */
 
 static void dimension_must_be_2_or_3(void)
@@ -511,7 +533,7 @@ static void all_problems_are_collected(void)
 
 CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds),
            T(cylinder_builds), T(explicit_mesh_builds_in_either_orientation),
-           T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact),
+           T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact), T(bodies_overlapping_at_start),
            T(dimension_must_be_2_or_3), T(vectors_have_three_components),
            T(shapes_of_the_other_dimension), T(box_errors), T(sphere_and_cylinder_errors),
            T(explicit_mesh_errors), T(gmsh_errors), T(fracture_builds_a_joint_on_every_interior_face),
