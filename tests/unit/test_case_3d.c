@@ -300,6 +300,14 @@ static void bodies_overlapping_at_start(void)
 
 /* ------------------------------------------------------------- problems */
 
+/* Values each > 0 whose ratio has no finite wave speed leave no stable
+ * step: named at the material, not at the document's root. */
+static void material_without_a_wave_speed(void)
+{
+    expect_variant("/materials/rock/density", "5e-324", "/materials/rock", "wave speed");
+    expect_variant("/materials/rock/young", "5e-324", "/materials/rock", "wave speed");
+}
+
 static void dimension_must_be_2_or_3(void)
 {
     expect_variant("/dimension", "4", "/dimension", "2 or 3, got 4");
@@ -534,7 +542,7 @@ static void all_problems_are_collected(void)
 CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds),
            T(cylinder_builds), T(explicit_mesh_builds_in_either_orientation),
            T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact), T(bodies_overlapping_at_start),
-           T(dimension_must_be_2_or_3), T(vectors_have_three_components),
+           T(material_without_a_wave_speed), T(dimension_must_be_2_or_3), T(vectors_have_three_components),
            T(shapes_of_the_other_dimension), T(box_errors), T(sphere_and_cylinder_errors),
            T(explicit_mesh_errors), T(gmsh_errors), T(fracture_builds_a_joint_on_every_interior_face),
            T(absurd_3d_divisions_are_refused_by_size), T(memory_estimate_3d_is_not_low),
