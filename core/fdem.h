@@ -408,6 +408,12 @@ const double *fdem_constraint_forces(const fdem_model *model);
  * for each such one); -1 for a constraint finalize did not count. */
 int fdem_constraint_node_count(const fdem_model *model, int c);
 
+/* Parts placed inside each other at t = 0 (after finalize; see
+ * start_overlap.c): 1 with a point (dimension numbers) of part *inner that
+ * lies inside an element of part *outer, 0 when no two parts do more than
+ * touch, -1 when out of memory. */
+int fdem_find_start_overlap(const fdem_model *model, int *inner, int *outer, double point[3]);
+
 /* ------------------------------------------------------------- checkpoints */
 
 /* The dynamic state (step, time, dt, positions, velocities, joint and

@@ -243,6 +243,31 @@ static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
     return 0;
 }
 
+/* Parts placed inside each other would start with the penalty energy of
+ * the whole overlap (start_overlap.c): named at the later part of the pair. */
+static int case_check_start_overlap(case_doc *doc, const fdem_model *model)
+{
+    int inner = -1, outer = -1;
+    double p[3] = {0, 0, 0};
+    int found = fdem_find_start_overlap(model, &inner, &outer, p);
+    if (found == 0) return 1;
+    if (found < 0) {
+        case_problem(doc, "/parts", "out of memory");
+        return 0;
+    }
+    char at[CASE_POINTER], where[96];
+    int later = inner > outer ? inner : outer; /* the pair's later part: one pointer per pair */
+    pointer_join_index(at, sizeof at, "/parts", later);
+    if (doc->dimension == 3)
+        snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", p[0], p[1], p[2]);
+    else
+        snprintf(where, sizeof where, "(%.6g, %.6g)", p[0], p[1]);
+    case_problem(doc, at, "part %d overlaps part %d at the start: the point %s of part %d "
+                          "lies inside an element of part %d; bodies must start apart or just "
+                          "touching", later, inner + outer - later, where, inner, outer);
+    return 0;
+}
+
 static fdem_model *case_build_model(case_doc *doc, case_info *info)
 {
     fdem_model *model = fdem_model_create();
@@ -272,7 +297,9 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
             case_choose_dt(doc, model, info);
     }
     /* Both checks, whatever the first finds: one answer names every problem. */
-    if (ok) ok = case_check_selections(doc, model) & (case_choose_dt(doc, model, info) == 0);
+    if (ok)
+        ok = case_check_selections(doc, model) & (case_choose_dt(doc, model, info) == 0) &
+             case_check_start_overlap(doc, model);
     if (!ok) {
         fdem_model_destroy(model);
         return NULL;

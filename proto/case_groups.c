@@ -81,6 +81,10 @@ static void read_group_material(case_doc *doc, case_part *part, int count, const
                                "\"fracture\" block", json_string_value(value));
     if (g < 0 || !part->element_material) return;
     const gmsh_group *group = &part->groups.group[g];
+    if (group->element_count == 0) { /* the material would silently apply to nothing */
+        case_problem(doc, ptr, "the group \"%.64s\" has no element of the mesh", name);
+        return;
+    }
     for (int k = 0; k < group->element_count; k++)
         if (group->elements[k] < count) part->element_material[group->elements[k]] = mat;
 }

@@ -125,6 +125,12 @@ static void material_read(case_doc *doc, const char *name, const json_t *value,
         material_require(doc, isfinite(10 * def->young), ptr, "young", "is too large",
                          def->young);
     }
+    /* each > 0, yet e.g. a subnormal density leaves no finite wave speed
+     * and so no stable step: the material is at fault, not the case */
+    double speed = def->young > 0 && def->density > 0 ? sqrt(def->young / def->density) : 1;
+    if (!(speed > 0 && isfinite(speed)))
+        case_problem(doc, ptr, "young / density (%g / %g) gives no finite wave speed, so no "
+                               "stable time step", def->young, def->density);
     material_read_poisson(doc, value, ptr, &def->poisson);
     if (case_number_member(doc, value, ptr, "damping", 0, &def->damping))
         material_require(doc, def->damping >= 0, ptr, "damping", "must be >= 0", def->damping);

@@ -150,6 +150,62 @@ static int mesh_validate(case_part *part, const mesh_kind *kind, fdem_error *err
     return fdem_mesh_validate(&part->mesh, &reoriented, err);
 }
 
+/* A cell's nodes in increasing order (unused corners -1) and its index:
+ * equal keys are the same element listed twice, in any node order. */
+typedef struct cell_key {
+    int32_t nodes[4];
+    int index;
+} cell_key;
+
+static int cell_key_compare(const void *pa, const void *pb)
+{
+    const cell_key *a = pa, *b = pb;
+    for (int k = 0; k < 4; k++)
+        if (a->nodes[k] != b->nodes[k]) return a->nodes[k] < b->nodes[k] ? -1 : 1;
+    return (a->index > b->index) - (a->index < b->index);
+}
+
+static cell_key cell_key_of(const mesh_kind *kind, const int32_t *cells, int t)
+{
+    cell_key c = {{-1, -1, -1, -1}, t};
+    memcpy(c.nodes, cells + (size_t)kind->corners * (size_t)t, (size_t)kind->corners * sizeof *cells);
+    for (int i = 1; i < kind->corners; i++) /* insertion sort of 3 or 4 */
+        for (int j = i; j > 0 && c.nodes[j - 1] > c.nodes[j]; j--) {
+            int32_t s = c.nodes[j];
+            c.nodes[j] = c.nodes[j - 1];
+            c.nodes[j - 1] = s;
+        }
+    return c;
+}
+
+/* A repeated element would carry its mass and stiffness twice and pass
+ * every other check (a fracturing part would find its faces "shared by
+ * more than two"), so it is named here: the later of the first pair
+ * found, with the earlier in the message (the list has one problem, as
+ * the engine's checks give). gmsh files need no such check:
+ * the reader merges their repeats (2.2 writes one per physical group). */
+static void mesh_check_repeats(case_doc *doc, const mesh_kind *kind, mesh_arrays a,
+                               const char *cells_ptr)
+{
+    int n = *a.cell_count;
+    cell_key *keys = malloc((size_t)n * sizeof *keys);
+    if (!keys) {
+        case_problem(doc, cells_ptr, "out of memory");
+        return;
+    }
+    for (int t = 0; t < n; t++) keys[t] = cell_key_of(kind, *a.cells, t);
+    qsort(keys, (size_t)n, sizeof *keys, cell_key_compare);
+    for (int t = 1; t < n; t++)
+        if (memcmp(keys[t].nodes, keys[t - 1].nodes, sizeof keys[t].nodes) == 0) {
+            char at[CASE_POINTER];
+            pointer_join_index(at, sizeof at, cells_ptr, keys[t].index);
+            case_problem(doc, at, "%s %d has the same nodes as %s %d", kind->cell_word,
+                         keys[t].index, kind->cell_word, keys[t - 1].index);
+            break;
+        }
+    free(keys);
+}
+
 /* A problem about item err->item of the mesh at `mesh_ptr`: under its
  * "nodes" or element list when it names one, else at the mesh itself. */
 static void mesh_item_problem(case_doc *doc, const mesh_kind *kind, const fdem_error *err,
@@ -188,7 +244,10 @@ void case_read_mesh(case_doc *doc, case_part *part, const json_t *mesh, const ch
     int ok = mesh_read_nodes(doc, kind, a, nodes, nodes_ptr);
     ok &= mesh_read_cells(doc, kind, a, cells, cells_ptr);
     fdem_error err = {0};
-    if (ok && mesh_validate(part, kind, &err) != 0) mesh_item_problem(doc, kind, &err, ptr);
+    if (ok && mesh_validate(part, kind, &err) != 0)
+        mesh_item_problem(doc, kind, &err, ptr);
+    else if (ok)
+        mesh_check_repeats(doc, kind, a, cells_ptr);
 }
 
 /* ---------------------------------------------------------------- gmsh */

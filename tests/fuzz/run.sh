@@ -42,6 +42,8 @@ import json, sys
 text = open(sys.argv[1]).read()
 doc = {"materials": {"m": {"density": 1000, "young": 1e9, "poisson": 0.2}},
        "parts": [{"material": "m", "gmsh": text}], "time": {"end": 0.01}}
+if "cube" in sys.argv[1]:  # the tetrahedral files: a 3D case
+    doc["dimension"] = 3
 open(sys.argv[2], "w").write(json.dumps(doc))
 PY
 done
@@ -58,6 +60,16 @@ cat > "$corpus/inline-mesh.json" <<'JSON'
    "triangles": [[0,1,2],[1,3,2]]}}, {"material": "r", "disc": {"center": [3, 0], "radius": 1, "divisions": 12}}],
  "constraints": [{"box": [2, -2, 4, 2], "force": [1, 0]}], "gravity": [0, -9.81],
  "time": {"end": 1e-3, "dt": 1e-7, "safety": 0.9}, "output": {"interval": 1e-4}}
+JSON
+cat > "$corpus/inline-tets.json" <<'JSON'
+{"dimension": 3, "materials": {"r": {"density": 2700, "young": 3e10, "poisson": 0.25, "fracture":
+  {"tensile_strength": 5e6, "cohesion": 2e7, "friction_angle": 30, "energy_I": 20, "energy_II": 100}}},
+ "parts": [{"material": "r", "fracture": true, "mesh": {"nodes": [[0,0,0],[1,0,0],[0,1,0],[0,0,1],[1,1,1]],
+   "tetrahedra": [[0,1,2,3],[1,2,3,4]]}},
+  {"material": "r", "sphere": {"center": [3, 0, 0], "radius": 1, "divisions": 8}, "velocity": [-1, 0, 0]},
+  {"material": "r", "cylinder": {"axis": "y", "radius": 0.5, "length": 1, "divisions": [8, 1]}, "velocity": [0, 0, 1]}],
+ "constraints": [{"box": [-1, -1, -1, 0.1, 2, 0.1], "fix": ["x", "z"]}, {"box": [2, -2, -2, 4, 2, 2], "force": [1, 0, 0]}],
+ "gravity": [0, 0, -9.81], "time": {"end": 1e-3, "dt": 1e-7}, "output": {"interval": 1e-4}}
 JSON
 printf '{"time": {"end": 1e999}}' > "$corpus/inline-overflow.json"
 printf '[[[[[[[[[[' > "$corpus/inline-deep.json"

@@ -222,6 +222,15 @@ class Solid3DTest(DaemonTestCase):
              "/parts/0/mesh/tetrahedra/0"),
             (solid_case("c", BOX, constraints=[{"box": [0, 0, 1, 1], "fix": ["z"]}]),
              "/constraints/0/box"),
+            # the same tetrahedron twice, and a second body inside the first
+            (solid_case("t", {"mesh": {"nodes": [[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]],
+                                       "tetrahedra": [[0, 1, 2, 3], [3, 1, 2, 0]]}}),
+             "/parts/0/mesh/tetrahedra/1"),
+            (dict(solid_case("o", BOX), parts=[
+                {"name": "a", "material": "rock", **BOX},
+                {"name": "b", "material": "rock",
+                 "box": {"origin": [0.05, 0, 0], "size": [0.1, 0.1, 0.1], "divisions": [1, 1, 1]}}]),
+             "/parts/1"),
         ]
         for case, pointer in bad:
             status, body = self.d.json("POST", "/cases", case)

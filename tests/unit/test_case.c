@@ -380,6 +380,27 @@ static void explicit_mesh_errors(void)
     expect_variant("/parts/2/mesh/nodes/4", "[5, 5]", "/parts/2/mesh/nodes/4",
                    "not used by any triangle");
     expect_variant("/parts/2/mesh/triangles", NULL, "/parts/2/mesh", "\"triangles\"");
+    /* a repeated triangle (in any order) would double its mass and stiffness */
+    expect_variant("/parts/2/mesh/triangles/2", "[2, 1, 3]", "/parts/2/mesh/triangles/2",
+                   "same nodes as triangle 1");
+}
+
+/* The platen lowered into the disc is refused at its part; lowered until
+ * it rests on the disc's top vertex it builds. */
+static void bodies_overlapping_at_start(void)
+{
+    expect_variant("/parts/1/rectangle/origin", "[-0.01, 0.02]", "/parts/1",
+                   "part 1 overlaps part 0 at the start");
+    json_t *doc = load(base_text);
+    edit(doc, "/parts/1/rectangle/origin", load("[-0.01, 0.025]"));
+    problems p;
+    case_info info;
+    fdem_model *m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(m != NULL, "resting on the disc: %d problems", p.count);
+    if (!m) dump_problems(&p);
+    problems_free(&p);
+    fdem_model_destroy(m);
 }
 
 static void gmsh_errors(void)
@@ -688,7 +709,8 @@ CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(malformed_json_is_400), T(deep_nesting_is_400), T(duplicate_keys_are_400),
            T(overflowing_numbers_are_400), T(not_an_object), T(unknown_keys_are_named),
            T(wrong_types_are_named), T(material_ranges), T(unknown_material_is_suggested),
-           T(part_shapes), T(explicit_mesh_errors), T(gmsh_errors), T(part_flags_and_names),
+           T(part_shapes), T(explicit_mesh_errors),
+           T(bodies_overlapping_at_start), T(gmsh_errors), T(part_flags_and_names),
            T(constraint_errors), T(velocity_constraint_may_leave_a_component_free),
            T(time_errors), T(dt_above_stable_step), T(output_errors),
            T(absurd_divisions_are_refused_by_size), T(memory_estimate_is_not_low),

@@ -276,7 +276,37 @@ static void two_parts_build_or_wait_for_contact(void)
     problems_free(&p);
 }
 
+/* A second body placed into the block is refused at its part, whether it
+ * reaches in partly or sits exactly on the block; one just touching it
+ * builds (the lid above, flush on the top face). */
+static void bodies_overlapping_at_start(void)
+{
+    const char *lid = "{'name': 'lid', 'material': 'rock', 'box': {'origin': [0, 0, 0.3], "
+                      "'size': [0.1, 0.2, 0.1], 'divisions': [2, 3, 1]}}";
+    json_t *doc = load(base3d);
+    edit(doc, "/parts/1", load(lid));
+    case_info info;
+    fdem_model *m = build_ok(doc, &info);
+    if (m) fdem_model_destroy(m);
+    doc = load(base3d);
+    edit(doc, "/parts/1", load(lid));
+    edit(doc, "/parts/1/box/origin/2", json_real(0.25));
+    expect_doc(doc, GiB, 422, "/parts/1", "part 1 overlaps part 0 at the start");
+    doc = load(base3d);
+    edit(doc, "/parts/1", load("{'name': 'twin', 'material': 'rock', 'box': {'origin': [0, 0, 0],"
+                               " 'size': [0.1, 0.2, 0.3], 'divisions': [2, 3, 4]}}"));
+    expect_doc(doc, GiB, 422, "/parts/1", "overlaps part 0");
+}
+
 /* ------------------------------------------------------------- problems */
+
+/* Values each > 0 whose ratio has no finite wave speed leave no stable
+ * step: named at the material, not at the document's root. */
+static void material_without_a_wave_speed(void)
+{
+    expect_variant("/materials/rock/density", "5e-324", "/materials/rock", "wave speed");
+    expect_variant("/materials/rock/young", "5e-324", "/materials/rock", "wave speed");
+}
 
 static void dimension_must_be_2_or_3(void)
 {
@@ -397,6 +427,9 @@ static void explicit_mesh_errors(void)
          "at least 4 nodes"},
         {"/tetrahedra", NULL, "/parts/0/mesh", "missing required \"tetrahedra\""},
         {"/triangles", "[[0, 1, 2]]", "/parts/0/mesh/triangles", "unknown key \"triangles\""},
+        /* a repeated tetrahedron (in any order) would double its mass and stiffness */
+        {"/tetrahedra/2", "[3, 2, 1, 0]", "/parts/0/mesh/tetrahedra/2",
+         "same nodes as tetrahedron 0"},
     };
     expect_shape_edits("mesh", two_tets, bad, sizeof bad / sizeof bad[0]);
 }
@@ -508,8 +541,8 @@ static void all_problems_are_collected(void)
 
 CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds),
            T(cylinder_builds), T(explicit_mesh_builds_in_either_orientation),
-           T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact),
-           T(dimension_must_be_2_or_3), T(vectors_have_three_components),
+           T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact), T(bodies_overlapping_at_start),
+           T(material_without_a_wave_speed), T(dimension_must_be_2_or_3), T(vectors_have_three_components),
            T(shapes_of_the_other_dimension), T(box_errors), T(sphere_and_cylinder_errors),
            T(explicit_mesh_errors), T(gmsh_errors), T(fracture_builds_a_joint_on_every_interior_face),
            T(absurd_3d_divisions_are_refused_by_size), T(memory_estimate_3d_is_not_low),

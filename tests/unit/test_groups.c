@@ -204,6 +204,53 @@ static void group_selector(void)
             }
 }
 
+/* The text of `file` with one more physical name: "ghost", of dimension
+ * dim, whose tag no element carries (gmsh writes such a name when a
+ * physical group's entities were deleted or never meshed). */
+static json_t *with_ghost_group(const char *file, int dim)
+{
+    size_t length = 0;
+    char *raw = read_file(file, &length);
+    char *text = raw ? malloc(length + 1) : NULL; /* read_file's bytes have no NUL */
+    if (text) memcpy(text, raw, length), text[length] = 0;
+    free(raw);
+    const char *head = text ? strstr(text, "$PhysicalNames\n") : NULL;
+    const char *end = text ? strstr(text, "$EndPhysicalNames") : NULL;
+    if (!head || !end) {
+        free(text);
+        return json_string("");
+    }
+    const char *names = head + strlen("$PhysicalNames\n");
+    char *after_count = NULL;
+    long count = strtol(names, &after_count, 10);
+    size_t size = length + 64;
+    char *out = malloc(size);
+    snprintf(out, size, "%.*s%ld%.*s%d 99 \"ghost\"\n%s", (int)(names - text), text, count + 1,
+             (int)(end - after_count), after_count, dim, end);
+    json_t *string = json_string(out);
+    free(out);
+    free(text);
+    return string;
+}
+
+/* A named group with no element of the mesh is refused where a case names
+ * it, for each use: a material on it would silently apply to nothing. */
+static void empty_group_is_refused(void)
+{
+    for (int dim = 2; dim <= 3; dim++)
+        for (int v = 0; v < 2; v++) {
+            const char *file = dim == 3 ? cube_files[v] : bar_files[v];
+            json_t *doc = bar_case(file, dim);
+            edit(doc, "/parts/0/gmsh", with_ghost_group(file, dim));
+            edit(doc, "/parts/0/materials", load("{'ghost': 'stiff'}"));
+            expect_doc(doc, GiB, 422, "/parts/0/materials/ghost", "has no element of the mesh");
+            doc = bar_case(file, dim);
+            edit(doc, "/parts/0/gmsh", with_ghost_group(file, dim - 1));
+            edit(doc, "/constraints", load("[{'part': 'bar', 'group': 'ghost', 'fix': ['x']}]"));
+            expect_doc(doc, GiB, 422, "/constraints/0/group", "has no node of the mesh");
+        }
+}
+
 /* Mean of `component` of the element strain over elements whose centroid
  * x lies in (lo, hi). */
 static double mean_strain(const fdem_model *m, const double *strain, double lo, double hi)
@@ -566,6 +613,7 @@ static void jointed_block_example(void)
     fdem_model_destroy(m);
 }
 
-CHECK_MAIN(T(groups_2d), T(groups_3d), T(group_selector), T(two_materials_bonded),
+CHECK_MAIN(T(groups_2d), T(groups_3d), T(group_selector), T(empty_group_is_refused),
+           T(two_materials_bonded),
            T(joint_set_on_group), T(weibull_statistics), T(weibull_reproducible),
            T(weibull_follows_faces), T(jointed_block_example))
