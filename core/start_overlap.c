@@ -10,9 +10,11 @@
  * candidates are the pairs of elements of different parts whose bounding
  * circles (spheres) touch, from the engine's own NBS detection (linear in
  * the element count); a pair overlaps when a vertex or the centroid of
- * one lies inside the other by more than a thousandth of its depth
- * (barycentric coordinates), so bodies placed touching, up to rounding,
- * pass. Two simplices can cross without either holding a vertex or the
+ * one lies inside the other by more than a tenth of its depth
+ * (barycentric coordinates): bodies placed touching pass, and so do the
+ * shallow overlaps of curved boundaries meshed apart (a disc's 16-gon in
+ * a hole's 16-gon: a vertex up to a chord's sagitta, about 6 % of an
+ * element's depth, inside), which contact pushes apart at once. Two simplices can cross without either holding a vertex or the
  * centroid of the other, but overlapping bodies always have some pair of
  * elements that does not (the deepest ones).
  */
@@ -24,7 +26,7 @@
 #include "nbs.h"
 
 /* Barycentric margin: a point is inside when every coordinate exceeds it. */
-#define START_OVERLAP_MARGIN 1e-3
+#define START_OVERLAP_MARGIN 0.1
 
 static const double *corner_of(const fdem_model *m, int e, int k)
 {
