@@ -14,9 +14,10 @@
  * (barycentric coordinates): bodies placed touching pass, and so do the
  * shallow overlaps of curved boundaries meshed apart (a disc's 16-gon in
  * a hole's 16-gon: a vertex up to a chord's sagitta, about 6 % of an
- * element's depth, inside), which contact pushes apart at once. Two simplices can cross without either holding a vertex or the
- * centroid of the other, but overlapping bodies always have some pair of
- * elements that does not (the deepest ones).
+ * element's depth, inside), which contact pushes apart at once. Two
+ * simplices can cross without either holding a vertex or the centroid of
+ * the other; bodies sunk into each other by more than about a tenth of an
+ * element always have some pair that does not (the deepest ones).
  */
 #include <math.h>
 #include <stdlib.h>
