@@ -109,6 +109,20 @@ static inline void expect_doc(json_t *doc, size_t limit, int status, const char 
     expect_refused(m, &p, status, pointer, needle);
 }
 
+/* Builds `doc` (and frees it), expecting a model: NULL after reporting
+ * the problems. `info` may be NULL. */
+static inline fdem_model *expect_built(json_t *doc, case_info *info)
+{
+    problems p;
+    case_info own;
+    fdem_model *m = build_json(doc, GiB, info ? info : &own, &p);
+    json_decref(doc);
+    CHECK(m != NULL, "refused with %d problems", p.count);
+    if (!m) dump_problems(&p);
+    problems_free(&p);
+    return m;
+}
+
 /* `base` (single-quoted JSON) with `value` (single-quoted, or NULL to
  * delete) at `at`, expected to fail with a 422 at `pointer` mentioning
  * `needle`. */

@@ -391,16 +391,9 @@ static void bodies_overlapping_at_start(void)
 {
     expect_variant("/parts/1/rectangle/origin", "[-0.01, 0.02]", "/parts/1",
                    "part 1 overlaps part 0 at the start");
-    json_t *doc = load(base_text);
+    json_t *doc = load(base_text); /* resting on the disc */
     edit(doc, "/parts/1/rectangle/origin", load("[-0.01, 0.025]"));
-    problems p;
-    case_info info;
-    fdem_model *m = build_json(doc, GiB, &info, &p);
-    json_decref(doc);
-    CHECK(m != NULL, "resting on the disc: %d problems", p.count);
-    if (!m) dump_problems(&p);
-    problems_free(&p);
-    fdem_model_destroy(m);
+    fdem_model_destroy(expect_built(doc, NULL));
 }
 
 static void gmsh_errors(void)
@@ -462,13 +455,7 @@ static void velocity_constraint_may_leave_a_component_free(void)
 {
     json_t *doc = load(base_text);
     edit(doc, "/constraints/0/velocity", load("[null, -0.05]"));
-    problems p;
-    case_info info;
-    fdem_model *m = build_json(doc, GiB, &info, &p);
-    json_decref(doc);
-    CHECK(m != NULL, "%d problems", p.count);
-    if (m) fdem_model_destroy(m);
-    problems_free(&p);
+    fdem_model_destroy(expect_built(doc, NULL));
 }
 
 /* ------------------------------------------------------ time, output */

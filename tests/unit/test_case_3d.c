@@ -73,17 +73,6 @@ static void expect_shape_edits(const char *key, const char *shape, const shape_e
     }
 }
 
-static fdem_model *build_ok(json_t *doc, case_info *info)
-{
-    problems p;
-    fdem_model *m = build_json(doc, GiB, info, &p);
-    json_decref(doc);
-    CHECK(m != NULL, "%d problems", p.count);
-    if (!m) dump_problems(&p);
-    problems_free(&p);
-    return m;
-}
-
 /* The model holds exactly the generator's mesh: same counts, same nodes. */
 static void check_same_mesh(const fdem_model *m, const fdem_tet_mesh *want)
 {
@@ -103,7 +92,7 @@ static void check_same_mesh(const fdem_model *m, const fdem_tet_mesh *want)
 static void box_case_builds(void)
 {
     case_info info;
-    fdem_model *m = build_ok(load(base3d), &info);
+    fdem_model *m = expect_built(load(base3d), &info);
     if (!m) return;
     CHECK(fdem_get_dimension(m) == 3, "dimension %d", fdem_get_dimension(m));
     CHECK(fdem_nodes_per_element(m) == 4 && fdem_stress_components(m) == 6,
@@ -149,7 +138,7 @@ static void gravity_has_three_components(void)
     edit(doc, "/parts/0/velocity", NULL);
     edit(doc, "/gravity", load("[1, -2, -9.81]"));
     case_info info;
-    fdem_model *m = build_ok(doc, &info);
+    fdem_model *m = expect_built(doc, &info);
     if (!m) return;
     fdem_error err;
     CHECK(fdem_step(m, &err) == 0, "%s", err.message);
@@ -164,7 +153,7 @@ static void gravity_has_three_components(void)
 static void sphere_builds(void)
 {
     case_info info;
-    fdem_model *m = build_ok(with_shape("sphere", load("{'center': [1, 2, 3], 'radius': 0.05, "
+    fdem_model *m = expect_built(with_shape("sphere", load("{'center': [1, 2, 3], 'radius': 0.05, "
                                                        "'divisions': 12}")),
                              &info);
     if (!m) return;
@@ -180,7 +169,7 @@ static void sphere_builds(void)
 static void cylinder_builds(void)
 {
     case_info info;
-    fdem_model *m = build_ok(with_shape("cylinder", load("{'center': [0, 0, 0], 'axis': 'y', "
+    fdem_model *m = expect_built(with_shape("cylinder", load("{'center': [0, 0, 0], 'axis': 'y', "
                                                          "'radius': 0.05, 'length': 0.2, "
                                                          "'divisions': [16, 5]}")),
                              &info);
@@ -204,7 +193,7 @@ static void cylinder_builds(void)
 static void explicit_mesh_builds_in_either_orientation(void)
 {
     case_info info;
-    fdem_model *m = build_ok(with_shape("mesh", load(two_tets)), &info);
+    fdem_model *m = expect_built(with_shape("mesh", load(two_tets)), &info);
     if (m) {
         fdem_counts c = fdem_get_counts(m);
         CHECK(c.nodes == 5 && c.elements == 2, "nodes %d elements %d", c.nodes, c.elements);
@@ -213,7 +202,7 @@ static void explicit_mesh_builds_in_either_orientation(void)
     /* the second tetrahedron given with negative volume is turned round */
     json_t *mesh = load(two_tets);
     edit(mesh, "/tetrahedra/1", load("[2, 1, 3, 4]"));
-    m = build_ok(with_shape("mesh", mesh), &info);
+    m = expect_built(with_shape("mesh", mesh), &info);
     if (!m) return;
     const int32_t *tet = fdem_tetrahedra(m);
     const double *x = fdem_initial_positions(m);
@@ -241,7 +230,7 @@ static void gmsh_tetrahedra_build(void)
         char *text = read_file(files[f], &length);
         if (!text) continue;
         case_info info;
-        fdem_model *m = build_ok(with_shape("gmsh", json_stringn(text, length)), &info);
+        fdem_model *m = expect_built(with_shape("gmsh", json_stringn(text, length)), &info);
         free(text);
         if (!m) continue;
         fdem_counts c = fdem_get_counts(m);
@@ -286,7 +275,7 @@ static void bodies_overlapping_at_start(void)
     json_t *doc = load(base3d);
     edit(doc, "/parts/1", load(lid));
     case_info info;
-    fdem_model *m = build_ok(doc, &info);
+    fdem_model *m = expect_built(doc, &info);
     if (m) fdem_model_destroy(m);
     doc = load(base3d);
     edit(doc, "/parts/1", load(lid));
@@ -458,7 +447,7 @@ static void fracture_builds_a_joint_on_every_interior_face(void)
     json_t *doc = load(base3d);
     edit(doc, "/parts/0/fracture", json_true());
     case_info info;
-    fdem_model *m = build_ok(doc, &info);
+    fdem_model *m = expect_built(doc, &info);
     if (m) {
         fdem_counts c = fdem_get_counts(m);
         CHECK(c.elements == 144 && c.nodes == 4 * 144, "%d elements, %d nodes", c.elements,

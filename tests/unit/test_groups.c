@@ -156,18 +156,6 @@ static json_t *bar_case(const char *file, int dimension)
     return doc;
 }
 
-static fdem_model *build_or_report(json_t *doc)
-{
-    problems p;
-    case_info info;
-    fdem_model *m = build_json(doc, GiB, &info, &p);
-    json_decref(doc);
-    CHECK(m != NULL, "refused with %d problems", p.count);
-    if (!m) dump_problems(&p);
-    problems_free(&p);
-    return m;
-}
-
 /* {"part", "group"} selects exactly the nodes on the group: every copy of
  * them in a fracturing part, whatever the group's dimension. */
 static void group_selector(void)
@@ -182,7 +170,7 @@ static void group_selector(void)
                           " {'part': 'bar', 'group': 'interface', 'fix': ['x']},"
                           " {'part': 'bar', 'group': 'origin', 'fix': ['y']},"
                           " {'part': 'bar', 'group': 'soft', 'fix': ['y']}]"));
-                fdem_model *m = build_or_report(doc);
+                fdem_model *m = expect_built(doc, NULL);
                 if (!m) continue;
                 const double *x = fdem_initial_positions(m);
                 fdem_counts c = fdem_get_counts(m);
@@ -295,7 +283,7 @@ static void two_materials_bonded(void)
                              " {'part': 'bar', 'group': 'right', 'force': [0, 0]}]"));
         edit(doc, dim == 3 ? "/constraints/4/force/0" : "/constraints/2/force/0",
              json_real(sigma * area));
-        fdem_model *m = build_or_report(doc);
+        fdem_model *m = expect_built(doc, NULL);
         if (!m) continue;
         fdem_counts c = fdem_get_counts(m);
         double *strain = malloc(sizeof(double) * (size_t)fdem_stress_components(m) *
@@ -341,7 +329,7 @@ static void joint_set_on_group(void)
             edit(doc, "/parts/0/fracture", json_true());
             edit(doc, "/parts/0/discontinuities",
                  load("{'interface': {'tensile_strength': 1e5, 'cohesion': 2e5}}"));
-            fdem_model *m = build_or_report(doc);
+            fdem_model *m = expect_built(doc, NULL);
             if (!m) continue;
             gmsh_groups g = {0};
             fdem_mesh mesh = {0};
@@ -394,7 +382,7 @@ static void weibull_statistics(void)
 {
     json_t *doc = load(weibull_plate);
     edit(doc, "/parts/0/rectangle/divisions", load("[100, 100]"));
-    fdem_model *m = build_or_report(doc);
+    fdem_model *m = expect_built(doc, NULL);
     if (!m) return;
     int N = m->joint_count;
     double sum = 0, sum_log = 0, sum_log2 = 0;
@@ -423,7 +411,7 @@ static fdem_model *pulled_plate(int seed, int threads)
 {
     json_t *doc = load(weibull_plate);
     edit(doc, "/materials/rock/fracture/variation/seed", json_integer(seed));
-    fdem_model *m = build_or_report(doc);
+    fdem_model *m = expect_built(doc, NULL);
     if (!m) return NULL;
     fdem_set_threads(m, threads);
     while (fdem_get_time(m) < 4e-5)
@@ -595,7 +583,7 @@ static void jointed_block_example(void)
     json_t *doc = json_loadb(text, length, 0, &error);
     free(text);
     edit(doc, "/time/end", json_real(1.6e-3));
-    fdem_model *m = build_or_report(doc);
+    fdem_model *m = expect_built(doc, NULL);
     if (!m) return;
     double peak = 0, width = 0.05, beta = M_PI / 6;
     while (fdem_get_time(m) < 1.6e-3 && fdem_step(m, NULL) == 0)
