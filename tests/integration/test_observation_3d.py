@@ -34,7 +34,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, Daemon, DaemonTestCase
+from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase
 
 STATE = "/cases/%s/state?fields=position,velocity,stress,damage"
 ROWS = {"kinetic": "kinetic_energy", "elastic": "elastic_energy", "joint": "joint_energy",
@@ -49,11 +49,16 @@ def example(name):
 
 
 def fracturing_disc():
+    """16349 steps, 16 joints broken by the end; under the sanitizers (each
+    step about ten times dearer) the platens go twice as fast for half the
+    time: 8175 steps, 8 joints broken, 5 fragments, so the CI stays within
+    its time."""
     case = example("brazilian-disc-3d.json")
+    speed, end = (0.4, 1e-4) if SLOW > 1 else (0.2, 2e-4)
     case["parts"][0]["cylinder"]["divisions"] = [16, 1]
-    case["constraints"][0]["velocity"] = [0, -0.2, 0]
-    case["constraints"][1]["velocity"] = [0, 0.2, 0]
-    case["time"]["end"] = 2e-4
+    case["constraints"][0]["velocity"] = [0, -speed, 0]
+    case["constraints"][1]["velocity"] = [0, speed, 0]
+    case["time"]["end"] = end
     return case
 
 
