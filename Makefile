@@ -11,7 +11,7 @@
 
 CC      ?= cc
 PYTHON  := /usr/bin/python3
-PKGS    := libmicrohttpd jansson hdf5 libcurl
+PKGS    := libmicrohttpd jansson hdf5 libcurl zlib
 
 ifeq ($(SAN),1)
 BUILD   := build-san

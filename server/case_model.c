@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "checkpoint_file.h"
 #include "io_thread.h"
 #include "persist.h"
 
@@ -130,9 +131,20 @@ static case_model_rc case_model_restore(server_case *c, fdem_model *model, int r
                     strerror(errno));
         return CASE_MODEL_OK;
     }
+    size_t payload = 0;
+    char damage[256] = "";
+    checkpoint_file_kind kind = checkpoint_file_open(ckpt, size, &payload, damage, sizeof damage);
+    if (kind == CHECKPOINT_FILE_DAMAGED) {
+        free(ckpt);
+        snprintf(err, errlen, "%s could not be restored: %s", name, damage);
+        return CASE_MODEL_BROKEN;
+    }
+    if (kind == CHECKPOINT_FILE_BARE)
+        fprintf(stderr, "fdemd: case %s: %s has no checksum (written before fdemd sealed its "
+                "checkpoints); restoring it on the engine's own checks\n", c->id, name);
     fdem_error e;
     memset(&e, 0, sizeof e);
-    int failed = fdem_checkpoint_read(model, ckpt, size, &e) != 0;
+    int failed = fdem_checkpoint_read(model, ckpt, payload, &e) != 0;
     free(ckpt);
     if (failed && case_model_out_of_memory(e.message))
         return CASE_MODEL_NO_MEMORY;

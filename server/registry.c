@@ -135,17 +135,6 @@ void case_release(server_case *c)
         case_free(c);
 }
 
-void *case_checkpoint_take(const fdem_model *m, size_t *size)
-{
-    *size = fdem_checkpoint_size(m);
-    void *buf = malloc(*size ? *size : 1);
-    if (buf && fdem_checkpoint_write(m, buf, *size) != 0) {
-        free(buf);
-        buf = NULL;
-    }
-    return buf;
-}
-
 /* ------------------------------------------------------------- listing */
 
 static int registry_append_locked(server_case *c)

@@ -176,7 +176,4 @@ void case_set_snapshots(server_case *c, int snapshots);
 void registry_worker_exited(server_case *c, case_state final_state);
 int id_is_valid(const char *s);
 
-/* fdem_checkpoint_write into a malloc'd buffer (NULL on failure). */
-void *case_checkpoint_take(const fdem_model *m, size_t *size);
-
 #endif

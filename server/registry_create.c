@@ -16,6 +16,7 @@
 #include <sys/stat.h>
 
 #include "case_model.h"
+#include "checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
 #include "persist.h"
@@ -144,7 +145,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         goto fail;
     }
     size_t ckpt_size = 0;
-    void *ckpt = case_checkpoint_take(model, &ckpt_size);
+    void *ckpt = checkpoint_file_take(model, &ckpt_size);
     snapshot *first = snapshot_take(model, info.fields);
     c->last_snapshot_step = c->last_checkpoint_step = fdem_get_step(model);
     if (io_create(c, first, ckpt, ckpt_size, err, errlen) != 0)

@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "case_model.h"
+#include "checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
 
@@ -139,7 +140,7 @@ static void worker_keep_end_checkpoint(server_case *c)
     int event_count = 0;
     fdem_event *events = worker_drain_events(c->model, &event_count);
     size_t size = 0;
-    void *ckpt = case_checkpoint_take(c->model, &size);
+    void *ckpt = checkpoint_file_take(c->model, &size);
     io_write_named_checkpoint(c, CASE_END_CHECKPOINT, events, event_count, ckpt, size);
 }
 
@@ -201,7 +202,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * makes progress between far-apart snapshots survive a crash too. */
         if (snap || now - clk->last_checkpoint >= registry_config()->checkpoint_every) {
             events = worker_drain_events(m, &event_count);
-            ckpt = case_checkpoint_take(m, &ckpt_size);
+            ckpt = checkpoint_file_take(m, &ckpt_size);
             c->last_checkpoint_step = fdem_get_step(m);
             clk->last_checkpoint = now;
         }
@@ -237,7 +238,7 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
         c->last_snapshot_step = step;
     }
     if ((why == EXIT_PAUSE || why == EXIT_STOP) && step != c->last_checkpoint_step) {
-        ckpt = case_checkpoint_take(c->model, &ckpt_size);
+        ckpt = checkpoint_file_take(c->model, &ckpt_size);
         c->last_checkpoint_step = step;
     }
     worker_publish(c, clk, worker_now(), 0);

@@ -16,6 +16,7 @@ import sys
 import tempfile
 import time
 import unittest
+import zlib
 
 import h5py
 
@@ -47,6 +48,20 @@ def daemon_on_tmpfs(test, size):
     test.addCleanup(d.close)
     d.start()
     return d, where
+
+
+def edit_checkpoint(path, offset, data, seal=True):
+    """Writes `data` at `offset` of a checkpoint.bin and, when `seal`, makes
+    its trailer ("FDCK" and the CRC-32 of the bytes before it) hold again,
+    as a deliberate edit would; without, the edit is damage."""
+    with open(path, "r+b") as f:
+        f.seek(offset)
+        f.write(data)
+        if seal:
+            f.seek(0)
+            body = f.read()[:-8]
+            f.seek(len(body))
+            f.write(b"FDCK" + zlib.crc32(body).to_bytes(4, "little"))
 
 
 def result_snapshots(daemon, case_id):
@@ -108,9 +123,9 @@ class StoredFilesTest(unittest.TestCase):
         paused = d.json("POST", "/cases/%s/pause" % cid)[1]
         self.assertEqual(d.stop()[0], 0)
         path = os.path.join(d.data_dir, cid, "checkpoint.bin")
-        with open(path, "r+b") as f:
-            f.seek(24)                      # int64 step after six int32
-            f.write((-5).to_bytes(8, "little", signed=True))
+        # int64 step after six int32, the checksum made to hold: the
+        # engine's own checks are what refuse it
+        edit_checkpoint(path, 24, (-5).to_bytes(8, "little", signed=True))
         d.start()
         st = d.status(cid)
         self.assertEqual(st["state"], "failed", st)
@@ -118,15 +133,66 @@ class StoredFilesTest(unittest.TestCase):
         self.assertEqual(st["snapshots"], paused["snapshots"])
         # Nothing was dropped: mend the checkpoint and the case is back.
         self.assertEqual(d.stop()[0], 0)
-        with open(path, "r+b") as f:
-            f.seek(24)
-            f.write(paused["step"].to_bytes(8, "little", signed=True))
+        edit_checkpoint(path, 24, paused["step"].to_bytes(8, "little", signed=True))
         d.start()
         st = d.status(cid)
         self.assertEqual(st["state"], "paused", st)
         self.assertEqual(st["snapshots"], paused["snapshots"])
         self.assertEqual(len(result_snapshots(d, cid)[0]), paused["snapshots"])
         self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_a_changed_byte_in_the_checkpoint_fails_the_case_and_mending_it_brings_it_back(self):
+        """A byte changed in the middle of a position is still a finite
+        number: without the checksum the case came back paused and carried
+        on from a state it never had."""
+        d = self.d
+        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] >= 3, what="3 snapshots")
+        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
+        self.assertEqual(d.stop()[0], 0)
+        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        good = open(path, "rb").read()
+        self.assertEqual(good[-8:-4], b"FDCK")
+        self.assertEqual(int.from_bytes(good[-4:], "little"), zlib.crc32(good[:-8]))
+        middle = len(good) // 2
+        edit_checkpoint(path, middle, bytes([good[middle] ^ 0x04]), seal=False)
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "failed", st)
+        self.assertIn("checkpoint.bin", st["error"])
+        self.assertIn("CRC-32", st["error"])
+        self.assertEqual(st["snapshots"], paused["snapshots"])
+        self.assertEqual(d.stop()[0], 0)
+        with open(path, "wb") as f:
+            f.write(good)
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "paused", st)
+        self.assertEqual(st["step"], paused["step"])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_a_checkpoint_from_before_the_checksum_is_restored(self):
+        """checkpoint.bin of an earlier daemon has no trailer: it is restored
+        on the engine's own checks, and the next checkpoint is sealed."""
+        d = self.d
+        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] >= 2, what="2 snapshots")
+        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
+        self.assertEqual(d.stop()[0], 0)
+        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        good = open(path, "rb").read()
+        with open(path, "wb") as f:
+            f.write(good[:-8])
+        d.start()
+        st = d.status(cid)
+        self.assertEqual(st["state"], "paused", st)
+        self.assertEqual(st["step"], paused["step"])
+        self.assertIn("has no checksum", d.log_tail())
+        d.json("POST", "/cases/%s/start" % cid)
+        d.wait(cid, lambda s: s["step"] > paused["step"], what="a step past the pause")
+        d.json("POST", "/cases/%s/pause" % cid)
+        self.assertEqual(d.stop()[0], 0)
+        self.assertEqual(open(path, "rb").read()[-8:-4], b"FDCK")
 
     def test_finished_case_edited_to_running_does_not_step_past_its_end(self):
         d = self.d

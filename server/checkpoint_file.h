@@ -1,0 +1,36 @@
+/*
+ * checkpoint_file.h - checkpoint.bin on disk: the engine's checkpoint bytes
+ * (core/checkpoint.c) followed by an 8-byte trailer, the magic "FDCK" and
+ * the CRC-32 (zlib's, little-endian) of the bytes before it.
+ *
+ * Contract:
+ *  - checkpoint_file_take() returns a malloc'd, sealed buffer of *size bytes
+ *    holding model m's state, or NULL without memory.
+ *  - checkpoint_file_open() checks a file's bytes: CHECKPOINT_FILE_SEALED
+ *    (the checksum holds; *payload is the engine's part), CHECKPOINT_FILE_BARE
+ *    (no trailer: a file of a daemon from before the checksum, all of it
+ *    the engine's) or CHECKPOINT_FILE_DAMAGED, with a message in err naming
+ *    the sums. A bare file is still checked by the engine's own reader
+ *    (sizes, counts, finite values); a file whose trailer was damaged reads
+ *    as bare and is then the wrong size for its model.
+ */
+#ifndef FDEMD_CHECKPOINT_FILE_H
+#define FDEMD_CHECKPOINT_FILE_H
+
+#include <stddef.h>
+
+#include "fdem.h"
+
+#define CHECKPOINT_FILE_TRAILER 8
+
+typedef enum {
+    CHECKPOINT_FILE_SEALED,
+    CHECKPOINT_FILE_BARE,
+    CHECKPOINT_FILE_DAMAGED
+} checkpoint_file_kind;
+
+void *checkpoint_file_take(const fdem_model *m, size_t *size);
+checkpoint_file_kind checkpoint_file_open(const void *bytes, size_t size, size_t *payload,
+                                          char *err, size_t errlen);
+
+#endif /* FDEMD_CHECKPOINT_FILE_H */
