@@ -369,21 +369,74 @@ double stage_clock(void)
 
 fdem_stage_times fdem_get_stage_times(const fdem_model *m) { return m->times; }
 
-/* Names the first node whose state is not finite and an element that uses it. */
+/* The most stressed element (the first whose stress is not finite, else
+ * the largest stress component) and its first node; -1 without elements. */
+static int element_most_stressed(const fdem_model *m, int *node)
+{
+    double s[6], most = -1;
+    const int comps = model_stress_comps(m);
+    int found = -1;
+    for (int e = 0; e < m->elem_count && most < INFINITY; e++) {
+        element_stress_one(m, e, s);
+        for (int q = 0; q < comps; q++) {
+            double size = isfinite(s[q]) ? fabs(s[q]) : INFINITY;
+            if (size > most) most = size, found = e;
+        }
+    }
+    if (found >= 0) *node = m->elem_node[(size_t)m->elem_nodes * (size_t)found];
+    return found;
+}
+
+/* The node with the largest position or velocity component. */
+static int node_farthest(const fdem_model *m, double *x_out, double *v_out)
+{
+    const size_t D = (size_t)m->dim;
+    int found = 0;
+    double most = -1;
+    for (int i = 0; i < m->node_count; i++)
+        for (size_t d = 0; d < D; d++) {
+            double size = fmax(fabs(m->pos[D * (size_t)i + d]), fabs(m->vel[D * (size_t)i + d]));
+            if (size > most) most = size, found = i;
+        }
+    double x = 0, v = 0;
+    for (size_t d = 0; d < D; d++) {
+        x = fmax(x, fabs(m->pos[D * (size_t)found + d]));
+        v = fmax(v, fabs(m->vel[D * (size_t)found + d]));
+    }
+    *x_out = x, *v_out = v;
+    return found;
+}
+
+/* Says where the step failed: at the first node whose state is not finite;
+ * when every node is finite, either the elastic energy overflowed (the most
+ * stressed element) or positions and velocities grew past what their sums
+ * can hold in double precision (the farthest node). */
 static void report_non_finite(fdem_model *m, double h, fdem_error *err)
 {
     int node = -1;
     const size_t D = (size_t)m->dim;
+    const long long step = (long long)m->step + 1;
     for (int i = 0; i < m->node_count && node < 0; i++)
         for (size_t d = 0; d < D; d++)
             if (!isfinite(m->pos[D * (size_t)i + d]) || !isfinite(m->vel[D * (size_t)i + d]))
                 node = i;
-    int elem = node >= 0 ? element_of_node(m, node) : -1;
-    model_error(err, FDEM_ITEM_ELEMENT, elem,
-                "the solution became non-finite at step %lld (t = %.6g s) in element %d (node %d) "
-                "with dt = %.6g s; the stable step is %.6g s: reduce time.safety or check the "
-                "material stiffness, penalty and applied loads",
-                (long long)m->step + 1, m->time + h, elem, node, h, m->stable_dt);
+    if (node >= 0 || !isfinite(m->elastic_energy)) {
+        int elem = node >= 0 ? element_of_node(m, node) : element_most_stressed(m, &node);
+        model_error(err, elem >= 0 ? FDEM_ITEM_ELEMENT : FDEM_ITEM_NONE, elem,
+                    "the solution became non-finite at step %lld (t = %.6g s) in element %d "
+                    "(node %d) with dt = %.6g s; the stable step is %.6g s: reduce time.safety "
+                    "or check the material stiffness, penalty and applied loads",
+                    step, m->time + h, elem, node, h, m->stable_dt);
+        return;
+    }
+    double x, v;
+    node = node_farthest(m, &x, &v);
+    int elem = element_of_node(m, node);
+    model_error(err, elem >= 0 ? FDEM_ITEM_ELEMENT : FDEM_ITEM_NONE, elem,
+                "the solution grew past what double precision can carry at step %lld "
+                "(t = %.6g s): node %d of element %d is %.3g m out and moves at %.3g m/s; check "
+                "the coordinates, initial velocities and applied loads",
+                step, m->time + h, node, elem, x, v);
 }
 
 /* Zeroes the force of every node the element pass adds to; the nodes of

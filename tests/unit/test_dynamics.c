@@ -209,6 +209,31 @@ static void checkpoint_with_a_bad_header_is_refused(void)
     fdem_model_destroy(m);
 }
 
+/* Two nodes moving at 1e308 m/s keep a finite position and velocity, but
+ * the finiteness check sums them and overflows: the step fails, and the
+ * error names one of them and its element. It said "element -1 (node -1)"
+ * when it looked only for a non-finite node. */
+static void overflow_of_finite_values_names_a_node(void)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
+    build_rectangle(m, mat, 0, 0, 0.1, 0.1, 3, 3);
+    build_finalize(m, 0.5);
+    fdem_error err;
+    CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+    m->vel[0] = m->vel[2] = 1e308;
+    CHECK(fdem_step(m, &err) < 0, "a step whose sums overflow passed");
+    int e = -1, node = -1;
+    const char *at = strstr(err.message, "node ");
+    CHECK(at && sscanf(at, "node %d of element %d", &node, &e) == 2, "message: %s", err.message);
+    CHECK((node == 0 || node == 1) && e >= 0 && e < m->elem_count, "node %d, element %d: %s",
+          node, e, err.message);
+    CHECK(err.kind == FDEM_ITEM_ELEMENT && err.item == e, "kind %d item %d", (int)err.kind,
+          err.item);
+    fdem_model_destroy(m);
+}
+
 CHECK_MAIN(T(free_fall_matches_half_g_t_squared), T(free_fall_with_changing_step),
            T(bar_period_is_4L_over_c), T(hanging_block_reaction_equals_weight),
-           T(checkpoint_round_trip_continues_identically), T(checkpoint_with_a_bad_header_is_refused))
+           T(checkpoint_round_trip_continues_identically), T(checkpoint_with_a_bad_header_is_refused),
+           T(overflow_of_finite_values_names_a_node))
