@@ -7,6 +7,7 @@
  * worker checkpoints on its way out), close the HDF5 files on the I/O
  * thread, and exit 0.
  */
+#include <arpa/inet.h>
 #include <errno.h>
 #include <getopt.h>
 #include <signal.h>
@@ -99,6 +100,9 @@ static int parse_listen(const char *s, fdemd_config *cfg)
     cfg->listen_host[colon - s] = '\0';
     if (strcmp(cfg->listen_host, "localhost") == 0)
         strcpy(cfg->listen_host, "127.0.0.1");
+    struct in_addr ipv4;
+    if (inet_pton(AF_INET, cfg->listen_host, &ipv4) != 1)
+        return -2; /* a bad option like the others (exit 2), not a failed start */
     int port = 0;
     if (parse_int(colon + 1, 0, &port) != 0 || port > 65535)
         return -1;
@@ -141,7 +145,13 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     while ((opt = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         const char *bad = NULL;
         switch (opt) {
-        case 'l': if (parse_listen(optarg, cfg)) bad = "--listen takes HOST:PORT, e.g. 127.0.0.1:8080"; break;
+        case 'l':
+            switch (parse_listen(optarg, cfg)) {
+            case 0: break;
+            case -2: bad = "--listen serves IPv4 only: HOST is a dotted address such as 127.0.0.1 or 0.0.0.0 (or localhost)"; break;
+            default: bad = "--listen takes HOST:PORT, e.g. 127.0.0.1:8080"; break;
+            }
+            break;
         case 'd':
             if (!*optarg || strlen(optarg) >= sizeof cfg->data_dir) bad = "--data takes a directory path";
             else strcpy(cfg->data_dir, optarg);

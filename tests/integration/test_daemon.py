@@ -36,6 +36,14 @@ class CommandLineTest(unittest.TestCase):
             self.assertIn("fdemd", out.stderr)
             self.assertEqual(out.stdout, "")
 
+    def test_an_ipv6_address_is_a_bad_option(self):
+        # exit 2 like every bad option (it was 1, a failed start, after
+        # the daemon had begun setting up)
+        for host in ("::1:0", "[::1]:0"):
+            out = self.run_fdemd("--listen", host)
+            self.assertEqual(out.returncode, 2, out.stderr)
+            self.assertIn("IPv4 only", out.stderr)
+
     def test_port_in_use(self):
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))
