@@ -52,7 +52,9 @@ static void print_events(const json_t *body)
                (long long)json_integer_value(json_object_get(e, "joint")), position,
                mode_name(json_integer_value(json_object_get(e, "mode"))), energy, i + 1, total);
     }
-    printf("energy in all: %.6g J (per metre in 2D)\n", total);
+    /* n > 0 here; a position has as many components as the case has dimensions */
+    size_t dims = json_array_size(json_object_get(json_array_get(list, 0), "position"));
+    printf("energy in all: %.6g %s\n", total, dims == 3 ? "J" : "J per metre of thickness");
 }
 
 int cmd_events(const ctl_options *o, int argc, char **argv)

@@ -39,9 +39,12 @@ static void print_fragments(const json_t *body)
     const json_t *list = json_object_get(body, "fragments");
     double total = 0;
     for (size_t i = 0; i < json_array_size(list); i++) total += number_at(json_array_get(list, i), "mass");
-    printf("step %lld, t = %.6g s: %zu fragments, total mass %.6g kg (per metre in 2D)\n",
+    /* a centroid has as many components as the case has dimensions */
+    size_t dims = json_array_size(json_object_get(json_array_get(list, 0), "centroid"));
+    const char *unit = dims == 3 ? "kg" : dims == 2 ? "kg per metre of thickness" : "kg (per metre in 2D)";
+    printf("step %lld, t = %.6g s: %zu fragments, total mass %.6g %s\n",
            (long long)json_integer_value(json_object_get(body, "step")), number_at(body, "time"),
-           json_array_size(list), total);
+           json_array_size(list), total, unit);
     printf("%6s %9s %12s %12s %12s  %-30s %s\n", "id", "elements", "mass", "size", "diameter",
            "centroid", "velocity");
     for (size_t i = 0; i < json_array_size(list); i++) {

@@ -182,6 +182,7 @@ class FragmentsThroughDaemon(DaemonTestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         n = len(self.fragments["fragments"])
         self.assertIn("%d fragments" % n, r.stdout)
+        self.assertIn("kg per metre of thickness", r.stdout)  # a 2D case
         self.assertIn("sieve curve", r.stdout)
         self.assertIn("100.00 %", r.stdout)
         rows = [line for line in r.stdout.splitlines() if line.split()[:1] and
@@ -268,6 +269,12 @@ class Fragments3DThroughDaemon(DaemonTestCase):
         self.assertAlmostEqual(piece["diameter"], (6 * volume / np.pi) ** (1 / 3), delta=1e-12)
         np.testing.assert_allclose(piece["velocity"], [0, 0, -2], atol=1e-9)
         self.assertEqual(piece["elements"], st["elements"])
+        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
+        env.pop("FDEMD_TOKEN", None)
+        r = subprocess.run([FDEMCTL, "fragments", st["id"]], capture_output=True, text=True,
+                           env=env, timeout=30 * SLOW)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertRegex(r.stdout, r"1 fragments, total mass \S+ kg\n")  # 3D: no "per metre"
 
     def test_separate_boxes_are_two_fragments(self):
         size = [0.1, 0.1, 0.1]
