@@ -183,10 +183,10 @@ int boundary_load_select(fdem_model *m, fdem_error *err)
         const constraint *c = &m->constraints[k];
         if (is_boundary_load(c) && c->facet_count == 0) {
             model_error(err, FDEM_ITEM_CONSTRAINT, k,
-                        "constraint %d selects no boundary %s: a %s acts on the %s of a body "
+                        "constraint %d selects no boundary %s: %s acts on the %s of a body "
                         "whose nodes are all selected",
                         k, m->dim == 3 ? "face" : "edge",
-                        c->def.kind == FDEM_CONSTRAINT_PRESSURE ? "pressure" : "absorbing boundary",
+                        c->def.kind == FDEM_CONSTRAINT_PRESSURE ? "a pressure" : "an absorbing boundary",
                         m->dim == 3 ? "faces" : "edges");
             return -1;
         }

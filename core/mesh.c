@@ -197,6 +197,12 @@ int fdem_mesh_validate(fdem_mesh *mesh, int *reoriented, fdem_error *err)
         double ey = fabs(mesh->xy[2 * t[1] + 1] - mesh->xy[2 * t[0] + 1]) +
                     fabs(mesh->xy[2 * t[2] + 1] - mesh->xy[2 * t[0] + 1]);
         double scale = (ex + ey) * (ex + ey);
+        if (ex + ey > 0 && !(isfinite(scale) && scale > MESH_SMALLEST_CUBE)) {
+            model_error(err, FDEM_ITEM_TRIANGLE, k,
+                       "triangle %d is %.3g m across: an area of that scale cannot be computed "
+                       "in double precision; give the coordinates in metres", k, ex + ey);
+            return -1;
+        }
         if (!(fabs(a2) > 1e-12 * scale)) {
             model_error(err, FDEM_ITEM_TRIANGLE, k,
                        "triangle %d has zero area (nodes %d, %d, %d are collinear or coincide)",

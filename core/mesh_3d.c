@@ -234,19 +234,17 @@ static double tet_volume_of(const fdem_tet_mesh *m, const int32_t *t)
     return tet_volume(node_xyz(m, t[0]), node_xyz(m, t[1]), node_xyz(m, t[2]), node_xyz(m, t[3]));
 }
 
-/* Largest edge from node 0, cubed: the scale a zero volume is judged at. */
-static double tet_size3(const fdem_tet_mesh *m, const int32_t *t)
+/* Largest edge from node 0: cubed, the scale a zero volume is judged at. */
+static double tet_size(const fdem_tet_mesh *m, const int32_t *t)
 {
     double l = 0;
     for (int a = 1; a < 4; a++) {
-        double d2 = 0;
-        for (int i = 0; i < 3; i++) {
-            double d = node_xyz(m, t[a])[i] - node_xyz(m, t[0])[i];
-            d2 += d * d;
-        }
-        l = fmax(l, sqrt(d2));
+        const double *p = node_xyz(m, t[a]), *o = node_xyz(m, t[0]);
+        /* hypot: the squares of edges beyond 1e154 m or below 1e-154 m
+         * would overflow or underflow */
+        l = fmax(l, hypot(hypot(p[0] - o[0], p[1] - o[1]), p[2] - o[2]));
     }
-    return l * l * l;
+    return l;
 }
 
 static int tet_check_nodes(const fdem_tet_mesh *m, int k, fdem_error *err)
@@ -300,8 +298,14 @@ int fdem_tet_mesh_validate(fdem_tet_mesh *mesh, int *reoriented, fdem_error *err
     for (int k = 0; k < mesh->tet_count; k++) {
         if (tet_check_nodes(mesh, k, err) != 0) return -1;
         int32_t *t = mesh->tet + 4 * (size_t)k;
-        double v = tet_volume_of(mesh, t);
-        if (!(fabs(v) > 1e-12 * tet_size3(mesh, t))) {
+        double v = tet_volume_of(mesh, t), size = tet_size(mesh, t), size3 = size * size * size;
+        if (size > 0 && !(isfinite(size3) && size3 > MESH_SMALLEST_CUBE)) {
+            model_error(err, FDEM_ITEM_TETRAHEDRON, k,
+                        "tetrahedron %d is %.3g m across: a volume of that scale cannot be "
+                        "computed in double precision; give the coordinates in metres", k, size);
+            return -1;
+        }
+        if (!(fabs(v) > 1e-12 * size3)) {
             model_error(err, FDEM_ITEM_TETRAHEDRON, k,
                         "tetrahedron %d has zero volume (nodes %d, %d, %d, %d are coplanar or coincide)",
                         k, (int)t[0], (int)t[1], (int)t[2], (int)t[3]);

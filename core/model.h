@@ -528,6 +528,12 @@ typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[
  * border of two colours is loaded once per colour, so large meshes get
  * blocks many rows deep (few border nodes), while 64 blocks still spread
  * over any core count this daemon meets. */
+/* The mesh checks (mesh.c, mesh_3d.c) take an element only when its size
+ * squared (2D) or cubed (3D) is above this and finite: the 1e-12 tolerance
+ * on its area or volume is then still a normal double. Edges from about
+ * 1e-93 m (3D; 1e-140 m in 2D) up to 5e102 m (1e154 m) pass. */
+#define MESH_SMALLEST_CUBE 1e-280
+
 #define SCATTER_BLOCK_ELEMENTS 1024
 #define SCATTER_BLOCK_JOINTS 2048
 #define SCATTER_BLOCK_NODES 4096

@@ -80,6 +80,16 @@ static void validation_names_the_triangle(void)
     fdem_mesh n = {3, 1, nan_xy, one};
     CHECK(fdem_mesh_validate(&n, NULL, &err) < 0 && err.kind == FDEM_ITEM_NODE && err.item == 2,
           "%s", err.message);
+    /* a sound triangle at scales whose area overflows or underflows: named
+     * as such, not as "zero area" (nodes collinear or coincident) */
+    const double scales[] = {1e200, 1e-200};
+    for (int s = 0; s < 2; s++) {
+        double scaled[] = {0, 0, scales[s], 0, 0, scales[s]};
+        fdem_mesh k = {3, 1, scaled, one};
+        CHECK(fdem_mesh_validate(&k, NULL, &err) < 0 && err.kind == FDEM_ITEM_TRIANGLE &&
+                  err.item == 0 && strstr(err.message, "m across"),
+              "scale %g: %s", scales[s], err.message);
+    }
 }
 
 static void unused_node_is_rejected(void)

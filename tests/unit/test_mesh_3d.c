@@ -316,6 +316,17 @@ static void test_tet_validate(void)
     m = two_tets(xyz, tet);
     m.tet_count = 0;
     CHECK(fdem_tet_mesh_validate(&m, NULL, &err) != 0, "empty mesh accepted");
+    /* sound tetrahedra at scales whose volumes overflow or underflow: named
+     * as such, not as "zero volume" (nodes coplanar or coincident) */
+    const double scales[] = {1e200, 1e-200};
+    for (int s = 0; s < 2; s++) {
+        m = two_tets(xyz, tet);
+        for (int i = 0; i < 15; i++) xyz[i] *= scales[s];
+        CHECK(fdem_tet_mesh_validate(&m, NULL, &err) != 0 && err.kind == FDEM_ITEM_TETRAHEDRON &&
+                  err.item == 0 && strstr(err.message, "m across") &&
+                  strstr(err.message, "double precision"),
+              "scale %g: %s", scales[s], err.message);
+    }
 }
 
 int main(int argc, char **argv)
