@@ -27,10 +27,14 @@
 
 static const gmsh_kind gmsh_triangles = {
     2, 3, 2, "triangle",
-    "no 3-node triangles (element type 2) in $Elements; mesh the surfaces in 2D (gmsh -2)"};
+    "no 3-node triangles (element type 2) in $Elements; mesh the surfaces in 2D (gmsh -2)", 9,
+    "only second-order 6-node triangles (element type 9) in $Elements; fdemd takes linear "
+    "3-node ones: mesh with -order 1 (gmsh's default)"};
 static const gmsh_kind gmsh_tetrahedra = {
     4, 4, 3, "tetrahedron",
-    "no 4-node tetrahedra (element type 4) in $Elements; mesh the volumes in 3D (gmsh -3)"};
+    "no 4-node tetrahedra (element type 4) in $Elements; mesh the volumes in 3D (gmsh -3)", 11,
+    "only second-order 10-node tetrahedra (element type 11) in $Elements; fdemd takes linear "
+    "4-node ones: mesh with -order 1 (gmsh's default)"};
 
 int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
 {
@@ -307,6 +311,7 @@ static int gmsh_read_elements22(gmsh_reader *r)
         if (gmsh_line_longs(r, &l, head, 3, "\"number type number-of-tags ...\"") < 0)
             return -1;
         int kept = head[1] == r->kind->type;
+        r->quadratic_count += head[1] == r->kind->quadratic_type;
         if (!kept && !r->want_groups) continue;
         if (head[2] < 0 || head[2] > GMSH_MAX_TOKENS)
             return gmsh_fail(r, "bad number of element tags (%lld)", head[2]);
@@ -332,6 +337,7 @@ static int gmsh_read_element_block41(gmsh_reader *r, long long *total)
     long long n = head[3];
     if (gmsh_check_count(r, n, 4, "elements in the block") < 0) return -1;
     int kept = head[2] == r->kind->type;
+    if (head[2] == r->kind->quadratic_type) r->quadratic_count += n;
     if (r->want_groups && (head[0] < 0 || head[0] > 3))
         return gmsh_fail(r, "entity dimension %lld is not 0 to 3", head[0]);
     for (long long i = 0; i < n; i++) {
@@ -441,7 +447,8 @@ static int gmsh_read_sections(gmsh_reader *r)
     if (!r->version) return gmsh_fail(r, "not a gmsh mesh: no $MeshFormat section");
     if (!r->seen_nodes) return gmsh_fail(r, "no $Nodes section");
     if (!r->seen_elements) return gmsh_fail(r, "no $Elements section");
-    if (r->element_count == 0) return gmsh_fail(r, "%s", r->kind->missing);
+    if (r->element_count == 0)
+        return gmsh_fail(r, "%s", r->quadratic_count ? r->kind->only_quadratic : r->kind->missing);
     return 0;
 }
 

@@ -41,6 +41,8 @@ typedef struct gmsh_kind {
     int type, nodes, dims;
     const char *name;    /* "triangle" */
     const char *missing; /* the message when the file has none */
+    int quadratic_type;  /* gmsh's second-order twin (6-node triangle, 10-node tetrahedron) */
+    const char *only_quadratic; /* the message when the file has only those */
 } gmsh_kind;
 
 /* An element of any type that may belong to physical groups: key is its
@@ -79,6 +81,7 @@ typedef struct gmsh_reader {
     long node_count, node_capacity;
     gmsh_element *elements;
     long element_count, element_capacity;
+    long long quadratic_count; /* elements of kind->quadratic_type met */
     char *message;
     size_t message_size;
     int failed;

@@ -303,9 +303,39 @@ static void tetrahedra_rejects(void)
     check_every_prefix("tests/data/cube_v41.msh", read_tetrahedra);
 }
 
+/* A mesh of second-order elements only (gmsh -order 2) is named as such:
+ * it used to be told to "mesh the volumes in 3D (gmsh -3)", which it was. */
+static void second_order_meshes_are_named(void)
+{
+    fdem_tet_mesh tets;
+    fdem_mesh tris;
+    char message[256] = "";
+    static const char *tet10_v22 =
+        V22 "$Nodes\n10\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 .5 0 0\n6 .5 .5 0\n"
+            "7 0 .5 0\n8 0 0 .5\n9 0 .5 .5\n10 .5 0 .5\n$EndNodes\n"
+            "$Elements\n1\n1 11 2 1 1 1 2 3 4 5 6 7 8 10 9\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(tet10_v22, strlen(tet10_v22), &tets, message, sizeof message) != 0 &&
+              strstr(message, "second-order 10-node tetrahedra") && strstr(message, "-order 1"),
+          "10-node tetrahedra, v2.2: %s", message);
+    static const char *tet10_v41 =
+        V41 "$Nodes\n1 10 1 10\n3 1 0 10\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n"
+            "0 0 0\n1 0 0\n0 1 0\n0 0 1\n.5 0 0\n.5 .5 0\n0 .5 0\n0 0 .5\n0 .5 .5\n.5 0 .5\n"
+            "$EndNodes\n$Elements\n1 1 1 1\n3 1 11 1\n1 1 2 3 4 5 6 7 8 10 9\n$EndElements\n";
+    CHECK(gmsh_read_tetrahedra(tet10_v41, strlen(tet10_v41), &tets, message, sizeof message) != 0 &&
+              strstr(message, "second-order 10-node tetrahedra"),
+          "10-node tetrahedra, v4.1: %s", message);
+    static const char *tri6_v22 =
+        V22 "$Nodes\n6\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 .5 0 0\n5 .5 .5 0\n6 0 .5 0\n"
+            "$EndNodes\n$Elements\n1\n1 9 2 1 1 1 2 3 4 5 6\n$EndElements\n";
+    CHECK(gmsh_read(tri6_v22, strlen(tri6_v22), &tris, message, sizeof message) != 0 &&
+              strstr(message, "second-order 6-node triangles"),
+          "6-node triangles: %s", message);
+}
+
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
            T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
            T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
            T(rejects_bad_references), T(rejects_missing_sections),
            T(every_prefix_of_a_real_file), T(cube_tetrahedra_v22), T(cube_tetrahedra_v41),
+           T(second_order_meshes_are_named),
            T(tetrahedra_rejects))
