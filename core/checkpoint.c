@@ -17,7 +17,7 @@
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
-#define CHECKPOINT_VERSION 5
+#define CHECKPOINT_VERSION 6
 
 /* Version 1 (fdemd 0.1): the header up to external_work, then positions,
  * velocities and damage. Read for cases stored by that version; they carry
@@ -53,12 +53,16 @@ typedef struct checkpoint_header {
      * layout; 3D joints are numbered by their tetrahedra (joint_tet_model.c),
      * so an earlier file's 3D joint damage would land on other joints. */
     int64_t pending_events;
+    /* version 6: time's compensation (model_time_after; 0 from earlier
+     * files, whose time was summed plainly) */
+    double time_carry;
 } checkpoint_header;
 
 /* The header of a version 2 file: everything before joint_friction_energy;
  * of a version 3 one, everything before pending_events. */
 #define CHECKPOINT_HEADER_V2 offsetof(checkpoint_header, joint_friction_energy)
 #define CHECKPOINT_HEADER_V3 offsetof(checkpoint_header, pending_events)
+#define CHECKPOINT_HEADER_V5 offsetof(checkpoint_header, time_carry)
 
 static int checkpoint_has_detection(const fdem_model *m) { return m->contact.enabled; }
 
@@ -105,6 +109,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.spring_records = (int64_t)(spring_bytes / contact_record_bytes(&m->contact));
     h.energy = fdem_get_energy(m);
     h.pending_events = m->event_count;
+    h.time_carry = m->time_carry;
     unsigned char *p = buf;
     memcpy(p, &h, sizeof h);
     p += sizeof h;
@@ -177,6 +182,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     } else {
         header = h1.version == 2 ? CHECKPOINT_HEADER_V2
                : h1.version == 3 ? CHECKPOINT_HEADER_V3
+               : h1.version <= 5 ? CHECKPOINT_HEADER_V5
                                  : sizeof h;
         if (size < header) {
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint is truncated (%zu bytes)", size);
@@ -245,6 +251,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     p += sizeof(double) * (size_t)m->joint_count;
     m->step = h1.step;
     m->time = h1.time;
+    m->time_carry = isfinite(h.time_carry) && fabs(h.time_carry) <= h1.dt ? h.time_carry : 0;
     m->dt = h1.dt;
     m->dt_prev = h1.dt_prev;
     m->contact_work = h1.contact_work;

@@ -72,8 +72,8 @@ static int next_mark(const uint8_t *mark, int j, int count)
 int events_collect(fdem_model *m, int broke)
 {
     if (events_reserve(m, broke)) return -1;
-    /* the end of this step: fdem_step forms m->time + dt the same way */
-    double time = m->time + m->dt;
+    /* the end of this step, as fdem_step forms it */
+    double carry, time = model_time_after(m, m->dt, &carry);
     int found = 0;
     for (int j = next_mark(m->joint_broke, 0, m->joint_count); j < m->joint_count && found < broke;
          j = next_mark(m->joint_broke, j + 1, m->joint_count)) {

@@ -506,7 +506,9 @@ int fdem_step(fdem_model *m, fdem_error *err)
     m->dt_prev = h;
     m->havg_last = havg;
     m->restored_energy_valid = 0;
-    m->time += h;
+    double carry;
+    m->time = model_time_after(m, h, &carry);
+    m->time_carry = carry;
     m->step++;
     return 0;
 }
