@@ -17,7 +17,7 @@
 #include "model.h"
 
 #define CHECKPOINT_MAGIC 0x31434446u /* "FDC1" */
-#define CHECKPOINT_VERSION 6
+#define CHECKPOINT_VERSION FDEM_CHECKPOINT_VERSION
 
 /* Version 1 (fdemd 0.1): the header up to external_work, then positions,
  * velocities and damage. Read for cases stored by that version; they carry
@@ -150,6 +150,16 @@ static int checkpoint_header_sane(const checkpoint_header_v1 *h, fdem_error *err
                 "checkpoint has %s (step %lld, t = %g s, dt = %g s); it is damaged",
                 bad, (long long)h->step, h->time, h->dt);
     return -1;
+}
+
+int fdem_checkpoint_version(const void *buf, size_t size)
+{
+    checkpoint_header_v1 h1;
+    if (size < sizeof h1) return -1;
+    memcpy(&h1, buf, sizeof h1);
+    if (h1.magic != CHECKPOINT_MAGIC || h1.version < 1 || h1.version > CHECKPOINT_VERSION)
+        return -1;
+    return (int)h1.version;
 }
 
 int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error *err)

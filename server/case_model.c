@@ -123,6 +123,17 @@ static case_model_rc case_model_restore(server_case *c, fdem_model *model, int r
         name = CASE_RESUME_CHECKPOINT;
     snprintf(path, sizeof path, "%s/%s", c->dir, name);
     if (persist_read_file(path, &ckpt, &size, CASE_MODEL_MAX_CHECKPOINT) != 0) {
+        /* Only a file that is not there means "from t = 0". One that is
+         * there but cannot be read (EIO, past the size limit, not a
+         * regular file) restored as step 0 would cut result.h5 back to its
+         * first row; it fails the case with its files kept instead, and a
+         * failed allocation waits for memory like the engine's own. */
+        if (errno == ENOMEM)
+            return CASE_MODEL_NO_MEMORY;
+        if (errno != ENOENT) {
+            snprintf(err, errlen, "%s could not be read: %s", name, strerror(errno));
+            return CASE_MODEL_BROKEN;
+        }
         pthread_mutex_lock(&c->lock);
         int started = c->fig.step != 0;
         pthread_mutex_unlock(&c->lock);

@@ -72,8 +72,20 @@ checkpoint_file_kind checkpoint_file_open(const void *bytes, size_t size, size_t
     *payload = size;
     if (size < CHECKPOINT_FILE_TRAILER ||
         memcmp(p + size - CHECKPOINT_FILE_TRAILER, checkpoint_file_magic,
-               sizeof checkpoint_file_magic) != 0)
-        return CHECKPOINT_FILE_BARE;
+               sizeof checkpoint_file_magic) != 0) {
+        /* Every daemon that writes the engine's version 6 or later seals
+         * it: such a file without its trailer had its end damaged or cut
+         * off, and is not restored unchecked (or refused only for its
+         * size, an error that invites cutting the trailer off). */
+        if (fdem_checkpoint_version(p, size) < CHECKPOINT_FILE_SEALED_SINCE)
+            return CHECKPOINT_FILE_BARE;
+        snprintf(err, errlen,
+                 "it is damaged: it is of checkpoint version %d, always written with a trailer "
+                 "(FDCK and a CRC-32), but its last 8 bytes are not one (the end of the file "
+                 "changed or was cut off after fdemd wrote it)",
+                 fdem_checkpoint_version(p, size));
+        return CHECKPOINT_FILE_DAMAGED;
+    }
     size_t body = size - CHECKPOINT_FILE_TRAILER;
     uint32_t stored = checkpoint_file_get32(p + body + 4), actual = checkpoint_file_crc(p, body);
     if (stored != actual) {

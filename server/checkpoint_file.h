@@ -11,8 +11,9 @@
  *    (no trailer: a file of a daemon from before the checksum, all of it
  *    the engine's) or CHECKPOINT_FILE_DAMAGED, with a message in err naming
  *    the sums. A bare file is still checked by the engine's own reader
- *    (sizes, counts, finite values); a file whose trailer was damaged reads
- *    as bare and is then the wrong size for its model.
+ *    (sizes, counts, finite values). Bare means of an engine version
+ *    before CHECKPOINT_FILE_SEALED_SINCE: a later one without a trailer
+ *    (its end damaged or cut off) is DAMAGED.
  */
 #ifndef FDEMD_CHECKPOINT_FILE_H
 #define FDEMD_CHECKPOINT_FILE_H
@@ -22,6 +23,9 @@
 #include "fdem.h"
 
 #define CHECKPOINT_FILE_TRAILER 8
+/* The engine's checkpoint version (fdem_checkpoint_version) the first sealing
+ * daemon wrote: no daemon ever wrote it bare. */
+#define CHECKPOINT_FILE_SEALED_SINCE 6
 
 typedef enum {
     CHECKPOINT_FILE_SEALED,
