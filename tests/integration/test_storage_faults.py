@@ -116,88 +116,79 @@ class StoredFilesTest(unittest.TestCase):
         cid = self.d.create(tiny_case("done", end=end), start=True)["id"]
         return self.d.wait_state(cid, "finished")
 
-    def test_negative_checkpoint_step_keeps_every_snapshot(self):
+    def paused_and_stopped(self, snapshots):
+        """A case paused once it has `snapshots` snapshots, its daemon
+        stopped: its id, the pause's status and its checkpoint.bin."""
         d = self.d
         cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
-        d.wait(cid, lambda s: s["snapshots"] >= 4, what="4 snapshots")
+        d.wait(cid, lambda s: s["snapshots"] >= snapshots, what="%d snapshots" % snapshots)
         paused = d.json("POST", "/cases/%s/pause" % cid)[1]
         self.assertEqual(d.stop()[0], 0)
-        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
-        # int64 step after six int32, the checksum made to hold: the
-        # engine's own checks are what refuse it
-        edit_checkpoint(path, 24, (-5).to_bytes(8, "little", signed=True))
+        return cid, paused, os.path.join(d.data_dir, cid, "checkpoint.bin")
+
+    def assert_fails_keeping_snapshots(self, cid, paused, *words):
+        """Started again, the case is failed with `words` in its error and
+        every snapshot kept; the daemon is stopped again."""
+        d = self.d
         d.start()
         st = d.status(cid)
         self.assertEqual(st["state"], "failed", st)
-        self.assertIn("negative step", st["error"])
+        for word in words:
+            self.assertIn(word, st["error"])
         self.assertEqual(st["snapshots"], paused["snapshots"])
-        # Nothing was dropped: mend the checkpoint and the case is back.
         self.assertEqual(d.stop()[0], 0)
-        edit_checkpoint(path, 24, paused["step"].to_bytes(8, "little", signed=True))
+
+    def assert_back_as_paused(self, cid, paused):
+        """Started again, the case is paused where it was, every snapshot
+        in result.h5."""
+        d = self.d
         d.start()
         st = d.status(cid)
         self.assertEqual(st["state"], "paused", st)
+        self.assertEqual(st["step"], paused["step"])
         self.assertEqual(st["snapshots"], paused["snapshots"])
         self.assertEqual(len(result_snapshots(d, cid)[0]), paused["snapshots"])
-        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_negative_checkpoint_step_keeps_every_snapshot(self):
+        cid, paused, path = self.paused_and_stopped(4)
+        # int64 step after six int32, the checksum made to hold: the
+        # engine's own checks are what refuse it
+        edit_checkpoint(path, 24, (-5).to_bytes(8, "little", signed=True))
+        self.assert_fails_keeping_snapshots(cid, paused, "negative step")
+        # Nothing was dropped: mend the checkpoint and the case is back.
+        edit_checkpoint(path, 24, paused["step"].to_bytes(8, "little", signed=True))
+        self.assert_back_as_paused(cid, paused)
+        self.assertEqual(self.d.stop()[0], 0, self.d.log_tail())
 
     def test_a_changed_byte_in_the_checkpoint_fails_the_case_and_mending_it_brings_it_back(self):
         """A byte changed in the middle of a position is still a finite
         number: without the checksum the case came back paused and carried
         on from a state it never had."""
-        d = self.d
-        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
-        d.wait(cid, lambda s: s["snapshots"] >= 3, what="3 snapshots")
-        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
-        self.assertEqual(d.stop()[0], 0)
-        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        cid, paused, path = self.paused_and_stopped(3)
         good = open(path, "rb").read()
         self.assertEqual(good[-8:-4], b"FDCK")
         self.assertEqual(int.from_bytes(good[-4:], "little"), zlib.crc32(good[:-8]))
         middle = len(good) // 2
         edit_checkpoint(path, middle, bytes([good[middle] ^ 0x04]), seal=False)
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "failed", st)
-        self.assertIn("checkpoint.bin", st["error"])
-        self.assertIn("CRC-32", st["error"])
-        self.assertEqual(st["snapshots"], paused["snapshots"])
-        self.assertEqual(d.stop()[0], 0)
+        self.assert_fails_keeping_snapshots(cid, paused, "checkpoint.bin", "CRC-32")
         with open(path, "wb") as f:
             f.write(good)
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "paused", st)
-        self.assertEqual(st["step"], paused["step"])
-        self.assertEqual(d.stop()[0], 0, d.log_tail())
+        self.assert_back_as_paused(cid, paused)
+        self.assertEqual(self.d.stop()[0], 0, self.d.log_tail())
 
     def test_an_unreadable_checkpoint_fails_the_case_and_keeps_every_snapshot(self):
         """checkpoint.bin there but unreadable (here a directory in its
         place: EIO, a file past the size limit and a failed allocation take
         the same path) is not a missing one: the case came back paused at
         step 0 and result.h5 was cut to its first row."""
-        d = self.d
-        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
-        d.wait(cid, lambda s: s["snapshots"] >= 3, what="3 snapshots")
-        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
-        self.assertEqual(d.stop()[0], 0)
-        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        cid, paused, path = self.paused_and_stopped(3)
         os.rename(path, path + ".kept")
         os.mkdir(path)
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "failed", st)
-        self.assertIn("checkpoint.bin", st["error"])
-        self.assertEqual(st["snapshots"], paused["snapshots"])
-        self.assertEqual(d.stop()[0], 0)
+        self.assert_fails_keeping_snapshots(cid, paused, "checkpoint.bin")
         os.rmdir(path)
         os.rename(path + ".kept", path)
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "paused", st)
-        self.assertEqual(st["step"], paused["step"])
-        self.assertEqual(len(result_snapshots(d, cid)[0]), paused["snapshots"])
-        self.assertEqual(d.stop()[0], 0, d.log_tail())
+        self.assert_back_as_paused(cid, paused)
+        self.assertEqual(self.d.stop()[0], 0, self.d.log_tail())
 
     def test_a_damaged_trailer_is_not_taken_for_a_checkpoint_from_before_the_checksum(self):
         """Every checkpoint of engine version 6 on was written sealed: one
@@ -205,41 +196,23 @@ class StoredFilesTest(unittest.TestCase):
         older daemon's file (the log said so) and refused for its size, an
         error that invites cutting the 8 bytes off, which would restore it
         unchecked."""
-        d = self.d
-        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
-        d.wait(cid, lambda s: s["snapshots"] >= 2, what="2 snapshots")
-        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
-        self.assertEqual(d.stop()[0], 0)
-        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        cid, paused, path = self.paused_and_stopped(2)
         good = open(path, "rb").read()
         for damaged in (good[:-8] + b"FDCX" + good[-4:], good[:-8]):
             with open(path, "wb") as f:
                 f.write(damaged)
-            d.start()
-            st = d.status(cid)
-            self.assertEqual(st["state"], "failed", st)
-            self.assertIn("checkpoint.bin", st["error"])
-            self.assertIn("trailer", st["error"])
-            self.assertNotIn("has no checksum", d.log_tail())
-            self.assertEqual(st["snapshots"], paused["snapshots"])
-            self.assertEqual(d.stop()[0], 0)
+            self.assert_fails_keeping_snapshots(cid, paused, "checkpoint.bin", "trailer")
+            self.assertNotIn("has no checksum", self.d.log_tail())
         with open(path, "wb") as f:
             f.write(good)
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "paused", st)
-        self.assertEqual(st["step"], paused["step"])
-        self.assertEqual(d.stop()[0], 0, d.log_tail())
+        self.assert_back_as_paused(cid, paused)
+        self.assertEqual(self.d.stop()[0], 0, self.d.log_tail())
 
     def test_a_checkpoint_from_before_the_checksum_is_restored(self):
         """checkpoint.bin of an earlier daemon has no trailer: it is restored
         on the engine's own checks, and the next checkpoint is sealed."""
         d = self.d
-        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
-        d.wait(cid, lambda s: s["snapshots"] >= 2, what="2 snapshots")
-        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
-        self.assertEqual(d.stop()[0], 0)
-        path = os.path.join(d.data_dir, cid, "checkpoint.bin")
+        cid, paused, path = self.paused_and_stopped(2)
         good = open(path, "rb").read()
         # what that daemon wrote: checkpoint version 5, whose header ends
         # before version 6's time_carry (a double at byte 240), no trailer
@@ -247,10 +220,7 @@ class StoredFilesTest(unittest.TestCase):
         self.assertEqual(int.from_bytes(body[4:8], "little"), 6)
         with open(path, "wb") as f:
             f.write(body[:4] + (5).to_bytes(4, "little") + body[8:240] + body[248:])
-        d.start()
-        st = d.status(cid)
-        self.assertEqual(st["state"], "paused", st)
-        self.assertEqual(st["step"], paused["step"])
+        self.assert_back_as_paused(cid, paused)
         self.assertIn("has no checksum", d.log_tail())
         d.json("POST", "/cases/%s/start" % cid)
         d.wait(cid, lambda s: s["step"] > paused["step"], what="a step past the pause")

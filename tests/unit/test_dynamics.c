@@ -181,14 +181,23 @@ static void checkpoint_round_trip_continues_identically(void)
     fdem_model_destroy(b);
 }
 
+/* A small elastic square of side `side` in `cells` x `cells` cells (two
+ * triangles each), built and finalized: the tests below need a model, not
+ * particular physics. */
+static fdem_model *small_square(double side, int cells)
+{
+    fdem_model *m = fdem_model_create();
+    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
+    build_rectangle(m, mat, 0, 0, side, side, cells, cells);
+    build_finalize(m, 0.5);
+    return m;
+}
+
 /* A checkpoint whose header was damaged (negative step, NaN time) is
  * refused and leaves the model as it was. */
 static void checkpoint_with_a_bad_header_is_refused(void)
 {
-    fdem_model *m = fdem_model_create();
-    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
-    build_rectangle(m, mat, 0, 0, 0.1, 0.1, 3, 3);
-    build_finalize(m, 0.5);
+    fdem_model *m = small_square(0.1, 3);
     fdem_error err;
     for (int s = 0; s < 10; s++) fdem_step(m, &err);
     size_t size = fdem_checkpoint_size(m);
@@ -215,10 +224,7 @@ static void checkpoint_with_a_bad_header_is_refused(void)
  * when it looked only for a non-finite node. */
 static void overflow_of_finite_values_names_a_node(void)
 {
-    fdem_model *m = fdem_model_create();
-    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
-    build_rectangle(m, mat, 0, 0, 0.1, 0.1, 3, 3);
-    build_finalize(m, 0.5);
+    fdem_model *m = small_square(0.1, 3);
     fdem_error err;
     CHECK(fdem_step(m, &err) == 0, "%s", err.message);
     m->vel[0] = m->vel[2] = 1e308;
@@ -240,10 +246,7 @@ static void overflow_of_finite_values_names_a_node(void)
  * the compensation: a restored model goes on to the same time bits. */
 static void time_after_many_steps_is_their_sum(void)
 {
-    fdem_model *m = fdem_model_create();
-    int mat = build_material(m, 1000, 1e8, 0.3, 0, 0.2);
-    build_rectangle(m, mat, 0, 0, 1, 1, 1, 1);
-    build_finalize(m, 0.5);
+    fdem_model *m = small_square(1, 1);
     fdem_error err;
     const double dt = 3.125e-6;
     fdem_set_dt(m, dt);
@@ -260,9 +263,7 @@ static void time_after_many_steps_is_their_sum(void)
     double t = fdem_get_time(m);
     CHECK(fabs(t - 0.5) <= 0x1p-53, "t = %.17g after 160000 steps of %g s (off by %.3g s)", t, dt,
           t - 0.5);
-    fdem_model *r = fdem_model_create();
-    build_rectangle(r, build_material(r, 1000, 1e8, 0.3, 0, 0.2), 0, 0, 1, 1, 1, 1);
-    build_finalize(r, 0.5);
+    fdem_model *r = small_square(1, 1);
     fdem_set_dt(r, dt);
     CHECK(fdem_checkpoint_read(r, buf, size, &err) == 0, "%s", err.message);
     for (int s = 100001; s < 160000; s++) fdem_step(r, &err);
