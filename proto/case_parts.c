@@ -158,7 +158,7 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     }
     json_t *velocity = case_member(value, ptr, "velocity", at);
     if (velocity)
-        part->has_velocity = case_read_vector(doc, velocity, at, doc->dimension, part->velocity);
+        part->has_velocity = case_read_axes(doc, velocity, at, part->velocity);
     json_t *stress = case_member(value, ptr, "initial_stress", at);
     if (stress) case_read_initial_stress(doc, part, stress, at);
 }
