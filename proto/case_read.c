@@ -307,6 +307,49 @@ const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char 
     return buf;
 }
 
+/* Names of the same quantity in other codes and textbooks, none a typo of
+ * ours: a rock engineer's first case says "E" or "poisson_ratio". Offered
+ * only where the name they mean is allowed. */
+static const char *const case_other_names[][2] = {
+    {"E", "young"},           {"youngs_modulus", "young"}, {"young_modulus", "young"},
+    {"youngs", "young"},      {"elastic_modulus", "young"}, {"modulus", "young"},
+    {"nu", "poisson"},        {"poisson_ratio", "poisson"}, {"poissons_ratio", "poisson"},
+    {"rho", "density"},       {"mass_density", "density"},  {"mu", "friction"},
+    {"friction_coefficient", "friction"}, {"phi", "friction_angle"}, {"c", "cohesion"},
+    {"ft", "tensile_strength"}, {"f_t", "tensile_strength"}, {"tensile", "tensile_strength"},
+    {"GI", "energy_I"},       {"G_I", "energy_I"},          {"Gf", "energy_I"},
+    {"G_f", "energy_I"},      {"GII", "energy_II"},         {"G_II", "energy_II"}};
+
+/* Keys of one section met in another ("interval" in "time"): where they go. */
+static const char *const case_key_homes[][3] = {
+    {"interval", "/output", "belongs in \"output\""},
+    {"fields", "/output", "belongs in \"output\""},
+    {"dt", "/time", "belongs in \"time\""},
+    {"end", "/time", "belongs in \"time\""},
+    {"safety", "/time", "belongs in \"time\""},
+    {"gravity", "", "belongs at the top of the case"},
+    {"dimension", "", "belongs at the top of the case"}};
+
+/* The hint for an unknown key that is no typo: another name of an allowed
+ * key, or a key of another section. */
+static void case_key_hint(char *buf, size_t size, const char *key, const char *ptr,
+                          const char *const *allowed, int count)
+{
+    for (size_t i = 0; i < sizeof case_other_names / sizeof case_other_names[0]; i++) {
+        if (strcmp(key, case_other_names[i][0]) != 0) continue;
+        for (int k = 0; k < count; k++)
+            if (strcmp(allowed[k], case_other_names[i][1]) == 0) {
+                snprintf(buf, size, "; did you mean \"%s\"?", allowed[k]);
+                return;
+            }
+    }
+    for (size_t i = 0; i < sizeof case_key_homes / sizeof case_key_homes[0]; i++)
+        if (strcmp(key, case_key_homes[i][0]) == 0 && strcmp(ptr, case_key_homes[i][1]) != 0) {
+            snprintf(buf, size, "; \"%s\" %s", key, case_key_homes[i][2]);
+            return;
+        }
+}
+
 int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
                     const char *const *allowed, const char *what)
 {
@@ -320,8 +363,9 @@ int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
         if (known) continue;
         char at[CASE_POINTER], hint[96];
         pointer_join(at, sizeof at, ptr, key);
-        case_problem(doc, at, "unknown key \"%.64s\" in %s%s", key, what,
-                     case_did_you_mean(doc, hint, sizeof hint, key, allowed, count));
+        case_did_you_mean(doc, hint, sizeof hint, key, allowed, count);
+        if (!hint[0]) case_key_hint(hint, sizeof hint, key, ptr, allowed, count);
+        case_problem(doc, at, "unknown key \"%.64s\" in %s%s", key, what, hint);
         ok = 0;
     }
     return ok;
