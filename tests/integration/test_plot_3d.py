@@ -195,6 +195,24 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertIn("2D results only", r.stderr)
         self.assertFalse(os.path.exists(png))
 
+    def test_damage_in_3d_says_where_to_look(self):
+        r, _ = self.plot(self.h5, "--field", "damage")
+        self.assertIn("ParaView", r.stderr)
+        self.assertIn("fdemctl events", r.stderr)
+
+    def test_the_xdmf_sidecar_is_pointed_at_its_h5(self):
+        # fdemctl fetch leaves R.h5 and R.xdmf side by side, and "open the
+        # .xdmf" is what the demo says for ParaView: given to plot_result it
+        # was "file signature not found"
+        xdmf = os.path.join(self.work.name, "box3d.xdmf")
+        with open(xdmf, "w") as f:
+            f.write('<?xml version="1.0" ?>\n<Xdmf Version="3.0"></Xdmf>\n')
+        r, png = self.plot(xdmf)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("XDMF", r.stderr)
+        self.assertIn("box3d.h5", r.stderr)
+        self.assertFalse(os.path.exists(png))
+
     def test_bad_view_is_a_clear_error(self):
         r, _ = self.plot(self.h5, "--view", "up")
         self.assertNotEqual(r.returncode, 0)
