@@ -317,6 +317,37 @@ class FracturingResultTests(DaemonRunTestCase):
         self.assert_drawn(*self.plot(self.h5))
 
 
+class DemoScriptTests(unittest.TestCase):
+    """scripts/demo.sh hands what follows the example to plot_result.py: the
+    3D sphere pile, drawn from the default view, is the outside of its box
+    and shows no sphere (examples/README.md: look in with --view 75,-60)."""
+
+    def run_demo(self, *args):
+        out = tempfile.TemporaryDirectory(prefix="demo-")
+        self.addCleanup(out.cleanup)
+        env = dict(os.environ, OUT=out.name, PYTHON=PYTHON,
+                   BIN=os.path.dirname(fdemd_harness.FDEMD_BIN))
+        r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "demo.sh"),
+                            "examples/freefall-3d.json"] + list(args),
+                           cwd=ROOT, env=env, capture_output=True, text=True,
+                           timeout=120 * SLOW)
+        return r, out.name
+
+    def test_plot_options_reach_plot_result(self):
+        r, out = self.run_demo("--view", "90,0")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(os.path.exists(os.path.join(out, "freefall-3d.png")))
+        self.assertTrue(os.path.exists(os.path.join(out, "demo-fdemd.log")))
+        r, _ = self.run_demo("--view", "up")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("ELEVATION,AZIMUTH", r.stderr)
+
+    def test_a_3d_demo_says_how_to_choose_the_view(self):
+        r, _ = self.run_demo()
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("--view", r.stdout)
+
+
 class VonMises3DTests(unittest.TestCase):
     """The exact 3D von Mises formula on states with a known answer."""
 
