@@ -151,7 +151,7 @@ static void case_read_dimension(case_doc *doc, const json_t *dimension)
 
 static void case_read_gravity(case_doc *doc, const json_t *gravity)
 {
-    if (gravity) case_read_vector(doc, gravity, "/gravity", doc->dimension, doc->gravity);
+    if (gravity) case_read_axes(doc, gravity, "/gravity", doc->gravity);
 }
 
 static void case_read_gravity_amplitude(case_doc *doc, const json_t *table)

@@ -70,8 +70,9 @@ static void constraint_read_box(case_doc *doc, fdem_constraint_def *def, const j
     int dim = doc->dimension;
     def->select = FDEM_SELECT_BOX;
     if (!json_is_array(box) || json_array_size(box) != (size_t)(2 * dim)) {
-        case_problem(doc, ptr, "expected %s, got %s%s", box_layout(dim), case_type_word(box),
-                     json_is_array(box) ? " of another length" : "");
+        char got[160];
+        case_problem(doc, ptr, "expected %s, got %s", box_layout(dim),
+                     case_wrong_tuple(doc, box, 2, got, sizeof got));
         return;
     }
     if (!case_read_vector(doc, box, ptr, 2 * dim, def->box)) return;
@@ -99,8 +100,9 @@ static void constraint_read_fix(case_doc *doc, fdem_constraint_def *def, const j
     def->kind = FDEM_CONSTRAINT_FIX;
     if (!json_is_array(fix) || json_array_size(fix) == 0 ||
         json_array_size(fix) > (size_t)dim) {
+        char got[160];
         case_problem(doc, ptr, "expected a list of the components to fix (some of %s), got %s",
-                     axis_names(dim), case_type_word(fix));
+                     axis_names(dim), case_wrong_tuple(doc, fix, 1, got, sizeof got));
         return;
     }
     size_t i;
@@ -115,7 +117,11 @@ static void constraint_read_fix(case_doc *doc, fdem_constraint_def *def, const j
         if (axis >= 0)
             *flags[axis] = 1;
         else if (s)
-            case_problem(doc, at, "expected %s, got \"%.32s\"", axis_names(dim), s);
+            case_problem(doc, at, "expected %s, got \"%.32s\"%s", axis_names(dim), s,
+                         dim == 2 && strcmp(s, "z") == 0
+                             ? " (this case is 2D: set \"dimension\": 3 at the top of the case "
+                               "for a 3D one)"
+                             : "");
         else
             case_problem(doc, at, "expected %s, got %s", axis_names(dim), case_type_word(c));
     }
@@ -129,8 +135,9 @@ static void constraint_read_velocity(case_doc *doc, fdem_constraint_def *def, co
     const char *layout = dim == 3 ? "[vx, vy, vz]" : "[vx, vy]";
     def->kind = FDEM_CONSTRAINT_VELOCITY;
     if (!json_is_array(v) || json_array_size(v) != (size_t)dim) {
-        case_problem(doc, ptr, "expected %s (null leaves a component free), got %s%s", layout,
-                     case_type_word(v), json_is_array(v) ? " of another length" : "");
+        char got[160];
+        case_problem(doc, ptr, "expected %s (null leaves a component free), got %s", layout,
+                     case_wrong_tuple(doc, v, 1, got, sizeof got));
         return;
     }
     int *free_flag[3] = {&def->free_x, &def->free_y, &def->free_z};
@@ -235,7 +242,7 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         constraint_read_velocity(doc, &c->def, a, at);
     } else if (action == 2) {
         c->def.kind = FDEM_CONSTRAINT_FORCE;
-        case_read_vector(doc, a, at, doc->dimension, c->def.value);
+        case_read_axes(doc, a, at, c->def.value);
     } else if (action == 3) {
         c->def.kind = FDEM_CONSTRAINT_PRESSURE;
         case_read_number(doc, a, at, &c->def.value[0]);

@@ -128,6 +128,14 @@ int case_read_number(case_doc *doc, const json_t *value, const char *ptr, double
  * dimension, a box selector, ...); the message says how many. */
 int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
                      double *out);
+/* A vector of the case's dimension: its `dimension` numbers, or a problem
+ * that names the dimension when the length is the other one's. */
+int case_read_axes(case_doc *doc, const json_t *value, const char *ptr, double *out);
+/* What a value that is not the expected tuple is, for "got ...": its type,
+ * an array's length and, when that is `per_axis` times the other
+ * dimension (per_axis > 0), a note naming "dimension". Returns buf. */
+const char *case_wrong_tuple(const case_doc *doc, const json_t *value, int per_axis, char *buf,
+                             size_t size);
 /* "two", "three", ... for "expected an array of three numbers". */
 const char *case_count_word(int count);
 /* An integer-valued number (2 or 2.0 or 1e3) in [lo, hi]. */

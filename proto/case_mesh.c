@@ -91,8 +91,8 @@ static int mesh_read_nodes(case_doc *doc, const mesh_kind *kind, mesh_arrays a,
     for (int i = 0; *a.nodes && i < *a.node_count; i++) {
         char at[CASE_POINTER];
         pointer_join_index(at, sizeof at, ptr, i);
-        ok &= case_read_vector(doc, json_array_get(nodes, (size_t)i), at, dim,
-                               &(*a.nodes)[(size_t)dim * (size_t)i]);
+        ok &= case_read_axes(doc, json_array_get(nodes, (size_t)i), at,
+                             &(*a.nodes)[(size_t)dim * (size_t)i]);
     }
     return ok;
 }

@@ -137,11 +137,21 @@ static void part_read_material(case_doc *doc, case_part *part, const json_t *val
     part->material = case_material_index(doc, name);
     if (part->material >= 0) return;
     const char **names = malloc((size_t)(doc->material_count + 1) * sizeof *names);
-    char hint[96] = "";
+    char hint[160] = "";
     if (names) {
         for (int i = 0; i < doc->material_count; i++) names[i] = doc->materials[i].name;
         case_did_you_mean(doc, hint, sizeof hint, name, names, doc->material_count);
         free(names);
+    }
+    /* no close name: list the ones there are (a material named in the part
+     * but never defined, or defined under another name); at most three, of
+     * at most 24 characters, so the hint always fits */
+    if (!hint[0] && doc->material_count > 0) {
+        size_t used = (size_t)snprintf(hint, sizeof hint, "; the case's materials are ");
+        for (int i = 0; i < doc->material_count && i < 3; i++)
+            used += (size_t)snprintf(hint + used, sizeof hint - used, "%s\"%.24s\"",
+                                     i ? ", " : "", doc->materials[i].name);
+        if (doc->material_count > 3) snprintf(hint + used, sizeof hint - used, ", ...");
     }
     case_problem(doc, at, "unknown material \"%.64s\"%s", name, hint);
 }
@@ -158,7 +168,7 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     }
     json_t *velocity = case_member(value, ptr, "velocity", at);
     if (velocity)
-        part->has_velocity = case_read_vector(doc, velocity, at, doc->dimension, part->velocity);
+        part->has_velocity = case_read_axes(doc, velocity, at, part->velocity);
     json_t *stress = case_member(value, ptr, "initial_stress", at);
     if (stress) case_read_initial_stress(doc, part, stress, at);
 }

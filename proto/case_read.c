@@ -80,22 +80,44 @@ const char *case_count_word(int count)
     return count >= 0 && count <= 6 ? words[count] : "several";
 }
 
+const char *case_wrong_tuple(const case_doc *doc, const json_t *value, int per_axis, char *buf,
+                             size_t size)
+{
+    if (!json_is_array(value)) {
+        snprintf(buf, size, "%s", case_type_word(value));
+        return buf;
+    }
+    /* The usual cause of a vector of the wrong length is a case written for
+     * the other dimension ("dimension": 3 left out, or left in), and the
+     * shape is then the only other problem that says so. */
+    size_t n = json_array_size(value);
+    const char *note = "";
+    if (per_axis > 0 && doc->dimension == 2 && n == (size_t)(3 * per_axis))
+        note = " (this case is 2D: set \"dimension\": 3 at the top of the case for a 3D one)";
+    else if (per_axis > 0 && doc->dimension == 3 && n == (size_t)(2 * per_axis))
+        note = " (this case has \"dimension\": 3, so vectors have three components)";
+    snprintf(buf, size, "an array of %zu item%s%s", n, n == 1 ? "" : "s", note);
+    return buf;
+}
+
 /* 1 when `value` is an array of exactly `count` items, else a problem
- * "expected an array of three numbers [layout], got ...". */
+ * "expected an array of three numbers [layout], got ...". `per_axis` > 0:
+ * `count` is that many per axis of the case (see case_wrong_tuple). */
 static int case_expect_tuple(case_doc *doc, const json_t *value, const char *ptr, int count,
-                             const char *items, const char *layout)
+                             int per_axis, const char *items, const char *layout)
 {
     if (json_is_array(value) && json_array_size(value) == (size_t)count) return 1;
-    case_problem(doc, ptr, "expected an array of %s %s%s%s, got %s%s", case_count_word(count),
-                 items, layout[0] ? " " : "", layout, case_type_word(value),
-                 json_is_array(value) ? " of another length" : "");
+    char got[160];
+    case_problem(doc, ptr, "expected an array of %s %s%s%s, got %s", case_count_word(count),
+                 items, layout[0] ? " " : "", layout,
+                 case_wrong_tuple(doc, value, per_axis, got, sizeof got));
     return 0;
 }
 
-int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
-                     double *out)
+static int case_read_numbers(case_doc *doc, const json_t *value, const char *ptr, int count,
+                             int per_axis, double *out)
 {
-    if (!case_expect_tuple(doc, value, ptr, count, "numbers", "")) return 0;
+    if (!case_expect_tuple(doc, value, ptr, count, per_axis, "numbers", "")) return 0;
     int ok = 1;
     for (int k = 0; k < count; k++) {
         char item[CASE_POINTER];
@@ -103,6 +125,17 @@ int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int co
         ok &= case_read_number(doc, json_array_get(value, (size_t)k), item, &out[k]);
     }
     return ok;
+}
+
+int case_read_vector(case_doc *doc, const json_t *value, const char *ptr, int count,
+                     double *out)
+{
+    return case_read_numbers(doc, value, ptr, count, 0, out);
+}
+
+int case_read_axes(case_doc *doc, const json_t *value, const char *ptr, double *out)
+{
+    return case_read_numbers(doc, value, ptr, doc->dimension, 1, out);
 }
 
 int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long lo, long hi,
@@ -132,7 +165,7 @@ int case_read_integer(case_doc *doc, const json_t *value, const char *ptr, long 
 int case_read_integers(case_doc *doc, const json_t *value, const char *ptr, int count,
                        const long *lo, long hi, const char *layout, long *out)
 {
-    if (!case_expect_tuple(doc, value, ptr, count, "whole numbers", layout)) return 0;
+    if (!case_expect_tuple(doc, value, ptr, count, 0, "whole numbers", layout)) return 0;
     int ok = 1;
     for (int k = 0; k < count; k++) {
         char item[CASE_POINTER];
@@ -274,6 +307,49 @@ const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char 
     return buf;
 }
 
+/* Names of the same quantity in other codes and textbooks, none a typo of
+ * ours: a rock engineer's first case says "E" or "poisson_ratio". Offered
+ * only where the name they mean is allowed. */
+static const char *const case_other_names[][2] = {
+    {"E", "young"},           {"youngs_modulus", "young"}, {"young_modulus", "young"},
+    {"youngs", "young"},      {"elastic_modulus", "young"}, {"modulus", "young"},
+    {"nu", "poisson"},        {"poisson_ratio", "poisson"}, {"poissons_ratio", "poisson"},
+    {"rho", "density"},       {"mass_density", "density"},  {"mu", "friction"},
+    {"friction_coefficient", "friction"}, {"phi", "friction_angle"}, {"c", "cohesion"},
+    {"ft", "tensile_strength"}, {"f_t", "tensile_strength"}, {"tensile", "tensile_strength"},
+    {"GI", "energy_I"},       {"G_I", "energy_I"},          {"Gf", "energy_I"},
+    {"G_f", "energy_I"},      {"GII", "energy_II"},         {"G_II", "energy_II"}};
+
+/* Keys of one section met in another ("interval" in "time"): where they go. */
+static const char *const case_key_homes[][3] = {
+    {"interval", "/output", "belongs in \"output\""},
+    {"fields", "/output", "belongs in \"output\""},
+    {"dt", "/time", "belongs in \"time\""},
+    {"end", "/time", "belongs in \"time\""},
+    {"safety", "/time", "belongs in \"time\""},
+    {"gravity", "", "belongs at the top of the case"},
+    {"dimension", "", "belongs at the top of the case"}};
+
+/* The hint for an unknown key that is no typo: another name of an allowed
+ * key, or a key of another section. */
+static void case_key_hint(char *buf, size_t size, const char *key, const char *ptr,
+                          const char *const *allowed, int count)
+{
+    for (size_t i = 0; i < sizeof case_other_names / sizeof case_other_names[0]; i++) {
+        if (strcmp(key, case_other_names[i][0]) != 0) continue;
+        for (int k = 0; k < count; k++)
+            if (strcmp(allowed[k], case_other_names[i][1]) == 0) {
+                snprintf(buf, size, "; did you mean \"%s\"?", allowed[k]);
+                return;
+            }
+    }
+    for (size_t i = 0; i < sizeof case_key_homes / sizeof case_key_homes[0]; i++)
+        if (strcmp(key, case_key_homes[i][0]) == 0 && strcmp(ptr, case_key_homes[i][1]) != 0) {
+            snprintf(buf, size, "; \"%s\" %s", key, case_key_homes[i][2]);
+            return;
+        }
+}
+
 int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
                     const char *const *allowed, const char *what)
 {
@@ -287,8 +363,9 @@ int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
         if (known) continue;
         char at[CASE_POINTER], hint[96];
         pointer_join(at, sizeof at, ptr, key);
-        case_problem(doc, at, "unknown key \"%.64s\" in %s%s", key, what,
-                     case_did_you_mean(doc, hint, sizeof hint, key, allowed, count));
+        case_did_you_mean(doc, hint, sizeof hint, key, allowed, count);
+        if (!hint[0]) case_key_hint(hint, sizeof hint, key, ptr, allowed, count);
+        case_problem(doc, at, "unknown key \"%.64s\" in %s%s", key, what, hint);
         ok = 0;
     }
     return ok;

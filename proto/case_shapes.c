@@ -46,7 +46,7 @@ static void shape_read_point(case_doc *doc, case_part *part, const json_t *shape
 {
     char at[CASE_POINTER];
     json_t *point = case_member(shape, ptr, key, at);
-    if (point) case_read_vector(doc, point, at, doc->dimension, part->at);
+    if (point) case_read_axes(doc, point, at, part->at);
 }
 
 /* --------------------------------------------------- rectangle and box */
@@ -63,7 +63,7 @@ void case_read_block(case_doc *doc, case_part *part, const json_t *block, const 
     json_t *size = case_member(block, ptr, "size", at);
     if (!size) {
         case_problem(doc, ptr, "missing required \"size\" %s", size_layout);
-    } else if (case_read_vector(doc, size, at, dim, part->size)) {
+    } else if (case_read_axes(doc, size, at, part->size)) {
         int positive = 1;
         for (int k = 0; k < dim; k++) positive &= part->size[k] > 0;
         shape_format_vector(text, sizeof text, part->size, dim);

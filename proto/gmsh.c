@@ -29,12 +29,17 @@ static const gmsh_kind gmsh_triangles = {
     2, 3, 2, "triangle",
     "no 3-node triangles (element type 2) in $Elements; mesh the surfaces in 2D (gmsh -2)", 9,
     "only second-order 6-node triangles (element type 9) in $Elements; fdemd takes linear "
-    "3-node ones: mesh with -order 1 (gmsh's default)"};
+    "3-node ones: mesh with -order 1 (gmsh's default)", 4,
+    "4-node tetrahedra (element type 4) in $Elements: this is a 3D mesh and the case is 2D; "
+    "set \"dimension\": 3 at the top of the case (or mesh the surfaces only, gmsh -2)"};
 static const gmsh_kind gmsh_tetrahedra = {
     4, 4, 3, "tetrahedron",
     "no 4-node tetrahedra (element type 4) in $Elements; mesh the volumes in 3D (gmsh -3)", 11,
     "only second-order 10-node tetrahedra (element type 11) in $Elements; fdemd takes linear "
-    "4-node ones: mesh with -order 1 (gmsh's default)"};
+    "4-node ones: mesh with -order 1 (gmsh's default)", 2,
+    "no 4-node tetrahedra (element type 4) in $Elements, only 3-node triangles: this is a 2D "
+    "mesh and the case has \"dimension\": 3; mesh the volumes in 3D (gmsh -3), or leave out "
+    "\"dimension\": 3 for a 2D case"};
 
 int gmsh_fail(gmsh_reader *r, const char *fmt, ...)
 {
@@ -312,6 +317,7 @@ static int gmsh_read_elements22(gmsh_reader *r)
             return -1;
         int kept = head[1] == r->kind->type;
         r->quadratic_count += head[1] == r->kind->quadratic_type;
+        r->other_count += head[1] == r->kind->other_type;
         if (!kept && !r->want_groups) continue;
         if (head[2] < 0 || head[2] > GMSH_MAX_TOKENS)
             return gmsh_fail(r, "bad number of element tags (%lld)", head[2]);
@@ -338,6 +344,7 @@ static int gmsh_read_element_block41(gmsh_reader *r, long long *total)
     if (gmsh_check_count(r, n, 4, "elements in the block") < 0) return -1;
     int kept = head[2] == r->kind->type;
     if (head[2] == r->kind->quadratic_type) r->quadratic_count += n;
+    if (head[2] == r->kind->other_type) r->other_count += n;
     if (r->want_groups && (head[0] < 0 || head[0] > 3))
         return gmsh_fail(r, "entity dimension %lld is not 0 to 3", head[0]);
     for (long long i = 0; i < n; i++) {
@@ -447,8 +454,15 @@ static int gmsh_read_sections(gmsh_reader *r)
     if (!r->version) return gmsh_fail(r, "not a gmsh mesh: no $MeshFormat section");
     if (!r->seen_nodes) return gmsh_fail(r, "no $Nodes section");
     if (!r->seen_elements) return gmsh_fail(r, "no $Elements section");
+    /* A 2D case given a 3D file would keep its surface triangles, flattened
+     * onto z = 0 and overlapping: refuse it whole rather than let the mesh
+     * check report a "zero area" triangle of a wall. A 3D case given a 2D
+     * file has no tetrahedra at all: say it is the dimension, not the mesher. */
+    if (r->kind->dims == 2 && r->other_count > 0) return gmsh_fail(r, "%s", r->kind->other);
     if (r->element_count == 0)
-        return gmsh_fail(r, "%s", r->quadratic_count ? r->kind->only_quadratic : r->kind->missing);
+        return gmsh_fail(r, "%s", r->quadratic_count ? r->kind->only_quadratic
+                                  : r->other_count   ? r->kind->other
+                                                     : r->kind->missing);
     return 0;
 }
 

@@ -43,6 +43,8 @@ typedef struct gmsh_kind {
     const char *missing; /* the message when the file has none */
     int quadratic_type;  /* gmsh's second-order twin (6-node triangle, 10-node tetrahedron) */
     const char *only_quadratic; /* the message when the file has only those */
+    int other_type;      /* the other dimension's linear element (tetrahedron, triangle) */
+    const char *other;   /* the message when the file is a mesh of the other dimension */
 } gmsh_kind;
 
 /* An element of any type that may belong to physical groups: key is its
@@ -82,6 +84,7 @@ typedef struct gmsh_reader {
     gmsh_element *elements;
     long element_count, element_capacity;
     long long quadratic_count; /* elements of kind->quadratic_type met */
+    long long other_count;     /* elements of kind->other_type met */
     char *message;
     size_t message_size;
     int failed;

@@ -6,14 +6,21 @@
 # follows its progress, fetches result.h5 + result.xdmf into out/, draws a
 # PNG and stops the daemon with SIGTERM, the way a user would.
 #
-#   scripts/demo.sh [examples/CASE.json]     (default examples/collision.json)
+#   scripts/demo.sh [examples/CASE.json [PLOT OPTIONS]]   (default examples/collision.json)
+#
+# PLOT OPTIONS go to plot_result.py as they are (--field, --component,
+# --view ELEV,AZIM): a 3D result is drawn as the outside of its bodies, so
+# a box with spheres in it needs --view 75,-60 to show them. OUT (default
+# out) is where the files go.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 BIN=${BIN:-bin}
 PYTHON=${PYTHON:-/usr/bin/python3}
 EXAMPLE=${1:-examples/collision.json}
-OUT=out
+[ $# -gt 0 ] && shift
+PLOT_ARGS=("$@")
+OUT=${OUT:-out}
 DATA=$OUT/demo-data
 LOG=$OUT/demo-fdemd.log
 
@@ -59,7 +66,12 @@ say "fdemctl fetch $id -o $OUT/$name.h5 --force"
 "$BIN/fdemctl" fetch "$id" -o "$OUT/$name.h5" --force   # the demo replaces its own output
 
 say "plot_result.py -> $OUT/$name.png"
-"$PYTHON" clients/python/plot_result.py "$OUT/$name.h5" -o "$OUT/$name.png"
+"$PYTHON" clients/python/plot_result.py "$OUT/$name.h5" -o "$OUT/$name.png" ${PLOT_ARGS[@]+"${PLOT_ARGS[@]}"}
+dimension=$("$PYTHON" -c 'import json, sys; print(json.load(open(sys.argv[1])).get("dimension", 2))' "$EXAMPLE")
+if [ "$dimension" = 3 ] && [ ${#PLOT_ARGS[@]} -eq 0 ]; then
+  echo "(3D: the outside of the bodies, seen from --view 25,-60; to look into a box from above:"
+  echo " scripts/demo.sh $EXAMPLE --view 75,-60)"
+fi
 
 say "stopping fdemd (SIGTERM)"
 kill -TERM "$daemon"

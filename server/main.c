@@ -102,10 +102,14 @@ static int parse_listen(const char *s, fdemd_config *cfg)
         strcpy(cfg->listen_host, "127.0.0.1");
     struct in_addr ipv4;
     if (inet_pton(AF_INET, cfg->listen_host, &ipv4) != 1)
-        return -2; /* a bad option like the others (exit 2), not a failed start */
+        /* a bad option like the others (exit 2), not a failed start; an
+         * address with a colon or bracket is IPv6, anything else a name */
+        return strpbrk(cfg->listen_host, ":[]") ? -2 : -3;
     int port = 0;
-    if (parse_int(colon + 1, 0, &port) != 0 || port > 65535)
+    if (parse_int(colon + 1, 0, &port) != 0)
         return -1;
+    if (port > 65535)
+        return -4;
     cfg->listen_port = port;
     return 0;
 }
@@ -141,6 +145,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
 
+    char listen_error[256];
     int opt;
     while ((opt = getopt_long(argc, argv, "h", opts, NULL)) != -1) {
         const char *bad = NULL;
@@ -148,7 +153,15 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case 'l':
             switch (parse_listen(optarg, cfg)) {
             case 0: break;
-            case -2: bad = "--listen serves IPv4 only: HOST is a dotted address such as 127.0.0.1 or 0.0.0.0 (or localhost)"; break;
+            case -2: bad = "--listen serves IPv4 only, not IPv6: HOST is a dotted address such as 127.0.0.1 or 0.0.0.0 (or localhost)"; break;
+            case -3:
+                snprintf(listen_error, sizeof listen_error,
+                         "--listen takes a dotted IPv4 address (or localhost), not a host name "
+                         "(\"%.64s\"): 127.0.0.1 for this machine only, 0.0.0.0 for every "
+                         "interface", cfg->listen_host);
+                bad = listen_error;
+                break;
+            case -4: bad = "--listen: PORT is 0 to 65535 (0 picks a free port)"; break;
             default: bad = "--listen takes HOST:PORT, e.g. 127.0.0.1:8080"; break;
             }
             break;

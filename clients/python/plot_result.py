@@ -43,6 +43,7 @@ then as an HDF5 SWMR reader.
 
 import argparse
 import json
+import os
 import sys
 
 import matplotlib
@@ -62,6 +63,18 @@ COMPONENTS = {2: ("xx", "yy", "xy"), 3: ("xx", "yy", "zz", "yz", "xz", "xy")}
 
 def open_result(path):
     """Opens result.h5 read-only, as a SWMR reader if a writer holds it."""
+    # The .xdmf beside a fetched .h5 is what the docs say to open in
+    # ParaView, so it is the file a user hands over by mistake; h5py would
+    # only say "file signature not found".
+    try:
+        with open(path, "rb") as f:
+            head = f.read(64).lstrip()
+    except OSError:
+        head = b""
+    if head.startswith(b"<?xml") or head.startswith(b"<Xdmf"):
+        h5 = os.path.splitext(path)[0] + ".h5"
+        raise OSError("it is the XDMF sidecar for ParaView, not the HDF5 result: "
+                      "give its .h5 (%s)" % h5)
     try:
         return h5py.File(path, "r")
     except OSError as plain_error:
@@ -318,7 +331,9 @@ def view_angles(text):
 
 def plot_3d(f, args, field):
     if field == "damage":
-        sys.exit("plot_result: --field damage is drawn for 2D results only")
+        sys.exit("plot_result: --field damage is drawn for 2D results only; in 3D open the "
+                 ".xdmf in ParaView (its joints block is coloured by damage) or list the "
+                 "broken joints with fdemctl events ID")
     s, count = snapshot_index(f, args.snapshot)
     xyz, where = snapshot_positions(f, s)
     faces, element = surface_of_snapshot(f, s)

@@ -44,6 +44,19 @@ class CommandLineTest(unittest.TestCase):
             self.assertEqual(out.returncode, 2, out.stderr)
             self.assertIn("IPv4 only", out.stderr)
 
+    def test_listen_errors_name_the_part_at_fault(self):
+        # a port out of range or a host name was told only "takes
+        # HOST:PORT" or "serves IPv4 only", though neither was the fault
+        out = self.run_fdemd("--listen", "127.0.0.1:99999")
+        self.assertEqual(out.returncode, 2, out.stderr)
+        self.assertIn("PORT is 0 to 65535", out.stderr)
+        out = self.run_fdemd("--listen", "simhost:8080")
+        self.assertEqual(out.returncode, 2, out.stderr)
+        self.assertIn("not a host name", out.stderr)
+        self.assertIn("simhost", out.stderr)
+        out = self.run_fdemd("--listen", "[::1]:8080")
+        self.assertIn("IPv6", out.stderr)
+
     def test_port_in_use(self):
         with socket.socket() as s:
             s.bind(("127.0.0.1", 0))

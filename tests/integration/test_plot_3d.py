@@ -195,6 +195,24 @@ class SyntheticResultTests(Plot3DTestCase):
         self.assertIn("2D results only", r.stderr)
         self.assertFalse(os.path.exists(png))
 
+    def test_damage_in_3d_says_where_to_look(self):
+        r, _ = self.plot(self.h5, "--field", "damage")
+        self.assertIn("ParaView", r.stderr)
+        self.assertIn("fdemctl events", r.stderr)
+
+    def test_the_xdmf_sidecar_is_pointed_at_its_h5(self):
+        # fdemctl fetch leaves R.h5 and R.xdmf side by side, and "open the
+        # .xdmf" is what the demo says for ParaView: given to plot_result it
+        # was "file signature not found"
+        xdmf = os.path.join(self.work.name, "box3d.xdmf")
+        with open(xdmf, "w") as f:
+            f.write('<?xml version="1.0" ?>\n<Xdmf Version="3.0"></Xdmf>\n')
+        r, png = self.plot(xdmf)
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("XDMF", r.stderr)
+        self.assertIn("box3d.h5", r.stderr)
+        self.assertFalse(os.path.exists(png))
+
     def test_bad_view_is_a_clear_error(self):
         r, _ = self.plot(self.h5, "--view", "up")
         self.assertNotEqual(r.returncode, 0)
@@ -297,6 +315,37 @@ class FracturingResultTests(DaemonRunTestCase):
 
     def test_stress_plot(self):
         self.assert_drawn(*self.plot(self.h5))
+
+
+class DemoScriptTests(unittest.TestCase):
+    """scripts/demo.sh hands what follows the example to plot_result.py: the
+    3D sphere pile, drawn from the default view, is the outside of its box
+    and shows no sphere (examples/README.md: look in with --view 75,-60)."""
+
+    def run_demo(self, *args):
+        out = tempfile.TemporaryDirectory(prefix="demo-")
+        self.addCleanup(out.cleanup)
+        env = dict(os.environ, OUT=out.name, PYTHON=PYTHON,
+                   BIN=os.path.dirname(fdemd_harness.FDEMD_BIN))
+        r = subprocess.run(["bash", os.path.join(ROOT, "scripts", "demo.sh"),
+                            "examples/freefall-3d.json"] + list(args),
+                           cwd=ROOT, env=env, capture_output=True, text=True,
+                           timeout=120 * SLOW)
+        return r, out.name
+
+    def test_plot_options_reach_plot_result(self):
+        r, out = self.run_demo("--view", "90,0")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertTrue(os.path.exists(os.path.join(out, "freefall-3d.png")))
+        self.assertTrue(os.path.exists(os.path.join(out, "demo-fdemd.log")))
+        r, _ = self.run_demo("--view", "up")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("ELEVATION,AZIMUTH", r.stderr)
+
+    def test_a_3d_demo_says_how_to_choose_the_view(self):
+        r, _ = self.run_demo()
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("--view", r.stdout)
 
 
 class VonMises3DTests(unittest.TestCase):

@@ -334,6 +334,25 @@ static void material_ranges(void)
     expect_variant("/materials", "{}", "/materials", "at least one material");
 }
 
+/* The names other codes and textbooks use are pointed at ours, and a key
+ * put in the wrong section is pointed at its own: none of these is a typo
+ * of the right name, so they used to come without a hint. */
+static void other_names_and_places_are_suggested(void)
+{
+    static const struct { const char *at, *meant; } names[] = {
+        {"/materials/rock/youngs_modulus", "did you mean \"young\""},
+        {"/materials/rock/E", "did you mean \"young\""},
+        {"/materials/rock/poisson_ratio", "did you mean \"poisson\""},
+        {"/materials/rock/nu", "did you mean \"poisson\""},
+        {"/materials/rock/rho", "did you mean \"density\""},
+        {"/materials/rock/fracture/G_I", "did you mean \"energy_I\""},
+        {"/time/interval", "\"interval\" belongs in \"output\""},
+        {"/output/dt", "\"dt\" belongs in \"time\""},
+        {"/time/gravity", "\"gravity\" belongs at the top of the case"}};
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+        expect_variant(names[i].at, "1", names[i].at, names[i].meant);
+}
+
 static void unknown_material_is_suggested(void)
 {
     expect_variant("/parts/0/material", "'granit'", "/parts/0/material",
@@ -342,6 +361,9 @@ static void unknown_material_is_suggested(void)
     edit(doc, "/materials/granite", load("{'density': 2700, 'young': 3e10, 'poisson': 0.25}"));
     edit(doc, "/parts/1/material", json_string("granit"));
     expect_doc(doc, GiB, 422, "/parts/1/material", "did you mean \"granite\"");
+    /* far from every name: the ones the case has are listed */
+    expect_variant("/parts/0/material", "'sandstone'", "/parts/0/material",
+                   "the case's materials are \"rock\", \"steel\"");
 }
 
 /* ----------------------------------------------------------- parts */
@@ -696,6 +718,7 @@ CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(malformed_json_is_400), T(deep_nesting_is_400), T(duplicate_keys_are_400),
            T(overflowing_numbers_are_400), T(not_an_object), T(unknown_keys_are_named),
            T(wrong_types_are_named), T(material_ranges), T(unknown_material_is_suggested),
+           T(other_names_and_places_are_suggested),
            T(part_shapes), T(explicit_mesh_errors),
            T(bodies_overlapping_at_start), T(gmsh_errors), T(part_flags_and_names),
            T(constraint_errors), T(velocity_constraint_may_leave_a_component_free),

@@ -528,6 +528,36 @@ static void all_problems_are_collected(void)
     problems_free(&p);
 }
 
+/* A case written for one dimension and read as the other (the usual cause:
+ * "dimension": 3 left out, or left in) says so at every vector and fix,
+ * not only at the shape: these messages used to end "got an array of
+ * another length". */
+static void vectors_of_the_other_dimension_name_it(void)
+{
+    json_t *doc = load(base3d);
+    edit(doc, "/dimension", NULL);
+    problems p;
+    case_info info;
+    fdem_model *m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(m == NULL, "built");
+    static const char *const as_2d[] = {"/gravity", "/parts/0/velocity", "/constraints/0/velocity",
+                                        "/constraints/1/box", "/constraints/1/fix",
+                                        "/constraints/2/box", "/constraints/2/force",
+                                        "/parts/0/box"};
+    for (int i = 0; i < 8; i++)
+        CHECK(has_problem(&p, as_2d[i], "\"dimension\": 3"), "%s does not name the dimension",
+              as_2d[i]);
+    if (m) fdem_model_destroy(m);
+    problems_free(&p);
+    static const struct { const char *at, *value; } as_3d[] = {
+        {"/gravity", "[0, -9.81]"}, {"/parts/0/velocity", "[1, 0]"},
+        {"/constraints/0/velocity", "[null, -1]"}, {"/constraints/1/box", "[-1, -1, 1, 1]"},
+        {"/constraints/2/force", "[0, -1000]"}, {"/parts/0/box/size", "[0.1, 0.2]"}};
+    for (int i = 0; i < 6; i++)
+        expect_variant(as_3d[i].at, as_3d[i].value, as_3d[i].at, "this case has \"dimension\": 3");
+}
+
 CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds),
            T(cylinder_builds), T(explicit_mesh_builds_in_either_orientation),
            T(gmsh_tetrahedra_build), T(two_parts_build_or_wait_for_contact), T(bodies_overlapping_at_start),
@@ -535,4 +565,4 @@ CHECK_MAIN(T(box_case_builds), T(gravity_has_three_components), T(sphere_builds)
            T(shapes_of_the_other_dimension), T(box_errors), T(sphere_and_cylinder_errors),
            T(explicit_mesh_errors), T(gmsh_errors), T(fracture_builds_a_joint_on_every_interior_face),
            T(absurd_3d_divisions_are_refused_by_size), T(memory_estimate_3d_is_not_low),
-           T(all_problems_are_collected))
+           T(all_problems_are_collected), T(vectors_of_the_other_dimension_name_it))

@@ -332,10 +332,42 @@ static void second_order_meshes_are_named(void)
           "6-node triangles: %s", message);
 }
 
+/* A mesh of the other dimension names the missing "dimension": 3 (or the one
+ * too many). A 3D file read for a 2D case used to be read as its surface
+ * triangles projected on z = 0 and refused as "triangle 14 has zero area". */
+static void other_dimension_is_named(void)
+{
+    static const char *const cubes[] = {"tests/data/cube_v22.msh", "tests/data/cube_v41.msh"};
+    for (int i = 0; i < 2; i++) {
+        size_t length = 0;
+        char *text = read_file(cubes[i], &length);
+        if (!text) continue;
+        fdem_mesh tris;
+        char message[256] = "";
+        CHECK(gmsh_read(text, length, &tris, message, sizeof message) != 0 &&
+                  strstr(message, "3D mesh") && strstr(message, "\"dimension\": 3"),
+              "%s read for a 2D case: %s", cubes[i], message);
+        free(text);
+    }
+    static const char *const squares[] = {"tests/data/square_v22.msh", "tests/data/square_v41.msh"};
+    for (int i = 0; i < 2; i++) {
+        size_t length = 0;
+        char *text = read_file(squares[i], &length);
+        if (!text) continue;
+        fdem_tet_mesh tets;
+        char message[256] = "";
+        CHECK(gmsh_read_tetrahedra(text, length, &tets, message, sizeof message) != 0 &&
+                  strstr(message, "no 4-node tetrahedra") && strstr(message, "2D mesh") &&
+                  strstr(message, "\"dimension\": 3"),
+              "%s read for a 3D case: %s", squares[i], message);
+        free(text);
+    }
+}
+
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
            T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
            T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
            T(rejects_bad_references), T(rejects_missing_sections),
            T(every_prefix_of_a_real_file), T(cube_tetrahedra_v22), T(cube_tetrahedra_v41),
-           T(second_order_meshes_are_named),
+           T(second_order_meshes_are_named), T(other_dimension_is_named),
            T(tetrahedra_rejects))
