@@ -109,6 +109,17 @@ static inline void expect_doc(json_t *doc, size_t limit, int status, const char 
     expect_refused(m, &p, status, pointer, needle);
 }
 
+/* Builds `doc` (and frees it), expecting no model: its problems in *p,
+ * for checks at several pointers (free them after). */
+static inline void build_refused(json_t *doc, size_t limit, problems *p)
+{
+    case_info info;
+    fdem_model *m = build_json(doc, limit, &info, p);
+    json_decref(doc);
+    CHECK(m == NULL, "a model was built");
+    if (m) fdem_model_destroy(m);
+}
+
 /* Builds `doc` (and frees it), expecting a model: NULL after reporting
  * the problems. `info` may be NULL. */
 static inline fdem_model *expect_built(json_t *doc, case_info *info)
