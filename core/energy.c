@@ -175,7 +175,9 @@ fdem_energy fdem_get_energy(const fdem_model *m)
     en.joint = m->joint_energy;
     en.friction = m->friction_energy + m->joint_friction_energy;
     en.fracture = m->fracture_energy;
-    en.contact = -(m->contact_work - 0.5 * havg * contact_power) - m->friction_energy;
+    /* b - a, not -(a - b): the same bits but for zero, which this way is
+     * +0 (a model without contacts showed "contact -0") */
+    en.contact = (0.5 * havg * contact_power - m->contact_work) - m->friction_energy;
     en.damping = m->damping_work + boundary_load_last_half_step(m, 1);
     en.gravity_work = m->gravity_amplitude ? gravity_work_of_amplitude(m) : gravity_work;
     en.external_work = m->external_work - constraints_last_half_step(m);

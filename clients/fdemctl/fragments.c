@@ -45,17 +45,25 @@ static void print_fragments(const json_t *body)
     printf("step %lld, t = %.6g s: %zu fragments, total mass %.6g %s\n",
            (long long)json_integer_value(json_object_get(body, "step")), number_at(body, "time"),
            json_array_size(list), total, unit);
-    printf("%6s %9s %12s %12s %12s  %-30s %s\n", "id", "elements", "mass", "size", "diameter",
-           "centroid", "velocity");
+    /* the centroid column as wide as its widest entry (a 3D one runs past
+     * 30 characters and pushed the velocities out of line) */
+    int width = (int)strlen("centroid");
+    for (size_t i = 0; i < json_array_size(list); i++) {
+        char centroid[96];
+        vector_text(json_object_get(json_array_get(list, i), "centroid"), centroid, sizeof centroid);
+        if ((int)strlen(centroid) > width) width = (int)strlen(centroid);
+    }
+    printf("%6s %9s %12s %12s %12s  %-*s %s\n", "id", "elements", "mass", "size", "diameter",
+           width, "centroid", "velocity");
     for (size_t i = 0; i < json_array_size(list); i++) {
         const json_t *f = json_array_get(list, i);
         char centroid[96], velocity[96];
         vector_text(json_object_get(f, "centroid"), centroid, sizeof centroid);
         vector_text(json_object_get(f, "velocity"), velocity, sizeof velocity);
-        printf("%6lld %9lld %12.6g %12.6g %12.6g  %-30s %s\n",
+        printf("%6lld %9lld %12.6g %12.6g %12.6g  %-*s %s\n",
                (long long)json_integer_value(json_object_get(f, "id")),
                (long long)json_integer_value(json_object_get(f, "elements")), number_at(f, "mass"),
-               number_at(f, "size"), number_at(f, "diameter"), centroid, velocity);
+               number_at(f, "size"), number_at(f, "diameter"), width, centroid, velocity);
     }
     const json_t *curve = json_object_get(body, "distribution");
     printf("\nsieve curve: mass fraction passing\n%12s %9s\n", "diameter", "passing");

@@ -197,6 +197,8 @@ class FdemctlTests(ClientTestCase):
         self.assertEqual(table.returncode, 0)
         self.assertIn("finished", table.stdout)
         self.assertIn("100.0 %", table.stdout)
+        # one body, no contact: its contact account is 0, not "-0"
+        self.assertRegex(table.stdout, r"contact 0[,\n]")
         s = json.loads(self.ctl("status", case_id, "--json").stdout)
         for key in ("id", "name", "state", "step", "time", "end_time", "progress", "dt",
                     "nodes", "elements", "snapshots"):
