@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "model.h"
+#include "node_ids.h"
 #include "vec3.h"
 
 static int is_boundary_load(const constraint *c)
@@ -72,17 +73,8 @@ typedef struct facet_key {
 static int facet_key_compare(const void *pa, const void *pb)
 {
     const facet_key *a = pa, *b = pb;
-    for (int k = 0; k < 3; k++)
-        if (a->vertex[k] != b->vertex[k]) return a->vertex[k] < b->vertex[k] ? -1 : 1;
-    return (a->elem > b->elem) - (a->elem < b->elem);
-}
-
-static void sort3(int32_t v[3])
-{
-    int32_t t;
-    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
-    if (v[1] > v[2]) { t = v[1]; v[1] = v[2]; v[2] = t; }
-    if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
+    int c = node_ids_compare(a->vertex, b->vertex, 3);
+    return c ? c : (a->elem > b->elem) - (a->elem < b->elem);
 }
 
 /* Every element facet, sorted so that the two sides of an interior facet
@@ -101,7 +93,7 @@ static facet_key *facets_sorted(const fdem_model *m, int *out_count)
             const int *v = facet_vertices(m, f);
             k->vertex[2] = -1; /* 2D: a sorted edge has it first */
             for (int j = 0; j < D; j++) k->vertex[j] = m->node_origin[n[v[j]]];
-            sort3(k->vertex);
+            node_ids_sort(k->vertex, 3);
             k->elem = e;
             k->facet = f;
         }

@@ -27,6 +27,7 @@
 #include <string.h>
 
 #include "model.h"
+#include "node_ids.h"
 
 /* -------------------------------------------------------------- draws */
 
@@ -55,22 +56,14 @@ double weibull_factor(uint64_t seed, uint64_t index, double modulus)
  * lexicographically. */
 static int face_compare(const void *pa, const void *pb)
 {
-    const int32_t *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a[i] != b[i]) return a[i] < b[i] ? -1 : 1;
-    return 0;
+    return node_ids_compare(pa, pb, 3);
 }
 
 static void face_key(const int32_t *vertices, int dim, int32_t key[3])
 {
     key[2] = -1;
     for (int i = 0; i < dim; i++) key[i] = vertices[i];
-    for (int i = 1; i < dim; i++) /* insertion sort of two or three */
-        for (int k = i; k > 0 && key[k - 1] > key[k]; k--) {
-            int32_t t = key[k];
-            key[k] = key[k - 1];
-            key[k - 1] = t;
-        }
+    node_ids_sort(key, dim);
 }
 
 int fdem_add_joint_set(fdem_model *m, int part_index, const fdem_fracture_params *params,

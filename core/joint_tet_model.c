@@ -12,6 +12,7 @@
 #include "element_tet.h"
 #include "joint_tet.h"
 #include "model.h"
+#include "node_ids.h"
 #include "vec3.h"
 
 typedef struct face_ref {
@@ -23,22 +24,13 @@ typedef struct face_ref {
 static int face_compare(const void *pa, const void *pb)
 {
     const face_ref *a = pa, *b = pb;
-    for (int i = 0; i < 3; i++)
-        if (a->key[i] != b->key[i]) return a->key[i] < b->key[i] ? -1 : 1;
-    return a->tet < b->tet ? -1 : a->tet > b->tet;
+    int c = node_ids_compare(a->key, b->key, 3);
+    return c ? c : a->tet < b->tet ? -1 : a->tet > b->tet;
 }
 
 static int same_face(const face_ref *a, const face_ref *b)
 {
-    return a->key[0] == b->key[0] && a->key[1] == b->key[1] && a->key[2] == b->key[2];
-}
-
-static void sort3(int32_t k[3])
-{
-    int32_t t;
-    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
-    if (k[1] > k[2]) t = k[1], k[1] = k[2], k[2] = t;
-    if (k[0] > k[1]) t = k[0], k[0] = k[1], k[1] = t;
+    return node_ids_compare(a->key, b->key, 3) == 0;
 }
 
 /* Writes joint j between face f_a of element ea and the same face of eb:
@@ -95,7 +87,7 @@ int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int t
         for (int f = 0; f < 4; f++) {
             face_ref *r = &faces[4 * (size_t)t + f];
             for (int i = 0; i < 3; i++) r->key[i] = tet[4 * t + tet_face_nodes[f][i]];
-            sort3(r->key);
+            node_ids_sort(r->key, 3);
             r->tet = t;
             r->face = f;
         }

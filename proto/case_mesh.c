@@ -18,6 +18,7 @@
 
 #include "case_internal.h"
 #include "gmsh.h"
+#include "node_ids.h"
 
 typedef struct mesh_kind {
     int dimension;           /* numbers per node */
@@ -160,21 +161,15 @@ typedef struct cell_key {
 static int cell_key_compare(const void *pa, const void *pb)
 {
     const cell_key *a = pa, *b = pb;
-    for (int k = 0; k < 4; k++)
-        if (a->nodes[k] != b->nodes[k]) return a->nodes[k] < b->nodes[k] ? -1 : 1;
-    return (a->index > b->index) - (a->index < b->index);
+    int c = node_ids_compare(a->nodes, b->nodes, 4);
+    return c ? c : (a->index > b->index) - (a->index < b->index);
 }
 
 static cell_key cell_key_of(const mesh_kind *kind, const int32_t *cells, int t)
 {
     cell_key c = {{-1, -1, -1, -1}, t};
     memcpy(c.nodes, cells + (size_t)kind->corners * (size_t)t, (size_t)kind->corners * sizeof *cells);
-    for (int i = 1; i < kind->corners; i++) /* insertion sort of 3 or 4 */
-        for (int j = i; j > 0 && c.nodes[j - 1] > c.nodes[j]; j--) {
-            int32_t s = c.nodes[j];
-            c.nodes[j] = c.nodes[j - 1];
-            c.nodes[j - 1] = s;
-        }
+    node_ids_sort(c.nodes, kind->corners);
     return c;
 }
 
@@ -196,7 +191,7 @@ static void mesh_check_repeats(case_doc *doc, const mesh_kind *kind, mesh_arrays
     for (int t = 0; t < n; t++) keys[t] = cell_key_of(kind, *a.cells, t);
     qsort(keys, (size_t)n, sizeof *keys, cell_key_compare);
     for (int t = 1; t < n; t++)
-        if (memcmp(keys[t].nodes, keys[t - 1].nodes, sizeof keys[t].nodes) == 0) {
+        if (node_ids_compare(keys[t].nodes, keys[t - 1].nodes, 4) == 0) {
             char at[CASE_POINTER];
             pointer_join_index(at, sizeof at, cells_ptr, keys[t].index);
             case_problem(doc, at, "%s %d has the same nodes as %s %d", kind->cell_word,
