@@ -23,24 +23,23 @@ double element_stable_dt(const fdem_model *m, int e)
     return dt * initial_stress_dt_factor(m, e);
 }
 
-/* A block part run by part run (elements of a part are contiguous): a
- * part with an in-situ stress through the kernel's loop with the
- * pre-stress, a fixed part whose forces are kept (fixed_part.c) not at
- * all, the rest through the plain loop, so a model without either pays
- * nothing for them. */
+scatter_block_fn element_forces_loop_of(const fdem_model *m, const part *p)
+{
+    if (m->dim == 3) return p->stressed ? tet_element_forces_range_stressed : tet_element_forces_range;
+    return p->stressed ? tri_element_forces_range_stressed : tri_element_forces_range;
+}
+
+/* A block part run by part run (elements of a part are contiguous): each
+ * run through its part's loop (element_forces_loop_of), a fixed part whose
+ * forces are kept (fixed_part.c) not at all, so a model without in-situ
+ * stress or fixed parts pays nothing for them. */
 static void forces_by_part_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    const int three = m->dim == 3, kept = fixed_parts_kept(m);
+    const int kept = fixed_parts_kept(m);
     for (int e = begin; e < end;) {
         const part *p = &m->parts[m->elem_part[e]];
         int stop = p->elem_begin + p->elem_count < end ? p->elem_begin + p->elem_count : end;
-        if (kept && p->fixed)
-            ; /* fixed_parts_forces */
-        else if (p->stressed)
-            (three ? tet_element_forces_range_stressed : tri_element_forces_range_stressed)(m, e, stop,
-                                                                                           sums);
-        else
-            (three ? tet_element_forces_range : tri_element_forces_range)(m, e, stop, sums);
+        if (!(kept && p->fixed)) element_forces_loop_of(m, p)(m, e, stop, sums);
         e = stop;
     }
 }

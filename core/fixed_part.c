@@ -115,11 +115,7 @@ static void fixed_forces_compute(fdem_model *m)
         const part *p = &m->parts[k];
         if (!p->fixed) continue;
         memset(m->force + D * (size_t)p->node_begin, 0, sizeof(double) * D * (size_t)p->node_count);
-        scatter_block_fn run = m->dim == 3 ? (p->stressed ? tet_element_forces_range_stressed
-                                                          : tet_element_forces_range)
-                                           : (p->stressed ? tri_element_forces_range_stressed
-                                                          : tri_element_forces_range);
-        run(m, p->elem_begin, p->elem_begin + p->elem_count, sums);
+        element_forces_loop_of(m, p)(m, p->elem_begin, p->elem_begin + p->elem_count, sums);
     }
     fixed_forces_copy(m, 1);
     m->fixed_energy = sums[0];

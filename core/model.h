@@ -381,10 +381,6 @@ static inline const int32_t *element_nodes(const fdem_model *m, int e)
     return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
 }
 
-/* A part whose elements' forces are stored, not added, at each step: a
- * fracturing part in 3D, where every element has nodes of its own, so the
- * step need not zero their forces first (element_tet_model.c; the triangle
- * kernel adds everywhere). */
 /* The time after a step of h. Time is a running sum of steps, and summed
  * plainly its rounding grew with the step count: the 160000 steps of
  * examples/incline.json ended 7e-13 s short of time.end, so the daemon took
@@ -399,10 +395,20 @@ static inline double model_time_after(const fdem_model *m, double h, double *car
     return t;
 }
 
+/* A part whose elements' forces are stored, not added, at each step: a
+ * fracturing part in 3D, where every element has nodes of its own, so the
+ * step need not zero their forces first (element_tet_model.c; the triangle
+ * kernel adds everywhere). */
 static inline int model_part_stores_forces(const fdem_model *m, const part *p)
 {
     return m->dim == 3 && p->fracture;
 }
+
+/* The mesh checks (mesh.c, mesh_3d.c) take an element only when its size
+ * squared (2D) or cubed (3D) is above this and finite: the 1e-12 tolerance
+ * on its area or volume is then still a normal double. Edges from about
+ * 1e-93 m (3D; 1e-140 m in 2D) up to 5e102 m (1e154 m) pass. */
+#define MESH_SMALLEST_CUBE 1e-280
 
 /* Initial area (2D) or volume (3D), set by element_prepare. */
 static inline double element_size0(const fdem_model *m, int e)
@@ -539,16 +545,14 @@ int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_F
  * block order, to the same totals; each totals[i] from SCATTER_MAX on
  * becomes the largest sums[i] (and what it held before, if larger). */
 typedef void (*scatter_block_fn)(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
+/* The element loop of part p's elements: its dimension's kernel, with the
+ * pre-stress where the part has one (element.c, fixed_part.c). */
+scatter_block_fn element_forces_loop_of(const fdem_model *m, const part *p);
+
 /* Smallest blocks, and the block count aimed at above that: a node on the
  * border of two colours is loaded once per colour, so large meshes get
  * blocks many rows deep (few border nodes), while 64 blocks still spread
  * over any core count this daemon meets. */
-/* The mesh checks (mesh.c, mesh_3d.c) take an element only when its size
- * squared (2D) or cubed (3D) is above this and finite: the 1e-12 tolerance
- * on its area or volume is then still a normal double. Edges from about
- * 1e-93 m (3D; 1e-140 m in 2D) up to 5e102 m (1e154 m) pass. */
-#define MESH_SMALLEST_CUBE 1e-280
-
 #define SCATTER_BLOCK_ELEMENTS 1024
 #define SCATTER_BLOCK_JOINTS 2048
 #define SCATTER_BLOCK_NODES 4096
