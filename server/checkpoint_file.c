@@ -77,13 +77,14 @@ checkpoint_file_kind checkpoint_file_open(const void *bytes, size_t size, size_t
          * it: such a file without its trailer had its end damaged or cut
          * off, and is not restored unchecked (or refused only for its
          * size, an error that invites cutting the trailer off). */
-        if (fdem_checkpoint_version(p, size) < CHECKPOINT_FILE_SEALED_SINCE)
+        int version = fdem_checkpoint_version(p, size);
+        if (version < CHECKPOINT_FILE_SEALED_SINCE)
             return CHECKPOINT_FILE_BARE;
         snprintf(err, errlen,
                  "it is damaged: it is of checkpoint version %d, always written with a trailer "
                  "(FDCK and a CRC-32), but its last 8 bytes are not one (the end of the file "
                  "changed or was cut off after fdemd wrote it)",
-                 fdem_checkpoint_version(p, size));
+                 version);
         return CHECKPOINT_FILE_DAMAGED;
     }
     size_t body = size - CHECKPOINT_FILE_TRAILER;
