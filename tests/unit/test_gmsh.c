@@ -76,19 +76,58 @@ static void disc_hole_v41(void)
 
 /* Parses `text` expecting failure with `needle` (and "line" when asked) in
  * the message. */
+/* Reads text with one of the two readers, freeing what it returns: 0 or -1. */
+typedef int (*gmsh_reader_fn)(const char *text, size_t length, char *message, size_t size);
+
+static int read_triangles(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_mesh m;
+    if (gmsh_read(text, length, &m, message, size) != 0) return -1;
+    fdem_mesh_free(&m);
+    return 0;
+}
+
+static int read_tetrahedra(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_tet_mesh m;
+    if (gmsh_read_tetrahedra(text, length, &m, message, size) != 0) return -1;
+    fdem_tet_mesh_free(&m);
+    return 0;
+}
+
+/* `read` refuses the length bytes of text (copied without a NUL: the
+ * reader must not need one) with a message holding every needle (a NULL
+ * ends the list) and, with_line, the line at fault. */
+static void check_refused(gmsh_reader_fn read, const char *text, size_t length,
+                          const char *const *needles, int with_line)
+{
+    char *copy = malloc(length ? length : 1);
+    memcpy(copy, text, length);
+    char message[256] = "";
+    CHECK(read(copy, length, message, sizeof message) == -1, "accepted: %.60s", text);
+    for (; *needles; needles++)
+        CHECK(strstr(message, *needles) != NULL, "message \"%s\" lacks \"%s\"", message, *needles);
+    if (with_line) CHECK(strstr(message, "line") != NULL, "no line in \"%s\"", message);
+    free(copy);
+}
+
+#define NEEDLES(...) ((const char *const[]){__VA_ARGS__, NULL})
+
+/* The triangle reader refuses text with needle in its message. */
 static void check_fails(const char *text, const char *needle, int with_line)
 {
-    size_t length = strlen(text);
-    char *copy = malloc(length ? length : 1); /* no NUL: the reader must not need one */
-    memcpy(copy, text, length);
-    fdem_mesh m;
-    char message[256] = "";
-    int rc = gmsh_read(copy, length, &m, message, sizeof message);
-    CHECK(rc == -1, "accepted: %.60s", text);
-    CHECK(strstr(message, needle) != NULL, "message \"%s\" lacks \"%s\"", message, needle);
-    if (with_line) CHECK(strstr(message, "line") != NULL, "no line in \"%s\"", message);
-    if (rc == 0) fdem_mesh_free(&m);
-    free(copy);
+    check_refused(read_triangles, text, strlen(text), NEEDLES(needle), with_line);
+}
+
+/* A file of tests/data refused by `read` as check_refused says (no check
+ * where the file is missing, as the other file tests). */
+static void check_file_refused(const char *path, gmsh_reader_fn read, const char *const *needles)
+{
+    size_t length = 0;
+    char *text = read_file(path, &length);
+    if (!text) return;
+    check_refused(read, text, length, needles, 0);
+    free(text);
 }
 
 #define V22 "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n"
@@ -197,25 +236,6 @@ static void rejects_missing_sections(void)
     check_fails(V22 V22, "second $MeshFormat", 1);
 }
 
-/* Reads text with one of the two readers, freeing what it returns: 0 or -1. */
-typedef int (*gmsh_reader_fn)(const char *text, size_t length, char *message, size_t size);
-
-static int read_triangles(const char *text, size_t length, char *message, size_t size)
-{
-    fdem_mesh m;
-    if (gmsh_read(text, length, &m, message, size) != 0) return -1;
-    fdem_mesh_free(&m);
-    return 0;
-}
-
-static int read_tetrahedra(const char *text, size_t length, char *message, size_t size)
-{
-    fdem_tet_mesh m;
-    if (gmsh_read_tetrahedra(text, length, &m, message, size) != 0) return -1;
-    fdem_tet_mesh_free(&m);
-    return 0;
-}
-
 /* Every prefix of a real file must fail cleanly (or, for the full length,
  * succeed): exercises every truncation point under ASan. Only the whole
  * file and the file without its final newline parse. */
@@ -307,29 +327,22 @@ static void tetrahedra_rejects(void)
  * it used to be told to "mesh the volumes in 3D (gmsh -3)", which it was. */
 static void second_order_meshes_are_named(void)
 {
-    fdem_tet_mesh tets;
-    fdem_mesh tris;
-    char message[256] = "";
     static const char *tet10_v22 =
         V22 "$Nodes\n10\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n5 .5 0 0\n6 .5 .5 0\n"
             "7 0 .5 0\n8 0 0 .5\n9 0 .5 .5\n10 .5 0 .5\n$EndNodes\n"
             "$Elements\n1\n1 11 2 1 1 1 2 3 4 5 6 7 8 10 9\n$EndElements\n";
-    CHECK(gmsh_read_tetrahedra(tet10_v22, strlen(tet10_v22), &tets, message, sizeof message) != 0 &&
-              strstr(message, "second-order 10-node tetrahedra") && strstr(message, "-order 1"),
-          "10-node tetrahedra, v2.2: %s", message);
+    check_refused(read_tetrahedra, tet10_v22, strlen(tet10_v22),
+                  NEEDLES("second-order 10-node tetrahedra", "-order 1"), 0);
     static const char *tet10_v41 =
         V41 "$Nodes\n1 10 1 10\n3 1 0 10\n1\n2\n3\n4\n5\n6\n7\n8\n9\n10\n"
             "0 0 0\n1 0 0\n0 1 0\n0 0 1\n.5 0 0\n.5 .5 0\n0 .5 0\n0 0 .5\n0 .5 .5\n.5 0 .5\n"
             "$EndNodes\n$Elements\n1 1 1 1\n3 1 11 1\n1 1 2 3 4 5 6 7 8 10 9\n$EndElements\n";
-    CHECK(gmsh_read_tetrahedra(tet10_v41, strlen(tet10_v41), &tets, message, sizeof message) != 0 &&
-              strstr(message, "second-order 10-node tetrahedra"),
-          "10-node tetrahedra, v4.1: %s", message);
+    check_refused(read_tetrahedra, tet10_v41, strlen(tet10_v41),
+                  NEEDLES("second-order 10-node tetrahedra"), 0);
     static const char *tri6_v22 =
         V22 "$Nodes\n6\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 .5 0 0\n5 .5 .5 0\n6 0 .5 0\n"
             "$EndNodes\n$Elements\n1\n1 9 2 1 1 1 2 3 4 5 6\n$EndElements\n";
-    CHECK(gmsh_read(tri6_v22, strlen(tri6_v22), &tris, message, sizeof message) != 0 &&
-              strstr(message, "second-order 6-node triangles"),
-          "6-node triangles: %s", message);
+    check_fails(tri6_v22, "second-order 6-node triangles", 0);
 }
 
 /* A mesh of the other dimension names the missing "dimension": 3 (or the one
@@ -337,31 +350,12 @@ static void second_order_meshes_are_named(void)
  * triangles projected on z = 0 and refused as "triangle 14 has zero area". */
 static void other_dimension_is_named(void)
 {
-    static const char *const cubes[] = {"tests/data/cube_v22.msh", "tests/data/cube_v41.msh"};
-    for (int i = 0; i < 2; i++) {
-        size_t length = 0;
-        char *text = read_file(cubes[i], &length);
-        if (!text) continue;
-        fdem_mesh tris;
-        char message[256] = "";
-        CHECK(gmsh_read(text, length, &tris, message, sizeof message) != 0 &&
-                  strstr(message, "3D mesh") && strstr(message, "\"dimension\": 3"),
-              "%s read for a 2D case: %s", cubes[i], message);
-        free(text);
-    }
-    static const char *const squares[] = {"tests/data/square_v22.msh", "tests/data/square_v41.msh"};
-    for (int i = 0; i < 2; i++) {
-        size_t length = 0;
-        char *text = read_file(squares[i], &length);
-        if (!text) continue;
-        fdem_tet_mesh tets;
-        char message[256] = "";
-        CHECK(gmsh_read_tetrahedra(text, length, &tets, message, sizeof message) != 0 &&
-                  strstr(message, "no 4-node tetrahedra") && strstr(message, "2D mesh") &&
-                  strstr(message, "\"dimension\": 3"),
-              "%s read for a 3D case: %s", squares[i], message);
-        free(text);
-    }
+    const char *const *read_for_2d = NEEDLES("3D mesh", "\"dimension\": 3");
+    const char *const *read_for_3d = NEEDLES("no 4-node tetrahedra", "2D mesh", "\"dimension\": 3");
+    check_file_refused("tests/data/cube_v22.msh", read_triangles, read_for_2d);
+    check_file_refused("tests/data/cube_v41.msh", read_triangles, read_for_2d);
+    check_file_refused("tests/data/square_v22.msh", read_tetrahedra, read_for_3d);
+    check_file_refused("tests/data/square_v41.msh", read_tetrahedra, read_for_3d);
 }
 
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
