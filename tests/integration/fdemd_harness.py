@@ -177,6 +177,16 @@ class Daemon:
         finally:
             conn.close()
 
+    def fdemctl(self, *args, stdin=None, cwd=None, timeout=30):
+        """Runs fdemctl against this daemon (FDEMD_URL, its token if it has
+        one) and returns the CompletedProcess, text out and err."""
+        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.port)
+        env.pop("FDEMD_TOKEN", None)
+        if self.default_token:
+            env["FDEMD_TOKEN"] = self.default_token
+        return subprocess.run([FDEMCTL_BIN] + list(args), input=stdin, capture_output=True,
+                              text=True, env=env, cwd=cwd, timeout=timeout * SLOW)
+
     def json(self, method, path, body=None, **kw):
         status, headers, data = self.request(method, path, body, **kw)
         try:

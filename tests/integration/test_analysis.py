@@ -25,7 +25,6 @@ from fdemd_harness import ROOT, SLOW, DaemonTestCase, tiny_case
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
 
-FDEMCTL = os.path.join(ROOT, os.environ.get("FDEMCTL_BIN", "bin/fdemctl"))
 RHO = 2700.0
 BAR = (0.1, 0.01)  # m, 20 x 2 divisions
 
@@ -175,10 +174,7 @@ class FragmentsThroughDaemon(DaemonTestCase):
                                               str(len(self.fragments["fragments"]))])
 
     def test_fdemctl_prints_table_and_curve(self):
-        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
-        env.pop("FDEMD_TOKEN", None)
-        r = subprocess.run([FDEMCTL, "fragments", self.case_id], capture_output=True, text=True,
-                           env=env, timeout=30 * SLOW)
+        r = self.d.fdemctl("fragments", self.case_id)
         self.assertEqual(r.returncode, 0, r.stderr)
         n = len(self.fragments["fragments"])
         self.assertIn("%d fragments" % n, r.stdout)
@@ -188,8 +184,7 @@ class FragmentsThroughDaemon(DaemonTestCase):
         rows = [line for line in r.stdout.splitlines() if line.split()[:1] and
                 line.split()[0].isdigit() and len(line.split()) >= 7]
         self.assertEqual(len(rows), n, r.stdout)
-        raw = subprocess.run([FDEMCTL, "fragments", self.case_id, "--json"], capture_output=True,
-                             text=True, env=env, timeout=30 * SLOW)
+        raw = self.d.fdemctl("fragments", self.case_id, "--json")
         self.assertEqual(json.loads(raw.stdout), self.fragments)
 
     def test_python_client_fragments(self):
@@ -269,10 +264,7 @@ class Fragments3DThroughDaemon(DaemonTestCase):
         self.assertAlmostEqual(piece["diameter"], (6 * volume / np.pi) ** (1 / 3), delta=1e-12)
         np.testing.assert_allclose(piece["velocity"], [0, 0, -2], atol=1e-9)
         self.assertEqual(piece["elements"], st["elements"])
-        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
-        env.pop("FDEMD_TOKEN", None)
-        r = subprocess.run([FDEMCTL, "fragments", st["id"]], capture_output=True, text=True,
-                           env=env, timeout=30 * SLOW)
+        r = self.d.fdemctl("fragments", st["id"])
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertRegex(r.stdout, r"1 fragments, total mass \S+ kg\n")  # 3D: no "per metre"
 

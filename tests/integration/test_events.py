@@ -22,7 +22,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import FDEMCTL_BIN, ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 from fdemd_client import Client  # noqa: E402
@@ -210,10 +210,7 @@ class EventsThroughDaemon(DaemonTestCase):
         return "http://127.0.0.1:%d" % self.d.port
 
     def ctl(self, *args):
-        env = dict(os.environ, FDEMD_URL=self.url())
-        env.pop("FDEMD_TOKEN", None)
-        return subprocess.run([FDEMCTL_BIN] + list(args), capture_output=True, text=True, env=env,
-                              timeout=30 * SLOW)
+        return self.d.fdemctl(*args)
 
     def test_fdemctl_events(self):
         for dimension, case_id, _, body, _ in self.each():

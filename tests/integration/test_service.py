@@ -8,19 +8,17 @@ overwriting a file unless forced."""
 import json
 import os
 import re
-import subprocess
 import sys
 import tempfile
 import time
 import unittest
 from datetime import datetime
 
-from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import ROOT, Daemon, DaemonTestCase, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
 
-FDEMCTL = os.path.join(ROOT, os.environ.get("FDEMCTL_BIN", "bin/fdemctl"))  # abs stays abs
 SIZING_KEYS = {"nodes", "elements", "joints", "dt", "steps", "snapshots", "memory_bytes",
                "result_bytes", "estimated_seconds"}
 STATES = ("created", "queued", "running", "paused", "finished", "stopped", "failed")
@@ -125,9 +123,7 @@ class ServiceTest(DaemonTestCase):
 
     def test_fdemctl_wait_never_prints_running_100(self):
         case_id = self.d.create(tiny_case("waited", end=0.003, interval=0.0003), start=True)["id"]
-        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
-        r = subprocess.run([FDEMCTL, "wait", case_id, "--interval", "0.05"], capture_output=True,
-                           text=True, env=env, timeout=60 * SLOW)
+        r = self.d.fdemctl("wait", case_id, "--interval", "0.05", timeout=60)
         self.assertEqual(r.returncode, 0, r.stderr)
         lines = r.stdout.splitlines()
         self.assertTrue(lines)
@@ -446,10 +442,7 @@ class FetchTest(unittest.TestCase):
         self.work.cleanup()
 
     def ctl(self, *args):
-        env = dict(os.environ, FDEMD_URL=self.url)
-        env.pop("FDEMD_TOKEN", None)
-        return subprocess.run([FDEMCTL] + list(args), capture_output=True, text=True, env=env,
-                              cwd=self.work.name, timeout=30 * SLOW)
+        return self.d.fdemctl(*args, cwd=self.work.name)
 
     def test_fdemctl_fetch_names_the_file_after_the_case_and_never_overwrites(self):
         r = self.ctl("fetch", self.case_id)

@@ -11,22 +11,18 @@ of both routes, and fdemctl's and the Python client's commands."""
 import json
 import os
 import signal
-import subprocess
 import sys
 import unittest
 
 import numpy as np
 
-from fdemd_harness import SLOW, Daemon, DaemonTestCase, fetched_result, tiny_case
+from fdemd_harness import Daemon, DaemonTestCase, fetched_result, tiny_case
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 from fdemd_client import Client, FdemdError  # noqa: E402
 
-FDEMCTL = os.environ.get("FDEMCTL_BIN", "bin/fdemctl")
-if not os.path.isabs(FDEMCTL):
-    FDEMCTL = os.path.join(ROOT, FDEMCTL)
 
 OLD_END, NEW_END, INTERVAL = 0.0004, 0.001, 0.00005
 
@@ -348,10 +344,7 @@ class UploadLimitTests(unittest.TestCase):
 class ClientCommandTests(DaemonTestCase):
 
     def ctl(self, *args, stdin=None):
-        env = dict(os.environ, FDEMD_URL="http://127.0.0.1:%d" % self.d.port)
-        env.pop("FDEMD_TOKEN", None)
-        return subprocess.run([FDEMCTL] + list(args), input=stdin, capture_output=True,
-                              text=True, env=env, cwd=self.tmp, timeout=30 * SLOW)
+        return self.d.fdemctl(*args, stdin=stdin, cwd=self.tmp)
 
     def test_fdemctl_extend(self):
         case_id = self.d.create(staged_case("ctl-extend", OLD_END), start=True)["id"]
