@@ -341,8 +341,10 @@ static int32_t nbs3_row_map(const nbs3_scan *s, int k, int32_t list)
 }
 
 /* Out of x-set k again, its x-links holding x again (nbs3_layer_map) for
- * the next layer's walks of this row. */
-static void nbs3_row_unmap(const nbs3_scan *s, int k, int32_t list)
+ * the next layer's walks of this row. Inlined: it runs once a row, and a
+ * sparse packing's rows hold one or two elements (1/1e4: 1.3-1.6 ns of
+ * 22-26 an element as a call). */
+static NBS_ALWAYS_INLINE void nbs3_row_unmap(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->cells[k];
     for (int32_t j = list, after; j >= 0; j = after) {
