@@ -275,18 +275,13 @@ static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(
 static inline int32_t nbs3_down(int32_t v, int32_t size) { return (v - 1) & (size - 1); }
 static inline int32_t nbs3_up(int32_t v, int32_t size) { return (v + 1) & (size - 1); }
 
-/* A layer in a y-set: its list, its element count, and how many rows it
- * has once nbs3_layer_rows has done them (-1 until then). */
-typedef struct nbs3_layer {
-    int32_t list, count, rows;
-} nbs3_layer;
-
 /* Layer `list` into y-set k, and out again (by looping over its elements).
  * Mapping also puts each element's x in its x-link, dead until its row is
  * mapped: every walk of a row then reads x beside the row link it has just
  * loaded instead of converting the centre on its chain of dependent loads
- * (row link, centre, x, heads), and nbs3_row_unmap puts it back. */
-static nbs3_layer nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
+ * (row link, centre, x, heads), and nbs3_row_unmap puts it back. Returns
+ * the layer's element count. */
+static int32_t nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->rows[k], count = 0;
     for (int32_t j = list; j >= 0; j = s->layer_next[j], count++) {
@@ -294,36 +289,13 @@ static nbs3_layer nbs3_layer_map(const nbs3_scan *s, int k, int32_t list)
         s->next[j] = (nbs_next_3d){heads[y], nbs3_x(s, j)};
         heads[y] = j;
     }
-    return (nbs3_layer){list, count, -1};
+    return count;
 }
 
-/* Empties the consecutive non-empty rows around row y, at most `left` of
- * them; returns how many of `left` remain. */
-static int32_t nbs3_rows_clear_stretch(int32_t *heads, int32_t ny, int32_t y, int32_t left)
-{
-    heads[y] = NBS_EMPTY;
-    left--;
-    for (int32_t v = nbs3_down(y, ny); left > 0 && heads[v] != NBS_EMPTY; v = nbs3_down(v, ny))
-        heads[v] = NBS_EMPTY, left--;
-    for (int32_t v = nbs3_up(y, ny); left > 0 && heads[v] != NBS_EMPTY; v = nbs3_up(v, ny))
-        heads[v] = NBS_EMPTY, left--;
-    return left;
-}
-
-/* The book empties a layer's rows by looping over its elements, which
- * converts every centre again. A layer whose rows are known and form one
- * consecutive stretch (a packed layer) is emptied from its first element's
- * row in O(rows): 1 ns of the 29 a 1e6 packing took. Otherwise, or when the
- * row count is not known (a layer of another run, mapped only as the layer
- * below), the loop over elements. */
-static void nbs3_layer_unmap(const nbs3_scan *s, int k, nbs3_layer layer)
+static void nbs3_layer_unmap(const nbs3_scan *s, int k, int32_t list)
 {
     int32_t *heads = s->rows[k];
-    if (layer.list < 0) return;
-    if (layer.rows > 0 &&
-        nbs3_rows_clear_stretch(heads, s->ay.size, nbs3_y(s, layer.list), layer.rows) == 0)
-        return;
-    for (int32_t j = layer.list; j >= 0; j = s->layer_next[j]) heads[nbs3_y(s, j)] = NBS_EMPTY;
+    for (int32_t j = list; j >= 0; j = s->layer_next[j]) heads[nbs3_y(s, j)] = NBS_EMPTY;
 }
 
 /* Row `list` into x-set k (head insertion: an element's link leads to the
@@ -554,13 +526,11 @@ static NBS_ALWAYS_INLINE int nbs3_cross(const nbs3_scan *s, int use_body, int32_
  * The search stops once the runs have taken all `left` elements of the
  * layer: in a packed layer the first run takes every row, and the rest of
  * the search (a centre converted and a head read per element) was 2 ns of
- * the 30 a 1e6 packing took. The rows done are counted into *rows_done
- * for nbs3_layer_unmap. */
+ * the 30 a 1e6 packing took. */
 static NBS_ALWAYS_INLINE int nbs3_layer_rows(const nbs3_scan *s, int use_body, int32_t layer,
                                              int32_t left, int cur, int below,
-                                             int32_t *rows_done, nbs_pairs *pairs)
+                                             nbs_pairs *pairs)
 {
-    int32_t done = 0;
     int32_t *rows = s->rows[cur];
     const int32_t *low = s->rows[below];
     const int32_t ny = s->ay.size;
@@ -583,7 +553,6 @@ static NBS_ALWAYS_INLINE int nbs3_layer_rows(const nbs3_scan *s, int use_body, i
             row.cur = 1 - row.held;
             if (nbs3_row_own(s, use_body, &row, pairs) != 0) return -1;
             left -= row.count;
-            done++;
             int32_t low_down = nbs_row_list(low[nbs3_down(y, ny)]);
             size_t room = (size_t)row.count + (held_ours ? (size_t)row.held_count : 0);
             if (nbs3_cross(s, use_body, low_down, row.cur, held_ours ? row.held : -1, room, pairs) ||
@@ -605,7 +574,6 @@ static NBS_ALWAYS_INLINE int nbs3_layer_rows(const nbs3_scan *s, int use_body, i
             return -1;
         nbs3_row_unmap(s, row.held, held_list);
     }
-    *rows_done = done;
     return 0;
 }
 
@@ -636,19 +604,18 @@ static NBS_ALWAYS_INLINE int nbs3_layers_detect(const nbs3_scan *s, int use_body
             z = zb;
         }
         int held = 1;
-        nbs3_layer held_layer = nbs3_layer_map(s, held, nbs_row_list(layers[nbs3_down(z, nz)]));
+        int32_t held_list = nbs_row_list(layers[nbs3_down(z, nz)]);
+        nbs3_layer_map(s, held, held_list);
         for (;;) {
             int32_t head = layers[z];
             layers[z] = -2 - head;
             int cur = 1 - held;
-            nbs3_layer layer = nbs3_layer_map(s, cur, head);
-            left -= (size_t)layer.count;
-            int failed = nbs3_layer_rows(s, use_body, head, layer.count, cur, held, &layer.rows,
-                                         pairs);
-            if (failed) return -1;
-            nbs3_layer_unmap(s, held, held_layer);
+            int32_t count = nbs3_layer_map(s, cur, head);
+            left -= (size_t)count;
+            if (nbs3_layer_rows(s, use_body, head, count, cur, held, pairs) != 0) return -1;
+            nbs3_layer_unmap(s, held, held_list);
             held = cur;
-            held_layer = layer;
+            held_list = head;
             int32_t zb = nbs3_down(z, nz), za = nbs3_up(z, nz);
             if (layers[zb] < NBS_EMPTY) layers[zb] = NBS_EMPTY;
             if (layers[za] < 0) {
@@ -657,7 +624,7 @@ static NBS_ALWAYS_INLINE int nbs3_layers_detect(const nbs3_scan *s, int use_body
             }
             z = za;
         }
-        nbs3_layer_unmap(s, held, held_layer);
+        nbs3_layer_unmap(s, held, held_list);
     }
     return 0;
 }
