@@ -49,8 +49,13 @@
  *    is still met once; folding only adds candidates, which the exact
  *    sphere test removes.
  *  - Only non-empty layers and rows are visited, found by looping over
- *    elements; lists are cleared by looping over the elements just mapped.
- *    Nothing loops over nx, ny or nz, so CPU is O(N) however sparse.
+ *    elements (a loop that stops once the runs have taken every element:
+ *    in a packed grid the first run takes them all); lists are cleared by
+ *    looping over the elements just mapped. Nothing loops over nx, ny or
+ *    nz, so CPU is O(N) however sparse.
+ *  - The walk is instantiated twice, with and without body ids, so that
+ *    a row costs no call (a sparse packing's rows hold one or two
+ *    elements).
  *  - Spheres with a non-finite or absurd centre or radius take no part (in
  *    both detectors), as in 2D.
  */
