@@ -489,6 +489,147 @@ static void test_nbs3_wrapped_run(void)
     spheres_free(&s);
 }
 
+/* Centres on the unit lattice (m, j, k), 0 <= m, j, k < side, leaving out
+ * every third row (j % 3 == 2) and every third layer (k % 3 == 2): blocks
+ * of two rows and two layers, so every layer and every row is the first
+ * or the last of its run. Radii 0.5 (1 + 1e-9): face neighbours touch.
+ * Returns the count placed. */
+static size_t put_blocky_lattice(spheres *s, int side)
+{
+    size_t i = 0;
+    for (int k = 0; k < side; k++)
+        for (int j = 0; j < side; j++)
+            for (int m = 0; m < side; m++) {
+                if (j % 3 == 2 || k % 3 == 2) continue;
+                s->p[0][i] = m, s->p[1][i] = j, s->p[2][i] = k;
+                s->r[i] = 0.5 * (1 + 1e-9);
+                i++;
+            }
+    return i;
+}
+
+/* The walk exists twice (with and without body ids), and the walks of a
+ * lower row against one x-set (the first row of a run against the row
+ * below it, the last row against its two) are out of line once a case.
+ * In blocks of two rows and layers every row is the first or last of its
+ * run, and with four body ids (and -1) by column most touching pairs
+ * across layers share a body, in both kinds of walk. */
+static void test_nbs3_bodies_across_runs(void)
+{
+    rng_seed(31);
+    int side = 9;
+    spheres s = spheres_new((size_t)side * side * side);
+    s.n = put_blocky_lattice(&s, side);
+    for (size_t i = 0; i < s.n; i++) /* layers meet their own body, x sometimes too */
+        s.body[i] = (int32_t)(((int)s.p[0][i] / 2 + (int)s.p[1][i]) % 5) - 1;
+    size_t all = expect_exact("blocky lattice, bodies ignored", &s, 0, 0);
+    size_t kept = expect_exact("blocky lattice, bodies", &s, 1, 0);
+    CHECK(kept < all && kept > all / 2, "blocky lattice: %zu pairs with bodies, %zu without",
+          kept, all);
+    spheres_shuffle(&s);
+    expect_exact("blocky lattice shuffled, bodies", &s, 1, 0);
+    spheres_free(&s);
+}
+
+/* The layer and row searches stop once the runs have taken every valid
+ * sphere, counted apart from the walk. Invalid spheres interleaved with a
+ * lattice of many runs, and a few lone spheres each in a layer of its own
+ * at the end of the index order (the last runs the search finds): a count
+ * one short would leave such a layer undone, its head not empty. */
+static void test_nbs3_invalid_many_runs(void)
+{
+    rng_seed(32);
+    int side = 8;
+    size_t lone = 4;
+    spheres s = spheres_new((size_t)side * side * side + lone);
+    static const double bad[] = {NAN, INFINITY, -INFINITY, 2e150, -2e150};
+    for (int every = 2; every <= 3; every++)
+        for (int shuffled = 0; shuffled <= 1; shuffled++) {
+            size_t n = put_blocky_lattice(&s, side);
+            for (size_t t = 0; t < lone; t++, n++) {
+                s.p[0][n] = 1.0 + (double)t, s.p[1][n] = 2.0, s.p[2][n] = 20.0 + 3.0 * (double)t;
+                s.r[n] = 0.5;
+            }
+            s.n = n;
+            for (size_t i = (size_t)every - 1, k = 0; i + lone < n; i += (size_t)every, k++) {
+                if (k % 6 == 5)
+                    s.r[i] = k % 12 == 5 ? -1.0 : NAN;
+                else
+                    s.p[k % 3][i] = bad[k % 5];
+            }
+            if (shuffled) { /* the lone spheres stay last */
+                s.n = n - lone;
+                spheres_shuffle(&s);
+                s.n = n;
+            }
+            for (size_t i = 0; i < n; i++) s.body[i] = (int32_t)(i % 3) - 1;
+            char what[64];
+            snprintf(what, sizeof what, "invalid 1 in %d, %s", every,
+                     shuffled ? "shuffled" : "in order");
+            size_t found = expect_exact(what, &s, 0, 0);
+            CHECK(found > n / 10, "%s: only %zu pairs", what, found);
+            expect_exact(what, &s, 1, 0);
+        }
+    spheres_free(&s);
+}
+
+/* The extremes are taken two spheres a step, with a scalar tail: whatever
+ * index holds the lowest or highest centre on an axis, or the largest
+ * radius (a lane, the other lane, the tail of an odd count), the layout
+ * must be the one of any other order. 32 spheres in a small cube and one
+ * far out (or with a larger radius), moved through every index. */
+static void test_nbs3_bounds_any_index(void)
+{
+    rng_seed(33);
+    for (size_t n = 33; n <= 34; n++) {
+        spheres s = spheres_new(n);
+        for (int what_moves = 0; what_moves < 7; what_moves++) {
+            int32_t size0[3] = {0, 0, 0};
+            double cell0 = 0;
+            for (size_t at = 0; at < n; at++) {
+                double o[3] = {20, -20, 40};
+                rng_seed(34 + (uint64_t)what_moves);
+                put_in_cube(&s, 0, n, o, 2.0, 0.4, 0.5);
+                /* the odd one out goes to index `at` */
+                size_t odd = n - 1;
+                if (what_moves < 6) {
+                    int axis = what_moves / 2;
+                    s.p[axis][odd] = o[axis] + (what_moves % 2 ? 25.0 : -23.0);
+                } else {
+                    s.r[odd] = 3.0;
+                }
+                for (int a = 0; a < 3; a++) {
+                    double t = s.p[a][at]; s.p[a][at] = s.p[a][odd]; s.p[a][odd] = t;
+                }
+                double t = s.r[at]; s.r[at] = s.r[odd]; s.r[odd] = t;
+                char what[64];
+                snprintf(what, sizeof what, "bounds n=%zu case %d at %zu", n, what_moves, at);
+                expect_exact(what, &s, 0, 0);
+                nbs_grid_3d g;
+                nbs_pairs p;
+                nbs_grid_3d_init(&g);
+                nbs_pairs_init(&p);
+                CHECK(detect(&g, &s, 0, &p) == 0, "%s: detect failed", what);
+                int32_t size[3] = {g.nx, g.ny, g.nz};
+                if (at == 0) {
+                    for (int a = 0; a < 3; a++) size0[a] = size[a];
+                    cell0 = g.cell;
+                    CHECK(what_moves < 6 ? size[what_moves / 2] >= 16 : g.cell > 6.0,
+                          "%s: tables %d %d %d, cell %g: the odd one out not taken", what,
+                          size[0], size[1], size[2], g.cell);
+                }
+                CHECK(size[0] == size0[0] && size[1] == size0[1] && size[2] == size0[2] &&
+                          g.cell == cell0,
+                      "%s: tables %d %d %d, cell %g; at index 0 %d %d %d, %g", what, size[0],
+                      size[1], size[2], g.cell, size0[0], size0[1], size0[2], cell0);
+                nbs_grid_3d_free(&g);
+                nbs_pairs_free(&p);
+            }
+        }
+        spheres_free(&s);
+    }
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -504,6 +645,9 @@ int main(int argc, char **argv)
         {"test_nbs3_integer_ram", test_nbs3_integer_ram},
         {"test_nbs3_reuse", test_nbs3_reuse},
         {"test_nbs3_wrapped_run", test_nbs3_wrapped_run},
+        {"test_nbs3_bodies_across_runs", test_nbs3_bodies_across_runs},
+        {"test_nbs3_invalid_many_runs", test_nbs3_invalid_many_runs},
+        {"test_nbs3_bounds_any_index", test_nbs3_bounds_any_index},
     };
     return check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }
