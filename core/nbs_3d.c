@@ -175,10 +175,12 @@ static inline double nbs3_lanes_max(__m128d v)
  * that compiles to one instruction) and the sum is one addition a sphere on
  * its dependent chain: this loop was 38 instructions a sphere, a sixth of
  * a sparse detection. With SSE2 it takes two spheres a step (0.3-1 ns of
- * the 1e6 detection at density 1): minpd and maxpd pick exactly as the
- * scalar a < b ? a : b does, and the order of the sum does not matter, as
- * it only decides finiteness (all-valid values are below 1e150, so no
- * order overflows). */
+ * the 1e6 detection at density 1): minpd and maxpd pick as the scalar
+ * a < b ? a : b does in each lane, so the extremes are the same numbers
+ * (a -0 and a +0 may trade places as the lower bound, which changes no
+ * difference v - lo nor the cell), and the order of the sum does not
+ * matter, as it only decides finiteness (all-valid values are below
+ * 1e150, so no order overflows). */
 static nbs3_bounds nbs3_bounds_of(size_t n, const double *const c[3], const double *r)
 {
     nbs3_bounds b;
