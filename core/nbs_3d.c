@@ -562,7 +562,8 @@ static NBS_ALWAYS_INLINE int nbs3_layer_rows(const nbs3_scan *s, int use_body, i
             left -= row.count;
             int32_t low_down = nbs_row_list(low[nbs3_down(y, ny)]);
             size_t room = (size_t)row.count + (held_ours ? (size_t)row.held_count : 0);
-            if (nbs3_cross(s, use_body, low_down, row.cur, held_ours ? row.held : -1, room, pairs) ||
+            int two = held_ours ? row.held : -1;
+            if (nbs3_cross(s, use_body, low_down, row.cur, two, room, pairs) ||
                 (held_ours && nbs3_cross(s, use_body, nbs_row_list(low[y]), row.held, -1,
                                          (size_t)row.held_count, pairs)))
                 return -1;
