@@ -20,6 +20,12 @@
 
 /* ------------------------------------------------------------ reading */
 
+/* pool[first ..]; NULL while the pool is empty (then nothing is read). */
+static const long long *pool_at(const gmsh_reader *r, long first)
+{
+    return r->pool ? r->pool + first : NULL;
+}
+
 static int pool_push(gmsh_reader *r, long long value)
 {
     if (gmsh_grow((void **)&r->pool, &r->pool_capacity, r->pool_count + 1, sizeof *r->pool))
@@ -135,6 +141,8 @@ int gmsh_note_element(gmsh_reader *r, int dim, long long key, const gmsh_line *l
     gmsh_member *e = &r->members[r->member_count++];
     *e = (gmsh_member){dim, key, kept, r->pool_count, 0};
     if (kept >= 0) return 0; /* its nodes are the kept element's */
+    if (first >= l->count) /* more tags declared than the line holds, or no nodes */
+        return gmsh_fail(r, "the element's line ends before its node tags");
     for (int k = first; k < l->count; k++) {
         long long tag;
         if (gmsh_token_long(l, k, &tag) < 0)
@@ -210,7 +218,7 @@ static int group_add_member(gmsh_reader *r, const gmsh_member *e, gmsh_group *g,
                             group_lists *lists, const long *sorted, const int32_t *renumber,
                             const long *element_of)
 {
-    const long long *tags = e->kept >= 0 ? r->elements[e->kept].tags : r->pool + e->first;
+    const long long *tags = e->kept >= 0 ? r->elements[e->kept].tags : pool_at(r, e->first);
     int count = e->kept >= 0 ? r->kind->nodes : (int)e->count;
     int32_t face[4];
     int on_mesh = 1;
@@ -245,7 +253,7 @@ static const long long *member_physicals(const gmsh_reader *r, const gmsh_member
     for (long k = 0; k < r->entity_count; k++)
         if (r->entities[k].dim == e->dim && r->entities[k].tag == e->key) {
             *count = r->entities[k].count;
-            return r->pool + r->entities[k].first;
+            return pool_at(r, r->entities[k].first);
         }
     *count = 0;
     return NULL;

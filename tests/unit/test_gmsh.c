@@ -358,10 +358,47 @@ static void other_dimension_is_named(void)
     check_file_refused("tests/data/square_v41.msh", read_tetrahedra, read_for_3d);
 }
 
+static int read_triangles_grouped(const char *text, size_t length, char *message, size_t size)
+{
+    fdem_mesh m;
+    gmsh_groups g;
+    if (gmsh_read_grouped(text, length, &m, &g, message, size) != 0) return -1;
+    fdem_mesh_free(&m);
+    gmsh_groups_free(&g);
+    return 0;
+}
+
+/* A group member that is not a kept triangle has its nodes read from its
+ * own line. A line ending before them (more tags declared than the line
+ * holds, or no node at all) made the first such member point into an empty
+ * tag pool: a null pointer plus an offset, which the fuzzer's UBSan build
+ * stopped on (a mutated "61 22 21 1 535 450 536" in examples/gmsh-plate),
+ * and the member was taken with no nodes. Now the line is named. */
+static void member_without_nodes_is_refused(void)
+{
+    const char *groups = "$PhysicalNames\n2\n2 1 \"plate\"\n1 2 \"edge\"\n$EndPhysicalNames\n";
+    const char *nodes = "$Nodes\n3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n$EndNodes\n";
+    static const char *const members[] = {"2 1 21 2 1 1 2", "2 1 2 2 1", "2 22 21 1 535 450 536"};
+    for (size_t k = 0; k < sizeof members / sizeof members[0]; k++) {
+        char text[512];
+        snprintf(text, sizeof text, V22 "%s%s$Elements\n2\n1 2 2 1 1 1 2 3\n%s\n$EndElements\n",
+                 groups, nodes, members[k]);
+        check_refused(read_triangles_grouped, text, strlen(text),
+                      NEEDLES("ends before its node tags", "$Elements"), 1);
+    }
+    static const char *v41 =
+        V41 "$PhysicalNames\n1\n2 1 \"plate\"\n$EndPhysicalNames\n"
+            "$Entities\n0 0 1 0\n1 0 0 0 1 1 0 1 1 0\n$EndEntities\n"
+            "$Nodes\n1 3 1 3\n2 1 0 3\n1\n2\n3\n0 0 0\n1 0 0\n0 1 0\n$EndNodes\n"
+            "$Elements\n2 2 1 2\n2 1 2 1\n1 1 2 3\n2 1 1 1\n2\n$EndElements\n";
+    check_refused(read_triangles_grouped, v41, strlen(v41),
+                  NEEDLES("ends before its node tags"), 1);
+}
+
 CHECK_MAIN(T(square_v22), T(square_v41), T(disc_hole_v22), T(disc_hole_v41),
            T(tags_and_renumbering_v22), T(blocks_v41), T(rejects_binary),
            T(rejects_other_versions), T(rejects_garbage), T(rejects_truncated),
            T(rejects_bad_references), T(rejects_missing_sections),
            T(every_prefix_of_a_real_file), T(cube_tetrahedra_v22), T(cube_tetrahedra_v41),
            T(second_order_meshes_are_named), T(other_dimension_is_named),
-           T(tetrahedra_rejects))
+           T(tetrahedra_rejects), T(member_without_nodes_is_refused))
