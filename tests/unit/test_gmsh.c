@@ -74,8 +74,6 @@ static void disc_hole_v41(void)
     check_file("tests/data/disc_hole_v41.msh", 42, 58, 2.625632949971628);
 }
 
-/* Parses `text` expecting failure with `needle` (and "line" when asked) in
- * the message. */
 /* Reads text with one of the two readers, freeing what it returns: 0 or -1. */
 typedef int (*gmsh_reader_fn)(const char *text, size_t length, char *message, size_t size);
 
