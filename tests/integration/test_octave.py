@@ -1,6 +1,7 @@
 """The Octave commands of docs/results.md ("Reading results in Octave"),
 run as they stand there on a fetched result, print what h5py reads from
-the same file. Skipped (saying so) without octave-cli, as in CI."""
+the same file. Skipped (saying so) without octave-cli; scripts/install-deps.sh
+installs it."""
 import os
 import re
 import shutil

@@ -6,7 +6,7 @@ components), stress and strain as 3x3 tensors, principal stresses, joint
 damage, and the energy and constraint-force series as field data.
 
 Runs paraview_load.py under pvpython; skipped (saying so) where pvpython
-is not installed, as in CI."""
+is not installed (scripts/install-deps.sh installs python3-paraview)."""
 import io
 import json
 import os
