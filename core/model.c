@@ -737,7 +737,7 @@ int fdem_constraint_node_count(const fdem_model *m, int c)
  * joint the raw NBS list's extra pairs of joined elements, held at each
  * detection until they are dropped (contact_drop_joined). */
 typedef struct memory_figures {
-    size_t D, elem_nodes, stress_comps, hot, slots;
+    size_t D, elem_nodes, stress_comps, hot, slots, nbs_packed;
     double kept_pairs, near_pairs, spring_sets, records, joined_pairs;
 } memory_figures;
 
@@ -748,9 +748,9 @@ typedef struct memory_figures {
  * the raw list: 2D 16.1 (uniaxial-compression; brazilian-disc 9.3,
  * jointed-block 5.5), 3D 62 (brazilian-disc-3d-arc; prism 58.7). Smaller
  * models sit on the first capacities (memory_fixed). */
-static const memory_figures memory_2d = {2, 3, 3, sizeof(element_hot), TRI_CONTACT_SLOTS,
+static const memory_figures memory_2d = {2, 3, 3, sizeof(element_hot), TRI_CONTACT_SLOTS, 0,
                                          2, 2, 0.5, 0.25, 17};
-static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_SLOTS,
+static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_SLOTS, 4,
                                          32, 8, 2, 0.5, 64};
 
 /* pos, vel, force, pos0 (dim each), mass, inv_mass; node_part, node_origin;
@@ -777,7 +777,8 @@ static size_t memory_element(const memory_figures *f, int joints)
 
 /* Detection arrays (centre and radius, box, elem_gap; body, piece, active,
  * near_active; in_pair; the NBS grid's heads, 12 bytes measured in 3D, 40
- * in 2D) and the pair lists at their capacities: a kept pair is two element
+ * in 2D, and in 3D its packed copy of the spheres, nbs_packed doubles) and
+ * the pair lists at their capacities: a kept pair is two element
  * ids and its spring_of, a near_pair 24 bytes, a set slots doubles and a
  * free-list slot, a record a contact_record. */
 static size_t memory_contact_element(const memory_figures *f)
@@ -786,8 +787,8 @@ static size_t memory_contact_element(const memory_figures *f)
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 2) * sizeof(double) + 4 * sizeof(int32_t) + 1 + 10 * sizeof(int32_t) +
-           (size_t)lists;
+    return (3 * f->D + 2 + f->nbs_packed) * sizeof(double) + 4 * sizeof(int32_t) + 1 +
+           10 * sizeof(int32_t) + (size_t)lists;
 }
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;

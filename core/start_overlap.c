@@ -20,11 +20,12 @@
  * element always have some pair where one holds a vertex or the centroid of
  * the other (the deepest ones).
  *
- * Memory: the spheres (4 doubles an element), the NBS grid and the pair
- * list live only during this check, at build time, while the model's own
- * contact lists are still at their first capacities; fdem_memory_estimate
- * prices those lists grown (3D: 32 kept pairs an element, 384 bytes), far
- * above this check's 32 bytes an element and its pairs.
+ * Memory: the spheres (4 doubles an element), the NBS grid (in 3D with
+ * its packed copy of them, 4 more) and the pair list live only during this
+ * check, at build time, while the model's own contact lists are still at
+ * their first capacities; fdem_memory_estimate prices those lists grown
+ * (3D: 32 kept pairs an element, 384 bytes), far above this check's 64
+ * bytes an element and its pairs.
  */
 #include <math.h>
 #include <stdlib.h>
