@@ -88,6 +88,15 @@ static inline int nbs3_sphere_valid(double x, double y, double z, double r)
  * are aligned SSE2 loads. */
 #define NBS3_PACKED (4 * sizeof(double))
 
+/* The sphere test in SSE2 only where scalar doubles are SSE2 too: with x87
+ * arithmetic (-m32) nbs_spheres_touch in the all-pairs check may round
+ * twice where the SSE2 test rounds once, and the two would disagree. */
+#if defined(__SSE2__) && defined(__SSE2_MATH__)
+#define NBS3_SSE2_TEST 1
+#else
+#define NBS3_SSE2_TEST 0
+#endif
+
 /* ------------------------------------------------------------- lifecycle */
 
 void nbs_grid_3d_init(nbs_grid_3d *grid)
@@ -320,7 +329,10 @@ static inline int32_t nbs3_y(const nbs3_scan *s, int32_t j)
     return nbs3_coord(&s->ay, s->sphere[4 * (size_t)j + 1], s->inv);
 }
 
-static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j) { return nbs3_coord(&s->az, s->cz[j], s->inv); }
+static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j)
+{
+    return nbs3_coord(&s->az, s->cz[j], s->inv);
+}
 
 /* neighbours on a table of a power of two slots */
 static inline int32_t nbs3_down(int32_t v, int32_t size) { return (v - 1) & (size - 1); }
@@ -437,7 +449,7 @@ static inline int32_t nbs3_trio_and(nbs3_trio t) { return t.down & t.mid & t.up;
  * nbs_spheres_touch, which are added in its order: the same decisions as
  * the all-pairs check, bit for bit. */
 typedef struct nbs3_ball {
-#if defined(__SSE2__)
+#if NBS3_SSE2_TEST
     __m128d xy, zr;
 #else
     double x, y, z, r;
@@ -448,7 +460,7 @@ typedef struct nbs3_ball {
 static inline nbs3_ball nbs3_ball_of(const nbs3_probe *p, int32_t e)
 {
     const double *q = p->sphere + 4 * (size_t)e;
-#if defined(__SSE2__)
+#if NBS3_SSE2_TEST
     nbs3_ball b = {_mm_load_pd(q), _mm_xor_pd(_mm_load_pd(q + 2), _mm_set_pd(-0.0, 0.0)), e};
 #else
     nbs3_ball b = {q[0], q[1], q[2], q[3], e};
@@ -458,7 +470,7 @@ static inline nbs3_ball nbs3_ball_of(const nbs3_probe *p, int32_t e)
 
 static inline int nbs3_ball_touches(nbs3_ball b, const double *q)
 {
-#if defined(__SSE2__)
+#if NBS3_SSE2_TEST
     __m128d dxy = _mm_sub_pd(b.xy, _mm_load_pd(q));
     __m128d dzr = _mm_sub_pd(b.zr, _mm_load_pd(q + 2));
     dxy = _mm_mul_pd(dxy, dxy);

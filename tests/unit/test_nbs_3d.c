@@ -12,6 +12,7 @@
 #include "nbs.h"
 #include "pair_sets.h"
 
+#include <malloc.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -632,6 +633,152 @@ static void test_nbs3_bounds_any_index(void)
     }
 }
 
+/* The candidate test adds the squares in the order of nbs_spheres_touch,
+ * (dx2 + dy2) + dz2. Two pairs (found by search) whose reach squared lies
+ * between that sum and the sums of the orders dx2 + (dy2 + dz2) and
+ * (dx2 + dz2) + dy2: one touches, one does not, and only that order decides
+ * both as the all-pairs check does. Reach is 2r, exact. */
+static void test_nbs3_sum_order(void)
+{
+    static const double cases[2][4] = { /* dx, dy, dz, r */
+        {0x1.50ec52f1e7886p-2, 0x1.675f6ce9a4c7ep-1, 0x1.3254aa29f5d02p-1, 0x1.f55d5eb92ca6cp-2},
+        {0x1.b836ef5c17e69p-1, 0x1.93c3bae409b98p-2, 0x1.ec1f3a4796418p-2, 0x1.0f9c8f10933aep-1},
+    };
+    static const int touching[2] = {1, 0};
+    spheres s = spheres_new(2);
+    for (int k = 0; k < 2; k++) {
+        const double *c = cases[k];
+        for (int a = 0; a < 3; a++) s.p[a][0] = 0.0, s.p[a][1] = c[a];
+        s.r[0] = s.r[1] = c[3];
+        double dx2 = c[0] * c[0], dy2 = c[1] * c[1], dz2 = c[2] * c[2];
+        double reach2 = (c[3] + c[3]) * (c[3] + c[3]);
+        double yz = dy2 + dz2, xz = dx2 + dz2;
+        int other1 = dx2 + yz <= reach2, other2 = xz + dy2 <= reach2;
+        CHECK(other1 != touching[k] && other2 != touching[k],
+              "case %d: not a borderline of the order of the sum", k);
+        char what[32];
+        snprintf(what, sizeof what, "sum order case %d", k);
+        size_t found = expect_exact(what, &s, 0, 0);
+        CHECK(found == (size_t)touching[k], "%s: %zu pairs, want %d", what, found, touching[k]);
+    }
+    spheres_free(&s);
+}
+
+/* Rows are taken from y (of the packed copy): a line of spheres along y,
+ * touching in twos, has one or two a row, and each walk makes room in the
+ * pair list for a row's pairs, so the list stays at its first N pairs. A
+ * row taken from x or z would hold the whole line, every sphere the
+ * candidate of every other, and the room made for it would outgrow N. */
+static void test_nbs3_line_along_y(void)
+{
+    size_t n = 4096; /* a power of two >= NBS_FIRST_PAIRS: the list starts at N */
+    spheres s = spheres_new(n);
+    for (size_t i = 0; i < n; i++) {
+        s.p[0][i] = 1.0, s.p[2][i] = -2.0, s.r[i] = 0.5;
+        s.p[1][i] = 4.0 * (double)(i / 2) + 0.9 * (double)(i % 2);
+    }
+    nbs_grid_3d g;
+    nbs_pairs p;
+    nbs_grid_3d_init(&g);
+    nbs_pairs_init(&p);
+    CHECK(detect(&g, &s, 0, &p) == 0, "line along y: detect failed");
+    CHECK(p.count == n / 2, "line along y: %zu pairs, want %zu", p.count, n / 2);
+    CHECK(p.capacity <= n, "line along y: the pair list grew to %zu for %zu spheres", p.capacity,
+          n);
+    nbs_grid_3d_free(&g);
+    nbs_pairs_free(&p);
+    expect_exact("line along y", &s, 0, 0);
+    spheres_free(&s);
+}
+
+/* Cells are taken from x (of the packed copy): once a detection is done,
+ * each sphere's x-link holds its x cell again (nbs3_row_unmap), the
+ * truncation of (x - lowest x) / d on the x-table. */
+static void test_nbs3_x_links_hold_x(void)
+{
+    rng_seed(35);
+    size_t n = 501;
+    spheres s = spheres_new(n);
+    double o[3] = {-7, 3, 11};
+    put_in_cube(&s, 0, n, o, 8, 0.2, 0.5);
+    nbs_grid_3d g;
+    nbs_pairs p;
+    nbs_grid_3d_init(&g);
+    nbs_pairs_init(&p);
+    CHECK(detect(&g, &s, 0, &p) == 0, "x-links: detect failed");
+    double lo = s.p[0][0], inv = 1.0 / g.cell;
+    for (size_t i = 1; i < n; i++) lo = fmin(lo, s.p[0][i]);
+    size_t wrong = 0;
+    for (size_t i = 0; i < n; i++) {
+        int32_t x = (int32_t)((int64_t)((s.p[0][i] - lo) * inv) & (int64_t)(g.nx - 1));
+        wrong += g.next[i].cell != x;
+    }
+    CHECK(wrong == 0, "x-links: %zu of %zu spheres do not hold their x cell", wrong, n);
+    nbs_grid_3d_free(&g);
+    nbs_pairs_free(&p);
+    spheres_free(&s);
+}
+
+/* glibc's count of the bytes in use (mallinfo2, as test_memory) */
+static double heap_in_use(void)
+{
+    struct mallinfo2 m = mallinfo2();
+    return (double)m.uordblks + (double)m.hblkhd;
+}
+
+/* Whether heap_in_use sees a 64 KiB block: not where the sanitizers or
+ * valgrind keep the books (they find leaks themselves). */
+static int heap_is_counted(void)
+{
+    double before = heap_in_use();
+    char *volatile block = malloc(65536);
+    double grown = heap_in_use() - before;
+    free(block);
+    return grown >= 65536 && grown <= 65536 + 4096;
+}
+
+/* A grid grown by less than double (1001 spheres, then 1002, then 1500
+ * within the room taken) holds room for all of them, its heap is what
+ * nbs_memory_bytes_3d counts (the packed copy of a smaller N not left
+ * behind), and nbs_grid_3d_free gives it all back (the heap is read where
+ * heap_is_counted). One sphere too many for its room is overrun by a few
+ * bytes only, so the check fails before a larger overrun can hang. */
+static void test_nbs3_grow_and_free(void)
+{
+    rng_seed(36);
+    static const size_t sizes[3] = {1001, 1002, 1500};
+    spheres s = spheres_new(1500);
+    double o[3] = {5, 5, -5};
+    put_in_cube(&s, 0, 1500, o, 11, 0.2, 0.5);
+    int counted_heap = heap_is_counted();
+    double before = heap_in_use();
+    nbs_grid_3d g;
+    nbs_pairs p;
+    nbs_grid_3d_init(&g);
+    nbs_pairs_init(&p);
+    for (int k = 0; k < 3; k++) {
+        s.n = sizes[k];
+        CHECK(detect(&g, &s, 0, &p) == 0, "grow: detect of %zu failed", s.n);
+        CHECK(g.n_capacity >= s.n, "grow: room for %zu spheres, detected %zu", g.n_capacity,
+              s.n);
+        if (g.n_capacity < s.n) break;
+    }
+    double grown = heap_in_use() - before, counted = (double)nbs_memory_bytes_3d(&g, &p);
+    CHECK(!counted_heap || fabs(grown - counted) <= 4096,
+          "grow: the heap grew by %.0f, counted %.0f", grown, counted);
+    nbs_pairs want;
+    nbs_pairs_init(&want);
+    nbs_detect_brute_3d(s.n, s.p[0], s.p[1], s.p[2], s.r, NULL, &want);
+    check_same_pairs("grown grid", &p, &want);
+    nbs_pairs_free(&want);
+    nbs_grid_3d_free(&g);
+    nbs_pairs_free(&p);
+    double left = heap_in_use() - before;
+    CHECK(!counted_heap || fabs(left) <= 4096, "grow: %.0f bytes left after nbs_grid_3d_free",
+          left);
+    spheres_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -650,6 +797,10 @@ int main(int argc, char **argv)
         {"test_nbs3_bodies_across_runs", test_nbs3_bodies_across_runs},
         {"test_nbs3_invalid_many_runs", test_nbs3_invalid_many_runs},
         {"test_nbs3_bounds_any_index", test_nbs3_bounds_any_index},
+        {"test_nbs3_sum_order", test_nbs3_sum_order},
+        {"test_nbs3_line_along_y", test_nbs3_line_along_y},
+        {"test_nbs3_x_links_hold_x", test_nbs3_x_links_hold_x},
+        {"test_nbs3_grow_and_free", test_nbs3_grow_and_free},
     };
     return check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }
