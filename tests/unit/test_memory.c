@@ -11,13 +11,13 @@
  * a step (the raw pair list at detection) and finalize's scratch are not
  * seen here; valgrind massif measured them (core/model.c, memory priced).
  */
-#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "case.h"
 #include "check.h"
 #include "fdem.h"
+#include "heap_count.h"
 #include "problems.h"
 #include "read_file.h"
 
@@ -124,27 +124,24 @@ static void threads_add_their_touch_lists(void)
     fdem_model_destroy(m);
 }
 
-/* fdem_memory_bytes() against the allocator's own count (glibc mallinfo2;
- * the sanitizers' allocator keeps its own books, so only the plain build
- * checks it). What the model holds once built and stepped: within 3% and
+/* fdem_memory_bytes() against the allocator's own count (heap_count.h:
+ * only the plain build checks it). What the model holds once built and stepped: within 3% and
  * 8 KB of what was allocated for it (the builder's leftovers, case_info),
  * and not above it by more than the few KB of part, material and
  * constraint tables counted at their capacities. */
 static void memory_bytes_counts_the_heap(void)
 {
-#ifndef FDEM_SAN
+#if HEAP_COUNTED
     const memory_case cases[] = {{"examples/jointed-block.json", 300},
                                  {"examples/uniaxial-prism-3d.json", 100},
                                  {"examples/tunnel.json", 50}};
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
-        struct mallinfo2 before = mallinfo2();
+        double before = heap_in_use();
         fdem_model *m = memory_build(cases[i].path);
         if (!m) continue;
         memory_peak(m, cases[i].steps);
         double counted = (double)fdem_memory_bytes(m);
-        struct mallinfo2 after = mallinfo2();
-        double heap = (double)(after.uordblks + after.hblkhd) -
-                      (double)(before.uordblks + before.hblkhd);
+        double heap = heap_in_use() - before;
         printf("  %-38s fdem_memory_bytes %9.0f heap %9.0f\n", cases[i].path, counted, heap);
         CHECK(counted <= heap + 4096, "%s: counts %.0f bytes, the heap grew by %.0f", cases[i].path,
               counted, heap);

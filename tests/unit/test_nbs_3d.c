@@ -9,10 +9,10 @@
  * fast under ASan. Comparisons are exact: same sphere test, same doubles.
  */
 #include "check.h"
+#include "heap_count.h"
 #include "nbs.h"
 #include "pair_sets.h"
 
-#include <malloc.h>
 #include <stdint.h>
 #include <stdlib.h>
 
@@ -719,29 +719,11 @@ static void test_nbs3_x_links_hold_x(void)
     spheres_free(&s);
 }
 
-/* glibc's count of the bytes in use (mallinfo2, as test_memory) */
-static double heap_in_use(void)
-{
-    struct mallinfo2 m = mallinfo2();
-    return (double)m.uordblks + (double)m.hblkhd;
-}
-
-/* Whether heap_in_use sees a 64 KiB block: not where the sanitizers or
- * valgrind keep the books (they find leaks themselves). */
-static int heap_is_counted(void)
-{
-    double before = heap_in_use();
-    char *volatile block = malloc(65536);
-    double grown = heap_in_use() - before;
-    free(block);
-    return grown >= 65536 && grown <= 65536 + 4096;
-}
-
 /* A grid grown by less than double (1001 spheres, then 1002, then 1500
  * within the room taken) holds room for all of them, its heap is what
  * nbs_memory_bytes_3d counts (the packed copy of a smaller N not left
  * behind), and nbs_grid_3d_free gives it all back (the heap is read where
- * heap_is_counted). One sphere too many for its room is overrun by a few
+ * HEAP_COUNTED). One sphere too many for its room is overrun by a few
  * bytes only, so the check fails before a larger overrun can hang. */
 static void test_nbs3_grow_and_free(void)
 {
@@ -750,7 +732,6 @@ static void test_nbs3_grow_and_free(void)
     spheres s = spheres_new(1500);
     double o[3] = {5, 5, -5};
     put_in_cube(&s, 0, 1500, o, 11, 0.2, 0.5);
-    int counted_heap = heap_is_counted();
     double before = heap_in_use();
     nbs_grid_3d g;
     nbs_pairs p;
@@ -764,7 +745,7 @@ static void test_nbs3_grow_and_free(void)
         if (g.n_capacity < s.n) break;
     }
     double grown = heap_in_use() - before, counted = (double)nbs_memory_bytes_3d(&g, &p);
-    CHECK(!counted_heap || fabs(grown - counted) <= 4096,
+    CHECK(!HEAP_COUNTED || fabs(grown - counted) <= 4096,
           "grow: the heap grew by %.0f, counted %.0f", grown, counted);
     nbs_pairs want;
     nbs_pairs_init(&want);
@@ -774,7 +755,7 @@ static void test_nbs3_grow_and_free(void)
     nbs_grid_3d_free(&g);
     nbs_pairs_free(&p);
     double left = heap_in_use() - before;
-    CHECK(!counted_heap || fabs(left) <= 4096, "grow: %.0f bytes left after nbs_grid_3d_free",
+    CHECK(!HEAP_COUNTED || fabs(left) <= 4096, "grow: %.0f bytes left after nbs_grid_3d_free",
           left);
     spheres_free(&s);
 }
