@@ -88,6 +88,12 @@ static inline int nbs3_sphere_valid(double x, double y, double z, double r)
  * are aligned SSE2 loads. */
 #define NBS3_PACKED (4 * sizeof(double))
 
+/* Element j's packed sphere, (x, y, z, r). */
+static inline const double *nbs3_packed(const double *sphere, int32_t j)
+{
+    return sphere + 4 * (size_t)j;
+}
+
 /* The sphere test in SSE2 only where scalar doubles are SSE2 too: with x87
  * arithmetic (-m32) nbs_spheres_touch in the all-pairs check may round
  * twice where the SSE2 test rounds once, and the two would disagree. */
@@ -321,12 +327,12 @@ static inline int32_t nbs3_coord(const nbs3_axis *a, double v, double inv)
  * own array, where the layer passes find it beside nothing else */
 static inline int32_t nbs3_x(const nbs3_scan *s, int32_t j)
 {
-    return nbs3_coord(&s->ax, s->sphere[4 * (size_t)j], s->inv);
+    return nbs3_coord(&s->ax, nbs3_packed(s->sphere, j)[0], s->inv);
 }
 
 static inline int32_t nbs3_y(const nbs3_scan *s, int32_t j)
 {
-    return nbs3_coord(&s->ay, s->sphere[4 * (size_t)j + 1], s->inv);
+    return nbs3_coord(&s->ay, nbs3_packed(s->sphere, j)[1], s->inv);
 }
 
 static inline int32_t nbs3_z(const nbs3_scan *s, int32_t j)
@@ -459,7 +465,7 @@ typedef struct nbs3_ball {
 
 static inline nbs3_ball nbs3_ball_of(const nbs3_probe *p, int32_t e)
 {
-    const double *q = p->sphere + 4 * (size_t)e;
+    const double *q = nbs3_packed(p->sphere, e);
 #if NBS3_SSE2_TEST
     nbs3_ball b = {_mm_load_pd(q), _mm_xor_pd(_mm_load_pd(q + 2), _mm_set_pd(-0.0, 0.0)), e};
 #else
@@ -492,7 +498,7 @@ static NBS_ALWAYS_INLINE void nbs3_chain_test(const nbs3_probe *p, int use_body,
     const double *sphere = p->sphere;
     const nbs_next_3d *next = p->next;
     for (int32_t j = list; j >= 0; j = next[j].cell) {
-        if (!nbs3_ball_touches(b, sphere + 4 * (size_t)j)) continue;
+        if (!nbs3_ball_touches(b, nbs3_packed(sphere, j))) continue;
         if (use_body && nbs_same_body(p->body, b.e, j)) continue;
         o->a[o->count] = b.e;
         o->b[o->count] = j;
