@@ -3,8 +3,8 @@
  *
  * Only what stepping changes is stored (step, time, step sizes, positions,
  * velocities, joint damage, the last contact detection, the stick springs,
- * energy accumulators, each joint's fracture account and the fracture
- * events not drained yet): the static model is rebuilt from the case document,
+ * energy accumulators, each joint's fracture account, the fracture
+ * events not drained yet and the slip the joints' points keep): the static model is rebuilt from the case document,
  * so a checkpoint stays small and a model of another shape is detected by
  * its counts and refused. A model restored from a checkpoint steps on to the
  * same bits as the one that wrote it.
@@ -54,7 +54,8 @@ typedef struct checkpoint_header {
      * so an earlier file's 3D joint damage would land on other joints. */
     int64_t pending_events;
     /* version 6: time's compensation (model_time_after; 0 from earlier
-     * files, whose time was summed plainly) */
+     * files, whose time was summed plainly). Version 7: the same header;
+     * the slip each joint point keeps (joint_law.h) follows the events. */
     double time_carry;
 } checkpoint_header;
 
@@ -78,12 +79,18 @@ static size_t checkpoint_body_size(const fdem_model *m, int has_detection, int h
            spring_bytes;
 }
 
+/* The joints' slip (version 7), dim points a joint. */
+static size_t checkpoint_slip_size(const fdem_model *m)
+{
+    return sizeof(joint_slip) * (size_t)m->dim * (size_t)m->joint_count;
+}
+
 size_t fdem_checkpoint_size(const fdem_model *m)
 {
     return sizeof(checkpoint_header) +
            checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
                                 contact_history_checkpoint_size(&m->contact)) +
-           events_checkpoint_size(m);
+           events_checkpoint_size(m) + checkpoint_slip_size(m);
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
@@ -130,7 +137,10 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
         p += vb;
     }
     contact_history_checkpoint_write(&m->contact, p);
-    events_checkpoint_write(m, p + spring_bytes);
+    p += spring_bytes;
+    events_checkpoint_write(m, p);
+    p += events_checkpoint_size(m);
+    if (m->joint_count) memcpy(p, m->joint_slip, checkpoint_slip_size(m));
     return 0;
 }
 
@@ -227,6 +237,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         if (h1.version >= 4)
             expected += sizeof(double) * (size_t)m->joint_count +
                         sizeof(fdem_event) * (size_t)h.pending_events;
+        if (h1.version >= 7) expected += checkpoint_slip_size(m);
     }
     if (size != expected) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,
@@ -244,12 +255,20 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
      * reports only what it dissipates from now on when it breaks */
     if (m->joint_count) memset(m->joint_fracture, 0, sizeof(double) * (size_t)m->joint_count);
     m->event_count = 0;
-    if (h1.version >= 4 &&
-        events_checkpoint_read(m, springs + (size_t)h.spring_records *
-                                                contact_record_bytes(&m->contact),
-                               h.pending_events)) {
+    const unsigned char *events =
+        springs + (size_t)h.spring_records * contact_record_bytes(&m->contact);
+    if (h1.version >= 4 && events_checkpoint_read(m, events, h.pending_events)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory restoring fracture events");
         return -1;
+    }
+    /* before version 7 no joint kept its slip: a damaged joint takes it
+     * from its sliding at the first step after the restart (the slide
+     * beyond its elastic limit, which is what the law then measured) */
+    if (m->joint_count) {
+        if (h1.version >= 7)
+            memcpy(m->joint_slip, events + events_checkpoint_size(m), checkpoint_slip_size(m));
+        else
+            memset(m->joint_slip, 0, checkpoint_slip_size(m));
     }
     size_t nb = sizeof(double) * (size_t)m->dim * (size_t)m->node_count;
     size_t vb = sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count;

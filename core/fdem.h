@@ -428,7 +428,7 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
 /* The format version a checkpoint buffer says it is in (1 to the current
  * one, FDEM_CHECKPOINT_VERSION), or -1 when it does not start like one. */
-#define FDEM_CHECKPOINT_VERSION 6
+#define FDEM_CHECKPOINT_VERSION 7
 int fdem_checkpoint_version(const void *buf, size_t size);
 
 /* Seconds spent in each stage of fdem_step() since the model was built

@@ -9,21 +9,26 @@
  * gives the opening delta (along n, A's outward normal) and the sliding s
  * (along the edge), both in the current configuration.
  *
- * Law (Munjiza 2004 ch. 7, as in Y-Geo). Penalty-elastic up to the
- * strength: sigma = p delta / h, tau = p s / h (h the smaller adjacent
- * element size, p the material penalty), up to the tensile strength f_t and
- * the shear strength f_s = cohesion + sigma_c tan(phi) (sigma_c the
- * compressive normal stress). Past the elastic limits delta_p, s_p the
- * traction softens as f z(D), Munjiza's curve with a = 0.63, b = 1.8,
- * c = 6, where D = sqrt(Dn^2 + Ds^2) combines the opening and sliding
- * beyond their limits over the softening spans delta_c - delta_p, chosen so
- * that a joint pulled apart in pure mode I absorbs exactly G_I per unit
- * area (elastic part plus softening: softening_span), and likewise G_II in
- * pure mode II: the mixed-mode criterion
- * (dn)^2 + (ds)^2 >= 1 is D >= 1. D never decreases (damage
- * is irreversible); at D = 1 the joint is broken, exerts nothing, and its
- * two triangles meet through contact from then on. Compression is resisted
- * by the joint's penalty while it holds.
+ * Law (Munjiza 2004 ch. 7, as in Y-Geo, with the slip given a history).
+ * Penalty-elastic up to the strength: sigma = p delta / h, tau = p s_e / h
+ * (h the smaller adjacent element size, p the material penalty, s_e the
+ * elastic part of the sliding s), up to the tensile strength f_t and the
+ * shear strength f_s = cohesion + sigma_c tan(phi) (sigma_c the compressive
+ * normal stress). Sliding beyond f_s is plastic slip (Coulomb friction as
+ * plasticity: an elastic trial and a return onto f_s, each point keeping
+ * its plastic slide), so the shear traction always opposes the slip and
+ * friction never gives energy back. Past the elastic limits the traction
+ * softens by z(D), Munjiza's curve with a = 0.63, b = 1.8, c = 6, where
+ * D = sqrt(Dn^2 + Ds^2) combines the opening beyond its limit and the slip
+ * path over the softening spans delta_c - delta_p, chosen so that a joint
+ * pulled apart in pure mode I absorbs exactly G_I per unit area (elastic
+ * part plus softening: softening_span), and likewise G_II in pure mode II:
+ * the mixed-mode criterion (dn)^2 + (ds)^2 >= 1 is D >= 1. D never
+ * decreases (damage is irreversible); at D = 1 the joint is broken, exerts
+ * nothing, and its two triangles meet through contact (with its own
+ * Coulomb friction and stick springs) from then on: a broken joint keeps
+ * no residual friction of its own. Compression is resisted by the joint's
+ * penalty while it holds.
  *
  * The law at one integration point is joint_law.h's, shared with the 3D
  * joint (joint_tet.c); this file owns the 2D geometry around it: the edge,
@@ -147,6 +152,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     if (!m->joint_count) return m->joint_set_count ? joint_strengths_assign(m, err) : 0;
     size_t J = (size_t)m->joint_count;
     m->joint_damage = calloc(J, sizeof(double));
+    m->joint_slip = calloc(J * (size_t)m->dim, sizeof(joint_slip));
     m->joint_fracture = calloc(J, sizeof(double));
     m->joint_broke = calloc(J, 1);
     m->joint_h = malloc(sizeof(double) * J);
@@ -154,7 +160,7 @@ int joint_prepare(fdem_model *m, fdem_error *err)
     int faces = m->dim + 1; /* an element's faces, so at most its joints */
     m->elem_joint = malloc(sizeof(int32_t) * (size_t)faces * (size_t)m->elem_count);
     m->vertex_broken = calloc((size_t)m->node_count, 1);
-    if (!m->joint_damage || !m->joint_fracture || !m->joint_broke || !m->joint_h ||
+    if (!m->joint_damage || !m->joint_slip || !m->joint_fracture || !m->joint_broke || !m->joint_h ||
         !m->elem_joint || !m->vertex_broken || !m->joint_k) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for joints");
         return -1;
@@ -309,40 +315,41 @@ static double joint_compression(double k, double L, double delta0, double delta1
 
 /* Forces on face A's nodes (fa0, fa1) from the Gauss-point law, for a joint
  * that is damaged or leaving its elastic range; updates *damage (the
- * largest either Gauss point asks for, never less than before) and adds to
- * *e the joint's stored energy, what the damage growth dissipated and the
- * work of the frictional part of the shear traction over the last step; a
- * joint that breaks while pressed shut adds the energy of its compression,
- * which the contact of its faces takes over, to e->handed. d0 and d1 are
- * the displacements of b0 against a0 and b1 against a1, step0 and step1 how
- * much they changed in the last step; (tx, ty) the unit face tangent and L
- * the face length. */
+ * largest either Gauss point asks for, never less than before) and the
+ * slip each point keeps (slip[2]), and adds to *e the joint's stored
+ * energy and what its damage growth and slip dissipated; a joint that
+ * breaks while pressed shut adds the energy of its compression, which the
+ * contact of its faces takes over, to e->handed. d0 and d1 are the
+ * displacements of b0 against a0 and b1 against a1; (tx, ty) the unit face
+ * tangent and L the face length. The slide is along that tangent, so a
+ * rigid rotation of the pair leaves it, and the plastic slide kept against
+ * it, as they were. */
 static void joint_forces_general(const joint_law *law, const double d0[2], const double d1[2],
-                                 const double step0[2], const double step1[2], double tx,
-                                 double ty, double L, double *damage, double fa0[2],
-                                 double fa1[2], joint_energy *e)
+                                 double tx, double ty, double L, double *damage,
+                                 joint_slip slip[2], double fa0[2], double fa1[2],
+                                 joint_energy *e)
 {
     double nx = ty, ny = -tx; /* A's outward normal */
     joint_point g[2];
-    double slide_before[2];
     for (int i = 0; i < 2; i++) {
         double xi = gauss[i];
         double dx = (1 - xi) * d0[0] + xi * d1[0], dy = (1 - xi) * d0[1] + xi * d1[1];
-        joint_point_measure(law, dx * nx + dy * ny, dx * tx + dy * ty, &g[i]);
-        double ux = dx - ((1 - xi) * step0[0] + xi * step1[0]);
-        double uy = dy - ((1 - xi) * step0[1] + xi * step1[1]);
-        slide_before[i] = ux * tx + uy * ty;
+        const double slide[2] = {dx * tx + dy * ty, 0};
+        joint_point_measure(law, dx * nx + dy * ny, slide, &slip[i], &g[i]);
     }
     double D = joint_points_damage(g, 2, *damage);
-    double z_old = joint_softening(*damage), z = joint_softening(D);
+    /* z(D) is not monotone to the last bit: damage that grew must not
+     * book a release below zero */
+    double z_old = joint_softening(*damage), z = fmin(z_old, joint_softening(D));
     *damage = D;
     if (D >= 1) e->broke = joint_points_mode(law, g, 2);
     double w = 0.5 * L; /* Gauss weight */
     fa0[0] = fa0[1] = fa1[0] = fa1[1] = 0;
     for (int i = 0; i < 2; i++) {
-        double xi = gauss[i], sigma, tau;
-        joint_point_respond(law, &g[i], w, z_old, z, slide_before[i], e, &sigma, &tau);
-        double Tx = w * (sigma * nx + tau * tx), Ty = w * (sigma * ny + tau * ty);
+        double xi = gauss[i], sigma, tau[2];
+        joint_point_respond(law, &g[i], w, z_old, z, e, &sigma, tau);
+        slip[i] = g[i].slip;
+        double Tx = w * (sigma * nx + tau[0] * tx), Ty = w * (sigma * ny + tau[0] * ty);
         fa0[0] += (1 - xi) * Tx; fa0[1] += (1 - xi) * Ty;
         fa1[0] += xi * Tx;       fa1[1] += xi * Ty;
     }
@@ -353,8 +360,7 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
 }
 
 typedef struct joint_view_2d {
-    const double *x, *v;
-    double h_last; /* x = x_before + h_last v: the last step */
+    const double *x;
     const joint_strength *strengths;
 } joint_view_2d;
 
@@ -363,15 +369,16 @@ typedef struct joint_view_2d {
  * joint (11 % more instructions measured). */
 static inline joint_view_2d joint_view_of(const fdem_model *m)
 {
-    return (joint_view_2d){m->pos, m->vel, m->dt_prev, m->joint_strengths};
+    return (joint_view_2d){m->pos, m->joint_strengths};
 }
 
-/* A joint past the elastic test: its law point by point (joint_forces_general)
- * with the relative step of the last step; returns the new damage, face A's
- * forces in fa. Kept out of line and handed the gaps by value, so that
- * nothing the elastic path holds has its address taken: it stays in
- * registers (joint_forces_range_2d took 5-11 % more instructions with this
- * path inline in a function of two callers, which gcc then kept apart). */
+/* A joint past the elastic test: its law point by point
+ * (joint_forces_general) with the slip its points keep; returns the new
+ * damage, face A's forces in fa. Kept out of line and handed the gaps by
+ * value, so that nothing the elastic path holds has its address taken: it
+ * stays in registers (joint_forces_range_2d took 5-11 % more instructions
+ * with this path inline in a function of two callers, which gcc then kept
+ * apart). */
 static __attribute__((noinline)) double joint_softening_2d(const fdem_model *m,
                                                             const joint_view_2d *w, int j,
                                                             double damage, double d0x,
@@ -379,17 +386,11 @@ static __attribute__((noinline)) double joint_softening_2d(const fdem_model *m,
                                                             double tx, double ty, double L,
                                                             double fa[4], joint_energy *e)
 {
-    const double *v = w->v, h_last = w->h_last;
     const double d0[2] = {d0x, d0y}, d1[2] = {d1x, d1y};
-    const int32_t *n = m->joint_node + 4 * j;
     const joint_law law = joint_law_of(&w->strengths[m->joint_strength_of[j]], m->joint_k[j]);
     double inv_L = 1.0 / L;
-    const double *va0 = v + 2 * (size_t)n[0], *va1 = v + 2 * (size_t)n[1];
-    const double *vb0 = v + 2 * (size_t)n[2], *vb1 = v + 2 * (size_t)n[3];
-    double step0[2] = {h_last * (vb0[0] - va0[0]), h_last * (vb0[1] - va0[1])};
-    double step1[2] = {h_last * (vb1[0] - va1[0]), h_last * (vb1[1] - va1[1])};
-    joint_forces_general(&law, d0, d1, step0, step1, tx * inv_L, ty * inv_L, L, &damage, fa,
-                         fa + 2, e);
+    joint_forces_general(&law, d0, d1, tx * inv_L, ty * inv_L, L, &damage,
+                         m->joint_slip + 2 * (size_t)j, fa, fa + 2, e);
     return damage;
 }
 

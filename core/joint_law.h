@@ -3,19 +3,23 @@
  * by the 2D joint (joint.c, two Gauss points on an edge) and the 3D joint
  * (joint_tet.c, three points on a triangle). It lives here, once, so the two
  * dimensions cannot drift apart: the law is dimension-free once the sliding
- * is a magnitude along its own direction (2D passes the signed slide along
- * the edge, 3D the length of the sliding vector).
+ * is a vector in the face's own frame (2D passes the signed slide along the
+ * edge as [s, 0], 3D the two components along the face's tangents).
  *
  * Contract:
  *  - joint_point_measure: opening, sliding, the shear strength with its
- *    compression part (Mohr-Coulomb) and the damage D they ask for
- *    (mixed-mode: D = sqrt(Dn^2 + Ds^2), spans set by energy_I, energy_II).
+ *    compression part (Mohr-Coulomb), the return of the slip (Coulomb
+ *    plasticity: the point's joint_slip, kept by the caller per point from
+ *    step to step and zero while the joint is undamaged) and the damage D
+ *    they ask for (mixed-mode: D = sqrt(Dn^2 + Ds^2), spans set by
+ *    energy_I, energy_II).
  *  - joint_points_damage: the joint's damage, the largest its points ask
  *    for, never less than before, at most 1.
  *  - joint_point_respond: the point's tractions (sigma along the normal,
- *    positive opening only; tau along the sliding) for softening z, and its
- *    share (weight w) of the stored energy, of what the damage growth
- *    dissipated and of the frictional work over the last step.
+ *    positive opening only; tau along the face frame of the sliding) for
+ *    softening z, and its share (weight w) of the stored energy and of what
+ *    the damage growth and the slip dissipated (fracture, friction: each
+ *    >= 0 at every evaluation).
  *  - joint_point_elastic: the undamaged elastic test on unnormalised
  *    projections (both scaled by the same positive `scale`).
  *  - joint_points_mode: how a joint that broke broke (tensile, shear or
@@ -25,6 +29,7 @@
 #ifndef FDEM_JOINT_LAW_H
 #define FDEM_JOINT_LAW_H
 
+#include <float.h>
 #include <math.h>
 
 /* One material's cohesive constants for one joint. */
@@ -39,8 +44,8 @@ typedef struct joint_law {
 /* What a joint's points book over one evaluation. */
 typedef struct joint_energy {
     double stored;     /* held in the joint now */
-    double dissipated; /* by damage growth (fracture account) */
-    double friction;   /* by the sigma_c tan(phi) part of the shear traction */
+    double dissipated; /* by damage growth and cohesive slip (fracture account) */
+    double friction;   /* by slip against the sigma_c tan(phi) part of the strength */
     double handed;     /* compression energy of a joint that broke shut */
     int broke;         /* how the joint broke in this evaluation (JOINT_MODE_*), 0 if it holds */
 } joint_energy;
@@ -72,36 +77,86 @@ static inline double softening_span(double f, double p, double G)
     return span > p ? span : p;
 }
 
+/* What one integration point keeps from step to step: its plastic slide
+ * (the part of the sliding that friction let through, in the face's own
+ * frame) and its accumulated slip (the length of the path that plastic
+ * slide has run). An undamaged point keeps zeros. */
+typedef struct joint_slip {
+    double plastic[2];
+    double path;
+} joint_slip;
+
 /* One integration point of a joint leaving its elastic range or already
- * damaged. */
+ * damaged. The sliding is a vector in the face (2D: along the edge, its
+ * second component 0; 3D: along the face's two tangents, joint_tet.c), so
+ * one law serves both dimensions. */
 typedef struct joint_point {
-    double delta, slide;   /* opening and sliding */
-    double fs;             /* shear strength there: cohesion + compression tan(phi) */
-    double D;              /* the damage its opening and sliding ask for */
+    double delta;    /* opening */
+    double slide[2]; /* sliding, in the face's own frame */
+    joint_slip slip; /* after this evaluation's return */
+    double flow;     /* the plastic slip of this evaluation (>= 0) */
+    double fs;       /* shear strength there: cohesion + compression tan(phi) */
+    double D;        /* the damage its opening and its slip ask for */
 } joint_point;
 
-/* The opening and the sliding of point g beyond their elastic limits, each
- * over its softening span: Dn and Ds, 1 at the critical opening (sliding)
- * of a joint loaded in that mode alone. */
+/* The opening beyond its elastic limit and the accumulated slip of point
+ * g, each over its softening span: Dn and Ds, 1 at the critical opening
+ * (sliding) of a joint loaded in that mode alone. Under a monotonic slide
+ * at a constant compression the path is |s| - s_p, so the softening is
+ * Munjiza's curve in the sliding, as before slip had a history; sliding
+ * to and fro wears the cohesion down as one long slide would, so the
+ * cohesion dissipates G_II at most, however the joint is cycled. */
 static inline void joint_point_parts(const joint_law *law, const joint_point *g, double *dn,
                                      double *ds)
 {
     double k = law->k, ft = law->tensile_strength;
     double dp = ft / k, sp = g->fs / k;
     *dn = g->delta > dp ? (g->delta - dp) / softening_span(ft, dp, law->energy_I) : 0;
-    *ds = fabs(g->slide) > sp ? (fabs(g->slide) - sp) / softening_span(g->fs, sp, law->energy_II)
-                              : 0;
+    *ds = g->slip.path > 0 ? g->slip.path / softening_span(g->fs, sp, law->energy_II) : 0;
 }
 
-static inline void joint_point_measure(const joint_law *law, double delta, double slide,
-                                       joint_point *g)
+/* Coulomb slip as plasticity: the elastic trial slide s - plastic (the
+ * plastic slide kept from the last evaluation) against the yield slide
+ * s_p = f_s / k, returned onto it along its own direction. The slip then
+ * always runs the way the shear traction points, so friction dissipates
+ * at every step and every point, however the compression changes. Before,
+ * the traction was f_s clamp(s / s_p): a joint that slid out under low
+ * compression and was driven back under high compression gave back more
+ * work than it took (18.7x the platen work as kinetic energy in an
+ * undamped Brazilian disc). hypot(x, 0) is |x| exactly (C11 F.10.4.3): a
+ * 2D point gets the bits of a one-component return. */
+static inline void joint_point_return(const joint_law *law, joint_point *g,
+                                      const joint_slip *before)
+{
+    double e0 = g->slide[0] - before->plastic[0], e1 = g->slide[1] - before->plastic[1];
+    double trial = hypot(e0, e1), sp = g->fs / law->k;
+    g->slip = *before;
+    g->flow = 0;
+    if (!(trial > sp)) return;
+    double flow = trial - sp, share = flow / trial;
+    g->slip.plastic[0] += share * e0;
+    g->slip.plastic[1] += share * e1;
+    g->slip.path += flow;
+    g->flow = flow;
+}
+
+/* Measures point g at opening delta and sliding slide[2] from the slip it
+ * kept (before): its strength, its return and the damage it asks for. A
+ * point that has slipped is damaged (D > 0, if only DBL_MIN), so an
+ * undamaged joint has no slip to keep and the elastic fast paths, which
+ * keep none, stay exact. */
+static inline void joint_point_measure(const joint_law *law, double delta, const double slide[2],
+                                       const joint_slip *before, joint_point *g)
 {
     g->delta = delta;
-    g->slide = slide;
+    g->slide[0] = slide[0];
+    g->slide[1] = slide[1];
     g->fs = law->cohesion + (delta < 0 ? -law->k * delta * law->tan_phi : 0);
+    joint_point_return(law, g, before);
     double dn, ds;
     joint_point_parts(law, g, &dn, &ds);
     g->D = sqrt(dn * dn + ds * ds);
+    if (g->D == 0 && g->slip.path > 0) g->D = DBL_MIN;
 }
 
 /* The mode of a joint whose points g[0 .. count) broke it: that of the
@@ -130,69 +185,50 @@ static inline double joint_points_damage(const joint_point *g, int count, double
     return D > 1 ? 1 : D;
 }
 
-/* The stored energy psi = z(D) phi(delta, s) (plus 1/2 k delta^2 in
- * compression, which damage leaves alone): phi is the undamaged joint's
- * energy, 1/2 k x^2 up to the elastic limit and linear beyond it, for the
- * opening and the sliding alike. The tractions are f_t min(delta/delta_p, 1) z
- * and f_s clamp(s/s_p) z. Damage growing by dD dissipates -z'(D) phi dD,
- * which joint_point_respond books as (z_old - z_new) phi.
- *
- * Beyond the elastic slip s_p, phi grows with the cohesion c only: the rest
- * of the shear strength, sigma_c tan(phi), is friction, and its work is
- * dissipated as the joint slides (joint_friction_slip), not stored. Storing
- * it (f_s (|s| - s_p / 2), as before) made psi follow the strength when the
- * compression changed, without the normal force doing that work: the law is
- * not the gradient of such a psi (d tau / d delta != d sigma / d s), and
- * after the peak of a Brazilian disc 10.9 % of the work went to no account. */
+/* The stored energy psi = z(D) phi (plus 1/2 k delta^2 in compression,
+ * which damage leaves alone), phi the undamaged joint's energy: for the
+ * opening 1/2 k delta^2 up to the elastic limit and linear beyond it, for
+ * the sliding 1/2 k |s - plastic|^2, the elastic slide's. The tractions are
+ * f_t min(delta/delta_p, 1) z and z k (s - plastic), each the derivative of
+ * psi at fixed damage and slip, so the joint stores exactly what they do
+ * not dissipate. Damage growing from z_old to z dissipates
+ * (z_old - z) phi; the slip dissipates z f_s per unit of flow, its
+ * cohesive part (z c) as fracture, its frictional part (z sigma_c tan phi)
+ * as friction. Each of the three is >= 0 at every step. */
 static inline double joint_phi(const joint_law *law, const joint_point *g)
 {
-    double k = law->k, ft = law->tensile_strength;
-    double dp = ft / k, sp = g->fs / k, phi = 0;
+    double k = law->k, ft = law->tensile_strength, dp = ft / k, phi = 0;
     if (g->delta > 0)
         phi += g->delta <= dp ? 0.5 * k * g->delta * g->delta : ft * (g->delta - 0.5 * dp);
-    double s = fabs(g->slide);
-    phi += s <= sp ? 0.5 * k * s * s : 0.5 * k * sp * sp + law->cohesion * (s - sp);
-    return phi;
+    double e0 = g->slide[0] - g->slip.plastic[0], e1 = g->slide[1] - g->slip.plastic[1];
+    return phi + 0.5 * k * (e0 * e0 + e1 * e1);
 }
 
-/* The slide beyond the elastic limit s_p that the last step added at a
- * point (negative when it slid back toward s_p), on the side the joint is
- * on now; the frictional traction sigma_c tan(phi) z works through it.
- * slide_before is the sliding a step ago (the step's relative displacement
- * taken off the current one) along the current sliding direction. Zero
- * within the elastic limit. */
-static inline double joint_friction_slip(const joint_point *g, double k, double slide_before)
-{
-    double sp = g->fs / k, s = fabs(g->slide);
-    if (!(s > sp)) return 0;
-    double side = g->slide > 0 ? 1 : -1;
-    return s - fmax(side * slide_before, sp);
-}
-
-/* Tractions at a point for damage with softening factor z. */
+/* Tractions at a point for damage with softening factor z: sigma along
+ * the normal, tau[2] along the face frame of slide. */
 static inline void joint_point_traction(const joint_law *law, const joint_point *g, double z,
-                                        double *sigma, double *tau)
+                                        double *sigma, double tau[2])
 {
-    double k = law->k, ft = law->tensile_strength;
-    double dp = ft / k, sp = g->fs / k;
+    double k = law->k, ft = law->tensile_strength, dp = ft / k;
     /* compression is resisted over the shut part of the face by each
      * dimension's kernel, integrated exactly */
     *sigma = g->delta > 0 ? ft * fmin(g->delta / dp, 1.0) * z : 0;
-    double r = g->slide / sp;
-    *tau = g->fs * (r > 1 ? 1 : r < -1 ? -1 : r) * z;
+    tau[0] = z * k * (g->slide[0] - g->slip.plastic[0]);
+    tau[1] = z * k * (g->slide[1] - g->slip.plastic[1]);
 }
 
 /* The tractions at point g (weight w: its share of the face) once the
  * joint's softening went from z_old to z, and its share of the energies. */
 static inline void joint_point_respond(const joint_law *law, const joint_point *g, double w,
-                                       double z_old, double z, double slide_before,
-                                       joint_energy *e, double *sigma, double *tau)
+                                       double z_old, double z, joint_energy *e, double *sigma,
+                                       double tau[2])
 {
     double phi = w * joint_phi(law, g);
     e->dissipated += (z_old - z) * phi;
     e->stored += z * phi;
-    double frictional = g->fs - law->cohesion; /* sigma_c tan(phi) */
-    e->friction += w * z * frictional * joint_friction_slip(g, law->k, slide_before);
+    double worked = w * z * g->flow; /* against z f_s, the traction on the yield slide */
+    e->dissipated += worked * law->cohesion;
+    e->friction += worked * (g->fs - law->cohesion);
     joint_point_traction(law, g, z, sigma, tau);
 }
 

@@ -17,10 +17,10 @@
  * closed at another would let that corner sink into the neighbour
  * unresisted, as two Gauss points did in 2D (see joint_compression).
  *
- * Sliding. The sliding is a vector in the face; the law sees its length s
- * and returns a shear traction along its direction e. The step's
- * relative displacement projected on e gives the slide a step ago, through
- * which the frictional part of the shear strength works.
+ * Sliding. The sliding is a vector in the face, given to the law as its
+ * two components in the face's own frame (face_frame), where each point
+ * keeps its plastic slide (joint_law.h's Coulomb return); the law returns
+ * the shear traction in the same frame.
  */
 #include "joint_tet.h"
 #include "vec3.h"
@@ -135,41 +135,54 @@ static double joint_tet_compression(double k, double area, const double delta[3]
 
 /* ------------------------------------------------------------- general */
 
+/* The face's own frame: t1 along its first mean edge (a + d/2), t2 = n x t1
+ * in the face. It turns with the face, so a rigid rotation of the pair
+ * leaves the slide's components, and the plastic slide kept in them, as
+ * they were. Returns 0 for an edge of no length. */
+static int face_frame(const double *pos, const int32_t node[6], const double d[3][3],
+                      const double n[3], double t1[3], double t2[3])
+{
+    double e1[3];
+    for (int c = 0; c < 3; c++)
+        e1[c] = (node_at(pos, node[1])[c] - node_at(pos, node[0])[c]) + 0.5 * (d[1][c] - d[0][c]);
+    double along = vec3_dot(e1, n);
+    for (int c = 0; c < 3; c++) e1[c] -= along * n[c];
+    double len = sqrt(vec3_dot(e1, e1));
+    if (!(len > 0)) return 0;
+    for (int c = 0; c < 3; c++) t1[c] = e1[c] / len;
+    vec3_cross(n, t1, t2);
+    return 1;
+}
+
 /* Forces on face A from the law at the three points, for a joint that is
- * damaged or leaving its elastic range; updates *damage and books into e.
- * d: the gaps at the corners, step: how much they changed over the last
- * step, n the unit normal, area the face area. */
-static void joint_tet_general(const joint_law *law, const double d[3][3],
-                              const double step[3][3], const double n[3], double area,
-                              double *damage, double fa[9], joint_energy *e)
+ * damaged or leaving its elastic range; updates *damage and the slip each
+ * point keeps (slip[3]) and books into e. d: the gaps at the corners, n
+ * the unit normal, t1 and t2 the face frame, area the face area. */
+static void joint_tet_general(const joint_law *law, const double d[3][3], const double n[3],
+                              const double t1[3], const double t2[3], double area,
+                              double *damage, joint_slip slip[3], double fa[9], joint_energy *e)
 {
     joint_point g[3];
-    double slide_dir[3][3], slide_before[3];
     for (int p = 0; p < 3; p++) {
-        double gap[3], was[3];
+        double gap[3];
         gap_at(d, rule[p], gap);
-        gap_at(step, rule[p], was);
-        double delta = vec3_dot(gap, n), s = 0;
-        for (int c = 0; c < 3; c++) {
-            slide_dir[p][c] = gap[c] - delta * n[c];
-            was[c] = gap[c] - was[c]; /* the gap a step ago */
-        }
-        s = sqrt(vec3_dot(slide_dir[p], slide_dir[p]));
-        for (int c = 0; c < 3; c++) slide_dir[p][c] = s > 0 ? slide_dir[p][c] / s : 0;
-        joint_point_measure(law, delta, s, &g[p]);
-        slide_before[p] = vec3_dot(was, slide_dir[p]);
+        const double slide[2] = {vec3_dot(gap, t1), vec3_dot(gap, t2)};
+        joint_point_measure(law, vec3_dot(gap, n), slide, &slip[p], &g[p]);
     }
     double D = joint_points_damage(g, 3, *damage);
-    double z_old = joint_softening(*damage), z = joint_softening(D);
+    /* z(D) is not monotone to the last bit: damage that grew must not
+     * book a release below zero */
+    double z_old = joint_softening(*damage), z = fmin(z_old, joint_softening(D));
     *damage = D;
     if (D >= 1) e->broke = joint_points_mode(law, g, 3);
     double w = area / 3;
     memset(fa, 0, 9 * sizeof(double));
     for (int p = 0; p < 3; p++) {
-        double sigma, tau;
-        joint_point_respond(law, &g[p], w, z_old, z, slide_before[p], e, &sigma, &tau);
+        double sigma, tau[2];
+        joint_point_respond(law, &g[p], w, z_old, z, e, &sigma, tau);
+        slip[p] = g[p].slip;
         for (int c = 0; c < 3; c++) {
-            double T = w * (sigma * n[c] + tau * slide_dir[p][c]);
+            double T = w * (sigma * n[c] + tau[0] * t1[c] + tau[1] * t2[c]);
             for (int i = 0; i < 3; i++) fa[3 * i + c] += rule[p][i] * T;
         }
     }
@@ -179,8 +192,8 @@ static void joint_tet_general(const joint_law *law, const double d[3][3],
     if (D >= 1) e->handed += squeezed; /* broken shut: its overlap goes on as contact */
 }
 
-int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
-                     const int32_t node[6], double *damage, double fa[9], joint_energy *e)
+int joint_tet_forces(const joint_law *law, const double *pos, const int32_t node[6],
+                     double *damage, joint_slip slip[3], double fa[9], joint_energy *e)
 {
     if (*damage >= 1.0) {
         memset(fa, 0, 9 * sizeof(double));
@@ -188,13 +201,12 @@ int joint_tet_forces(const joint_law *law, const double *pos, const double *vel,
     }
     double d[3][3], N[3];
     double N_len = joint_tet_gaps(pos, node, d, N);
-    return joint_tet_forces_of_gaps(law, d, N, N_len, vel, h_last, node, damage, fa, e);
+    return joint_tet_forces_of_gaps(law, pos, d, N, N_len, node, damage, slip, fa, e);
 }
 
-int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const double N[3],
-                             double N_len, const double *vel, double h_last,
-                             const int32_t node[6], double *damage, double fa[9],
-                             joint_energy *e)
+int joint_tet_forces_of_gaps(const joint_law *law, const double *pos, const double d[3][3],
+                             const double N[3], double N_len, const int32_t node[6],
+                             double *damage, joint_slip slip[3], double fa[9], joint_energy *e)
 {
     memset(fa, 0, 9 * sizeof(double));
     if (*damage >= 1.0) return 0;
@@ -204,15 +216,10 @@ int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const d
         e->stored += joint_tet_elastic_forces(law->k, area, d, fa);
         return 1;
     }
-    double step[3][3] = {{0}};
-    if (vel)
-        for (int i = 0; i < 3; i++)
-            vec3_sub(node_at(vel, node[3 + i]), node_at(vel, node[i]), step[i]);
-    for (int i = 0; i < 3; i++)
-        for (int c = 0; c < 3; c++) step[i][c] *= h_last;
-    double n[3] = {N[0] / N_len, N[1] / N_len, N[2] / N_len};
+    double n[3] = {N[0] / N_len, N[1] / N_len, N[2] / N_len}, t1[3], t2[3];
+    if (!face_frame(pos, node, d, n, t1, t2)) return 1; /* no edge to slide along */
     joint_energy mine = {0};
-    joint_tet_general(law, d, step, n, area, damage, fa, &mine);
+    joint_tet_general(law, d, n, t1, t2, area, damage, slip, fa, &mine);
     e->dissipated += mine.dissipated;
     e->friction += mine.friction;
     e->handed += mine.handed;

@@ -18,10 +18,13 @@
  *    reaction, so they sum to zero); a rigid motion of the pair gives none.
  *  - *damage never decreases; at 1 the joint is broken: fa is zero, nothing
  *    is stored, and the function returns 0 (1 while it holds).
- *  - e gets the stored energy, the dissipation of damage growth, the
- *    frictional work over the last step (vel may be NULL: none) and, for a
- *    joint that broke shut, the compression energy contact takes over;
- *    e->broke the mode of a break in this call (joint_points_mode).
+ *  - slip[3] is what the joint's three points keep from evaluation to
+ *    evaluation (joint_law.h: plastic slide in the face frame, slip path);
+ *    zero for an undamaged joint, updated while it is damaged.
+ *  - e gets the stored energy, what damage growth and slip dissipated
+ *    (fracture, friction: each >= 0) and, for a joint that broke shut, the
+ *    compression energy contact takes over; e->broke the mode of a break
+ *    in this call (joint_points_mode).
  */
 #ifndef FDEM_JOINT_TET_H
 #define FDEM_JOINT_TET_H
@@ -35,18 +38,16 @@
 #include <math.h>
 #include <stddef.h>
 
-/* h_last: the last step, so that x - h_last v is where the nodes were. */
-int joint_tet_forces(const joint_law *law, const double *pos, const double *vel, double h_last,
-                     const int32_t node[6], double *damage, double fa[9], joint_energy *e);
+int joint_tet_forces(const joint_law *law, const double *pos, const int32_t node[6],
+                     double *damage, joint_slip slip[3], double fa[9], joint_energy *e);
 
 /* joint_tet_forces for a joint whose gaps d, normal N and |N| the caller
  * already has from joint_tet_gaps (or a lane of joint_tet_gaps_at_pair:
  * the same bits), so that a joint the fast path turned down does not
  * compute them again. */
-int joint_tet_forces_of_gaps(const joint_law *law, const double d[3][3], const double N[3],
-                             double N_len, const double *vel, double h_last,
-                             const int32_t node[6], double *damage, double fa[9],
-                             joint_energy *e);
+int joint_tet_forces_of_gaps(const joint_law *law, const double *pos, const double d[3][3],
+                             const double N[3], double N_len, const int32_t node[6],
+                             double *damage, joint_slip slip[3], double fa[9], joint_energy *e);
 
 /* ------------------------------------------------ the intact fast path
  * Nearly every joint in nearly every step is undamaged and far inside its

@@ -205,7 +205,8 @@ static int joint_through_kernel(fdem_model *m, int j, const double d[3][3], cons
     double damage = m->joint_damage[j];
     /* this joint's own, for its fracture account and its event */
     joint_energy e = {0};
-    int holds = joint_tet_forces_of_gaps(&law, d, N, N_len, m->vel, m->dt_prev, n, &damage, fa, &e);
+    int holds = joint_tet_forces_of_gaps(&law, m->pos, d, N, N_len, n, &damage,
+                                         m->joint_slip + 3 * (size_t)j, fa, &e);
     m->joint_damage[j] = damage;
     t->stored += e.stored;
     t->dissipated += e.dissipated;

@@ -81,7 +81,7 @@ void fdem_model_destroy(fdem_model *m)
     boundary_load_free(m);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
     free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
-    free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
+    free(m->joint_slip); free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
     free(m->stress0_defs); free(m->elem_stress0);
@@ -792,7 +792,7 @@ static size_t memory_contact_element(const memory_figures *f)
 }
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;
- * joint_strength_of, a strength record of its own (varied strengths), its
+ * the slip its dim points keep; joint_strength_of, a strength record of its own (varied strengths), its
  * fracture event (in a list that grows by doubling), the raw NBS list's
  * pairs of joined elements (two element ids each), and on several threads
  * the joint sweep's slots, at most one per 8 joints (a face's forces, its
@@ -801,7 +801,7 @@ static size_t memory_joint(const memory_figures *f)
 {
     size_t slot = JOINT_FACE_VALUES * sizeof(double) + 4 * sizeof(int32_t) + 1;
     return (2 * f->D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 + sizeof(int32_t) +
-           sizeof(joint_strength) + 2 * sizeof(fdem_event) +
+           f->D * sizeof(joint_slip) + sizeof(joint_strength) + 2 * sizeof(fdem_event) +
            (size_t)(f->joined_pairs * 2 * sizeof(int32_t)) + (slot + 7) / 8;
 }
 
@@ -898,8 +898,9 @@ size_t fdem_memory_bytes(const fdem_model *m)
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
                           : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     /* joints: 2 dim nodes and 2 elements; damage, fracture, h, k; broke;
-     * strength_of; elem_joint */
-    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1);
+     * the slip of its dim points; strength_of; elem_joint */
+    b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 +
+                                   D * sizeof(joint_slip));
     if (m->joint_strength_of) b += (size_t)m->joint_count * sizeof(int32_t);
     b += (size_t)m->event_capacity * sizeof(fdem_event);
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);

@@ -288,6 +288,8 @@ struct fdem_model {
     joint_set *joint_sets;   /* fdem_add_joint_set, resolved at finalize */
     int joint_set_count;
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
+    joint_slip *joint_slip;  /* dim per joint, one per integration point: the plastic slide
+                                and slip path each keeps (joint_law.h); zero while undamaged */
     int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
                                 refreshed at each contact detection */

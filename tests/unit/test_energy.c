@@ -192,13 +192,16 @@ static void checkpoint_carries_the_joints_friction(void)
           ea.friction, eb.friction);
     /* version 2: the same bytes less the header's last three numbers (joint
      * friction, version 3; pending events, version 4; time's carry,
-     * version 6) and version 4's sections after the springs (each joint's
-     * fracture account, the events not drained) */
+     * version 6) and the sections after the springs (version 4: each
+     * joint's fracture account, the events not drained; version 7: the
+     * slip its points keep) */
     size_t v2_header = sizeof(uint32_t) * 2 + 4 * sizeof(int32_t) + sizeof(int64_t) +
                        10 * sizeof(double) + sizeof(int64_t) + 2 * sizeof(int32_t) +
                        sizeof(int64_t) + 2 * sizeof(int32_t) + sizeof(fdem_energy);
     size_t cut = 2 * sizeof(double) + sizeof(int64_t);
-    size_t tail = sizeof(double) * (size_t)a->joint_count + sizeof(fdem_event) * (size_t)a->event_count;
+    size_t tail = sizeof(double) * (size_t)a->joint_count +
+                  sizeof(fdem_event) * (size_t)a->event_count +
+                  sizeof(joint_slip) * 2 * (size_t)a->joint_count;
     size_t old_size = size - cut - tail;
     unsigned char *old = malloc(old_size);
     memcpy(old, buf, v2_header);

@@ -249,10 +249,12 @@ static void mode_rule(void)
         {0.0, 1.0, JOINT_MODE_SHEAR},   {0.3, 1.0, JOINT_MODE_SHEAR},
         {0.8, 0.8, JOINT_MODE_MIXED},   {1.0, 0.4, JOINT_MODE_MIXED},
     };
+    const joint_slip none = {{0, 0}, 0};
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         joint_point g[2];
-        joint_point_measure(&law, 0, 0, &g[0]); /* an unstrained point beside it */
-        joint_point_measure(&law, dp + cases[k].dn * span_n, sp + cases[k].ds * span_s, &g[1]);
+        const double still[2] = {0, 0}, slid[2] = {sp + cases[k].ds * span_s, 0};
+        joint_point_measure(&law, 0, still, &none, &g[0]); /* an unstrained point beside it */
+        joint_point_measure(&law, dp + cases[k].dn * span_n, slid, &none, &g[1]);
         CHECK(joint_points_mode(&law, g, 2) == cases[k].mode, "Dn %g Ds %g: mode %d, want %d",
               cases[k].dn, cases[k].ds, joint_points_mode(&law, g, 2), cases[k].mode);
     }

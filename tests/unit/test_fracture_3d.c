@@ -119,7 +119,8 @@ static void reference_joint_range(fdem_model *m, int begin, int end, double sums
         const joint_law law = joint_law_of(&m->joint_strengths[m->joint_strength_of[j]], m->joint_k[j]);
         double fa[9];
         joint_energy e = {0};
-        int holds = joint_tet_forces(&law, m->pos, m->vel, m->dt_prev, n, &m->joint_damage[j], fa, &e);
+        int holds = joint_tet_forces(&law, m->pos, n, &m->joint_damage[j], m->joint_slip + 3 * (size_t)j,
+                                     fa, &e);
         acc[1] += e.stored;
         acc[2] += e.dissipated;
         acc[3] += e.handed;

@@ -100,6 +100,15 @@ static void kernel_resultant(const double pos[18], const double fa[9], double F[
     }
 }
 
+/* joint_tet_forces for a joint whose points kept no slip, evaluated on its
+ * own (the slip it would keep is dropped). */
+static int forces_fresh(const joint_law *law, const double pos[18], double *damage, double fa[9],
+                        joint_energy *e)
+{
+    joint_slip slip[3] = {{{0, 0}, 0}, {{0, 0}, 0}, {{0, 0}, 0}};
+    return joint_tet_forces(law, pos, six, damage, slip, fa, e);
+}
+
 static void check_close3(const double got[3], const double want[3], double rel, const char *what)
 {
     double diff[3] = {got[0] - want[0], got[1] - want[1], got[2] - want[2]};
@@ -123,7 +132,7 @@ static void elastic_joint_integrates_its_traction(void)
     place_pair(R, shift, gap_mixed, pos);
     double damage = 0;
     joint_energy e = {0};
-    CHECK(joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e) == 1, "joint broke");
+    CHECK(forces_fresh(&law, pos, &damage, fa, &e) == 1, "joint broke");
     CHECK(damage == 0, "an elastic joint was damaged: %g", damage);
     kernel_resultant(pos, fa, F, M);
     face_integral(pos, 1, Fw, Mw);
@@ -160,7 +169,7 @@ static void damaged_open_joint_integrates_softened_traction(void)
     place_pair(R, shift, gap_open, pos);
     double damage = 0.4;
     joint_energy e = {0};
-    joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e);
+    forces_fresh(&law, pos, &damage, fa, &e);
     CHECK(damage == 0.4, "damage moved to %g", damage);
     CHECK(e.dissipated == 0, "dissipated %g without damage growth", e.dissipated);
     kernel_resultant(pos, fa, F, M);
@@ -174,19 +183,13 @@ static void damaged_open_joint_integrates_softened_traction(void)
 static void rigid_motion_gives_no_force(void)
 {
     joint_law law = law_of();
-    double R[9], pos[18], fa[9], vel[18];
+    double R[9], pos[18], fa[9];
     static const double none[9] = {0};
     rotation(axis, 2.3, R);
     place_pair(R, shift, none, pos);
-    /* a rigid spin about the axis plus a drift, the same for both faces */
-    double omega[3] = {30, -20, 10}, drift[3] = {1, 2, -3};
-    for (int i = 0; i < 6; i++) {
-        cross(omega, pos + 3 * i, vel + 3 * i);
-        for (int c = 0; c < 3; c++) vel[3 * i + c] += drift[c];
-    }
     double damage = 0.3;
     joint_energy e = {0};
-    joint_tet_forces(&law, pos, vel, 1e-7, six, &damage, fa, &e);
+    forces_fresh(&law, pos, &damage, fa, &e);
     double largest = 0;
     for (int k = 0; k < 9; k++) largest = fmax(largest, fabs(fa[k]));
     CHECK(largest == 0, "rigid motion: force %g N", largest);
@@ -199,11 +202,11 @@ static void rigid_motion_gives_no_force(void)
     double pos0[18], fa0[9], R2[9], pos1[18], fa1[9];
     place_pair(ident, zero, gap_mixed, pos0);
     damage = 0;
-    joint_tet_forces(&law, pos0, NULL, 0, six, &damage, fa0, &e);
+    forces_fresh(&law, pos0, &damage, fa0, &e);
     rotation(axis, 2.3, R2);
     place_pair(R2, shift, gap_mixed, pos1);
     damage = 0;
-    joint_tet_forces(&law, pos1, NULL, 0, six, &damage, fa1, &e);
+    forces_fresh(&law, pos1, &damage, fa1, &e);
     for (int i = 0; i < 3; i++) {
         double want[3];
         apply(R2, fa0 + 3 * i, want);
@@ -229,7 +232,7 @@ static void shut_part_forces_are_energy_gradient(void)
         double pos[18], fa[9], damage = 0.5;
         joint_energy e = {0};
         place_pair(R, shift, gaps[which], pos);
-        joint_tet_forces(&law, pos, NULL, 0, six, &damage, fa, &e);
+        forces_fresh(&law, pos, &damage, fa, &e);
         CHECK(damage == 0.5, "damage moved to %g", damage);
         double grad[9], h = 1e-12;
         for (int k = 0; k < 9; k++) {
@@ -238,7 +241,7 @@ static void shut_part_forces_are_energy_gradient(void)
                 pos[9 + k] = keep + (side ? h : -h);
                 double D = 0.5;
                 joint_energy es = {0};
-                joint_tet_forces(&law, pos, NULL, 0, six, &D, f_unused, &es);
+                forces_fresh(&law, pos, &D, f_unused, &es);
                 E[side] = es.stored;
             }
             pos[9 + k] = keep;
@@ -258,6 +261,7 @@ static double pull_apart(const double R[9], const double total_local[3], int ste
     double total[3], pos[18], fa[9], work = 0, prev = 0;
     apply(R, total_local, total);
     double len = norm3(total);
+    joint_slip slip[3] = {{{0, 0}, 0}, {{0, 0}, 0}, {{0, 0}, 0}};
     *damage = 0;
     *dissipated = 0;
     for (int s = 1; s <= steps; s++) {
@@ -266,7 +270,7 @@ static double pull_apart(const double R[9], const double total_local[3], int ste
             for (int c = 0; c < 3; c++) gap[3 * i + c] = f * total_local[c];
         place_pair(R, shift, gap, pos);
         joint_energy e = {0};
-        joint_tet_forces(&law, pos, NULL, 0, six, damage, fa, &e);
+        joint_tet_forces(&law, pos, six, damage, slip, fa, &e);
         *dissipated += e.dissipated;
         *last_stored = e.stored;
         double pull = 0; /* the force on A along the motion resists B's motion */
@@ -318,14 +322,14 @@ static void mode_II_dissipates_energy_II(void)
 static void sheared_under_compression_closes_the_balance(void)
 {
     joint_law law = law_of();
-    double R[9], pos[18], vel[18] = {0}, fa[9];
+    double R[9], pos[18], fa[9];
+    joint_slip slip[3] = {{{0, 0}, 0}, {{0, 0}, 0}, {{0, 0}, 0}};
     rotation(axis, 1.3, R);
     double shut = -0.5 * FT / law.k; /* sigma_c = f_t / 2 */
     double fs = COHESION + 0.5 * FT * law.tan_phi, sp = fs / law.k;
     double total = 1.5 * (sp + softening_span(fs, sp, GII)), dir[3] = {0.6, 0.8, 0}, world[3];
     apply(R, dir, world);
     int steps = 40000;
-    double h = 1.0; /* the step between evaluations: vel = increment / h */
     double damage = 0, work = 0, prev = 0, stored0 = 0, stored = 0;
     joint_energy acc = {0};
     for (int s = 0; s <= steps; s++) {
@@ -336,10 +340,8 @@ static void sheared_under_compression_closes_the_balance(void)
             gap[3 * i + 2] = shut;
         }
         place_pair(R, shift, gap, pos);
-        for (int i = 0; i < 3; i++)
-            for (int c = 0; c < 3; c++) vel[9 + 3 * i + c] = s ? world[c] * total / steps / h : 0;
         joint_energy e = {0};
-        joint_tet_forces(&law, pos, vel, h, six, &damage, fa, &e);
+        joint_tet_forces(&law, pos, six, &damage, slip, fa, &e);
         acc.dissipated += e.dissipated;
         acc.friction += e.friction;
         acc.handed += e.handed;
