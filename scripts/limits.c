@@ -13,6 +13,9 @@
  *                            joints first soften and break (centre or under
  *                            the platens)
  *   limits uniaxial < CASE   peak platen stress P/W (3D: P/(W t)), the same crack record
+ *   limits energy < CASE     the energy balance at every output time: the worst residual
+ *                            against the work put in so far, the lowest friction and
+ *                            fracture accounts, the largest kinetic energy against that work
  *
  * Both dimensions: a 3D case (tetrahedra, joints on faces) is measured the
  * same way, with the load along y and the thickness along z.
@@ -414,12 +417,74 @@ static int run_fracture(const char *kind)
     return 0;
 }
 
+/* ---------------------------------------------------------------- energy */
+
+/* The energy that went through the model by time t, the scale of its
+ * residual (as tests/unit/test_energy.c takes it): the largest of the
+ * energy it started with, the work of the loads and that of gravity. */
+static double energy_through(const fdem_model *m, const fdem_energy *e)
+{
+    return fmax(m->initial_energy, fmax(fabs(e->external_work), fabs(e->gravity_work)));
+}
+
+/* What was put in by time t: the energy it started with and the work of
+ * the loads and of gravity; no kinetic energy may exceed it. */
+static double energy_put_in(const fdem_model *m, const fdem_energy *e)
+{
+    return m->initial_energy + e->external_work + e->gravity_work;
+}
+
+static int run_energy(void)
+{
+    case_info info;
+    fdem_model *m = load_case(&info);
+    if (!m) return 1;
+    double t0 = cpu_seconds(), next = 0;
+    fdem_energy e = fdem_get_energy(m);
+    double worst = 0, worst_at = 0, least_friction = 0, least_fracture = 0, kinetic_ratio = 0;
+    double kinetic_at = 0;
+    long samples = 0;
+    for (;;) {
+        double t = fdem_get_time(m);
+        if (t >= next || t >= info.end_time) {
+            e = fdem_get_energy(m);
+            double through = energy_through(m, &e), put_in = energy_put_in(m, &e);
+            if (through > 0 && fabs(e.residual) / through > worst) {
+                worst = fabs(e.residual) / through;
+                worst_at = t;
+            }
+            if (put_in > 0 && e.kinetic / put_in > kinetic_ratio) {
+                kinetic_ratio = e.kinetic / put_in;
+                kinetic_at = t;
+            }
+            least_friction = fmin(least_friction, e.friction);
+            least_fracture = fmin(least_fracture, e.fracture);
+            samples++;
+            while (next <= t) next += info.output_interval;
+        }
+        if (t >= info.end_time) break;
+        if (step_or_report(m)) return 1;
+    }
+    printf("{\"samples\": %ld, \"worst_residual\": %.6g, \"worst_at\": %.6g, "
+           "\"least_friction\": %.6g, \"least_fracture\": %.6g, \"kinetic_over_put_in\": %.6g, \"kinetic_at\": %.6g, "
+           "\"work\": %.6g, \"kinetic\": %.6g, \"elastic\": %.6g, \"joint\": %.6g, "
+           "\"contact\": %.6g, \"friction\": %.6g, \"fracture\": %.6g, \"damping\": %.6g, "
+           "\"residual\": %.6g, \"broken\": %d, \"steps\": %lld, \"seconds\": %.3f}\n",
+           samples, worst, worst_at, least_friction, least_fracture, kinetic_ratio, kinetic_at,
+           energy_through(m, &e), e.kinetic, e.elastic, e.joint, e.contact, e.friction,
+           e.fracture, e.damping, e.residual, fdem_get_counts(m).broken_joints,
+           (long long)m->step, cpu_seconds() - t0);
+    fdem_model_destroy(m);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: limits beam|brazilian|uniaxial < CASE.json\n");
+        fprintf(stderr, "usage: limits beam|brazilian|uniaxial|energy < CASE.json\n");
         return 2;
     }
+    if (strcmp(argv[1], "energy") == 0) return run_energy();
     if (strcmp(argv[1], "beam") == 0) return run_beam();
     if (strcmp(argv[1], "brazilian") == 0 || strcmp(argv[1], "uniaxial") == 0)
         return run_fracture(argv[1]);
