@@ -31,7 +31,12 @@ typedef enum worker_exit {
 
 typedef struct worker_clock {
     double last_publish, last_checkpoint;
-    int64_t steps_at_publish;
+    /* steps_per_second is measured over windows of its own (0.2 s or 100
+     * steps): tying the publish clock to that window published nearly
+     * every step once a step took over 0.5 ms (816 energy evaluations in
+     * 1,100 steps of a 100k-element block, 9 % of the daemon's CPU) */
+    double speed_since;
+    int64_t steps_at_speed;
     double steps_per_second;
     double run_started;     /* when this run began stepping */
     double elapsed_before;  /* wall seconds spent stepping in earlier runs */
@@ -63,12 +68,13 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.dt = fdem_get_dt(m);
     fig.counts = fdem_get_counts(m);
     fig.energy = fdem_get_energy(m);
-    double wall = now - clk->last_publish;
-    if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_publish > 100))
-        clk->steps_per_second = (double)(fig.step - clk->steps_at_publish) / wall;
-    if (wall > 0.2 || fig.step - clk->steps_at_publish > 100) {
-        clk->last_publish = now;
-        clk->steps_at_publish = fig.step;
+    clk->last_publish = now;
+    double wall = now - clk->speed_since;
+    if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_speed > 100))
+        clk->steps_per_second = (double)(fig.step - clk->steps_at_speed) / wall;
+    if (wall > 0.2 || fig.step - clk->steps_at_speed > 100) {
+        clk->speed_since = now;
+        clk->steps_at_speed = fig.step;
     }
     fig.steps_per_second = running ? clk->steps_per_second : 0.0;
     fig.snapshots = -1; /* owned by the I/O thread */
@@ -301,7 +307,7 @@ static void *worker_main(void *arg)
         pthread_mutex_lock(&c->lock);
         double elapsed_before = c->fig.elapsed > 0 ? c->fig.elapsed : 0.0;
         pthread_mutex_unlock(&c->lock);
-        worker_clock clk = {now, now, fdem_get_step(c->model), 0.0, now, elapsed_before};
+        worker_clock clk = {now, now, now, fdem_get_step(c->model), 0.0, now, elapsed_before};
         case_log(c, "started at step %lld (t = %.6g of %.6g s, dt = %.3g s)",
                  (long long)fdem_get_step(c->model), fdem_get_time(c->model), c->info.end_time,
                  fdem_get_dt(c->model));
