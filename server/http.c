@@ -485,7 +485,8 @@ int http_start(const fdemd_config *cfg)
         MHD_OPTION_NOTIFY_CONNECTION, http_connection_event, NULL,
         MHD_OPTION_UNESCAPE_CALLBACK, http_unescape, NULL,
         MHD_OPTION_END);
-    gate_limits limits = {cfg->max_connections_per_ip, HTTP_CONNECTION_LIMIT, cfg->request_timeout};
+    gate_limits limits = {cfg->max_connections_per_ip, HTTP_CONNECTION_LIMIT, cfg->request_timeout,
+                          cfg->token != NULL};
     if (!http_daemon || gate_start(listen_fd, &limits, http_hand_over) != 0) {
         fprintf(stderr, "fdemd: cannot start the HTTP server\n");
         if (http_daemon)
