@@ -151,3 +151,133 @@ class TokenTest(DaemonTestCase):
         reply, _ = raw_exchange(self.d.port, b"GET /cases HTTP/1.1\r\nHost: x\r\n"
                                 b"Authorization: Bearer T\r\n\r\n")
         self.assertEqual(status_of(reply), 200, reply[:200])
+
+
+def boom_case(name="boom"):
+    """Goes non-finite within a few steps (an absurd force): a failed case."""
+    case = tiny_case(name, end=0.01, divisions=(4, 4))
+    case["constraints"].append({"box": [0.09, 0.09, 0.2, 0.2], "force": [1e300, 1e300]})
+    return case
+
+
+class ApiTest(DaemonTestCase):
+    """Answers of the routes to values a client can get wrong."""
+
+    def test_since_is_decimal_only(self):
+        # Before: strtod read "0x10" as 16 and answered 200.
+        case_id = self.d.create(tiny_case("since"))["id"]
+        for bad in ("0x10", "0X1p3", "infinity", "1_0", "0x"):
+            status, body = self.d.json("GET", "/cases/%s/events?since=%s" % (case_id, bad))
+            self.assertEqual(status, 400, (bad, body))
+            self.assertIn("decimal", body["detail"])
+        for good in ("16", "-1.5e-3", "0.25", "%2B2"):
+            status, body = self.d.json("GET", "/cases/%s/events?since=%s" % (case_id, good))
+            self.assertEqual(status, 200, (good, body))
+
+    def test_a_clone_patch_that_is_no_object_is_422(self):
+        # Before: "Malformed JSON" (400) for bodies that are valid JSON.
+        case_id = self.d.create(tiny_case("source"))["id"]
+        for patch, word in (("5", "a number"), ("null", "null"), ("[1]", "an array"),
+                            ('"x"', "a string")):
+            status, body = self.d.json("POST", "/cases/%s/clone" % case_id, patch,
+                                       headers={"Content-Type": "application/json"})
+            self.assertEqual(status, 422, (patch, body))
+            self.assertEqual(body["errors"][0]["pointer"], "")
+            self.assertIn("must be an object", body["errors"][0]["message"])
+            self.assertIn(word, body["errors"][0]["message"])
+        status, body = self.d.json("POST", "/cases/%s/clone" % case_id, "{",
+                                   headers={"Content-Type": "application/json"})
+        self.assertEqual(status, 400, body)  # malformed stays malformed
+
+    def test_state_of_a_failed_case_is_409_with_its_error(self):
+        # Before: 200, with nulls when the failure was at t = 0 (an infinite
+        # initial stress, now refused) or with the state of the last
+        # checkpoint before the failure, as if nothing had gone wrong.
+        case_id = self.d.create(boom_case(), start=True)["id"]
+        st = self.d.wait_state(case_id, "failed")
+        for route in ("state?fields=position,velocity,stress", "state", "fragments"):
+            status, body = self.d.json("GET", "/cases/%s/%s" % (case_id, route))
+            self.assertEqual(status, 409, (route, body))
+            self.assertIn("failed", body["detail"])
+            self.assertIn(st["error"], body["detail"])
+        # a finished case still answers 200 with numbers
+        done = self.d.create(tiny_case("fine", end=2e-5), start=True)["id"]
+        self.d.wait_state(done, "finished")
+        status, body = self.d.json("GET", "/cases/%s/state" % done)
+        self.assertEqual(status, 200, body)
+        self.assertNotIn(None, [x for p in body["position"] for x in p])
+
+
+MiB = 1 << 20
+
+
+class UploadBudgetTest(DaemonTestCase):
+    """Uploads over --max-memory: each costs 12 times its size while parsed
+    (memory_budget.c), so two holders of 24 MiB take 576 MiB of 600."""
+    BODY = 24 * MiB
+    DAEMON_ARGS = ("--max-memory", "600M", "--request-timeout", "60")
+
+    def ask(self):
+        """Sends the head of an upload of BODY bytes with Expect:
+        100-continue, which the daemon answers before the body either way:
+        (socket, status of that answer)."""
+        s = socket.create_connection(("127.0.0.1", self.d.port), timeout=30 * SLOW)
+        s.sendall(b"POST /cases HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                  b"Expect: 100-continue\r\nContent-Length: %d\r\n\r\n" % self.BODY)
+        head = b""
+        while b"\r\n\r\n" not in head:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            head += chunk
+        return s, status_of(head)
+
+    def test_every_refused_upload_gets_its_503(self):
+        holders = []
+        try:
+            for _ in range(2):  # each admitted (100 Continue): the budget is full
+                s, status = self.ask()
+                holders.append(s)
+                self.assertEqual(status, 100)
+                s.sendall(b"{")
+            s, status = self.ask()
+            s.close()
+            self.assertEqual(status, 503)
+            body = b"{" + b" " * (self.BODY - 2) + b"}"
+            results = [None] * 4
+
+            def upload(k):
+                # a plain client: the whole body, then the answer
+                # (http.client, curl without Expect, ...)
+                try:
+                    reply, _ = raw_exchange(self.d.port, b"POST /cases HTTP/1.1\r\nHost: x\r\n"
+                                            b"Content-Type: application/json\r\n"
+                                            b"Content-Length: %d\r\n\r\n" % len(body) + body,
+                                            timeout=60)
+                    results[k] = reply
+                except OSError as e:
+                    results[k] = repr(e).encode()
+
+            threads = [threading.Thread(target=upload, args=(k,)) for k in range(4)]
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join()
+            for reply in results:
+                self.assertEqual(status_of(reply), 503, reply[:300])
+                status, head, problem = problem_of(reply)
+                self.assertIn(b"Retry-After: ", head)
+                self.assertIn("--max-memory", problem["detail"])
+        finally:
+            for s in holders:
+                s.close()
+        # once the holders are gone, the budget is free again
+        deadline = time.monotonic() + 10 * SLOW
+        while True:
+            s, status = self.ask()
+            s.close()
+            if status == 100:
+                break
+            self.assertLess(time.monotonic(), deadline, "the budget was never given back")
+            time.sleep(0.05)
+
