@@ -43,7 +43,8 @@ static void case_read_name(case_doc *doc, const json_t *root)
              strlen(json_string_value(name)) != json_string_length(name))
         case_problem(doc, "/name", "the name must be at most %d bytes, without NUL characters",
                      CASE_NAME - 1);
-    else if (json_string_length(name) > 0)
+    else if (json_string_length(name) > 0 &&
+             case_check_name_text(doc, json_string_value(name), "/name", "the name"))
         snprintf(doc->name, sizeof doc->name, "%s", json_string_value(name));
 }
 

@@ -113,7 +113,7 @@ static void part_read_name(case_doc *doc, case_part *part, int index, const json
     } else if (json_string_length(name) == 0 || json_string_length(name) >= CASE_NAME ||
                strlen(json_string_value(name)) != json_string_length(name)) {
         case_problem(doc, at, "a part name must be 1 to %d bytes long", CASE_NAME - 1);
-    } else {
+    } else if (case_check_name_text(doc, json_string_value(name), at, "the part name")) {
         snprintf(part->name, sizeof part->name, "%s", json_string_value(name));
     }
 }

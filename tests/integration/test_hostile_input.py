@@ -281,3 +281,38 @@ class UploadBudgetTest(DaemonTestCase):
             self.assertLess(time.monotonic(), deadline, "the budget was never given back")
             time.sleep(0.05)
 
+
+class CaseTextTest(DaemonTestCase):
+    """Names with control characters."""
+
+    def problems(self, case):
+        status, body = self.d.json("POST", "/cases", case)
+        self.assertEqual(status, 422, body)
+        return {e["pointer"]: e["message"] for e in body["errors"]}
+
+    def test_control_characters_in_names_are_422(self):
+        # Before: 201; U+0001 made result.xdmf invalid XML, and a newline
+        # in a name wrote a forged line into the daemon's log.
+        forged = 'fdemd: case 0123456789abcdef "forged": finished'
+        errors = self.problems(tiny_case("x\n" + forged))
+        self.assertIn("U+000A", errors["/name"])
+        self.assertIn("control character", errors["/name"])
+        self.assertIn("U+0001", self.problems(tiny_case("a\u0001b"))["/name"])
+        self.assertIn("U+0085", self.problems(tiny_case("next\u0085line"))["/name"])
+        case = tiny_case("parts")
+        case["parts"][0]["name"] = "block\r"
+        self.assertIn("U+000D", self.problems(case)["/parts/0/name"])
+        case = tiny_case("materials")
+        case["materials"] = {"ro\u0007ck": case["materials"]["rock"]}
+        case["parts"][0]["material"] = "ro\u0007ck"
+        self.assertIn("U+0007", self.problems(case)["/materials/ro\u0007ck"])
+        with open(self.d.log_path, "rb") as f:
+            self.assertNotIn(forged.encode(), f.read())
+
+    def test_printable_names_still_make_valid_xdmf(self):
+        import xml.etree.ElementTree as ET
+        st = self.d.create(tiny_case("grès <&> \"ü\" 'é' \u2603", end=2e-5), start=True)
+        self.d.wait_state(st["id"], "finished")
+        status, _, data = self.d.request("GET", "/cases/%s/result.xdmf" % st["id"])
+        self.assertEqual(status, 200)
+        ET.fromstring(data)  # raises on invalid XML
