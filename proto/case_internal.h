@@ -210,7 +210,11 @@ void case_read_constraints(case_doc *doc, const json_t *constraints);
  * or -1 after a problem). */
 void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
                               const char *ptr);
-int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index);
+/* height: the lowest and highest node of the part (y in 2D, z in 3D); a
+ * stress not finite, or above CASE_MAX_INITIAL_STRESS, anywhere between
+ * is a problem at the value or gradient that makes it so. */
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index,
+                            const double height[2]);
 /* case_materials.c: a fracture block and its variation (zero when it has
  * none); required = 0 lets keys be absent (f keeps what it held) but wants
  * at least one. */

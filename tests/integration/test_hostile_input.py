@@ -283,7 +283,7 @@ class UploadBudgetTest(DaemonTestCase):
 
 
 class CaseTextTest(DaemonTestCase):
-    """Names with control characters."""
+    """Names with control characters, and cases that can never run."""
 
     def problems(self, case):
         status, body = self.d.json("POST", "/cases", case)
@@ -316,3 +316,38 @@ class CaseTextTest(DaemonTestCase):
         status, _, data = self.d.request("GET", "/cases/%s/result.xdmf" % st["id"])
         self.assertEqual(status, 200)
         ET.fromstring(data)  # raises on invalid XML
+
+    def test_initial_stress_not_finite_at_the_parts_extent_is_422(self):
+        # Before: 201, then failed at once with an error that blamed dt.
+        case = tiny_case("deep")
+        case["parts"][0]["initial_stress"] = {"value": [0, 0, 0], "gradient": [0, 1e308, 0],
+                                              "reference": -10}
+        message = self.problems(case)["/parts/0/initial_stress/gradient"]
+        self.assertIn("syy", message)
+        self.assertIn("inf Pa", message)
+        self.assertIn("lowest node", message)
+        case["parts"][0]["initial_stress"] = {"value": [-1e300, 0, 0]}
+        message = self.problems(case)["/parts/0/initial_stress/value"]
+        self.assertIn("sxx", message)
+        # a real in-situ stress is accepted
+        case["parts"][0]["initial_stress"] = {"value": [-1e7, -2e7, 0], "gradient": [0, 2.7e4, 0],
+                                              "reference": 0}
+        status, body = self.d.json("POST", "/cases?dry_run=true", case)
+        self.assertEqual(status, 200, body)
+
+    def test_runs_of_absurdly_many_steps_are_422(self):
+        # Before: 201; dt = 5e-324 is below the rounding of any time, so
+        # the time never advanced, and an end of 1e308 s never ends.
+        case = tiny_case("tiny-dt")
+        case["time"]["dt"] = 5e-324
+        message = self.problems(case)["/time/dt"]
+        self.assertIn("steps", message)
+        self.assertIn("at most 1e+12 steps", message)
+        self.assertIn('"auto"', message)
+        case = tiny_case("forever", end=1e308)
+        case["output"]["interval"] = 1e306
+        message = self.problems(case)["/time/end"]
+        self.assertIn("steps", message)
+        self.assertIn("use an end of at most", message)
+        status, body = self.d.json("POST", "/cases?dry_run=true", tiny_case("normal"))
+        self.assertEqual(status, 200, body)
