@@ -273,8 +273,9 @@ static void gate_admit_waiting(double now)
     }
 }
 
-/* Makes poll() report fd readable only once more than `seen` bytes are
- * queued (see the top of the file). Returns the mark now set. */
+/* Makes poll() report fd readable only once `lowat` bytes are queued (one
+ * more than were seen: see the top of the file). Returns the mark now in
+ * force (1, the default, if it could not be set). */
 static int gate_set_lowat(int fd, int lowat)
 {
     return setsockopt(fd, SOL_SOCKET, SO_RCVLOWAT, &lowat, sizeof lowat) == 0 ? lowat : 1;
