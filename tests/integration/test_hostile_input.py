@@ -8,6 +8,7 @@ import os
 import socket
 import threading
 import time
+import unittest
 
 from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
 from test_hostile_requests import raw_exchange, status_of
@@ -351,3 +352,35 @@ class CaseTextTest(DaemonTestCase):
         self.assertIn("use an end of at most", message)
         status, body = self.d.json("POST", "/cases?dry_run=true", tiny_case("normal"))
         self.assertEqual(status, 200, body)
+
+
+class LogLineTest(unittest.TestCase):
+    """Whatever text reaches the log stays on its line: a name stored by an
+    older fdemd (which took control characters) comes back at a restart."""
+
+    def test_a_stored_name_with_a_newline_is_escaped_in_the_log(self):
+        d = Daemon()
+        try:
+            d.start()
+            case_id = d.create(tiny_case("plain", end=2e-5), start=True)["id"]
+            d.wait_state(case_id, "finished")
+            self.assertEqual(d.stop()[0], 0)
+            forged = 'fdemd: case 0123456789abcdef "forged": finished'
+            path = os.path.join(d.data_dir, case_id, "status.json")
+            with open(path) as f:
+                status = json.load(f)
+            status["name"] = "older\n" + forged
+            with open(path, "w") as f:
+                json.dump(status, f)
+            d.start()
+            self.assertEqual(d.status(case_id)["state"], "finished")
+            self.assertEqual(d.stop()[0], 0)
+            with open(d.log_path, "rb") as f:
+                lines = f.read().decode(errors="replace").splitlines()
+            self.assertEqual([l for l in lines if l.startswith("fdemd: case 0123456789abcdef")],
+                             [], "a forged log line")
+            restored = [l for l in lines if case_id in l and "restored after a restart" in l]
+            self.assertEqual(len(restored), 1, lines[-10:])
+            self.assertIn('"older\\x0A' + forged + '": restored', restored[0])
+        finally:
+            d.close()
