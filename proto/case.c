@@ -43,7 +43,8 @@ static void case_read_name(case_doc *doc, const json_t *root)
              strlen(json_string_value(name)) != json_string_length(name))
         case_problem(doc, "/name", "the name must be at most %d bytes, without NUL characters",
                      CASE_NAME - 1);
-    else if (json_string_length(name) > 0)
+    else if (json_string_length(name) > 0 &&
+             case_check_name_text(doc, json_string_value(name), "/name", "the name"))
         snprintf(doc->name, sizeof doc->name, "%s", json_string_value(name));
 }
 
@@ -224,6 +225,27 @@ void case_dt_problem(case_doc *doc, double stable, const char *whose)
                  doc->safety);
 }
 
+/* time.end / dt within CASE_MAX_STEPS; else a problem at whichever of the
+ * two the user can fix: a given dt when "auto" would do, else the end. */
+static int case_check_steps(case_doc *doc, double dt, double stable)
+{
+    double steps = doc->end_time / dt, auto_dt = doc->safety * stable;
+    if (steps <= CASE_MAX_STEPS) return 0;
+    if (!doc->dt_auto && doc->end_time / auto_dt <= CASE_MAX_STEPS)
+        case_problem(doc, "/time/dt", "dt = %g s would take %.3g steps to reach time.end = %g s; "
+                                      "a case may take at most %.0e steps: use a dt of at "
+                                      "least %.4g s, or \"auto\" (%.4g s here)",
+                     dt, steps, doc->end_time, CASE_MAX_STEPS, doc->end_time / CASE_MAX_STEPS,
+                     auto_dt);
+    else
+        case_problem(doc, "/time/end", "end = %g s would take %.3g steps of %g s (the %s time "
+                                       "step); a case may take at most %.0e steps: use an end of "
+                                       "at most %.4g s",
+                     doc->end_time, steps, dt, doc->dt_auto ? "stable" : "given",
+                     CASE_MAX_STEPS, CASE_MAX_STEPS * dt);
+    return -1;
+}
+
 /* "auto" is safety x the stable step; a given dt must not exceed it. */
 static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
 {
@@ -237,6 +259,7 @@ static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
         return -1;
     }
     double dt = doc->dt_auto ? doc->safety * stable : doc->dt;
+    if (case_check_steps(doc, dt, stable) != 0) return -1;
     fdem_set_dt(model, dt);
     info->dt = dt;
     info->stable_dt = stable;

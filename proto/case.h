@@ -32,6 +32,15 @@ enum case_field {
 /* Snapshots a case may ask for, and how many an output.interval left out
  * gives (interval = time.end / CASE_DEFAULT_SNAPSHOTS). */
 #define CASE_MAX_SNAPSHOTS 1e6
+/* Steps a case may take (time.end / dt). At a million steps a second this
+ * is twelve days of one core; beyond it a run is a typo (time.end 1e308,
+ * time.dt 5e-324), and a step below the rounding of the time (about 1e-16
+ * of it) would never advance it at all. */
+#define CASE_MAX_STEPS 1e12
+/* Largest initial stress accepted, Pa: a million times the strength of any
+ * rock or steel. Above it the stress is a typo, and its square (the energy
+ * it stores) or its effect on the stable step is not finite. */
+#define CASE_MAX_INITIAL_STRESS 1e15
 #define CASE_DEFAULT_SNAPSHOTS 100
 
 typedef struct case_info {

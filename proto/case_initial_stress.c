@@ -10,6 +10,7 @@
  * reference height where value holds, since a gradient from an unstated
  * height is a guess the user did not make.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -66,10 +67,42 @@ void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *bloc
     part->has_stress0 = ok;
 }
 
-int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index)
+/* The field is linear in the height, so its extremes over the part are at
+ * its lowest and highest nodes. A gradient of 1e308 made the stress there
+ * infinite: the case was accepted and failed at once with an error that
+ * blamed the time step. Here it is a 422 at the member to change. */
+static int check_extent(case_doc *doc, const case_part *part, int i, const double height[2])
+{
+    const int count = doc->dimension == 3 ? 6 : 3;
+    static const char *const names2[] = {"sxx", "syy", "sxy"};
+    static const char *const names3[] = {"sxx", "syy", "szz", "syz", "sxz", "sxy"};
+    const char *const *names = doc->dimension == 3 ? names3 : names2;
+    for (int end = 0; end < 2; end++)
+        for (int k = 0; k < count; k++) {
+            double dh = height[end] - part->stress0_reference;
+            double s = part->stress0_value[k] + part->stress0_gradient[k] * dh;
+            if (isfinite(s) && fabs(s) <= CASE_MAX_INITIAL_STRESS) continue;
+            char ptr[CASE_POINTER];
+            snprintf(ptr, sizeof ptr, "/parts/%d/initial_stress/%s", i,
+                     part->stress0_gradient[k] != 0 ? "gradient" : "value");
+            case_problem(doc, ptr, "the initial stress %s of part \"%s\" would be %g Pa at its "
+                                   "%s node (%s = %g m, reference %g m); it must be finite and "
+                                   "at most %g Pa in size: check the units (Pa, and Pa per metre "
+                                   "for the gradient)",
+                         names[k], part->name, s, end ? "highest" : "lowest",
+                         doc->dimension == 3 ? "z" : "y", height[end],
+                         part->stress0_reference, CASE_MAX_INITIAL_STRESS);
+            return -1;
+        }
+    return 0;
+}
+
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index,
+                            const double height[2])
 {
     const case_part *part = &doc->parts[i];
     if (!part->has_stress0) return 0;
+    if (check_extent(doc, part, i, height) != 0) return -1;
     fdem_error err = {0};
     if (fdem_set_part_initial_stress(model, index, part->stress0_value, part->stress0_gradient,
                                      part->stress0_reference, &err) == 0)

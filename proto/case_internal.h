@@ -136,6 +136,13 @@ int case_read_axes(case_doc *doc, const json_t *value, const char *ptr, double *
  * dimension (per_axis > 0), a note naming "dimension". Returns buf. */
 const char *case_wrong_tuple(const case_doc *doc, const json_t *value, int per_axis, char *buf,
                              size_t size);
+/* Names (of the case, a part, a material) go into result.xdmf (XML 1.0
+ * has no form for U+0001 and its kin, not even escaped) and the daemon's
+ * log (a newline would forge a log line), so a control character in one
+ * (C0, DEL or C1) is refused: 1 when `name` is acceptable, else 0 after a
+ * problem at ptr naming the character, its byte offset and `what`. */
+int case_check_name_text(case_doc *doc, const char *name, const char *ptr, const char *what);
+
 /* "two", "three", ... for "expected an array of three numbers". */
 const char *case_count_word(int count);
 /* An integer-valued number (2 or 2.0 or 1e3) in [lo, hi]. */
@@ -203,7 +210,11 @@ void case_read_constraints(case_doc *doc, const json_t *constraints);
  * or -1 after a problem). */
 void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
                               const char *ptr);
-int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index);
+/* height: the lowest and highest node of the part (y in 2D, z in 3D); a
+ * stress not finite, or above CASE_MAX_INITIAL_STRESS, anywhere between
+ * is a problem at the value or gradient that makes it so. */
+int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index,
+                            const double height[2]);
 /* case_materials.c: a fracture block and its variation (zero when it has
  * none); required = 0 lets keys be absent (f keeps what it held) but wants
  * at least one. */

@@ -172,6 +172,7 @@ void case_read_materials(case_doc *doc, const json_t *materials)
         char ptr[CASE_POINTER];
         pointer_join(ptr, sizeof ptr, "/materials", name);
         m->name = name;
+        case_check_name_text(doc, name, ptr, "the material name");
         case_names_add(doc, &doc->material_names, name, doc->material_count - 1);
         material_read(doc, name, value, ptr, &m->def);
     }

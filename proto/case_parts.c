@@ -113,7 +113,7 @@ static void part_read_name(case_doc *doc, case_part *part, int index, const json
     } else if (json_string_length(name) == 0 || json_string_length(name) >= CASE_NAME ||
                strlen(json_string_value(name)) != json_string_length(name)) {
         case_problem(doc, at, "a part name must be 1 to %d bytes long", CASE_NAME - 1);
-    } else {
+    } else if (case_check_name_text(doc, json_string_value(name), at, "the part name")) {
         snprintf(part->name, sizeof part->name, "%s", json_string_value(name));
     }
 }
@@ -244,6 +244,21 @@ static int part_add_mesh(const case_doc *doc, fdem_model *model, case_part *part
     return fdem_add_part(model, &part->mesh, part->material, part->fracture, err);
 }
 
+/* Lowest and highest node of the part (y in 2D, z in 3D): where its
+ * initial stress field takes its extreme values. */
+static void part_height_range(const case_doc *doc, const case_part *part, double height[2])
+{
+    const int dim = doc->dimension == 3 ? 3 : 2;
+    const double *xyz = dim == 3 ? part->tet_mesh.xyz : part->mesh.xy;
+    int count = dim == 3 ? part->tet_mesh.node_count : part->mesh.node_count;
+    height[0] = height[1] = 0;
+    for (int n = 0; xyz && n < count; n++) {
+        double h = xyz[(size_t)dim * (size_t)n + (size_t)(dim - 1)];
+        if (n == 0 || h < height[0]) height[0] = h;
+        if (n == 0 || h > height[1]) height[1] = h;
+    }
+}
+
 /* Generated shapes are meshed here, after the memory check. */
 static int part_add(case_doc *doc, fdem_model *model, int i)
 {
@@ -257,6 +272,8 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
         return -1;
     }
     int index = part_add_mesh(doc, model, part, &err);
+    double height[2];
+    part_height_range(doc, part, height);
     fdem_mesh_free(&part->mesh); /* the engine keeps its own copy */
     fdem_tet_mesh_free(&part->tet_mesh);
     if (index < 0) {
@@ -270,7 +287,7 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }
-    return case_add_initial_stress(doc, model, i, index);
+    return case_add_initial_stress(doc, model, i, index, height);
 }
 
 /* Every part is meshed and checked even after one is refused, so that one

@@ -370,3 +370,20 @@ int case_check_keys(case_doc *doc, const json_t *object, const char *ptr,
     }
     return ok;
 }
+
+int case_check_name_text(case_doc *doc, const char *name, const char *ptr, const char *what)
+{
+    const unsigned char *u = (const unsigned char *)name;
+    for (size_t i = 0; u[i]; i++) {
+        unsigned code = u[i];
+        if (code == 0xC2 && u[i + 1] >= 0x80 && u[i + 1] <= 0x9F)
+            code = u[i + 1]; /* U+0080..U+009F in UTF-8 */
+        else if (code >= 0x20 && code != 0x7F)
+            continue;
+        case_problem(doc, ptr, "%s holds the control character U+%04X at byte %zu; names go "
+                               "into result.xdmf and the daemon's log, so they must be printable "
+                               "text", what, code, i);
+        return 0;
+    }
+    return 1;
+}

@@ -240,6 +240,20 @@ char *registry_clone_document(server_case *c, const char *body, size_t size, siz
         *status = 400;
         return NULL;
     }
+    /* RFC 7396 would let a number or null replace the whole document, which
+     * can never be a case; it is valid JSON, so not "Malformed JSON" but a
+     * 422 that says what a patch must be. */
+    if (!json_is_object(patch)) {
+        snprintf(p->title, sizeof p->title, "Invalid patch");
+        problems_add(p, 422, "", "a clone's body is a JSON Merge Patch of the case document, "
+                                 "which must be an object (e.g. {\"name\": \"copy\"}), not %s",
+                     json_is_null(patch) ? "null" : json_is_array(patch) ? "an array"
+                     : json_is_string(patch) ? "a string" : json_is_boolean(patch) ? "a boolean"
+                                                                          : "a number");
+        json_decref(patch);
+        *status = 422;
+        return NULL;
+    }
     *status = 500;
     json_t *doc = NULL;
     if (atomic_load(&c->deleted))

@@ -15,7 +15,8 @@
  *  - registry_clone_document(): the stored case.json of `c` with the patch
  *    merged in (RFC 7396), as text to give to registry_create() (which then
  *    validates it, with pointers into this patched document). NULL with
- *    *status 400 (patch not JSON, in `p`), 404 or 500 (err).
+ *    *status 400 (patch not JSON, in `p`), 422 (the patch is not an
+ *    object, in `p`), 404 or 500 (err).
  */
 #ifndef FDEMD_CASE_STAGES_H
 #define FDEMD_CASE_STAGES_H

@@ -255,15 +255,37 @@ int case_persist_status(server_case *c)
 
 /* ------------------------------------------------------------- the log */
 
+/* Copies `in` with every control character (C0, DEL, C1) written as
+ * \xNN or \uNNNN: a log line is one line whatever text a user put into
+ * it. Names are refused with control characters (case_check_name_text),
+ * but names stored by an older daemon and messages quoting a document
+ * still reach the log. */
+static void case_log_escape(char *out, size_t size, const char *in)
+{
+    size_t n = 0;
+    const unsigned char *u = (const unsigned char *)in;
+    for (size_t i = 0; u[i] && n + 7 < size; i++) {
+        if (u[i] == 0xC2 && u[i + 1] >= 0x80 && u[i + 1] <= 0x9F)
+            n += (size_t)snprintf(out + n, size - n, "\\u%04X", u[++i]);
+        else if (u[i] < 0x20 || u[i] == 0x7F || u[i] == '\\')
+            n += (size_t)snprintf(out + n, size - n, "\\x%02X", u[i]);
+        else
+            out[n++] = (char)u[i];
+    }
+    out[n] = '\0';
+}
+
 void case_log(server_case *c, const char *fmt, ...)
 {
-    char line[1400];
+    char line[1400], safe_line[1400], name[sizeof c->info.name * 4];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
+    case_log_escape(safe_line, sizeof safe_line, line);
+    case_log_escape(name, sizeof name, c->info.name);
     /* One fprintf per line: lines of concurrent cases never interleave. */
-    fprintf(stderr, "fdemd: case %s \"%s\": %s\n", c->id, c->info.name, line);
+    fprintf(stderr, "fdemd: case %s \"%s\": %s\n", c->id, name, safe_line);
 }
 
 void case_log_state(server_case *c, case_state state)

@@ -16,6 +16,14 @@
  * runs before it closes the socket, so a descriptor number is never reused
  * while its slot is still counted.
  *
+ * Why the gate sets SO_RCVLOWAT on a connection whose headers are not
+ * whole yet: it only peeks, so the bytes stay queued and poll() would
+ * report the socket readable again at once, for ever: one client holding
+ * half a header made this thread spin (31,800 poll+recv in 2 s, issue 30).
+ * With the low-water mark one byte above what has been seen, poll() wakes
+ * only for new bytes, a hang-up or the deadline; the mark goes back to 1
+ * before libmicrohttpd gets the socket.
+ *
  * Why a connection over its address's limit waits a moment before its 503:
  * every answer closes its connection, and a client that keeps N
  * connections busy opens the next one as soon as it has read an answer,
@@ -66,6 +74,7 @@ typedef struct gate_held {
     double accepted;
     double deadline;   /* whole headers by then; a waiting one: its 503 */
     int waiting;       /* not counted yet: its address was at its limit */
+    int lowat;         /* SO_RCVLOWAT set on it (1: the socket's default) */
 } gate_held;
 
 static struct {
@@ -159,10 +168,13 @@ static const char *gate_reason(int status)
 {
     switch (status) {
     case 400: return "Bad Request";
+    case 401: return "Unauthorized";
     case 408: return "Request Timeout";
     case 411: return "Length Required";
     case 413: return "Payload Too Large";
+    case 414: return "URI Too Long";
     case 431: return "Request Header Fields Too Large";
+    case 505: return "HTTP Version Not Supported";
     default: return "Service Unavailable";
     }
 }
@@ -190,7 +202,10 @@ static void gate_answer_and_close(int fd, int status, const char *title, const c
                      "HTTP/1.1 %d %s\r\nContent-Type: application/problem+json\r\n"
                      "Cache-Control: no-store\r\nConnection: close\r\n%s"
                      "Content-Length: %zu\r\n\r\n",
-                     status, gate_reason(status), status == 503 ? "Retry-After: 1\r\n" : "",
+                     status, gate_reason(status),
+                     status == 503   ? "Retry-After: 1\r\n"
+                     : status == 401 ? "WWW-Authenticate: Bearer realm=\"fdemd\"\r\n"
+                                     : "",
                      text ? strlen(text) : 0);
     if (send(fd, head, (size_t)n, MSG_NOSIGNAL | MSG_DONTWAIT) == n && text)
         (void)!send(fd, text, strlen(text), MSG_NOSIGNAL | MSG_DONTWAIT);
@@ -232,7 +247,7 @@ static int gate_park(int fd, const struct sockaddr_in *addr, double now)
     pthread_mutex_lock(&gate.lock);
     gate.waiting++;
     pthread_mutex_unlock(&gate.lock);
-    gate.held[gate.held_count++] = (gate_held){fd, *addr, now, now + GATE_SLOT_GRACE, 1};
+    gate.held[gate.held_count++] = (gate_held){fd, *addr, now, now + GATE_SLOT_GRACE, 1, 1};
     return 1;
 }
 
@@ -258,9 +273,18 @@ static void gate_admit_waiting(double now)
     }
 }
 
-/* Looks at what has arrived on held connection `index`; returns 1 when the
- * connection left the gate (answered, closed or handed over). */
-static int gate_examine(int index)
+/* Makes poll() report fd readable only once `lowat` bytes are queued (one
+ * more than were seen: see the top of the file). Returns the mark now in
+ * force (1, the default, if it could not be set). */
+static int gate_set_lowat(int fd, int lowat)
+{
+    return setsockopt(fd, SOL_SOCKET, SO_RCVLOWAT, &lowat, sizeof lowat) == 0 ? lowat : 1;
+}
+
+/* Looks at what has arrived on held connection `index` (poll() said
+ * `revents`); returns 1 when the connection left the gate (answered,
+ * closed or handed over). */
+static int gate_examine(int index, short revents)
 {
     static char buf[GATE_HEAD_MAX];
     gate_held h = gate.held[index];
@@ -274,18 +298,32 @@ static int gate_examine(int index)
     }
     size_t end = http_frame_head_end(buf, (size_t)n);
     if (!end) {
-        if ((size_t)n < sizeof buf) return 0;
+        if ((size_t)n < sizeof buf && !(revents & (POLLRDHUP | POLLHUP | POLLERR))) {
+            gate.held[index].lowat = gate_set_lowat(h.fd, (int)n + 1);
+            return 0;
+        }
         gate_release(index);
-        gate_answer_and_close(h.fd, 431, "Request header fields too large",
-                              "the request line and headers exceed 32 KiB");
+        if ((size_t)n < sizeof buf) /* no more can come: the client shut its side */
+            gate_answer_and_close(h.fd, 400, "Bad request",
+                                  "the connection was closed before the request headers "
+                                  "were complete");
+        else
+            gate_answer_and_close(h.fd, 431, "Request header fields too large",
+                                  "the request line and headers exceed 32 KiB");
         return 1;
     }
     http_frame_verdict v;
     gate_release(index);
     if (http_frame_check(buf, end, &v)) {
-        gate_answer_and_close(h.fd, v.status, v.title, v.detail);
+        if (v.nul_in_credentials && gate.limits.token)
+            gate_answer_and_close(h.fd, 401, "Unauthorized",
+                                  "the Authorization header holds a NUL byte, so it is no "
+                                  "bearer token of this daemon");
+        else
+            gate_answer_and_close(h.fd, v.status, v.title, v.detail);
         return 1;
     }
+    if (h.lowat != 1) gate_set_lowat(h.fd, 1);
     /* on failure the new owner has closed the socket without telling us */
     if (!gate.hand_over(h.fd, &h.addr)) gate_closed(h.fd);
     return 1;
@@ -308,7 +346,8 @@ static void gate_accept_all(void)
                                   why ? why : "too many connections are waiting for headers");
             continue;
         }
-        gate.held[gate.held_count++] = (gate_held){fd, addr, now, now + gate.limits.timeout, 0};
+        gate.held[gate.held_count++] =
+            (gate_held){fd, addr, now, now + gate.limits.timeout, 0, 1};
     }
 }
 
@@ -342,7 +381,7 @@ static void *gate_main(void *arg)
         for (int i = 0; i < gate.held_count; i++) {
             /* a waiting connection is not read before it is counted */
             int fd = gate.held[i].waiting ? -1 : gate.held[i].fd;
-            fds[2 + i] = (struct pollfd){.fd = fd, .events = POLLIN};
+            fds[2 + i] = (struct pollfd){.fd = fd, .events = POLLIN | POLLRDHUP};
             if (gate.held[i].deadline - now < wait) wait = gate.held[i].deadline - now;
         }
         int polled = gate.held_count;
@@ -356,7 +395,7 @@ static void *gate_main(void *arg)
         if (gate.stopping) break;
         /* backwards, since gate_release() moves the last entry into i */
         for (int i = polled - 1; i >= 0; i--)
-            if (fds[2 + i].revents) gate_examine(i);
+            if (fds[2 + i].revents) gate_examine(i, fds[2 + i].revents);
         gate_cut_late(gate_now());
         gate_admit_waiting(gate_now());
         if (fds[1].revents) gate_accept_all();

@@ -8,8 +8,9 @@
  *    `total` connections, or when its address has `per_ip` and none of
  *    them closes within a quarter of a second (GATE_SLOT_GRACE); it is
  *    cut (408) when its header block is not whole `timeout` seconds after it
- *    was accepted; it is answered (400, 411, 413, 431) when the block frames
- *    its body ambiguously (http_frame.h). Every other connection is passed
+ *    was accepted; it is answered (400, 401, 411, 413, 414, 431, 505) when
+ *    the block frames its body ambiguously or is malformed (http_frame.h),
+ *    and 400 when the client shuts its side before the block is whole. Every other connection is passed
  *    to `hand_over`, which owns the socket from then on.
  *  - The owner of a handed-over connection calls gate_closed(fd) before it
  *    closes the socket, so the per-address count stays true; it may call it
@@ -29,6 +30,7 @@ typedef struct gate_limits {
     int per_ip;        /* connections per client address */
     int total;         /* connections in all, held or handed over */
     double timeout;    /* seconds for a whole request */
+    int token;         /* the daemon wants a bearer token (a NUL in one is a 401) */
 } gate_limits;
 
 int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_over);

@@ -35,6 +35,7 @@ typedef struct http_request {
     double deadline;  /* the whole request must have arrived by then */
     int answered;     /* a response was queued before the body */
     int too_large;
+    char *busy;       /* a 503 owed once the body is drained (see http_owe_busy) */
     char *body;
     size_t size, capacity, limit;
     membudget_lease lease; /* the body and what parsing it costs */
@@ -201,6 +202,25 @@ static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn, cons
 
 /* ------------------------------------------------------ request phases */
 
+/* A 503 for the memory budget is owed, not sent, to a client that is
+ * sending its body without waiting (no "Expect: 100-continue"): answering
+ * at once makes libmicrohttpd close the socket with the body unread, the
+ * kernel then resets the connection, and a client still writing its body
+ * never reads the answer (of four concurrent 60 MB uploads over the budget,
+ * two got their 503 and two a reset, issue 30). So the body is read and
+ * dropped, never held (it costs no budget), and the 503 follows it; the
+ * whole request still has --request-timeout to arrive. A client that asked
+ * for 100-continue waits for the answer, and gets it at once. Returns 1
+ * when the answer is owed. */
+static int http_owe_busy(struct MHD_Connection *conn, http_request *r, const char *detail)
+{
+    const char *expect = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
+    if (r->limit == 0 || (expect && strcasecmp(expect, "100-continue") == 0))
+        return 0;
+    r->busy = strdup(detail);
+    return r->busy != NULL;
+}
+
 /* Everything that can be decided from the request line and headers.
  * Returns 1 when a response was queued. */
 static int http_check_headers(struct MHD_Connection *conn, const char *method, http_request *r,
@@ -259,6 +279,8 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         else
             snprintf(detail, sizeof detail, "parsing a body of %s bytes would take this daemon past "
                      "its memory budget (--max-memory) now; try again later", cl);
+        if (http_owe_busy(conn, r, detail))
+            return 0;
         *rc = http_reply_unavailable(conn, detail, NULL);
         return 1;
     }
@@ -353,7 +375,7 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     if (*upload_data_size > 0) {
         if (!http_in_time(conn, r))
             return MHD_NO; /* nothing can be answered in the middle of a body */
-        if (!r->too_large && http_collect(r, upload_data, *upload_data_size) != 0)
+        if (!r->too_large && !r->busy && http_collect(r, upload_data, *upload_data_size) != 0)
             return MHD_NO;
         *upload_data_size = 0;
         return MHD_YES;
@@ -365,6 +387,8 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     if (r->too_large)
         return http_reply_problem(conn, 413, "Payload too large",
                                   "the body is longer than its Content-Length or --max-upload", NULL);
+    if (r->busy)
+        return http_reply_unavailable(conn, r->busy, NULL);
     membudget_request_enter(&r->lease);
     enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
     membudget_request_leave();
@@ -387,6 +411,7 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
     http_request *r = *req_cls;
     if (r) {
         free(r->body);
+        free(r->busy);
         membudget_release(&r->lease);
         free(r);
         *req_cls = NULL;
@@ -485,7 +510,8 @@ int http_start(const fdemd_config *cfg)
         MHD_OPTION_NOTIFY_CONNECTION, http_connection_event, NULL,
         MHD_OPTION_UNESCAPE_CALLBACK, http_unescape, NULL,
         MHD_OPTION_END);
-    gate_limits limits = {cfg->max_connections_per_ip, HTTP_CONNECTION_LIMIT, cfg->request_timeout};
+    gate_limits limits = {cfg->max_connections_per_ip, HTTP_CONNECTION_LIMIT, cfg->request_timeout,
+                          cfg->token != NULL};
     if (!http_daemon || gate_start(listen_fd, &limits, http_hand_over) != 0) {
         fprintf(stderr, "fdemd: cannot start the HTTP server\n");
         if (http_daemon)

@@ -11,6 +11,12 @@
  *    no Transfer-Encoding, and every Content-Length field is 1*DIGIT (after
  *    leading blanks) with the same value. Anything else gets a status (400,
  *    411 or 413) and a one-line reason for the client.
+ *  - It also refuses, so that libmicrohttpd never answers them itself (in
+ *    HTML, or not at all): a request line that is not METHOD SP target SP
+ *    HTTP/d.d (400) or of another version than 1.0 and 1.1 (505), more
+ *    than 64 query parameters (414) or 100 header fields (431), a header
+ *    line without "name:" (400), and a NUL byte anywhere (400, with
+ *    nul_in_credentials set when it is in the Authorization field).
  */
 #ifndef FDEMD_HTTP_FRAME_H
 #define FDEMD_HTTP_FRAME_H
@@ -22,6 +28,7 @@ typedef struct http_frame_verdict {
     char title[48];    /* "Bad request", ... */
     char detail[200];
     long long content_length; /* the agreed value when acceptable, else -1 */
+    int nul_in_credentials;   /* the NUL refused is in the Authorization field */
 } http_frame_verdict;
 
 /* Offset just past the blank line ending the header block, or 0 if `data`

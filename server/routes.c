@@ -332,10 +332,57 @@ static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c
 /* The state at one step boundary (taken between steps of a running case,
  * rebuilt from the checkpoint of a stopped one) turned into JSON by
  * to_json: GET /state and GET /fragments share the lock and the path. */
+static int routes_all_finite(const double *v, size_t n)
+{
+    for (size_t i = 0; v && i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+static int routes_state_is_finite(const snapshot *s)
+{
+    size_t nodes = (size_t)s->dimension * (size_t)s->nodes;
+    size_t tensors = (size_t)s->stress_components * (size_t)s->elements;
+    return isfinite(s->time) && routes_all_finite(s->position, nodes) &&
+           routes_all_finite(s->velocity, nodes) && routes_all_finite(s->stress, tensors) &&
+           routes_all_finite(s->strain, tensors) && routes_all_finite(s->damage, (size_t)s->joints) &&
+           routes_all_finite(s->principal_stress, (size_t)s->dimension * (size_t)s->elements);
+}
+
+/* A failed case has no state to show: the one it failed in may be
+ * non-finite (a 200 full of nulls looked like data), and the one it could
+ * be rebuilt from is its last checkpoint, from before whatever went wrong.
+ * So it is a 409 carrying the case's own error, which says where and why;
+ * result.h5 keeps what was written. A state with non-finite numbers that
+ * is caught between two steps, before the worker marks the case failed,
+ * gets the same answer. Returns 0 when the state may be served. */
+static int routes_no_state(struct MHD_Connection *conn, server_case *c, const snapshot *s,
+                           enum MHD_Result *rc)
+{
+    char detail[sizeof c->error + 160];
+    pthread_mutex_lock(&c->lock);
+    int failed = c->state == CASE_FAILED;
+    if (failed)
+        snprintf(detail, sizeof detail, "the case failed, so it has no state to show (result.h5 "
+                 "keeps the snapshots written before): %s", c->error);
+    else
+        snprintf(detail, sizeof detail, "the state holds non-finite numbers, which JSON cannot "
+                 "carry (the solution became non-finite)");
+    pthread_mutex_unlock(&c->lock);
+    if (!failed && (!s || routes_state_is_finite(s)))
+        return 0;
+    *rc = http_reply_problem(conn, 409, failed ? "Case failed" : "State not finite", detail, NULL);
+    return 1;
+}
+
 static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_case *c,
                                            unsigned fields, json_t *(*to_json)(const snapshot *))
 {
     int status = 0;
+    enum MHD_Result rc;
+    if (routes_no_state(conn, c, NULL, &rc))
+        return rc;
     snapshot *s = case_take_state(c, fields, &status);
     if (!s && status == 503)
         return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
@@ -344,6 +391,10 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
     if (!s)
         return http_reply_problem(conn, 409, "Conflict",
                                   "the stored case could not be rebuilt to read its state", NULL);
+    if (routes_no_state(conn, c, s, &rc)) {
+        snapshot_free(s);
+        return rc;
+    }
     /* The JSON tree of a state is ~100 bytes per number: it is charged to
      * the budget, and its pages go back to the OS once it is sent off. */
     membudget_lease lease = {0};
@@ -351,7 +402,6 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
     json_t *o = to_json(s);
     membudget_meter_end();
     snapshot_free(s);
-    enum MHD_Result rc;
     if (!o && membudget_meter_refused())
         rc = http_reply_unavailable(conn, "the JSON form of this state would take the daemon past "
                                     "its memory budget (--max-memory) now", NULL);
@@ -388,6 +438,13 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
  * time it saw gets only what broke after; a step's events are written
  * together, so none of that step is missed. A case without fracture, or
  * not started, has none. */
+/* strtod() also reads hexadecimal ("0x10" is 16), "inf" and "nan"; a time
+ * in a URL is a decimal number, so anything else is refused before it. */
+static int routes_is_decimal(const char *text)
+{
+    return *text && strspn(text, "0123456789+-.eE") == strlen(text);
+}
+
 static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
 {
     const char *text = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "since");
@@ -395,11 +452,11 @@ static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
     if (text) {
         char *end = NULL;
         errno = 0;
-        since = strtod(text, &end);
-        if (!*text || *end || errno == ERANGE || !isfinite(since)) {
+        since = routes_is_decimal(text) ? strtod(text, &end) : NAN;
+        if (!end || *end || errno == ERANGE || !isfinite(since)) {
             char detail[160];
-            snprintf(detail, sizeof detail, "?since= takes a finite time in seconds; not \"%.64s\"",
-                     text);
+            snprintf(detail, sizeof detail, "?since= takes a finite decimal time in seconds "
+                     "(e.g. 0.0015 or 1.5e-3); not \"%.64s\"", text);
             return http_reply_problem(conn, 400, "Bad request", detail, NULL);
         }
     }
@@ -477,8 +534,8 @@ static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, 
     char *doc = registry_clone_document(c, body, size, &length, &p, &status, err, sizeof err);
     membudget_lease *lease = membudget_request_lease();
     enum MHD_Result rc;
-    if (!doc && status == 400)
-        rc = routes_reply_problems(conn, 400, &p, "patch");
+    if (!doc && (status == 400 || status == 422))
+        rc = routes_reply_problems(conn, status, &p, "patch");
     else if (!doc && status == 404)
         rc = routes_no_case(conn, c->id);
     else if (!doc)

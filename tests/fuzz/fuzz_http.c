@@ -79,8 +79,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *bytes, size_t size)
     int status = http_frame_check(data, head, &v);
     if (status != v.status) __builtin_trap();
     if (status) {
-        if (status != 400 && status != 411 && status != 413) __builtin_trap();
+        if (status != 400 && status != 411 && status != 413 && status != 414 && status != 431 &&
+            status != 505)
+            __builtin_trap();
         if (!v.title[0] || !v.detail[0] || v.content_length != -1) __builtin_trap();
+        if (v.nul_in_credentials && (status != 400 || !memchr(data, '\0', head))) __builtin_trap();
         return 0;
     }
     if (v.content_length < -1) __builtin_trap();

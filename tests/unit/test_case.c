@@ -441,6 +441,10 @@ static void part_flags_and_names(void)
                    "needs a \"fracture\" block in material \"steel\"");
     expect_variant("/parts/1/name", "'disc'", "/parts/1", "already used");
     expect_variant("/parts/1/name", "''", "/parts/1/name", "1 to 127 bytes");
+    /* control characters would break result.xdmf and the log (issue 30) */
+    expect_variant("/name", "'a\\u0001b'", "/name", "control character U+0001 at byte 1");
+    expect_variant("/parts/1/name", "'top\\n'", "/parts/1/name", "U+000A at byte 3");
+    expect_variant("/name", "'next\\u0085line'", "/name", "U+0085");
     /* a default name ("part1") may collide with a given one */
     json_t *doc = load(base_text);
     edit(doc, "/parts/0/name", json_string("part1"));
@@ -492,6 +496,16 @@ static void time_errors(void)
     expect_variant("/time/dt", "-1e-6", "/time/dt", "> 0");
     expect_variant("/time/safety", "1.5", "/time/safety", "(0, 1]");
     expect_variant("/time/safety", "0", "/time/safety", "(0, 1]");
+}
+
+/* More than CASE_MAX_STEPS steps: at the member that makes them so. */
+static void absurd_step_counts(void)
+{
+    expect_variant("/time/dt", "5e-324", "/time/dt", "a dt of at least 2e-15 s");
+    json_t *doc = load(base_text);
+    edit(doc, "/time/end", json_real(1e308));
+    edit(doc, "/output/interval", json_real(1e306));
+    expect_doc(doc, GiB, 422, "/time/end", "use an end of at most");
 }
 
 /* dt above the stable step: rejected with the stable value in the message. */
@@ -715,7 +729,7 @@ CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(part_shapes), T(explicit_mesh_errors),
            T(bodies_overlapping_at_start), T(gmsh_errors), T(part_flags_and_names),
            T(constraint_errors), T(velocity_constraint_may_leave_a_component_free),
-           T(time_errors), T(dt_above_stable_step), T(output_errors),
+           T(time_errors), T(absurd_step_counts), T(dt_above_stable_step), T(output_errors),
            T(absurd_divisions_are_refused_by_size), T(memory_estimate_is_not_low),
            T(all_problems_are_collected), T(independent_problems_in_one_pass),
            T(pointer_escaping), T(many_problems_are_capped),

@@ -91,6 +91,40 @@ static void folding_and_blanks_before_colon_are_400(void)
     CHECK(verdict(POST "X-Other : fine?\r\n\r\n", &v) == 400, "any field name");
 }
 
+/* What libmicrohttpd would answer in HTML, or hold silently (issue 30). */
+static void malformed_heads_are_refused_here(void)
+{
+    http_frame_verdict v;
+    CHECK(verdict("GET /health HTTP/2.0\r\n\r\n", &v) == 505, "%d", v.status);
+    CHECK(verdict("GET /health HTTP/1.0\r\n\r\n", &v) == 0, "%s", v.detail);
+    CHECK(verdict("GARBAGE\r\n\r\n", &v) == 400, "no parts");
+    CHECK(verdict("GET  /health HTTP/1.1\r\n\r\n", &v) == 400, "double space");
+    CHECK(verdict("GET /health HTTP/1.1\r\nNoColon\r\n\r\n", &v) == 400, "field without colon");
+    CHECK(verdict("GET /health HTTP/1.1\r\n: v\r\n\r\n", &v) == 400, "empty field name");
+    char head[8192] = "GET /cases?a=1";
+    for (int i = 0; i < 64; i++) strcat(head, "&b=2");
+    strcat(head, " HTTP/1.1\r\n\r\n");
+    CHECK(verdict(head, &v) == 414 && strstr(v.detail, "65 query parameters"), "%s", v.detail);
+    snprintf(head, sizeof head, "GET /cases?a=1&b=2 HTTP/1.1\r\n");
+    for (int i = 0; i < 100; i++) strcat(head, "X-A: 1\r\n");
+    strcat(head, "\r\n");
+    CHECK(verdict(head, &v) == 0, "100 fields: %s", v.detail);
+    strcpy(head + strlen(head) - 2, "X-A: 1\r\n\r\n");
+    CHECK(verdict(head, &v) == 431, "101 fields: %d", v.status);
+}
+
+static void nul_bytes_are_refused(void)
+{
+    static const char with_token[] = "GET /cases HTTP/1.1\r\nAuthorization: Bearer T\0junk\r\n\r\n";
+    http_frame_verdict v;
+    CHECK(http_frame_check(with_token, sizeof with_token - 1, &v) == 400 && v.nul_in_credentials,
+          "in the token: %d %d", v.status, v.nul_in_credentials);
+    static const char elsewhere[] = "GET /cases HTTP/1.1\r\nX-A: \0\r\n\r\n";
+    CHECK(http_frame_check(elsewhere, sizeof elsewhere - 1, &v) == 400 && !v.nul_in_credentials,
+          "elsewhere: %d %d", v.status, v.nul_in_credentials);
+}
+
 CHECK_MAIN(T(head_end_finds_the_blank_line), T(plain_lengths_are_accepted),
            T(malformed_lengths_are_400), T(disagreeing_lengths_are_400), T(huge_lengths_are_413),
-           T(transfer_encoding_is_refused), T(folding_and_blanks_before_colon_are_400))
+           T(transfer_encoding_is_refused), T(folding_and_blanks_before_colon_are_400),
+           T(malformed_heads_are_refused_here), T(nul_bytes_are_refused))
