@@ -101,6 +101,8 @@ typedef struct server_case {
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
 
+    int stop_pending;          /* a stop is making `stopped` durable: the queue skips the
+                                  case meanwhile (`lock`) */
     int paused_by_shutdown;    /* running or queued when the daemon stopped (`lock`):
                                   status.json says so, and the restart logs it as resumed */
     int load_broken;           /* its stored files could not be loaded at start-up: they are
@@ -137,7 +139,8 @@ server_case *registry_create(const char *body, size_t size, int start, problems 
 json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_status);
 
 /* start/pause/stop: 0, or 409 (or 503: no memory for the model now) with a
- * sentence in msg. */
+ * sentence in msg; stop also 500 when `stopped` could not be stored (the
+ * case is then failed with the write error). */
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);

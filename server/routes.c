@@ -326,6 +326,8 @@ static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c
         return routes_no_case(conn, c->id);
     if (status == 503)
         return http_reply_unavailable(conn, msg, NULL);
+    if (status == 500)
+        return http_reply_problem(conn, 500, "Internal error", msg, NULL);
     return http_reply_problem(conn, (unsigned)status, "Conflict", msg, NULL);
 }
 

@@ -66,5 +66,59 @@ class SnapshotCountTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
+def busy_case(d):
+    """A case whose snapshots (~3 MB each, every 2 steps) keep the I/O
+    thread busy, so that other cases' file work waits behind them."""
+    case = tiny_case("busy", end=1.0, divisions=(200, 200))
+    st = d.create(case)
+    case["output"]["interval"] = 2 * st["dt"]
+    case["time"]["end"] = 2 * st["dt"] * 100000
+    d.request("DELETE", "/cases/" + st["id"])
+    return d.create(case)["id"]
+
+
+class StopTest(unittest.TestCase):
+    """Item 11: a stop of a case no worker runs is shown (and answered)
+    only once status.json says stopped."""
+
+    ROUNDS = int(os.environ.get("CRASH_ROUNDS", "5"))
+
+    def test_a_stop_seen_survives_sigkill(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        busy = busy_case(d)
+        turned_back = []
+        for round_ in range(self.ROUNDS):
+            st = d.json("POST", "/cases/%s/start" % busy)[1]
+            self.assertEqual(st["state"], "running", st)
+            d.wait(busy, lambda s: s["snapshots"] >= 2, timeout=60, what="busy snapshots")
+            cid = d.create(tiny_case("stopped-%d" % round_))["id"]
+            answers = []
+
+            def stop():
+                try:
+                    answers.append(d.json("POST", "/cases/%s/stop" % cid))
+                except OSError:  # the daemon was killed before it answered
+                    pass
+            stopper = threading.Thread(target=stop)
+            stopper.start()
+            deadline = time.monotonic() + 60 * SLOW
+            while d.status(cid)["state"] != "stopped":  # seen: the daemon dies at once
+                self.assertLess(time.monotonic(), deadline, "the stop never showed")
+            d.kill()
+            stopper.join()
+            d.start()
+            after = d.status(cid)
+            if after["state"] != "stopped":
+                turned_back.append((round_, after["state"], answers[0][0] if answers else None))
+            status, problem = d.json("POST", "/cases/%s/start" % cid)
+            if after["state"] == "stopped":
+                self.assertEqual(status, 409, problem)
+        self.assertEqual(turned_back, [], "rounds (round, state after restart, stop's answer "
+                         "if any) where a stop seen turned back, of %d" % self.ROUNDS)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
