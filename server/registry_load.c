@@ -15,6 +15,7 @@
 #include <sys/stat.h>
 
 #include "case_model.h"
+#include "case_stages.h"
 #include "memory_budget.h"
 #include "persist.h"
 #include "registry.h"
@@ -190,6 +191,7 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
+    registry_extend_recover(c); /* before the check: it rebuilds with the new end */
     /* A case that could not be loaded keeps its files as they are, so that
      * once the damage is mended it comes back as it was. */
     c->load_broken = case_check_stored(c) != 0;

@@ -120,5 +120,104 @@ class StopTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
+EXTEND_POINTS = ("extend:intent", "extend:case.json", "extend:result.h5", "extend:resume-point",
+                 "extend:status.json")
+OLD_END, NEW_END, INTERVAL = 0.0004, 0.001, 0.00005
+
+
+def stored_end(daemon, case_id):
+    """time.end as GET /case and result.h5's `case` attribute have it."""
+    status, doc = daemon.json("GET", "/cases/%s/case" % case_id)
+    assert status == 200, doc
+    with fetched_result(daemon, case_id) as f:
+        return doc["time"]["end"], json.loads(f.attrs["case"])["time"]["end"]
+
+
+class ExtendTest(unittest.TestCase):
+    """Item 12: an extend cut short by a crash between its writes comes
+    back whole (paused with the new end, every file agreeing) and runs on;
+    it never leaves a case that answers 409 to both extend and start."""
+
+    POINTS = tuple(p for p in os.environ.get("EXTEND_POINTS", ",".join(EXTEND_POINTS)).split(","))
+
+    def crash_extend(self, d, cid, end, point):
+        """Restarts `d` with the fault point set and asks for the extend:
+        the daemon must die there. Then restarts it plainly."""
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+        d.env = {"FDEMD_FAULT_POINT": point}
+        d.start()
+        try:
+            status, body = d.json("POST", "/cases/%s/extend" % cid, {"end": end})
+        except OSError:
+            status, body = None, None
+        code = d.proc.wait(30 * SLOW)
+        d._closed()
+        d.env = None
+        self.assertEqual((status, code), (None, -signal.SIGKILL),
+                         "the daemon did not die at %s (it answered %s %s)" % (point, status, body))
+        d.start()
+
+    def test_an_extend_of_a_finished_case_cut_short_comes_back_whole(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        # What an extend no crash interrupts gives: the series to match.
+        ref = d.create(tiny_case("reference", end=OLD_END, interval=INTERVAL), start=True)["id"]
+        d.wait_state(ref, "finished")
+        self.assertEqual(d.json("POST", "/cases/%s/extend" % ref, {"end": NEW_END})[0], 200)
+        d.json("POST", "/cases/%s/start" % ref)
+        self.assertEqual(d.wait_state(ref, ("finished", "failed"), timeout=60)["state"], "finished")
+        with fetched_result(d, ref) as f:
+            expected = list(f["/snapshots/time"][...])
+        broken = []
+        for point in self.POINTS:
+            cid = d.create(tiny_case("finished", end=OLD_END, interval=INTERVAL), start=True)["id"]
+            d.wait_state(cid, "finished")
+            self.crash_extend(d, cid, NEW_END, point)
+            st = d.status(cid)
+            ends = stored_end(d, cid)
+            if (st["state"], st["end_time"]) + ends != ("paused", NEW_END, NEW_END, NEW_END):
+                again = d.json("POST", "/cases/%s/extend" % cid, {"end": NEW_END})[0]
+                start = d.json("POST", "/cases/%s/start" % cid)[0]
+                broken.append((point, st["state"], st["end_time"]) + ends + (again, start))
+                continue
+            status, st = d.json("POST", "/cases/%s/start" % cid)
+            self.assertEqual((status, st["state"]), (200, "running"), (point, st))
+            st = d.wait_state(cid, ("finished", "failed"), timeout=60)
+            self.assertEqual((st["state"], st["time"]), ("finished", NEW_END), (point, st))
+            with fetched_result(d, cid) as f:
+                times = f["/snapshots/time"][...]
+            self.assertEqual(len(times), st["snapshots"], point)
+            self.assertEqual(list(times), expected, point)
+        self.assertEqual(broken, [], "points that left the case torn: (point, state, end_time, "
+                         "case.json end, result.h5 end, extend again, start)")
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_an_extend_of_a_paused_case_cut_short_comes_back_whole(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        broken = []
+        for point in self.POINTS:
+            cid = d.create(tiny_case("paused", end=1.0), start=True)["id"]
+            d.wait(cid, lambda s: s["step"] > 20, what="steps")
+            paused = d.json("POST", "/cases/%s/pause" % cid)[1]
+            self.assertEqual(paused["state"], "paused", paused)
+            self.crash_extend(d, cid, 2.0, point)
+            st = d.status(cid)
+            ends = stored_end(d, cid)
+            if (st["state"], st["end_time"]) + ends != ("paused", 2.0, 2.0, 2.0):
+                broken.append((point, st["state"], st["end_time"]) + ends)
+                continue
+            self.assertEqual(st["step"], paused["step"], point)
+            status, st = d.json("POST", "/cases/%s/start" % cid)
+            self.assertEqual((status, st["state"]), (200, "running"), (point, st))
+            d.wait(cid, lambda s: s["step"] > paused["step"], what="a step past the pause")
+            self.assertEqual(d.json("POST", "/cases/%s/stop" % cid)[1]["state"], "stopped")
+        self.assertEqual(broken, [], "points that left the case torn: (point, state, end_time, "
+                         "case.json end, result.h5 end)")
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
