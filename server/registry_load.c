@@ -69,16 +69,19 @@ static void case_load_figures(server_case *c, const json_t *st)
 }
 
 /* The state the case was in when the daemon stopped: a case the shutdown
- * paused was running (or queued). */
-static case_state case_load_status(server_case *c, const char *path)
+ * paused was running (or queued). A status.json that cannot be read fails
+ * the case with *broken set: the file is kept as found. */
+static case_state case_load_status(server_case *c, const char *path, int *broken)
 {
     json_error_t jerr;
     json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
     const char *state = st ? json_string_value(json_object_get(st, "state")) : NULL;
     const char *created = st ? json_string_value(json_object_get(st, "created")) : NULL;
     const char *error = st ? json_string_value(json_object_get(st, "error")) : NULL;
-    if (!st || case_state_parse(state, &c->state) != 0) {
-        case_fail_loading(c, "status.json could not be read (%s)", st ? "no valid state" : jerr.text);
+    *broken = !st || case_state_parse(state, &c->state) != 0;
+    if (*broken) {
+        case_fail_loading(c, "status.json could not be read (%s); it is kept as found",
+                          st ? "no valid state" : jerr.text);
     } else if (error) {
         snprintf(c->error, sizeof c->error, "%s", error);
     }
@@ -133,7 +136,7 @@ static int case_check_stored(server_case *c)
         broken = 1;
     } else if (rc == CASE_MODEL_OK) {
         if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0) {
-            case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+            case_fail_loading(c, "%s", err);
             broken = 1;
         }
         case_finish_if_at_end(c);
@@ -186,7 +189,8 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
         case_release(c);
         return NULL;
     }
-    case_state stored = case_load_status(c, path);
+    int status_broken = 0;
+    case_state stored = case_load_status(c, path, &status_broken);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
@@ -194,7 +198,7 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
     registry_extend_recover(c); /* before the check: it rebuilds with the new end */
     /* A case that could not be loaded keeps its files as they are, so that
      * once the damage is mended it comes back as it was. */
-    c->load_broken = case_check_stored(c) != 0;
+    c->load_broken = status_broken || case_check_stored(c) != 0;
     if (!c->load_broken)
         case_persist_status(c);
     persist_reserve(c->dir);

@@ -219,5 +219,63 @@ class ExtendTest(unittest.TestCase):
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
+class DamagedFilesTest(unittest.TestCase):
+    """Item 13: a damaged result.h5 or status.json of a paused case is kept
+    as found, the case failed naming the file, and putting the good file
+    back brings the case back as it was (as for a damaged checkpoint)."""
+
+    def paused_case(self, d, snapshots=6):
+        cid = d.create(tiny_case("paused", end=10.0, interval=2e-5), start=True)["id"]
+        d.wait(cid, lambda s: s["snapshots"] >= snapshots, what="%d snapshots" % snapshots)
+        paused = d.json("POST", "/cases/%s/pause" % cid)[1]
+        self.assertEqual(paused["state"], "paused", paused)
+        return cid, paused
+
+    def check_kept(self, name, damage, words):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        cid, paused = self.paused_case(d)
+        d.kill()
+        path = os.path.join(d.data_dir, cid, name)
+        with open(path, "rb") as f:
+            good = f.read()
+        damaged = damage(good)
+        with open(path, "wb") as f:
+            f.write(damaged)
+        d.start()
+        st = d.status(cid)
+        with open(path, "rb") as f:
+            found = f.read()
+        self.assertEqual((st["state"], found == damaged), ("failed", True),
+                         "%s of a case paused at step %d with %d snapshots: now %s at step %d "
+                         "with %d snapshots, the damaged file %s"
+                         % (name, paused["step"], paused["snapshots"], st["state"], st["step"],
+                            st["snapshots"], "kept" if found == damaged else "replaced"))
+        for word in words:
+            self.assertIn(word, st["error"])
+        self.assertEqual(d.json("POST", "/cases/%s/start" % cid)[0], 409)
+        d.kill()  # and once more: still kept
+        d.start()
+        self.assertEqual(d.status(cid)["state"], "failed")
+        with open(path, "rb") as f:
+            self.assertEqual(f.read(), damaged)
+        d.kill()
+        with open(path, "wb") as f:  # mended: the case is back as it was
+            f.write(good)
+        d.start()
+        st = d.status(cid)
+        self.assertEqual((st["state"], st["step"], st["snapshots"]),
+                         ("paused", paused["step"], paused["snapshots"]), st)
+        self.assertEqual(snapshot_count(d, cid), paused["snapshots"])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+    def test_a_damaged_result_file_of_a_paused_case_is_kept(self):
+        self.check_kept("result.h5", lambda good: good[:len(good) // 2], ["result.h5"])
+
+    def test_a_damaged_status_of_a_paused_case_is_kept(self):
+        self.check_kept("status.json", lambda good: b"\x00\x01" + good[2:], ["status.json"])
+
+
 if __name__ == "__main__":
     unittest.main()
