@@ -736,6 +736,7 @@ void registry_shutdown(void)
     pthread_mutex_lock(&reg_lock);
     reg_shutting_down = 1;
     pthread_mutex_unlock(&reg_lock);
+    registry_stop_checks(); /* it finishes the case it is checking */
     int count = 0;
     server_case **cases = registry_list(&count);
     for (int i = 0; i < count; i++) {
@@ -750,7 +751,9 @@ void registry_shutdown(void)
         membudget_lease unreserve = case_take_reserve_locked(c);
         pthread_mutex_unlock(&c->lock);
         membudget_release(&unreserve);
-        if (!c->load_broken) /* one that could not be loaded keeps its files as found */
+        /* one that could not be loaded keeps its files as found; one not
+         * checked yet keeps the status.json it was loaded from */
+        if (!c->load_broken && !atomic_load(&c->unchecked))
             case_persist_status(c);
         io_close(c);
         pthread_mutex_unlock(&c->ctl_lock);

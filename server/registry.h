@@ -107,6 +107,9 @@ typedef struct server_case {
                                   status.json says so, and the restart logs it as resumed */
     int load_broken;           /* its stored files could not be loaded at start-up: they are
                                   kept as found (so that, mended, the case comes back) */
+    _Atomic int unchecked;     /* loaded at start-up, its stored files not checked yet: the
+                                  daemon listens first (registry_ensure_checked) */
+    case_state stored_state;   /* the state status.json had at start-up (for the log) */
 
     /* worker-private */
     int64_t resume_rows_until; /* >= 0: resumed from the step before an extended case's
@@ -115,7 +118,19 @@ typedef struct server_case {
     int64_t last_snapshot_step, last_checkpoint_step;
 } server_case;
 
+/* Lists the stored cases from their status.json; the rebuild that checks
+ * the files of a case that may run again is left to
+ * registry_check_in_background() (called once the daemon listens) or to
+ * the first request for the case, whichever comes first. */
 int registry_init(const fdemd_config *cfg);
+/* Checks every case loaded unchecked, oldest first, on a thread of its own
+ * (stopped and joined by registry_shutdown). 0, or -1 if no thread could be
+ * made (the cases are then checked as requests come). */
+int registry_check_in_background(void);
+/* A case's stored files checked now if start-up has not yet (waits for a
+ * check in progress): every request on one case calls it first, so it
+ * never acts on files a crash left uncut. */
+void registry_ensure_checked(server_case *c);
 const fdemd_config *registry_config(void);
 void registry_shutdown(void);  /* pauses running cases, closes results */
 

@@ -40,5 +40,7 @@ int case_persist_status_as(server_case *c, case_state state, char *ended, size_t
  * holds no acknowledged case. */
 server_case *registry_load_case(const fdemd_config *cfg, const char *id);
 void registry_sweep_half_made(const fdemd_config *cfg, const char *name);
+/* Stops the background check and waits for it (registry_shutdown). */
+void registry_stop_checks(void);
 
 #endif

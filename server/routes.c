@@ -537,6 +537,7 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
     server_case *c = registry_find(m->id);
     if (!c)
         return routes_no_case(conn, m->id);
+    registry_ensure_checked(c);
     enum MHD_Result rc = route_case(conn, c, m->kind, method, body, body_size);
     case_release(c);
     return rc;

@@ -277,5 +277,64 @@ class DamagedFilesTest(unittest.TestCase):
         self.check_kept("status.json", lambda good: b"\x00\x01" + good[2:], ["status.json"])
 
 
+class ListenFirstTest(unittest.TestCase):
+    """Item 14: a restart listens before it rebuilds the stored cases that
+    may run again (three 384k-tetrahedron cases kept it unreachable for
+    17 s). A case whose case.json is a FIFO makes its rebuild wait until
+    the test writes to it: a daemon that rebuilt before listening never
+    came up; now it answers, and a request for another case checks that
+    case at once."""
+
+    def test_the_daemon_answers_while_a_stored_case_is_being_checked(self):
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        slow = d.create(tiny_case("slow", end=10.0, interval=2e-5), start=True)["id"]
+        other = d.create(tiny_case("other", end=10.0, interval=2e-5), start=True)["id"]
+        for cid in (slow, other):
+            d.wait(cid, lambda s: s["snapshots"] >= 2, what="snapshots")
+        d.kill()
+        fifo = os.path.join(d.data_dir, slow, "case.json")
+        with open(fifo, "rb") as f:
+            document = f.read()
+        os.unlink(fifo)
+        os.mkfifo(fifo)
+        released = []
+
+        def release():  # once the daemon has opened the FIFO to read it
+            deadline = time.monotonic() + 60 * SLOW
+            while time.monotonic() < deadline:
+                try:
+                    fd = os.open(fifo, os.O_WRONLY | os.O_NONBLOCK)
+                except OSError:  # ENXIO: no reader yet
+                    time.sleep(0.01)
+                    continue
+                os.close(fd)
+                released.append(True)
+                return
+        self.addCleanup(release)  # never leave the daemon blocked
+        d.start()
+        self.assertEqual(d.request("GET", "/health")[0], 200)
+        listed = [c["id"] for c in d.json("GET", "/cases")[1]["cases"]]
+        self.assertEqual(listed, [slow, other])
+        st = d.status(other)  # checked on the spot, not behind the blocked one
+        self.assertEqual(st["state"], "paused", st)
+        self.assertEqual(snapshot_count(d, other), st["snapshots"])
+        new = d.create(tiny_case("new", end=0.0002), start=True)["id"]
+        self.assertEqual(d.wait_state(new, ("finished", "failed"))["state"], "finished")
+        release()
+        self.assertEqual(released, [True])
+        # Its case.json was not a file: the case fails naming it, files kept.
+        st = d.wait_state(slow, "failed", timeout=60)
+        self.assertIn("case.json", st["error"])
+        os.unlink(fifo)
+        with open(fifo, "wb") as f:
+            f.write(document)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+        d.start()
+        self.assertEqual(d.status(slow)["state"], "paused")
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
