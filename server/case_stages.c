@@ -247,8 +247,13 @@ static int stages_store_extension(server_case *c, double end, case_state was, in
     }
     fault_point("extend:case.json");
     if (io_replace_document(c, text, length, err, sizeof err) != 0) {
-        case_record_io_failure(c, "result.h5", err);
-        snprintf(msg, msglen, "case.json has the new end, but result.h5 could not take it: %s", err);
+        /* Not a storage fault of a run (case_record_io_failure would fail
+         * the case's next start): the record stays, and the next extend
+         * or start-up completes it. */
+        snprintf(msg, msglen, "case.json has the new end, but result.h5 could not take it: %s; "
+                 "the extend is completed by the next extend of this case or at the daemon's "
+                 "next start", err);
+        fprintf(stderr, "fdemd: case %s: %s\n", c->id, msg);
         goto done;
     }
     fault_point("extend:result.h5");

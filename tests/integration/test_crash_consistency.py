@@ -193,6 +193,34 @@ class ExtendTest(unittest.TestCase):
                          "case.json end, result.h5 end, extend again, start)")
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
+    def test_an_extend_answered_500_half_way_is_completed_by_the_next(self):
+        """result.h5 cannot take the new document (a directory in its
+        place): 500 with case.json already rewritten. Before, the repeat
+        was 409 (\"not beyond the current end\") and so was start."""
+        d = Daemon()
+        self.addCleanup(d.close)
+        d.start()
+        cid = d.create(tiny_case("finished", end=OLD_END, interval=INTERVAL), start=True)["id"]
+        done = d.wait_state(cid, "finished")
+        path = os.path.join(d.data_dir, cid, "result.h5")
+        os.rename(path, path + ".kept")
+        os.mkdir(path)
+        status, problem = d.json("POST", "/cases/%s/extend" % cid, {"end": NEW_END})
+        self.assertEqual(status, 500, problem)
+        self.assertIn("result.h5", problem["detail"])
+        self.assertEqual(d.status(cid)["state"], "finished")
+        os.rmdir(path)
+        os.rename(path + ".kept", path)
+        status, st = d.json("POST", "/cases/%s/extend" % cid, {"end": NEW_END})
+        self.assertEqual((status, st.get("state"), st.get("end_time")), (200, "paused", NEW_END), st)
+        self.assertEqual(stored_end(d, cid), (NEW_END, NEW_END))
+        self.assertEqual(d.json("POST", "/cases/%s/start" % cid)[0], 200)
+        st = d.wait_state(cid, ("finished", "failed"), timeout=60)
+        self.assertEqual((st["state"], st["time"]), ("finished", NEW_END), st)
+        self.assertGreater(st["snapshots"], done["snapshots"])
+        self.assertEqual(snapshot_count(d, cid), st["snapshots"])
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
     def test_an_extend_of_a_paused_case_cut_short_comes_back_whole(self):
         d = Daemon()
         self.addCleanup(d.close)
