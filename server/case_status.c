@@ -236,10 +236,17 @@ static void case_status_write_failed(server_case *c, const char *reason)
 
 int case_persist_status(server_case *c)
 {
+    return case_persist_status_counting(c, -1);
+}
+
+int case_persist_status_counting(server_case *c, int snapshots)
+{
     if (atomic_load(&c->deleted))
         return 0;
     char reason[128] = "";
     json_t *o = case_status_json(c);
+    if (o && snapshots >= 0)
+        json_object_set_new(o, "snapshots", json_integer(snapshots));
     pthread_mutex_lock(&c->lock);
     int paused_by_shutdown = c->paused_by_shutdown;
     pthread_mutex_unlock(&c->lock);

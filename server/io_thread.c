@@ -214,13 +214,14 @@ static void io_do_append(io_job *j)
                             j->ckpt_size);
     /* A restart resumes at checkpoint.bin and cuts result.h5 back to it, so
      * a count shown before the checkpoint holding its row is durable is
-     * turned back by a crash: it is shown only now. After a failed write
-     * the case ends failed, keeping every row written (it is never cut
-     * back), so the count shows them too. */
+     * turned back by a crash: it is shown only now, after status.json
+     * (which a restart lists before it checks the case) has it too. After
+     * a failed write the case ends failed, keeping every row written (it
+     * is never cut back), so the count shows them too. */
+    if (j->ckpt && !atomic_load(&c->io_failed))
+        case_persist_status_counting(c, appended);
     if (appended >= 0)
         case_set_snapshots(c, appended);
-    if (j->ckpt && !atomic_load(&c->io_failed))
-        case_persist_status(c);
     pthread_mutex_lock(&c->lock);
     c->io_pending--;
     pthread_cond_broadcast(&c->cv);

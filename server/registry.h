@@ -182,6 +182,10 @@ void case_log_state(server_case *c, case_state state);
 /* Writes status.json durably; 0, or -1 after recording the failure with
  * case_record_io_failure (a case with no worker becomes failed at once). */
 int case_persist_status(server_case *c);
+/* The same with `snapshots` (>= 0) as the stored count: the I/O thread
+ * stores a new count before it shows it, so that a restart's listing,
+ * made from status.json, never shows less than a client has seen. */
+int case_persist_status_counting(server_case *c, int snapshots);
 /* Records that writing `file` of the case failed for `reason` (the first
  * failure is kept); the running case ends `failed` with this error. */
 void case_record_io_failure(server_case *c, const char *file, const char *reason);
