@@ -2,20 +2,22 @@
 (issue 30; contract 1 "Nothing that was acknowledged is lost", 5.3 extend,
 5.5). Each test SIGKILLs the real daemon at a moment a client has just
 seen something, restarts it on the same --data and checks that what was
-seen is still there: the snapshot count a status showed, a stop answered
-200, an extend interrupted between its writes (a test-only fault point,
-FDEMD_FAULT_POINT, makes the daemon kill itself there), and damaged files
-of a paused case, which are kept as found rather than replaced.
+seen is still there: the snapshot count a status showed, a stop seen as
+`stopped`, an extend interrupted between its writes (a test-only fault
+point, FDEMD_FAULT_POINT, makes the daemon kill itself there), and damaged
+files of a paused case, which are kept as found rather than replaced. A
+last test checks that a restart listens before it rebuilds stored cases.
 
-Every wait is for a state, with a generous deadline, never for wall time."""
+CRASH_ROUNDS (default 5) sets how many kills the racing tests make;
+EXTEND_POINTS (comma-separated) narrows the extend's fault points, e.g. to
+the ones a daemon without extend.json has. Every wait is for a state, with
+a generous deadline, never for wall time."""
 import json
 import os
 import signal
 import threading
 import time
 import unittest
-
-import h5py
 
 from fdemd_harness import SLOW, Daemon, fetched_result, tiny_case
 
