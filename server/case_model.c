@@ -239,8 +239,21 @@ int case_model_attach(server_case *c, fdem_model *model, const case_info *info, 
     int64_t keep = c->resume_rows_until > step ? c->resume_rows_until : step;
     if (io_reopen(c, keep, close_after, err, errlen) == 0)
         return 0;
-    fprintf(stderr, "fdemd: case %s: result.h5 could not be reopened (%s); starting a new one "
-            "from the checkpoint\n", c->id, err);
+    /* A file that is there but will not open holds the snapshots the
+     * status reported: a new one would silently drop them. It is kept as
+     * found (the case fails, as for a damaged checkpoint), so that putting
+     * a good copy back brings the case back. Only a missing one is made
+     * anew. */
+    char path[1200], why[512];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    if (lstat(path, &st) == 0 || errno != ENOENT) {
+        snprintf(why, sizeof why, "%s", err);
+        snprintf(err, errlen, "result.h5 could not be reopened (it is kept as found): %s", why);
+        return -1;
+    }
+    fprintf(stderr, "fdemd: case %s: result.h5 is missing; starting a new one from the "
+            "checkpoint\n", c->id);
     snapshot *s = snapshot_take(model, info->fields);
     if (io_create(c, s, NULL, 0, err, errlen) != 0)
         return -1;

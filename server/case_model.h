@@ -10,7 +10,9 @@
  *    are broken (err says which and why).
  *  - case_model_attach() makes a built model the case's and opens its
  *    result file at the model's step (snapshots a crash left after the
- *    checkpoint are dropped); case_model_drop() closes the result file,
+ *    checkpoint are dropped); a result.h5 that is there but cannot be
+ *    reopened is an error and is left as found (only a missing one is made
+ *    anew from the checkpoint); case_model_drop() closes the result file,
  *    frees the model and releases c->reserve.
  *  - Extend (case_stages.c): the worker keeps, besides checkpoint.bin,
  *    the state one step before the step it cut to land on time.end

@@ -20,8 +20,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "case_model.h"
+#include "fault_point.h"
 #include "io_thread.h"
 #include "json_patch.h"
 #include "persist.h"
@@ -172,14 +174,59 @@ static int stages_keep_resume_point(server_case *c, char *msg, size_t msglen)
     return 0;
 }
 
-/* Rewrites the stored files for the new end; 0 or an HTTP status. */
-static int stages_store_extension(server_case *c, double end, case_state was, problems *p,
-                                  char *msg, size_t msglen)
+/* The extend's one durable record (case_stages.h), written before any of
+ * its files changes: from then on the extend is carried out, now or, after
+ * a crash between its writes, at the next start-up. */
+#define STAGES_INTENT "extend.json"
+
+static int stages_write_intent(server_case *c, double end, char *msg, size_t msglen)
+{
+    json_t *o = json_pack("{s:f}", "end", end);
+    char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
+    json_decref(o);
+    int rc = text ? persist_write_atomic(c->dir, STAGES_INTENT, text, strlen(text)) : -1;
+    if (rc != 0)
+        snprintf(msg, msglen, "cannot store %s: %s", STAGES_INTENT,
+                 text ? strerror(errno) : "out of memory");
+    free(text);
+    return rc;
+}
+
+/* 1 with the end of an extend begun and not completed, else 0. */
+static int stages_read_intent(server_case *c, double *end)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", c->dir, STAGES_INTENT);
+    json_t *o = json_load_file(path, JSON_REJECT_DUPLICATES, NULL);
+    const json_t *v = json_object_get(o, "end");
+    int found = json_is_number(v) && isfinite(json_number_value(v));
+    if (found)
+        *end = json_number_value(v);
+    json_decref(o);
+    return found;
+}
+
+static void stages_drop_intent(server_case *c)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", c->dir, STAGES_INTENT);
+    if (unlink(path) == 0)
+        persist_fsync_dir(c->dir);
+}
+
+/* Rewrites the stored files for the new end; 0 or an HTTP status. `redo`:
+ * completing an extend whose record is already stored, so a case.json that
+ * already says `end` is left as it is and every step may be one a crash
+ * had already done. */
+static int stages_store_extension(server_case *c, double end, case_state was, int redo,
+                                  problems *p, char *msg, size_t msglen)
 {
     json_t *doc = stages_load_document(c, msg, msglen);
     if (!doc)
         return 500;
-    int status = stages_set_end(doc, end, p, msg, msglen);
+    double stored_end = json_number_value(json_object_get(json_object_get(doc, "time"), "end"));
+    int stored = redo && stored_end >= end;
+    int status = stored ? 0 : stages_set_end(doc, end, p, msg, msglen);
     size_t length = 0;
     char *text = status == 0 ? json_dump_document(doc, &length) : NULL;
     json_decref(doc);
@@ -188,25 +235,94 @@ static int stages_store_extension(server_case *c, double end, case_state was, pr
     char err[600] = "";
     if (!text) {
         snprintf(msg, msglen, "out of memory writing the case document");
-        status = 500;
-    } else if (persist_write_atomic(c->dir, "case.json", text, length) != 0) {
-        snprintf(msg, msglen, "cannot store case.json: %s", strerror(errno));
-        status = 500;
-    } else if (io_replace_document(c, text, length, err, sizeof err) != 0) {
-        case_record_io_failure(c, "result.h5", err);
-        snprintf(msg, msglen, "case.json has the new end, but result.h5 could not take it: %s", err);
-        status = 500;
-    } else if (was == CASE_FINISHED && stages_keep_resume_point(c, msg, msglen) != 0) {
-        status = 500;
+        return 500;
     }
+    status = 500;
+    if (!redo && stages_write_intent(c, end, msg, msglen) != 0)
+        goto done;
+    fault_point("extend:intent");
+    if (!stored && persist_write_atomic(c->dir, "case.json", text, length) != 0) {
+        snprintf(msg, msglen, "cannot store case.json: %s", strerror(errno));
+        goto done;
+    }
+    fault_point("extend:case.json");
+    if (io_replace_document(c, text, length, err, sizeof err) != 0) {
+        /* Not a storage fault of a run (case_record_io_failure would fail
+         * the case's next start): the record stays, and the next extend
+         * or start-up completes it. */
+        snprintf(msg, msglen, "case.json has the new end, but result.h5 could not take it: %s; "
+                 "the extend is completed by the next extend of this case or at the daemon's "
+                 "next start", err);
+        fprintf(stderr, "fdemd: case %s: %s\n", c->id, msg);
+        goto done;
+    }
+    fault_point("extend:result.h5");
+    if (was == CASE_FINISHED && stages_keep_resume_point(c, msg, msglen) != 0)
+        goto done;
+    fault_point("extend:resume-point");
+    status = 0;
+done:
     free(text);
     return status;
+}
+
+/* The case shows paused with the new end; once status.json says so the
+ * record goes. A failed status write leaves the record for a restart. */
+static void stages_settle(server_case *c, double end)
+{
+    pthread_mutex_lock(&c->lock);
+    c->info.end_time = end;
+    c->state = CASE_PAUSED;
+    c->finished_at[0] = '\0';
+    pthread_mutex_unlock(&c->lock);
+    if (case_persist_status(c) != 0)
+        return;
+    fault_point("extend:status.json");
+    stages_drop_intent(c);
+}
+
+/* Completes an extend whose record is stored (cut short by a crash, or by
+ * a failed write of an earlier request); 0, 1 when there is none, or an
+ * HTTP status with msg. */
+static int stages_complete_stored(server_case *c, double *end, char *msg, size_t msglen)
+{
+    if (!stages_read_intent(c, end))
+        return 1;
+    problems p;
+    problems_init(&p);
+    pthread_mutex_lock(&c->lock);
+    case_state was = c->state;
+    pthread_mutex_unlock(&c->lock);
+    int status = stages_store_extension(c, *end, was, 1, &p, msg, msglen);
+    if (status == 0) {
+        stages_settle(c, *end);
+        case_log(c, "completed an extend to end = %.6g s that was cut short (was %s); now "
+                 "paused", *end, case_state_name(was));
+    } else if (p.count) {
+        status = 500; /* the record holds an end the document refuses */
+        snprintf(msg, msglen, "%s", p.items[0].message);
+    }
+    problems_free(&p);
+    return status;
+}
+
+void registry_extend_recover(server_case *c)
+{
+    double end = 0;
+    char msg[640] = "";
+    if (c->state != CASE_FINISHED && c->state != CASE_PAUSED)
+        return; /* a case failed at loading keeps its files as found */
+    int status = stages_complete_stored(c, &end, msg, sizeof msg);
+    if (status > 1)
+        fprintf(stderr, "fdemd: case %s: an extend to end = %.6g s cut short by a crash could "
+                "not be completed: %s; %s is kept for the next start-up\n", c->id, end, msg,
+                STAGES_INTENT);
 }
 
 int registry_extend(server_case *c, const char *body, size_t size, problems *p, char *msg,
                     size_t msglen)
 {
-    double end = 0;
+    double end = 0, stored_end = 0;
     int status = stages_read_end(body, size, &end, p);
     if (status != 0)
         return status;
@@ -214,15 +330,22 @@ int registry_extend(server_case *c, const char *body, size_t size, problems *p, 
     case_state was;
     double old_end = c->info.end_time;
     status = stages_extendable(c, &was, msg, msglen);
-    if (status == 0)
-        status = stages_store_extension(c, end, was, p, msg, msglen);
     if (status == 0) {
-        pthread_mutex_lock(&c->lock);
-        c->info.end_time = end;
-        c->state = CASE_PAUSED;
-        c->finished_at[0] = '\0';
-        pthread_mutex_unlock(&c->lock);
-        case_persist_status(c);
+        /* An earlier request that failed half way is completed first: a
+         * repeat of it is then answered as it would have been. */
+        int left = stages_complete_stored(c, &stored_end, msg, msglen);
+        if (left == 0 && stored_end == end) {
+            pthread_mutex_unlock(&c->ctl_lock);
+            return 0;
+        }
+        status = left == 1 ? 0 : left;
+        if (left == 0)
+            status = stages_extendable(c, &was, msg, msglen);
+    }
+    if (status == 0)
+        status = stages_store_extension(c, end, was, 0, p, msg, msglen);
+    if (status == 0) {
+        stages_settle(c, end);
         case_log(c, "extended from end = %.6g s to %.6g s (was %s); now paused, start it to go on",
                  old_end, end, case_state_name(was));
     }

@@ -12,6 +12,16 @@
  *    is the same document, status.json has end_time t. Else 400/422 with
  *    `p` (pointers into the body), 404, 409 (state, or t not beyond the
  *    current end) or 500 with a sentence in msg.
+ *    The steps are made crash-atomic by one durable record written before
+ *    any of them, DIR/ID/extend.json {"end": t}: once it is stored the
+ *    extend is carried out, by this request or, after a crash between its
+ *    writes, by registry_extend_recover() at start-up (every step can be
+ *    redone); it is removed once status.json says paused with end t. An
+ *    extend that failed half way (500) is completed by the next extend.
+ *  - registry_extend_recover(): at start-up, a case loaded finished or
+ *    paused with such a record is completed (paused, end t, all files
+ *    agreeing); a step that fails again leaves the record for the next
+ *    start-up and the case as loaded.
  *  - registry_clone_document(): the stored case.json of `c` with the patch
  *    merged in (RFC 7396), as text to give to registry_create() (which then
  *    validates it, with pointers into this patched document). NULL with
@@ -27,6 +37,7 @@
 
 int registry_extend(server_case *c, const char *body, size_t size, problems *p, char *msg,
                     size_t msglen);
+void registry_extend_recover(server_case *c);
 char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
                               problems *p, int *status, char *err, size_t errlen);
 

@@ -104,6 +104,16 @@ static void io_write_checkpoint(server_case *c, const char *name, const void *ck
         case_model_forget_resume(c);
 }
 
+/* result_append() flushes HDF5's buffers to the kernel; the row is on
+ * disk, and may be counted, once the file is synced too. */
+static void io_sync_result(server_case *c)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    if (persist_fsync_path(path) != 0)
+        case_record_io_failure(c, "result.h5", strerror(errno));
+}
+
 /* Closes result.h5 after a failed write, so that what was committed stays
  * a readable file (the flags of an open SWMR writer are cleared on close). */
 static void io_close_after_failure(server_case *c)
@@ -187,22 +197,31 @@ static void io_do_append(io_job *j)
             io_close_after_failure(c);
         }
     }
+    int appended = -1;
     if (j->snap && c->result && !c->deleted && io_snapshot_is_new(c, j->snap)) {
         char err[256] = "";
         if (result_append(c->result, j->snap, err, sizeof err) != 0) {
             case_record_io_failure(c, "result.h5", err);
             io_close_after_failure(c);
         } else {
-            case_set_snapshots(c, result_snapshot_count(c->result));
+            appended = result_snapshot_count(c->result);
             io_write_xdmf(c, 0);
+            io_sync_result(c);
         }
     }
-    if (j->ckpt && !atomic_load(&c->io_failed)) {
+    if (j->ckpt && !atomic_load(&c->io_failed))
         io_write_checkpoint(c, j->ckpt_name ? j->ckpt_name : CASE_CHECKPOINT, j->ckpt,
                             j->ckpt_size);
-        if (!atomic_load(&c->io_failed))
-            case_persist_status(c);
-    }
+    /* A restart resumes at checkpoint.bin and cuts result.h5 back to it, so
+     * a count shown before the checkpoint holding its row is durable is
+     * turned back by a crash: it is shown only now, after status.json
+     * (which a restart lists before it checks the case) has it too. After
+     * a failed write the case ends failed, keeping every row written (it
+     * is never cut back), so the count shows them too. */
+    if (j->ckpt && !atomic_load(&c->io_failed))
+        case_persist_status_counting(c, appended);
+    if (appended >= 0)
+        case_set_snapshots(c, appended);
     pthread_mutex_lock(&c->lock);
     c->io_pending--;
     pthread_cond_broadcast(&c->cv);

@@ -7,6 +7,9 @@
  *    checkpoint queued with a snapshot lands on disk only after that
  *    snapshot is appended (checkpoint step <= last snapshot in result.h5,
  *    which is what result_reopen(keep_until_step) after a crash relies on).
+ *  - A snapshot's row is counted in the status (`snapshots`) only once it
+ *    and the checkpoint queued with it are fsynced: a restart cuts
+ *    result.h5 back to checkpoint.bin, so an earlier count could turn back.
  *  - io_append() and io_checkpoint() take ownership of what they are given
  *    and return at once; the other calls wait for their job (they wait on
  *    file I/O, never on a simulation step).

@@ -237,6 +237,7 @@ int main(int argc, char **argv)
     }
     printf("listening on %s:%d\n", cfg.listen_host, port);
     fflush(stdout);
+    registry_check_in_background();
 
     int sig = 0;
     while (sigwait(&stop_signals, &sig) != 0)

@@ -228,7 +228,8 @@ static server_case *registry_dispatch_one_locked(void)
     for (int i = 0; i < reg_count; i++) {
         server_case *c = reg_cases[i];
         pthread_mutex_lock(&c->lock);
-        if (c->state == CASE_QUEUED && (!next || c->queue_seq < next->queue_seq))
+        if (c->state == CASE_QUEUED && !c->stop_pending &&
+            (!next || c->queue_seq < next->queue_seq))
             next = c;
         pthread_mutex_unlock(&c->lock);
     }
@@ -496,10 +497,39 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
     return status;
 }
 
+/* A stop of a case no worker runs (created, queued, paused): `stopped` is
+ * made durable first and shown after, so a crash never brings back a
+ * startable case whose stop a client has seen. 0, or 500 with msg (the
+ * case is then failed with the write error). */
+static int case_stop_idle(server_case *c, char *msg, size_t msglen)
+{
+    io_close(c);
+    char ended[sizeof c->finished_at];
+    int written = case_persist_status_as(c, CASE_STOPPED, ended, sizeof ended) == 0;
+    membudget_lease unreserve = {0};
+    pthread_mutex_lock(&c->lock);
+    c->stop_pending = 0;
+    if (written) {
+        c->state = CASE_STOPPED;
+        if (!c->finished_at[0])
+            snprintf(c->finished_at, sizeof c->finished_at, "%s", ended);
+    } else {
+        snprintf(msg, msglen, "the stop could not be stored: %s", c->io_error);
+    }
+    if (case_state_is_terminal(c->state))
+        unreserve = case_take_reserve_locked(c);
+    case_state now = c->state;
+    pthread_mutex_unlock(&c->lock);
+    membudget_release(&unreserve);
+    case_log_state(c, now);
+    if (!written)
+        registry_dispatch(); /* a queued case that failed leaves its turn */
+    return written ? 0 : 500;
+}
+
 int registry_stop(server_case *c, char *msg, size_t msglen)
 {
-    int status = 0, close_result = 0;
-    membudget_lease unreserve = {0};
+    int status = 0, idle = 0;
     pthread_mutex_lock(&c->ctl_lock);
     pthread_mutex_lock(&c->lock);
     if (atomic_load(&c->deleted)) {
@@ -511,10 +541,8 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
             status = 409;
         }
     } else if (!case_state_is_terminal(c->state)) {
-        c->state = CASE_STOPPED;
-        case_mark_ended_locked(c, CASE_STOPPED);
-        unreserve = case_take_reserve_locked(c);
-        close_result = 1;
+        c->stop_pending = 1; /* a queued case must not start meanwhile */
+        idle = 1;
     } else {
         snprintf(msg, msglen,
                  "the case is %s; stop is allowed only when it is created, queued, running or paused",
@@ -522,13 +550,8 @@ int registry_stop(server_case *c, char *msg, size_t msglen)
         status = 409;
     }
     pthread_mutex_unlock(&c->lock);
-    membudget_release(&unreserve);
-    if (close_result)
-        io_close(c);
-    if (status == 0)
-        case_persist_status(c);
-    if (close_result)
-        case_log_state(c, CASE_STOPPED);
+    if (idle)
+        status = case_stop_idle(c, msg, msglen);
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
 }
@@ -713,6 +736,7 @@ void registry_shutdown(void)
     pthread_mutex_lock(&reg_lock);
     reg_shutting_down = 1;
     pthread_mutex_unlock(&reg_lock);
+    registry_stop_checks(); /* it finishes the case it is checking */
     int count = 0;
     server_case **cases = registry_list(&count);
     for (int i = 0; i < count; i++) {
@@ -727,7 +751,9 @@ void registry_shutdown(void)
         membudget_lease unreserve = case_take_reserve_locked(c);
         pthread_mutex_unlock(&c->lock);
         membudget_release(&unreserve);
-        if (!c->load_broken) /* one that could not be loaded keeps its files as found */
+        /* one that could not be loaded keeps its files as found; one not
+         * checked yet keeps the status.json it was loaded from */
+        if (!c->load_broken && !atomic_load(&c->unchecked))
             case_persist_status(c);
         io_close(c);
         pthread_mutex_unlock(&c->ctl_lock);

@@ -101,10 +101,15 @@ typedef struct server_case {
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
 
+    int stop_pending;          /* a stop is making `stopped` durable: the queue skips the
+                                  case meanwhile (`lock`) */
     int paused_by_shutdown;    /* running or queued when the daemon stopped (`lock`):
                                   status.json says so, and the restart logs it as resumed */
     int load_broken;           /* its stored files could not be loaded at start-up: they are
                                   kept as found (so that, mended, the case comes back) */
+    _Atomic int unchecked;     /* loaded at start-up, its stored files not checked yet: the
+                                  daemon listens first (registry_ensure_checked) */
+    case_state stored_state;   /* the state status.json had at start-up (for the log) */
 
     /* worker-private */
     int64_t resume_rows_until; /* >= 0: resumed from the step before an extended case's
@@ -113,7 +118,19 @@ typedef struct server_case {
     int64_t last_snapshot_step, last_checkpoint_step;
 } server_case;
 
+/* Lists the stored cases from their status.json; the rebuild that checks
+ * the files of a case that may run again is left to
+ * registry_check_in_background() (called once the daemon listens) or to
+ * the first request for the case, whichever comes first. */
 int registry_init(const fdemd_config *cfg);
+/* Checks every case loaded unchecked, oldest first, on a thread of its own
+ * (stopped and joined by registry_shutdown). 0, or -1 if no thread could be
+ * made (the cases are then checked as requests come). */
+int registry_check_in_background(void);
+/* A case's stored files checked now if start-up has not yet (waits for a
+ * check in progress): every request on one case calls it first, so it
+ * never acts on files a crash left uncut. */
+void registry_ensure_checked(server_case *c);
 const fdemd_config *registry_config(void);
 void registry_shutdown(void);  /* pauses running cases, closes results */
 
@@ -137,7 +154,8 @@ server_case *registry_create(const char *body, size_t size, int start, problems 
 json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_status);
 
 /* start/pause/stop: 0, or 409 (or 503: no memory for the model now) with a
- * sentence in msg. */
+ * sentence in msg; stop also 500 when `stopped` could not be stored (the
+ * case is then failed with the write error). */
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);
@@ -164,6 +182,10 @@ void case_log_state(server_case *c, case_state state);
 /* Writes status.json durably; 0, or -1 after recording the failure with
  * case_record_io_failure (a case with no worker becomes failed at once). */
 int case_persist_status(server_case *c);
+/* The same with `snapshots` (>= 0) as the stored count: the I/O thread
+ * stores a new count before it shows it, so that a restart's listing,
+ * made from status.json, never shows less than a client has seen. */
+int case_persist_status_counting(server_case *c, int snapshots);
 /* Records that writing `file` of the case failed for `reason` (the first
  * failure is kept); the running case ends `failed` with this error. */
 void case_record_io_failure(server_case *c, const char *file, const char *reason);

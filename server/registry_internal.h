@@ -29,10 +29,18 @@ void case_energy_from_json(fdem_energy *energy, const json_t *o);
  * status.json (0, or -1 with the reason). */
 json_t *case_status_json_as(server_case *c, case_state state, const char *error);
 int case_write_status_json(server_case *c, json_t *o, char *reason, size_t reason_size);
+/* Writes status.json as it will be in `state` (a terminal one with its
+ * finished_at, also copied to `ended`) while the case still shows its
+ * current state: the caller switches only once this returned 0, so no
+ * client sees a state a crash would turn back. -1 as case_persist_status
+ * (a case no worker runs is then failed with the write error). */
+int case_persist_status_as(server_case *c, case_state state, char *ended, size_t ended_size);
 
 /* registry_load.c: a stored case (a reference), or NULL when the directory
  * holds no acknowledged case. */
 server_case *registry_load_case(const fdemd_config *cfg, const char *id);
 void registry_sweep_half_made(const fdemd_config *cfg, const char *name);
+/* Stops the background check and waits for it (registry_shutdown). */
+void registry_stop_checks(void);
 
 #endif

@@ -2,7 +2,9 @@
  * registry_load.c - a stored case read back from the data directory at
  * start-up: its status.json (state, figures), a check of its stored files
  * (rebuilt once when the memory budget allows, then freed), and the sweep
- * of half-made cases.
+ * of half-made cases. The check of a case that may run again is left until
+ * the daemon listens (a thread of its own, or the first request for the
+ * case, registry_ensure_checked): a big model takes seconds to rebuild.
  *
  * Memory short for a moment never makes a case fail; a case whose files
  * cannot be loaded keeps them as found (load_broken), so that once mended
@@ -10,21 +12,27 @@
  */
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
 
 #include "case_model.h"
+#include "case_stages.h"
 #include "memory_budget.h"
 #include "persist.h"
 #include "registry.h"
 #include "registry_internal.h"
 
+/* The case lock is taken: a check runs while requests read the status. */
 static void case_fail_loading(server_case *c, const char *fmt, const char *detail)
 {
+    pthread_mutex_lock(&c->lock);
     c->state = CASE_FAILED;
     snprintf(c->error, sizeof c->error, fmt, detail);
     case_mark_ended_locked(c, CASE_FAILED);
+    pthread_mutex_unlock(&c->lock);
     fprintf(stderr, "fdemd: case %s: %s\n", c->id, c->error);
 }
 
@@ -68,16 +76,19 @@ static void case_load_figures(server_case *c, const json_t *st)
 }
 
 /* The state the case was in when the daemon stopped: a case the shutdown
- * paused was running (or queued). */
-static case_state case_load_status(server_case *c, const char *path)
+ * paused was running (or queued). A status.json that cannot be read fails
+ * the case with *broken set: the file is kept as found. */
+static case_state case_load_status(server_case *c, const char *path, int *broken)
 {
     json_error_t jerr;
     json_t *st = json_load_file(path, JSON_REJECT_DUPLICATES, &jerr);
     const char *state = st ? json_string_value(json_object_get(st, "state")) : NULL;
     const char *created = st ? json_string_value(json_object_get(st, "created")) : NULL;
     const char *error = st ? json_string_value(json_object_get(st, "error")) : NULL;
-    if (!st || case_state_parse(state, &c->state) != 0) {
-        case_fail_loading(c, "status.json could not be read (%s)", st ? "no valid state" : jerr.text);
+    *broken = !st || case_state_parse(state, &c->state) != 0;
+    if (*broken) {
+        case_fail_loading(c, "status.json could not be read (%s); it is kept as found",
+                          st ? "no valid state" : jerr.text);
     } else if (error) {
         snprintf(c->error, sizeof c->error, "%s", error);
     }
@@ -105,8 +116,10 @@ static void case_finish_if_at_end(server_case *c)
     double dt = fdem_get_dt(c->model);
     if (fdem_get_time(c->model) >= c->info.end_time - 1e-6 * dt) {
         fprintf(stderr, "fdemd: case %s: its checkpoint is at the end time; it is finished\n", c->id);
+        pthread_mutex_lock(&c->lock);
         c->state = CASE_FINISHED;
         case_mark_ended_locked(c, CASE_FINISHED);
+        pthread_mutex_unlock(&c->lock);
     }
 }
 
@@ -132,7 +145,7 @@ static int case_check_stored(server_case *c)
         broken = 1;
     } else if (rc == CASE_MODEL_OK) {
         if (case_model_attach(c, model, &info, 1, err, sizeof err) != 0) {
-            case_fail_loading(c, "result.h5 could not be recreated: %s", err);
+            case_fail_loading(c, "%s", err);
             broken = 1;
         }
         case_finish_if_at_end(c);
@@ -185,19 +198,78 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
         case_release(c);
         return NULL;
     }
-    case_state stored = case_load_status(c, path);
+    int status_broken = 0;
+    case_state stored = case_load_status(c, path, &status_broken);
     if (!c->created[0])
         iso_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
+    registry_extend_recover(c); /* before the check: it rebuilds with the new end */
+    persist_reserve(c->dir);
+    c->stored_state = stored;
     /* A case that could not be loaded keeps its files as they are, so that
      * once the damage is mended it comes back as it was. */
-    c->load_broken = case_check_stored(c) != 0;
+    c->load_broken = status_broken;
+    if (!status_broken && !case_state_is_terminal(c->state)) {
+        atomic_store(&c->unchecked, 1); /* rebuilt once the daemon listens */
+        return c;
+    }
     if (!c->load_broken)
         case_persist_status(c);
-    persist_reserve(c->dir);
     case_log_restored(c, stored);
     return c;
+}
+
+void registry_ensure_checked(server_case *c)
+{
+    if (!atomic_load(&c->unchecked))
+        return;
+    pthread_mutex_lock(&c->ctl_lock);
+    if (atomic_load(&c->unchecked)) {
+        c->load_broken = case_check_stored(c) != 0;
+        if (!c->load_broken)
+            case_persist_status(c);
+        case_log_restored(c, c->stored_state);
+        atomic_store(&c->unchecked, 0);
+    }
+    pthread_mutex_unlock(&c->ctl_lock);
+}
+
+/* Start-up's rebuilds run here, after the daemon listens: three stored
+ * 384k-tetrahedron cases kept it unreachable for 17 s when they ran before. */
+static pthread_t check_thread;
+static int check_running;
+static atomic_int check_quit;
+
+static void *check_main(void *arg)
+{
+    (void)arg;
+    int count = 0;
+    server_case **cases = registry_list(&count);
+    for (int i = 0; cases && i < count && !atomic_load(&check_quit); i++)
+        registry_ensure_checked(cases[i]);
+    registry_list_free(cases, count);
+    return NULL;
+}
+
+int registry_check_in_background(void)
+{
+    if (pthread_create(&check_thread, NULL, check_main, NULL) != 0) {
+        fprintf(stderr, "fdemd: cannot start the thread that checks stored cases; each is "
+                "checked when it is first asked for\n");
+        return -1;
+    }
+    check_running = 1;
+    return 0;
+}
+
+void registry_stop_checks(void)
+{
+    if (!check_running)
+        return;
+    atomic_store(&check_quit, 1);
+    pthread_join(check_thread, NULL);
+    check_running = 0;
 }
 
 /* A case being created or deleted when the daemon stopped: never

@@ -326,6 +326,8 @@ static enum MHD_Result route_command(struct MHD_Connection *conn, server_case *c
         return routes_no_case(conn, c->id);
     if (status == 503)
         return http_reply_unavailable(conn, msg, NULL);
+    if (status == 500)
+        return http_reply_problem(conn, 500, "Internal error", msg, NULL);
     return http_reply_problem(conn, (unsigned)status, "Conflict", msg, NULL);
 }
 
@@ -592,6 +594,7 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
     server_case *c = registry_find(m->id);
     if (!c)
         return routes_no_case(conn, m->id);
+    registry_ensure_checked(c);
     enum MHD_Result rc = route_case(conn, c, m->kind, method, body, body_size);
     case_release(c);
     return rc;

@@ -156,7 +156,9 @@ class PersistenceTest(unittest.TestCase):
         json.dump(status, open(os.path.join(broken, "status.json"), "w"))
 
         d.start()
-        cases = {c["id"]: c for c in d.json("GET", "/cases")[1]["cases"]}
+        # GET /cases/ID waits for the case's start-up check (the list may
+        # show a case's stored status.json while it is being checked).
+        cases = {c["id"]: d.status(c["id"]) for c in d.json("GET", "/cases")[1]["cases"]}
         self.assertEqual(cases[good]["state"], "finished")
         self.assertEqual(cases["0123456789abcdef"]["state"], "failed")
         self.assertTrue(cases["0123456789abcdef"]["error"])

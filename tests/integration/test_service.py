@@ -373,6 +373,7 @@ class ServiceLogTest(unittest.TestCase):
         code, _ = self.d.stop()
         self.assertEqual(code, 0)
         self.d.start()
+        self.d.status(case_id)  # a request for the case waits for its start-up check and line
         lines = self.lines_of(case_id)
         self.assertEqual(len([line for line in lines if line.startswith("resumed")]), 1, lines)
         self.assertTrue(lines[-1].startswith("restored after a restart: paused at step %d"
