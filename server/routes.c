@@ -538,6 +538,8 @@ static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, 
         rc = routes_reply_problems(conn, status, &p, "patch");
     else if (!doc && status == 404)
         rc = routes_no_case(conn, c->id);
+    else if (!doc && status == 503)
+        rc = http_reply_unavailable(conn, err, NULL);
     else if (!doc)
         rc = http_reply_problem(conn, 500, "Internal error", err, NULL);
     else if (lease && membudget_grow(lease, membudget_upload_cost(length)) != 0)

@@ -144,5 +144,39 @@ class DeepJsonTest(DaemonTestCase):
         self.assertEqual(status, 422, body)  # read, then refused as an unknown member
 
 
+class WideCloneTest(DaemonTestCase):
+    """Within 64 levels a patch's trees and rewritten text still cost some
+    30 times its size, against 12 admitted: the clone is metered, and a
+    budget that cannot cover it answers 503 instead of growing the RSS."""
+    DAEMON_ARGS = ("--max-memory", "96M")
+
+    def test_a_clone_beyond_the_budget_is_503(self):
+        pid = self.d.proc.pid
+        cid = self.d.create(tiny_case("source"))["id"]
+        idle = memory(pid)
+        patch = deep_object(40, 600000)  # ~6 MB, admitted at 72 MiB
+        status, headers, body = self.d.request("POST", "/cases/%s/clone" % cid, patch,
+                                               {"Content-Type": "application/json"})
+        peak = memory(pid)["VmHWM"]
+        print("  %.1f MB patch 40 deep, --max-memory 96M: %s, peak RSS %.1f MiB (idle %.1f MiB)"
+              % (len(patch) / 1e6, status, peak / MiB, idle["VmRSS"] / MiB))
+        self.assertEqual(status, 503, body[:300])
+        self.assertGreater(int(headers["retry-after"]), 0)
+        self.assertIn("--max-memory", json.loads(body)["detail"])
+        if RSS_MEANINGFUL:
+            self.assertLess(peak, idle["VmHWM"] + 96 * MiB + 16 * MiB, "peak RSS %.0f MiB" % (peak / MiB))
+        # The budget comes back once the refused request is done with (its
+        # lease goes when libmicrohttpd reports it complete, which may be
+        # just after the client has its answer): an ordinary clone then
+        # goes through.
+        deadline = time.monotonic() + 10 * SLOW
+        while True:
+            status, body = self.d.json("POST", "/cases/%s/clone" % cid, {"name": "copy"})
+            if status != 503 or time.monotonic() > deadline:
+                break
+            time.sleep(0.05)
+        self.assertEqual(status, 201, body)
+
+
 if __name__ == "__main__":
     unittest.main()
