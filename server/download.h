@@ -7,7 +7,9 @@
  * HTTP thread, nor the I/O thread, for the length of a copy: a running
  * case's file is copied by a thread of its own while the response streams
  * the bytes already copied, and the case's writes wait only for that copy
- * (its other requests and other cases do not wait at all).
+ * (its other requests and other cases do not wait at all). With `head`
+ * (a HEAD request) it answers the same headers, the size included, and
+ * copies nothing; a copy whose client goes away is stopped and released.
  */
 #ifndef FDEMD_DOWNLOAD_H
 #define FDEMD_DOWNLOAD_H
@@ -16,6 +18,6 @@
 
 #include "registry.h"
 
-enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c);
+enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c, int head);
 
 #endif

@@ -178,5 +178,110 @@ class WideCloneTest(DaemonTestCase):
         self.assertEqual(status, 201, body)
 
 
+def download_copies(pid):
+    """The copies (unlinked .download-N.h5 files) the daemon holds open."""
+    out = []
+    fd_dir = "/proc/%d/fd" % pid
+    for name in os.listdir(fd_dir):
+        try:
+            target = os.readlink(os.path.join(fd_dir, name))
+        except OSError:
+            continue
+        if "/.download-" in target:
+            out.append(target)
+    return out
+
+
+class DownloadCopyTest(DaemonTestCase):
+    """A download of a running case's result.h5 copies it while the case's
+    writes wait. A HEAD started a whole copy, and a GET that hung up kept
+    its copy going to the end: a case fell from 166 to 2 steps/s."""
+    # Large enough that a copy outlasts the moment its client hangs up (40
+    # of 147 MB were copied by then here), small enough to be quick: the
+    # file grows by ~3.2 MB every 8 steps while the tests run.
+    MEGABYTES = 150
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        # 80k elements, ~3.2 MB per snapshot, one snapshot every 8 steps.
+        case = tiny_case("big", end=1.0, divisions=(200, 200))
+        st = cls.d.create(case)
+        case["output"]["interval"] = 8 * st["dt"]
+        case["time"]["end"] = 8 * st["dt"] * 100000
+        cls.d.request("DELETE", "/cases/" + st["id"])
+        cls.cid = cls.d.create(case, start=True)["id"]
+        cls.d.wait(cls.cid, lambda s: s["snapshots"] * 3.2 >= cls.MEGABYTES, timeout=120,
+                   what="a big result")
+
+    @classmethod
+    def tearDownClass(cls):
+        try:
+            cls.d.request("DELETE", "/cases/" + cls.cid)
+        finally:
+            super().tearDownClass()
+
+    def steps_advance(self):
+        step = self.d.status(self.cid)["step"]
+        self.d.wait(self.cid, lambda s: s["step"] > step + 4 or s["state"] != "running",
+                    timeout=20, what="steps after step %d" % step)
+        self.assertEqual(self.d.status(self.cid)["state"], "running")
+
+    def test_head_answers_the_size_and_copies_nothing(self):
+        pid = self.d.proc.pid
+        seen, stop = [], threading.Event()
+
+        def watch():  # bounded by the stop event, set below whatever happens
+            while not stop.is_set():
+                seen.extend(download_copies(pid))
+                time.sleep(0.001)
+        watcher = threading.Thread(target=watch)
+        watcher.start()
+        try:
+            for _ in range(5):
+                conn = self.d.connection()
+                try:
+                    conn.request("HEAD", "/cases/%s/result.h5" % self.cid)
+                    resp = conn.getresponse()
+                    data = resp.read()
+                finally:
+                    conn.close()
+                self.assertEqual(resp.status, 200)
+                self.assertEqual(data, b"")
+                self.assertEqual(resp.getheader("Content-Type"), "application/x-hdf5")
+                self.assertGreater(int(resp.getheader("Content-Length")), self.MEGABYTES * 1e6 * 0.9)
+            self.steps_advance()
+        finally:
+            stop.set()
+            watcher.join()
+        print("  5 HEAD of a %d MB result.h5: copies seen %d" % (self.MEGABYTES, len(set(seen))))
+        self.assertEqual(sorted(set(seen)), [])
+
+    def test_a_get_that_hangs_up_leaves_no_copy(self):
+        pid = self.d.proc.pid
+        s = socket.create_connection(("127.0.0.1", self.d.port), timeout=30 * SLOW)
+        try:
+            s.sendall(b"GET /cases/%s/result.h5 HTTP/1.1\r\nHost: x\r\n\r\n" % self.cid.encode())
+            head = b""
+            while b"\r\n\r\n" not in head:
+                chunk = s.recv(65536)
+                if not chunk:
+                    break
+                head += chunk
+            self.assertEqual(status_of(head), 200, head[:300])
+        finally:
+            # a reset, as a client killed mid-download leaves
+            s.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, b"\x01\x00\x00\x00\x00\x00\x00\x00")
+            s.close()
+        deadline = time.monotonic() + 20 * SLOW
+        while "abandoned by its client" not in self.d.log_tail() or download_copies(pid):
+            self.assertLess(time.monotonic(), deadline, "the copy was not released: %s\n%s"
+                            % (download_copies(pid), self.d.log_tail()[-600:]))
+            time.sleep(0.02)
+        line = [l for l in self.d.log_tail().splitlines() if "abandoned by its client" in l][-1]
+        print("  " + line)
+        self.steps_advance()
+
+
 if __name__ == "__main__":
     unittest.main()
