@@ -15,7 +15,8 @@
  * copier stops at its next piece, releasing the hold and the copy's disk
  * space at once. Otherwise a GET that hung up still held the case's writes
  * for a whole copy, and a HEAD started one: a case fell from 166 to 2
- * steps/s under them (issue 30).
+ * steps/s under them (issue 30). Nor may copies take the disk space the
+ * running cases are about to write (download_headroom).
  */
 #define _GNU_SOURCE /* fallocate */
 #include "download.h"
@@ -27,13 +28,18 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "http.h"
 #include "io_thread.h"
+#include "memory_budget.h"
 #include "result.h"
 
 #define DOWNLOAD_BLOCK (256 * 1024) /* bytes per response read */
+#define DOWNLOAD_ROWS_AHEAD 8              /* snapshots of room kept per writing case */
+#define DOWNLOAD_MIN_HEADROOM ((size_t)4 << 20) /* status.json, .reserve files, slack */
 
 typedef struct download {
     server_case *c;
@@ -120,6 +126,63 @@ static void download_response_done(void *cls)
     download_unref(d);
 }
 
+static size_t download_file_size(const server_case *c, const char *name)
+{
+    char path[1200];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", c->dir, name);
+    return stat(path, &st) == 0 ? (size_t)st.st_size : 0;
+}
+
+/* Room the cases that are writing will soon need in --data: for each
+ * running or queued case, its next DOWNLOAD_ROWS_AHEAD snapshots (priced at
+ * the mean row of its result.h5 so far, mesh included, so rather more) and
+ * two checkpoints (one is written beside the other). A copy may not eat
+ * into it: nine unread copies once filled a 200 MB disk and another user's
+ * running case failed for good (issue 30). */
+static size_t download_headroom(void)
+{
+    size_t need = DOWNLOAD_MIN_HEADROOM;
+    int count = 0;
+    server_case **all = registry_list(&count);
+    for (int i = 0; all && i < count; i++) {
+        server_case *c = all[i];
+        pthread_mutex_lock(&c->lock);
+        int writing = c->state == CASE_RUNNING || c->state == CASE_QUEUED;
+        int rows = c->fig.snapshots > 0 ? c->fig.snapshots : 1;
+        pthread_mutex_unlock(&c->lock);
+        if (writing)
+            need += download_file_size(c, "result.h5") / (size_t)rows * DOWNLOAD_ROWS_AHEAD +
+                    2 * download_file_size(c, "checkpoint.bin");
+    }
+    registry_list_free(all, count);
+    return need;
+}
+
+/* 0 when a copy of `size` bytes leaves the headroom free (or cannot be
+ * made at all), else -1 with a sentence in detail: a 503, as copies are
+ * read off and released and cases end. */
+static int download_check_room(server_case *c, size_t size, char *detail, size_t detail_size)
+{
+    struct statvfs fs;
+    if (statvfs(c->dir, &fs) != 0)
+        return 0; /* the copy's own fallocate then says what is wrong */
+    size_t avail = (size_t)fs.f_bavail * (size_t)fs.f_frsize;
+    size_t headroom = download_headroom();
+    /* No room for the copy at all is the copy's own 507 (fallocate). */
+    if (avail < size || avail - size >= headroom)
+        return 0;
+    char copy[32], free_now[32], keep[32];
+    snprintf(detail, detail_size,
+             "result.h5 of case %s is being written, and the consistent copy a download needs "
+             "(%s) would leave less than the %s kept free for the running cases in the data "
+             "directory (%s free now); try again later, or once the case has ended (its file "
+             "is then sent without a copy)", c->id, membudget_describe(size, copy, sizeof copy),
+             membudget_describe(headroom, keep, sizeof keep),
+             membudget_describe(avail, free_now, sizeof free_now));
+    return -1;
+}
+
 /* An unlinked file with room for `size` bytes, so a full disk is a 507
  * now rather than a cut-off transfer later. */
 static int download_make_copy_file(server_case *c, size_t size)
@@ -165,6 +228,13 @@ static enum MHD_Result download_refuse(struct MHD_Connection *conn, server_case 
 static enum MHD_Result download_copy_and_stream(struct MHD_Connection *conn, server_case *c,
                                                 int src, size_t size)
 {
+    char detail[700];
+    if (download_check_room(c, size, detail, sizeof detail) != 0) {
+        close(src);
+        io_release_hold(c);
+        fprintf(stderr, "fdemd: case %s: download refused: %s\n", c->id, detail);
+        return http_reply_unavailable(conn, detail, NULL);
+    }
     download *d = calloc(1, sizeof *d);
     int dst = d ? download_make_copy_file(c, size) : -1;
     int saved = d ? errno : ENOMEM;

@@ -283,5 +283,46 @@ class DownloadCopyTest(DaemonTestCase):
         self.steps_advance()
 
 
+class DiskHeadroomTest(unittest.TestCase):
+    """Copies for downloads of running cases were allocated while any disk
+    space was left: nine unread ones filled a 200 MB disk and another
+    user's running case failed for good. A copy must now leave the running
+    cases room for their next snapshots and checkpoints (503 otherwise)."""
+
+    def test_a_copy_that_would_eat_the_headroom_is_503(self):
+        from test_storage_faults import daemon_on_tmpfs
+        d, _ = daemon_on_tmpfs(self, "64m")
+        # A running case that writes nothing more during the test: its next
+        # snapshot is half a minute away.
+        case = d.case_lasting(60.0, name="running", divisions=(60, 60))
+        case["output"]["interval"] = case["time"]["end"] / 2
+        cid = d.create(case, start=True)["id"]
+        d.wait(cid, lambda s: s["state"] == "running" and s["step"] > 0, what="running")
+        status, headers, _ = d.request("HEAD", "/cases/%s/result.h5" % cid)
+        self.assertEqual(status, 200)
+        size = int(headers["content-length"])
+        # Leave room for the copy and 1 MiB: the copy fits, the headroom
+        # (at least 4 MiB) does not.
+        filler = os.path.join(d.data_dir, "filler")
+        fs = os.statvfs(d.data_dir)
+        with open(filler, "wb") as f:
+            f.truncate(0)
+            os.posix_fallocate(f.fileno(), 0, fs.f_bavail * fs.f_frsize - size - MiB)
+        status, headers, body = d.request("GET", "/cases/%s/result.h5" % cid)
+        print("  GET of a %.1f MB running result.h5 with %.1f MB free: %d"
+              % (size / 1e6, (size + MiB) / 1e6, status))
+        self.assertEqual(status, 503, body[:200])
+        self.assertGreater(int(headers["retry-after"]), 0)
+        self.assertIn("kept free for the running cases", json.loads(body)["detail"])
+        self.assertEqual(d.status(cid)["state"], "running")
+        # With the room back, the download goes through whole.
+        os.unlink(filler)
+        status, headers, body = d.request("GET", "/cases/%s/result.h5" % cid)
+        self.assertEqual(status, 200)
+        self.assertGreaterEqual(len(body), size)
+        d.json("POST", "/cases/%s/stop" % cid)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
 if __name__ == "__main__":
     unittest.main()
