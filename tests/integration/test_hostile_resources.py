@@ -12,7 +12,7 @@ import threading
 import time
 import unittest
 
-from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import SLOW, TERMINAL, Daemon, DaemonTestCase, tiny_case
 from test_hostile_input import problem_of
 from test_hostile_requests import read_until_closed, status_of
 from test_memory import RSS_MEANINGFUL, memory
@@ -321,6 +321,49 @@ class DiskHeadroomTest(unittest.TestCase):
         self.assertEqual(status, 200)
         self.assertGreaterEqual(len(body), size)
         d.json("POST", "/cases/%s/stop" % cid)
+        self.assertEqual(d.stop()[0], 0, d.log_tail())
+
+
+class DiskFullRetryTest(unittest.TestCase):
+    """A case that failed only because the disk was full failed for good:
+    start was a 409 however much room was made. It now starts again from
+    its last checkpoint, as a restarted case does, and ends as the same run
+    uninterrupted would have."""
+
+    def test_a_case_failed_for_a_full_disk_starts_again_once_there_is_room(self):
+        import subprocess
+        import numpy as np
+        from test_storage_faults import daemon_on_tmpfs
+        from fdemd_harness import fetched_result
+        d, where = daemon_on_tmpfs(self, "2m")
+        # ~33 KB per snapshot: 1001 of them cannot fit in 2 MiB.
+        case = tiny_case("full", end=0.01, divisions=(20, 20), interval=1e-5)
+        cid = d.create(case, start=True)["id"]
+        st = d.wait_state(cid, ("finished", "failed", "stopped"), timeout=60)
+        self.assertEqual(st["state"], "failed", st)
+        self.assertIn("No space left on device", st["error"])
+        failed_at = st["snapshots"]
+        done = subprocess.run(["mount", "-o", "remount,size=128m", where], capture_output=True, text=True)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        status, body = d.json("POST", "/cases/%s/start" % cid)
+        print("  start of a case failed for a full disk (%d of 1001 snapshots), room made: %d"
+              % (failed_at, status))
+        self.assertEqual(status, 200, body)
+        self.assertIn(body["state"], ("running", "finished"))
+        self.assertIsNone(body["error"])
+        st = d.wait_state(cid, ("finished", "failed", "stopped"), timeout=60)
+        self.assertEqual(st["state"], "finished", (st, d.log_tail()))
+        self.assertEqual(st["snapshots"], 1001)
+        self.assertIsNone(st["error"])
+        self.assertIn("started again from its last checkpoint after failing for a full disk",
+                      d.log_tail(20000))
+        reference = d.create(dict(case, name="reference"), start=True)["id"]
+        st = d.wait_state(reference, TERMINAL, timeout=60)
+        self.assertEqual(st["state"], "finished", st)
+        with fetched_result(d, cid) as f, fetched_result(d, reference) as g:
+            self.assertEqual(f["/snapshots/time"].shape[0], 1001)
+            self.assertTrue(np.array_equal(f["/snapshots/step"][...], g["/snapshots/step"][...]))
+            self.assertTrue(np.array_equal(f["/snapshots/position"][...], g["/snapshots/position"][...]))
         self.assertEqual(d.stop()[0], 0, d.log_tail())
 
 
