@@ -321,8 +321,6 @@ static void case_wait_worker_locked(server_case *c)
         pthread_cond_wait(&c->cv, &c->lock);
 }
 
-/* 0 when `c` may start now, else 404 or 409 with a sentence in msg. With
- * the registry lock and the case lock held. */
 /* A case that failed only because a write found the disk full: nothing is
  * wrong with it, and its last checkpoint and the rows before it are intact
  * (no checkpoint follows a lost write), so it may start again from there
@@ -333,6 +331,8 @@ static int case_failed_for_room_locked(const server_case *c)
            (strstr(c->error, strerror(ENOSPC)) || strstr(c->error, strerror(EDQUOT)));
 }
 
+/* 0 when `c` may start now, else 404 or 409 with a sentence in msg. With
+ * the registry lock and the case lock held. */
 static int case_startable_locked(server_case *c, char *msg, size_t msglen)
 {
     if (atomic_load(&c->deleted))
