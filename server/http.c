@@ -369,27 +369,24 @@ static enum MHD_Result http_reply_timeout(struct MHD_Connection *conn)
     return http_reply_problem(conn, 408, "Request timeout", detail, NULL);
 }
 
-/* Only routes that take a JSON body have one by now (http_check_headers). */
-static enum MHD_Result http_handle_json_body(struct MHD_Connection *conn, http_request *r,
-                                             const char *method)
+/* Only routes that take a JSON body have one by now (http_check_headers).
+ * Returns 1 when it nests too deeply, with its 400 queued in *rc. */
+static int http_refuse_deep_json(struct MHD_Connection *conn, const http_request *r,
+                                 enum MHD_Result *rc)
 {
     int line = 0, column = 0;
-    if (json_depth_exceeds(r->body, r->size, JSON_MAX_DEPTH, &line, &column)) {
-        problems p;
-        problems_init(&p);
-        problems_add(&p, 400, "", "line %d, column %d: arrays and objects nest deeper than %d "
-                     "levels, the most this daemon reads (a case needs fewer than 10)",
-                     line, column, JSON_MAX_DEPTH);
-        char detail[160];
-        snprintf(detail, sizeof detail, "the JSON body nests deeper than %d levels", JSON_MAX_DEPTH);
-        enum MHD_Result rc = http_reply_problem(conn, 400, "JSON nested too deeply", detail, &p);
-        problems_free(&p);
-        return rc;
-    }
-    membudget_request_enter(&r->lease);
-    enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body, r->size);
-    membudget_request_leave();
-    return rc;
+    if (!json_depth_exceeds(r->body, r->size, JSON_MAX_DEPTH, &line, &column))
+        return 0;
+    problems p;
+    problems_init(&p);
+    problems_add(&p, 400, "", "line %d, column %d: arrays and objects nest deeper than %d "
+                 "levels, the most this daemon reads (a case needs fewer than 10)",
+                 line, column, JSON_MAX_DEPTH);
+    char detail[160];
+    snprintf(detail, sizeof detail, "the JSON body nests deeper than %d levels", JSON_MAX_DEPTH);
+    *rc = http_reply_problem(conn, 400, "JSON nested too deeply", detail, &p);
+    problems_free(&p);
+    return 1;
 }
 
 static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const char *url,
@@ -438,10 +435,11 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
                                   "the body is longer than its Content-Length or --max-upload", NULL);
     if (r->owed)
         return http_reply_owed(conn, r);
-    if (r->size > 0)
-        return http_handle_json_body(conn, r, method);
+    enum MHD_Result rc;
+    if (r->size > 0 && http_refuse_deep_json(conn, r, &rc))
+        return rc;
     membudget_request_enter(&r->lease);
-    enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+    rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
     membudget_request_leave();
     return rc;
 }
