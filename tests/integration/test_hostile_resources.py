@@ -1,7 +1,9 @@
 """Hostile use of resources, third review (issue 30, contract 5.5): request
 bodies no route reads, JSON nested deep enough to blow up once rewritten,
-and downloads that copy a running case's file for nobody. Each test failed
-on the code before its fix (the commit that adds it says by how much).
+downloads that copy a running case's file for nobody or into the room the
+running cases need, and cases failed for good by a full disk. Each test
+failed on the code before its fix (the commit that adds it says by how
+much).
 
 RSS is read from /proc/PID/status; sanitizer builds keep freed memory in
 quarantine, so there only the answers are checked."""
@@ -12,7 +14,7 @@ import threading
 import time
 import unittest
 
-from fdemd_harness import SLOW, TERMINAL, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import SLOW, TERMINAL, DaemonTestCase, tiny_case
 from test_hostile_input import problem_of
 from test_hostile_requests import read_until_closed, status_of
 from test_memory import RSS_MEANINGFUL, memory
