@@ -54,11 +54,20 @@ static void dump_put(dump_buffer *b, const char *s, size_t n)
         size_t cap = b->capacity ? b->capacity : 256;
         while (cap < b->length + n + 1)
             cap *= 2;
-        char *grown = realloc(b->text, cap);
+        /* jansson's allocator, so that a daemon metering jansson (its
+         * memory budget) also meters the text: a rewritten document can be
+         * many times its source. The text is still free()d as usual. */
+        json_malloc_t jmalloc;
+        json_free_t jfree;
+        json_get_alloc_funcs(&jmalloc, &jfree);
+        char *grown = jmalloc(cap);
         if (!grown) {
             b->failed = 1;
             return;
         }
+        if (b->text)
+            memcpy(grown, b->text, b->length + 1);
+        jfree(b->text);
         b->text = grown;
         b->capacity = cap;
     }

@@ -12,7 +12,10 @@
  *    real is written with the fewest digits that read back to the same
  *    double (jansson writes 17 digits: 0.1 becomes 0.10000000000000001),
  *    so a rewritten document reads like the uploaded one and gives the
- *    same numbers. malloc'd text, or NULL when memory runs out.
+ *    same numbers. The text comes from jansson's allocator (so a daemon
+ *    that meters jansson meters it too) and is free()d when that allocator
+ *    is malloc-based, as jansson's default and fdemd's meter are; NULL
+ *    when memory runs out.
  */
 #ifndef FDEM_JSON_PATCH_H
 #define FDEM_JSON_PATCH_H

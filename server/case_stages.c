@@ -26,6 +26,7 @@
 #include "fault_point.h"
 #include "io_thread.h"
 #include "json_patch.h"
+#include "memory_budget.h"
 #include "persist.h"
 #include "registry_internal.h"
 
@@ -355,7 +356,7 @@ int registry_extend(server_case *c, const char *body, size_t size, problems *p, 
 
 /* ----------------------------------------------------------------- clone */
 
-char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
+static char *stages_clone_document(server_case *c, const char *body, size_t size, size_t *length,
                               problems *p, int *status, char *err, size_t errlen)
 {
     json_t *patch = stages_parse(body, size, JSON_DECODE_ANY, p);
@@ -390,5 +391,25 @@ char *registry_clone_document(server_case *c, const char *body, size_t size, siz
     json_decref(patched);
     json_decref(doc);
     json_decref(patch);
+    return text;
+}
+
+/* The patch's tree, the stored document's, their merge and its text can
+ * be many times the patch (issue 30: a 1 MB patch became 1 GB), so all of
+ * it is metered against the request's lease; 503 when the budget refuses. */
+char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
+                              problems *p, int *status, char *err, size_t errlen)
+{
+    membudget_lease own = {0};
+    membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
+    membudget_meter_begin(lease, lease->bytes);
+    char *text = stages_clone_document(c, body, size, length, p, status, err, errlen);
+    membudget_meter_end();
+    if (!text && membudget_meter_refused()) {
+        *status = 503;
+        snprintf(err, errlen, "patching the case document would take the daemon past its "
+                 "memory budget (--max-memory) now; try again later");
+    }
+    membudget_release(&own);
     return text;
 }

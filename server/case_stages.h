@@ -26,7 +26,8 @@
  *    merged in (RFC 7396), as text to give to registry_create() (which then
  *    validates it, with pointers into this patched document). NULL with
  *    *status 400 (patch not JSON, in `p`), 422 (the patch is not an
- *    object, in `p`), 404 or 500 (err).
+ *    object, in `p`), 404, 503 (the work would pass --max-memory; it is
+ *    metered against the request's lease) or 500 (err).
  */
 #ifndef FDEMD_CASE_STAGES_H
 #define FDEMD_CASE_STAGES_H

@@ -9,6 +9,14 @@
  * releases the hold as soon as the last byte is copied, not when the
  * client has read them. The response streams from that copy as it grows,
  * so a slow client costs disk space for its copy and nothing else.
+ *
+ * A copy is for a client that reads it: a HEAD gets the size without one,
+ * and when the client goes away (libmicrohttpd drops the response) the
+ * copier stops at its next piece, releasing the hold and the copy's disk
+ * space at once. Otherwise a GET that hung up still held the case's writes
+ * for a whole copy, and a HEAD started one: a case fell from 166 to 2
+ * steps/s under them (issue 30). Nor may copies take the disk space the
+ * running cases are about to write (download_headroom).
  */
 #define _GNU_SOURCE /* fallocate */
 #include "download.h"
@@ -20,19 +28,25 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "http.h"
 #include "io_thread.h"
+#include "memory_budget.h"
 #include "result.h"
 
 #define DOWNLOAD_BLOCK (256 * 1024) /* bytes per response read */
+#define DOWNLOAD_ROWS_AHEAD 8              /* snapshots of room kept per writing case */
+#define DOWNLOAD_MIN_HEADROOM ((size_t)4 << 20) /* status.json, .reserve files, slack */
 
 typedef struct download {
     server_case *c;
     int src, dst;
     size_t size;
     atomic_int refs;           /* the copier and the response */
+    atomic_int abandoned;      /* the response is gone: nobody will read the copy */
     pthread_mutex_t lock;
     pthread_cond_t progress;
     size_t copied;             /* guarded by lock */
@@ -57,7 +71,7 @@ static void *download_copier(void *arg)
     download *d = arg;
     size_t done = 0;
     int failed = 0;
-    while (done < d->size) {
+    while (done < d->size && !atomic_load(&d->abandoned)) {
         ssize_t n = result_image_copy_step(d->src, d->dst, done, d->size);
         if (n <= 0) {
             failed = n < 0 ? errno : EIO;
@@ -71,6 +85,10 @@ static void *download_copier(void *arg)
     }
     close(d->src);
     io_release_hold(d->c);
+    if (!failed && done < d->size)
+        fprintf(stderr, "fdemd: case %s: a download of result.h5 was abandoned by its client; "
+                "its copy was stopped after %zu of %zu bytes and released\n", d->c->id, done,
+                d->size);
     if (failed) {
         fprintf(stderr, "fdemd: case %s: copying result.h5 for a download failed: %s\n", d->c->id,
                 strerror(failed));
@@ -103,7 +121,66 @@ static ssize_t download_read(void *cls, uint64_t pos, char *buf, size_t max)
 
 static void download_response_done(void *cls)
 {
-    download_unref(cls);
+    download *d = cls;
+    atomic_store(&d->abandoned, 1);
+    download_unref(d);
+}
+
+static size_t download_file_size(const server_case *c, const char *name)
+{
+    char path[1200];
+    struct stat st;
+    snprintf(path, sizeof path, "%s/%s", c->dir, name);
+    return stat(path, &st) == 0 ? (size_t)st.st_size : 0;
+}
+
+/* Room the cases that are writing will soon need in --data: for each
+ * running or queued case, its next DOWNLOAD_ROWS_AHEAD snapshots (priced at
+ * the mean row of its result.h5 so far, mesh included, so rather more) and
+ * two checkpoints (one is written beside the other). A copy may not eat
+ * into it: nine unread copies once filled a 200 MB disk and another user's
+ * running case failed for good (issue 30). */
+static size_t download_headroom(void)
+{
+    size_t need = DOWNLOAD_MIN_HEADROOM;
+    int count = 0;
+    server_case **all = registry_list(&count);
+    for (int i = 0; all && i < count; i++) {
+        server_case *c = all[i];
+        pthread_mutex_lock(&c->lock);
+        int writing = c->state == CASE_RUNNING || c->state == CASE_QUEUED;
+        int rows = c->fig.snapshots > 0 ? c->fig.snapshots : 1;
+        pthread_mutex_unlock(&c->lock);
+        if (writing)
+            need += download_file_size(c, "result.h5") / (size_t)rows * DOWNLOAD_ROWS_AHEAD +
+                    2 * download_file_size(c, "checkpoint.bin");
+    }
+    registry_list_free(all, count);
+    return need;
+}
+
+/* 0 when a copy of `size` bytes leaves the headroom free (or cannot be
+ * made at all), else -1 with a sentence in detail: a 503, as copies are
+ * read off and released and cases end. */
+static int download_check_room(server_case *c, size_t size, char *detail, size_t detail_size)
+{
+    struct statvfs fs;
+    if (statvfs(c->dir, &fs) != 0)
+        return 0; /* the copy's own fallocate then says what is wrong */
+    size_t avail = (size_t)fs.f_bavail * (size_t)fs.f_frsize;
+    size_t headroom = download_headroom();
+    /* No room for the copy at all is the copy's own 507 (fallocate). */
+    if (avail < size || avail - size >= headroom)
+        return 0;
+    char copy[32], free_now[32], keep[32];
+    snprintf(detail, detail_size,
+             "result.h5 of case %s is being written, and the consistent copy a download needs "
+             "(%s) would leave less than the %s kept free for the running cases in the data "
+             "directory (%s free now); try again later, or once the case has ended (its file "
+             "is then sent without a copy)", c->id, membudget_describe(size, copy, sizeof copy),
+             membudget_describe(headroom, keep, sizeof keep),
+             membudget_describe(avail, free_now, sizeof free_now));
+    return -1;
 }
 
 /* An unlinked file with room for `size` bytes, so a full disk is a 507
@@ -151,6 +228,13 @@ static enum MHD_Result download_refuse(struct MHD_Connection *conn, server_case 
 static enum MHD_Result download_copy_and_stream(struct MHD_Connection *conn, server_case *c,
                                                 int src, size_t size)
 {
+    char detail[700];
+    if (download_check_room(c, size, detail, sizeof detail) != 0) {
+        close(src);
+        io_release_hold(c);
+        fprintf(stderr, "fdemd: case %s: download refused: %s\n", c->id, detail);
+        return http_reply_unavailable(conn, detail, NULL);
+    }
     download *d = calloc(1, sizeof *d);
     int dst = d ? download_make_copy_file(c, size) : -1;
     int saved = d ? errno : ENOMEM;
@@ -166,6 +250,7 @@ static enum MHD_Result download_copy_and_stream(struct MHD_Connection *conn, ser
     d->dst = dst;
     d->size = size;
     atomic_init(&d->refs, 2);
+    atomic_init(&d->abandoned, 0);
     pthread_mutex_init(&d->lock, NULL);
     pthread_cond_init(&d->progress, NULL);
     struct MHD_Response *resp =
@@ -192,7 +277,7 @@ static enum MHD_Result download_copy_and_stream(struct MHD_Connection *conn, ser
     return download_queue(conn, resp);
 }
 
-enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c)
+enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c, int head)
 {
     int fd = -1, held = 0, status = 500;
     size_t size = 0;
@@ -203,7 +288,10 @@ enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c)
         return http_reply_problem(conn, (unsigned)status,
                                   status == 404 ? "Not found" : "Damaged result file", err, NULL);
     }
-    if (!held)
+    /* HEAD: the size a GET would get now; the file is never read. */
+    if (head && held)
+        io_release_hold(c);
+    if (!held || head)
         return http_reply_fd(conn, fd, size, "application/x-hdf5", "result.h5");
     return download_copy_and_stream(conn, c, fd, size);
 }

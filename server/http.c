@@ -23,6 +23,7 @@
 
 #include "memory_budget.h"
 #include "gate.h"
+#include "json_depth.h"
 #include "routes.h"
 
 #define HTTP_THREADS 4
@@ -35,7 +36,9 @@ typedef struct http_request {
     double deadline;  /* the whole request must have arrived by then */
     int answered;     /* a response was queued before the body */
     int too_large;
-    char *busy;       /* a 503 owed once the body is drained (see http_owe_busy) */
+    unsigned owed_status; /* an answer owed once the body is drained (see http_owe) */
+    const char *owed_title;
+    char *owed;           /* its detail */
     char *body;
     size_t size, capacity, limit;
     membudget_lease lease; /* the body and what parsing it costs */
@@ -202,29 +205,40 @@ static enum MHD_Result http_reply_unauthorized(struct MHD_Connection *conn, cons
 
 /* ------------------------------------------------------ request phases */
 
-/* A 503 for the memory budget is owed, not sent, to a client that is
+/* A refusal decided from the headers (503 for the memory budget, 413 for a
+ * body on a route that takes none) is owed, not sent, to a client that is
  * sending its body without waiting (no "Expect: 100-continue"): answering
  * at once makes libmicrohttpd close the socket with the body unread, the
  * kernel then resets the connection, and a client still writing its body
  * never reads the answer (of four concurrent 60 MB uploads over the budget,
  * two got their 503 and two a reset, issue 30). So the body is read and
- * dropped, never held (it costs no budget), and the 503 follows it; the
+ * dropped, never held (it costs no budget), and the answer follows it; the
  * whole request still has --request-timeout to arrive. A client that asked
  * for 100-continue waits for the answer, and gets it at once. Returns 1
  * when the answer is owed. */
-static int http_owe_busy(struct MHD_Connection *conn, http_request *r, const char *detail)
+static int http_owe(struct MHD_Connection *conn, http_request *r, unsigned status,
+                    const char *title, const char *detail)
 {
     const char *expect = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_EXPECT);
     if (r->limit == 0 || (expect && strcasecmp(expect, "100-continue") == 0))
         return 0;
-    r->busy = strdup(detail);
-    return r->busy != NULL;
+    r->owed = strdup(detail);
+    r->owed_status = status;
+    r->owed_title = title;
+    return r->owed != NULL;
+}
+
+static enum MHD_Result http_reply_owed(struct MHD_Connection *conn, const http_request *r)
+{
+    if (r->owed_status == 503)
+        return http_reply_unavailable(conn, r->owed, NULL);
+    return http_reply_problem(conn, r->owed_status, r->owed_title, r->owed, NULL);
 }
 
 /* Everything that can be decided from the request line and headers.
  * Returns 1 when a response was queued. */
-static int http_check_headers(struct MHD_Connection *conn, const char *method, http_request *r,
-                              enum MHD_Result *rc)
+static int http_check_headers(struct MHD_Connection *conn, const char *url, const char *method,
+                              http_request *r, enum MHD_Result *rc)
 {
     const char *unauthorized = r->route.kind != ROUTE_HEALTH ? http_unauthorized_reason(conn) : NULL;
     if (unauthorized) {
@@ -268,6 +282,18 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         return 1;
     }
     r->limit = (size_t)length;
+    /* A route that takes no body never buffers one: up to --max-upload of it
+     * per connection would be held outside the memory budget (48 GET
+     * /health with 64 MiB bodies took the RSS to 3 GB, issue 30). */
+    if (length > 0 && !routes_takes_body(r->route.kind, method)) {
+        char detail[400];
+        snprintf(detail, sizeof detail, "%.16s %.200s takes no request body; this one has %s "
+                 "bytes (send it without one)", method, url, cl);
+        if (http_owe(conn, r, 413, "Payload too large", detail))
+            return 0;
+        *rc = http_reply_problem(conn, 413, "Payload too large", detail, NULL);
+        return 1;
+    }
     if (routes_takes_body(r->route.kind, method) &&
         membudget_grow(&r->lease, membudget_upload_cost(r->limit)) != 0) {
         char detail[240], need[32], limit[32];
@@ -279,7 +305,7 @@ static int http_check_headers(struct MHD_Connection *conn, const char *method, h
         else
             snprintf(detail, sizeof detail, "parsing a body of %s bytes would take this daemon past "
                      "its memory budget (--max-memory) now; try again later", cl);
-        if (http_owe_busy(conn, r, detail))
+        if (http_owe(conn, r, 503, "Service unavailable", detail))
             return 0;
         *rc = http_reply_unavailable(conn, detail, NULL);
         return 1;
@@ -343,6 +369,26 @@ static enum MHD_Result http_reply_timeout(struct MHD_Connection *conn)
     return http_reply_problem(conn, 408, "Request timeout", detail, NULL);
 }
 
+/* Only routes that take a JSON body have one by now (http_check_headers).
+ * Returns 1 when it nests too deeply, with its 400 queued in *rc. */
+static int http_refuse_deep_json(struct MHD_Connection *conn, const http_request *r,
+                                 enum MHD_Result *rc)
+{
+    int line = 0, column = 0;
+    if (!json_depth_exceeds(r->body, r->size, JSON_MAX_DEPTH, &line, &column))
+        return 0;
+    problems p;
+    problems_init(&p);
+    problems_add(&p, 400, "", "line %d, column %d: arrays and objects nest deeper than %d "
+                 "levels, the most this daemon reads (a case needs fewer than 10)",
+                 line, column, JSON_MAX_DEPTH);
+    char detail[160];
+    snprintf(detail, sizeof detail, "the JSON body nests deeper than %d levels", JSON_MAX_DEPTH);
+    *rc = http_reply_problem(conn, 400, "JSON nested too deeply", detail, &p);
+    problems_free(&p);
+    return 1;
+}
+
 static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const char *url,
                                    const char *method, const char *version, const char *upload_data,
                                    size_t *upload_data_size, void **req_cls)
@@ -362,7 +408,7 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
             r->answered = 1;
             return http_reply_timeout(conn);
         }
-        if (http_check_headers(conn, method, r, &rc)) {
+        if (http_check_headers(conn, url, method, r, &rc)) {
             r->answered = 1;
             return rc;
         }
@@ -375,7 +421,7 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     if (*upload_data_size > 0) {
         if (!http_in_time(conn, r))
             return MHD_NO; /* nothing can be answered in the middle of a body */
-        if (!r->too_large && !r->busy && http_collect(r, upload_data, *upload_data_size) != 0)
+        if (!r->too_large && !r->owed && http_collect(r, upload_data, *upload_data_size) != 0)
             return MHD_NO;
         *upload_data_size = 0;
         return MHD_YES;
@@ -387,10 +433,13 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     if (r->too_large)
         return http_reply_problem(conn, 413, "Payload too large",
                                   "the body is longer than its Content-Length or --max-upload", NULL);
-    if (r->busy)
-        return http_reply_unavailable(conn, r->busy, NULL);
+    if (r->owed)
+        return http_reply_owed(conn, r);
+    enum MHD_Result rc;
+    if (r->size > 0 && http_refuse_deep_json(conn, r, &rc))
+        return rc;
     membudget_request_enter(&r->lease);
-    enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+    rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
     membudget_request_leave();
     return rc;
 }
@@ -411,7 +460,7 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
     http_request *r = *req_cls;
     if (r) {
         free(r->body);
-        free(r->busy);
+        free(r->owed);
         membudget_release(&r->lease);
         free(r);
         *req_cls = NULL;

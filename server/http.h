@@ -10,8 +10,10 @@
  *    every request passes the gate.
  *  - Requests are checked before their body is read: 401 (token), 404/405
  *    (route), 411 (POST /cases without Content-Length), 413 (Content-Length
- *    above --max-upload). Only then is the body collected and the route
- *    called; a request not whole by --request-timeout gets 408 or is cut.
+ *    above --max-upload, or any body on a route that takes none: such a
+ *    body is never held). Only then is the body collected, against the
+ *    memory budget, and the route called; a request not whole by
+ *    --request-timeout gets 408 or is cut.
  *  - Every error body is RFC 9457 problem+json with an "errors" list.
  */
 #ifndef FDEMD_HTTP_H

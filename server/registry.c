@@ -322,6 +322,16 @@ static void case_wait_worker_locked(server_case *c)
         pthread_cond_wait(&c->cv, &c->lock);
 }
 
+/* A case that failed only because a write found the disk full: nothing is
+ * wrong with it, and its last checkpoint and the rows before it are intact
+ * (no checkpoint follows a lost write), so it may start again from there
+ * once there is room, as a restarted case does (issue 30). */
+static int case_failed_for_room_locked(const server_case *c)
+{
+    return c->state == CASE_FAILED &&
+           (strstr(c->error, strerror(ENOSPC)) || strstr(c->error, strerror(EDQUOT)));
+}
+
 /* 0 when `c` may start now, else 404 or 409 with a sentence in msg. With
  * the registry lock and the case lock held. */
 static int case_startable_locked(server_case *c, char *msg, size_t msglen)
@@ -332,9 +342,9 @@ static int case_startable_locked(server_case *c, char *msg, size_t msglen)
         snprintf(msg, msglen, "the daemon is shutting down");
         return 409;
     }
-    if (c->state != CASE_CREATED && c->state != CASE_PAUSED) {
-        snprintf(msg, msglen, "the case is %s; start is allowed only when it is created or paused",
-                 case_state_name(c->state));
+    if (c->state != CASE_CREATED && c->state != CASE_PAUSED && !case_failed_for_room_locked(c)) {
+        snprintf(msg, msglen, "the case is %s; start is allowed only when it is created or paused "
+                 "(or failed because the disk was full)", case_state_name(c->state));
         return 409;
     }
     if (c->worker_active) {
@@ -404,8 +414,23 @@ int registry_start(server_case *c, char *msg, size_t msglen)
     pthread_mutex_lock(&c->lock);
     int status = case_startable_locked(c, msg, msglen);
     int will_run = reg_running < reg_cfg->max_running;
+    int retry = status == 0 && c->state == CASE_FAILED;
     pthread_mutex_unlock(&c->lock);
     pthread_mutex_unlock(&reg_lock);
+
+    if (retry && persist_reserve(c->dir) != 0) {
+        snprintf(msg, msglen, "the case failed because the disk was full, and there is still no "
+                 "room in %s (%s); free some space, then start it again", c->dir, strerror(errno));
+        status = 503;
+    }
+    if (retry && status == 0) {
+        /* The failed write is behind it: the rebuild below reopens
+         * result.h5 at the last checkpoint, dropping the rows after it. */
+        pthread_mutex_lock(&c->lock);
+        c->io_error[0] = '\0';
+        atomic_store(&c->io_failed, 0);
+        pthread_mutex_unlock(&c->lock);
+    }
 
     fdem_model *model = NULL;
     if (status == 0)
@@ -419,7 +444,13 @@ int registry_start(server_case *c, char *msg, size_t msglen)
         pthread_mutex_lock(&c->lock);
         status = case_startable_locked(c, msg, msglen);
         if (status == 0) {
-            c->queued_from = c->state;
+            /* A retry that cannot get its memory when its turn comes waits
+             * paused: its files are a paused case's, the error is behind it. */
+            c->queued_from = retry ? CASE_PAUSED : c->state;
+            if (retry) {
+                c->error[0] = '\0';
+                c->finished_at[0] = '\0';
+            }
             c->model = model;
             if (case_start_locked(c) != 0) {
                 snprintf(msg, msglen, "the daemon could not start a thread for this case");
@@ -441,6 +472,8 @@ int registry_start(server_case *c, char *msg, size_t msglen)
     }
     if (status == 0)
         case_persist_status(c);
+    if (status == 0 && retry)
+        case_log(c, "started again from its last checkpoint after failing for a full disk");
     if (queued)
         case_log(c, "queued: --max-running (%d) cases are running", reg_cfg->max_running);
     pthread_mutex_unlock(&c->ctl_lock);

@@ -153,9 +153,11 @@ server_case *registry_create(const char *body, size_t size, int start, problems 
  * and *http_status 400/422/503. */
 json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_status);
 
-/* start/pause/stop: 0, or 409 (or 503: no memory for the model now) with a
- * sentence in msg; stop also 500 when `stopped` could not be stored (the
- * case is then failed with the write error). */
+/* start/pause/stop: 0, or 409 (or 503: no memory for the model now, or no
+ * room on disk for a case that failed for a full disk, which start takes
+ * back to its last checkpoint) with a sentence in msg; stop also 500 when
+ * `stopped` could not be stored (the case is then failed with the write
+ * error). */
 int registry_start(server_case *c, char *msg, size_t msglen);
 int registry_pause(server_case *c, char *msg, size_t msglen);
 int registry_stop(server_case *c, char *msg, size_t msglen);

@@ -540,6 +540,8 @@ static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, 
         rc = routes_reply_problems(conn, status, &p, "patch");
     else if (!doc && status == 404)
         rc = routes_no_case(conn, c->id);
+    else if (!doc && status == 503)
+        rc = http_reply_unavailable(conn, err, NULL);
     else if (!doc)
         rc = http_reply_problem(conn, 500, "Internal error", err, NULL);
     else if (lease && membudget_grow(lease, membudget_upload_cost(length)) != 0)
@@ -571,7 +573,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_EVENTS:
         return route_events(conn, c);
     case ROUTE_CASE_RESULT_H5:
-        return download_reply(conn, c);
+        return download_reply(conn, c, strcmp(method, "HEAD") == 0);
     case ROUTE_CASE_RESULT_XDMF:
         return routes_serve_file(conn, c, "result.xdmf", "application/xml");
     case ROUTE_CASE_EXTEND:

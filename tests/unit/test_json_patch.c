@@ -2,12 +2,13 @@
  * test_json_patch.c - JSON Merge Patch against every example of RFC 7396
  * appendix A (and the section 3 example), and the document dump: reals in
  * the fewest digits that read back to the same double, every value and the
- * member order kept.
+ * member order kept. And the nesting scan that guards every JSON body.
  */
 #include <stdlib.h>
 #include <string.h>
 
 #include "check.h"
+#include "json_depth.h"
 #include "json_patch.h"
 
 static json_t *parse(const char *text)
@@ -104,5 +105,26 @@ static void dump_writes_the_shortest_exact_reals(void)
     json_decref(doc);
 }
 
+/* Brackets in strings (escaped quotes included) do not count; the first
+ * bracket past the limit is located by line and column. */
+static void depth_scan_counts_only_real_nesting(void)
+{
+    int line = 0, column = 0;
+    const char *flat = "{\"a\": \"[[[{{{\\\"[[[\", \"b\": [[1], [2]]}";
+    CHECK(!json_depth_exceeds(flat, strlen(flat), 3, &line, &column), "strings counted: %s", flat);
+    CHECK(json_depth_exceeds(flat, strlen(flat), 2, &line, &column) && line == 1 && column == 28,
+          "limit 2 on %s: line %d column %d", flat, line, column);
+    const char *deep = "{\n  \"x\": [\n    [[]]]}";
+    CHECK(json_depth_exceeds(deep, strlen(deep), 3, &line, &column) && line == 3 && column == 6,
+          "limit 3 on the deep text: line %d column %d", line, column);
+    CHECK(!json_depth_exceeds(deep, strlen(deep), 4, NULL, NULL), "4 levels are within 4");
+    char many[200];
+    memset(many, '[', 100);
+    memset(many + 100, ']', 100);
+    CHECK(!json_depth_exceeds(many, 200, 100, NULL, NULL) && json_depth_exceeds(many, 200, 99, NULL, NULL),
+          "100 levels: within 100, past 99");
+}
+
 CHECK_MAIN(T(rfc7396_appendix_a), T(rfc7396_section_3_example),
-           T(a_patch_on_a_case_changes_only_what_it_names), T(dump_writes_the_shortest_exact_reals))
+           T(a_patch_on_a_case_changes_only_what_it_names), T(dump_writes_the_shortest_exact_reals),
+           T(depth_scan_counts_only_real_nesting))
