@@ -23,6 +23,7 @@
 
 #include "memory_budget.h"
 #include "gate.h"
+#include "heavy_work.h"
 #include "json_depth.h"
 #include "routes.h"
 
@@ -42,7 +43,25 @@ typedef struct http_request {
     char *body;
     size_t size, capacity, limit;
     membudget_lease lease; /* the body and what parsing it costs */
+    /* a request answered on a heavy-work thread (heavy_work.h): its
+     * connection, method, and the answer kept for when it is resumed */
+    struct MHD_Connection *conn;
+    const char *method;
+    int heavy_done;
+    unsigned heavy_status;
+    struct MHD_Response *heavy_answer;
 } http_request;
+
+/* What a heavy-work thread's routes answered: http_queue keeps it here
+ * instead of queueing it, since a suspended connection takes its answer
+ * only from its own access callback once resumed. */
+typedef struct http_kept_answer {
+    unsigned status;
+    struct MHD_Response *resp;
+} http_kept_answer;
+
+static _Thread_local http_kept_answer *tl_kept;
+static _Thread_local int tl_deferred; /* a route asked for a heavy-work thread */
 
 static struct MHD_Daemon *http_daemon;
 static const fdemd_config *http_cfg;
@@ -57,6 +76,13 @@ static enum MHD_Result http_queue(struct MHD_Connection *conn, unsigned status,
     /* One request per connection: every request then passes the gate,
      * which alone applies the header checks and the deadline's first part. */
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
+    if (tl_kept) {
+        if (tl_kept->resp) /* a second answer to one request: keep the first */
+            MHD_destroy_response(resp);
+        else
+            *tl_kept = (http_kept_answer){status, resp};
+        return MHD_YES;
+    }
     enum MHD_Result rc = MHD_queue_response(conn, status, resp);
     MHD_destroy_response(resp);
     return rc;
@@ -160,6 +186,18 @@ enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
         MHD_add_response_header(resp, "Content-Disposition", disposition);
     }
     return http_queue(conn, 200, resp);
+}
+
+enum MHD_Result http_defer_heavy(struct MHD_Connection *conn)
+{
+    (void)conn;
+    tl_deferred = 1;
+    return MHD_YES;
+}
+
+int http_on_heavy_thread(void)
+{
+    return tl_kept != NULL;
 }
 
 /* ------------------------------------------------------ authentication */
@@ -389,6 +427,45 @@ static int http_refuse_deep_json(struct MHD_Connection *conn, const http_request
     return 1;
 }
 
+/* A deferred request on a heavy-work thread: the same route, its answer
+ * kept, then the connection resumed so that its callback sends it. */
+static void http_heavy_run(void *arg)
+{
+    http_request *r = arg;
+    http_kept_answer kept = {0, NULL};
+    tl_kept = &kept;
+    membudget_request_enter(&r->lease);
+    routes_handle(r->conn, &r->route, r->method, r->body ? r->body : "", r->size);
+    membudget_request_leave();
+    tl_kept = NULL;
+    r->heavy_status = kept.status;
+    r->heavy_answer = kept.resp;
+    r->heavy_done = 1;
+    MHD_resume_connection(r->conn);
+}
+
+/* Runs the route; one that asks for a heavy-work thread (a model build)
+ * gets one, its connection suspended meanwhile, or a 503 at once when the
+ * queue is full. */
+static enum MHD_Result http_route(struct MHD_Connection *conn, http_request *r, const char *method)
+{
+    tl_deferred = 0;
+    membudget_request_enter(&r->lease);
+    enum MHD_Result rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
+    membudget_request_leave();
+    if (!tl_deferred)
+        return rc;
+    tl_deferred = 0;
+    if (heavy_work_reserve() != 0)
+        return http_reply_unavailable(conn, "the daemon is building as many models as it takes "
+                                      "at once for other requests; try again shortly", NULL);
+    r->conn = conn;
+    r->method = method;
+    MHD_suspend_connection(conn);
+    heavy_work_submit(http_heavy_run, r);
+    return MHD_YES;
+}
+
 static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const char *url,
                                    const char *method, const char *version, const char *upload_data,
                                    size_t *upload_data_size, void **req_cls)
@@ -414,6 +491,16 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
         }
         return MHD_YES;
     }
+    if (r->heavy_done) { /* resumed: the heavy-work thread's answer */
+        r->heavy_done = 0;
+        struct MHD_Response *resp = r->heavy_answer;
+        r->heavy_answer = NULL;
+        if (!resp)
+            return MHD_NO;
+        enum MHD_Result rc = MHD_queue_response(conn, r->heavy_status, resp);
+        MHD_destroy_response(resp);
+        return rc;
+    }
     if (r->answered) {
         *upload_data_size = 0;
         return MHD_YES;
@@ -438,10 +525,7 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     enum MHD_Result rc;
     if (r->size > 0 && http_refuse_deep_json(conn, r, &rc))
         return rc;
-    membudget_request_enter(&r->lease);
-    rc = routes_handle(conn, &r->route, method, r->body ? r->body : "", r->size);
-    membudget_request_leave();
-    return rc;
+    return http_route(conn, r, method);
 }
 
 static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cls,
@@ -459,6 +543,8 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
         gate_closed(info->connect_fd);
     http_request *r = *req_cls;
     if (r) {
+        if (r->heavy_answer)
+            MHD_destroy_response(r->heavy_answer);
         free(r->body);
         free(r->owed);
         membudget_release(&r->lease);
@@ -540,9 +626,13 @@ int http_start(const fdemd_config *cfg)
 {
     http_cfg = cfg;
     int port = 0;
-    int listen_fd = http_listen(cfg, &port);
-    if (listen_fd < 0)
+    if (heavy_work_start() != 0)
         return -1;
+    int listen_fd = http_listen(cfg, &port);
+    if (listen_fd < 0) {
+        heavy_work_stop();
+        return -1;
+    }
     /* Connections arrive through the gate (MHD_add_connection), so
      * libmicrohttpd has no listening socket of its own and no limits of its
      * own: the gate's counts are the ones that hold. */
@@ -568,6 +658,7 @@ int http_start(const fdemd_config *cfg)
         else
             close(listen_fd);
         http_daemon = NULL;
+        heavy_work_stop();
         return -1;
     }
     return port;
@@ -576,6 +667,7 @@ int http_start(const fdemd_config *cfg)
 void http_stop(void)
 {
     gate_stop(); /* no new connections while the open ones are closed */
+    heavy_work_stop(); /* answers and resumes every suspended request first */
     if (http_daemon) {
         MHD_stop_daemon(http_daemon);
         http_daemon = NULL;

@@ -39,6 +39,12 @@ enum MHD_Result http_reply_unavailable(struct MHD_Connection *conn, const char *
                                        const problems *p);
 enum MHD_Result http_reply_not_allowed(struct MHD_Connection *conn, const char *allow);
 enum MHD_Result http_reply_empty(struct MHD_Connection *conn, unsigned status);
+/* A route whose work is a model build calls http_defer_heavy() (and returns
+ * what it returns) unless http_on_heavy_thread(): the request is then run
+ * again, whole, on a heavy-work thread (heavy_work.h) while its connection
+ * waits suspended, so the threads that answer HTTP never build models. */
+enum MHD_Result http_defer_heavy(struct MHD_Connection *conn);
+int http_on_heavy_thread(void);
 /* Serves `size` bytes of an open descriptor (closed by libmicrohttpd). */
 enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
                               const char *content_type, const char *filename);

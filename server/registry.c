@@ -667,6 +667,21 @@ int registry_delete(server_case *c, char *msg, size_t msglen)
     return status;
 }
 
+int case_holds_model(server_case *c)
+{
+    /* counted as a waiter, as case_take_state is, so the worker yields the
+     * lock at its next step instead of taking it again first */
+    atomic_fetch_add(&c->state_waiters, 1);
+    pthread_mutex_lock(&c->model_lock);
+    int held = c->model != NULL;
+    pthread_mutex_unlock(&c->model_lock);
+    pthread_mutex_lock(&c->yield_lock);
+    atomic_fetch_sub(&c->state_waiters, 1);
+    pthread_cond_broadcast(&c->yield_cv);
+    pthread_mutex_unlock(&c->yield_lock);
+    return held;
+}
+
 snapshot *case_take_state(server_case *c, unsigned fields, int *status)
 {
     atomic_fetch_add(&c->state_waiters, 1);

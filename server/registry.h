@@ -169,6 +169,9 @@ int registry_delete(server_case *c, char *msg, size_t msglen);
  * checkpoint's (a temporary rebuild). NULL with *status 503 (memory short
  * now) or 409 (the stored case cannot be rebuilt). */
 snapshot *case_take_state(server_case *c, unsigned fields, int *status);
+/* Whether the case holds its model now (running, or being stepped): its
+ * state is then a copy, not a rebuild. Waits at most one step. */
+int case_holds_model(server_case *c);
 
 json_t *case_status_json(server_case *c);
 const char *case_state_name(case_state s);

@@ -272,6 +272,8 @@ static enum MHD_Result routes_reply_problems(struct MHD_Connection *conn, int st
 
 static enum MHD_Result route_create_case(struct MHD_Connection *conn, const char *body, size_t size)
 {
+    if (!http_on_heavy_thread()) /* validating and sizing builds the model */
+        return http_defer_heavy(conn);
     int start = routes_flag(conn, "start");
     if (start < 0)
         return http_reply_problem(conn, 400, "Bad request", "?start= takes true or false", NULL);
@@ -385,6 +387,9 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
     enum MHD_Result rc;
     if (routes_no_state(conn, c, NULL, &rc))
         return rc;
+    /* a case that holds no model rebuilds one from its checkpoint to be read */
+    if (!http_on_heavy_thread() && !case_holds_model(c))
+        return http_defer_heavy(conn);
     snapshot *s = case_take_state(c, fields, &status);
     if (!s && status == 503)
         return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
@@ -528,6 +533,8 @@ static enum MHD_Result route_extend(struct MHD_Connection *conn, server_case *c,
 static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, const char *body,
                                    size_t size)
 {
+    if (!http_on_heavy_thread())
+        return http_defer_heavy(conn);
     problems p;
     problems_init(&p);
     int status = 0;
