@@ -110,6 +110,8 @@ static gate_ip *gate_find_ip(uint32_t ip)
     return NULL;
 }
 
+static const char GATE_ALL_FULL[] =
+    "the daemon has as many connections open as it serves; try again shortly";
 static const char GATE_PER_IP_FULL[] =
     "your address has as many connections open as it may "
     "(--max-connections-per-ip); close one or try again shortly";
@@ -122,7 +124,7 @@ static int gate_admit(int fd, uint32_t ip, double now, const char **why)
     pthread_mutex_lock(&gate.lock);
     gate_ip *entry = gate_find_ip(ip);
     if (fd >= gate.slot_count || gate.total >= gate.limits.total) {
-        *why = "the daemon has as many connections open as it serves; try again shortly";
+        *why = GATE_ALL_FULL;
     } else if (entry && entry->count >= gate.limits.per_ip) {
         *why = GATE_PER_IP_FULL;
     } else {
@@ -329,6 +331,29 @@ static int gate_examine(int index, short revents)
     return 1;
 }
 
+/* Closes the connection that has waited longest for its headers, to make
+ * room for a new one when every slot is taken; 0 when none is waiting for
+ * headers (every slot is a request being served). Idle connections are
+ * cut first: one sending its headers takes milliseconds, so the oldest
+ * held one is the likeliest to be a client holding a slot on purpose
+ * (16 idle connections from each of 33 addresses filled all 512 slots,
+ * and everyone else got 503 for as long as they kept them). */
+static int gate_cut_oldest_idle(void)
+{
+    int oldest = -1;
+    for (int i = 0; i < gate.held_count; i++)
+        if (!gate.held[i].waiting &&
+            (oldest < 0 || gate.held[i].accepted < gate.held[oldest].accepted))
+            oldest = i;
+    if (oldest < 0) return 0;
+    int fd = gate.held[oldest].fd;
+    gate_release(oldest);
+    gate_answer_and_close(fd, 408, "Request timeout",
+                          "every connection slot was taken and this connection had waited "
+                          "longest without sending whole request headers");
+    return 1;
+}
+
 static void gate_accept_all(void)
 {
     for (;;) {
@@ -339,8 +364,14 @@ static void gate_accept_all(void)
         if (fd < 0) return; /* EAGAIN, or out of descriptors until some close */
         double now = gate_now();
         const char *why = NULL;
-        if (addr.sin_family != AF_INET || gate.held_count >= gate.limits.total ||
-            !gate_admit(fd, addr.sin_addr.s_addr, now, &why)) {
+        int admitted = addr.sin_family == AF_INET && gate.held_count < gate.limits.total &&
+                       gate_admit(fd, addr.sin_addr.s_addr, now, &why);
+        if (!admitted && addr.sin_family == AF_INET && why != GATE_PER_IP_FULL &&
+            gate_cut_oldest_idle()) {
+            why = NULL;
+            admitted = gate_admit(fd, addr.sin_addr.s_addr, now, &why);
+        }
+        if (!admitted) {
             if (why == GATE_PER_IP_FULL && gate_park(fd, &addr, now)) continue;
             gate_answer_and_close(fd, 503, "Too many connections",
                                   why ? why : "too many connections are waiting for headers");

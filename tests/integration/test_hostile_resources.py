@@ -379,3 +379,41 @@ class DiskFullRetryTest(unittest.TestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class IdleSlotsTest(DaemonTestCase):
+    """16 idle connections (half a request head each) from each of 33
+    loopback addresses filled all 512 slots, and every other client got 503
+    for as long as they were held (item 2). Now a connection that finds
+    every slot taken cuts the one that has waited longest for its headers
+    (answered 408), so /health is served while they are held."""
+    ADDRESSES = 33
+    PER_ADDRESS = 16
+
+    def test_idle_connections_are_cut_first_when_every_slot_is_taken(self):
+        idle = []
+        try:
+            for a in range(self.ADDRESSES):
+                for _ in range(self.PER_ADDRESS):
+                    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+                    s.bind(("127.0.0.%d" % (2 + a), 0))
+                    s.connect(("127.0.0.1", self.d.port))
+                    s.sendall(b"GET /health HTTP/1.1\r\nHo")
+                    idle.append(s)
+            # accepted after every idle one (the listen queue is in order)
+            status, body = self.d.json("GET", "/health")
+            self.assertEqual(status, 200, body)
+            self.assertEqual(self.d.json("GET", "/cases")[0], 200)
+            cut = 0
+            for s in idle:
+                s.settimeout(0)
+                try:
+                    head = s.recv(64)
+                except BlockingIOError:
+                    continue
+                cut += head.startswith(b"HTTP/1.1 408")
+            # the 16 beyond 512, and one for each of the two requests
+            self.assertGreaterEqual(cut, 2)
+        finally:
+            for s in idle:
+                s.close()
