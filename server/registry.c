@@ -667,32 +667,38 @@ int registry_delete(server_case *c, char *msg, size_t msglen)
     return status;
 }
 
-int case_holds_model(server_case *c)
+/* model_lock taken by a request that reads the model: counted as a
+ * waiter, so the worker yields the lock at its next step instead of taking
+ * it again first (a request never waits longer than one step). */
+static void case_model_lock_to_read(server_case *c)
 {
-    /* counted as a waiter, as case_take_state is, so the worker yields the
-     * lock at its next step instead of taking it again first */
     atomic_fetch_add(&c->state_waiters, 1);
     pthread_mutex_lock(&c->model_lock);
-    int held = c->model != NULL;
+}
+
+static void case_model_unlock_read(server_case *c)
+{
     pthread_mutex_unlock(&c->model_lock);
     pthread_mutex_lock(&c->yield_lock);
     atomic_fetch_sub(&c->state_waiters, 1);
     pthread_cond_broadcast(&c->yield_cv);
     pthread_mutex_unlock(&c->yield_lock);
+}
+
+int case_holds_model(server_case *c)
+{
+    case_model_lock_to_read(c);
+    int held = c->model != NULL;
+    case_model_unlock_read(c);
     return held;
 }
 
 snapshot *case_take_state(server_case *c, unsigned fields, int *status)
 {
-    atomic_fetch_add(&c->state_waiters, 1);
-    pthread_mutex_lock(&c->model_lock);
+    case_model_lock_to_read(c);
     snapshot *s = c->model ? snapshot_take(c->model, fields) : NULL;
     int held = c->model != NULL;
-    pthread_mutex_unlock(&c->model_lock);
-    pthread_mutex_lock(&c->yield_lock);
-    atomic_fetch_sub(&c->state_waiters, 1);
-    pthread_cond_broadcast(&c->yield_cv);
-    pthread_mutex_unlock(&c->yield_lock);
+    case_model_unlock_read(c);
     *status = 503;
     if (!held)
         s = case_model_state_from_disk(c, fields, status);

@@ -82,17 +82,19 @@ static void check_makes_no_energy(const char *name, const watch *w, int least_br
 
 /* A 160-triangle bar, friction angle 10 degrees, crushed along its length
  * at 0.05 m/s from one end while the other is held. */
+static const char CRUSHED_BAR[] =
+    "{'name': 'bar', 'materials': {'rock': {'density': 2700, 'young': 3e10, "
+    "'poisson': 0.3, 'friction': 0.3, 'fracture': {'tensile_strength': 1e6, "
+    "'cohesion': 3e6, 'friction_angle': 10, 'energy_I': 10, 'energy_II': 50}}}, "
+    "'parts': [{'name': 'bar', 'material': 'rock', 'fracture': true, "
+    "'rectangle': {'origin': [0, 0], 'size': [0.08, 0.02], 'divisions': [20, 4]}}], "
+    "'constraints': [{'box': [-1, -1, 1e-6, 1], 'fix': ['x', 'y']}, "
+    "{'box': [0.079999, -1, 1, 1], 'velocity': [-0.05, 0]}], "
+    "'time': {'end': 0.001}}";
+
 static void crushed_bar_2d_makes_no_energy(void)
 {
-    fdem_model *m = expect_built(load(
-        "{'name': 'bar', 'materials': {'rock': {'density': 2700, 'young': 3e10, "
-        "'poisson': 0.3, 'friction': 0.3, 'fracture': {'tensile_strength': 1e6, "
-        "'cohesion': 3e6, 'friction_angle': 10, 'energy_I': 10, 'energy_II': 50}}}, "
-        "'parts': [{'name': 'bar', 'material': 'rock', 'fracture': true, "
-        "'rectangle': {'origin': [0, 0], 'size': [0.08, 0.02], 'divisions': [20, 4]}}], "
-        "'constraints': [{'box': [-1, -1, 1e-6, 1], 'fix': ['x', 'y']}, "
-        "{'box': [0.079999, -1, 1, 1], 'velocity': [-0.05, 0]}], "
-        "'time': {'end': 0.001}}"), NULL);
+    fdem_model *m = expect_built(load(CRUSHED_BAR), NULL);
     if (!m) return;
     watch w = run_watched(m, 0.001);
     check_makes_no_energy("crushed bar 2D", &w, 0);
@@ -287,14 +289,8 @@ static void kept_slip_turns_with_the_joint(void)
  * start from no slip. One of version 7 restores the slip to the bit. */
 static void checkpoint_keeps_the_slip_and_reads_version_6(void)
 {
-    const char *doc = "{'name': 'bar', 'materials': {'rock': {'density': 2700, 'young': 3e10, "
-        "'poisson': 0.3, 'fracture': {'tensile_strength': 1e6, 'cohesion': 3e6, "
-        "'friction_angle': 10, 'energy_I': 10, 'energy_II': 50}}}, "
-        "'parts': [{'name': 'bar', 'material': 'rock', 'fracture': true, "
-        "'rectangle': {'origin': [0, 0], 'size': [0.08, 0.02], 'divisions': [20, 4]}}], "
-        "'constraints': [{'box': [-1, -1, 1e-6, 1], 'fix': ['x', 'y']}, "
-        "{'box': [0.079999, -1, 1, 1], 'velocity': [-0.05, 0]}], 'time': {'end': 0.001}}";
-    fdem_model *a = expect_built(load(doc), NULL), *b = expect_built(load(doc), NULL);
+    fdem_model *a = expect_built(load(CRUSHED_BAR), NULL);
+    fdem_model *b = expect_built(load(CRUSHED_BAR), NULL);
     if (!a || !b) return;
     fdem_error err;
     while (fdem_get_time(a) < 5e-4)
