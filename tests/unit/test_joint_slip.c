@@ -103,7 +103,8 @@ static void crushed_bar_2d_makes_no_energy(void)
 }
 
 /* examples/brazilian-disc.json with its damping taken away: the case of
- * the issue. Under the sanitizers, up to the peak and the first cracks. */
+ * the issue. Under the sanitizers, up to the first dozen broken joints
+ * (0.6 ms: 12 broken; 23 at the end, 0.8 ms). */
 static void brazilian_disc_2d_undamped_makes_no_energy(void)
 {
     size_t length;
@@ -114,7 +115,7 @@ static void brazilian_disc_2d_undamped_makes_no_energy(void)
     free(text);
     edit(doc, "/materials/rock/damping", json_real(0));
 #ifdef FDEM_SAN
-    double end = 0.0005;
+    double end = 0.0006;
 #else
     double end = 0.0008;
 #endif
