@@ -8,7 +8,15 @@
  * compressible neo-Hookean solid sigma = (mu/J)(B - I) + (lambda/J) ln J I,
  * B = F F^T: objective (a rigid rotation R gives B = I, so no stress) and
  * equal to plane-strain linear elasticity at small strain. Viscous damping
- * adds 2 eta D with D = sym([v][x]^-1); an in-situ pre-stress S0 adds
+ * adds 2 eta D with D = sym([v][x_mid]^-1) on the mid-step configuration
+ * x_mid = x - h_last v / 2 (v the half-step velocity, the chord of the last
+ * step, h_last = dt_prev), so a rigid rotation gives D = 0 to round-off:
+ * with the current x it gave D ~ h omega^2 / 2 and damped a free spin
+ * (issue 29). The viscous stress's forces are applied on the mid-step
+ * edges, in the same scatter as the elastic ones, so the damping power
+ * booked, -det [x_mid] (eta D : D), is that of the forces applied (the
+ * other way, forces on the current edges, would book a power that is not
+ * theirs by a relative h omega). An in-situ pre-stress S0 adds
  * F S0 F^T / J (initial_stress.c), in a second instance of the loop that
  * only the elements of stressed parts run.
  *
@@ -176,17 +184,31 @@ static inline double prestress_add(double a, double b, double c, double d, doubl
     return 0.5 * (txx + tyy - s0[0] - s0[1]);
 }
 
-/* The rate of deformation D = sym([v][x]^-1) of an element (current
- * geometry) as (D11, D22, D12) and det [x], or 0 for an element of no
- * area. The division is paid only by damped elements. */
-static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, double x1,
-                                      double y1, double x2, double y2, double *det_out,
-                                      double D[3])
+/* The rate of deformation D = sym([v][x]^-1) of an element on its mid-step
+ * configuration x_mid = x - hh v (hh = h_last / 2: the positions halfway
+ * along the last step, whose chord velocity v is) as (D11, D22, D12), the
+ * mid-step edge vectors in mid (x1, y1, x2, y2) and det [x_mid] in *det_out;
+ * returns 0 (D and det unset) for a mid-step element of no area. For a
+ * rigid motion the chord velocity is W x_mid with W skew (the Cayley
+ * transform of the step's rotation), so D = 0 to round-off; on the current
+ * geometry it was of order h omega^2 (the spin was damped). The division
+ * is paid only by damped elements. */
+static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, double hh,
+                                      double x1, double y1, double x2, double y2, double mid[4],
+                                      double *det_out, double D[3])
 {
-    double det = x1 * y2 - x2 * y1;
-    if (!(fabs(det) > 0)) return 0;
     double u1 = v[2 * n1] - v[2 * n0], w1 = v[2 * n1 + 1] - v[2 * n0 + 1];
     double u2 = v[2 * n2] - v[2 * n0], w2 = v[2 * n2 + 1] - v[2 * n0 + 1];
+    x1 -= hh * u1;
+    y1 -= hh * w1;
+    x2 -= hh * u2;
+    y2 -= hh * w2;
+    mid[0] = x1;
+    mid[1] = y1;
+    mid[2] = x2;
+    mid[3] = y2;
+    double det = x1 * y2 - x2 * y1;
+    if (!(fabs(det) > 0)) return 0;
     double inv = 1.0 / det;
     /* [x]^-1 = (1/det) (y2 -x2; -y1 x1); L = [v][x]^-1 */
     double L11 = (u1 * y2 - u2 * y1) * inv, L12 = (-u1 * x2 + u2 * x1) * inv;
@@ -198,20 +220,22 @@ static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, d
     return 1;
 }
 
-/* The viscous half stress eta D into hv and the power of the nodal forces
- * of it and of prev (the last step's viscous half stress) with these
- * velocities, added to power[0] and power[1]: sum_a f_a . v_a =
- * -A sigma : L = -det [x] (h : D) for a half stress h. The two powers are
- * the same expression on two stresses, written as a loop over the pair so
- * that the compiler evaluates them side by side in one vector register
- * (each lane rounds exactly as the scalar would, so the damping account
- * keeps its bits; 18.9 -> 17.2 ns per damped element, CPU time). */
-static inline void viscous_half(const double *v, int n0, int n1, int n2, double x1, double y1,
-                                double x2, double y2, double eta, const double prev[3],
-                                double hv[3], double power[2])
+/* The viscous half stress eta D (D on the mid-step configuration) into hv,
+ * the mid-step edges into mid, and the power of the nodal forces of it and
+ * of prev (the last step's viscous half stress), both applied on the
+ * mid-step edges, with these velocities, added to power[0] and power[1]:
+ * sum_a f_a . v_a = -A sigma : L = -det [x_mid] (h : D) for a half stress
+ * h. The two powers are the same expression on two stresses, written as a
+ * loop over the pair so that the compiler evaluates them side by side in
+ * one vector register (each lane rounds exactly as the scalar would, so
+ * the damping account keeps its bits; 18.9 -> 17.2 ns per damped element,
+ * CPU time). */
+static inline void viscous_half(const double *v, int n0, int n1, int n2, double hh, double x1,
+                                double y1, double x2, double y2, double eta, const double prev[3],
+                                double hv[3], double mid[4], double power[2])
 {
     double det, D[3];
-    if (!rate_of_deformation(v, n0, n1, n2, x1, y1, x2, y2, &det, D)) {
+    if (!rate_of_deformation(v, n0, n1, n2, hh, x1, y1, x2, y2, mid, &det, D)) {
         hv[0] = hv[1] = hv[2] = 0;
         power[0] += 0.0;
         power[1] += 0.0;
@@ -229,6 +253,26 @@ static inline void edge_traction_forces(double *f, int n0, int n1, int n2, doubl
 {
     double f1x = hs[2] * x2 - hs[0] * y2, f1y = hs[1] * x2 - hs[2] * y2;
     double f2x = hs[0] * y1 - hs[2] * x1, f2y = hs[2] * y1 - hs[1] * x1;
+    double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
+    g1[0] += f1x;
+    g1[1] += f1y;
+    g2[0] += f2x;
+    g2[1] += f2y;
+    g0[0] -= f1x + f2x;
+    g0[1] -= f1y + f2y;
+}
+
+/* The same for a damped element: the elastic half stress hs on the current
+ * edges and the viscous one hv on the mid-step edges mid, in one scatter
+ * (the power booked for hv is that of these forces: viscous_half). */
+static inline void edge_traction_forces_damped(double *f, int n0, int n1, int n2, double x1,
+                                               double y1, double x2, double y2, const double hs[3],
+                                               const double mid[4], const double hv[3])
+{
+    double f1x = (hs[2] * x2 - hs[0] * y2) + (hv[2] * mid[2] - hv[0] * mid[3]);
+    double f1y = (hs[1] * x2 - hs[2] * y2) + (hv[1] * mid[2] - hv[2] * mid[3]);
+    double f2x = (hs[0] * y1 - hs[2] * x1) + (hv[0] * mid[1] - hv[2] * mid[0]);
+    double f2y = (hs[2] * y1 - hs[1] * x1) + (hv[2] * mid[1] - hv[1] * mid[0]);
     double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
     g1[0] += f1x;
     g1[1] += f1y;
@@ -267,6 +311,7 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
     double energy = 0, power[2] = {0, 0}; /* of this step's and the last step's viscous stress */
     int32_t cur_mat = -1;
     double hlambda = 0, hmu = 0;
+    const double hh = 0.5 * m->dt_prev; /* x_mid = x - hh v */
     const element_hot *el = m->elem + begin, *end = m->elem + end_index;
     for (; el < end; el++) {
         ELEM_PREFETCH_READ(end - el > ELEM_PREFETCH ? el + ELEM_PREFETCH : el);
@@ -294,18 +339,17 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
             /* Damping is booked with the step-averaged velocity, like every
              * work: its forces' power with the velocities before this step
              * now, and with those after it at the next step, from the stored
-             * stress on the geometry then (a step's strain later: a relative
-             * error of the strain increment, ~1e-6). */
-            double hv[3];
-            viscous_half(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, prev, hv, power);
+             * stress on the mid-step geometry then (a step later: a relative
+             * error of a step's displacement gradient, ~1e-6). */
+            double hv[3], mid[4];
+            viscous_half(vel, n0, n1, n2, hh, x1, y1, x2, y2, el->eta, prev, hv, mid, power);
             prev[0] = hv[0];
             prev[1] = hv[1];
             prev[2] = hv[2];
-            hs[0] += hv[0];
-            hs[1] += hv[1];
-            hs[2] += hv[2];
+            edge_traction_forces_damped(f, n0, n1, n2, x1, y1, x2, y2, hs, mid, hv);
+        } else {
+            edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
         }
-        edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
         if (prev) prev += 3; /* NULL + 0 would be undefined: undamped models have no array */
     }
     sums[0] += energy;
@@ -341,8 +385,9 @@ void tri_element_stress(const fdem_model *m, int e, double out[3])
     neo_hookean_half(a, b, c, d, 0.5 * mat->lambda, 0.5 * mat->mu, out, &w, &invJ);
     if (m->elem_stress0 && m->parts[m->elem_part[e]].stressed)
         prestress_add(a, b, c, d, 0.5 * invJ, m->elem_stress0 + 3 * (size_t)e, out);
-    double det, D[3];
-    if (el->eta > 0 && rate_of_deformation(m->vel, n0, n1, n2, x1, y1, x2, y2, &det, D))
+    double det, D[3], mid[4]; /* the D of the forces: mid-step configuration */
+    if (el->eta > 0 &&
+        rate_of_deformation(m->vel, n0, n1, n2, 0.5 * m->dt_prev, x1, y1, x2, y2, mid, &det, D))
         for (int k = 0; k < 3; k++) out[k] += el->eta * D[k];
     for (int k = 0; k < 3; k++) out[k] *= 2; /* exact */
 }
