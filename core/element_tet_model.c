@@ -16,12 +16,20 @@
  * chord of the last step, h_last = dt_prev): for a rigid motion that chord
  * velocity is W x_mid with W skew (the Cayley transform of the step's
  * rotation), so a spin gives D = 0 to round-off, where on the current x it
- * gave D ~ h omega^2 / 2 and a free spin lost energy (issue 29). Its forces
- * are the loads of sigma_v / 6 on the mid-step face vectors, added to the
- * elastic ones before the one scatter (tet_kernel_face_loads_add), so the
- * power booked, -(sigma_v : S) / 6 on the same faces, is exactly that of
- * the forces applied; forces on the current faces would not be (a relative
- * h omega off for a spinning body).
+ * gave D ~ h omega^2 / 2 and a free spin was damped, booked in proportion
+ * to dt^2 (issue 29). Its forces are the loads of sigma_v / 6 on the
+ * mid-step face vectors, added to the elastic ones before the one scatter
+ * (tet_kernel_face_loads_add), so the power booked now, -(sigma_v : S) / 6
+ * on the same faces, is exactly that of the forces applied; forces on the
+ * current faces would not be (a relative h omega off for a spinning body).
+ * The same forces' power with the velocities after the step is booked at
+ * the next step from the stored stress on that step's mid-step faces, one
+ * step's motion later than the faces it acted on (as before this change,
+ * when it was the current faces): the account's one approximation, an
+ * error of order h |L|^2 |sigma_v| V (L the velocity gradient, spin
+ * included), small beside the power 2 eta D : D V unless an element spins
+ * fast while hardly deforming (its sigma_v, and so the error, then vanish
+ * with D: a free spin books nothing, test_damping.c).
  */
 #include <math.h>
 #include <string.h>

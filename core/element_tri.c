@@ -346,8 +346,10 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
             /* Damping is booked with the step-averaged velocity, like every
              * work: its forces' power with the velocities before this step
              * now, and with those after it at the next step, from the stored
-             * stress on the mid-step geometry then (a step later: a relative
-             * error of a step's displacement gradient, ~1e-6). */
+             * stress on the mid-step geometry then (a step's motion later
+             * than the edges it acted on: an error of order h |L|^2 |sigma|
+             * A, L the velocity gradient, spin included; element_tet_model.c
+             * says when that matters). */
             double hv[3], mid[4];
             viscous_half(vel, n0, n1, n2, hh, x1, y1, x2, y2, el->eta, prev, hv, mid, power);
             prev[0] = hv[0];
