@@ -163,10 +163,9 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
     for (int l = 0; l < TET_N; l++) sum->energy += w[l] * t[l].volume0;
     if (__builtin_expect(damped, 0)) {
         /* a branch of its own down to the scatter, laid out away from the
-         * undamped path below, which is the loop's as it always was: with
-         * g formed in either branch the undamped loop ran ~10-15 % slower
-         * on the same instructions; like this ~5-10 % (CPU time on a busy
-         * machine, not yet understood: issue 29 report) */
+         * undamped path below, which is the loop's as it always was (with
+         * g formed in either branch, or the damped code in line, the
+         * undamped loop ran ~10 % slower on the same instructions) */
         TET_V gd[4][3];
         TET_VFN(tet_damp_group)(m, t, c, s, gd, sum, store);
         TET_VFN(tet_scatter_group)(m, t, gd, store);
