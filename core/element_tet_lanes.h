@@ -47,39 +47,30 @@ TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], cons
         vec3_scatter(f, node[a], g[a][0][lane], g[a][1][lane], g[a][2][lane], a == 0, store);
 }
 
-/* Lane `lane` of a group's faces and sixth stress as scalars, its face
- * loads with the damping (tet_damp) into g's lane. */
+/* Lane `lane` of a group's edges and face loads as scalars, the damping
+ * applied to it (tet_damp), and the loads put back. */
 static inline void TET_VFN(tet_damp_lane)(const fdem_model *m, const tet_hot *t, int lane,
-                                          const TET_V c[3][3], const TET_V s[6], TET_V g[4][3],
-                                          tet_sums *sum)
+                                          const TET_V e[3][3], TET_V g[4][3], tet_sums *sum)
 {
-    double cl[3][3], sl[6], gl[4][3];
+    double el[3][3], gl[4][3];
     TET_UNROLL
-    for (int q = 0; q < 9; q++) cl[q / 3][q % 3] = c[q / 3][q % 3][lane];
+    for (int q = 0; q < 9; q++) el[q / 3][q % 3] = e[q / 3][q % 3][lane];
     TET_UNROLL
-    for (int q = 0; q < 6; q++) sl[q] = s[q][lane];
-    tet_damp(m, t, cl, sl, gl, sum);
+    for (int q = 0; q < 12; q++) gl[q / 3][q % 3] = g[q / 3][q % 3][lane];
+    tet_damp(m, t, el, gl, sum);
     TET_UNROLL
     for (int q = 0; q < 12; q++) g[q / 3][q % 3][lane] = gl[q / 3][q % 3];
 }
 
-/* The face loads g of a group with damping (tet_kernel_face_loads of the
- * sixth stress s on the faces c, and the viscous loads on the mid-step
- * faces): if every eta > 0 and none is flat at mid-step, lane by lane what
- * tet_damp does to each element alone, the powers booked in element order
- * as one at a time would; else each damped lane through tet_damp_lane.
- * The edges are formed again here, as tet_damp does (see there). */
+/* The damping of a group with edges e and face loads g (every eta > 0,
+ * none flat at mid-step), lane by lane what tet_damp does to each element
+ * alone, the powers booked in element order as one at a time would; else
+ * each damped lane through tet_damp_lane. */
 TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
-                                        const TET_V c[3][3], const TET_V s[6], TET_V g[4][3],
-                                        tet_sums *sum, const int store)
+                                        const TET_V e[3][3], TET_V g[4][3], tet_sums *sum,
+                                        const int store)
 {
-    TET_VFN(tet_kernel_face_loads)(s, c, g);
-    TET_V x[4][3], e[3][3], v[4][3], dv[3][3], cm[3][3], S[6], sv[6], prev[6], eta2;
-    if (store)
-        TET_GATHER_OWN(m->pos, t, x);
-    else
-        TET_VFN(tet_gather_nodes)(m->pos, t, x);
-    TET_VFN(tet_kernel_edges)(x[0], x[1], x[2], x[3], e);
+    TET_V v[4][3], dv[3][3], cm[3][3], S[6], sv[6], prev[6], eta2;
     if (store)
         TET_GATHER_OWN(m->vel, t, v);
     else
@@ -91,7 +82,7 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
     for (int l = 0; l < TET_N; l++) all &= t[l].eta > 0 && fabs(det[l]) > 0;
     if (!all) {
         for (int l = 0; l < TET_N; l++)
-            if (t[l].eta > 0) TET_VFN(tet_damp_lane)(m, t + l, l, c, s, g, sum);
+            if (t[l].eta > 0) TET_VFN(tet_damp_lane)(m, t + l, l, e, g, sum);
         return;
     }
     TET_VFN(tet_kernel_rate_of)(dv, cm, S);
@@ -114,18 +105,6 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
     for (int q = 0; q < 6; q++) sixth[q] = sv[q] * (1.0 / 6);
     TET_VFN(tet_kernel_face_loads_add)(sixth, cm, g);
     TET_STORE_SIX(stored, sv);
-}
-
-/* The scatter of a group's loads g (`store`: the storing loop). */
-TET_KERNEL void TET_VFN(tet_scatter_group)(fdem_model *m, const tet_hot *t, const TET_V g[4][3],
-                                           const int store)
-{
-    if (store) {
-        TET_STORE_OWN(m->force, t, g);
-        return;
-    }
-    TET_UNROLL
-    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l, 0);
 }
 
 /* TET_N elements t[0 .. TET_N-1] of one material. */
@@ -156,24 +135,20 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
         w += TET_VFN(tet_kernel_prestress)(F, invJ * (1.0 / 6), S0, s);
     }
     TET_VFN(tet_kernel_faces)(e, c);
+    TET_V g[4][3];
+    TET_VFN(tet_kernel_face_loads)(s, c, g);
     int damped = 0;
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) damped |= t[l].eta > 0;
+    if (damped) TET_VFN(tet_damp_group)(m, t, e, g, sum, store);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) sum->energy += w[l] * t[l].volume0;
-    if (__builtin_expect(damped, 0)) {
-        /* a branch of its own down to the scatter, laid out away from the
-         * undamped path below, which is the loop's as it always was (with
-         * g formed in either branch, or the damped code in line, the
-         * undamped loop ran ~10 % slower on the same instructions) */
-        TET_V gd[4][3];
-        TET_VFN(tet_damp_group)(m, t, c, s, gd, sum, store);
-        TET_VFN(tet_scatter_group)(m, t, gd, store);
+    if (store) {
+        TET_STORE_OWN(m->force, t, g);
         return;
     }
-    TET_V g[4][3];
-    TET_VFN(tet_kernel_face_loads)(s, c, g);
-    TET_VFN(tet_scatter_group)(m, t, g, store);
+    TET_UNROLL
+    for (int l = 0; l < TET_N; l++) TET_VFN(tet_scatter_lane)(m->force, t[l].node, g, l, 0);
 }
 
 /* the parameters are this inclusion's alone: the next one defines its own */

@@ -127,24 +127,15 @@ typedef struct tet_sums {
     double energy, power_now, power_prev;
 } tet_sums;
 
-/* The face loads g of a damped element t (eta > 0): those of its elastic
- * sixth stress s on the current faces c (tet_kernel_face_loads) and those
- * of sigma_v / 6 on the mid-step faces, so the power booked is that of the
- * forces applied. Stores the new viscous stress and books both powers
- * (-V sigma_v : D = -(sigma_v : S) / 6, S = det D, the 1/6 applied to the
- * totals). The edges are formed again from the positions (the same bits)
- * and g is computed here or after the branch: so the loop keeps no more
- * numbers live across its damping branch than it always did (keeping the
- * edges live cost the undamped 3D loop ~10 % with no more instructions). */
-static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double c[3][3],
-                            const double s[6], double g[4][3], tet_sums *sum)
+/* The damping of element t (eta > 0) with edges e and face loads g (of the
+ * elastic sixth stress, tet_kernel_face_loads): stores the new viscous
+ * stress, books both powers (-V sigma_v : D = -(sigma_v : S) / 6, S =
+ * det D, the 1/6 applied to the totals) and adds the loads of sigma_v / 6
+ * on the mid-step faces to g, so the power booked is that of the forces
+ * applied. */
+static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double e[3][3],
+                            double g[4][3], tet_sums *sum)
 {
-    tet_kernel_face_loads(s, c, g);
-    const double *pos = m->pos;
-    const int32_t *n = t->node;
-    double e[3][3];
-    tet_kernel_edges(pos + 3 * (size_t)n[0], pos + 3 * (size_t)n[1], pos + 3 * (size_t)n[2],
-                     pos + 3 * (size_t)n[3], e);
     double cm[3][3], S[6], sv[6], *prev = m->elem_viscous + 6 * (size_t)(t - m->tet);
     if (tet_viscous(m->vel, t->node, e, 0.5 * m->dt_prev, t->eta, cm, S, sv)) {
         sum->power_now -= tet_kernel_contract(sv, S);
@@ -190,10 +181,8 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     sum->energy += w * t->volume0;
     tet_kernel_faces(e, c);
     double g[4][3];
-    if (t->eta > 0)
-        tet_damp(m, t, c, s, g, sum);
-    else
-        tet_kernel_face_loads(s, c, g);
+    tet_kernel_face_loads(s, c, g);
+    if (t->eta > 0) tet_damp(m, t, e, g, sum);
     tet_scatter(m->force, n, g, store);
 }
 
