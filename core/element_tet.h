@@ -13,7 +13,9 @@
  *    sigma = (mu/J)(B - I) + (lambda/J) ln J I with the full 3D lambda and
  *    mu; any rigid rotation gives zero stress; below J = TET_J_MIN the law
  *    continues along its tangent so squashed elements stay finite.
- *  - tet_forces: adds the viscous stress 2 eta D (D = sym([v][x]^-1)) and
+ *  - tet_forces: adds the viscous stress 2 eta D (D = sym([v][x]^-1) at
+ *    the positions given; the engine's loop takes D, and applies the
+ *    viscous forces, on the mid-step configuration: element_tet_model.c) and
  *    writes the nodal forces f_a = -V sigma grad N_a (f[3a .. 3a+2]); the
  *    four sum to zero to round-off (node 0 takes minus the sum of the other
  *    three) and their moment vanishes (sigma is symmetric). Returns the

@@ -22,16 +22,23 @@
  *  - tet_kernel_prestress: adds scale F S0 F^T (an in-situ pre-stress S0
  *    pushed forward) to a stress, returns S0 : E.
  *  - tet_kernel_rate: the symmetric part of sum_k (v_k - v_0) (x) c_k, which
- *    is det times the rate of deformation D (no division here).
+ *    is det times the rate of deformation D (no division here);
+ *    tet_kernel_rate_of the same from the differences v_k - v_0.
+ *  - tet_kernel_mid_faces: the face vectors and det of the mid-step edges
+ *    e_k - (h/2)(v_k - v_0), where the damping's D is taken (a rigid
+ *    motion's chord velocity is skew on them: element_tet_model.c).
  *  - tet_kernel_face_loads: g_a = s c_a for a stress s already scaled by
  *    1/6 and g_0 = g_1 + g_2 + g_3; the nodal forces are f_a = -g_a
  *    (-V sigma grad N_a = -sigma c_a / 6) and f_0 = g_0: the four sum to
  *    zero exactly. Unnegated, so a scatter subtracts and saves the signs.
+ *    tet_kernel_face_loads_add adds a second stress's loads on other face
+ *    vectors (g_1..g_3) and sums g_0 again.
  *  - tet_kernel_contract: s : S of two symmetric tensors in Voigt order.
- *  - Each of edges, faces, gradient, stress, prestress, rate, contract and
- *    face_loads also exists as name_pair over tet_pair, two elements in the
- *    lanes of one SIMD register (element_tet_kernel_body.h is written once
- *    for both), with the same bits per element as the scalar one.
+ *  - Each of edges, faces, mid_faces, gradient, stress, prestress, rate,
+ *    rate_of, contract, face_loads and face_loads_add also exists as
+ *    name_pair over tet_pair, two elements in the lanes of one SIMD
+ *    register (element_tet_kernel_body.h is written once for both), with
+ *    the same bits per element as the scalar one.
  */
 #ifndef FDEM_ELEMENT_TET_KERNEL_H
 #define FDEM_ELEMENT_TET_KERNEL_H

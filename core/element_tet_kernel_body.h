@@ -89,6 +89,24 @@ TET_KERNEL void TET_FN(tet_kernel_face_loads)(const TET_T s[6], const TET_T c[3]
     for (int i = 0; i < 3; i++) g[0][i] = g[1][i] + g[2][i] + g[3][i];
 }
 
+/* g_a += s c_a (a = 1..3) and g_0 = g_1 + g_2 + g_3 again: the loads of a
+ * second stress on other face vectors (the viscous stress on the mid-step
+ * faces) added to those of tet_kernel_face_loads, the four still summing
+ * to zero exactly. */
+TET_KERNEL void TET_FN(tet_kernel_face_loads_add)(const TET_T s[6], const TET_T c[3][3],
+                                                  TET_T g[4][3])
+{
+    TET_UNROLL
+    for (int a = 1; a <= 3; a++) {
+        const TET_T *ca = c[a - 1];
+        g[a][0] += s[0] * ca[0] + s[5] * ca[1] + s[4] * ca[2];
+        g[a][1] += s[5] * ca[0] + s[1] * ca[1] + s[3] * ca[2];
+        g[a][2] += s[4] * ca[0] + s[3] * ca[1] + s[2] * ca[2];
+    }
+    TET_UNROLL
+    for (int i = 0; i < 3; i++) g[0][i] = g[1][i] + g[2][i] + g[3][i];
+}
+
 /* s += scale F S0 F^T: the in-situ pre-stress S0 pushed forward (scale =
  * 1/J, or 1/(6J) for the sixth stress); returns its strain energy density
  * S0 : E = (tr(F S0 F^T) - tr S0) / 2 (initial_stress.c). */
@@ -114,11 +132,22 @@ TET_KERNEL TET_T TET_FN(tet_kernel_prestress)(const TET_T F[9], TET_T scale, con
     return 0.5 * (tau[0] + tau[1] + tau[2] - S0[0] - S0[1] - S0[2]);
 }
 
-TET_KERNEL void TET_FN(tet_kernel_rate)(const TET_T *v0, const TET_T *v1, const TET_T *v2,
-                                        const TET_T *v3, const TET_T c[3][3], TET_T S[6])
+/* The face vectors c of the mid-step edges e - hh dv (e the edges, dv the
+ * velocity differences v_k - v_0, hh = h_last / 2); returns their det. */
+TET_KERNEL TET_T TET_FN(tet_kernel_mid_faces)(const TET_T e[3][3], const TET_T dv[3][3], double hh,
+                                              TET_T c[3][3])
 {
-    TET_T dv[3][3];
-    TET_FN(tet_kernel_edges)(v0, v1, v2, v3, dv);
+    TET_T em[3][3];
+    TET_UNROLL
+    for (int k = 0; k < 3; k++)
+        TET_UNROLL
+        for (int i = 0; i < 3; i++) em[k][i] = e[k][i] - hh * dv[k][i];
+    return TET_FN(tet_kernel_faces)(em, c);
+}
+
+/* tet_kernel_rate from the velocity differences dv[k] = v_{k+1} - v_0. */
+TET_KERNEL void TET_FN(tet_kernel_rate_of)(const TET_T dv[3][3], const TET_T c[3][3], TET_T S[6])
+{
     TET_T L[3][3];
     TET_UNROLL
     for (int i = 0; i < 3; i++)
@@ -131,6 +160,14 @@ TET_KERNEL void TET_FN(tet_kernel_rate)(const TET_T *v0, const TET_T *v1, const 
     S[3] = 0.5 * (L[1][2] + L[2][1]);
     S[4] = 0.5 * (L[0][2] + L[2][0]);
     S[5] = 0.5 * (L[0][1] + L[1][0]);
+}
+
+TET_KERNEL void TET_FN(tet_kernel_rate)(const TET_T *v0, const TET_T *v1, const TET_T *v2,
+                                        const TET_T *v3, const TET_T c[3][3], TET_T S[6])
+{
+    TET_T dv[3][3];
+    TET_FN(tet_kernel_edges)(v0, v1, v2, v3, dv);
+    TET_FN(tet_kernel_rate_of)(dv, c, S);
 }
 
 /* s : S with the shear terms counted twice (symmetric tensors in Voigt order) */

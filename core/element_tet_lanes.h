@@ -47,43 +47,45 @@ TET_KERNEL void TET_VFN(tet_scatter_lane)(double *f, const int32_t node[4], cons
         vec3_scatter(f, node[a], g[a][0][lane], g[a][1][lane], g[a][2][lane], a == 0, store);
 }
 
-/* Lane `lane` of a group's face vectors and sixth stress as scalars, the
- * damping applied to it, and the stress put back. */
+/* Lane `lane` of a group's edges and face loads as scalars, the damping
+ * applied to it (tet_damp), and the loads put back. */
 static inline void TET_VFN(tet_damp_lane)(const fdem_model *m, const tet_hot *t, int lane,
-                                          const TET_V c[3][3], TET_V det, TET_V s[6],
-                                          tet_sums *sum)
+                                          const TET_V e[3][3], TET_V g[4][3], tet_sums *sum)
 {
-    double cl[3][3], sl[6];
+    double el[3][3], gl[4][3];
     TET_UNROLL
-    for (int q = 0; q < 9; q++) cl[q / 3][q % 3] = c[q / 3][q % 3][lane];
+    for (int q = 0; q < 9; q++) el[q / 3][q % 3] = e[q / 3][q % 3][lane];
     TET_UNROLL
-    for (int q = 0; q < 6; q++) sl[q] = s[q][lane];
-    tet_damp(m, t, cl, det[lane], sl, sum);
+    for (int q = 0; q < 12; q++) gl[q / 3][q % 3] = g[q / 3][q % 3][lane];
+    tet_damp(m, t, el, gl, sum);
     TET_UNROLL
-    for (int q = 0; q < 6; q++) s[q][lane] = sl[q];
+    for (int q = 0; q < 12; q++) g[q / 3][q % 3][lane] = gl[q / 3][q % 3];
 }
 
-/* The damping of a group (every eta > 0, none flat), lane by lane what
- * tet_damp does to each element alone, the powers booked in element
- * order as one at a time would; else each lane through tet_damp_lane. */
+/* The damping of a group with edges e and face loads g (every eta > 0,
+ * none flat at mid-step), lane by lane what tet_damp does to each element
+ * alone, the powers booked in element order as one at a time would; else
+ * each damped lane through tet_damp_lane. */
 TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
-                                        const TET_V c[3][3], TET_V det, TET_V s[6],
-                                        tet_sums *sum, const int store)
+                                        const TET_V e[3][3], TET_V g[4][3], tet_sums *sum,
+                                        const int store)
 {
+    TET_V v[4][3], dv[3][3], cm[3][3], S[6], sv[6], prev[6], eta2;
+    if (store)
+        TET_GATHER_OWN(m->vel, t, v);
+    else
+        TET_VFN(tet_gather_nodes)(m->vel, t, v);
+    TET_VFN(tet_kernel_edges)(v[0], v[1], v[2], v[3], dv);
+    TET_V det = TET_VFN(tet_kernel_mid_faces)(e, dv, 0.5 * m->dt_prev, cm);
     int all = 1;
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) all &= t[l].eta > 0 && fabs(det[l]) > 0;
     if (!all) {
         for (int l = 0; l < TET_N; l++)
-            if (t[l].eta > 0) TET_VFN(tet_damp_lane)(m, t + l, l, c, det, s, sum);
+            if (t[l].eta > 0) TET_VFN(tet_damp_lane)(m, t + l, l, e, g, sum);
         return;
     }
-    TET_V v[4][3], S[6], sv[6], prev[6], eta2;
-    if (store)
-        TET_GATHER_OWN(m->vel, t, v);
-    else
-        TET_VFN(tet_gather_nodes)(m->vel, t, v);
-    TET_VFN(tet_kernel_rate)(v[0], v[1], v[2], v[3], c, S);
+    TET_VFN(tet_kernel_rate_of)(dv, cm, S);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) eta2[l] = 2 * t[l].eta;
     TET_V scale = eta2 / det;
@@ -98,8 +100,10 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
         sum->power_now -= now[l];
         sum->power_prev -= before[l];
     }
+    TET_V sixth[6];
     TET_UNROLL
-    for (int q = 0; q < 6; q++) s[q] += sv[q] * (1.0 / 6);
+    for (int q = 0; q < 6; q++) sixth[q] = sv[q] * (1.0 / 6);
+    TET_VFN(tet_kernel_face_loads_add)(sixth, cm, g);
     TET_STORE_SIX(stored, sv);
 }
 
@@ -130,15 +134,15 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
         for (int q = 0; q < 6; q++) S0[q] = TET_GATHER(p, q);
         w += TET_VFN(tet_kernel_prestress)(F, invJ * (1.0 / 6), S0, s);
     }
-    TET_V det = TET_VFN(tet_kernel_faces)(e, c);
+    TET_VFN(tet_kernel_faces)(e, c);
+    TET_V g[4][3];
+    TET_VFN(tet_kernel_face_loads)(s, c, g);
     int damped = 0;
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) damped |= t[l].eta > 0;
-    if (damped) TET_VFN(tet_damp_group)(m, t, c, det, s, sum, store);
+    if (damped) TET_VFN(tet_damp_group)(m, t, e, g, sum, store);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) sum->energy += w[l] * t[l].volume0;
-    TET_V g[4][3];
-    TET_VFN(tet_kernel_face_loads)(s, c, g);
     if (store) {
         TET_STORE_OWN(m->force, t, g);
         return;

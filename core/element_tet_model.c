@@ -10,6 +10,26 @@
  * Forces come from the face vectors c_k (twice the area vectors through
  * node 0), f_a = -sigma c_{a-1} / 6, node 0 taking minus the sum of the
  * other three so each element's forces sum to exactly zero.
+ *
+ * The damping stress 2 eta D takes D = sym([v][x_mid]^-1) on the mid-step
+ * configuration x_mid = x - h_last v / 2 (v the half-step velocity, the
+ * chord of the last step, h_last = dt_prev): for a rigid motion that chord
+ * velocity is W x_mid with W skew (the Cayley transform of the step's
+ * rotation), so a spin gives D = 0 to round-off, where on the current x it
+ * gave D ~ h omega^2 / 2 and a free spin was damped, booked in proportion
+ * to dt^2 (issue 29). Its forces are the loads of sigma_v / 6 on the
+ * mid-step face vectors, added to the elastic ones before the one scatter
+ * (tet_kernel_face_loads_add), so the power booked now, -(sigma_v : S) / 6
+ * on the same faces, is exactly that of the forces applied; forces on the
+ * current faces would not be (a relative h omega off for a spinning body).
+ * The same forces' power with the velocities after the step is booked at
+ * the next step from the stored stress on that step's mid-step faces, one
+ * step's motion later than the faces it acted on (as before this change,
+ * when it was the current faces): the account's one approximation, an
+ * error of order h |L|^2 |sigma_v| V (L the velocity gradient, spin
+ * included), small beside the power 2 eta D : D V unless an element spins
+ * fast while hardly deforming (its sigma_v, and so the error, then vanish
+ * with D: a free spin books nothing, test_damping.c).
  */
 #include <math.h>
 #include <string.h>
@@ -80,18 +100,22 @@ static inline void tet_constants_load(tet_constants *k, const material *mats, in
     k->hlambda = 0.5 * mats[which].lambda;
 }
 
-/* The damping stress 2 eta D (D = S / det, S = tet_kernel_rate) into sv,
- * full (the stored per-element value); a flat element gets none (returns 0,
- * sv zero). */
-static inline int tet_viscous(const double *vel, const int32_t node[4], const double c[3][3],
-                              double det, double eta, double S[6], double sv[6])
+/* The damping stress 2 eta D of an element on its mid-step configuration
+ * (edges e - hh [v], hh = h_last / 2; D = S / det, S = tet_kernel_rate_of)
+ * into sv, full (the stored per-element value), with S, and the mid-step
+ * face vectors in cm; a flat element gets none (returns 0, sv zero). */
+static inline int tet_viscous(const double *vel, const int32_t node[4], const double e[3][3],
+                              double hh, double eta, double cm[3][3], double S[6], double sv[6])
 {
+    double dv[3][3];
+    tet_kernel_edges(vel + 3 * (size_t)node[0], vel + 3 * (size_t)node[1],
+                     vel + 3 * (size_t)node[2], vel + 3 * (size_t)node[3], dv);
+    double det = tet_kernel_mid_faces(e, dv, hh, cm);
     if (!(fabs(det) > 0)) {
         memset(sv, 0, 6 * sizeof(double));
         return 0;
     }
-    tet_kernel_rate(vel + 3 * (size_t)node[0], vel + 3 * (size_t)node[1],
-                    vel + 3 * (size_t)node[2], vel + 3 * (size_t)node[3], c, S);
+    tet_kernel_rate_of(dv, cm, S);
     double scale = 2 * eta / det;
     TET_UNROLL
     for (int k = 0; k < 6; k++) sv[k] = scale * S[k];
@@ -103,18 +127,23 @@ typedef struct tet_sums {
     double energy, power_now, power_prev;
 } tet_sums;
 
-/* The damping of element t (eta > 0) on its sixth stress s: stores the
- * new viscous stress, books both powers (-V sigma_v : D = -(sigma_v : S) / 6,
- * S = det D, the 1/6 applied to the totals), adds sigma_v / 6 to s. */
-static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double c[3][3],
-                            double det, double s[6], tet_sums *sum)
+/* The damping of element t (eta > 0) with edges e and face loads g (of the
+ * elastic sixth stress, tet_kernel_face_loads): stores the new viscous
+ * stress, books both powers (-V sigma_v : D = -(sigma_v : S) / 6, S =
+ * det D, the 1/6 applied to the totals) and adds the loads of sigma_v / 6
+ * on the mid-step faces to g, so the power booked is that of the forces
+ * applied. */
+static inline void tet_damp(const fdem_model *m, const tet_hot *t, const double e[3][3],
+                            double g[4][3], tet_sums *sum)
 {
-    double S[6], sv[6], *prev = m->elem_viscous + 6 * (size_t)(t - m->tet);
-    if (tet_viscous(m->vel, t->node, c, det, t->eta, S, sv)) {
+    double cm[3][3], S[6], sv[6], *prev = m->elem_viscous + 6 * (size_t)(t - m->tet);
+    if (tet_viscous(m->vel, t->node, e, 0.5 * m->dt_prev, t->eta, cm, S, sv)) {
         sum->power_now -= tet_kernel_contract(sv, S);
         sum->power_prev -= tet_kernel_contract(prev, S);
+        double sixth[6];
         TET_UNROLL
-        for (int q = 0; q < 6; q++) s[q] += sv[q] * (1.0 / 6);
+        for (int q = 0; q < 6; q++) sixth[q] = sv[q] * (1.0 / 6);
+        tet_kernel_face_loads_add(sixth, cm, g);
     }
     TET_UNROLL
     for (int q = 0; q < 6; q++) prev[q] = sv[q];
@@ -150,10 +179,10 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
     double w = tet_kernel_stress(F, k->smu, k->slambda, k->hmu, k->hlambda, s, &J, &invJ);
     if (stressed) w += tet_kernel_prestress(F, invJ * (1.0 / 6), tet_stress0(m, t), s);
     sum->energy += w * t->volume0;
-    double det = tet_kernel_faces(e, c);
-    if (t->eta > 0) tet_damp(m, t, c, det, s, sum);
+    tet_kernel_faces(e, c);
     double g[4][3];
     tet_kernel_face_loads(s, c, g);
+    if (t->eta > 0) tet_damp(m, t, e, g, sum);
     tet_scatter(m->force, n, g, store);
 }
 
@@ -302,7 +331,8 @@ static void tet_forces_quad(fdem_model *m, const tet_hot *t, tet_constants *k, t
  *  - ln J by the series of log_near1.h instead of libm;
  *  - everything inline and unrolled, no per-element call or table lookup;
  *  - records prefetched ahead;
- *  - damping: one division, and its power from s : S directly. */
+ *  - damping: one division, and its power from s : S directly (the mid-step
+ *    faces cost one more cross product per face). */
 TET_KERNEL void tet_forces_run(fdem_model *m, int begin, int end_index, const int stressed,
                                const int store, const int quads, tet_constants *constants,
                                tet_sums *sums)
@@ -430,7 +460,8 @@ void tet_element_stress(const fdem_model *m, int e, double out[6])
     tet_kernel_stress(F, mat->mu, mat->lambda, 0.5 * mat->mu, 0.5 * mat->lambda, out, &J, &invJ);
     if (m->elem_stress0 && m->parts[m->elem_part[e]].stressed)
         tet_kernel_prestress(F, invJ, tet_stress0(m, t), out);
-    double S[6], sv[6], det = tet_kernel_faces(ed, c);
-    if (t->eta > 0 && tet_viscous(m->vel, t->node, c, det, t->eta, S, sv))
+    /* the viscous stress of the forces: on the mid-step configuration */
+    double S[6], sv[6];
+    if (t->eta > 0 && tet_viscous(m->vel, t->node, ed, 0.5 * m->dt_prev, t->eta, c, S, sv))
         for (int q = 0; q < 6; q++) out[q] += sv[q];
 }

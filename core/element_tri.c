@@ -8,7 +8,17 @@
  * compressible neo-Hookean solid sigma = (mu/J)(B - I) + (lambda/J) ln J I,
  * B = F F^T: objective (a rigid rotation R gives B = I, so no stress) and
  * equal to plane-strain linear elasticity at small strain. Viscous damping
- * adds 2 eta D with D = sym([v][x]^-1); an in-situ pre-stress S0 adds
+ * adds 2 eta D with D = sym([v][x_mid]^-1) on the mid-step configuration
+ * x_mid = x - h_last v / 2 (v the half-step velocity, the chord of the last
+ * step, h_last = dt_prev), so a rigid rotation gives D = 0 to round-off:
+ * with the current x it gave D ~ h omega^2 / 2 and a free spin was damped,
+ * booked in proportion to dt^2 (issue 29). The viscous stress's forces are
+ * applied on the mid-step edges, in the same scatter as the elastic ones,
+ * so the damping power booked, -det [x_mid] (eta D : D), is that of the
+ * forces applied (the other way, forces on the current edges, would book
+ * a power that is not theirs by a relative h omega; the power of the same
+ * forces with the next velocities is booked at the next step on its
+ * mid-step edges: tri_forces). An in-situ pre-stress S0 adds
  * F S0 F^T / J (initial_stress.c), in a second instance of the loop that
  * only the elements of stressed parts run.
  *
@@ -176,50 +186,64 @@ static inline double prestress_add(double a, double b, double c, double d, doubl
     return 0.5 * (txx + tyy - s0[0] - s0[1]);
 }
 
-/* The rate of deformation D = sym([v][x]^-1) of an element (current
- * geometry) as (D11, D22, D12) and det [x], or 0 for an element of no
- * area. The division is paid only by damped elements. */
-static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, double x1,
-                                      double y1, double x2, double y2, double *det_out,
-                                      double D[3])
+/* The rate of deformation D = sym([v][x]^-1) of an element on its mid-step
+ * configuration x_mid = x - hh v (hh = h_last / 2: the positions halfway
+ * along the last step, whose chord velocity v is), as det [x_mid] D in a
+ * (D11, D22, D12 times det) and 1 / det in *inv_out, with the mid-step edge
+ * vectors in mid (x1, y1, x2, y2); returns 0 (a, inv unset) for a mid-step
+ * element of no area. For a rigid motion the chord velocity is W x_mid
+ * with W skew (the Cayley transform of the step's rotation), so D = 0 to
+ * round-off; on the current geometry it was of order h omega^2 (the spin
+ * was damped). The division is paid only by damped elements. */
+static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, double hh,
+                                      double x1, double y1, double x2, double y2, double mid[4],
+                                      double *inv_out, double a[3])
 {
-    double det = x1 * y2 - x2 * y1;
-    if (!(fabs(det) > 0)) return 0;
     double u1 = v[2 * n1] - v[2 * n0], w1 = v[2 * n1 + 1] - v[2 * n0 + 1];
     double u2 = v[2 * n2] - v[2 * n0], w2 = v[2 * n2 + 1] - v[2 * n0 + 1];
-    double inv = 1.0 / det;
-    /* [x]^-1 = (1/det) (y2 -x2; -y1 x1); L = [v][x]^-1 */
-    double L11 = (u1 * y2 - u2 * y1) * inv, L12 = (-u1 * x2 + u2 * x1) * inv;
-    double L21 = (w1 * y2 - w2 * y1) * inv, L22 = (-w1 * x2 + w2 * x1) * inv;
-    D[0] = L11;
-    D[1] = L22;
-    D[2] = 0.5 * (L12 + L21);
-    *det_out = det;
+    x1 -= hh * u1;
+    y1 -= hh * w1;
+    x2 -= hh * u2;
+    y2 -= hh * w2;
+    mid[0] = x1;
+    mid[1] = y1;
+    mid[2] = x2;
+    mid[3] = y2;
+    double det = x1 * y2 - x2 * y1;
+    if (!(fabs(det) > 0)) return 0;
+    /* det [x]^-1 = (y2 -x2; -y1 x1); det L = [v] det [x]^-1 */
+    a[0] = u1 * y2 - u2 * y1;
+    a[1] = w2 * x1 - w1 * x2;
+    a[2] = 0.5 * ((u2 * x1 - u1 * x2) + (w1 * y2 - w2 * y1));
+    *inv_out = 1.0 / det;
     return 1;
 }
 
-/* The viscous half stress eta D into hv and the power of the nodal forces
- * of it and of prev (the last step's viscous half stress) with these
- * velocities, added to power[0] and power[1]: sum_a f_a . v_a =
- * -A sigma : L = -det [x] (h : D) for a half stress h. The two powers are
- * the same expression on two stresses, written as a loop over the pair so
- * that the compiler evaluates them side by side in one vector register
- * (each lane rounds exactly as the scalar would, so the damping account
- * keeps its bits; 18.9 -> 17.2 ns per damped element, CPU time). */
-static inline void viscous_half(const double *v, int n0, int n1, int n2, double x1, double y1,
-                                double x2, double y2, double eta, const double prev[3],
-                                double hv[3], double power[2])
+/* The viscous half stress eta D (D on the mid-step configuration) into hv,
+ * the mid-step edges into mid, and the power of the nodal forces of it and
+ * of prev (the last step's viscous half stress), both applied on the
+ * mid-step edges, with these velocities, added to power[0] and power[1]:
+ * sum_a f_a . v_a = -A sigma : L = -det [x_mid] (h : D) = -(h : a) for a
+ * half stress h (a = det D: rate_of_deformation). The two powers are the
+ * same expression on two stresses, written as a loop over the pair so that
+ * the compiler evaluates them side by side in one vector register (each
+ * lane rounds exactly as the scalar would, so the damping account keeps its
+ * bits; 18.9 -> 17.2 ns per damped element, CPU time). */
+static inline void viscous_half(const double *v, int n0, int n1, int n2, double hh, double x1,
+                                double y1, double x2, double y2, double eta, const double prev[3],
+                                double hv[3], double mid[4], double power[2])
 {
-    double det, D[3];
-    if (!rate_of_deformation(v, n0, n1, n2, x1, y1, x2, y2, &det, D)) {
+    double inv, a[3];
+    if (!rate_of_deformation(v, n0, n1, n2, hh, x1, y1, x2, y2, mid, &inv, a)) {
         hv[0] = hv[1] = hv[2] = 0;
         power[0] += 0.0;
         power[1] += 0.0;
         return;
     }
-    for (int k = 0; k < 3; k++) hv[k] = eta * D[k];
+    double scale = eta * inv;
+    for (int k = 0; k < 3; k++) hv[k] = scale * a[k];
     const double s0[2] = {hv[0], prev[0]}, s1[2] = {hv[1], prev[1]}, s2[2] = {hv[2], prev[2]};
-    for (int k = 0; k < 2; k++) power[k] += -det * (s0[k] * D[0] + s1[k] * D[1] + 2 * s2[k] * D[2]);
+    for (int k = 0; k < 2; k++) power[k] -= s0[k] * a[0] + s1[k] * a[1] + 2 * s2[k] * a[2];
 }
 
 /* Nodal forces 1/2 sigma m_a of a half stress hs on the element with edge
@@ -236,6 +260,33 @@ static inline void edge_traction_forces(double *f, int n0, int n1, int n2, doubl
     g2[1] += f2y;
     g0[0] -= f1x + f2x;
     g0[1] -= f1y + f2y;
+}
+
+/* The same for a damped element: the elastic half stress hs on the current
+ * edges and the viscous one hv on the mid-step edges mid, in one scatter
+ * (the power booked for hv is that of these forces: viscous_half). The x
+ * and y components side by side in one vector register: per component
+ * the operations of the scalar expression (hs2 x2 - hs0 y2) + (hv2 mx2 -
+ * hv0 my2) and so on, in half the instructions. */
+typedef double tri_xy __attribute__((vector_size(16)));
+static inline void edge_traction_forces_damped(double *f, int n0, int n1, int n2, double x1,
+                                               double y1, double x2, double y2, const double hs[3],
+                                               const double mid[4], const double hv[3])
+{
+    const tri_xy A = {hs[2], hs[1]}, B = {hs[0], hs[2]}, Av = {hv[2], hv[1]}, Bv = {hv[0], hv[2]};
+    tri_xy f1 = (x2 * A - y2 * B) + (mid[2] * Av - mid[3] * Bv);
+    tri_xy f2 = (y1 * B - x1 * A) + (mid[1] * Bv - mid[0] * Av);
+    double *g0 = f + 2 * (size_t)n0, *g1 = f + 2 * (size_t)n1, *g2 = f + 2 * (size_t)n2;
+    tri_xy h0, h1, h2;
+    memcpy(&h0, g0, sizeof h0);
+    memcpy(&h1, g1, sizeof h1);
+    memcpy(&h2, g2, sizeof h2);
+    h1 += f1;
+    h2 += f2;
+    h0 -= f1 + f2;
+    memcpy(g1, &h1, sizeof h1);
+    memcpy(g2, &h2, sizeof h2);
+    memcpy(g0, &h0, sizeof h0);
 }
 
 /* The hot loop: one pass over the element records, gathering three nodes
@@ -267,6 +318,7 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
     double energy = 0, power[2] = {0, 0}; /* of this step's and the last step's viscous stress */
     int32_t cur_mat = -1;
     double hlambda = 0, hmu = 0;
+    const double hh = 0.5 * m->dt_prev; /* x_mid = x - hh v */
     const element_hot *el = m->elem + begin, *end = m->elem + end_index;
     for (; el < end; el++) {
         ELEM_PREFETCH_READ(end - el > ELEM_PREFETCH ? el + ELEM_PREFETCH : el);
@@ -294,18 +346,19 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
             /* Damping is booked with the step-averaged velocity, like every
              * work: its forces' power with the velocities before this step
              * now, and with those after it at the next step, from the stored
-             * stress on the geometry then (a step's strain later: a relative
-             * error of the strain increment, ~1e-6). */
-            double hv[3];
-            viscous_half(vel, n0, n1, n2, x1, y1, x2, y2, el->eta, prev, hv, power);
+             * stress on the mid-step geometry then (a step's motion later
+             * than the edges it acted on: an error of order h |L|^2 |sigma|
+             * A, L the velocity gradient, spin included; element_tet_model.c
+             * says when that matters). */
+            double hv[3], mid[4];
+            viscous_half(vel, n0, n1, n2, hh, x1, y1, x2, y2, el->eta, prev, hv, mid, power);
             prev[0] = hv[0];
             prev[1] = hv[1];
             prev[2] = hv[2];
-            hs[0] += hv[0];
-            hs[1] += hv[1];
-            hs[2] += hv[2];
+            edge_traction_forces_damped(f, n0, n1, n2, x1, y1, x2, y2, hs, mid, hv);
+        } else {
+            edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
         }
-        edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
         if (prev) prev += 3; /* NULL + 0 would be undefined: undamped models have no array */
     }
     sums[0] += energy;
@@ -341,8 +394,11 @@ void tri_element_stress(const fdem_model *m, int e, double out[3])
     neo_hookean_half(a, b, c, d, 0.5 * mat->lambda, 0.5 * mat->mu, out, &w, &invJ);
     if (m->elem_stress0 && m->parts[m->elem_part[e]].stressed)
         prestress_add(a, b, c, d, 0.5 * invJ, m->elem_stress0 + 3 * (size_t)e, out);
-    double det, D[3];
-    if (el->eta > 0 && rate_of_deformation(m->vel, n0, n1, n2, x1, y1, x2, y2, &det, D))
-        for (int k = 0; k < 3; k++) out[k] += el->eta * D[k];
+    double inv, D[3], mid[4]; /* the D of the forces: mid-step configuration */
+    if (el->eta > 0 &&
+        rate_of_deformation(m->vel, n0, n1, n2, 0.5 * m->dt_prev, x1, y1, x2, y2, mid, &inv, D)) {
+        double scale = el->eta * inv; /* as viscous_half */
+        for (int k = 0; k < 3; k++) out[k] += scale * D[k];
+    }
     for (int k = 0; k < 3; k++) out[k] *= 2; /* exact */
 }
