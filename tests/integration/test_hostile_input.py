@@ -11,7 +11,7 @@ import time
 import unittest
 
 from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
-from test_hostile_requests import raw_exchange, status_of
+from test_hostile_requests import raw_exchange, read_until_closed, status_of
 
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
@@ -56,12 +56,7 @@ class GateTest(DaemonTestCase):
             # the rest of the header still completes the request
             s.sendall(b"1\r\n\r\n")
             s.settimeout(10 * SLOW)
-            reply = b""
-            while True:
-                chunk = s.recv(65536)
-                if not chunk:
-                    break
-                reply += chunk
+            reply = read_until_closed(s)
             self.assertEqual(status_of(reply), 200, reply[:200])
         finally:
             s.close()
@@ -73,12 +68,7 @@ class GateTest(DaemonTestCase):
             t0 = time.monotonic()
             s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
             s.shutdown(socket.SHUT_WR)
-            reply = b""
-            while True:
-                chunk = s.recv(65536)
-                if not chunk:
-                    break
-                reply += chunk
+            reply = read_until_closed(s)
             seconds = time.monotonic() - t0
         finally:
             s.close()
