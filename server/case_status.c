@@ -239,19 +239,11 @@ int case_persist_status(server_case *c)
     return case_persist_status_counting(c, -1);
 }
 
-int case_persist_status_counting(server_case *c, int snapshots)
+/* Writes status object o (consumed) as the case's status.json under its
+ * persist lock; a failed write is recorded on the case. */
+static int case_status_store(server_case *c, json_t *o)
 {
-    if (atomic_load(&c->deleted))
-        return 0;
     char reason[128] = "";
-    json_t *o = case_status_json(c);
-    if (o && snapshots >= 0)
-        json_object_set_new(o, "snapshots", json_integer(snapshots));
-    pthread_mutex_lock(&c->lock);
-    int paused_by_shutdown = c->paused_by_shutdown;
-    pthread_mutex_unlock(&c->lock);
-    if (o && paused_by_shutdown)
-        json_object_set_new(o, "paused_by_shutdown", json_true());
     pthread_mutex_lock(&c->persist_lock);
     int rc = case_write_status_json(c, o, reason, sizeof reason);
     pthread_mutex_unlock(&c->persist_lock);
@@ -260,9 +252,23 @@ int case_persist_status_counting(server_case *c, int snapshots)
     return rc;
 }
 
+int case_persist_status_counting(server_case *c, int snapshots)
+{
+    if (atomic_load(&c->deleted))
+        return 0;
+    json_t *o = case_status_json(c);
+    if (o && snapshots >= 0)
+        json_object_set_new(o, "snapshots", json_integer(snapshots));
+    pthread_mutex_lock(&c->lock);
+    int paused_by_shutdown = c->paused_by_shutdown;
+    pthread_mutex_unlock(&c->lock);
+    if (o && paused_by_shutdown)
+        json_object_set_new(o, "paused_by_shutdown", json_true());
+    return case_status_store(c, o);
+}
+
 int case_persist_status_as(server_case *c, case_state state, char *ended, size_t ended_size)
 {
-    char reason[128] = "";
     json_t *o = case_status_json_as(c, state, NULL);
     ended[0] = '\0';
     if (case_state_is_terminal(state)) {
@@ -274,12 +280,7 @@ int case_persist_status_as(server_case *c, case_state state, char *ended, size_t
         if (o)
             json_object_set_new(o, "finished_at", json_string(ended));
     }
-    pthread_mutex_lock(&c->persist_lock);
-    int rc = case_write_status_json(c, o, reason, sizeof reason);
-    pthread_mutex_unlock(&c->persist_lock);
-    if (rc != 0)
-        case_status_write_failed(c, reason);
-    return rc;
+    return case_status_store(c, o);
 }
 
 /* ------------------------------------------------------------- the log */
