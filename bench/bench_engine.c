@@ -31,8 +31,8 @@
 
 #include "../tests/unit/build_container_3d.h"
 #include "../tests/unit/build_model.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
 #include "stream.h"
 
 static double now(void)

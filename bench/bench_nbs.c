@@ -22,8 +22,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "nbs.h"
-#include "nbs_internal.h" /* the sphere test NBS uses, for the baseline */
+#include "nbs/nbs.h"
+#include "nbs/nbs_internal.h" /* the sphere test NBS uses, for the baseline */
 #include "stream.h"
 
 #define GRID_MAX_CELLS ((int64_t)1 << 26) /* 256 MB of int32 counts */

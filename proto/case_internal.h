@@ -19,7 +19,7 @@
 #include "case.h"
 #include "fdem.h"
 #include "gmsh.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 #include "problems.h"
 
 #define CASE_POINTER 256 /* = sizeof problem.pointer */

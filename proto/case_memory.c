@@ -31,7 +31,7 @@ static void memory_disc_counts(double divisions, double *nodes, double *elements
 /* The 3D generators map a lattice of cells, six tetrahedra each, onto the
  * shape. A sphere (cylinder cross-section) of d edges around the rim is a
  * cube (square) of n cells a side, n = d / 4 rounded up to even, as
- * cells_for_circle() in core/mesh_3d.c chooses it. */
+ * cells_for_circle() in core/mesh/mesh_3d.c chooses it. */
 static double memory_cells_for_circle(double divisions)
 {
     double n = ceil(divisions / 4);

@@ -18,7 +18,7 @@
 
 #include "case_internal.h"
 #include "gmsh.h"
-#include "node_ids.h"
+#include "math/node_ids.h"
 
 typedef struct mesh_kind {
     int dimension;           /* numbers per node */

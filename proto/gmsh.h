@@ -14,7 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 #include "fdem.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 /* Physical groups (contract 5.3), read from $PhysicalNames and the
  * elements' tags (2.2) or their entities' (4.1, $Entities). Only named

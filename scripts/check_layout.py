@@ -18,6 +18,7 @@ Prints each circle with the includes or symbols that close it and exits 1
 when there is one; lists files past the ~800-line mark without failing.
 
     check_layout.py [--objects build]
+    check_layout.py --self-test   (shows that a circle is found, and only then)
 """
 import argparse
 import os
@@ -136,11 +137,37 @@ def report(kind, edges):
     return not bad
 
 
+def self_test():
+    """A tree with a circle of two folders must fail, the same tree without
+    the include that closes it must pass: the check can fail."""
+    import contextlib
+    import io
+    import tempfile
+    ok = True
+    for closed in (True, False):
+        with tempfile.TemporaryDirectory() as top:
+            for folder, text in (("a", '#include "b/b.h"\n'),
+                                 ("b", '#include "a/a.h"\n' if closed else "")):
+                os.makedirs(os.path.join(top, "core", folder))
+                with open(os.path.join(top, "core", folder, folder + ".h"), "w") as f:
+                    f.write("")
+                with open(os.path.join(top, "core", folder, folder + ".c"), "w") as f:
+                    f.write(text)
+            with contextlib.redirect_stdout(io.StringIO()):
+                passed = report("includes", include_edges(top))
+            ok = ok and passed == (not closed)
+    print(("PASS" if ok else "FAIL") + " layout_check_finds_a_circle_and_only_a_circle")
+    return 0 if ok else 1
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--objects", help="build folder whose objects to read with nm")
     ap.add_argument("--top", default=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    ap.add_argument("--self-test", action="store_true", help=self_test.__doc__.split("\n")[0])
     args = ap.parse_args()
+    if args.self_test:
+        return self_test()
     ok = report("includes", include_edges(args.top))
     if args.objects and os.path.isdir(os.path.join(args.objects, "core")):
         ok = report("calls", call_edges(args.top, args.objects)) and ok

@@ -36,7 +36,7 @@
 
 #include "../tests/unit/joint_face_3d.h"
 #include "case.h"
-#include "model.h"
+#include "model/model.h"
 
 #define WINDOW 2e-6
 

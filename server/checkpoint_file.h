@@ -1,6 +1,6 @@
 /*
  * checkpoint_file.h - checkpoint.bin on disk: the engine's checkpoint bytes
- * (core/checkpoint.c) followed by an 8-byte trailer, the magic "FDCK" and
+ * (core/checkpoint/checkpoint.c) followed by an 8-byte trailer, the magic "FDCK" and
  * the CRC-32 (zlib's, little-endian) of the bytes before it.
  *
  * Contract:

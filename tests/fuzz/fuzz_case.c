@@ -17,7 +17,7 @@
 
 #include "case.h"
 #include "gmsh.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 #define FUZZ_MEMORY_LIMIT ((size_t)64 << 20)
 

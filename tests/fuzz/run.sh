@@ -25,12 +25,14 @@ mkdir -p "$out" "$corpus" "$http_corpus"
 cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-omit-frame-pointer
         -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -Wno-unknown-pragmas"
 pkg=$(pkg-config --cflags --libs jansson hdf5)
+# every source of core/ and proto/, whatever folder it sits in
+engine=$(find core proto -name '*.c' | sort)
 # shellcheck disable=SC2086
-clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*.c $pkg -lm \
+clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c $engine $pkg -lm \
       -o "$out/fuzz_case"
 # shellcheck disable=SC2086
-clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c core/*.c \
-      proto/*.c $pkg -lm -o "$out/fuzz_http"
+clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c $engine \
+      $pkg -lm -o "$out/fuzz_http"
 
 # Seeds: the bundled examples, every gmsh test file as a part, small docs.
 for f in examples/*.json; do [ -e "$f" ] && cp "$f" "$corpus/"; done

@@ -57,7 +57,7 @@ class PersistenceTest(unittest.TestCase):
         by_id = {c["id"]: c for c in after}
         # Elastic energy is excepted: the engine reports the energy of the
         # positions a step's forces used, and after a restore that of the
-        # restored positions (core/checkpoint.c), one step apart.
+        # restored positions (core/checkpoint/checkpoint.c), one step apart.
         for st in (by_id[finished], before[finished]):
             st["energy"].pop("elastic")
         self.assertEqual(by_id[finished], before[finished])

@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "fdem.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 /* An open box of five slabs T thick - a floor under [0, X] x [0, Y] and
  * four walls up to H - meshed with tetrahedra of about `size`, as ONE mesh,

@@ -12,7 +12,7 @@
 #include <stdlib.h>
 
 #include "fdem.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 static inline void build_die(const char *what, const fdem_error *err)
 {

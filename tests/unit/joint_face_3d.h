@@ -14,7 +14,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "vec3.h"
+#include "math/vec3.h"
 
 static inline double joint_face_normal(const double *pos0, const int32_t *node, double N[3])
 {

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 
 #include "check.h"
-#include "nbs.h"
+#include "nbs/nbs.h"
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 

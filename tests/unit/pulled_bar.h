@@ -9,7 +9,7 @@
 #define FDEM_PULLED_BAR_H
 
 #include "build_model.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 /* Prescribes vx (other components free) on the nodes at x. */
 static inline void pulled_bar_end(fdem_model *m, double x, double vx)

@@ -13,7 +13,7 @@
 
 #include "case.h"
 #include "fdem.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 static int fixture_add_block(fdem_model *m, double ox, double oy, double w, double h, int nx,
                              int ny, int material, int fracture, fdem_error *err)

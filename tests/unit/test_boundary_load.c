@@ -19,8 +19,8 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
 
 static void add_constraint(fdem_model *m, const fdem_constraint_def *c)
 {

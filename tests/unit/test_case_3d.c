@@ -15,7 +15,7 @@
 #include "case_doc.h"
 #include "check.h"
 #include "gmsh.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 /* One 0.1 x 0.2 x 0.3 m box of 2 x 3 x 4 cells, three constraints. */
 static const char *base3d =

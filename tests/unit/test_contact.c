@@ -9,7 +9,7 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
 
 int contact_potential_force(fdem_model *m, int e1, int e2, double havg);
 

@@ -11,10 +11,11 @@
  */
 #include "build_container_3d.h"
 #include "check.h"
-#include "contact_tet.h"
+#include "kernel/contact_tet.h"
 #include "fdem.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
+#include "contact/contact.h"
 
 #include <stdint.h>
 #include <stdlib.h>

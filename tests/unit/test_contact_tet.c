@@ -6,7 +6,7 @@
  * sideways force or torque in a configuration symmetric about the axis.
  */
 #include "check.h"
-#include "contact_tet.h"
+#include "kernel/contact_tet.h"
 
 #include <stdint.h>
 #include <string.h>

@@ -17,7 +17,9 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "element/element.h"
+#include "step/step.h"
 
 static const double RHO = 2700, YOUNG = 3e10, NU = 0.25;
 

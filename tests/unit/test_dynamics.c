@@ -8,7 +8,8 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "contact/contact.h"
 
 static void free_fall_matches_half_g_t_squared(void)
 {

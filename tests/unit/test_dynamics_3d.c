@@ -8,9 +8,9 @@
  * steps on to the same bits; an undamped bar closes its energy balance.
  */
 #include "check.h"
-#include "element_tet.h"
+#include "kernel/element_tet.h"
 #include "fdem.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 #include "power_iteration.h"
 #include "bar_period_3d.h"
 

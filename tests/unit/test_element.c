@@ -6,7 +6,8 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "element/element.h"
 #include "power_iteration.h"
 
 static fdem_model *unit_block(double E, double nu)

@@ -10,8 +10,8 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
 
 #include <stdlib.h>
 

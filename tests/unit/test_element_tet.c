@@ -9,7 +9,7 @@
  * spin is not damped; the height and stable step of a regular tetrahedron.
  */
 #include "check.h"
-#include "element_tet.h"
+#include "kernel/element_tet.h"
 #include "rotation_3d.h"
 
 #include <stdint.h>

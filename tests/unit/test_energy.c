@@ -13,7 +13,7 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
 
 typedef struct balance {
     double worst;  /* largest |residual| / scale seen */

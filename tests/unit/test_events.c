@@ -10,8 +10,8 @@
  */
 #include "pulled_bar.h" /* before model.h, whose `part` its helpers' parameters would shadow */
 #include "check.h"
-#include "joint_law.h"
-#include "model.h"
+#include "kernel/joint_law.h"
+#include "model/model.h"
 
 #include <stdlib.h>
 #include <string.h>

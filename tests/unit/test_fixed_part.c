@@ -20,7 +20,7 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
 
 enum { STEPS = 160, CHECKPOINT_AT = 70 };
 

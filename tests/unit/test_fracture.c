@@ -38,7 +38,7 @@
 #include "case_doc.h"
 #include "check.h"
 #include "joint_face_3d.h"
-#include "model.h"
+#include "model/model.h"
 
 #define WINDOW 2e-6
 

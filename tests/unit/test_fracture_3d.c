@@ -12,10 +12,12 @@
 #include "bar_period_3d.h"
 #include "build_model.h"
 #include "check.h"
-#include "joint_tet.h"
+#include "kernel/joint_tet.h"
 #include "joint_face_3d.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
+#include "element/element.h"
+#include "joint/joint.h"
 #include "power_iteration.h"
 
 #include <stdint.h>

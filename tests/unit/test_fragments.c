@@ -9,7 +9,7 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 #include <stdlib.h>
 

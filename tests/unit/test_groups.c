@@ -18,8 +18,8 @@
 #include "case_doc.h"
 #include "check.h"
 #include "gmsh.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
 #include "read_file.h"
 
 static const char *const bar_files[] = {"tests/data/bar_groups_v22.msh",

@@ -22,8 +22,9 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "mesh_3d.h"
-#include "model.h"
+#include "mesh/mesh_3d.h"
+#include "model/model.h"
+#include "element/element.h"
 
 #define RHO 2700.0
 #define YOUNG 3e10

@@ -8,7 +8,8 @@
  */
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "joint/joint.h"
 
 static int fracture_material(fdem_model *m, double penalty_factor)
 {

@@ -19,9 +19,9 @@
  * version 6, which kept no slip, still reads.
  */
 #include "case_doc.h"
-#include "joint_law.h"
-#include "joint_tet.h"
-#include "model.h"
+#include "kernel/joint_law.h"
+#include "kernel/joint_tet.h"
+#include "model/model.h"
 #include "rotation_3d.h"
 
 /* What a run showed at its worst. */

@@ -17,7 +17,8 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "joint/joint.h"
 
 /* A fracturing block of some 3000 elements (three or more joint blocks):
  * 2D 40 x 40 squares of two triangles, 3D 8^3 cubes of six tetrahedra. */

@@ -11,8 +11,8 @@
  * while pressed shut, its work closes against stored + fracture + friction.
  */
 #include "check.h"
-#include "joint_law.h"
-#include "joint_tet.h"
+#include "kernel/joint_law.h"
+#include "kernel/joint_tet.h"
 #include "rotation_3d.h"
 
 #include <stdint.h>

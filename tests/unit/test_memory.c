@@ -9,7 +9,7 @@
  * allocated. Bundled examples, 2D and 3D, with and without contact and
  * fracture, are built as the daemon builds them and stepped. Peaks inside
  * a step (the raw pair list at detection) and finalize's scratch are not
- * seen here; valgrind massif measured them (core/model.c, memory priced).
+ * seen here; valgrind massif measured them (core/build/memory.c).
  */
 #include <stdio.h>
 #include <stdlib.h>

@@ -7,7 +7,7 @@
  * direction), and every validation error naming its node or tetrahedron.
  */
 #include "check.h"
-#include "mesh_3d.h"
+#include "mesh/mesh_3d.h"
 
 #include <stdint.h>
 #include <stdlib.h>

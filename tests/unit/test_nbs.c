@@ -9,7 +9,7 @@
  * ASan. Every comparison is exact (same circle test, same doubles).
  */
 #include "check.h"
-#include "nbs.h"
+#include "nbs/nbs.h"
 #include "pair_sets.h"
 
 #include <stdint.h>

@@ -10,7 +10,7 @@
  */
 #include "check.h"
 #include "heap_count.h"
-#include "nbs.h"
+#include "nbs/nbs.h"
 #include "pair_sets.h"
 
 #include <stdint.h>

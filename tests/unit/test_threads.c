@@ -12,7 +12,8 @@
 
 #include "build_model.h"
 #include "check.h"
-#include "model.h"
+#include "model/model.h"
+#include "parallel/scatter_plan.h"
 
 /* Every block appears once, and inside a colour no node is used by two
  * blocks. Returns the number of violations. */

@@ -1,0 +1,781 @@
+/*
+ * contact.c - the contact stage of either dimension: when to run detection,
+ * which candidate pairs to evaluate, and how their forces reach the nodes.
+ * The force between two elements is a dimension's kernel (contact_pair.h):
+ * triangles in contact_tri.c, tetrahedra in contact_tet.c; everything else
+ * is the same algorithm for both and is written here once.
+ *
+ * Detection (nbs.c, nbs_3d.c) runs on bounding circles or spheres inflated
+ * by a buffer, and only again once some node has moved more than half the
+ * buffer since the last run: until then every pair that can overlap is
+ * already a candidate. Each step the candidates whose element boxes overlap
+ * go to the kernel; their forces are added to the contact force array in
+ * pair order, on one thread or several (each thread lists its touching
+ * pairs, the lists are added in thread order): the same bits on any thread
+ * count.
+ *
+ * Most candidate pairs are far from touching (coarse tetrahedra have loose
+ * bounding spheres: a sphere pile has ~25 candidates per element and well
+ * under one touching), so the per-step walk takes only the "near" pairs:
+ * when the list is built every node's place is kept (pos_near), and two
+ * boxes with a gap g then cannot overlap while no node is farther than r
+ * from its kept place, if g > 2 r. The near list holds the other pairs,
+ * in pair order, each with its gap and what the walk reads of it (its
+ * elements, whether it holds springs: near_pair), so the walk streams one
+ * array instead of looking each pair up in the candidate arrays, and is
+ * rebuilt when some node passes r;
+ * a pair it leaves out has its boxes apart now and until then, exactly
+ * what the box test would have found, so its springs go at the rebuild as
+ * they would have gone that step: the same bits as walking every pair.
+ * In the same way a near pair whose gap is over twice the farthest travel
+ * so far is apart without a look at its boxes, and only elements with such
+ * a pair closing get their box computed.
+ *
+ * Friction's stick springs (contact_pair.h) are kept per candidate pair, a
+ * dimension's count of slots each (cs->slots), across steps, detections and
+ * checkpoints (contact_history.c); a pair whose boxes part lets them go.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "kernel/contact_pair.h"
+#include "model/model.h"
+#include "contact.h"
+#include "joint/joint.h"
+#include "parallel/scatter_plan.h"
+
+/* Fewer candidate pairs than this are evaluated on one thread: below it the
+ * threads' start-up costs more than they share. */
+#define CONTACT_THREADED_PAIRS 2048
+
+/* A dimension's pair kernel and the numbers the shared stage sizes by. */
+typedef struct contact_kernel {
+    int slots;          /* stick springs per pair */
+    int pair_out;       /* forces on both elements' nodes, then the dissipation */
+    int (*pair_force)(const contact_pair_in *in, double *springs, double *out);
+    double dt_factor;   /* contact_stable_dt: dt_factor h sqrt(rho / p) */
+    double near_step;   /* the near list's reach (cs->near_reach) per unit buffer */
+} contact_kernel;
+
+/* The near list (see the top of this file) is rebuilt every near_step x
+ * buffer of travel (detection comes at buffer/2) and holds the pairs whose
+ * boxes are within twice that: a shorter reach is more rebuilds and fewer
+ * pairs and boxes each step. A disc pile's near pairs mostly touch, so
+ * 1/16 and 1/64 walk about as much (callgrind: +0.3 % at 1/64); a
+ * tetrahedron's loose sphere gives ~25 candidates an element in a sphere
+ * pile and under 0.05 touching, and 1/64 walks far fewer of them (4k-element
+ * pile: boxes 157M -> 25M instructions in 493 steps, whole step -10 %;
+ * 1/128 gained no more). */
+static const contact_kernel contact_kernels[2] = {
+    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, 0.25, 1.0 / 16},
+    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153, 1.0 / 64},
+};
+
+/* Rows of numbers keyed by a candidate pair, in pair order. */
+typedef struct pair_rows {
+    long *pair;
+    double *row;
+    size_t count, capacity;
+} pair_rows;
+
+/* A thread's share of the pairs: those that touched with their forces
+ * (pair_out numbers each), those whose springs the pool is to adopt
+ * (slots each) or let go. */
+typedef struct contact_touches {
+    pair_rows touched, adopt, release;
+} contact_touches;
+
+static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
+{
+    if (list->count == list->capacity) {
+        size_t cap = list->capacity ? 2 * list->capacity : CONTACT_FIRST_ROWS;
+        long *p = realloc(list->pair, cap * sizeof *p);
+        if (!p) return -1;
+        list->pair = p;
+        if (width) {
+            double *f = realloc(list->row, cap * (size_t)width * sizeof *f);
+            if (!f) return -1;
+            list->row = f;
+        }
+        list->capacity = cap;
+    }
+    list->pair[list->count] = pair;
+    if (width) memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
+    list->count++;
+    return 0;
+}
+
+static size_t pair_rows_bytes(const pair_rows *list, int width)
+{
+    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)width);
+}
+
+static void pair_rows_free(pair_rows *list)
+{
+    free(list->pair);
+    free(list->row);
+}
+
+/* A near pair: what the per-step walk reads of a candidate pair, in one
+ * record. sprung mirrors contact_pair_sprung for the pair, kept by the walk
+ * as it lets springs go or adopts them, so a pair apart without springs
+ * (nearly all) reads nothing else. */
+typedef struct near_pair {
+    double gap;      /* its boxes' gap when the list was built */
+    uint32_t pair;   /* its index among the candidate pairs */
+    int32_t a, b;    /* its elements */
+    int32_t sprung;  /* some stick spring of it holds a force */
+} near_pair;
+
+/* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
+static inline int boxes_overlap(const double *a, const double *b, int dim)
+{
+    int apart = a[1] < b[0] || b[1] < a[0] || a[3] < b[2] || b[3] < a[2];
+    if (dim == 3) apart |= a[5] < b[4] || b[5] < a[4];
+    return !apart;
+}
+
+/* D and K are constants where it is called (element_box), so each
+ * dimension gets its own unrolled copy of this one loop. */
+static inline __attribute__((always_inline)) void box_of_nodes(const double *p, const int32_t *n,
+                                                               int D, int K, double *b)
+{
+    for (int d = 0; d < D; d++) {
+        double lo = p[D * n[0] + d], hi = lo;
+        for (int c = 1; c < K; c++) {
+            double x = p[D * n[c] + d];
+            lo = min2(lo, x);
+            hi = max2(hi, x);
+        }
+        b[2 * d] = lo;
+        b[2 * d + 1] = hi;
+    }
+}
+
+static inline void element_box(const fdem_model *m, int e, double *b)
+{
+    if (m->dim == 3) box_of_nodes(m->pos, m->tet[e].node, 3, 4, b);
+    else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
+}
+
+/* The current box of each listed element: those in some candidate pair
+ * when the near list is rebuilt, else those in some near pair. Most
+ * candidate pairs do not touch (their bounding circles, inflated by the
+ * buffer, overlap; their elements do not): the box test then reads two
+ * boxes instead of two element records and their scattered nodes. */
+static void contact_boxes(fdem_model *m, const int32_t *list, int count)
+{
+    double *box = m->contact.box;
+    size_t width = 2 * (size_t)m->dim;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
+/* The same for the near pairs' elements whose boxes can touch another's:
+ * an element whose every near pair had a gap over near_apart keeps its
+ * box from before, which no pair reads (pair_evaluate). */
+static void contact_near_boxes(fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    const int32_t *list = cs->near_active;
+    const double *elem_gap = cs->elem_gap;
+    double *box = cs->box, apart = cs->near_apart;
+    size_t width = 2 * (size_t)m->dim;
+    int count = cs->near_active_count;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++)
+        if (elem_gap[list[k]] <= apart) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
+/* The elements of the near pairs (of every candidate pair when near is
+ * NULL), once each and in element order (so that contact_boxes walks the
+ * mesh forwards), into list; returns how many. */
+static int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
+                                    size_t count, int32_t *list)
+{
+    memset(cs->in_pair, 0, (size_t)elem_count);
+    for (size_t i = 0; i < count; i++) {
+        cs->in_pair[near ? near[i].a : cs->pairs.a[i]] = 1;
+        cs->in_pair[near ? near[i].b : cs->pairs.b[i]] = 1;
+    }
+    int listed = 0;
+    for (int e = 0; e < elem_count; e++)
+        if (cs->in_pair[e]) list[listed++] = e;
+    return listed;
+}
+
+/* The widest gap between two boxes along an axis (negative: they overlap
+ * on every axis). */
+static inline double boxes_gap(const double *a, const double *b, int dim)
+{
+    double gap = -INFINITY;
+    for (int d = 0; d < dim; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
+    return gap;
+}
+
+/* The near list is to be rebuilt: a detection or a restore made it stale,
+ * or some node has gone past its reach since it was built. */
+static int contact_near_due(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->near_stale) return 1;
+    double moved2 = cs->near_disp2; /* the integrator's (central_difference_pass) */
+    if (moved2 > cs->near_reach * cs->near_reach) return 1;
+    /* boxes move by no more than their nodes: a gap over twice the
+     * farthest travel since the list was built is still open (a hair over
+     * it, for rounding) */
+    cs->near_apart = 2.0 * sqrt(moved2) * (1 + 1e-9);
+    return 0;
+}
+
+/* The near list (see the top of this file) and its elements from this
+ * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
+ * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
+static int contact_near_rebuild(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count > UINT32_MAX) return -1;
+    double reach = cs->kernel->near_step * cs->buffer;
+    /* a hair over 2 reach, so rounding in the gap never leaves out a pair
+     * that could touch */
+    double limit = 2.0 * reach * (1 + 1e-9);
+    int dim = m->dim;
+    size_t width = 2 * (size_t)dim, count = 0;
+    for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
+        double gap = boxes_gap(cs->box + width * (size_t)ea, cs->box + width * (size_t)eb, dim);
+        if (gap > limit) {
+            contact_springs_release(cs, k); /* apart now and until the next rebuild */
+            continue;
+        }
+        /* the list grows as it fills: it holds a tenth or so of the candidates */
+        if (count == cs->near_capacity &&
+            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near,
+                          CONTACT_FIRST_ROWS))
+            return -1;
+        cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb, contact_pair_sprung(cs, k)};
+        cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
+        cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
+    }
+    memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
+    cs->near_disp2 = 0;
+    cs->near_count = count;
+    cs->near_reach = reach;
+    cs->near_apart = 0;
+    cs->near_stale = 0;
+    cs->near_active_count =
+        contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
+    return 0;
+}
+
+/* This step's boxes of the elements the near list needs, the list rebuilt
+ * first when due (from the boxes of every candidate pair's elements).
+ * Returns 0, or -1 when out of memory. */
+static int contact_near_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
+        cs->near_count = 0;
+        return 0;
+    }
+    if (!contact_near_due(m)) {
+        contact_near_boxes(m);
+        return 0;
+    }
+    contact_boxes(m, cs->active, cs->active_count);
+    return contact_near_rebuild(m);
+}
+
+/* Force between two elements whose boxes overlap, both roles, into out
+ * (pair_out numbers); springs are the pair's stick springs (updated), h the
+ * last step's size, memo the walk's (contact_pair.h; NULL: none). The
+ * softer surface sets the penalty; friction is the larger of the two, so
+ * giving it on one material is enough. Returns 1 if they touched. Writes
+ * nothing in m. */
+static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
+                              double *out, contact_pair_memo *memo)
+{
+    const material *ma = &m->materials[element_material(m, e1)];
+    const material *mb = &m->materials[element_material(m, e2)];
+    contact_pair_in in = {m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
+                          min2(ma->penalty, mb->penalty),
+                          max2(ma->def.friction, mb->def.friction), h, memo};
+    return m->contact.kernel->pair_force(&in, springs, out);
+}
+
+/* Adds a pair's forces (contact_pair_force) to the contact force array and
+ * what its friction dissipated to the friction account; called in pair
+ * order, so every sum is formed in the same order on any thread count. */
+static inline __attribute__((always_inline)) void scatter_nodes(double *f, const int32_t *n1,
+                                                                 const int32_t *n2, int D, int K,
+                                                                 const double *out)
+{
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n1[c] + d] += out[D * c + d];
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n2[c] + d] += out[D * (K + c) + d];
+}
+
+static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
+{
+    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
+    if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
+    else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
+    m->friction_energy += out[2 * m->dim * m->elem_nodes];
+}
+
+/* What a pair's evaluation asks of the spring pool (contact_history.c):
+ * done at once on one thread, after the threads in pair order otherwise
+ * (the pool is shared; each pair's own set is not). */
+enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
+
+/* Near pair np this step: boxes apart, it lets its springs go (-1);
+ * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
+ * without a set of springs is evaluated on fresh (zeros); *pool says
+ * whether fresh is to be adopted or the pair's set let go (np->sprung
+ * says so at once). D is a constant where it is called, so each
+ * dimension's walk is compiled on its own with the box and spring loops
+ * unrolled. */
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, near_pair *np,
+                                                               double h, double *out,
+                                                               double *fresh, int *pool,
+                                                               contact_pair_memo *memo, int D)
+{
+    contact_state *cs = &m->contact;
+    const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
+    const size_t width = 2 * (size_t)D;
+    int32_t a = np->a, b = np->b;
+    *pool = SPRINGS_KEPT;
+    /* a gap over near_apart: apart, boxes not even computed this step */
+    if (np->gap > cs->near_apart ||
+        !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
+        if (np->sprung) {
+            *pool = SPRINGS_RELEASE;
+            np->sprung = 0;
+        }
+        return -1;
+    }
+    int32_t set = cs->spring_of[np->pair];
+    double *springs = fresh;
+    if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
+    else
+        for (int s = 0; s < slots; s++) fresh[s] = 0;
+    int touched = contact_pair_force(m, a, b, h, springs, out, memo);
+    /* a pair that did not touch has let every spring go (contact_pair.h):
+     * the springs are read only after a touch */
+    int any = 0;
+    if (touched)
+        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+    if (set < 0 && any) *pool = SPRINGS_ADOPT;
+    np->sprung = any;
+    return touched;
+}
+
+/* Force between two elements, both roles, added to the contact force
+ * array, with no friction history (for tests). Returns 1 if they touched. */
+int contact_potential_force(fdem_model *m, int e1, int e2, double h)
+{
+    double b1[6] = {0}, b2[6] = {0}, out[CONTACT_PAIR_OUT_MAX], springs[CONTACT_SLOTS_MAX] = {0};
+    element_box(m, e1, b1);
+    element_box(m, e2, b2);
+    if (!boxes_overlap(b1, b2, m->dim) || !contact_pair_force(m, e1, e2, h, springs, out, NULL))
+        return 0;
+    contact_pair_scatter(m, e1, e2, out);
+    return 1;
+}
+
+/* The bounding circle (2D) or sphere (3D) of element e at positions p:
+ * centred on the centroid, through the farthest node. */
+static void element_sphere(const fdem_model *m, const double *p, int e, double centre[3],
+                           double *r)
+{
+    const int D = m->dim, K = m->elem_nodes;
+    const int32_t *n = element_nodes(m, e);
+    double x[3] = {0, 0, 0};
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) x[d] += p[D * n[c] + d];
+    for (int d = 0; d < D; d++) x[d] /= K;
+    double r2 = 0;
+    for (int c = 0; c < K; c++) {
+        double s = 0;
+        for (int d = 0; d < D; d++) {
+            double dx = p[D * n[c] + d] - x[d];
+            s += dx * dx;
+        }
+        r2 = fmax(r2, s);
+    }
+    for (int d = 0; d < 3; d++) centre[d] = x[d];
+    *r = sqrt(r2);
+}
+
+/* Gives back what a pair list no longer needs once the glued pairs have
+ * left it: in an intact fracturing block nearly every pair the spheres
+ * found is glued (in 3D ~1.3-1.6 kB an element, more than half the
+ * model), held until the next detection for nothing. A list at most a
+ * quarter full is cut to twice its pairs; the next detection grows it
+ * again as it grew it first (doubling). */
+static void contact_pairs_fit(nbs_pairs *pairs)
+{
+    if (pairs->count > pairs->capacity / 4) return;
+    size_t keep = 2 * pairs->count > 64 ? 2 * pairs->count : 64;
+    if (keep >= pairs->capacity) return;
+    int32_t *a = realloc(pairs->a, keep * sizeof *a);
+    if (!a) return;
+    pairs->a = a;
+    pairs->capacity = keep; /* b may stay longer if its shrink fails */
+    int32_t *b = realloc(pairs->b, keep * sizeof *b);
+    if (b) pairs->b = b;
+}
+
+/* Pairs of triangles glued by intact joints never contact: they leave the
+ * candidate list. */
+static void contact_drop_joined(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    joint_mark_broken_vertices(m);
+    joint_fragment_labels(m, cs->piece);
+    size_t kept = 0;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int a = cs->pairs.a[k], b = cs->pairs.b[k];
+        if (m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, cs->piece, a, b))
+            continue;
+        cs->pairs.a[kept] = cs->pairs.a[k];
+        cs->pairs.b[kept] = cs->pairs.b[k];
+        kept++;
+    }
+    cs->pairs.count = kept;
+    contact_pairs_fit(&cs->pairs);
+}
+
+/* Candidate pairs from the bounding circles or spheres of the elements at
+ * `pos` (the current positions, or a checkpoint's positions at its last
+ * detection), with the stick springs of the pairs that stay. */
+static int contact_detect_at(fdem_model *m, const double *pos)
+{
+    contact_state *cs = &m->contact;
+    if (contact_history_set_aside(cs)) return -1;
+    for (int e = 0; e < m->elem_count; e++) {
+        double c[3];
+        element_sphere(m, pos, e, c, &cs->r[e]);
+        cs->cx[e] = c[0];
+        cs->cy[e] = c[1];
+        if (cs->cz) cs->cz[e] = c[2];
+        cs->r[e] += 0.5 * cs->buffer;
+    }
+    int failed = m->dim == 3 ? nbs_detect_3d(&cs->grid3, (size_t)m->elem_count, cs->cx, cs->cy,
+                                             cs->cz, cs->r, cs->body, &cs->pairs)
+                             : nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r,
+                                          cs->body, &cs->pairs);
+    if (failed) return -1;
+    if (m->joint_count) contact_drop_joined(m);
+    if (contact_history_take_back(cs)) return -1;
+    cs->active_count = contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, cs->active);
+    if (pos != cs->pos_detect)
+        memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->need_detect = 0;
+    cs->near_stale = 1;
+    cs->detections++;
+    return 0;
+}
+
+static int contact_detect(fdem_model *m)
+{
+    if (contact_detect_at(m, m->pos)) return -1;
+    m->contact.max_disp2 = 0;
+    return 0;
+}
+
+/* After a checkpoint restore: the candidate pairs of the last detection
+ * before it (same circles, same joints, so the same list in the same
+ * order: the run goes on bit for bit), with the stick springs the
+ * checkpoint held, waiting in the records. */
+int contact_restore_detection(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (!cs->enabled) return 0;
+    cs->pairs.count = 0;
+    cs->near_stale = 1;
+    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->force_is_zero = 1;
+    if (cs->need_detect) return 0; /* the next step detects anyway */
+    long detections = cs->detections;
+    if (contact_detect_at(m, cs->pos_detect)) return -1;
+    cs->detections = detections;
+    return 0;
+}
+
+int contact_init(fdem_model *m, fdem_error *err)
+{
+    contact_state *cs = &m->contact;
+    int fracture = 0;
+    for (int k = 0; k < m->part_count; k++) fracture |= m->parts[k].fracture;
+    cs->kernel = &contact_kernels[m->dim == 3];
+    cs->slots = cs->kernel->slots;
+    cs->pair_out = cs->kernel->pair_out;
+    cs->enabled = m->part_count > 1 || fracture;
+    if (!cs->enabled) return 0;
+    size_t E = (size_t)m->elem_count, N = (size_t)m->node_count, D = (size_t)m->dim;
+    cs->cx = malloc(sizeof(double) * E);
+    cs->cy = malloc(sizeof(double) * E);
+    cs->cz = D == 3 ? malloc(sizeof(double) * E) : NULL;
+    cs->r = malloc(sizeof(double) * E);
+    cs->body = malloc(sizeof(int32_t) * E);
+    cs->piece = malloc(sizeof(int32_t) * E);
+    cs->pos_detect = malloc(sizeof(double) * D * N);
+    cs->pos_near = malloc(sizeof(double) * D * N);
+    cs->force = calloc(D * N, sizeof(double));
+    cs->force_is_zero = 1;
+    cs->box = malloc(sizeof(double) * 2 * D * E);
+    cs->active = malloc(sizeof(int32_t) * E);
+    cs->near_active = malloc(sizeof(int32_t) * E);
+    cs->elem_gap = malloc(sizeof(double) * E);
+    cs->in_pair = malloc(E);
+    if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
+        !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active || !cs->elem_gap ||
+        !cs->in_pair) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
+        return -1;
+    }
+    /* Elements of one unbroken part never touch each other; those of a
+     * fracturing part each count as a body of their own. */
+    for (int e = 0; e < m->elem_count; e++) {
+        int p = m->elem_part[e];
+        cs->body[e] = m->parts[p].fracture ? m->part_count + e : p;
+    }
+    double rmax = 0;
+    for (int e = 0; e < m->elem_count; e++) {
+        double c[3], r;
+        element_sphere(m, m->pos, e, c, &r);
+        rmax = fmax(rmax, r);
+    }
+    cs->buffer = 0.4 * rmax;
+    cs->need_detect = 1;
+    /* the integrator measures from here until the first near list */
+    memcpy(cs->pos_near, m->pos, sizeof(double) * D * N);
+    cs->near_disp2 = 0;
+    return 0;
+}
+
+void contact_free(contact_state *cs)
+{
+    free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
+    free(cs->pos_detect); free(cs->pos_near); free(cs->force);
+    free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
+    free(cs->near);
+    for (int t = 0; t < cs->touch_lists; t++) {
+        pair_rows_free(&cs->touches[t].touched);
+        pair_rows_free(&cs->touches[t].adopt);
+        pair_rows_free(&cs->touches[t].release);
+    }
+    free(cs->touches);
+    free(cs->slip);
+    free(cs->spring_of);
+    free(cs->slip_free);
+    free(cs->records);
+    nbs_grid_free(&cs->grid);
+    nbs_grid_3d_free(&cs->grid3);
+    nbs_pairs_free(&cs->pairs);
+    memset(cs, 0, sizeof *cs);
+}
+
+double contact_stable_dt(const fdem_model *m)
+{
+    if (!m->contact.enabled) return INFINITY;
+    /* A face pressed a depth d into a triangle of altitude h is pushed back
+     * with p 3 d / h from each side, so a corner node of an element of
+     * size h, on two such faces, feels a spring of up to about 16 p / (rho
+     * h^2) per unit mass. 0.25 h sqrt(rho / p) keeps omega dt at 1 at
+     * safety 1: measured on flat impacts of shared-node and fracturing
+     * blocks (test_contact.c), the energy after the impact is within 1 % of
+     * the energy before at every safety up to 1 (0.45, the earlier factor,
+     * gained 20 % at safety 1). A tetrahedron's potential is steeper
+     * (p 4 d / h), and its corner node (mass rho h^3 / 24 against rho h^2 / 6)
+     * sits on three faces of area h^2 / 2 (a third each): 8/3 times the
+     * stiffness per unit mass, so the factor is 0.25 sqrt(3/8) = 0.153. */
+    double dt = INFINITY, factor = m->contact.kernel->dt_factor;
+    for (int e = 0; e < m->elem_count; e++) {
+        const material *mat = &m->materials[element_material(m, e)];
+        dt = fmin(dt, factor * m->elem_h[e] * sqrt(mat->def.density / mat->penalty));
+    }
+    return dt;
+}
+
+/* The threaded runs' lists, the stick springs (a set index per candidate
+ * pair, slots doubles per set in the pool: only pairs that touch hold a
+ * set), the records set aside across a detection and the near list. */
+size_t contact_memory_bytes(const contact_state *cs)
+{
+    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    b += cs->pair_capacity * sizeof(int32_t);
+    b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
+    b += cs->record_capacity * sizeof(contact_record);
+    b += cs->near_capacity * sizeof(near_pair);
+    for (int t = 0; t < cs->touch_lists; t++) {
+        b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
+        b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
+        b += pair_rows_bytes(&cs->touches[t].release, 0);
+    }
+    return b;
+}
+
+/* One list per thread; 0, or -1 if they cannot be had. */
+static int contact_touch_lists(contact_state *cs, int threads)
+{
+    if (threads <= cs->touch_lists) return 0;
+    contact_touches *t = realloc(cs->touches, sizeof *t * (size_t)threads);
+    if (!t) return -1;
+    memset(t + cs->touch_lists, 0, sizeof *t * (size_t)(threads - cs->touch_lists));
+    cs->touches = t;
+    cs->touch_lists = threads;
+    return 0;
+}
+
+/* Every candidate pair's force, added to the contact force array in pair
+ * order, one pair at a time. Returns the number of pairs that touched. */
+static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
+                                                                     int D)
+{
+    contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
+    int touching = 0;
+    for (size_t i = 0; i < cs->near_count; i++) {
+        near_pair *np = &cs->near[i];
+        double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
+        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
+        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, np->pair, fresh)) return -1;
+        if (touched <= 0) continue;
+        contact_pair_scatter(m, np->a, np->b, out);
+        touching++;
+    }
+    return touching;
+}
+
+static int contact_pairs_forces_serial(fdem_model *m, double h)
+{
+    return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
+}
+
+/* The same on several threads: each takes a contiguous share of the near
+ * pairs and lists the ones that touched with their forces; the lists are then
+ * added in thread order, which is pair order. Every node's sum is formed in
+ * the order the serial loop forms it: the same bits on any thread count.
+ * Returns the number of pairs that touched, or -1 if a list could not grow
+ * (nothing has been added then). */
+static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
+                                                                     long begin, long end,
+                                                                     contact_touches *list, int D)
+{
+    const contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
+    int touching = 0;
+    for (long i = begin; i < end; i++) {
+        near_pair *np = &cs->near[i];
+        long k = (long)np->pair;
+        double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
+        if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
+        if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
+        if (touched <= 0) continue;
+        touching++;
+        if (pair_rows_push(&list->touched, k, force, cs->pair_out)) return -1;
+    }
+    return touching;
+}
+
+static int contact_pairs_forces_threaded(fdem_model *m, double h)
+{
+    contact_state *cs = &m->contact;
+    long n = (long)cs->near_count;
+    const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b;
+    int touching = 0, failed = 0, used = 1;
+    contact_touches *lists = cs->touches;
+#pragma omp parallel num_threads(m->threads) reduction(+ : touching)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        if (t == 0) used = nt;
+        contact_touches *list = &lists[t];
+        list->touched.count = list->adopt.count = list->release.count = 0;
+        long begin = n * t / nt, end = n * (t + 1) / nt;
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, begin, end, list, 3)
+                               : pairs_forces_listed(m, h, begin, end, list, 2);
+        if (mine < 0) {
+#pragma omp atomic write
+            failed = 1;
+        } else {
+            touching += mine;
+        }
+    }
+    if (failed) return -1;
+    for (int t = 0; t < used; t++) {
+        const pair_rows *touched = &lists[t].touched;
+        for (size_t i = 0; i < touched->count; i++) {
+            long k = touched->pair[i];
+            contact_pair_scatter(m, pa[k], pb[k], touched->row + i * (size_t)cs->pair_out);
+        }
+        for (size_t i = 0; i < lists[t].release.count; i++)
+            contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
+        const pair_rows *adopt = &lists[t].adopt;
+        for (size_t i = 0; i < adopt->count; i++)
+            if (contact_springs_adopt(cs, (size_t)adopt->pair[i], adopt->row + i * (size_t)cs->slots))
+                return -1;
+    }
+    return touching;
+}
+
+/* Threads only pay off with enough pairs; without room for their lists the
+ * step stays on one thread. Returns the number of pairs that touched, or -1
+ * when out of memory. */
+static int contact_pairs_forces(fdem_model *m, double h)
+{
+    contact_state *cs = &m->contact;
+    if (m->threads > 1 && cs->near_count >= CONTACT_THREADED_PAIRS &&
+        contact_touch_lists(cs, m->threads) == 0) {
+        /* a list that cannot grow has already moved some stick springs:
+         * the step fails rather than run the pairs twice */
+        return contact_pairs_forces_threaded(m, h);
+    }
+    return contact_pairs_forces_serial(m, h);
+}
+
+/* Detection when due, then every candidate pair's force. The stick springs
+ * are loaded by the motion of the last step (m->dt_prev). Returns 0, or -1
+ * when out of memory. */
+int contact_forces(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (!cs->enabled) return 0;
+    double half = 0.5 * cs->buffer;
+    if (cs->need_detect || contact_travel_past(m, half * half)) {
+        double t0 = stage_clock();
+        if (contact_detect(m)) return -1;
+        double spent = stage_clock() - t0;
+        m->times.detection += spent;
+        m->times.contact -= spent; /* the caller books the whole call as contact */
+    }
+    /* With no candidate pair (bodies apart, an intact fracturing block) the
+     * force array stays zero, and the integrator skips reading it. */
+    if (!cs->force_is_zero)
+        memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->force_is_zero = cs->pairs.count == 0;
+    if (contact_near_refresh(m)) return -1;
+    int touching = contact_pairs_forces(m, m->dt_prev);
+    if (touching < 0) return -1;
+    cs->touching = touching;
+    return 0;
+}

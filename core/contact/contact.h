@@ -1,0 +1,57 @@
+/*
+ * contact.h - the contact stage of both dimensions: when to detect
+ * (travel since the last detection), NBS detection into candidate pairs,
+ * pairs the joints exclude, the near-pair list walked each step, the pair
+ * kernels (kernel/contact_tri.c, kernel/contact_tet.c) on one or several
+ * threads, the friction stick springs' history, and the overlap check of a
+ * model's start. Reads the joints (joint/joint.h) to skip joined pairs;
+ * the step (step/), finalize (build/) and checkpoints call it.
+ */
+#ifndef FDEM_CONTACT_H
+#define FDEM_CONTACT_H
+
+#include "model/model.h"
+
+/* First capacities of the contact lists that grow by doubling (pair and
+ * touch rows, near pairs, spring indices; stick-spring sets and records):
+ * a model with contact holds them however few its pairs, and the memory
+ * estimate prices them (build/memory.c, memory_fixed and fdem_memory_per_thread). */
+#define CONTACT_FIRST_ROWS 1024
+#define CONTACT_FIRST_SETS 256
+
+
+/* contact.c: the contact stage of both dimensions over the pair kernels of
+ * contact_tri.c and contact_tet.c (contact_pair.h) */
+int contact_init(fdem_model *m, fdem_error *err);
+void contact_free(contact_state *c);
+double contact_stable_dt(const fdem_model *m);
+int contact_forces(fdem_model *m);
+int contact_restore_detection(fdem_model *m);
+size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
+
+/* contact_history.c */
+int contact_history_reserve(contact_state *cs, size_t pairs);
+int contact_springs_adopt(contact_state *cs, size_t pair, const double *springs);
+void contact_springs_release(contact_state *cs, size_t pair);
+/* Some stick spring of candidate pair k holds a force. */
+static inline int contact_pair_sprung(const contact_state *cs, size_t k)
+{
+    return cs->spring_of[k] >= 0;
+}
+int contact_history_set_aside(contact_state *cs);
+int contact_history_take_back(contact_state *cs);
+size_t contact_history_checkpoint_size(const contact_state *cs);
+void contact_history_checkpoint_write(const contact_state *cs, unsigned char *p);
+int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, size_t count,
+                                    int elements);
+size_t contact_record_bytes(const contact_state *cs); /* one record in a checkpoint */
+
+
+/* the travel since detection (contact.max_disp2, a bound; contact_travel.c):
+ * grown by a step's largest squared node step, and whether some node is now
+ * farther than sqrt(limit2) from pos_detect (exact, read when the bound says
+ * it may be) */
+void contact_travel_step(fdem_model *m, double step2);
+int contact_travel_past(fdem_model *m, double limit2);
+
+#endif

@@ -1,0 +1,393 @@
+/*
+ * model.h - the engine's one model struct: the state every stage reads and
+ * writes, in one place. Stages do not declare their functions here; each
+ * folder's header does (element/element.h, contact/contact.h, ...), so a
+ * stage sees another only through what that one publishes. Besides the
+ * struct this header holds only what reads the state without computing
+ * (element_nodes, model_time_after, ...) and the helpers every stage needs
+ * (model_error, model_reserve, stage_clock: model.c).
+ *
+ * Layout follows the hot/cold split: what the per-step loops read and write
+ * (positions, velocities, forces, inverse masses, the 64-byte element record)
+ * sits in contiguous arrays of plain numbers; what only set-up, output and
+ * checkpoints touch (initial positions, masses, part ids) lives beside them.
+ * A step allocates only to grow the contact pair lists to a new high-water
+ * mark.
+ */
+#ifndef FDEM_MODEL_H
+#define FDEM_MODEL_H
+
+#include <stdint.h>
+
+#include "fdem.h"
+#include "kernel/contact_pair.h"
+#include "kernel/joint_law.h"
+#include "nbs/nbs.h"
+
+typedef struct material {
+    fdem_material_def def;
+    double lambda, mu;   /* Lame constants (plane strain uses the 3D ones) */
+    double penalty;      /* resolved: def.penalty or 10 * young */
+    double tan_phi;      /* joints: tan(fracture.friction_angle) */
+} material;
+
+/* Hot per-element record: exactly one cache line. */
+typedef struct element_hot {
+    int32_t node[3];     /* counter-clockwise */
+    int32_t material;
+    double xinv[4];      /* inverse of the initial edge matrix [X1-X0, X2-X0], row-major */
+    double area0;        /* initial area */
+    double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
+} element_hot;
+
+/* Hot per-tetrahedron record (3D models): two cache lines less 16 bytes. */
+typedef struct tet_hot {
+    int32_t node[4];     /* positive volume */
+    int32_t material;
+    int32_t unused;
+    double xinv[9];      /* inverse of the initial edge matrix [X1-X0, X2-X0, X3-X0], row-major */
+    double volume0;      /* initial volume */
+    double eta;          /* viscous coefficient of damping (Pa s); 0 = none */
+} tet_hot;
+
+/* The cohesive constants a joint reads in the hot loop (joint_strength.c):
+ * one per material, one per joint set, one per joint whose strengths were
+ * drawn (Weibull variation). A joint holds an index into this table, so
+ * heterogeneity costs the joint loop nothing. */
+typedef struct joint_strength {
+    double tensile_strength, cohesion, tan_phi, energy_I, energy_II;
+} joint_strength;
+
+/* A pre-existing discontinuity of a fracturing part: the faces (mesh
+ * vertices of the part, dim per face, each sorted, the list sorted) whose
+ * joints take params. */
+typedef struct joint_set {
+    int part;
+    fdem_fracture_params params;
+    fdem_variation variation;
+    int32_t *faces;
+    int face_count;
+} joint_set;
+
+typedef struct part {
+    int material;
+    int fracture;
+    int stressed;        /* has an in-situ stress (initial_stress.c) */
+    int fixed;           /* held still as a whole: its element forces are kept (fixed_part.c) */
+    int node_begin, node_count;
+    int elem_begin, elem_count;
+} part;
+
+/* An in-situ stress as given for a part, until finalize evaluates it per
+ * element (initial_stress.c). */
+typedef struct initial_stress_def {
+    int part;
+    double value[6], gradient[6], reference;
+} initial_stress_def;
+
+/* One constraint after node selection. Its nodes are entries
+ * [entry_begin, entry_begin + entry_count) of model.cnode / model.cdof. */
+typedef struct constraint {
+    fdem_constraint_def def;
+    int entry_begin, entry_count;
+    int32_t *vertices;   /* FDEM_SELECT_VERTICES: the owned, sorted copy def.vertices points to */
+    double force[3];     /* reaction (fix, velocity), applied (force, pressure) or dashpot
+                            (absorb) force of the last step */
+    double value_now[3]; /* def.value times the amplitude at the instant this step uses
+                            (constraint_set_time); def.value itself without an amplitude */
+    double *amplitude;   /* owned copy of def.amplitude (def.amplitude points here) */
+    int facet_begin, facet_count; /* PRESSURE, ABSORB: entries of model.bfacet_* */
+} constraint;
+
+/* Partial sums a scatter block hands back (see scatter_plan_run below). */
+#define SCATTER_SUMS 7
+#define SCATTER_MAX 5 /* sums[SCATTER_MAX] and on are maxima, not sums */
+
+/* Blocks of consecutive items (elements, nodes) grouped by colour:
+ * blocks of one colour share no node, so threads may run them side by side
+ * and add into node arrays without races (scatter_plan.c). */
+typedef struct scatter_plan {
+    int item_count, block_size, block_count;
+    int color_count;         /* 0: no blocks, scatter_plan_run runs the items serially */
+    int32_t *color_begin;    /* color_count + 1 offsets into block_order */
+    int32_t *block_order;    /* block indices, colour by colour */
+    double *block_sum;       /* SCATTER_SUMS partials per block, totalled in block order */
+} scatter_plan;
+
+/* The joint loop's plan (joint_sweep.c). Every node's joint forces are
+ * added in joint order on any thread count: one thread walks the joints in
+ * order; T threads walk T contiguous ranges of them side by side, each
+ * adding only into the elements it owns (those whose first joint is its
+ * own) and setting aside the forces on the faces of elements an earlier
+ * range owns (slots), which their owners add after a barrier. The energy
+ * sums are formed per fixed block of joints, in joint order, and totalled
+ * in block order, as scatter_plan_run does. */
+typedef struct joint_sweep {
+    int threads;          /* the thread count the ranges were cut for; 0: none yet */
+    int block_size, block_count;
+    double *block_sum;    /* SCATTER_SUMS per block */
+    int ranges;           /* 1: the whole loop on one thread */
+    int32_t *range_block; /* ranges + 1: each range's first block */
+    int32_t *cross_begin; /* ranges + 1 offsets into cross_joint */
+    int32_t *cross_joint; /* per range, in joint order: its joints with a slot */
+    int32_t *cross_slot;  /* 2 per cross joint: the slot of face A's and B's forces, or -1 */
+    int32_t *slot_begin;  /* ranges + 1: slots by the range owning their face */
+    int32_t *slot_face;   /* per slot: 2 joint + face (0 A, 1 B); joint order within a range */
+    double *slot_force;   /* JOINT_FACE_VALUES per slot */
+    uint8_t *slot_live;   /* the joint held in this step: its forces are to be added */
+} joint_sweep;
+
+/* Stick-spring history of one pair of elements lo < hi (contact_history.c):
+ * the tangential springs of lo's contactor boundaries against hi, then of
+ * hi's against lo, slots of them (contact_pair.h: 6 for triangles, 24 for
+ * tetrahedra). A checkpoint stores lo, hi and the slots used, so a 2D record
+ * there is 56 bytes as before 3D (contact_record_bytes). */
+typedef struct contact_record {
+    int32_t lo, hi;
+    double slip[CONTACT_SLOTS_MAX];
+} contact_record;
+
+typedef struct contact_state {
+    int enabled;             /* some pair of elements can ever touch */
+    const struct contact_kernel *kernel; /* the dimension's pair kernel (contact.c) */
+    int slots;               /* stick springs per pair */
+    int pair_out;            /* numbers a pair evaluation hands back */
+    double buffer;           /* added to circle diameters; re-detect after buffer/2 */
+    double max_disp2;        /* bound of the squared node displacement since detection,
+                                exact once past the limit (contact_travel.c) */
+    int need_detect;
+    long detections;
+    int touching;            /* pairs with non-zero force in the last step */
+    double *cx, *cy, *cz, *r; /* bounding circles (cz NULL) or spheres, one per element */
+    double *pos_detect;      /* node positions at the last detection */
+    double *force;           /* contact force per node (kept apart for its work) */
+    int force_is_zero;       /* force holds only zeros: no pair was evaluated */
+    int32_t *body;           /* body id per element: pairs of one body never touch */
+    int32_t *piece;          /* scratch: piece label per element (fracturing models) */
+    double *box;             /* 2 dim per element: lo, hi of each axis, each step, of the
+                                elements in some candidate pair */
+    int32_t *active;         /* the elements in some candidate pair, once each */
+    int active_count;
+    uint8_t *in_pair;        /* scratch per element for building active */
+    /* Stick springs: a set of slots doubles only for the candidate pairs
+     * whose springs hold something (pairs that touch: a few in a hundred
+     * of the candidates), the rest share no memory (contact_history.c). */
+    double *slip;            /* the sets, slots doubles each */
+    int32_t *spring_of;      /* per candidate pair: its set, or -1 (all its springs zero) */
+    size_t pair_capacity;    /* of spring_of */
+    int32_t *slip_free;      /* sets let go, to be handed out again */
+    size_t slip_count, slip_capacity, free_count; /* sets handed out or freed, allocated, free */
+    contact_record *records; /* history set aside across a detection or a restore */
+    size_t record_count, record_capacity;
+    struct near_pair *near;  /* candidate pairs whose boxes can overlap before some node
+                                moves near_reach from pos_near, in pair order, with what
+                                the walk reads of them (contact.c) */
+    size_t near_count, near_capacity;
+    double near_reach;       /* the list holds while no node is farther than this from */
+    double *pos_near;        /* its place when the list was built */
+    double near_disp2;       /* largest squared node displacement from pos_near since then
+                                (tracked by the integrator with max_disp2) */
+    double near_apart;       /* this step, a near_gap over this is still open */
+    int32_t *near_active;    /* the elements in some near pair, once each: their boxes */
+    int near_active_count;   /* are all a step needs while the list holds */
+    double *elem_gap;        /* per element: the smallest gap of its near pairs */
+    int near_stale;          /* a detection or a restore: the list is rebuilt next step */
+    struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
+    int touch_lists;         /* how many lists touches holds */
+    nbs_grid grid;           /* 2D detection */
+    nbs_grid_3d grid3;       /* 3D detection */
+    nbs_pairs pairs;
+} contact_state;
+
+struct fdem_model {
+    int finalized;
+    int dim;                 /* 2 or 3: numbers per node in every node array */
+    int elem_nodes;          /* 3 (triangles) or 4 (tetrahedra) */
+
+    /* nodes: hot */
+    int node_count, node_capacity;
+    double *pos, *vel, *force, *inv_mass;
+    /* nodes: cold */
+    double *pos0, *mass;
+    int32_t *node_part;
+    int32_t *node_origin;    /* the mesh vertex a node stands for: copies in a fracturing
+                                part share it; otherwise the node itself */
+    uint8_t *dof_owned;      /* bit d: component d prescribed by some constraint */
+
+    /* elements: triangles in elem (2D) or tetrahedra in tet (3D) */
+    int elem_count, elem_capacity;
+    element_hot *elem;
+    tet_hot *tet;
+    int32_t *elem_part;
+    int32_t *elem_node;      /* elem_nodes per element, packed (cold copy for output) */
+    double *elem_h;          /* smallest altitude (height) of the initial element */
+
+    int material_count, material_capacity;
+    material *materials;
+    int part_count, part_capacity;
+    part *parts;
+    double *part_velocity;   /* 3 per part (2D uses 2), applied at finalize */
+    initial_stress_def *stress0_defs; /* in-situ stresses as given, one per part that has one */
+    int stress0_def_count;
+    double *elem_stress0;    /* stress_comps per element: the 2nd Piola-Kirchhoff pre-stress
+                                S0 (the in-situ Cauchy stress at t = 0); NULL when no part
+                                has one, zeros in the elements of parts without */
+    double stress0_energy;   /* sum of V0 S0 : C^-1 : S0 / 2: what the in-situ stress holds
+                                at t = 0, linear elastic (a constant of the elastic energy) */
+    int fixed_parts;         /* parts with part.fixed (fixed_part.c) */
+    int fixed_valid;         /* fixed_force and fixed_energy are this model's */
+    double *fixed_force;     /* dim per node of the fixed parts, part after part: their
+                                elements' forces, the same every step from the second on */
+    double fixed_energy;     /* those elements' strain energy */
+
+    int constraint_count, constraint_capacity;
+    constraint *constraints;
+    int cnode_count;
+    int32_t *cnode;          /* node of each constraint entry */
+    uint8_t *cdof;           /* dofs this entry owns (bit d: component d) */
+    double *constraint_force_out; /* dim per constraint, for fdem_constraint_forces */
+
+    /* joints (fracture); joint_count == 0 when no part fractures */
+    int joint_count;
+    int32_t *joint_node;     /* 2 dim per joint: a0, a1 (, a2) on face A (outward of A),
+                                b0, b1 (, b2) their copies in B */
+    int32_t *joint_elem;     /* 2 per joint: elements A and B */
+    double *joint_h;         /* smaller size of the two elements: sets the stiffness */
+    double *joint_k;         /* penalty / joint_h: traction per unit opening or sliding */
+    int32_t *joint_strength_of; /* index into joint_strengths */
+    joint_strength *joint_strengths;
+    int joint_strength_count;
+    joint_set *joint_sets;   /* fdem_add_joint_set, resolved at finalize */
+    int joint_set_count;
+    double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
+    joint_slip *joint_slip;  /* dim per joint, one per integration point: the plastic slide
+                                and slip path each keeps (joint_law.h); zero while undamaged */
+    int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
+    uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
+                                refreshed at each contact detection */
+    double *joint_fracture;  /* per joint: what its damage growth dissipated so far (the
+                                fracture account joint by joint; its event's energy) */
+    uint8_t *joint_broke;    /* per joint: the mode of a break in this step's joint loop,
+                                0 otherwise; cleared as events_collect records it */
+    int broken_joints;
+    int fragments;
+    fdem_event *events;      /* fracture events not drained yet, in (step, joint) order */
+    int event_count, event_capacity;
+
+    double gravity[3];       /* this step's gravity: gravity_base times its amplitude */
+    double gravity_base[3];
+    double *gravity_amplitude; /* (t, a) pairs, NULL for a constant gravity */
+    int gravity_amplitude_count;
+    double gravity_work_sum; /* with a gravity amplitude: its work booked step by step */
+    double momentum[3];      /* with a gravity amplitude: sum m v after the last step */
+
+    /* boundary facets loaded by PRESSURE and ABSORB constraints
+     * (boundary_load.c): dim nodes per entry, ordered so that their area
+     * vector points out of the body, the element behind, and the force the
+     * last step put on each of its nodes (dim * dim per entry) */
+    int bfacet_count;
+    int32_t *bfacet_node;
+    int32_t *bfacet_elem;
+    double *bfacet_force;
+    double boundary_power_old[2]; /* this step's sum f . v_old: pressures, dashpots */
+    double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
+    int64_t step;
+    double time;
+    double time_carry;       /* what rounding took off time, added back next step (model_time_after) */
+    double stable_dt;
+
+    /* energy accounts (see fdem_energy and energy.c). Work is booked with
+     * the step-averaged velocity (v_old + v_new)/2 * havg, which is exactly
+     * what a force adds to the half-step kinetic energy; fdem_get_energy
+     * turns the sums into values at the start of the last step, where the
+     * elastic and joint energies are evaluated. */
+    double elastic_energy;   /* of the last force evaluation */
+    double joint_energy;     /* stored in intact joints, last force evaluation */
+    double contact_work;     /* work of all contact forces (normal and friction) */
+    double friction_energy;  /* dissipated by Coulomb sliding of contacts (>= 0) */
+    double joint_friction_energy; /* by the sigma_c tan(phi) part of intact joints' shear
+                                     strength as they slide (joint.c) */
+    double fracture_energy;  /* dissipated by joint softening and breaking (>= 0) */
+    double damping_work;     /* energy dissipated by viscous damping */
+    double external_work;
+    double initial_energy;   /* kinetic + elastic at t = 0 */
+    double initial_acceleration2; /* sum of m a.a at t = 0 over free dofs (energy.c) */
+    double first_dt;         /* the first step's size, 0 before it or after a restore */
+    double havg_last;        /* (h_current + h_next)/2 of the last step, 0 before it */
+    double *elem_viscous;    /* stress_comps per element: the viscous half stress of the last step, whose
+                                work with the new velocities the next step books
+                                (element.c); NULL when no element is damped */
+    fdem_energy restored_energy; /* the accounts a checkpoint held, reported until the next
+                                    step (the last step's forces they need are not stored) */
+    int restored_energy_valid;
+
+    contact_state contact;
+    fdem_stage_times times;
+
+    /* threads for the per-step loops; the plans fix the summation order so
+     * that the result does not depend on the thread count */
+    int threads;
+    scatter_plan elem_plan, node_plan;
+    joint_sweep joint_sweep;
+};
+
+/* model.c: the stage clock (seconds, monotonic) the stage times are read on */
+double stage_clock(void);
+
+/* model.c: fills *err (when not NULL) with a kind, an item and a message */
+void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+
+/* Grows *array (items of `size` bytes) to hold at least `need`, doubling
+ * from `first`: 0, or -1 when out of memory (*array is then unchanged). */
+int model_reserve(void **array, size_t *capacity, size_t need, size_t size, size_t first);
+
+/* Stress components per element: 3 in 2D, 6 in 3D. */
+static inline int model_stress_comps(const fdem_model *m) { return m->dim == 3 ? 6 : 3; }
+
+/* What every element's hot record holds, whichever its dimension. */
+static inline int element_material(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].material : m->elem[e].material;
+}
+
+static inline const int32_t *element_nodes(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].node : m->elem[e].node;
+}
+
+/* The time after a step of h. Time is a running sum of steps, and summed
+ * plainly its rounding grew with the step count: the 160000 steps of
+ * examples/incline.json ended 7e-13 s short of time.end, so the daemon took
+ * one more step of 7e-13 s, and each snapshot time was off by as much.
+ * Compensated (Kahan) summation keeps it within a rounding of the exact sum
+ * however many steps; *carry gets the compensation for the next step (the
+ * checkpoint keeps it, so a restart continues with the same bits). */
+static inline double model_time_after(const fdem_model *m, double h, double *carry)
+{
+    double y = h - m->time_carry, t = m->time + y;
+    *carry = (t - m->time) - y;
+    return t;
+}
+
+/* A part whose elements' forces are stored, not added, at each step: a
+ * fracturing part in 3D, where every element has nodes of its own, so the
+ * step need not zero their forces first (element_tet_model.c; the triangle
+ * kernel adds everywhere). */
+static inline int model_part_stores_forces(const fdem_model *m, const part *p)
+{
+    return m->dim == 3 && p->fracture;
+}
+
+/* Initial area (2D) or volume (3D), set by element_prepare. */
+static inline double element_size0(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
+}
+
+static inline double element_eta(const fdem_model *m, int e)
+{
+    return m->dim == 3 ? m->tet[e].eta : m->elem[e].eta;
+}
+
+#endif

@@ -1,0 +1,285 @@
+/*
+ * boundary_load.c - loads that act on a body's boundary rather than on its
+ * nodes (contract 5.3): a pressure along the current inward normal of every
+ * selected boundary edge (3D: face), and Lysmer-Kuhlemeyer dashpots that let
+ * waves leave through it. Both dimensions share every loop; only the area
+ * vector of a facet (an edge's rotated tangent, a face's half cross product)
+ * depends on the dimension.
+ *
+ * A boundary facet is an element edge (face) that no other element of the
+ * same body has: facets are keyed by their mesh vertices (node_origin), so
+ * the faces joined by joints inside a fracturing part are interior, and a
+ * crack opening during the run does not become loaded. A constraint loads
+ * the boundary facets whose nodes it all selects; the facets are found once
+ * at finalize, their forces are recomputed on the deformed geometry at
+ * every step. Nothing here runs for a model without such constraints.
+ *
+ * Energy: each facet force's work is booked as every force's, with the
+ * step-averaged velocity f . (v_old + v_new)/2 havg, as external work for a
+ * pressure and as dissipated (damping) for a dashpot; energy.c drops the
+ * last half step, as for the other accounts.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/model.h"
+#include "math/node_ids.h"
+#include "math/vec3.h"
+#include "step.h"
+
+static int is_boundary_load(const constraint *c)
+{
+    return c->def.kind == FDEM_CONSTRAINT_PRESSURE || c->def.kind == FDEM_CONSTRAINT_ABSORB;
+}
+
+/* The vertices of each facet of an element, ordered so that the facet's
+ * area vector points out of it: counter-clockwise edges of a triangle (the
+ * outward normal of edge a -> b is its tangent turned clockwise) and the
+ * faces of a positive tetrahedron seen from outside. */
+static const int tri_facets[3][3] = {{0, 1, -1}, {1, 2, -1}, {2, 0, -1}};
+static const int tet_facets[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+
+static const int *facet_vertices(const fdem_model *m, int f)
+{
+    return m->dim == 3 ? tet_facets[f] : tri_facets[f];
+}
+
+/* Outward area vector of the facet through nodes n (dim of them) at the
+ * current positions: length times the unit normal in 2D (per unit
+ * thickness), area times it in 3D. */
+static void facet_area_vector(const fdem_model *m, const int32_t *n, double s[3])
+{
+    const double *x = m->pos;
+    if (m->dim == 2) {
+        double dx = x[2 * n[1]] - x[2 * n[0]], dy = x[2 * n[1] + 1] - x[2 * n[0] + 1];
+        s[0] = dy;
+        s[1] = -dx;
+        s[2] = 0;
+        return;
+    }
+    double a[3], b[3];
+    vec3_sub(x + 3 * (size_t)n[1], x + 3 * (size_t)n[0], a);
+    vec3_sub(x + 3 * (size_t)n[2], x + 3 * (size_t)n[0], b);
+    vec3_cross(a, b, s);
+    for (int d = 0; d < 3; d++) s[d] *= 0.5;
+}
+
+/* One element facet, keyed by its sorted mesh vertices. */
+typedef struct facet_key {
+    int32_t vertex[3];
+    int32_t elem, facet;
+} facet_key;
+
+static int facet_key_compare(const void *pa, const void *pb)
+{
+    const facet_key *a = pa, *b = pb;
+    int c = node_ids_compare(a->vertex, b->vertex, 3);
+    return c ? c : (a->elem > b->elem) - (a->elem < b->elem);
+}
+
+/* Every element facet, sorted so that the two sides of an interior facet
+ * are neighbours. Returns the array (count in *out_count) or NULL. */
+static facet_key *facets_sorted(const fdem_model *m, int *out_count)
+{
+    const int D = m->dim, per = m->elem_nodes;
+    size_t count = (size_t)per * (size_t)m->elem_count;
+    facet_key *keys = malloc(sizeof *keys * (count ? count : 1));
+    if (!keys) return NULL;
+    size_t at = 0;
+    for (int e = 0; e < m->elem_count; e++) {
+        const int32_t *n = element_nodes(m, e);
+        for (int f = 0; f < per; f++) {
+            facet_key *k = &keys[at++];
+            const int *v = facet_vertices(m, f);
+            k->vertex[2] = -1; /* 2D: a sorted edge has it first */
+            for (int j = 0; j < D; j++) k->vertex[j] = m->node_origin[n[v[j]]];
+            node_ids_sort(k->vertex, 3);
+            k->elem = e;
+            k->facet = f;
+        }
+    }
+    qsort(keys, count, sizeof *keys, facet_key_compare);
+    *out_count = (int)count;
+    return keys;
+}
+
+static int facet_is_boundary(const facet_key *keys, int count, int i)
+{
+    const size_t bytes = sizeof keys[i].vertex;
+    return !(i > 0 && memcmp(keys[i].vertex, keys[i - 1].vertex, bytes) == 0) &&
+           !(i + 1 < count && memcmp(keys[i].vertex, keys[i + 1].vertex, bytes) == 0);
+}
+
+/* Boundary facet i of keys, when constraint c selects all its nodes: its
+ * nodes into n (outward order). */
+static int facet_selected(const fdem_model *m, const constraint *c, const facet_key *k,
+                          int32_t n[3])
+{
+    const int32_t *en = element_nodes(m, k->elem);
+    const int *v = facet_vertices(m, k->facet);
+    for (int j = 0; j < m->dim; j++) {
+        n[j] = en[v[j]];
+        if (!constraint_selects(m, c, n[j])) return 0;
+    }
+    return 1;
+}
+
+/* Pass 0 counts the entries of every boundary-load constraint, pass 1 fills
+ * them in. */
+static void facets_assign(fdem_model *m, const facet_key *keys, int count, int pass)
+{
+    const int D = m->dim;
+    int at = 0;
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (!is_boundary_load(c)) continue;
+        c->facet_begin = at;
+        for (int i = 0; i < count; i++) {
+            int32_t n[3];
+            if (!facet_is_boundary(keys, count, i) || !facet_selected(m, c, &keys[i], n)) continue;
+            if (pass) {
+                memcpy(m->bfacet_node + (size_t)D * (size_t)at, n, sizeof(int32_t) * (size_t)D);
+                m->bfacet_elem[at] = keys[i].elem;
+            }
+            at++;
+        }
+        c->facet_count = at - c->facet_begin;
+    }
+    m->bfacet_count = at;
+}
+
+int boundary_load_select(fdem_model *m, fdem_error *err)
+{
+    int wanted = 0;
+    for (int k = 0; k < m->constraint_count; k++) wanted |= is_boundary_load(&m->constraints[k]);
+    if (!wanted) return 0;
+    int count = 0;
+    facet_key *keys = facets_sorted(m, &count);
+    if (!keys) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the boundary facets");
+        return -1;
+    }
+    facets_assign(m, keys, count, 0);
+    const size_t D = (size_t)m->dim, n = (size_t)(m->bfacet_count ? m->bfacet_count : 1);
+    m->bfacet_node = malloc(sizeof(int32_t) * D * n);
+    m->bfacet_elem = malloc(sizeof(int32_t) * n);
+    m->bfacet_force = calloc(D * D * n, sizeof(double));
+    if (!m->bfacet_node || !m->bfacet_elem || !m->bfacet_force) {
+        free(keys);
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the boundary facets");
+        return -1;
+    }
+    facets_assign(m, keys, count, 1);
+    free(keys);
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        if (is_boundary_load(c) && c->facet_count == 0) {
+            model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                        "constraint %d selects no boundary %s: %s acts on the %s of a body "
+                        "whose nodes are all selected",
+                        k, m->dim == 3 ? "face" : "edge",
+                        c->def.kind == FDEM_CONSTRAINT_PRESSURE ? "a pressure" : "an absorbing boundary",
+                        m->dim == 3 ? "faces" : "edges");
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* The force on one vertex of a facet of outward area vector s: a pressure
+ * p pushes along -s, a dashpot resists the vertex's velocity v with the
+ * impedances z_p (normal) and z_s (tangential) over its share of the area. */
+static void vertex_force(const fdem_model *m, const constraint *c, int elem, const double s[3],
+                         const double *v, double f[3])
+{
+    const int D = m->dim;
+    if (c->def.kind == FDEM_CONSTRAINT_PRESSURE) {
+        for (int d = 0; d < D; d++) f[d] = -c->value_now[0] * s[d] / D;
+        return;
+    }
+    const material *mat = &m->materials[element_material(m, elem)];
+    double rho = mat->def.density;
+    double z_p = sqrt(rho * (mat->lambda + 2 * mat->mu)), z_s = sqrt(rho * mat->mu);
+    double area = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    double vn = 0;
+    for (int d = 0; d < D; d++) vn += v[d] * s[d] / area;
+    for (int d = 0; d < D; d++)
+        f[d] = -(area / D) * (z_s * v[d] + (z_p - z_s) * vn * s[d] / area);
+}
+
+/* The facet forces of this step, at the positions of t_n and (dashpots) the
+ * velocities v(t_n - h/2): added to the node forces, totalled per
+ * constraint, and their power with those velocities kept for the work. */
+void boundary_load_apply(fdem_model *m)
+{
+    if (!m->bfacet_count) return;
+    const int D = m->dim;
+    m->boundary_power_old[0] = m->boundary_power_old[1] = 0;
+    for (int k = 0; k < m->constraint_count; k++) {
+        constraint *c = &m->constraints[k];
+        if (!is_boundary_load(c)) continue;
+        int absorb = c->def.kind == FDEM_CONSTRAINT_ABSORB;
+        c->force[0] = c->force[1] = c->force[2] = 0;
+        for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++) {
+            const int32_t *n = m->bfacet_node + (size_t)D * (size_t)j;
+            double s[3];
+            facet_area_vector(m, n, s);
+            for (int a = 0; a < D; a++) {
+                size_t at = (size_t)D * (size_t)n[a];
+                double *f = m->bfacet_force + (size_t)D * ((size_t)D * (size_t)j + (size_t)a);
+                double fv[3] = {0, 0, 0};
+                vertex_force(m, c, m->bfacet_elem[j], s, m->vel + at, fv);
+                for (int d = 0; d < D; d++) {
+                    f[d] = fv[d];
+                    m->force[at + d] += fv[d];
+                    c->force[d] += fv[d];
+                    m->boundary_power_old[absorb] += fv[d] * m->vel[at + d];
+                }
+            }
+        }
+    }
+}
+
+/* sum f . v over the facet forces of the last step (absorb: of the
+ * dashpots, else of the pressures), with the velocities now held. */
+static double boundary_power(const fdem_model *m, int absorb)
+{
+    const int D = m->dim;
+    double power = 0;
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        if (!is_boundary_load(c) || (c->def.kind == FDEM_CONSTRAINT_ABSORB) != absorb) continue;
+        for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++)
+            for (int a = 0; a < D; a++) {
+                const double *f = m->bfacet_force + (size_t)D * ((size_t)D * (size_t)j + (size_t)a);
+                const double *v = m->vel + (size_t)D * (size_t)m->bfacet_node[(size_t)D * (size_t)j + (size_t)a];
+                for (int d = 0; d < D; d++) power += f[d] * v[d];
+            }
+    }
+    return power;
+}
+
+/* After every dof has its new velocity: the step's work of the facet forces. */
+void boundary_load_account(fdem_model *m, double havg)
+{
+    if (!m->bfacet_count) return;
+    m->external_work += 0.5 * havg * (m->boundary_power_old[0] + boundary_power(m, 0));
+    m->damping_work -= 0.5 * havg * (m->boundary_power_old[1] + boundary_power(m, 1));
+}
+
+/* Half the last step's work with the new velocities: what the sum above
+ * holds beyond x_n (added back for the dashpots, whose account counts
+ * dissipation, i.e. minus their work). */
+double boundary_load_last_half_step(const fdem_model *m, int absorb)
+{
+    if (!m->bfacet_count) return 0;
+    return 0.5 * m->havg_last * boundary_power(m, absorb);
+}
+
+void boundary_load_free(fdem_model *m)
+{
+    free(m->bfacet_node);
+    free(m->bfacet_elem);
+    free(m->bfacet_force);
+}
