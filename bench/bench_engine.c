@@ -19,7 +19,13 @@
  *  7. the fracturing block in 3D (every tetrahedron on its own nodes, a
  *     joint on every interior face; 1e4, 1e5), as in 3, damped and
  *     undamped (goal: <= 4x the elastic block 3D, which is undamped; each
- *     row also beside its own twin without fracture).
+ *     row also beside its own twin without fracture);
+ *  8. the fracturing blocks of 3 and 7 once broken (issue 34): every joint
+ *     broken in place, so the pieces hold together by contact alone across
+ *     faces that touch over their whole area, as after a split: ns per
+ *     element-step split over the stages, the pairs and detections that
+ *     drive it, against the same block intact (goal: <= 4x in 3D, <= 3x in
+ *     2D).
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -442,6 +448,64 @@ static void bench_fracturing_block(const fracture_kind *k, double bandwidth_gbs)
                goal);
 }
 
+/* Every joint of m broken where it stands: damage 1, so the joint loop
+ * skips it, and a detection due, so the contact stage takes the pairs the
+ * joints held apart (joint_contact_excluded) from the next step on. The
+ * state a block reaches once it has split everywhere, without the minutes
+ * of loading that would take. */
+static void break_every_joint(fdem_model *m)
+{
+    for (int j = 0; j < m->joint_count; j++) m->joint_damage[j] = 1;
+    m->broken_joints = m->joint_count;
+    m->contact.need_detect = 1;
+}
+
+/* The fracturing block after fracture against the same block intact, CPU
+ * ns per element-step (best of three replays of the same window), with the
+ * split over the stages (elements includes the joint loop) and what drives
+ * the cost: candidate pairs kept and pairs touching per element, detections
+ * per 1000 steps. */
+static void bench_broken_block(const fracture_kind *k, double goal)
+{
+    printf("\n## %s, every joint broken in place (after fracture)\n", k->title);
+    printf("%10s %7s %10s %10s %7s %9s %9s %9s %9s %9s %9s %10s\n", "elements", "steps",
+           "broken ns", "intact ns", "x", "forces%", "detect%", "contact%", "integr%",
+           "pairs/el", "touch/el", "det/1000");
+    char line[256] = "";
+    for (int s = 0; s < 2 && k->sizes[s]; s++) {
+        fdem_error err;
+        fdem_model *intact = vibrating_block(k, k->sizes[s], 1);
+        for (int w = 0; w < 3; w++) fdem_step(intact, &err);
+        int E = intact->elem_count, steps = (int)(5e6 / E);
+        if (steps < 10) steps = 10;
+        double intact_cpu = best_of_three(intact, steps).cpu;
+        fdem_model_destroy(intact);
+
+        fdem_model *m = vibrating_block(k, k->sizes[s], 1);
+        break_every_joint(m);
+        for (int w = 0; w < 3; w++) fdem_step(m, &err);
+        fdem_stage_times before = fdem_get_stage_times(m);
+        long det0 = fdem_get_counts(m).detections;
+        step_time t = best_of_three(m, steps);
+        fdem_stage_times after = fdem_get_stage_times(m);
+        fdem_counts c = fdem_get_counts(m);
+        double fe = after.elements - before.elements, de = after.detection - before.detection;
+        double co = after.contact - before.contact, in = after.integration - before.integration;
+        double sum = fe + de + co + in;
+        /* three replays of the window ran: a third of the detections each */
+        double det = (double)(c.detections - det0) / 3 * 1000 / steps;
+        printf("%10d %7d %10.1f %10.1f %7.2f %9.1f %9.1f %9.1f %9.1f %9.2f %9.3f %10.1f\n", E,
+               steps, t.cpu, intact_cpu, t.cpu / intact_cpu, 100 * fe / sum, 100 * de / sum,
+               100 * co / sum, 100 * in / sum, (double)c.contact_pairs / E,
+               (double)c.contacts / E, det);
+        snprintf(line + strlen(line), sizeof line - strlen(line), "%s %d: %.2fx", s ? ";" : "", E,
+                 t.cpu / intact_cpu);
+        fdem_model_destroy(m);
+    }
+    printf("goal: after fracture within %.0fx the intact fracturing block (CPU ns):%s\n", goal,
+           line);
+}
+
 /* One model on 1 thread and its twin (built and stepped alike, so their
  * states are the same bits) on `cores`: ns per element-step, the best of
  * three runs each, every run the same steps from the same checkpoint
@@ -520,7 +584,8 @@ static void bench_threads(int rows_2d, int rows_3d)
 }
 
 /* With no argument every section runs; otherwise only those named
- * (block, block3d, pile, pile3d, fracture, fracture3d, threads, threads3d), to iterate on one kernel. */
+ * (block, block3d, pile, pile3d, fracture, fracture3d, broken, broken3d, threads, threads3d),
+ * to iterate on one kernel. */
 static int wanted(int argc, char **argv, const char *name)
 {
     if (argc < 2) return 1;
@@ -542,6 +607,8 @@ int main(int argc, char **argv)
         bench_fracturing_block(&FRACTURE_3D, bw);
         bench_fracturing_block(&FRACTURE_3D_UNDAMPED, bw);
     }
+    if (wanted(argc, argv, "broken")) bench_broken_block(&FRACTURE_2D, 3);
+    if (wanted(argc, argv, "broken3d")) bench_broken_block(&FRACTURE_3D_UNDAMPED, 4);
     if (wanted(argc, argv, "threads") || wanted(argc, argv, "threads3d"))
         bench_threads(wanted(argc, argv, "threads"), wanted(argc, argv, "threads3d"));
     return 0;
