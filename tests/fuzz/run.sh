@@ -29,7 +29,7 @@ pkg=$(pkg-config --cflags --libs jansson hdf5)
 clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*.c $pkg -lm \
       -o "$out/fuzz_case"
 # shellcheck disable=SC2086
-clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c core/*.c \
+clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http/http_frame.c core/*.c \
       proto/*.c $pkg -lm -o "$out/fuzz_http"
 
 # Seeds: the bundled examples, every gmsh test file as a part, small docs.

@@ -24,7 +24,7 @@
 #include "case_model.h"
 #include "case_sizing.h"
 #include "io_thread.h"
-#include "persist.h"
+#include "store/persist.h"
 #include "registry_internal.h"
 #include "worker.h"
 

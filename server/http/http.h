@@ -23,7 +23,7 @@
 #include <jansson.h>
 #include <microhttpd.h>
 
-#include "config.h"
+#include "common/config.h"
 #include "problems.h"
 
 int http_start(const fdemd_config *cfg);

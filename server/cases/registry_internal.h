@@ -10,7 +10,7 @@
 
 #include <jansson.h>
 
-#include "config.h"
+#include "common/config.h"
 #include "registry.h"
 
 server_case *case_new(void);

@@ -26,9 +26,9 @@
 #include <jansson.h>
 
 #include "case.h"
-#include "config.h"
+#include "common/config.h"
 #include "fdem.h"
-#include "memory_budget.h"
+#include "common/memory_budget.h"
 #include "problems.h"
 #include "result.h"
 #include "snapshot.h"
