@@ -42,7 +42,7 @@ PKG_LIBS   = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
 CORE_SRC   := $(wildcard core/*.c core/*/*.c)
 PROTO_SRC  := $(wildcard proto/*.c)
-SERVER_SRC := $(wildcard server/*.c)
+SERVER_SRC := $(wildcard server/*.c server/*/*.c)
 CTL_SRC    := $(wildcard clients/fdemctl/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 BENCH_SRC  := $(wildcard bench/*.c)
@@ -76,7 +76,7 @@ $(BUILD)/proto/%.o: proto/%.c | $(BUILD)/.deps
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -c $< -o $@
 $(BUILD)/server/%.o: server/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Iserver -c $< -o $@
 $(BUILD)/clients/%.o: clients/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -c $< -o $@

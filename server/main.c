@@ -16,12 +16,12 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "config.h"
+#include "common/config.h"
 #include "fdem.h"
-#include "http.h"
-#include "io_thread.h"
-#include "memory_budget.h"
-#include "registry.h"
+#include "http/http.h"
+#include "cases/io_thread.h"
+#include "common/memory_budget.h"
+#include "cases/registry.h"
 
 static void usage(FILE *out)
 {

@@ -5,7 +5,7 @@
  *
  *  1. http_frame_head_end() finds the header block; http_frame_check()
  *     decides its framing (the code that runs on every connection before
- *     libmicrohttpd, see server/http_frame.c);
+ *     libmicrohttpd, see server/http/http_frame.c);
  *  2. a "fields=" query in the request target goes to case_parse_fields();
  *  3. when the framing is acceptable, the Content-Length bytes after the
  *     block are the body, and go to case_build() as POST /cases would.
@@ -22,7 +22,7 @@
 #include <string.h>
 
 #include "case.h"
-#include "http_frame.h"
+#include "http/http_frame.h"
 
 #define FUZZ_MEMORY_LIMIT ((size_t)64 << 20)
 

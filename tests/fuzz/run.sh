@@ -31,7 +31,7 @@ engine=$(find core proto -name '*.c' | sort)
 clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c $engine $pkg -lm \
       -o "$out/fuzz_case"
 # shellcheck disable=SC2086
-clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c $engine \
+clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http/http_frame.c $engine \
       $pkg -lm -o "$out/fuzz_http"
 
 # Seeds: the bundled examples, every gmsh test file as a part, small docs.

@@ -5,7 +5,7 @@ its document; so do POST /cases, dry runs and clones. Before, such requests
 ran on libmicrohttpd's four answering threads: four rebuilds of a
 750k-tetrahedron case held them all for 46 s, and /health, listed as always
 served, got no answer until one was done. Now they run on threads of their
-own (server/heavy_work.c) while their connections wait, so /health answers
+own (server/http/heavy_work.c) while their connections wait, so /health answers
 while they are still being built. The test orders events, not times: every
 /health answer must come before the first state is done."""
 import threading

@@ -33,7 +33,7 @@ def problem_of(reply):
 
 
 class GateTest(DaemonTestCase):
-    """The connection gate (server/gate.c, http_frame.c) on what it holds
+    """The connection gate (server/http/gate.c, http_frame.c) on what it holds
     before libmicrohttpd sees a request."""
     TIMEOUT = 3
     DAEMON_ARGS = ("--request-timeout", str(TIMEOUT))

@@ -1,11 +1,11 @@
 /*
  * test_http_frame.c - the framing checks the gate runs on a request's
- * header block (server/http_frame.c) before libmicrohttpd sees it.
+ * header block (server/http/http_frame.c) before libmicrohttpd sees it.
  *
  * Unit tests link only below the server, so the one pure server file under
  * test is compiled into this binary directly.
  */
-#include "../../server/http_frame.c"
+#include "../../server/http/http_frame.c"
 
 #include "check.h"
 

@@ -12,7 +12,7 @@
 #include <stddef.h>
 #include <microhttpd.h>
 
-#include "registry.h"
+#include "cases/registry.h"
 
 typedef enum route_kind {
     ROUTE_NONE, ROUTE_HEALTH, ROUTE_CASES, ROUTE_CASE, ROUTE_CASE_START, ROUTE_CASE_PAUSE,

@@ -18,7 +18,7 @@
 
 #include <microhttpd.h>
 
-#include "registry.h"
+#include "cases/registry.h"
 
 enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c, int head);
 

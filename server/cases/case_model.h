@@ -30,7 +30,7 @@
 #ifndef FDEMD_CASE_MODEL_H
 #define FDEMD_CASE_MODEL_H
 
-#include "memory_budget.h"
+#include "common/memory_budget.h"
 #include "registry.h"
 
 #define CASE_CHECKPOINT "checkpoint.bin"

@@ -21,7 +21,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "memory_budget.h"
+#include "common/memory_budget.h"
 #include "gate.h"
 #include "heavy_work.h"
 #include "json_depth.h"

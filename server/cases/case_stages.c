@@ -23,11 +23,11 @@
 #include <unistd.h>
 
 #include "case_model.h"
-#include "fault_point.h"
+#include "store/fault_point.h"
 #include "io_thread.h"
 #include "json_patch.h"
-#include "memory_budget.h"
-#include "persist.h"
+#include "common/memory_budget.h"
+#include "store/persist.h"
 #include "registry_internal.h"
 
 /* ---------------------------------------------------------------- reading */

@@ -1,4 +1,15 @@
 /*
+ * server/store/ - the files of the data directory, below the case
+ * lifecycle.
+ *  - Owns: atomic, fsynced writes, reads and removals (this header,
+ *    persist.c); checkpoint.bin sealed with a CRC-32 (checkpoint_file.c);
+ *    the named crash points tests place between durable writes
+ *    (fault_point.c).
+ *  - May call: core/ (the checkpoint's types), zlib and the C library; no
+ *    other server folder.
+ *  - Called by: cases/.
+ */
+/*
  * persist.h - durable files in the data directory.
  *
  * Contract: persist_write_atomic() leaves either the old or the new content

@@ -11,7 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "persist.h"
+#include "store/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
 

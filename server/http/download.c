@@ -33,8 +33,8 @@
 #include <unistd.h>
 
 #include "http.h"
-#include "io_thread.h"
-#include "memory_budget.h"
+#include "cases/io_thread.h"
+#include "common/memory_budget.h"
 #include "result.h"
 
 #define DOWNLOAD_BLOCK (256 * 1024) /* bytes per response read */

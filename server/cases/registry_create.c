@@ -16,10 +16,10 @@
 #include <sys/stat.h>
 
 #include "case_model.h"
-#include "checkpoint_file.h"
+#include "store/checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
-#include "persist.h"
+#include "store/persist.h"
 #include "registry_internal.h"
 
 /* A case id: CASE_ID_LEN hex digits from the kernel's random source. */

@@ -1,6 +1,7 @@
 /*
- * registry_internal.h - what registry.c, registry_create.c, case_status.c,
- * registry_load.c and case_stages.c share, and nothing else includes:
+ * registry_internal.h - what registry.c, case_record.c, registry_create.c,
+ * case_status.c, registry_load.c and case_stages.c share, and nothing else
+ * includes:
  * building a case record, its state names, the status object's durable
  * write, admitting a stored case, and loading one.
  */
@@ -9,7 +10,7 @@
 
 #include <jansson.h>
 
-#include "config.h"
+#include "common/config.h"
 #include "registry.h"
 
 server_case *case_new(void);

@@ -16,12 +16,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "case_stages.h"
+#include "cases/case_stages.h"
 #include "download.h"
 #include "events_json.h"
 #include "http.h"
-#include "io_thread.h"
-#include "memory_budget.h"
+#include "cases/io_thread.h"
+#include "common/memory_budget.h"
 #include "state_json.h"
 
 /* ------------------------------------------------------------- matching */

@@ -18,7 +18,7 @@
 #include <time.h>
 
 #include "case_model.h"
-#include "checkpoint_file.h"
+#include "store/checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
 

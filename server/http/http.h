@@ -1,4 +1,18 @@
 /*
+ * server/http/ - the daemon's front end: everything between a client's
+ * socket and the case lifecycle.
+ *  - Owns: accepting and holding connections (gate.c) and the framing
+ *    checks on a raw header block (http_frame.c); libmicrohttpd, request
+ *    bodies, authentication and the reply helpers (this header, http.c);
+ *    one function per API route (routes.c); result.h5 downloads
+ *    (download.c); the threads for requests that build a model
+ *    (heavy_work.c).
+ *  - May call: cases/ (registry.h, case_stages.h, io_thread.h), common/
+ *    (config.h, memory_budget.h), proto/ and core/.
+ *  - Called by: main.c only (http_start, http_stop). Nothing in cases/,
+ *    store/ or common/ calls back into this folder.
+ */
+/*
  * http.h - the libmicrohttpd daemon: connection handling, request bodies,
  * authentication, and the response helpers the routes use.
  *
@@ -23,7 +37,7 @@
 #include <jansson.h>
 #include <microhttpd.h>
 
-#include "config.h"
+#include "common/config.h"
 #include "problems.h"
 
 int http_start(const fdemd_config *cfg);

@@ -1,4 +1,14 @@
 /*
+ * server/common/ - what every part of the daemon shares and reads: its
+ * settings and its one memory account.
+ *  - Owns: the command-line settings (this header), filled once by main.c;
+ *    the --max-memory account every large allocation is reserved against
+ *    (memory_budget.c).
+ *  - May call: the C library and jansson's allocator hooks; no other
+ *    server folder.
+ *  - Called by: main.c, http/ and cases/.
+ */
+/*
  * config.h - the daemon's command-line settings, filled once by main() and
  * read-only afterwards (so every thread may read them without locking).
  */

@@ -20,8 +20,8 @@
 
 #include "case_model.h"
 #include "case_stages.h"
-#include "memory_budget.h"
-#include "persist.h"
+#include "common/memory_budget.h"
+#include "store/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
 

@@ -1,4 +1,19 @@
 /*
+ * server/cases/ - the case lifecycle: a case from upload to deletion.
+ *  - Owns: the case record and its reference count (case_record.c); the
+ *    registry table and state machine (this header, registry.c); storing an
+ *    upload (registry_create.c) and loading a stored case
+ *    (registry_load.c, registry_internal.h between them); status objects
+ *    and status.json (case_status.c); building, sizing and dropping models
+ *    (case_model.c, case_sizing.c); extend and clone (case_stages.c); one
+ *    worker thread per running case (worker.c); the one HDF5 I/O thread
+ *    (io_thread.c). The state machine, the workers and the I/O thread call
+ *    each other: that circle stays inside this folder.
+ *  - May call: store/ (persist.h, checkpoint_file.h, fault_point.h),
+ *    common/ (config.h, memory_budget.h), proto/ and core/.
+ *  - Called by: http/ and main.c; it never calls http/.
+ */
+/*
  * registry.h - the set of cases the daemon holds and their state machine.
  *
  * Contract:
@@ -26,9 +41,9 @@
 #include <jansson.h>
 
 #include "case.h"
-#include "config.h"
+#include "common/config.h"
 #include "fdem.h"
-#include "memory_budget.h"
+#include "common/memory_budget.h"
 #include "problems.h"
 #include "result.h"
 #include "snapshot.h"

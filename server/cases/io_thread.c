@@ -21,7 +21,7 @@
 #include <unistd.h>
 
 #include "case_model.h"
-#include "persist.h"
+#include "store/persist.h"
 
 typedef enum io_job_kind {
     IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_QUIT,
