@@ -25,7 +25,7 @@
 #include "case_model.h"
 #include "fault_point.h"
 #include "io_thread.h"
-#include "json_patch.h"
+#include "json/json_patch.h"
 #include "memory_budget.h"
 #include "persist.h"
 #include "registry_internal.h"

@@ -24,7 +24,7 @@
 #include <microhttpd.h>
 
 #include "config.h"
-#include "problems.h"
+#include "json/problems.h"
 
 int http_start(const fdemd_config *cfg);
 void http_stop(void);

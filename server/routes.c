@@ -18,11 +18,11 @@
 
 #include "case_stages.h"
 #include "download.h"
-#include "events_json.h"
+#include "state/events_json.h"
 #include "http.h"
 #include "io_thread.h"
 #include "memory_budget.h"
-#include "state_json.h"
+#include "state/state_json.h"
 
 /* ------------------------------------------------------------- matching */
 

@@ -26,11 +26,11 @@ cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-omit-fr
         -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -Wno-unknown-pragmas"
 pkg=$(pkg-config --cflags --libs jansson hdf5)
 # shellcheck disable=SC2086
-clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*.c $pkg -lm \
+clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c core/*.c proto/*/*.c $pkg -lm \
       -o "$out/fuzz_case"
 # shellcheck disable=SC2086
 clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http_frame.c core/*.c \
-      proto/*.c $pkg -lm -o "$out/fuzz_http"
+      proto/*/*.c $pkg -lm -o "$out/fuzz_http"
 
 # Seeds: the bundled examples, every gmsh test file as a part, small docs.
 for f in examples/*.json; do [ -e "$f" ] && cp "$f" "$corpus/"; done

@@ -37,9 +37,9 @@
 
 #include <stddef.h>
 #include <sys/types.h>
-#include "case.h"
+#include "case/case.h"
 #include "fdem.h"
-#include "snapshot.h"
+#include "state/snapshot.h"
 
 typedef struct result_file result_file;
 

@@ -18,9 +18,9 @@
 
 #include "case.h"
 #include "fdem.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "mesh_3d.h"
-#include "problems.h"
+#include "json/problems.h"
 
 #define CASE_POINTER 256 /* = sizeof problem.pointer */
 #define CASE_NAME 128

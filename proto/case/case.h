@@ -17,7 +17,7 @@
 
 #include <stddef.h>
 #include "fdem.h"
-#include "problems.h"
+#include "json/problems.h"
 
 enum case_field {
     CASE_FIELD_POSITION = 1u << 0,
