@@ -41,7 +41,7 @@ PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
 CORE_SRC   := $(wildcard core/*.c core/*/*.c)
-PROTO_SRC  := $(wildcard proto/*.c)
+PROTO_SRC  := $(wildcard proto/*.c proto/*/*.c)
 SERVER_SRC := $(wildcard server/*.c server/*/*.c)
 CTL_SRC    := $(wildcard clients/fdemctl/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
@@ -73,7 +73,7 @@ $(BUILD)/core/%.o: core/%.c | $(BUILD)/.deps
 	$(CC) $(CFLAGS) -Icore -fopenmp -c $< -o $@
 $(BUILD)/proto/%.o: proto/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -c $< -o $@
 $(BUILD)/server/%.o: server/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Iserver -c $< -o $@

@@ -35,7 +35,7 @@
 #include <time.h>
 
 #include "../tests/unit/joint_face_3d.h"
-#include "case.h"
+#include "case/case.h"
 #include "model/model.h"
 
 #define WINDOW 2e-6

@@ -4,7 +4,7 @@
  * Several checks find the same face or cell listed twice, or shared by two
  * elements, by sorting each one's node ids and the keys after them: joint
  * faces (joint_tet_model.c), joint sets (joint_strength.c), boundary
- * facets (boundary_load.c) and repeated mesh cells (proto/case_mesh.c).
+ * facets (boundary_load.c) and repeated mesh cells (proto/case/case_mesh.c).
  * Contract: node_ids_sort puts v[0 .. n) in increasing order;
  * node_ids_compare orders two such lists of n ids lexicographically
  * (-1, 0, 1), for qsort comparators that break ties their own way.

@@ -64,7 +64,7 @@ int case_model_gate(void *ctx, double estimate);
 /* case_build() of an upload: `lease` already holds the request's admission
  * (membudget_upload_cost); the JSON tree and the model are charged to it.
  * Memory short now is one problem with status 503. model_bytes (may be
- * NULL) gets the builder's estimate of the model (proto/case_memory.c). */
+ * NULL) gets the builder's estimate of the model (proto/case/case_memory.c). */
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
                                     case_info *info, problems *p, double *model_bytes);
 case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_model **model,

@@ -3,7 +3,7 @@
  *
  * The counts and the step come from the model the case builder made (the
  * same build POST /cases does), the memory from the builder's own estimate
- * (proto/case_memory.c, priced as the daemon's budget charges it), and the
+ * (proto/case/case_memory.c, priced as the daemon's budget charges it), and the
  * wall time from stepping that model for a moment on this machine: a
  * formula of element counts would be wrong on every other machine and for
  * every contact-heavy case.
@@ -62,7 +62,7 @@ static double sizing_snapshots(const case_info *info, double t0, double dt, doub
     return 1 + inside + (steps > 0 ? 1 : 0);
 }
 
-/* result.h5 as proto/result_h5.c lays it out: /mesh once, then per
+/* result.h5 as proto/result/result_h5.c lays it out: /mesh once, then per
  * snapshot the requested node and element fields, damage when there are
  * joints, the fragment id of every element, the constraint forces and the
  * scalar series (step, time and the energy accounts). HDF5's own metadata,

@@ -22,7 +22,7 @@
 #include <jansson.h>
 #include <stdint.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "fdem.h"
 
 /* A case whose estimated run is at least this long gets a warning. */

@@ -25,7 +25,7 @@
 #include "case_model.h"
 #include "store/fault_point.h"
 #include "io_thread.h"
-#include "json_patch.h"
+#include "json/json_patch.h"
 #include "common/memory_budget.h"
 #include "store/persist.h"
 #include "registry_internal.h"

@@ -1,5 +1,5 @@
 /*
- * io_thread.h - the single thread that calls HDF5 (proto/result.h).
+ * io_thread.h - the single thread that calls HDF5 (proto/result/result.h).
  *
  * Contract:
  *  - Jobs run strictly in the order they were queued, so a close queued

@@ -40,13 +40,13 @@
 #include <stdint.h>
 #include <jansson.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "common/config.h"
 #include "fdem.h"
 #include "common/memory_budget.h"
-#include "problems.h"
-#include "result.h"
-#include "snapshot.h"
+#include "json/problems.h"
+#include "result/result.h"
+#include "state/snapshot.h"
 
 typedef enum case_state {
     CASE_CREATED, CASE_QUEUED, CASE_RUNNING, CASE_PAUSED,

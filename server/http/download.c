@@ -35,7 +35,7 @@
 #include "http.h"
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
-#include "result.h"
+#include "result/result.h"
 
 #define DOWNLOAD_BLOCK (256 * 1024) /* bytes per response read */
 #define DOWNLOAD_ROWS_AHEAD 8              /* snapshots of room kept per writing case */

@@ -24,7 +24,7 @@
 #include "common/memory_budget.h"
 #include "gate.h"
 #include "heavy_work.h"
-#include "json_depth.h"
+#include "json/json_depth.h"
 #include "routes.h"
 
 #define HTTP_THREADS 4

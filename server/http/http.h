@@ -38,7 +38,7 @@
 #include <microhttpd.h>
 
 #include "common/config.h"
-#include "problems.h"
+#include "json/problems.h"
 
 int http_start(const fdemd_config *cfg);
 void http_stop(void);

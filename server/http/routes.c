@@ -18,11 +18,11 @@
 
 #include "cases/case_stages.h"
 #include "download.h"
-#include "events_json.h"
+#include "state/events_json.h"
 #include "http.h"
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
-#include "state_json.h"
+#include "state/state_json.h"
 
 /* ------------------------------------------------------------- matching */
 

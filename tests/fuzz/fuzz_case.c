@@ -15,8 +15,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "case.h"
-#include "gmsh.h"
+#include "case/case.h"
+#include "gmsh/gmsh.h"
 #include "mesh/mesh_3d.h"
 
 #define FUZZ_MEMORY_LIMIT ((size_t)64 << 20)

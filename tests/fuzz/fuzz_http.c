@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "http/http_frame.h"
 
 #define FUZZ_MEMORY_LIMIT ((size_t)64 << 20)

@@ -11,7 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "fdem.h"
 #include "mesh/mesh_3d.h"
 

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "case_doc.h"
 #include "check.h"
 

@@ -11,10 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "case_doc.h"
 #include "check.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "mesh/mesh_3d.h"
 
 /* One 0.1 x 0.2 x 0.3 m box of 2 x 3 x 4 cells, three constraints. */

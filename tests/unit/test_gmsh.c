@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "read_file.h"
 
 static double mesh_area(const fdem_mesh *m)

@@ -17,7 +17,7 @@
 
 #include "case_doc.h"
 #include "check.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "mesh/mesh_3d.h"
 #include "model/model.h"
 #include "read_file.h"

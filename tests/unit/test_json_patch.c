@@ -8,8 +8,8 @@
 #include <string.h>
 
 #include "check.h"
-#include "json_depth.h"
-#include "json_patch.h"
+#include "json/json_depth.h"
+#include "json/json_patch.h"
 
 static json_t *parse(const char *text)
 {

@@ -14,11 +14,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "check.h"
 #include "fdem.h"
 #include "heap_count.h"
-#include "problems.h"
+#include "json/problems.h"
 #include "read_file.h"
 
 /* An example and how long to step it: long enough for its contacts (or

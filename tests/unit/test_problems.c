@@ -6,7 +6,7 @@
 #include <string.h>
 
 #include "check.h"
-#include "problems.h"
+#include "json/problems.h"
 
 static void first_problem_sets_status_and_title(void)
 {

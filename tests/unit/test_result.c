@@ -19,9 +19,9 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "result.h"
+#include "result/result.h"
 #include "result_fixture.h"
-#include "state_json.h"
+#include "state/state_json.h"
 
 #define STEPS_BETWEEN 5
 

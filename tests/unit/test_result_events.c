@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "result.h"
+#include "result/result.h"
 #include "result_fixture.h"
 
 static char tmpdir[] = "/tmp/fdem-result-events-XXXXXX";

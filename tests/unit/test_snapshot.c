@@ -6,7 +6,7 @@
 
 #include "check.h"
 #include "result_fixture.h"
-#include "snapshot.h"
+#include "state/snapshot.h"
 
 static int equal_doubles(const double *a, const double *b, size_t n)
 {

@@ -7,9 +7,9 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "case.h"
+#include "case/case.h"
 #include "check.h"
-#include "state_json.h"
+#include "state/state_json.h"
 
 static double position[4] = {0.1 + 0.2, -1.5, 1e-300, 2.5e17};
 static double velocity[4] = {1.0, -2.0, 3.0, -4.0};

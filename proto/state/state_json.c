@@ -11,7 +11,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "case.h"
+#include "case/case.h"
 
 static json_t *number_or_null(double v)
 {

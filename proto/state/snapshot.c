@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "case.h"
+#include "case/case.h"
 
 /* malloc + memcpy of `count` doubles; a zero count gives NULL, not an error. */
 static double *copy_doubles(const double *src, size_t count, int *failed)

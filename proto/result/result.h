@@ -31,15 +31,23 @@
  *    XDMF Reader only).
  *  - Both dimensions share one layout (contract 5.2); the root attribute
  *    `dimension` says which, and /mesh/triangles becomes /mesh/tetrahedra.
+ *
+ * Folder proto/result/, result.h5 and result.xdmf: owns this header, the
+ * HDF5 files (result_h5.c writes; result_describe.c, result_events.c and
+ * result_views.c add to them; result_reopen.c reads them back; all share
+ * result_internal.h), the sidecar (result_xdmf.c) and the HDF5-free copy
+ * for downloads (result_image.c). May call core/, proto/case/ (case_info)
+ * and proto/state/ (the snapshots it writes). Called by server/ (the I/O
+ * thread, downloads) and the unit tests.
  */
 #ifndef FDEM_RESULT_H
 #define FDEM_RESULT_H
 
 #include <stddef.h>
 #include <sys/types.h>
-#include "case.h"
+#include "case/case.h"
 #include "fdem.h"
-#include "snapshot.h"
+#include "state/snapshot.h"
 
 typedef struct result_file result_file;
 

@@ -11,6 +11,12 @@
  * The fragment id of every element is always copied (result.h5 stores it
  * with every snapshot, contract 5.4); the fragment records are computed only
  * when SNAPSHOT_FRAGMENTS is in `fields` (GET /cases/ID/fragments).
+ *
+ * Folder proto/state/, a model's state on its way out of the engine: owns
+ * this header (the copy, snapshot.c) and the JSON of GET /cases/ID/state
+ * (state_json.h) and /cases/ID/events (events_json.h). May call core/ and
+ * proto/case/ (only the CASE_FIELD_* bits of case.h). Called by
+ * proto/result/ (which writes snapshots), server/ and the unit tests.
  */
 #ifndef FDEM_SNAPSHOT_H
 #define FDEM_SNAPSHOT_H

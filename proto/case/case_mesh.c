@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "case_internal.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "math/node_ids.h"
 
 typedef struct mesh_kind {

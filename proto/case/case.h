@@ -11,13 +11,21 @@
  *  - time.dt "auto" = safety x fdem_stable_dt(); a number above the stable
  *    step is rejected with 422 naming the stable value.
  *  - On success the model is finalized, its dt set, and `info` filled.
+ *
+ * Folder proto/case/, the case document -> engine model: owns this header
+ * (case_build(), case_info, the CASE_FIELD_* bits, case_parse_fields()) and
+ * the passes behind it, case*.c sharing case_internal.h, with case.c on top
+ * (no case file calls back into it). May call core/ (the engine),
+ * proto/json/ (problem lists, JSON Pointers) and proto/gmsh/ (gmsh parts and
+ * their named groups). Called by proto/result/ and proto/state/ (case_info,
+ * CASE_FIELD_*), server/, the unit tests, the fuzzers and scripts/limits.c.
  */
 #ifndef FDEM_CASE_H
 #define FDEM_CASE_H
 
 #include <stddef.h>
 #include "fdem.h"
-#include "problems.h"
+#include "json/problems.h"
 
 enum case_field {
     CASE_FIELD_POSITION = 1u << 0,

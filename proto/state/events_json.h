@@ -6,6 +6,8 @@
  * "position": [x, y(, z)], "mode", "energy"}, ...]} in the order of
  * /events (the order the joints broke); "since" is the filter's bound or
  * null. NULL when out of memory or a number is not finite.
+ *
+ * Folder: proto/state/ (its contract: snapshot.h).
  */
 #ifndef FDEM_EVENTS_JSON_H
 #define FDEM_EVENTS_JSON_H

@@ -12,6 +12,8 @@
  * when no array or object opens deeper than `limit`, else 1 with the line
  * and column (1-based, in bytes) of the first bracket past it. It does not
  * check that the text is valid JSON; the parser does that afterwards.
+ *
+ * Folder: proto/json/ (its contract: problems.h).
  */
 #ifndef FDEM_JSON_DEPTH_H
 #define FDEM_JSON_DEPTH_H

@@ -18,9 +18,9 @@
 
 #include "case.h"
 #include "fdem.h"
-#include "gmsh.h"
+#include "gmsh/gmsh.h"
 #include "mesh/mesh_3d.h"
-#include "problems.h"
+#include "json/problems.h"
 
 #define CASE_POINTER 256 /* = sizeof problem.pointer */
 #define CASE_NAME 128
@@ -185,6 +185,18 @@ const char *case_closest(const char *word, const char *const *candidates, int co
 const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char *word,
                               const char *const *candidates, int count);
 
+/* --------------------------------------- case_doc.c: problems and freeing */
+
+/* Turns an engine error into a problem at the pointer of the item it names;
+ * `fallback` is used when the error names nothing more precise. */
+void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback);
+
+/* The problem at /time/dt of a dt above `stable`; `whose` qualifies the
+ * model ("" or "'s valid parts"). */
+void case_dt_problem(case_doc *doc, double stable, const char *whose);
+
+void case_doc_free(case_doc *doc);
+
 /* -------------------------------------------------- the sections, pass 1 */
 void case_read_materials(case_doc *doc, const json_t *materials);
 int case_material_index(const case_doc *doc, const char *name);
@@ -240,21 +252,12 @@ int case_add_materials(case_doc *doc, fdem_model *model);
 int case_add_parts(case_doc *doc, fdem_model *model);
 int case_add_constraints(case_doc *doc, fdem_model *model);
 
-/* The problem at /time/dt of a dt above `stable`; `whose` qualifies the
- * model ("" or "'s valid parts"). */
-void case_dt_problem(case_doc *doc, double stable, const char *whose);
 /* case_probe.c: after pass 1 found problems, adds the /time/dt one a build
  * would find too, from a scratch model of the parts without problems. */
 void case_probe_dt(case_doc *doc, int from, size_t memory_limit, case_memory_gate gate,
                    void *gate_ctx);
 
-/* Turns an engine error into a problem at the pointer of the item it names;
- * `fallback` is used when the error names nothing more precise. */
-void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback);
-
 /* The pointer of part i's mesh source ("/parts/3/mesh" or "/parts/3/gmsh"). */
 void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr);
-
-void case_doc_free(case_doc *doc);
 
 #endif

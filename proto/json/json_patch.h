@@ -16,6 +16,8 @@
  *    that meters jansson meters it too) and is free()d when that allocator
  *    is malloc-based, as jansson's default and fdemd's meter are; NULL
  *    when memory runs out.
+ *
+ * Folder: proto/json/ (its contract: problems.h).
  */
 #ifndef FDEM_JSON_PATCH_H
 #define FDEM_JSON_PATCH_H

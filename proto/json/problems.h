@@ -8,6 +8,13 @@
  * a well-formed but invalid case. At most PROBLEMS_MAX problems are kept;
  * later ones only increase `dropped` (a broken document must not produce a
  * response larger than itself).
+ *
+ * Folder proto/json/, plain JSON and problem reporting, which know nothing
+ * of cases or the engine: owns this header (problem lists with JSON
+ * Pointers, problems.c), the nesting check of a JSON text before it is
+ * parsed (json_depth.h) and merge patch with the exact-number dump
+ * (json_patch.h). May call jansson and the C library only. Called by
+ * proto/case/, server/ and the unit tests.
  */
 #ifndef FDEM_PROBLEMS_H
 #define FDEM_PROBLEMS_H

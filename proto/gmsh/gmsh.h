@@ -7,6 +7,12 @@
  * z is ignored. Any malformed input (binary files, bad counts, unknown node
  * tags, truncated sections, non-finite numbers, no triangles) returns -1
  * with a message that names the section and line. Never reads past `length`.
+ *
+ * Folder proto/gmsh/, the gmsh reader: owns this header and what gmsh.c
+ * (sections, nodes, elements) and gmsh_groups.c (physical groups) share,
+ * gmsh_internal.h. May call core/ (the engine's mesh types) and the C
+ * library only: no JSON, no case. Called by proto/case/ (mesh and gmsh
+ * parts, selectors by group), the unit tests and the case fuzzer.
  */
 #ifndef FDEM_GMSH_H
 #define FDEM_GMSH_H

@@ -5,9 +5,10 @@
  * This file owns the order of things: parse, read every section (pass 1,
  * case_materials.c, case_parts.c, case_constraints.c and the small sections
  * here), estimate memory (pass 2, case_memory.c), build and finalize the
- * model (pass 3), then choose the time step. It also maps engine errors to
- * JSON Pointers, because only the case knows which document item became
- * which engine index.
+ * model (pass 3), then choose the time step. Engine errors are mapped to
+ * JSON Pointers (only the case knows which document item became which
+ * engine index) in case_doc.c, which the sections share; no case file calls
+ * back into this one.
  */
 #include <math.h>
 #include <stdio.h>
@@ -188,20 +189,6 @@ static void case_read(case_doc *doc, const json_t *root)
 
 /* ---------------------------------------------------------------- pass 3 */
 
-void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback)
-{
-    char ptr[CASE_POINTER];
-    snprintf(ptr, sizeof ptr, "%s", fallback);
-    if (err->kind == FDEM_ITEM_MATERIAL && err->item >= 0 && err->item < doc->material_count)
-        pointer_join(ptr, sizeof ptr, "/materials", doc->materials[err->item].name);
-    else if (err->kind == FDEM_ITEM_PART && err->item >= 0 && err->item < doc->part_count)
-        pointer_join_index(ptr, sizeof ptr, "/parts", err->item);
-    else if (err->kind == FDEM_ITEM_CONSTRAINT && err->item >= 0 &&
-             err->item < doc->constraint_count)
-        pointer_join_index(ptr, sizeof ptr, "/constraints", err->item);
-    case_problem(doc, ptr, "%s", err->message[0] ? err->message : "the engine refused the case");
-}
-
 /* Belt and braces: a constraint that selected nothing is a user error even
  * if the engine accepted it. */
 static int case_check_selections(case_doc *doc, const fdem_model *model)
@@ -215,14 +202,6 @@ static int case_check_selections(case_doc *doc, const fdem_model *model)
             ok = 0;
         }
     return ok;
-}
-
-void case_dt_problem(case_doc *doc, double stable, const char *whose)
-{
-    case_problem(doc, "/time/dt", "dt = %g s is above the stable time step of this model%s, "
-                                  "%.4g s; use at most that, or \"auto\" (%.4g s with safety "
-                                  "%g)", doc->dt, whose, stable, doc->safety * stable,
-                 doc->safety);
 }
 
 /* time.end / dt within CASE_MAX_STEPS; else a problem at whichever of the
@@ -341,23 +320,6 @@ static void case_fill_info(const case_doc *doc, case_info *info)
     info->constraint_count = doc->constraint_count;
     info->fracture = 0;
     for (int i = 0; i < doc->part_count; i++) info->fracture |= doc->parts[i].fracture;
-}
-
-void case_doc_free(case_doc *doc)
-{
-    for (int i = 0; i < doc->part_count; i++) {
-        fdem_mesh_free(&doc->parts[i].mesh);
-        fdem_tet_mesh_free(&doc->parts[i].tet_mesh);
-        case_part_groups_free(&doc->parts[i]);
-    }
-    for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].vertices);
-    free(doc->parts);
-    free(doc->materials);
-    for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].amplitude);
-    free(doc->constraints);
-    free(doc->gravity_amplitude);
-    json_decref(doc->material_names);
-    json_decref(doc->part_names);
 }
 
 static json_t *case_parse(const char *text, size_t length, problems *out)

@@ -7,6 +7,8 @@
  * in 3D) and damage as a number per joint; only the fields present in the
  * snapshot; strain like stress, principal_stress as `dimension` numbers per
  * element, descending.
+ *
+ * Folder: proto/state/ (its contract: snapshot.h).
  */
 #ifndef FDEM_STATE_JSON_H
 #define FDEM_STATE_JSON_H
