@@ -301,7 +301,9 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     memset(m->force, 0, nb);
     m->fixed_valid = 0; /* computed again from the restored positions: the same bits */
     if (h1.version == 1 || !h.has_detection) {
-        m->contact.need_detect = 1;
+        /* a model without contact never detects: its flag stays 0 as in a
+         * fresh one, so a restarted run writes the same bytes */
+        m->contact.need_detect = m->contact.enabled;
     } else {
         memcpy(m->contact.pos_detect, p, nb);
         p += nb;
