@@ -37,6 +37,7 @@
 #include "kernel/element_tet_kernel.h"
 #include "model/model.h"
 #include "math/vec3.h"
+#include "element.h"
 #if FDEM_QUADS
 #include <immintrin.h>
 #endif
@@ -303,7 +304,6 @@ TET_KERNEL void tet_store_six_quad(double *rows, const fdem_quad v[6])
 #define TET_LOAD_SIX(rows, v) tet_load_six_quad(rows, v)
 #define TET_STORE_SIX(rows, v) tet_store_six_quad(rows, v)
 #include "element_tet_lanes.h"
-#include "element.h"
 
 /* Four elements of one material: a call of its own, so that the baseline
  * loop, which never takes it, holds no AVX code. */

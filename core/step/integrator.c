@@ -17,6 +17,11 @@
 
 #include "model/model.h"
 #include "math/quad.h"
+#include "step.h"
+#include "contact/contact.h"
+#include "element/element.h"
+#include "joint/joint.h"
+#include "parallel/scatter_plan.h"
 
 /* The central difference update of nodes [begin, end), for every dof no
  * constraint owns, in D = 2 or 3 components (a constant at each call, so
@@ -140,11 +145,6 @@ central_difference_free_node(double *x, double *v, const double *f, const double
 
 #if FDEM_QUADS
 #include <immintrin.h>
-#include "step.h"
-#include "contact/contact.h"
-#include "element/element.h"
-#include "joint/joint.h"
-#include "parallel/scatter_plan.h"
 #pragma GCC push_options
 #pragma GCC target("avx2")
 
