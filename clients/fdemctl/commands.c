@@ -432,12 +432,14 @@ int cmd_case(const ctl_options *o, int argc, char **argv)
 }
 
 static const char USAGE_STATE[] =
-    "usage: fdemctl state ID [--fields position,velocity,stress,damage,strain,principal_stress]\n"
+    "usage: fdemctl state ID [--fields FIELD,...]\n"
+    "  FIELD: position, velocity, stress, damage, strain, principal_stress,\n"
+    "  displacement (default: position,velocity).\n"
     "  Prints the current state (taken at one step boundary) as JSON:\n"
-    "  position/velocity [[x, y], ...] per node ([[x, y, z], ...] in 3D),\n"
-    "  stress and strain [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz,\n"
-    "  xz, xy), principal_stress [[s1, s2], ...] (3D: three) descending,\n"
-    "  damage per joint.\n";
+    "  position/velocity/displacement [[x, y], ...] per node ([[x, y, z], ...]\n"
+    "  in 3D; displacement = position - initial position), stress and strain\n"
+    "  [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz, xz, xy),\n"
+    "  principal_stress [[s1, s2], ...] (3D: three) descending, damage per joint.\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

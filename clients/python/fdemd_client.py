@@ -236,11 +236,12 @@ class Client:
 
         Args:
             fields: names among "position", "velocity", "stress", "damage",
-                "strain", "principal_stress" (a list or a comma-separated
-                string); None = server default.
+                "strain", "principal_stress", "displacement" (a list or a
+                comma-separated string); None = server default.
         Returns:
-            {"step", "time", <field>: ...}: position/velocity [[x, y], ...]
-            per node ([[x, y, z], ...] in 3D), stress and strain [[xx, yy,
+            {"step", "time", <field>: ...}: position/velocity/displacement
+            [[x, y], ...] per node ([[x, y, z], ...] in 3D; displacement is
+            position - initial position), stress and strain [[xx, yy,
             xy], ...] per element (3D: xx, yy, zz, yz, xz, xy; strain is
             Green-Lagrange), principal_stress [[s1, s2], ...] (3D: three)
             descending, damage per joint; docs/api.md, "GET

@@ -2,10 +2,11 @@
 """plot_result.py - draw one snapshot of an fdemd result.h5 as a PNG.
 
     /usr/bin/python3 clients/python/plot_result.py result.h5 -o out.png \\
-        [--field stress|velocity|damage] [--snapshot -1] [--component C]
+        [--field stress|velocity|displacement|damage] [--snapshot -1] [--component C]
 
 Draws the deformed mesh of the chosen snapshot (positions from
-/snapshots/position, else the initial /mesh/position0). A 2D result is drawn
+/snapshots/position, else /mesh/position0 + /snapshots/displacement, else
+the initial /mesh/position0). A 2D result is drawn
 as its triangles, coloured by
 
   stress    von Mises stress per element, from the Cauchy stress
@@ -21,6 +22,11 @@ as its triangles, coloured by
             A file without the attribute (written before it existed)
             needs one of the two.
   velocity  speed |v| per node from /snapshots/velocity.
+  displacement
+            |u| per node, u = position - initial position, from
+            /snapshots/displacement (output.fields "displacement"); a file
+            without it but with /snapshots/position gives the same numbers
+            as /snapshots/position - /mesh/position0.
   damage    every joint of /mesh/joints as a segment coloured by its damage
             (0 intact ... 1 broken) over the mesh in grey.
 
@@ -30,13 +36,15 @@ tetrahedron and of no joint still holding: a broken joint's faces show the
 crack) in an equal-aspect perspective view (--view ELEV,AZIM), each
 face coloured by its tetrahedron's von Mises stress, exact from the six
 components (xx, yy, zz, yz, xz, xy) of /snapshots/stress, or by the mean
-speed of its three nodes for --field velocity. Only the surface is drawn:
+speed of its three nodes for --field velocity (the mean |u| for --field
+displacement). Only the surface is drawn:
 stress inside a body does not show.
 
 --component xx|yy|xy (3D also zz|yz|xz) colours by that Cauchy stress
 component instead of von Mises, on a diverging scale centred on zero.
 
-The default field is stress when the file has it, else velocity.
+The default field is stress when the file has it, else velocity, else
+displacement.
 The file may still be written by a running case: it is opened plainly first,
 then as an HDF5 SWMR reader.
 """
@@ -160,6 +168,31 @@ def scaled_unit(values, unit):
     return values, unit
 
 
+def scaled_length(values):
+    """Lengths in m rescaled to mm, \u00b5m or nm when small, for the colourbar."""
+    peak = float(np.nanmax(np.abs(values))) if values.size else 0.0
+    for factor, unit in ((1.0, "m"), (1e-3, "mm"), (1e-6, "\u00b5m")):
+        if peak >= factor:
+            return values / factor, unit
+    return (values / 1e-9, "nm") if peak > 0 else (values, "m")
+
+
+def node_displacement(f, s):
+    """(N, dimension) displacement of snapshot s: /snapshots/displacement,
+    else /snapshots/position - /mesh/position0 (the same numbers)."""
+    if "/snapshots/displacement" in f:
+        return f["/snapshots/displacement"][s]
+    if "/snapshots/position" in f:
+        return f["/snapshots/position"][s] - f["/mesh/position0"][:]
+    require(f, "/snapshots/displacement", 'add "displacement" (or "position") to output.fields')
+
+
+def displacement_magnitude(f, s):
+    """|u| per node, rescaled, and the colourbar label."""
+    values, unit = scaled_length(np.linalg.norm(node_displacement(f, s), axis=1))
+    return values, "displacement |u| [%s]" % unit
+
+
 def stress_component(f, s, dimension, component):
     """One Cauchy stress component per element, and its colourbar label."""
     names = COMPONENTS[dimension]
@@ -196,6 +229,12 @@ def draw_velocity(ax, f, tri, s, args):
     return art, "speed |v| [m/s]"
 
 
+def draw_displacement(ax, f, tri, s, args):
+    values, label = displacement_magnitude(f, s)
+    art = ax.tripcolor(tri, values, shading="gouraud", cmap="cividis")
+    return art, label
+
+
 def draw_damage(ax, f, tri, s, args):
     joints = require(f, "/mesh/joints", "no part of this case fractures")[:]
     damage = require(f, "/snapshots/damage", "no part of this case fractures")[s]
@@ -209,13 +248,16 @@ def draw_damage(ax, f, tri, s, args):
     return lines, "joint damage [-] (0 intact, 1 broken)"
 
 
-DRAW = {"stress": draw_stress, "velocity": draw_velocity, "damage": draw_damage}
+DRAW = {"stress": draw_stress, "velocity": draw_velocity, "displacement": draw_displacement,
+        "damage": draw_damage}
 
 
 def snapshot_positions(f, s):
     """Node positions of snapshot s, and which positions they are."""
     if "/snapshots/position" in f:
         return f["/snapshots/position"][s], "deformed"
+    if "/snapshots/displacement" in f:
+        return f["/mesh/position0"][:] + f["/snapshots/displacement"][s], "deformed"
     return f["/mesh/position0"][:], "initial positions"
 
 
@@ -311,6 +353,12 @@ def face_speed(f, s, faces):
     return speed[faces].mean(axis=1), "speed |v| [m/s] (face mean of its nodes)", "plasma"
 
 
+def face_displacement(f, s, faces):
+    """Per boundary face: the mean |u| of its three nodes."""
+    values, label = displacement_magnitude(f, s)
+    return values[faces].mean(axis=1), label + " (face mean of its nodes)", "cividis"
+
+
 def equal_aspect_3d(ax, xyz):
     """One metre is as long along x, y and z: a cube around the points."""
     low, high = xyz.min(axis=0), xyz.max(axis=0)
@@ -339,6 +387,8 @@ def plot_3d(f, args, field):
     faces, element = surface_of_snapshot(f, s)
     if field == "stress":
         values, label, cmap = face_stress(f, s, element, args)
+    elif field == "displacement":
+        values, label, cmap = face_displacement(f, s, faces)
     else:
         values, label, cmap = face_speed(f, s, faces)
 
@@ -366,9 +416,17 @@ def result_dimension(f):
     return int(f.attrs.get("dimension", 3 if "/mesh/tetrahedra" in f else 2))
 
 
+def default_field(f):
+    """stress when the file has it, else velocity, else displacement."""
+    for field in ("stress", "velocity", "displacement"):
+        if "/snapshots/" + field in f:
+            return field
+    return "velocity"  # which then says what to add to output.fields
+
+
 def plot(args):
     with open_result(args.result) as f:
-        field = args.field or ("stress" if "/snapshots/stress" in f else "velocity")
+        field = args.field or default_field(f)
         draw = plot_3d if result_dimension(f) == 3 else plot_2d
         fig = draw(f, args, field)
         fig.tight_layout()

@@ -27,9 +27,10 @@ static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
 /* In CASE_FIELD_* bit order: names[k] is bit 1u << k. */
 static const char *const field_names[] = {"position", "velocity", "stress", "damage",
-                                          "strain", "principal_stress"};
+                                          "strain", "principal_stress", "displacement"};
 #define FIELD_NAME_COUNT (int)(sizeof field_names / sizeof field_names[0])
-#define FIELD_NAME_LIST "position, velocity, stress, damage, strain, principal_stress"
+#define FIELD_NAME_LIST \
+    "position, velocity, stress, damage, strain, principal_stress, displacement"
 
 /* ------------------------------------------------------- small sections */
 

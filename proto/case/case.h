@@ -34,6 +34,9 @@ enum case_field {
     CASE_FIELD_DAMAGE   = 1u << 3,
     CASE_FIELD_STRAIN   = 1u << 4,
     CASE_FIELD_PRINCIPAL_STRESS = 1u << 5,
+    /* position - initial position per node, computed when a snapshot is
+     * taken (snapshot.c), never stored in the engine */
+    CASE_FIELD_DISPLACEMENT = 1u << 6,
 };
 
 #define CASE_MAX_PARTS 1024

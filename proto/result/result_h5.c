@@ -31,10 +31,11 @@
  * shape (S, 0, dimension) (axis 1 declared unlimited, since a chunk cannot
  * be wider than a fixed zero extent), so readers can index it uniformly.
  *
- * Both dimensions share the layout (contract 5.2): node rows and constraint
- * forces have `dimension` columns, stress rows fdem_stress_components(), and
- * the elements are /mesh/triangles (E, 3) in 2D or /mesh/tetrahedra (E, 4)
- * in 3D; the root attribute `dimension` says which.
+ * Both dimensions share the layout (contract 5.2): node rows (position,
+ * velocity, displacement) and constraint forces have `dimension` columns,
+ * stress rows fdem_stress_components(), and the elements are
+ * /mesh/triangles (E, 3) in 2D or /mesh/tetrahedra (E, 4) in 3D; the root
+ * attribute `dimension` says which.
  *
  * Not thread-safe: one I/O thread owns every result_file (see result.h).
  */
@@ -59,7 +60,7 @@
 
 const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
-    "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
+    "displacement", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
 };
@@ -276,6 +277,7 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         {SERIES_STRAIN, (fields & CASE_FIELD_STRAIN) != 0, c.elements,
          fdem_stress_components(model)},
         {SERIES_PRINCIPAL_STRESS, (fields & CASE_FIELD_PRINCIPAL_STRESS) != 0, c.elements, dim},
+        {SERIES_DISPLACEMENT, (fields & CASE_FIELD_DISPLACEMENT) != 0, c.nodes, dim},
         {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
@@ -341,6 +343,7 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_FRAGMENT: return s->fragment;
     case SERIES_STRAIN: return s->strain;
     case SERIES_PRINCIPAL_STRESS: return s->principal_stress;
+    case SERIES_DISPLACEMENT: return s->displacement;
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;
@@ -550,9 +553,9 @@ static int check_snapshot(const result_file *f, const snapshot *s, char *err, si
 {
     const series *pos = &f->ds[SERIES_POSITION], *str = &f->ds[SERIES_STRESS];
     const series *dmg = &f->ds[SERIES_DAMAGE], *cf = &f->ds[SERIES_CONSTRAINT_FORCE];
-    const series *vel = &f->ds[SERIES_VELOCITY];
-    hsize_t nodes = pos->rank ? pos->row[0] : vel->row[0];
-    if ((pos->rank || vel->rank) && (hsize_t)s->nodes != nodes) {
+    const series *vel = &f->ds[SERIES_VELOCITY], *dis = &f->ds[SERIES_DISPLACEMENT];
+    hsize_t nodes = pos->rank ? pos->row[0] : vel->rank ? vel->row[0] : dis->row[0];
+    if ((pos->rank || vel->rank || dis->rank) && (hsize_t)s->nodes != nodes) {
         snprintf(err, errlen, "snapshot has %d nodes, the result file %llu", s->nodes,
                  (unsigned long long)nodes);
         return -1;

@@ -10,9 +10,9 @@
  * vtkXdmf3DataSet::CopyShape). A view is an ordinary dataset to every
  * reader (HDF5 1.10 resolves the mapping), so the sidecar can name it in a
  * plain HDF DataItem. The views also present fields as ParaView wants them:
- * velocity padded to three components, and stress and strain as full 3x3
- * tensors (row-major; the 2D ones with zz, xz and yz zero), unmapped
- * entries reading as the fill value 0.
+ * velocity and displacement padded to three components (z = 0 in 2D), and
+ * stress and strain as full 3x3 tensors (row-major; the 2D ones with zz, xz
+ * and yz zero), unmapped entries reading as the fill value 0.
  *
  * SWMR writing cannot create datasets, so the views are made when a case's
  * file is closed (finished, paused, stopped): result_finish() closes the
@@ -50,6 +50,7 @@ static int view_shape_of(int kind, int width, int dimension, view_shape *v)
         *v = dimension == 3 ? tensor_3d : tensor_2d;
         break;
     case SERIES_VELOCITY:
+    case SERIES_DISPLACEMENT:
         v->columns = 3;
         for (int k = 0; k < 3; k++) v->source[k] = k < width ? k : -1;
         break;

@@ -15,7 +15,9 @@
  *    DataItems, result_views.c) once the file was finished; the Xdmf3
  *    readers crash on HyperSlab DataItems, which remain only for the
  *    snapshots of a case still running (legacy reader only).
- *  - velocity is a Node "Vector" of 3 components (2D: z = 0 in the view).
+ *  - velocity is a Node "Vector" of 3 components (2D: z = 0 in the view),
+ *    and so is displacement (position - /mesh/position0), which ParaView's
+ *    "Warp By Vector" applies to the geometry.
  *  - stress and strain are Cell "Tensor"s of 9 components, row-major
  *    xx xy xz / yx yy yz / zx zy zz; a 2D tensor is the in-plane one (zz,
  *    xz, yz read 0: /snapshots/stress does not hold the plane-strain zz).
@@ -27,7 +29,9 @@
  *    second Temporal collection ("joints", present when the model has
  *    joints) draws each joint as its face A (/xdmf/joint_faces, columns
  *    a0, a1 (3D: a0, a1, a2) of /mesh/joints: a line in 2D, a triangle in
- *    3D) on the same moving nodes, with damage as its cell value.
+ *    3D) on the same moving nodes, with damage as its cell value (and
+ *    displacement as its node vector, when written, so that a warp moves
+ *    the joints with the elements).
  *  - the energy series, the constraint forces and time are Grid (field
  *    data) attributes of every grid: the whole series, one tuple per
  *    snapshot (Dimensions "S 1", and "S C*dimension" for the forces, which
@@ -167,6 +171,19 @@ static void xdmf_geometry(const xdmf_ctx *x, int s)
     fprintf(x->out, "      </Geometry>\n");
 }
 
+/* A node field of `dimension` columns as a Node "Vector": its view, 3
+ * components (2D: z = 0), or before the views exist a HyperSlab of row s. */
+static void xdmf_node_vector(const xdmf_ctx *x, int s, const char *dataset)
+{
+    char dims[64];
+    fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Vector\" "
+            "Center=\"Node\">\n", dataset);
+    snprintf(dims, sizeof dims, "%ld 3", x->nodes);
+    if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, dataset);
+    else xdmf_row_item(x, s, x->nodes, x->dimension, -1, dataset);
+    fprintf(x->out, "      </Attribute>\n");
+}
+
 /* Face A of each joint: a line (a0, a1) in 2D, a triangle (a0, a1, a2) in
  * 3D: /xdmf/joint_faces once the views exist, else picked out of the
  * (J, 2 * dimension) /mesh/joints by a HyperSlab. */
@@ -203,6 +220,9 @@ static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
     if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, "damage");
     else xdmf_scalar_row_item(x, s, J, "Float", 8, "damage");
     fprintf(x->out, "      </Attribute>\n");
+    /* on the same nodes as the elements: Warp By Vector moves both blocks */
+    if (x->fields & CASE_FIELD_DISPLACEMENT)
+        xdmf_node_vector(x, s, "displacement");
     fprintf(x->out, "    </Grid>\n");
 }
 
@@ -288,14 +308,10 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
 
     xdmf_geometry(x, s);
 
-    if (x->fields & CASE_FIELD_VELOCITY) {
-        fprintf(x->out, "      <Attribute Name=\"velocity\" AttributeType=\"Vector\" "
-                "Center=\"Node\">\n");
-        snprintf(dims, sizeof dims, "%ld 3", x->nodes);
-        if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, "velocity");
-        else xdmf_row_item(x, s, x->nodes, x->dimension, -1, "velocity");
-        fprintf(x->out, "      </Attribute>\n");
-    }
+    if (x->fields & CASE_FIELD_VELOCITY)
+        xdmf_node_vector(x, s, "velocity");
+    if (x->fields & CASE_FIELD_DISPLACEMENT)
+        xdmf_node_vector(x, s, "displacement");
     if (x->fields & CASE_FIELD_STRESS)
         xdmf_cell_field(x, s, "stress", x->stress_components);
     if (x->fields & CASE_FIELD_STRAIN)

@@ -10,6 +10,11 @@
  * the result file stores it for every fracturing model (contract section 4);
  * the CASE_FIELD_DAMAGE bit in `fields` says whether the caller asked for it
  * (state_to_json shows only what was asked for).
+ *
+ * Displacement is not engine state: it is position - initial position,
+ * computed here per number, so it is exactly what a reader of result.h5
+ * gets by subtracting /mesh/position0 from /snapshots/position, and asking
+ * for it reads the model without changing it.
  */
 #include "snapshot.h"
 
@@ -43,6 +48,21 @@ static double *copy_element_field(const fdem_model *model, size_t values,
     }
     compute(model, dst);
     return dst;
+}
+
+/* position - initial position of every node, one subtraction per number
+ * (the bits a reader gets from /snapshots/position - /mesh/position0). */
+static double *node_displacements(const fdem_model *model, size_t count, int *failed)
+{
+    const double *x = fdem_positions(model), *x0 = fdem_initial_positions(model);
+    if (count == 0 || !x || !x0) return NULL;
+    double *u = malloc(count * sizeof *u);
+    if (!u) {
+        *failed = 1;
+        return NULL;
+    }
+    for (size_t i = 0; i < count; i++) u[i] = x[i] - x0[i];
+    return u;
 }
 
 static int32_t *copy_fragment_labels(const fdem_model *model, size_t elements, int *failed)
@@ -99,6 +119,10 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
                                                  fdem_element_principal_stress, &failed);
         if (s->principal_stress) s->fields |= CASE_FIELD_PRINCIPAL_STRESS;
     }
+    if (fields & CASE_FIELD_DISPLACEMENT) {
+        s->displacement = node_displacements(model, dim * nodes, &failed);
+        if (s->displacement) s->fields |= CASE_FIELD_DISPLACEMENT;
+    }
     s->fragment = copy_fragment_labels(model, elements, &failed);
     if (fields & SNAPSHOT_FRAGMENTS) {
         s->fragment_count = fdem_fragments(model, &s->fragments);
@@ -127,6 +151,7 @@ void snapshot_free(snapshot *s)
     free(s->damage);
     free(s->strain);
     free(s->principal_stress);
+    free(s->displacement);
     free(s->fragment);
     free(s->fragments);
     free(s->constraint_force);

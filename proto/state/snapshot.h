@@ -7,7 +7,8 @@
  * always copied; damage only when the model has joints. Node rows and
  * constraint forces have `dimension` numbers, stress rows
  * `stress_components` (3 in 2D, 6 in 3D), and so do strain rows;
- * principal_stress rows have `dimension` numbers.
+ * principal_stress rows have `dimension` numbers, and so do displacement
+ * rows (one per node: position - initial position, computed at the copy).
  * The fragment id of every element is always copied (result.h5 stores it
  * with every snapshot, contract 5.4); the fragment records are computed only
  * when SNAPSHOT_FRAGMENTS is in `fields` (GET /cases/ID/fragments).
@@ -41,6 +42,7 @@ typedef struct snapshot {
     double *damage;             /* joints, or NULL */
     double *strain;             /* stress_components * elements, or NULL */
     double *principal_stress;   /* dimension * elements, or NULL */
+    double *displacement;       /* dimension * nodes (position - position0), or NULL */
     int32_t *fragment;          /* fragment id per element (always) */
     fdem_fragment *fragments;   /* fragment_count records, with SNAPSHOT_FRAGMENTS */
     int fragment_count;

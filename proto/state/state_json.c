@@ -86,6 +86,9 @@ json_t *state_to_json(const snapshot *s)
     if ((s->fields & CASE_FIELD_PRINCIPAL_STRESS) && s->principal_stress)
         rc |= set_or_fail(obj, "principal_stress",
                           rows_to_json(s->principal_stress, s->elements, s->dimension));
+    if ((s->fields & CASE_FIELD_DISPLACEMENT) && s->displacement)
+        rc |= set_or_fail(obj, "displacement",
+                          rows_to_json(s->displacement, s->nodes, s->dimension));
     if (rc != 0) {
         json_decref(obj);
         return NULL;

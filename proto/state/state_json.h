@@ -6,7 +6,8 @@
  * [[sxx, syy, sxy], ...] per element ([[sxx, syy, szz, syz, sxz, sxy], ...]
  * in 3D) and damage as a number per joint; only the fields present in the
  * snapshot; strain like stress, principal_stress as `dimension` numbers per
- * element, descending.
+ * element, descending, and displacement (position - initial position) like
+ * position.
  *
  * Folder: proto/state/ (its contract: snapshot.h).
  */

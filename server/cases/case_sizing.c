@@ -85,6 +85,8 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
         row += elements * stress_width * 8;
     if (info->fields & CASE_FIELD_PRINCIPAL_STRESS)
         row += elements * dim * 8;
+    if (info->fields & CASE_FIELD_DISPLACEMENT)
+        row += nodes * dim * 8;
     return mesh + snapshots * row;
 }
 

@@ -351,7 +351,8 @@ static int routes_state_is_finite(const snapshot *s)
     return isfinite(s->time) && routes_all_finite(s->position, nodes) &&
            routes_all_finite(s->velocity, nodes) && routes_all_finite(s->stress, tensors) &&
            routes_all_finite(s->strain, tensors) && routes_all_finite(s->damage, (size_t)s->joints) &&
-           routes_all_finite(s->principal_stress, (size_t)s->dimension * (size_t)s->elements);
+           routes_all_finite(s->principal_stress, (size_t)s->dimension * (size_t)s->elements) &&
+           routes_all_finite(s->displacement, nodes);
 }
 
 /* A failed case has no state to show: the one it failed in may be

@@ -3,15 +3,17 @@ with one of ParaView's XDMF readers and prints, as JSON, what the reader
 gives at the first and the last time step, plus every message VTK sent to
 its output window (an error or a warning fails the test).
 
-  pvpython paraview_load.py READER FILE.xdmf
+  pvpython paraview_load.py READER FILE.xdmf [WARP]
 
 READER is XDMFReader (the legacy "XDMF Reader"), Xdmf3ReaderS or
-Xdmf3ReaderT.
+Xdmf3ReaderT. With WARP (a point vector array, e.g. displacement) the
+reader's output goes through Warp By Vector (scale 1) first, as a user
+would apply it, and the blocks described are the warped ones.
 """
 import json
 import sys
 
-from paraview.simple import XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
+from paraview.simple import WarpByVector, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
 from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
 
 # Everything VTK reports (errors, warnings, the HDF5 layer's complaints
@@ -53,7 +55,7 @@ def describe(block):
             "field_data": arrays(block.GetFieldData())}
 
 
-def main(reader_name, path):
+def main(reader_name, path, warp=None):
     if reader_name == "XDMFReader":
         reader = XDMFReader(FileNames=[path])
     else:
@@ -61,11 +63,14 @@ def main(reader_name, path):
             FileName=[path])
     times = reader.TimestepValues
     times = list(times) if hasattr(times, "__iter__") else [times]
+    last = reader
+    if warp:
+        last = WarpByVector(Input=reader, Vectors=["POINTS", warp], ScaleFactor=1.0)
     steps = []
     for index in (0, len(times) - 1):
-        reader.UpdatePipeline(times[index])
+        last.UpdatePipeline(times[index])
         # pvpython runs the pipeline in-process: the algorithm's own output
-        data = reader.GetClientSideObject().GetOutputDataObject(0)
+        data = last.GetClientSideObject().GetOutputDataObject(0)
         steps.append({"index": index, "blocks": [describe(b) for b in blocks(data)]})
     # pvpython routes print() through the output window too: write around it
     sys.__stdout__.write(json.dumps({"times": times, "steps": steps,
@@ -74,4 +79,4 @@ def main(reader_name, path):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2])
+    main(sys.argv[1], sys.argv[2], sys.argv[3] if len(sys.argv) > 3 else None)

@@ -4,7 +4,8 @@ a sphere and a gmsh cube falling freely, checked against free fall
 to 1 %), the state with three components per node and six stress
 components per element, result.h5 in the 3D layout (every dataset shape,
 positive tetrahedron volumes, lumped masses summing to rho V) and a
-result.xdmf with Tetrahedron topology; a bad 3D document is a 422 naming
+result.xdmf with Tetrahedron topology; the displacement of the falling box
+(1/2 g t^2 at every node); a bad 3D document is a 422 naming
 the pointer; two boxes colliding once contact between tetrahedral parts is
 in the engine."""
 import os
@@ -190,6 +191,27 @@ class Solid3DTest(DaemonTestCase):
         st, _, _ = self.run_free_fall(solid_case("gmsh", {"gmsh": text}, end=0.02, snapshots=4))
         # tests/data/cube.geo as the installed gmsh meshes it
         self.assertEqual((st["nodes"], st["elements"]), (45, 100))
+
+    def test_free_fall_displacement_is_half_g_t_squared(self):
+        """/snapshots/displacement of a falling box (contract 6.2): (S, N, 3),
+        position - position0 to the bit, every node down by 1/2 g t^2 (1 %)
+        and not sideways; GET /state's displacement is the last row."""
+        case = solid_case("box-u", BOX)
+        case["output"]["fields"] = ["position", "displacement"]
+        st = self.run_case(case)
+        self.assertEqual(st["state"], "finished", st.get("error"))
+        with h5py.File(self.download(st["id"], "result.h5"), "r") as f:
+            u, t = f["/snapshots/displacement"][...], f["/snapshots/time"][...]
+            self.assertEqual(u.shape, (len(t), st["nodes"], 3))
+            x = f["/snapshots/position"][...] - f["/mesh/position0"][...]
+            self.assertEqual(u.tobytes(), x.tobytes())
+        for s in range(1, len(t)):
+            np.testing.assert_allclose(-u[s, :, 2] / (0.5 * G * t[s] ** 2), 1.0, atol=0.01,
+                                       err_msg="t = %g" % t[s])
+        self.assertLess(np.abs(u[:, :, :2]).max(), 1e-6 * 0.5 * G * t[-1] ** 2)
+        status, state = self.d.json("GET", "/cases/%s/state?fields=displacement" % st["id"])
+        self.assertEqual(status, 200, state)
+        np.testing.assert_array_equal(np.array(state["displacement"]), u[-1])
 
     def test_fixed_box_holds_its_weight(self):
         """A box fixed at its base: the reaction of the fixed nodes carries

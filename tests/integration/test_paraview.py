@@ -1,9 +1,11 @@
 """result.xdmf in every XDMF reader of ParaView 5.11 (the legacy "XDMF
 Reader" and Xdmf3ReaderS, Xdmf3ReaderT), 2D and 3D: no error or warning
 from VTK or HDF5, the time steps of /snapshots/time, and at the first and
-last step the same numbers as result.h5: node positions, velocity (3
-components), stress and strain as 3x3 tensors, principal stresses, joint
-damage, and the energy and constraint-force series as field data.
+last step the same numbers as result.h5: node positions, velocity and
+displacement (3 components), stress and strain as 3x3 tensors, principal
+stresses, joint damage, and the energy and constraint-force series as
+field data; and Warp By Vector with displacement moves the initial mesh of
+a case that writes no positions onto position0 + displacement.
 
 Runs paraview_load.py under pvpython; skipped (saying so) where pvpython
 is not installed (scripts/install-deps.sh installs python3-paraview)."""
@@ -31,7 +33,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PVPYTHON = shutil.which("pvpython")
 READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")
 VTK_TRIANGLE, VTK_TETRA = 5, 10
-FIELDS = ["position", "velocity", "stress", "strain", "principal_stress"]
+FIELDS = ["position", "velocity", "stress", "strain", "principal_stress", "displacement"]
 FRACTURE = {"tensile_strength": 1e6, "cohesion": 2e6, "friction_angle": 30,
             "energy_I": 10, "energy_II": 50}
 # Row-major 3x3 tensor from the Voigt columns of /snapshots/stress
@@ -59,6 +61,14 @@ def case_3d():
             "output": {"interval": 0.0002, "fields": FIELDS}}
 
 
+def warp_case(case):
+    """The case writing displacement but no positions: ParaView shows the
+    initial mesh, and Warp By Vector moves it."""
+    case["name"] += "-warp"
+    case["output"]["fields"] = ["displacement", "stress"]
+    return case
+
+
 def tensor(voigt, dim):
     return np.array([voigt[:, k] if k is not None else np.zeros(len(voigt))
                      for k in TENSOR[dim]]).T
@@ -77,18 +87,19 @@ class ParaViewTest(unittest.TestCase):
         cls.tmp = tempfile.mkdtemp(prefix="fdemd-pv-")
         cls.d = Daemon().start()
         cls.results = {}
-        for dim, case in ((2, case_2d()), (3, case_3d())):
+        for key, case in ((2, case_2d()), (3, case_3d()), ("warp-2", warp_case(case_2d())),
+                          ("warp-3", warp_case(case_3d()))):
             st = cls.d.create(case, start=True)
             st = cls.d.wait_state(st["id"], ("finished", "failed"), timeout=120)
             assert st["state"] == "finished", st
-            folder = os.path.join(cls.tmp, str(dim))
+            folder = os.path.join(cls.tmp, str(key))
             os.makedirs(folder)
             for name in ("result.h5", "result.xdmf"):
                 status, _, data = cls.d.request("GET", "/cases/%s/%s" % (st["id"], name))
                 assert status == 200, (name, status)
                 with open(os.path.join(folder, name), "wb") as f:
                     f.write(data)
-            cls.results[dim] = folder
+            cls.results[key] = folder
 
     @classmethod
     def tearDownClass(cls):
@@ -96,8 +107,9 @@ class ParaViewTest(unittest.TestCase):
         cls.d.close()
         shutil.rmtree(cls.tmp, ignore_errors=True)
 
-    def load(self, reader, xdmf):
-        out = subprocess.run([PVPYTHON, os.path.join(HERE, "paraview_load.py"), reader, xdmf],
+    def load(self, reader, xdmf, *warp):
+        out = subprocess.run([PVPYTHON, os.path.join(HERE, "paraview_load.py"), reader, xdmf]
+                             + list(warp),
                              capture_output=True, text=True, timeout=300)
         self.assertEqual(out.returncode, 0, out.stderr[-3000:])
         # loguru (VTK's errors and warnings) and HDF5-DIAG write to stderr
@@ -116,6 +128,10 @@ class ParaViewTest(unittest.TestCase):
         cells, nodes = block["cell_data"], block["point_data"]
         np.testing.assert_array_equal(np.array(nodes["velocity"]),
                                       pad3(f["/snapshots/velocity"][s]), where)
+        displacement = f["/snapshots/displacement"][s]
+        np.testing.assert_array_equal(np.array(nodes["displacement"]), pad3(displacement), where)
+        np.testing.assert_array_equal(
+            displacement, f["/snapshots/position"][s] - f["/mesh/position0"][...], where)
         for name in ("stress", "strain"):
             self.assertEqual(len(cells[name][0]), 9, (where, name))
             np.testing.assert_array_equal(np.array(cells[name]),
@@ -161,6 +177,7 @@ class ParaViewTest(unittest.TestCase):
         The case writes a few snapshots a second, so most fetches of the
         pair see no snapshot fall between them."""
         case = tiny_case("pv-" + name, end=100.0, divisions=(3, 3), interval=0.2)
+        case["output"]["fields"].append("displacement")
         st = self.d.create(case, start=True)
         folder = os.path.join(self.tmp, name)
         os.makedirs(folder)
@@ -211,6 +228,10 @@ class ParaViewTest(unittest.TestCase):
                                           pad3(f["/snapshots/position"][s]))
             np.testing.assert_array_equal(np.array(block["cell_data"]["stress_xy"])[:, 0],
                                           f["/snapshots/stress"][s, :, 2])
+            # the HyperSlab of a 2D node vector: its two columns (z = 0 if padded)
+            displacement = np.array(block["point_data"]["displacement"])
+            np.testing.assert_array_equal(displacement[:, :2], f["/snapshots/displacement"][s])
+            self.assertFalse(np.any(displacement[:, 2:]))
 
     def test_paused_case_in_every_reader(self):
         """What docs/results.md tells a user who wants to look at a running
@@ -229,6 +250,29 @@ class ParaViewTest(unittest.TestCase):
     def test_3d_in_every_reader(self):
         for reader in READERS:
             self.check_reader(reader, 3)
+
+    def test_warp_by_displacement_in_every_reader(self):
+        """A case without positions is drawn on /mesh/position0; Warp By
+        Vector with `displacement` (scale 1) puts every node at position0
+        + displacement, in 2D and 3D, at the first and last step."""
+        for dim in (2, 3):
+            folder = self.results["warp-%d" % dim]
+            with h5py.File(os.path.join(folder, "result.h5"), "r") as f:
+                self.assertNotIn("/snapshots/position", f)
+                x0, u = f["/mesh/position0"][...], f["/snapshots/displacement"][...]
+            self.assertGreater(np.abs(u[-1]).max(), 0, "nothing moved")
+            for reader in READERS:
+                got = self.load(reader, os.path.join(folder, "result.xdmf"), "displacement")
+                for step in got["steps"]:
+                    s = step["index"]
+                    # the elements, and the joints on the same nodes
+                    self.assertEqual(len(step["blocks"]), 2)
+                    for b, block in enumerate(step["blocks"]):
+                        where = "%s, %dD, snapshot %d, block %d" % (reader, dim, s, b)
+                        np.testing.assert_array_equal(
+                            np.array(block["point_data"]["displacement"]), pad3(u[s]), where)
+                        np.testing.assert_allclose(np.array(block["points"]), pad3(x0 + u[s]),
+                                                   rtol=0, atol=1e-15, err_msg=where)
 
 
 if __name__ == "__main__":

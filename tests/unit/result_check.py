@@ -29,6 +29,7 @@ SERIES = {  # dataset -> key in the expected snapshot
     "stress": "stress", "damage": "damage", "constraint_force": "constraint_force",
     "kinetic_energy": "kinetic_energy", "elastic_energy": "elastic_energy",
     "fragment": "fragment", "strain": "strain", "principal_stress": "principal_stress",
+    "displacement": "displacement",
 }
 
 
@@ -92,13 +93,14 @@ def check_snapshots(f, exp, count, refresh=False, growing=False):
         t.refresh()
     need(t.shape == (count,) or (growing and t.shape[0] >= count),
          f"/snapshots/time has shape {t.shape}, want ({count},)")
+    opened = {}
     for name in SERIES:
         present = name in exp["series"]
         need((name in group) == present,
              f"/snapshots/{name} {'missing' if present else 'unexpected'}")
         if not present:
             continue
-        ds = group[name]
+        ds = opened[name] = group[name]
         if refresh:
             ds.refresh()
         need(ds.maxshape[0] is None, f"/snapshots/{name} is not extendible along S")
@@ -114,6 +116,23 @@ def check_snapshots(f, exp, count, refresh=False, growing=False):
             bad = np.argwhere(got != want)[0]
             raise Mismatch(f"/snapshots/{name}{list(bad)} = {got[tuple(bad)]!r}, "
                            f"want {want[tuple(bad)]!r}")
+    if count and "displacement" in opened and "position" in opened:
+        check_displacement(opened["displacement"], opened["position"], f["/mesh/position0"][()],
+                           count)
+
+
+def check_displacement(u, x, position0, count):
+    """/snapshots/displacement is /snapshots/position - /mesh/position0,
+    subtracted here by numpy, to the bit. u and x are the handles the
+    caller opened (and refreshed): a SWMR reader must not open a dataset
+    twice ("can't insert duplicate key")."""
+    got = u[:count]
+    want = x[:count] - position0
+    need(got.shape == want.shape, f"displacement shape {got.shape}, position {want.shape}")
+    if got.tobytes() != want.tobytes():
+        bad = np.argwhere(got.view(np.uint64) != want.view(np.uint64))[0]
+        raise Mismatch(f"/snapshots/displacement{list(bad)} = {got[tuple(bad)]!r}, "
+                       f"position - position0 = {want[tuple(bad)]!r}")
 
 
 def check_file(f, exp, count, refresh=False):
@@ -213,12 +232,23 @@ def check_view(f, path, s, dim):
     if field in ("stress", "strain"):
         want = np.array([row[:, k] if k is not None else np.zeros(len(row))
                          for k in TENSOR[dim]]).T
-    elif field == "velocity":
+    elif field in ("velocity", "displacement"):
         want = np.zeros((len(row), 3))
         want[:, :dim] = row
     else:
         want = row
     need(got.shape == want.shape and np.array_equal(got, want), f"view {path} differs from its row")
+
+
+def check_node_vector(a, item, n_nodes, dim):
+    """velocity and displacement: a Node Vector, three components through a
+    view (ParaView warps by it), `dim` through a HyperSlab of a running case."""
+    name = a.get("Name")
+    need(a.get("AttributeType") == "Vector" and a.get("Center") == "Node",
+         f"{name} is {a.get('AttributeType')} at {a.get('Center')}, want a Node Vector")
+    width = dim if item.get("ItemType") == "HyperSlab" else 3
+    need(dataitem_dims(item) == (n_nodes, width),
+         f"{name} is {dataitem_dims(item)}, want ({n_nodes}, {width})")
 
 
 def check_series(f, item, h5_name, snapshots):
@@ -281,7 +311,12 @@ def check_xdmf(f, exp, xdmf_path, h5_name):
                     check_view(f, ds.name, s, dim)
             rows = n_nodes if a.get("Center") == "Node" else n_elems
             need(dataitem_dims(item)[0] == rows, f"attribute {a.get('Name')} has wrong rows")
+            if a.get("Name") in ("velocity", "displacement"):
+                check_node_vector(a, item, n_nodes, dim)
             attrs[a.get("Name")] = a.get("Center")
+        for field in ("velocity", "displacement"):
+            need((field in attrs) == (field in exp["series"]),
+                 f"grid {s}: attribute {field} {'missing' if field in exp['series'] else 'unexpected'}")
         names = sorted(attrs)
     return f"xdmf: {len(grids)} grids, attributes {names}"
 

@@ -26,8 +26,8 @@ static int fixture_add_block(fdem_model *m, double ox, double oy, double w, doub
 }
 
 /* Sets dt = 0.5 x stable and fills `info` (when not NULL) as case_build
- * would: 1000 steps, a snapshot every 5, position, velocity, stress, strain
- * and principal_stress. */
+ * would: 1000 steps, a snapshot every 5, position, velocity, stress, strain,
+ * principal_stress and displacement. */
 static void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
                          int constraints, int fracture)
 {
@@ -41,7 +41,7 @@ static void fixture_info(fdem_model *m, case_info *info, const char *name, int p
     info->safety = 0.5;
     info->output_interval = 5 * info->dt;
     info->fields = CASE_FIELD_POSITION | CASE_FIELD_VELOCITY | CASE_FIELD_STRESS |
-                   CASE_FIELD_STRAIN | CASE_FIELD_PRINCIPAL_STRESS;
+                   CASE_FIELD_STRAIN | CASE_FIELD_PRINCIPAL_STRESS | CASE_FIELD_DISPLACEMENT;
     info->part_count = parts;
     info->constraint_count = constraints;
     info->fracture = fracture;

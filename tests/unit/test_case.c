@@ -544,6 +544,25 @@ static void output_errors(void)
     expect_variant("/output/fields", "['positon']", "/output/fields/0",
                    "did you mean \"position\"");
     expect_variant("/output/fields", "'position'", "/output/fields", "expected an array");
+    expect_variant("/output/fields", "['position', 'displacment']", "/output/fields/1",
+                   "did you mean \"displacement\"");
+}
+
+/* "displacement" is an output field of its own: asked alone, it is the
+ * only node field the case writes. */
+static void displacement_field_is_read(void)
+{
+    json_t *doc = load(base_text);
+    edit(doc, "/output/fields", load("['displacement', 'stress']"));
+    problems p;
+    case_info info;
+    fdem_model *m = build_json(doc, GiB, &info, &p);
+    json_decref(doc);
+    CHECK(m != NULL, "%d problems", p.count);
+    if (m) CHECK(info.fields == (CASE_FIELD_DISPLACEMENT | CASE_FIELD_STRESS), "fields %#x",
+                 info.fields);
+    fdem_model_destroy(m);
+    problems_free(&p);
 }
 
 /* ------------------------------------------------------------ memory */
@@ -715,6 +734,8 @@ static void parse_fields(void)
     CHECK(case_parse_fields("velocity,damage", &p) == (CASE_FIELD_VELOCITY | CASE_FIELD_DAMAGE),
           "velocity,damage");
     CHECK(case_parse_fields("", &p) == 0 && p.count == 0, "empty");
+    CHECK(case_parse_fields("displacement", &p) == CASE_FIELD_DISPLACEMENT && p.count == 0,
+          "displacement");
     case_parse_fields("position,presure", &p);
     CHECK(p.status == 400 && p.count == 1 && strstr(p.items[0].message, "\"presure\""),
           "status %d count %d", p.status, p.count);
@@ -730,6 +751,7 @@ CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(bodies_overlapping_at_start), T(gmsh_errors), T(part_flags_and_names),
            T(constraint_errors), T(velocity_constraint_may_leave_a_component_free),
            T(time_errors), T(absurd_step_counts), T(dt_above_stable_step), T(output_errors),
+           T(displacement_field_is_read),
            T(absurd_divisions_are_refused_by_size), T(memory_estimate_is_not_low),
            T(all_problems_are_collected), T(independent_problems_in_one_pass),
            T(pointer_escaping), T(many_problems_are_capped),

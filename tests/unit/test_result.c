@@ -29,6 +29,24 @@ static char tmpdir[256];
 
 /* ------------------------------------------------------------- test paths */
 
+/* The whole of a small text file, NUL-terminated (free() it); NULL if unreadable. */
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    char *text = NULL;
+    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    if (size >= 0 && fseek(f, 0, SEEK_SET) == 0 && (text = malloc((size_t)size + 1)) &&
+        fread(text, 1, (size_t)size, f) == (size_t)size) {
+        text[size] = '\0';
+    } else {
+        free(text);
+        text = NULL;
+    }
+    fclose(f);
+    return text;
+}
+
 static void tmp_path(char *out, size_t size, const char *name)
 {
     snprintf(out, size, "%s/%s", tmpdir, name);
@@ -102,6 +120,8 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
     if (info->fields & CASE_FIELD_STRAIN) json_array_append_new(series, json_string("strain"));
     if (info->fields & CASE_FIELD_PRINCIPAL_STRESS)
         json_array_append_new(series, json_string("principal_stress"));
+    if (info->fields & CASE_FIELD_DISPLACEMENT)
+        json_array_append_new(series, json_string("displacement"));
 
     return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
                      "dimension", dim, "dt", fdem_get_dt(m), "constraints", c.constraints,
@@ -701,6 +721,64 @@ static void test_result_3d_layout_and_xdmf(void)
     run_end(&r);
 }
 
+/* Displacement written without position, 2D and 3D: each snapshot's rows
+ * are x - x0 as subtracted here from the engine's arrays (the file then
+ * holds them, (S, N, dimension), checked by h5py), the sidecar names them
+ * as a Node Vector over the initial geometry, a HyperSlab while the file
+ * is open and a 3-component view once finished. The fixture's fields
+ * (with position) have result_check.py compare displacement with
+ * /snapshots/position - /mesh/position0 in every other test. */
+static void test_result_displacement_without_position(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        char h5[32], xdmf[32], json[32];
+        snprintf(h5, sizeof h5, "disp%d.h5", dim);
+        snprintf(xdmf, sizeof xdmf, "disp%d.xdmf", dim);
+        snprintf(json, sizeof json, "disp%d.json", dim);
+        run r;
+        memset(&r, 0, sizeof r);
+        fdem_model *m = dim == 3 ? fixture_model_3d(1, &r.info) : fixture_model(1, 1, &r.info);
+        if (run_start_with(&r, m, CASE_FIELD_VELOCITY | CASE_FIELD_DISPLACEMENT, h5) != 0) {
+            run_end(&r);
+            continue;
+        }
+        double moved = 0;
+        for (int i = 0; i < 4; i++) {
+            snapshot *s = snapshot_take(r.model, r.info.fields);
+            size_t n = (size_t)dim * (size_t)(s ? s->nodes : 0);
+            const double *x = fdem_positions(r.model), *x0 = fdem_initial_positions(r.model);
+            int exact = s && s->displacement && !s->position;
+            for (size_t k = 0; exact && k < n; k++) {
+                double u = x[k] - x0[k];
+                exact = memcmp(&u, &s->displacement[k], sizeof u) == 0;
+                moved = fmax(moved, fabs(u));
+            }
+            CHECK(exact, "%dD snapshot %d: displacement is not position - position0", dim, i);
+            CHECK(s && result_append(r.file, s, r.err, sizeof r.err) == 0, "append: %s", r.err);
+            if (s) expect_snapshot(r.expect, s);
+            snapshot_free(s);
+            fixture_step(r.model, 4 * STEPS_BETWEEN);
+        }
+        CHECK(moved > 0, "%dD: the model did not move", dim);
+        expect_save(r.expect, json);
+        CHECK(run_checker(h5, json, "swmr", NULL) == 0, "%dD displacement, swmr", dim);
+        run_check_xdmf(&r, xdmf, h5, json, "displacement xdmf, HyperSlabs");
+        run_finish(&r, h5);
+        run_check_xdmf(&r, xdmf, h5, json, "displacement xdmf, views");
+        char path[512];
+        tmp_path(path, sizeof path, xdmf);
+        char *text = read_text(path);
+        CHECK(text && strstr(text, "<Attribute Name=\"displacement\" AttributeType=\"Vector\" "
+                                   "Center=\"Node\">"), "%dD: no displacement vector in %s",
+              dim, xdmf);
+        free(text);
+        CHECK(result_close(r.file) == 0, "result_close");
+        r.file = NULL;
+        CHECK(run_checker(h5, json, "plain", NULL) == 0, "%dD displacement, closed file", dim);
+        run_end(&r);
+    }
+}
+
 static void test_result_bad_input_is_an_error(void)
 {
     char err[512] = "";
@@ -771,6 +849,7 @@ int main(int argc, char **argv)
         T(test_result_image_opens_plainly), T(test_result_image_checksum_matches_hdf5),
         T(test_result_check_file_refuses_damage), T(test_result_minimal_fields_without_constraints),
         T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),
+        T(test_result_displacement_without_position),
         T(test_result_bad_input_is_an_error),
         T(test_result_finish_on_a_full_disk_keeps_the_file_readable),
     };

@@ -2,6 +2,7 @@
  * test_snapshot.c - snapshot_take() copies exactly what the engine reports
  * at that step, only the requested fields, and never aliases engine memory.
  */
+#include <math.h>
 #include <stdlib.h>
 
 #include "check.h"
@@ -158,6 +159,74 @@ static void test_snapshot_of_a_3d_model(void)
     fdem_model_destroy(m);
 }
 
+/* x - x0 per number, computed here as a reader of result.h5 would. */
+static int is_position_minus_position0(const fdem_model *m, const double *u, size_t n)
+{
+    const double *x = fdem_positions(m), *x0 = fdem_initial_positions(m);
+    double *want = malloc(n * sizeof *want);
+    for (size_t i = 0; want && i < n; i++) want[i] = x[i] - x0[i];
+    int same = equal_doubles(u, want, n);
+    free(want);
+    return same;
+}
+
+/* Displacement alone, in 2D and 3D: position - initial position to the
+ * bit, without position being asked for; nonzero once the model moved. */
+static void test_snapshot_displacement_is_position_minus_position0(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = dim == 3 ? fixture_model_3d(1, NULL) : fixture_model(1, 1, NULL);
+        CHECK(m != NULL, "%dD fixture model", dim);
+        if (!m) continue;
+        snapshot *s0 = snapshot_take(m, CASE_FIELD_DISPLACEMENT);
+        CHECK(fixture_step(m, 30) == 0, "stepping");
+        snapshot *s = snapshot_take(m, CASE_FIELD_DISPLACEMENT);
+        CHECK(s0 && s && s0->displacement && s->displacement, "snapshot_take");
+        if (s0 && s && s0->displacement && s->displacement) {
+            size_t n = (size_t)dim * (size_t)s->nodes;
+            CHECK(s->fields == CASE_FIELD_DISPLACEMENT, "%dD fields %#x", dim, s->fields);
+            CHECK(s->position == NULL && s->velocity == NULL, "%dD: only displacement", dim);
+            CHECK(s->displacement != fdem_positions(m), "displacement aliases engine memory");
+            CHECK(is_position_minus_position0(m, s->displacement, n),
+                  "%dD displacement is not position - position0", dim);
+            double moved = 0;
+            for (size_t i = 0; i < n; i++) moved = fmax(moved, fabs(s->displacement[i]));
+            CHECK(moved > 0, "%dD: the model did not move", dim);
+            size_t nonzero = 0;
+            for (size_t i = 0; i < n; i++) nonzero += s0->displacement[i] != 0;
+            CHECK(nonzero == 0, "%dD: %zu displacements nonzero at step 0", dim, nonzero);
+        }
+        snapshot_free(s0);
+        snapshot_free(s);
+        fdem_model_destroy(m);
+    }
+}
+
+/* Taking displacement every step changes nothing in the model: two
+ * copies, one watched and one not, step to the same bits. */
+static void test_snapshot_displacement_leaves_the_run_alone(void)
+{
+    fdem_model *watched = fixture_model(1, 1, NULL), *alone = fixture_model(1, 1, NULL);
+    CHECK(watched && alone, "fixture models");
+    for (int i = 0; watched && alone && i < 40; i++) {
+        snapshot *s = snapshot_take(watched, CASE_FIELD_DISPLACEMENT | CASE_FIELD_POSITION);
+        CHECK(s != NULL, "snapshot_take");
+        snapshot_free(s);
+        CHECK(fixture_step(watched, 1) == 0 && fixture_step(alone, 1) == 0, "stepping");
+    }
+    if (watched && alone) {
+        size_t n = 2 * (size_t)fdem_get_counts(alone).nodes;
+        CHECK(equal_doubles(fdem_positions(watched), fdem_positions(alone), n), "positions");
+        CHECK(equal_doubles(fdem_velocities(watched), fdem_velocities(alone), n), "velocities");
+        fdem_energy a = fdem_get_energy(watched), b = fdem_get_energy(alone);
+        CHECK(memcmp(&a, &b, sizeof a) == 0, "energies");
+    }
+    fdem_model_destroy(watched);
+    fdem_model_destroy(alone);
+}
+
 CHECK_MAIN(T(test_snapshot_copies_requested_fields), T(test_snapshot_is_a_copy),
            T(test_snapshot_stress_matches_engine), T(test_snapshot_damage_of_fracturing_model),
-           T(test_snapshot_without_joints_has_no_damage), T(test_snapshot_of_a_3d_model))
+           T(test_snapshot_without_joints_has_no_damage), T(test_snapshot_of_a_3d_model),
+           T(test_snapshot_displacement_is_position_minus_position0),
+           T(test_snapshot_displacement_leaves_the_run_alone))

@@ -16,6 +16,7 @@ static double velocity[4] = {1.0, -2.0, 3.0, -4.0};
 static double stress[3] = {-3e6, 1.25e5, 7.0};
 static double damage[2] = {0.0, 0.75};
 static double constraint_force[2] = {10.0, -20.0};
+static double displacement[4] = {0.1 - 0.3, 0.0, -0.0, 5e-324};
 
 static snapshot two_node_snapshot(unsigned fields)
 {
@@ -34,6 +35,7 @@ static snapshot two_node_snapshot(unsigned fields)
     s.stress = stress;
     s.damage = damage;
     s.constraint_force = constraint_force;
+    s.displacement = displacement;
     return s;
 }
 
@@ -158,6 +160,32 @@ static void test_state_json_three_dimensions(void)
     json_decref(j);
 }
 
+/* displacement: a [dx, dy] row per node, exact, only when asked for. */
+static void test_state_json_displacement(void)
+{
+    snapshot s = two_node_snapshot(CASE_FIELD_DISPLACEMENT);
+    json_t *j = state_to_json(&s);
+    CHECK(j != NULL, "state_to_json returned NULL");
+    if (!j) return;
+    json_t *u = json_object_get(j, "displacement");
+    CHECK(json_array_size(u) == 2 && json_array_size(json_array_get(u, 0)) == 2,
+          "displacement is [[dx, dy], [dx, dy]]");
+    for (int i = 0; i < 4; i++)
+        CHECK(number_at(u, (size_t)(i / 2), (size_t)(i % 2)) == displacement[i] &&
+                  signbit(number_at(u, (size_t)(i / 2), (size_t)(i % 2))) ==
+                      signbit(displacement[i]),
+              "displacement[%d][%d] = %.17g, want %.17g", i / 2, i % 2,
+              number_at(u, (size_t)(i / 2), (size_t)(i % 2)), displacement[i]);
+    CHECK(json_object_get(j, "position") == NULL, "position not requested");
+    CHECK(json_object_size(j) == 3, "%zu keys, want step, time, displacement",
+          json_object_size(j));
+    json_decref(j);
+    s = two_node_snapshot(CASE_FIELD_POSITION | CASE_FIELD_VELOCITY);
+    j = state_to_json(&s);
+    CHECK(j && json_object_get(j, "displacement") == NULL, "displacement not requested");
+    json_decref(j);
+}
+
 CHECK_MAIN(T(test_state_json_all_fields), T(test_state_json_only_requested_fields),
            T(test_state_json_round_trip_is_exact), T(test_state_json_non_finite_becomes_null),
-           T(test_state_json_three_dimensions))
+           T(test_state_json_three_dimensions), T(test_state_json_displacement))
