@@ -34,6 +34,7 @@ import numpy as np
 from matplotlib import image
 
 from fdemd_harness import ROOT, SLOW, DaemonTestCase, tiny_case
+from test_observation_3d import file_items
 
 PLOT = os.path.join(ROOT, "clients", "python", "plot_result.py")
 PYTHON = "/usr/bin/python3"
@@ -75,24 +76,6 @@ def with_fields(case, fields):
 
 def bits(a):
     return np.ascontiguousarray(a).tobytes()
-
-
-def file_items(f):
-    """Every dataset's (shape, dtype, bytes) and every attribute, by name."""
-    items = {}
-
-    def attrs(name, obj):
-        for key, value in obj.attrs.items():
-            items[name + "@" + key] = repr(value) if isinstance(value, (str, bytes)) \
-                else np.asarray(value).tobytes()
-
-    def visit(name, obj):
-        if isinstance(obj, h5py.Dataset):
-            items[name] = (obj.shape, str(obj.dtype), obj[...].tobytes())
-        attrs(name, obj)
-    f.visititems(visit)
-    attrs("", f)
-    return items
 
 
 def pad3(rows):
