@@ -11,7 +11,7 @@ import time
 import unittest
 
 from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
-from test_hostile_requests import raw_exchange, read_until_closed, status_of
+from test_hostile_requests import raw_exchange, read_head, read_until_closed, status_of
 
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
 
@@ -215,12 +215,7 @@ class UploadBudgetTest(DaemonTestCase):
         s = socket.create_connection(("127.0.0.1", self.d.port), timeout=30 * SLOW)
         s.sendall(b"POST /cases HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
                   b"Expect: 100-continue\r\nContent-Length: %d\r\n\r\n" % self.BODY)
-        head = b""
-        while b"\r\n\r\n" not in head:
-            chunk = s.recv(65536)
-            if not chunk:
-                break
-            head += chunk
+        head = read_head(s)
         return s, status_of(head)
 
     def test_every_refused_upload_gets_its_503(self):

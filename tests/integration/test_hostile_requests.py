@@ -45,6 +45,18 @@ def read_until_closed(s):
     return reply
 
 
+def read_head(s):
+    """Reads until the end of a reply's header block (or a close): the head,
+    with whatever of the body came in the same reads."""
+    head = b""
+    while b"\r\n\r\n" not in head:
+        chunk = s.recv(65536)
+        if not chunk:
+            break
+        head += chunk
+    return head
+
+
 def status_of(reply):
     return int(reply.split(b" ", 2)[1]) if reply.startswith(b"HTTP/1.1 ") else None
 

@@ -16,7 +16,7 @@ import unittest
 
 from fdemd_harness import SLOW, TERMINAL, DaemonTestCase, tiny_case
 from test_hostile_input import problem_of
-from test_hostile_requests import read_until_closed, status_of
+from test_hostile_requests import read_head, read_until_closed, status_of
 from test_memory import RSS_MEANINGFUL, memory
 
 MiB = 1 << 20
@@ -264,12 +264,7 @@ class DownloadCopyTest(DaemonTestCase):
         s = socket.create_connection(("127.0.0.1", self.d.port), timeout=30 * SLOW)
         try:
             s.sendall(b"GET /cases/%s/result.h5 HTTP/1.1\r\nHost: x\r\n\r\n" % self.cid.encode())
-            head = b""
-            while b"\r\n\r\n" not in head:
-                chunk = s.recv(65536)
-                if not chunk:
-                    break
-                head += chunk
+            head = read_head(s)
             self.assertEqual(status_of(head), 200, head[:300])
         finally:
             # a reset, as a client killed mid-download leaves
