@@ -49,6 +49,13 @@ def tiny_case(name="tiny", end=0.001, divisions=(10, 10), interval=None, young=3
     return case
 
 
+def boom_case(name="boom"):
+    """Goes non-finite within a few steps (an absurd force): a failed case."""
+    case = tiny_case(name, end=0.01, divisions=(4, 4))
+    case["constraints"].append({"box": [0.09, 0.09, 0.2, 0.2], "force": [1e300, 1e300]})
+    return case
+
+
 @contextlib.contextmanager
 def fetched_result(daemon, case_id):
     """The case's result.h5 as GET /cases/ID/result.h5 serves it, open in

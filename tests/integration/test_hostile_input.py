@@ -10,7 +10,7 @@ import threading
 import time
 import unittest
 
-from fdemd_harness import SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import SLOW, Daemon, DaemonTestCase, boom_case, tiny_case
 from test_hostile_requests import raw_exchange, read_head, read_until_closed, status_of
 
 CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
@@ -142,13 +142,6 @@ class TokenTest(DaemonTestCase):
         reply, _ = raw_exchange(self.d.port, b"GET /cases HTTP/1.1\r\nHost: x\r\n"
                                 b"Authorization: Bearer T\r\n\r\n")
         self.assertEqual(status_of(reply), 200, reply[:200])
-
-
-def boom_case(name="boom"):
-    """Goes non-finite within a few steps (an absurd force): a failed case."""
-    case = tiny_case(name, end=0.01, divisions=(4, 4))
-    case["constraints"].append({"box": [0.09, 0.09, 0.2, 0.2], "force": [1e300, 1e300]})
-    return case
 
 
 class ApiTest(DaemonTestCase):

@@ -14,7 +14,7 @@ import time
 import unittest
 from datetime import datetime
 
-from fdemd_harness import ROOT, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import ROOT, Daemon, DaemonTestCase, boom_case, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
@@ -28,13 +28,6 @@ LONG = 1e3  # simulated seconds: never finishes within a test
 def iso(text):
     """An ISO 8601 UTC time as the daemon writes it ("...T...Z")."""
     return datetime.strptime(text, "%Y-%m-%dT%H:%M:%S.%fZ")
-
-
-def boom_case(name="boom"):
-    """Goes non-finite within a few steps (an absurd force): a failed case."""
-    case = tiny_case(name, end=0.01, divisions=(4, 4))
-    case["constraints"].append({"box": [0.09, 0.09, 0.2, 0.2], "force": [1e300, 1e300]})
-    return case
 
 
 class ServiceTest(DaemonTestCase):
