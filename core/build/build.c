@@ -59,7 +59,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->gravity_amplitude);
     boundary_load_free(m);
     free(m->constraints); free(m->cnode); free(m->cdof); free(m->constraint_force_out);
-    free(m->joint_node); free(m->joint_damage); free(m->joint_elem); free(m->joint_h);
+    free(m->joint_node); free(m->joint_damage); free(m->joint_offset); free(m->joint_elem); free(m->joint_h);
     free(m->joint_slip); free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);

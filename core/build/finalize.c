@@ -114,7 +114,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         return -1;
     }
     lump_masses(m);
-    if (joint_prepare(m, err)) return -1;
+    if (joint_prepare(m, err) || joint_prestress_prepare(m, err)) return -1;
     m->fragments = joint_fragment_count(m);
     if (contact_init(m, err)) return -1;
     if (build_scatter_plans(m)) {

@@ -101,8 +101,7 @@ static void prepare_part(fdem_model *m, const initial_stress_def *def)
     p->stressed = 1;
     for (int e = p->elem_begin; e < p->elem_begin + p->elem_count; e++) {
         double *s0 = m->elem_stress0 + (size_t)S * (size_t)e;
-        double dh = centroid_height(m, e) - def->reference;
-        for (int k = 0; k < S; k++) s0[k] = def->value[k] + def->gradient[k] * dh;
+        initial_stress_at(def, S, centroid_height(m, e), s0);
         m->stress0_energy += element_size0(m, e) *
                              locked_energy_density(m->dim, s0, mat->lambda, mat->mu);
     }

@@ -411,6 +411,7 @@ static __attribute__((noinline)) double joint_softening_2d(const fdem_model *m,
  * the damage bookkeeping. Only the elastic test needs the projections. */
 static inline __attribute__((always_inline)) int joint_evaluate_2d(fdem_model *m,
                                                                     const joint_view_2d *w, int j,
+                                                                    const double *offset,
                                                                     joint_totals *t,
                                                                     double fa[4])
 {
@@ -429,6 +430,7 @@ static inline __attribute__((always_inline)) int joint_evaluate_2d(fdem_model *m
     double L2 = tx * tx + ty * ty;
     if (!(L2 > 0)) return 0;
     double L = sqrt(L2);
+    if (offset) joint_add_offsets_2d(offset + 4 * (size_t)j, tx, ty, L, d0, d1);
     double *fa0 = fa, *fa1 = fa + 2;
     int elastic = 0;
     if (damage == 0) {
@@ -470,8 +472,12 @@ static inline __attribute__((always_inline)) int joint_evaluate_2d(fdem_model *m
 }
 
 /* Adds the forces of intact joints [begin, end) to m->force, continuing
- * the running sums (joint_totals) in sums. */
-void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+ * the running sums (joint_totals) in sums; offset is m->joint_offset,
+ * passed as a constant NULL by the loop of models without in-situ gaps so
+ * that theirs compiles without a trace of them. */
+static inline __attribute__((always_inline)) void joint_loop_2d(fdem_model *m, int begin, int end,
+                                                                const double *offset,
+                                                                double sums[SCATTER_SUMS])
 {
     double *f = m->force;
     const joint_view_2d w = joint_view_of(m);
@@ -479,7 +485,7 @@ void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTE
     joint_totals t = joint_totals_load(sums);
     for (int j = begin; j < end; j++) {
         double fa[4];
-        if (!joint_evaluate_2d(m, &w, j, &t, fa)) continue;
+        if (!joint_evaluate_2d(m, &w, j, offset, &t, fa)) continue;
         const int32_t *n = m->joint_node + 4 * j;
         double *ga0 = f + 2 * (size_t)n[0], *ga1 = f + 2 * (size_t)n[1];
         double *gb0 = f + 2 * (size_t)n[2], *gb1 = f + 2 * (size_t)n[3];
@@ -491,11 +497,23 @@ void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTE
     joint_totals_store(&t, sums);
 }
 
+static __attribute__((noinline)) void joint_offset_loop_2d(fdem_model *m, int begin, int end,
+                                                           double sums[SCATTER_SUMS])
+{
+    joint_loop_2d(m, begin, end, m->joint_offset, sums);
+}
+
+void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    if (m->joint_offset) joint_offset_loop_2d(m, begin, end, sums);
+    else joint_loop_2d(m, begin, end, NULL, sums);
+}
+
 /* Joint j alone, its face A forces handed back (joint_one_fn). */
 int joint_forces_one_2d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES])
 {
     const joint_view_2d w = joint_view_of(m);
-    return joint_evaluate_2d(m, &w, j, t, fa);
+    return joint_evaluate_2d(m, &w, j, m->joint_offset, t, fa);
 }
 
 /* Adds the forces of every intact joint to m->force, sets the joints'

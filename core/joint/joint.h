@@ -54,6 +54,19 @@ static inline double joint_spring_dt(double mass, double k)
 {
     return 0.9 * 2 * sqrt(mass / (2 * k));
 }
+/* Adds a 2D joint's in-situ gap (offset: opening then slide at a0, then at
+ * a1; joint_prestress.c) to its end gaps d0 and d1, turned into the frame
+ * of the current mean face: tangent (tx, ty) of length L, normal (ty, -tx)
+ * outward of A. */
+static inline void joint_add_offsets_2d(const double offset[4], double tx, double ty, double L,
+                                        double d0[2], double d1[2])
+{
+    double ux = tx / L, uy = ty / L; /* normal (uy, -ux) */
+    d0[0] += offset[0] * uy + offset[1] * ux;
+    d0[1] += -offset[0] * ux + offset[1] * uy;
+    d1[0] += offset[2] * uy + offset[3] * ux;
+    d1[1] += -offset[2] * ux + offset[3] * uy;
+}
 void *joint_build_scratch(size_t bytes, int part_index, fdem_error *err);
 int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err);
 int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
@@ -69,6 +82,11 @@ int joint_forces(fdem_model *m);
 void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 int joint_forces_one_2d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES]);
 int joint_fragment_count(const fdem_model *m);
+/* joint_prestress.c: the in-situ gaps of the joints of stressed fracturing
+ * parts (joint_offset), and their forces and energy at rest for the
+ * energy reference at t = 0 */
+int joint_prestress_prepare(fdem_model *m, fdem_error *err);
+double joint_prestress_rest_forces(fdem_model *m);
 /* events.c: the fracture events of the joints that broke in this step's
  * joint loop (joint_broke), appended in joint order; -1 without memory */
 int events_collect(fdem_model *m, int broke);

@@ -233,6 +233,7 @@ int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_F
     const joint_strength *s = &m->joint_strengths[m->joint_strength_of[j]];
     double d[3][3], N[3], k = m->joint_k[j];
     double N_len = joint_tet_gaps(m->pos, n, d, N);
+    if (m->joint_offset) joint_tet_add_offsets(m->pos, n, N, N_len, m->joint_offset + 9 * (size_t)j, d);
     if (damage == 0 && N_len > JOINT_TET_TINY_NORMAL &&
         joint_tet_surely_elastic_of(k, s->tensile_strength, s->cohesion, s->tan_phi, d)) {
         t->stored += joint_tet_elastic_forces(k, 0.5 * N_len, d, fa);
@@ -377,8 +378,22 @@ __attribute__((target("avx2"))) static void joint_forces_avx2(fdem_model *m, int
 }
 #endif
 
+/* Joints that carry an in-situ gap (joint_prestress.c) one at a time: the
+ * offsets turn with each face's frame, which the side-by-side lanes do not
+ * compute. Only models with a stressed fracturing part come here. */
+static void joint_forces_offset_loop(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    joint_totals t = joint_totals_load(sums);
+    for (int j = begin; j < end; j++) joint_alone(m, j, &t);
+    joint_totals_store(&t, sums);
+}
+
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
+    if (m->joint_offset) {
+        joint_forces_offset_loop(m, begin, end, sums);
+        return;
+    }
 #if FDEM_QUADS
     if (__builtin_cpu_supports("avx2")) {
         joint_forces_avx2(m, begin, end, sums);

@@ -18,7 +18,7 @@
  * unresisted, as two Gauss points did in 2D (see joint_compression).
  *
  * Sliding. The sliding is a vector in the face, given to the law as its
- * two components in the face's own frame (face_frame), where each point
+ * two components in the face's own frame (joint_tet_face_frame), where each point
  * keeps its plastic slide (joint_law.h's Coulomb return); the law returns
  * the shear traction in the same frame.
  */
@@ -139,8 +139,8 @@ static double joint_tet_compression(double k, double area, const double delta[3]
  * in the face. It turns with the face, so a rigid rotation of the pair
  * leaves the slide's components, and the plastic slide kept in them, as
  * they were. Returns 0 for an edge of no length. */
-static int face_frame(const double *pos, const int32_t node[6], const double d[3][3],
-                      const double n[3], double t1[3], double t2[3])
+int joint_tet_face_frame(const double *pos, const int32_t node[6], const double d[3][3],
+                         const double n[3], double t1[3], double t2[3])
 {
     double e1[3];
     for (int c = 0; c < 3; c++)
@@ -151,6 +151,19 @@ static int face_frame(const double *pos, const int32_t node[6], const double d[3
     if (!(len > 0)) return 0;
     for (int c = 0; c < 3; c++) t1[c] = e1[c] / len;
     vec3_cross(n, t1, t2);
+    return 1;
+}
+
+int joint_tet_add_offsets(const double *pos, const int32_t node[6], const double N[3],
+                          double N_len, const double offset[9], double d[3][3])
+{
+    if (!(N_len > 0)) return 0;
+    double n[3] = {N[0] / N_len, N[1] / N_len, N[2] / N_len}, t1[3], t2[3];
+    if (!joint_tet_face_frame(pos, node, d, n, t1, t2)) return 0;
+    for (int i = 0; i < 3; i++) {
+        const double *o = offset + 3 * i;
+        for (int c = 0; c < 3; c++) d[i][c] += o[0] * n[c] + o[1] * t1[c] + o[2] * t2[c];
+    }
     return 1;
 }
 
@@ -217,7 +230,7 @@ int joint_tet_forces_of_gaps(const joint_law *law, const double *pos, const doub
         return 1;
     }
     double n[3] = {N[0] / N_len, N[1] / N_len, N[2] / N_len}, t1[3], t2[3];
-    if (!face_frame(pos, node, d, n, t1, t2)) return 1; /* no edge to slide along */
+    if (!joint_tet_face_frame(pos, node, d, n, t1, t2)) return 1; /* no edge to slide along */
     joint_energy mine = {0};
     joint_tet_general(law, d, n, t1, t2, area, damage, slip, fa, &mine);
     e->dissipated += mine.dissipated;

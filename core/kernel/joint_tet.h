@@ -49,6 +49,20 @@ int joint_tet_forces_of_gaps(const joint_law *law, const double *pos, const doub
                              const double N[3], double N_len, const int32_t node[6],
                              double *damage, joint_slip slip[3], double fa[9], joint_energy *e);
 
+/* The face's own frame (unit n given): t1 along the mean first edge
+ * (a + d/2) projected into the face, t2 = n x t1; 0 for an edge of no
+ * length. The slide's components and the in-situ offsets live in it. */
+int joint_tet_face_frame(const double *pos, const int32_t node[6], const double d[3][3],
+                         const double n[3], double t1[3], double t2[3]);
+
+/* Adds a joint's in-situ gap to its corner gaps d (from joint_tet_gaps,
+ * whose N and |N| it takes): offset[3 i .. 3 i + 2] is corner i's opening
+ * and its slide along t1 and t2 of the face's frame, turned into the
+ * current frame, so the offset turns with the face. Returns 0 (d left as
+ * it was) for a degenerate face. */
+int joint_tet_add_offsets(const double *pos, const int32_t node[6], const double N[3],
+                          double N_len, const double offset[9], double d[3][3]);
+
 /* ------------------------------------------------ the intact fast path
  * Nearly every joint in nearly every step is undamaged and far inside its
  * strengths. These pieces of joint_tet_forces are inline so the model's

@@ -85,6 +85,16 @@ typedef struct initial_stress_def {
     double value[6], gradient[6], reference;
 } initial_stress_def;
 
+/* The stress of def at height h (y in 2D, z in 3D), in the layout of
+ * fdem_element_stress (S components): value + gradient (h - reference).
+ * The elements take it at their centroids (initial_stress.c), the joints
+ * at their corners (joint_prestress.c). */
+static inline void initial_stress_at(const initial_stress_def *def, int S, double h, double *out)
+{
+    double dh = h - def->reference;
+    for (int k = 0; k < S; k++) out[k] = def->value[k] + def->gradient[k] * dh;
+}
+
 /* One constraint after node selection. Its nodes are entries
  * [entry_begin, entry_begin + entry_count) of model.cnode / model.cdof. */
 typedef struct constraint {
@@ -259,6 +269,10 @@ struct fdem_model {
     int joint_strength_count;
     joint_set *joint_sets;   /* fdem_add_joint_set, resolved at finalize */
     int joint_set_count;
+    double *joint_offset;    /* dim x dim per joint, NULL when no fracturing part is stressed:
+                                the in-situ gap at each corner, its opening and then its
+                                slide, in the face's own frame, so that the joint carries
+                                sigma.n from t = 0 (joint_prestress.c) */
     double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
     joint_slip *joint_slip;  /* dim per joint, one per integration point: the plastic slide
                                 and slip path each keeps (joint_law.h); zero while undamaged */

@@ -30,6 +30,7 @@
 #include "model/model.h"
 #include "step.h"
 #include "element/element.h"
+#include "joint/joint.h"
 
 static void total_momentum(const fdem_model *m, double p[3]);
 
@@ -58,8 +59,9 @@ static double initial_acceleration2(const fdem_model *m)
  * residual from the first step on. The first step's h is only known when
  * it is taken (fdem_step records it); a model restored from a checkpoint
  * takes its current dt. The forces at t = 0 are the elements' and the
- * applied ones, pressures included (joints hold none; bodies start apart,
- * so no contact). */
+ * applied ones, pressures included, and those of joints that carry an
+ * in-situ gap (joint_prestress.c; other joints hold none; bodies start
+ * apart, so no contact). */
 void energy_initial(fdem_model *m)
 {
     double kinetic = 0;
@@ -71,6 +73,7 @@ void energy_initial(fdem_model *m)
     }
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     element_forces(m);
+    m->joint_energy = joint_prestress_rest_forces(m);
     constraint_apply_forces(m);
     boundary_load_apply(m);
     m->initial_acceleration2 = initial_acceleration2(m);
@@ -79,7 +82,7 @@ void energy_initial(fdem_model *m)
         memset(m->elem_viscous, 0,
                sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count);
     m->damping_work = 0;
-    m->initial_energy = kinetic + m->elastic_energy;
+    m->initial_energy = kinetic + m->elastic_energy + m->joint_energy;
     if (m->gravity_amplitude) total_momentum(m, m->momentum);
 }
 
