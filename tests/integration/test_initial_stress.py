@@ -74,6 +74,31 @@ class InitialStressTest(DaemonTestCase):
             self.assertLess(energy["kinetic"], 1e-6 * energy["elastic"])
             self.assertLess(abs(energy["residual"]), 1e-6 * energy["elastic"])
 
+    def test_fracturing_block_starts_at_rest(self):
+        """Contract 6.1: with fracture on, the joints carry sigma.n from
+        t = 0, so the block stays as still as the continuous one: no
+        fracture event, joint energy from the first snapshot on."""
+        for dimension in (2, 3):
+            case, stress = block_case(dimension)
+            case["materials"]["rock"]["fracture"] = {
+                "tensile_strength": 2e6, "cohesion": 6e6, "friction_angle": 30,
+                "energy_I": 20, "energy_II": 100}
+            case["parts"][0]["fracture"] = True
+            st, path = self.run_case(case, timeout=120)
+            with h5py.File(path, "r") as f:
+                s = f["/snapshots/stress"][...]
+                x, x0 = f["/snapshots/position"][...], f["/mesh/position0"][...]
+                events = f["/events/time"].shape[0] if "/events/time" in f else 0
+            self.assertLess(np.abs(x - x0).max(), 1e-9, "%dD: the block moved" % dimension)
+            worst = np.abs(s - np.array(stress)).max() / np.abs(stress).max()
+            self.assertLess(worst, 0.01, "%dD: stress off sigma0 by %.3g" % (dimension, worst))
+            energy = st["energy"]
+            self.assertGreater(energy["joint"], 0.05 * energy["elastic"],
+                               "%dD: the joints hold %g J" % (dimension, energy["joint"]))
+            self.assertLess(energy["kinetic"], 1e-6 * (energy["elastic"] + energy["joint"]))
+            self.assertEqual(energy["fracture"], 0)
+            self.assertEqual(events, 0, "%dD: %d joints broke" % (dimension, events))
+
     def test_borehole_hoop_stress_is_kirsch_plus_lame(self):
         case = example("borehole")
         sx, sy, _ = case["parts"][0]["initial_stress"]["value"]
