@@ -2,7 +2,8 @@
 """HTTP load figure for `make bench`: latency (p50, p99) and requests/s of
 GET /cases/ID against bin/fdemd on loopback while four cases step.
 
-Uses wrk when installed (2 threads, 8 connections, 5 s), else a bounded
+Uses wrk when installed (2 threads, 8 connections, 5 s; once with keep-alive and
+once with a connection per request, Connection: close), else a bounded
 Python client (4 threads x 500 requests). Never part of the tests.
 
     FDEMD_BIN=bin/fdemd /usr/bin/python3 bench/bench_http.py
@@ -24,8 +25,9 @@ WRK_SECONDS = 5
 PY_THREADS, PY_REQUESTS = 4, 500
 
 
-def wrk_figures(url):
-    out = subprocess.run(["wrk", "-t2", "-c8", "-d%ds" % WRK_SECONDS, "--latency", url],
+def wrk_figures(url, close=False):
+    extra = ["-H", "Connection: close"] if close else []
+    out = subprocess.run(["wrk", "-t2", "-c8", "-d%ds" % WRK_SECONDS, "--latency"] + extra + [url],
                          capture_output=True, text=True, timeout=WRK_SECONDS + 30).stdout
     unit = {"us": 1e-3, "ms": 1.0, "s": 1e3}
 
@@ -36,7 +38,8 @@ def wrk_figures(url):
     rate = re.search(r"Requests/sec:\s+([\d.]+)", out)
     errors = re.search(r"Non-2xx or 3xx responses: (\d+)", out)
     return pct(50), pct(99), float(rate.group(1)) if rate else float("nan"), \
-        int(errors.group(1)) if errors else 0, "wrk -t2 -c8 -d%ds" % WRK_SECONDS
+        int(errors.group(1)) if errors else 0, \
+        "wrk -t2 -c8 -d%ds%s" % (WRK_SECONDS, ", Connection: close" if close else ", keep-alive")
 
 
 def python_figures(port, ids):
@@ -76,13 +79,15 @@ def main():
         ids = [d.create(tiny_case("bench%d" % i, end=100.0, interval=1e-3), start=True)["id"]
                for i in range(4)]
         url = "http://127.0.0.1:%d/cases/%s" % (d.port, ids[0])
-        if shutil.which("wrk"):
-            p50, p99, rate, bad, how = wrk_figures(url)
-        else:
-            p50, p99, rate, bad, how = python_figures(d.port, ids)
-        steps = sum(d.status(i)["steps_per_second"] for i in ids)
-        print("http GET /cases/ID (4 cases running, %s): p50 %.3f ms, p99 %.3f ms, %.0f requests/s, "
-              "%d non-200; cases stepped %.3g steps/s in total meanwhile" % (how, p50, p99, rate, bad, steps))
+        # keep-alive (what clients that reuse a connection get), then a
+        # connection per request (what each passes through the gate)
+        runs = [wrk_figures(url), wrk_figures(url, close=True)] if shutil.which("wrk") \
+            else [python_figures(d.port, ids)]
+        for p50, p99, rate, bad, how in runs:
+            steps = sum(d.status(i)["steps_per_second"] for i in ids)
+            print("http GET /cases/ID (4 cases running, %s): p50 %.3f ms, p99 %.3f ms, %.0f "
+                  "requests/s, %d non-200; cases stepped %.3g steps/s in total meanwhile" %
+                  (how, p50, p99, rate, bad, steps))
         d.stop()
     finally:
         d.close()

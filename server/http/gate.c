@@ -24,8 +24,19 @@
  * only for new bytes, a hang-up or the deadline; the mark goes back to 1
  * before libmicrohttpd gets the socket.
  *
+ * Keep-alive. The gate reads only a connection's first request; later
+ * ones on a kept-alive connection go straight to libmicrohttpd. So the
+ * gate keeps a watchdog on every handed-over connection between requests
+ * (from its answer, gate_request_done(), to the next request's headers,
+ * gate_request_began()): past the request timeout it shuts the socket
+ * down, which bounds a client trickling its next request's headers as the
+ * held connections are bounded, and closes idle kept-alive connections;
+ * http.c checks a later request's framing on its parsed fields. Before,
+ * every answer closed its connection: 7,400 requests/s where keep-alive
+ * had given 21,600.
+ *
  * Why a connection over its address's limit waits a moment before its 503:
- * every answer closes its connection, and a client that keeps N
+ * a client that closes after each answer and keeps N
  * connections busy opens the next one as soon as it has read an answer,
  * while the server side counts the old one until libmicrohttpd reports it
  * done, a moment later. Refusing at once turned that moment into 503s for
@@ -59,8 +70,10 @@
 
 typedef struct gate_slot {
     uint32_t ip;       /* network order */
-    double accepted;
+    double began;      /* accepted, or the end of its last request (kept alive) */
     int live;          /* counted in gate_ips */
+    int idle;          /* handed over and between requests: the watchdog's */
+    int requests;      /* answered on it so far */
 } gate_slot;
 
 typedef struct gate_ip {
@@ -88,7 +101,7 @@ static struct {
     int held_count;
     pthread_mutex_t lock;     /* guards what follows: shared with MHD threads */
     gate_slot *slots;
-    int slot_count;
+    int slot_count, slot_high; /* slots[0 .. slot_high) have been used */
     gate_ip *ips;             /* addresses with a connection, unordered */
     int ip_count, total;
     int waiting;              /* held connections waiting for a slot */
@@ -135,7 +148,8 @@ static int gate_admit(int fd, uint32_t ip, double now, const char **why)
         }
         entry->count++;
         gate.total++;
-        gate.slots[fd] = (gate_slot){ip, now, 1};
+        gate.slots[fd] = (gate_slot){ip, now, 1, 0, 0};
+        if (fd >= gate.slot_high) gate.slot_high = fd + 1;
         ok = 1;
     }
     pthread_mutex_unlock(&gate.lock);
@@ -155,13 +169,57 @@ void gate_closed(int fd)
     pthread_mutex_unlock(&gate.lock);
 }
 
-double gate_accepted_at(int fd)
+double gate_request_began(int fd, int *later)
 {
     double t = 0;
+    *later = 0;
     pthread_mutex_lock(&gate.lock);
-    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) t = gate.slots[fd].accepted;
+    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) {
+        gate_slot *slot = &gate.slots[fd];
+        t = slot->began;
+        *later = slot->requests > 0;
+        slot->idle = 0;
+    }
     pthread_mutex_unlock(&gate.lock);
     return t;
+}
+
+void gate_request_done(int fd)
+{
+    pthread_mutex_lock(&gate.lock);
+    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) {
+        gate_slot *slot = &gate.slots[fd];
+        slot->requests++;
+        slot->idle = 1;
+        slot->began = gate_now();
+    }
+    pthread_mutex_unlock(&gate.lock);
+}
+
+/* The watchdog of kept-alive connections: one whose next request has not
+ * reached the daemon `timeout` seconds after its last answer is shut
+ * down (libmicrohttpd then sees the end of the stream, closes it and
+ * reports the close through gate_closed()); an idle one is closed as
+ * keep-alive servers do. Not closed here: the descriptor is
+ * libmicrohttpd's, and it must not be reused while it still holds it.
+ * Returns the seconds until the next such deadline (1 when none). */
+static double gate_cut_idle_kept(double now)
+{
+    double wait = 1.0;
+    pthread_mutex_lock(&gate.lock);
+    for (int fd = 0; fd < gate.slot_high; fd++) {
+        gate_slot *slot = &gate.slots[fd];
+        if (!slot->live || !slot->idle) continue;
+        double left = slot->began + gate.limits.timeout - now;
+        if (left > 0) {
+            if (left < wait) wait = left;
+            continue;
+        }
+        slot->idle = 0;
+        shutdown(fd, SHUT_RDWR);
+    }
+    pthread_mutex_unlock(&gate.lock);
+    return wait;
 }
 
 /* -------------------------------------------------------------- answers */
@@ -406,7 +464,7 @@ static void *gate_main(void *arg)
         return NULL;
     }
     for (;;) {
-        double now = gate_now(), wait = 1.0;
+        double now = gate_now(), wait = gate_cut_idle_kept(now);
         fds[0] = (struct pollfd){.fd = gate.wake[0], .events = POLLIN};
         fds[1] = (struct pollfd){.fd = gate.listen_fd, .events = POLLIN};
         for (int i = 0; i < gate.held_count; i++) {

@@ -15,8 +15,16 @@
  *  - The owner of a handed-over connection calls gate_closed(fd) before it
  *    closes the socket, so the per-address count stays true; it may call it
  *    earlier (once its one answer is sent), and a second call is a no-op.
- *  - gate_accepted_at(fd) is when that connection was accepted (monotonic
- *    seconds), so the whole-request deadline can be applied to the body.
+ *  - A handed-over connection may carry several requests (keep-alive).
+ *    gate_request_began(fd, &later) is when the request now at the daemon
+ *    began (monotonic seconds: the accept for the first, the end of the
+ *    last answer for a later one; *later says which), so the
+ *    whole-request deadline can be applied to the body; the owner calls it
+ *    when a request's headers are in, and gate_request_done(fd) when its
+ *    answer is sent. Between the two calls the connection is the daemon's;
+ *    from gate_request_done() on, the next request's headers must reach the
+ *    daemon within `timeout`, or the gate shuts the socket down (the
+ *    owner then closes it and calls gate_closed() as for any close).
  *  - gate_stop() stops accepting, closes held connections and joins.
  */
 #ifndef FDEMD_GATE_H
@@ -37,7 +45,8 @@ int gate_start(int listen_fd, const gate_limits *limits, gate_hand_over hand_ove
 void gate_stop(void);
 
 void gate_closed(int fd);
-double gate_accepted_at(int fd);
+double gate_request_began(int fd, int *later);
+void gate_request_done(int fd);
 
 /* Monotonic clock in seconds. */
 double gate_now(void);

@@ -24,6 +24,7 @@
 #include "common/memory_budget.h"
 #include "gate.h"
 #include "heavy_work.h"
+#include "http_frame.h"
 #include "json/json_depth.h"
 #include "routes.h"
 
@@ -36,6 +37,8 @@ typedef struct http_request {
     route_match route;
     double deadline;  /* the whole request must have arrived by then */
     int answered;     /* a response was queued before the body */
+    int later;        /* not its connection's first request (keep-alive) */
+    int closing;      /* its connection closes after the answer (see http_completed) */
     int too_large;
     unsigned owed_status; /* an answer owed once the body is drained (see http_owe) */
     const char *owed_title;
@@ -61,6 +64,7 @@ typedef struct http_kept_answer {
 } http_kept_answer;
 
 static _Thread_local http_kept_answer *tl_kept;
+static _Thread_local http_request *tl_request; /* the request being answered here */
 static _Thread_local int tl_deferred; /* a route asked for a heavy-work thread */
 
 static struct MHD_Daemon *http_daemon;
@@ -73,9 +77,14 @@ static enum MHD_Result http_queue(struct MHD_Connection *conn, unsigned status,
 {
     if (!resp)
         return MHD_NO;
-    /* One request per connection: every request then passes the gate,
-     * which alone applies the header checks and the deadline's first part. */
-    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
+    /* An error closes its connection: its request may have a body left
+     * unread, or be one no client should go on from; a success keeps it
+     * alive for the next request (gate.h). */
+    if (status >= 400) {
+        MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
+        if (tl_request)
+            tl_request->closing = 1;
+    }
     if (tl_kept) {
         if (tl_kept->resp) /* a second answer to one request: keep the first */
             MHD_destroy_response(resp);
@@ -382,12 +391,91 @@ static int http_collect(http_request *r, const char *data, size_t size)
  * then on libmicrohttpd's inactivity timeout is narrowed to the time left,
  * so a body that stalls is cut at the deadline and one that trickles is cut
  * at its first chunk after it. */
-static double http_request_deadline(struct MHD_Connection *conn)
+static double http_request_deadline(struct MHD_Connection *conn, int *later)
 {
     const union MHD_ConnectionInfo *info =
         MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
-    double accepted = info ? gate_accepted_at(info->connect_fd) : 0;
-    return (accepted > 0 ? accepted : gate_now()) + http_cfg->request_timeout;
+    *later = 0;
+    double began = info ? gate_request_began(info->connect_fd, later) : 0;
+    return (began > 0 ? began : gate_now()) + http_cfg->request_timeout;
+}
+
+/* Does the client want its connection closed after this request? It says
+ * "Connection: close", or speaks HTTP/1.0 without asking to keep alive. */
+static int http_has_token(const char *list, const char *token)
+{
+    size_t n = strlen(token);
+    for (const char *p = list; p && *p; p++)
+        if (strncasecmp(p, token, n) == 0)
+            return 1;
+    return 0;
+}
+
+static int http_client_closes(struct MHD_Connection *conn, const char *version)
+{
+    const char *c = MHD_lookup_connection_value(conn, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONNECTION);
+    if (http_has_token(c, "close"))
+        return 1;
+    return strcmp(version, MHD_HTTP_VERSION_1_0) == 0 && !http_has_token(c, "keep-alive");
+}
+
+/* The header block of a later request on a kept-alive connection, as
+ * libmicrohttpd parsed it, rebuilt for http_frame_check: the gate read the
+ * first request's raw bytes, but libmicrohttpd reads the later ones itself. */
+typedef struct http_rebuilt {
+    char text[32 * 1024];
+    size_t size;
+    int overflow;
+} http_rebuilt;
+
+static enum MHD_Result http_rebuild_field(void *cls, enum MHD_ValueKind kind, const char *key,
+                                          const char *value)
+{
+    (void)kind;
+    http_rebuilt *b = cls;
+    size_t room = sizeof b->text - b->size;
+    int n = snprintf(b->text + b->size, room, "%s: %s\r\n", key, value ? value : "");
+    if (n < 0 || (size_t)n + 2 >= room) { /* + the blank line */
+        b->overflow = 1;
+        return MHD_NO;
+    }
+    b->size += (size_t)n;
+    return MHD_YES;
+}
+
+/* The framing checks the gate makes on a first request, made on a later
+ * one from its parsed fields (disagreeing lengths, Transfer-Encoding, too
+ * many fields or query parameters). libmicrohttpd has read no body yet.
+ * Returns 1 when an answer was queued in *rc. What the parsed fields can no
+ * longer show (a malformed Content-Length, which libmicrohttpd answers
+ * itself before this) is in docs/api.md. */
+static int http_refuse_bad_framing(struct MHD_Connection *conn, const char *method,
+                                   const char *version, enum MHD_Result *rc)
+{
+    static _Thread_local http_rebuilt b;
+    b.size = 0;
+    b.overflow = 0;
+    int n = snprintf(b.text, sizeof b.text, "%s / %s\r\n", method, version);
+    b.size = n > 0 ? (size_t)n : 0;
+    MHD_get_connection_values(conn, MHD_HEADER_KIND, http_rebuild_field, &b);
+    http_frame_verdict v;
+    if (b.overflow) {
+        *rc = http_reply_problem(conn, 431, "Request header fields too large",
+                                 "the request line and headers exceed 32 KiB", NULL);
+        return 1;
+    }
+    memcpy(b.text + b.size, "\r\n", 2);
+    if (http_frame_check(b.text, b.size + 2, &v)) {
+        *rc = http_reply_problem(conn, (unsigned)v.status, v.title, v.detail, NULL);
+        return 1;
+    }
+    if (MHD_get_connection_values(conn, MHD_GET_ARGUMENT_KIND, NULL, NULL) > HTTP_FRAME_MAX_QUERY) {
+        *rc = http_reply_problem(conn, 414, "Too many query parameters",
+                                 "the request has more query parameters than any route takes",
+                                 NULL);
+        return 1;
+    }
+    return 0;
 }
 
 static int http_in_time(struct MHD_Connection *conn, const http_request *r)
@@ -434,10 +522,12 @@ static void http_heavy_run(void *arg)
     http_request *r = arg;
     http_kept_answer kept = {0, NULL};
     tl_kept = &kept;
+    tl_request = r;
     membudget_request_enter(&r->lease);
     routes_handle(r->conn, &r->route, r->method, r->body ? r->body : "", r->size);
     membudget_request_leave();
     tl_kept = NULL;
+    tl_request = NULL;
     r->heavy_status = kept.status;
     r->heavy_answer = kept.resp;
     r->heavy_done = 1;
@@ -473,19 +563,23 @@ static enum MHD_Result http_access(void *cls, struct MHD_Connection *conn, const
     (void)cls;
     (void)version;
     http_request *r = *req_cls;
+    tl_request = r;
     if (!r) {
         r = calloc(1, sizeof *r);
         if (!r)
             return MHD_NO;
         *req_cls = r;
-        r->deadline = http_request_deadline(conn);
+        tl_request = r;
+        r->deadline = http_request_deadline(conn, &r->later);
+        r->closing = http_client_closes(conn, version);
         routes_match(url, &r->route);
         enum MHD_Result rc = MHD_YES;
         if (!http_in_time(conn, r)) {
             r->answered = 1;
             return http_reply_timeout(conn);
         }
-        if (http_check_headers(conn, url, method, r, &rc)) {
+        if ((r->later && http_refuse_bad_framing(conn, method, version, &rc)) ||
+            http_check_headers(conn, url, method, r, &rc)) {
             r->answered = 1;
             return rc;
         }
@@ -532,16 +626,21 @@ static void http_completed(void *cls, struct MHD_Connection *conn, void **req_cl
                            enum MHD_RequestTerminationCode toe)
 {
     (void)cls;
-    (void)toe;
-    /* The connection carries this one request (Connection: close), so it
-     * stops counting against its address now, not at libmicrohttpd's next
-     * clean-up pass: the client has its whole answer and may already be
-     * opening its next connection (gate.c). */
+    /* A connection that closes after this answer stops counting against
+     * its address now, not at libmicrohttpd's next clean-up pass: the
+     * client has its whole answer and may already be opening its next
+     * connection (gate.c). One kept alive waits for its next request, under
+     * the gate's watchdog. */
+    http_request *r = *req_cls;
     const union MHD_ConnectionInfo *info =
         MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
-    if (info)
-        gate_closed(info->connect_fd);
-    http_request *r = *req_cls;
+    if (info) {
+        if (!r || r->closing || toe != MHD_REQUEST_TERMINATED_COMPLETED_OK)
+            gate_closed(info->connect_fd);
+        else
+            gate_request_done(info->connect_fd);
+    }
+    tl_request = NULL;
     if (r) {
         if (r->heavy_answer)
             MHD_destroy_response(r->heavy_answer);

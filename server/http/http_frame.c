@@ -31,7 +31,7 @@
  * route takes more than two parameters, and real clients send a dozen
  * fields, so these bounds refuse only what is hostile, and they keep the
  * records of a whole 32 KiB header block well inside the pool. */
-#define FRAME_MAX_QUERY_PARAMETERS 64
+#define FRAME_MAX_QUERY_PARAMETERS HTTP_FRAME_MAX_QUERY
 #define FRAME_MAX_FIELDS 100
 
 /* Empty lines before the request line are skipped (RFC 9112 section 2.2,

@@ -23,6 +23,10 @@
 
 #include <stddef.h>
 
+/* The most query parameters a request may carry (no route takes more
+ * than two; see http_frame.c for why there is a bound at all). */
+#define HTTP_FRAME_MAX_QUERY 64
+
 typedef struct http_frame_verdict {
     int status;        /* 0 when the framing is acceptable */
     char title[48];    /* "Bad request", ... */

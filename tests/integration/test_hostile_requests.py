@@ -6,6 +6,7 @@ refuse to send what a hostile client sends."""
 import http.client
 import json
 import random
+import re
 import socket
 import threading
 import time
@@ -319,3 +320,110 @@ class SlowClientTest(DaemonTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class KeepAliveTest(DaemonTestCase):
+    """Keep-alive (issue 30, item 5): a connection carries several requests,
+    and each later request is held to what the gate holds a first one to:
+    its headers within --request-timeout of the answer before it, and the
+    same framing checks, answered once and cleanly. Error answers close."""
+    TIMEOUT = 2
+    DAEMON_ARGS = ("--request-timeout", str(TIMEOUT))
+
+    def connect(self):
+        s = socket.create_connection(("127.0.0.1", self.d.port))
+        s.settimeout(10 * SLOW)
+        return s
+
+    def exchange(self, s, request):
+        """Sends one request on s and reads its whole answer (head and the
+        Content-Length body); returns (head, body)."""
+        s.sendall(request)
+        reply = read_head(s)
+        head, _, body = reply.partition(b"\r\n\r\n")
+        length = int(re.search(rb"(?i)content-length: *(\d+)", head).group(1))
+        while len(body) < length:
+            chunk = s.recv(65536)
+            if not chunk:
+                break
+            body += chunk
+        return head, body
+
+    def test_one_connection_carries_many_requests(self):
+        with self.connect() as s:
+            for _ in range(20):
+                head, body = self.exchange(s, b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n")
+                self.assertEqual(status_of(head), 200, head)
+                self.assertNotIn(b"connection: close", head.lower())
+                self.assertEqual(json.loads(body)["status"], "ok")
+            # a case made and read on the same connection
+            doc = json.dumps(tiny_case("kept")).encode()
+            head, body = self.exchange(s, b"POST /cases HTTP/1.1\r\nHost: x\r\nContent-Length: %d"
+                                       b"\r\n\r\n" % len(doc) + doc)
+            self.assertEqual(status_of(head), 201, head)
+            case_id = json.loads(body)["id"]
+            head, body = self.exchange(s, b"GET /cases/%s HTTP/1.1\r\nHost: x\r\n\r\n"
+                                       % case_id.encode())
+            self.assertEqual(json.loads(body)["id"], case_id)
+
+    def test_a_trickled_later_request_is_cut_at_the_deadline(self):
+        with self.connect() as s:
+            head, _ = self.exchange(s, b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n")
+            self.assertEqual(status_of(head), 200)
+            t0 = time.monotonic()
+            s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
+            s.settimeout(0.3)
+            closed = False
+            while time.monotonic() - t0 < 10 * SLOW and not closed:
+                try:
+                    closed = s.recv(65536) == b""
+                except socket.timeout:
+                    try:
+                        s.sendall(b"X-Slow: 1\r\n")
+                    except (BrokenPipeError, ConnectionResetError):
+                        closed = True
+                except ConnectionResetError:
+                    closed = True
+            alive = time.monotonic() - t0
+        self.assertTrue(closed, "the trickling connection was still open after %.1f s" % alive)
+        self.assertLess(alive, self.TIMEOUT + 1.5 * SLOW, "it lived %.1f s" % alive)
+        self.assertGreater(alive, self.TIMEOUT - 0.5)
+
+    def test_an_idle_kept_connection_is_closed(self):
+        with self.connect() as s:
+            self.exchange(s, b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n")
+            t0 = time.monotonic()
+            reply = read_until_closed(s)
+            alive = time.monotonic() - t0
+        self.assertEqual(reply, b"")
+        self.assertLess(alive, self.TIMEOUT + 1.5 * SLOW, "it lived %.1f s" % alive)
+
+    def test_a_later_request_gets_the_framing_checks(self):
+        doc = json.dumps(tiny_case("smuggled-later")).encode()
+        cases = [([b"Content-Length: %d" % len(doc), b"Content-Length: 2"], 400, b"disagree"),
+                 ([b"Transfer-Encoding: identity"], 411, b"Content-Length"),
+                 ([b"Transfer-Encoding: chunked", b"Content-Length: %d" % len(doc)], 400,
+                  b"Content-Length alone"),
+                 ([b"X-Field-%d: 1" % k for k in range(120)], 431, b"header fields")]
+        for headers, status, words in cases:
+            with self.connect() as s:
+                head, _ = self.exchange(s, b"GET /health HTTP/1.1\r\nHost: x\r\n\r\n")
+                self.assertEqual(status_of(head), 200)
+                t0 = time.monotonic()
+                s.sendall(b"POST /cases HTTP/1.1\r\nHost: x\r\n" +
+                          b"".join(h + b"\r\n" for h in headers) + b"\r\n" + doc)
+                reply = read_until_closed(s)
+                seconds = time.monotonic() - t0
+            self.assertLess(seconds, 2.0 * SLOW, "answered after %.1f s" % seconds)
+            self.assertEqual(reply.count(b"HTTP/1.1 "), 1, reply[:400])
+            self.assertEqual(status_of(reply), status, reply[:400])
+            self.assertIn(words, reply)
+        status, listing = self.d.json("GET", "/cases")
+        self.assertNotIn("smuggled-later", json.dumps(listing))
+
+    def test_an_error_answer_closes_its_connection(self):
+        with self.connect() as s:
+            s.sendall(b"GET /nowhere HTTP/1.1\r\nHost: x\r\n\r\n")
+            reply = read_until_closed(s)
+        self.assertEqual(status_of(reply), 404, reply[:200])
+        self.assertIn(b"connection: close", reply.lower())
