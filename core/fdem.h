@@ -213,6 +213,14 @@ typedef enum fdem_constraint_kind {
     FDEM_CONSTRAINT_PRESSURE, /* value[0] Pa on every boundary edge (face) whose nodes are all
                                  selected, along the current inward normal (boundary_load.c) */
     FDEM_CONSTRAINT_ABSORB,   /* Lysmer dashpots on the same boundary edges (faces) */
+    FDEM_CONSTRAINT_BOUNDARY_STRESS, /* contract 6.1: the traction sigma . n of the stress field
+                                        stress_value + stress_gradient (h - stress_reference) on
+                                        the current outward normal n of the same boundary edges
+                                        (faces), h the INITIAL height (y in 2D, z in 3D) of each
+                                        point, so the field is fixed to the material; lumped
+                                        consistently (linear along the facet), see boundary_load.c */
+    FDEM_CONSTRAINT_TRACTION, /* value[0..dim) Pa: a fixed vector traction per unit current
+                                 area of the same boundary edges (faces), |S|/dim per vertex */
 } fdem_constraint_kind;
 
 typedef struct fdem_constraint_def {
@@ -223,11 +231,17 @@ typedef struct fdem_constraint_def {
     int vertex_count;
     fdem_constraint_kind kind;
     int fix_x, fix_y, fix_z;    /* FIX */
-    double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness) */
+    double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness);
+                                   PRESSURE: p in value[0]; TRACTION: t (Pa) */
     int free_x, free_y, free_z; /* VELOCITY: component left free (JSON null) */
-    /* VELOCITY, FORCE, PRESSURE: the value times a(t), piecewise linear through
-     * amplitude_count (t, a) pairs (times strictly increasing), held constant
-     * outside them; NULL (count 0) is a(t) = 1. fdem_add_constraint copies it. */
+    /* BOUNDARY_STRESS: the field, fdem_stress_components numbers each in the layout of
+     * fdem_element_stress (2D: xx, yy, xy; 3D: xx, yy, zz, yz, xz, xy), as
+     * fdem_set_part_initial_stress takes it; all finite (checked at finalize). */
+    double stress_value[6], stress_gradient[6], stress_reference;
+    /* VELOCITY, FORCE, PRESSURE, TRACTION, BOUNDARY_STRESS (the whole field): the
+     * value times a(t), piecewise linear through amplitude_count (t, a) pairs
+     * (times strictly increasing), held constant outside them; NULL (count 0)
+     * is a(t) = 1. fdem_add_constraint copies it. */
     const double *amplitude;
     int amplitude_count;
 } fdem_constraint_def;
@@ -398,7 +412,7 @@ void fdem_element_strain(const fdem_model *model, double *out);
 void fdem_element_principal_stress(const fdem_model *model, double *out);
 void fdem_principal_values(int dimension, const double *voigt, double *out);
 
-/* Total reaction (fix, velocity), applied (force, pressure) or dashpot
+/* Total reaction (fix, velocity), applied (force, pressure, boundary stress, traction) or dashpot
  * (absorb) force of each constraint during the last step, `dimension`
  * doubles per constraint. */
 const double *fdem_constraint_forces(const fdem_model *model);

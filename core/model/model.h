@@ -105,8 +105,11 @@ typedef struct constraint {
                             (absorb) force of the last step */
     double value_now[3]; /* def.value times the amplitude at the instant this step uses
                             (constraint_set_time); def.value itself without an amplitude */
+    double amplitude_now; /* that amplitude (1 without one, set at finalize): BOUNDARY_STRESS
+                             scales its whole field by it */
     double *amplitude;   /* owned copy of def.amplitude (def.amplitude points here) */
-    int facet_begin, facet_count; /* PRESSURE, ABSORB: entries of model.bfacet_* */
+    int facet_begin, facet_count; /* boundary loads (boundary_load.c): entries of
+                                     model.bfacet_* */
 } constraint;
 
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
@@ -295,7 +298,7 @@ struct fdem_model {
     double gravity_work_sum; /* with a gravity amplitude: its work booked step by step */
     double momentum[3];      /* with a gravity amplitude: sum m v after the last step */
 
-    /* boundary facets loaded by PRESSURE and ABSORB constraints
+    /* boundary facets loaded by PRESSURE, ABSORB, BOUNDARY_STRESS and TRACTION constraints
      * (boundary_load.c): dim nodes per entry, ordered so that their area
      * vector points out of the body, the element behind, and the force the
      * last step put on each of its nodes (dim * dim per entry) */
@@ -303,7 +306,7 @@ struct fdem_model {
     int32_t *bfacet_node;
     int32_t *bfacet_elem;
     double *bfacet_force;
-    double boundary_power_old[2]; /* this step's sum f . v_old: pressures, dashpots */
+    double boundary_power_old[2]; /* this step's sum f . v_old: applied loads, dashpots */
     double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
     int64_t step;
     double time;

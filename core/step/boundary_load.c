@@ -1,9 +1,11 @@
 /*
  * boundary_load.c - loads that act on a body's boundary rather than on its
- * nodes (contract 5.3): a pressure along the current inward normal of every
- * selected boundary edge (3D: face), and Lysmer-Kuhlemeyer dashpots that let
- * waves leave through it. Both dimensions share every loop; only the area
- * vector of a facet (an edge's rotated tangent, a face's half cross product)
+ * nodes (contracts 5.3 and 6.1): a pressure along the current inward normal
+ * of every selected boundary edge (3D: face), the traction sigma . n of a
+ * given stress field on its current outward normal (boundary stress), a
+ * fixed vector traction, and Lysmer-Kuhlemeyer dashpots that let waves
+ * leave through it. Both dimensions share every loop; only the area vector
+ * of a facet (an edge's rotated tangent, a face's half cross product)
  * depends on the dimension.
  *
  * A boundary facet is an element edge (face) that no other element of the
@@ -14,10 +16,22 @@
  * at finalize, their forces are recomputed on the deformed geometry at
  * every step. Nothing here runs for a model without such constraints.
  *
+ * Lumping: a load uniform over a facet puts |S|/dim of it on each vertex.
+ * A boundary stress varies linearly with the height, so its traction is
+ * linear along the facet and is lumped consistently (int N_a t dA): 2D
+ * L (2 t_a + t_b) / 6, 3D A (2 t_a + t_b + t_c) / 12. Both are the traction
+ * at the vertex's weighted height (h_a + sum of the facet's h) / (dim + 1)
+ * times |S| / dim, so one formula serves both dimensions, and a uniform
+ * field gives exactly what a pressure gives. Consistent lumping is what
+ * makes a block whose elements hold the same linear field (constant strain,
+ * stress at the centroid, lumped gravity balancing its divergence) be at
+ * rest to round-off: by the divergence theorem each node's internal force is
+ * then exactly the sum of these loads and its weight.
+ *
  * Energy: each facet force's work is booked as every force's, with the
- * step-averaged velocity f . (v_old + v_new)/2 havg, as external work for a
- * pressure and as dissipated (damping) for a dashpot; energy.c drops the
- * last half step, as for the other accounts.
+ * step-averaged velocity f . (v_old + v_new)/2 havg, as external work for
+ * the applied loads and as dissipated (damping) for a dashpot; energy.c
+ * drops the last half step, as for the other accounts.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -26,11 +40,29 @@
 #include "model/model.h"
 #include "math/node_ids.h"
 #include "math/vec3.h"
+#include "math/voigt.h"
 #include "step.h"
 
 static int is_boundary_load(const constraint *c)
 {
-    return c->def.kind == FDEM_CONSTRAINT_PRESSURE || c->def.kind == FDEM_CONSTRAINT_ABSORB;
+    switch (c->def.kind) {
+    case FDEM_CONSTRAINT_PRESSURE:
+    case FDEM_CONSTRAINT_ABSORB:
+    case FDEM_CONSTRAINT_BOUNDARY_STRESS:
+    case FDEM_CONSTRAINT_TRACTION: return 1;
+    default: return 0;
+    }
+}
+
+/* "a pressure", ... for messages that name what a constraint does. */
+static const char *load_name(const constraint *c)
+{
+    switch (c->def.kind) {
+    case FDEM_CONSTRAINT_PRESSURE: return "a pressure";
+    case FDEM_CONSTRAINT_BOUNDARY_STRESS: return "a boundary stress";
+    case FDEM_CONSTRAINT_TRACTION: return "a traction";
+    default: return "an absorbing boundary";
+    }
 }
 
 /* The vertices of each facet of an element, ordered so that the facet's
@@ -149,11 +181,32 @@ static void facets_assign(fdem_model *m, const facet_key *keys, int count, int p
     m->bfacet_count = at;
 }
 
+/* A boundary stress field must be finite (fdem_add_constraint checks only
+ * the value vector the other kinds use). */
+static int stress_fields_finite(const fdem_model *m, fdem_error *err)
+{
+    const int S = model_stress_comps(m);
+    for (int k = 0; k < m->constraint_count; k++) {
+        const fdem_constraint_def *def = &m->constraints[k].def;
+        if (def->kind != FDEM_CONSTRAINT_BOUNDARY_STRESS) continue;
+        int finite = isfinite(def->stress_reference);
+        for (int i = 0; i < S; i++)
+            finite &= isfinite(def->stress_value[i]) && isfinite(def->stress_gradient[i]);
+        if (!finite) {
+            model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                        "constraint %d: the boundary stress is not finite", k);
+            return 0;
+        }
+    }
+    return 1;
+}
+
 int boundary_load_select(fdem_model *m, fdem_error *err)
 {
     int wanted = 0;
     for (int k = 0; k < m->constraint_count; k++) wanted |= is_boundary_load(&m->constraints[k]);
     if (!wanted) return 0;
+    if (!stress_fields_finite(m, err)) return -1;
     int count = 0;
     facet_key *keys = facets_sorted(m, &count);
     if (!keys) {
@@ -178,8 +231,7 @@ int boundary_load_select(fdem_model *m, fdem_error *err)
             model_error(err, FDEM_ITEM_CONSTRAINT, k,
                         "constraint %d selects no boundary %s: %s acts on the %s of a body "
                         "whose nodes are all selected",
-                        k, m->dim == 3 ? "face" : "edge",
-                        c->def.kind == FDEM_CONSTRAINT_PRESSURE ? "a pressure" : "an absorbing boundary",
+                        k, m->dim == 3 ? "face" : "edge", load_name(c),
                         m->dim == 3 ? "faces" : "edges");
             return -1;
         }
@@ -187,17 +239,13 @@ int boundary_load_select(fdem_model *m, fdem_error *err)
     return 0;
 }
 
-/* The force on one vertex of a facet of outward area vector s: a pressure
- * p pushes along -s, a dashpot resists the vertex's velocity v with the
- * impedances z_p (normal) and z_s (tangential) over its share of the area. */
-static void vertex_force(const fdem_model *m, const constraint *c, int elem, const double s[3],
-                         const double *v, double f[3])
+/* The dashpot force on a facet vertex of velocity v, for the facet's
+ * outward area vector s: the impedances z_p (normal) and z_s (tangential)
+ * of the element behind, over the vertex's share of the area. */
+static void dashpot_force(const fdem_model *m, int elem, const double s[3], const double *v,
+                          double f[3])
 {
     const int D = m->dim;
-    if (c->def.kind == FDEM_CONSTRAINT_PRESSURE) {
-        for (int d = 0; d < D; d++) f[d] = -c->value_now[0] * s[d] / D;
-        return;
-    }
     const material *mat = &m->materials[element_material(m, elem)];
     double rho = mat->def.density;
     double z_p = sqrt(rho * (mat->lambda + 2 * mat->mu)), z_s = sqrt(rho * mat->mu);
@@ -206,6 +254,57 @@ static void vertex_force(const fdem_model *m, const constraint *c, int elem, con
     for (int d = 0; d < D; d++) vn += v[d] * s[d] / area;
     for (int d = 0; d < D; d++)
         f[d] = -(area / D) * (z_s * v[d] + (z_p - z_s) * vn * s[d] / area);
+}
+
+/* Initial height (y in 2D, z in 3D) of node n: where the material point
+ * stood when the stress field was given. */
+static double initial_height(const fdem_model *m, int32_t n)
+{
+    return m->pos0[(size_t)m->dim * (size_t)n + (size_t)(m->dim - 1)];
+}
+
+/* Vertex a's consistent share of the linear traction sigma(h) . s over the
+ * facet of nodes n: the traction at the weighted height (h_a + sum h) /
+ * (dim + 1), times 1/dim (see the top of the file), times the amplitude. */
+static void boundary_stress_force(const fdem_model *m, const constraint *c, const int32_t *n,
+                                  int a, const double s[3], double f[3])
+{
+    const int D = m->dim, S = model_stress_comps(m);
+    const fdem_constraint_def *def = &c->def;
+    double h = initial_height(m, n[a]);
+    for (int b = 0; b < D; b++) h += initial_height(m, n[b]);
+    double dh = h / (D + 1) - def->stress_reference, sigma[6];
+    for (int k = 0; k < S; k++)
+        sigma[k] = c->amplitude_now * (def->stress_value[k] + def->stress_gradient[k] * dh);
+    for (int i = 0; i < D; i++) {
+        double t = 0;
+        for (int j = 0; j < D; j++) t += sigma[voigt_index(D, i, j)] * s[j];
+        f[i] = t / D;
+    }
+}
+
+/* The force on vertex a of facet j (nodes n, outward area vector s) from
+ * constraint c; dashpots use the vertex's velocity v. */
+static void vertex_force(const fdem_model *m, const constraint *c, int j, const int32_t *n, int a,
+                         const double s[3], const double *v, double f[3])
+{
+    const int D = m->dim;
+    switch (c->def.kind) {
+    case FDEM_CONSTRAINT_PRESSURE:
+        for (int d = 0; d < D; d++) f[d] = -c->value_now[0] * s[d] / D;
+        return;
+    case FDEM_CONSTRAINT_BOUNDARY_STRESS:
+        boundary_stress_force(m, c, n, a, s, f);
+        return;
+    case FDEM_CONSTRAINT_TRACTION: {
+        double area = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+        for (int d = 0; d < D; d++) f[d] = c->value_now[d] * area / D;
+        return;
+    }
+    default:
+        dashpot_force(m, m->bfacet_elem[j], s, v, f);
+        return;
+    }
 }
 
 /* The facet forces of this step, at the positions of t_n and (dashpots) the
@@ -229,7 +328,7 @@ void boundary_load_apply(fdem_model *m)
                 size_t at = (size_t)D * (size_t)n[a];
                 double *f = m->bfacet_force + (size_t)D * ((size_t)D * (size_t)j + (size_t)a);
                 double fv[3] = {0, 0, 0};
-                vertex_force(m, c, m->bfacet_elem[j], s, m->vel + at, fv);
+                vertex_force(m, c, j, n, a, s, m->vel + at, fv);
                 for (int d = 0; d < D; d++) {
                     f[d] = fv[d];
                     m->force[at + d] += fv[d];
@@ -242,7 +341,7 @@ void boundary_load_apply(fdem_model *m)
 }
 
 /* sum f . v over the facet forces of the last step (absorb: of the
- * dashpots, else of the pressures), with the velocities now held. */
+ * dashpots, else of the applied loads), with the velocities now held. */
 static double boundary_power(const fdem_model *m, int absorb)
 {
     const int D = m->dim;

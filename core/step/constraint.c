@@ -2,8 +2,8 @@
  * constraint.c - boundary conditions: node selection by part, box or mesh
  * vertices (a named group), fixed and prescribed-velocity components, forces
  * shared over a node set, their amplitudes in time, and the total reaction
- * of each constraint after every step (pressures and dashpots on boundary
- * facets: boundary_load.c).
+ * of each constraint after every step (the loads on boundary facets:
+ * pressures, boundary stresses, tractions and dashpots, boundary_load.c).
  *
  * A degree of freedom belongs to the last constraint (in case order) that
  * prescribes it, so overlapping selections are well defined and each
@@ -95,13 +95,18 @@ void constraint_set_time(fdem_model *m, double velocity_time)
         double t = c->def.kind == FDEM_CONSTRAINT_VELOCITY ? velocity_time : m->time;
         double a = amplitude_at(c->amplitude, c->def.amplitude_count, t);
         for (int d = 0; d < 3; d++) c->value_now[d] = c->def.value[d] * a;
+        c->amplitude_now = a;
     }
 }
 
 int constraint_select(fdem_model *m, fdem_error *err)
 {
     int total = 0, empty = 0, first_empty = -1;
-    for (int k = 0; k < m->constraint_count; k++) m->constraints[k].entry_count = -1; /* not counted */
+    for (int k = 0; k < m->constraint_count; k++) {
+        m->constraints[k].entry_count = -1; /* not counted */
+        /* constraint_set_time keeps it for tables only: without one it stays 1 */
+        if (!m->constraints[k].amplitude) m->constraints[k].amplitude_now = 1;
+    }
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
         if (c->def.select != FDEM_SELECT_BOX && (c->def.part < 0 || c->def.part >= m->part_count)) {

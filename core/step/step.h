@@ -2,10 +2,10 @@
  * step.h - one step of the central-difference scheme and what it applies:
  * the integrator (integrator.c: the order of a step and fdem_step),
  * constraints (constraint.c: fixed, velocity, force and amplitude-driven
- * dofs), boundary pressures and absorbing dashpots (boundary_load.c), and
- * the energy accounts the step books (energy.c, fdem_get_energy). Calls the
- * element, contact and joint stages; finalize (build/) and checkpoints
- * call it.
+ * dofs), boundary pressures, stresses, tractions and absorbing dashpots
+ * (boundary_load.c), and the energy accounts the step books (energy.c,
+ * fdem_get_energy). Calls the element, contact and joint stages; finalize
+ * (build/) and checkpoints call it.
  */
 #ifndef FDEM_STEP_H
 #define FDEM_STEP_H
@@ -23,7 +23,8 @@ void constraint_enforce(fdem_model *m, double h, double havg);
 /* constraint.c: the owned copy of a vertex selection */
 int constraint_keep_vertices(constraint *c);
 
-/* boundary_load.c: pressures and absorbing dashpots on boundary facets */
+/* boundary_load.c: pressures, boundary stresses, tractions and absorbing
+ * dashpots on boundary facets */
 int boundary_load_select(fdem_model *m, fdem_error *err);
 void boundary_load_apply(fdem_model *m);
 void boundary_load_account(fdem_model *m, double havg);

@@ -2,9 +2,10 @@
  * case_constraints.c - the "constraints" array of a case: each entry selects
  * nodes (a part by name, a named group of a gmsh part, or a box of initial
  * positions) and does one thing to them (fix components, prescribe a
- * velocity, apply a force, press on or absorb waves through the boundary
- * they span), a velocity, force or
- * pressure optionally scaled by an "amplitude" table in time.
+ * velocity, apply a force; press on, load with the traction of a stress
+ * field or a fixed traction, or absorb waves through the boundary they
+ * span), every value but a fix and an absorb optionally scaled by an
+ * "amplitude" table in time.
  *
  * Parts are read first, so a part selector is resolved to its index here and
  * a misspelt part name is reported with a suggestion. Whether a box selects
@@ -18,10 +19,10 @@
 
 #include "case_internal.h"
 
-static const char *const constraint_keys[] = {"part",     "group",  "box",    "fix",
-                                              "velocity", "force",  "pressure", "absorb",
-                                              "amplitude",
-                                              NULL};
+static const char *const constraint_keys[] = {"part",     "group",    "box",
+                                              "fix",      "velocity", "force",
+                                              "pressure", "absorb",   "boundary_stress",
+                                              "traction", "amplitude", NULL};
 
 static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
                                  const char *ptr)
@@ -189,7 +190,21 @@ static void constraint_read_absorb(case_doc *doc, fdem_constraint_def *def, cons
                                "constraint out");
 }
 
-/* "amplitude" only scales a value: a velocity, force or pressure. */
+/* "boundary_stress": {"value", "gradient", "reference"}, read as a part's
+ * "initial_stress" is (case_initial_stress.c); its range over the model's
+ * heights is checked once the model has its nodes (case_add_constraints). */
+static void constraint_read_boundary_stress(case_doc *doc, fdem_constraint_def *def,
+                                            const json_t *field, const char *ptr)
+{
+    def->kind = FDEM_CONSTRAINT_BOUNDARY_STRESS;
+    case_stress_field f;
+    case_read_stress_field(doc, field, ptr, "\"boundary_stress\"", &f);
+    memcpy(def->stress_value, f.value, sizeof f.value);
+    memcpy(def->stress_gradient, f.gradient, sizeof f.gradient);
+    def->stress_reference = f.reference;
+}
+
+/* "amplitude" only scales a value: not a fix or an absorbing boundary. */
 static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const json_t *value,
                                       const char *ptr)
 {
@@ -197,8 +212,9 @@ static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const j
     json_t *table = case_member(value, ptr, "amplitude", at);
     if (!table) return;
     if (c->def.kind == FDEM_CONSTRAINT_FIX || c->def.kind == FDEM_CONSTRAINT_ABSORB) {
-        case_problem(doc, at, "an amplitude scales a \"velocity\", \"force\" or \"pressure\", "
-                              "not %s", c->def.kind == FDEM_CONSTRAINT_FIX ? "\"fix\"" : "\"absorb\"");
+        case_problem(doc, at, "an amplitude scales a \"velocity\", \"force\", \"pressure\", "
+                              "\"boundary_stress\" or \"traction\", not %s",
+                     c->def.kind == FDEM_CONSTRAINT_FIX ? "\"fix\"" : "\"absorb\"");
         return;
     }
     c->amplitude = case_read_amplitude(doc, table, at, &c->def.amplitude_count);
@@ -208,7 +224,8 @@ static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const j
 static void constraint_read(case_doc *doc, case_constraint *c, int index, const json_t *value)
 {
     static const char *const selectors[] = {"part", "box"};
-    static const char *const actions[] = {"fix", "velocity", "force", "pressure", "absorb"};
+    static const char *const actions[] = {"fix",    "velocity",        "force",   "pressure",
+                                          "absorb", "boundary_stress", "traction"};
     char ptr[CASE_POINTER], at[CASE_POINTER], what[32];
     pointer_join_index(ptr, sizeof ptr, "/constraints", index);
     if (!case_expect_object(doc, value, ptr)) return;
@@ -231,9 +248,9 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
     else if (group && json_is_string(part) &&
              case_names_find(doc->part_names, json_string_value(part)) >= 0)
         constraint_read_group(doc, c, group, at); /* an unknown part is reported at "part" */
-    int action = constraint_pick(doc, value, ptr, actions, 5,
-                                 "an action: \"fix\", \"velocity\", \"force\", \"pressure\" "
-                                 "or \"absorb\"");
+    int action = constraint_pick(doc, value, ptr, actions, 7,
+                                 "an action: \"fix\", \"velocity\", \"force\", \"pressure\", "
+                                 "\"absorb\", \"boundary_stress\" or \"traction\"");
     if (action < 0) return;
     json_t *a = case_member(value, ptr, actions[action], at);
     if (action == 0) {
@@ -246,8 +263,13 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
     } else if (action == 3) {
         c->def.kind = FDEM_CONSTRAINT_PRESSURE;
         case_read_number(doc, a, at, &c->def.value[0]);
-    } else {
+    } else if (action == 4) {
         constraint_read_absorb(doc, &c->def, a, at);
+    } else if (action == 5) {
+        constraint_read_boundary_stress(doc, &c->def, a, at);
+    } else {
+        c->def.kind = FDEM_CONSTRAINT_TRACTION;
+        case_read_axes(doc, a, at, c->def.value);
     }
     constraint_read_amplitude(doc, c, value, ptr);
 }
@@ -267,6 +289,38 @@ void case_read_constraints(case_doc *doc, const json_t *constraints)
         constraint_read(doc, &doc->constraints[i], i, json_array_get(constraints, (size_t)i));
 }
 
+/* Lowest and highest initial node of the model (y in 2D, z in 3D), over
+ * the parts added so far. */
+static void model_height_range(const fdem_model *model, double height[2])
+{
+    const int dim = fdem_get_dimension(model), count = fdem_get_counts(model).nodes;
+    const double *x = fdem_initial_positions(model);
+    height[0] = height[1] = 0;
+    for (int n = 0; x && n < count; n++) {
+        double h = x[(size_t)dim * (size_t)n + (size_t)(dim - 1)];
+        if (n == 0 || h < height[0]) height[0] = h;
+        if (n == 0 || h > height[1]) height[1] = h;
+    }
+}
+
+/* A boundary stress must stay finite and plausible over the model's
+ * heights, as a part's initial stress over the part's. */
+static int check_boundary_stress(case_doc *doc, const fdem_model *model, int i)
+{
+    const fdem_constraint_def *def = &doc->constraints[i].def;
+    if (def->kind != FDEM_CONSTRAINT_BOUNDARY_STRESS) return 0;
+    case_stress_field f;
+    memcpy(f.value, def->stress_value, sizeof f.value);
+    memcpy(f.gradient, def->stress_gradient, sizeof f.gradient);
+    f.reference = def->stress_reference;
+    double height[2];
+    model_height_range(model, height);
+    char base[CASE_POINTER], ptr[CASE_POINTER];
+    pointer_join_index(base, sizeof base, "/constraints", i);
+    pointer_join(ptr, sizeof ptr, base, "boundary_stress");
+    return case_check_stress_extent(doc, &f, ptr, "boundary stress", "the model", height);
+}
+
 /* Every constraint is checked even after one is refused (one answer names
  * each); such a model is never finalized. */
 int case_add_constraints(case_doc *doc, fdem_model *model)
@@ -274,6 +328,10 @@ int case_add_constraints(case_doc *doc, fdem_model *model)
     int rc = 0;
     for (int i = 0; i < doc->constraint_count; i++) {
         fdem_error err = {0};
+        if (check_boundary_stress(doc, model, i) < 0) {
+            rc = -1;
+            continue;
+        }
         if (fdem_add_constraint(model, &doc->constraints[i].def, &err) < 0) {
             char ptr[CASE_POINTER];
             pointer_join_index(ptr, sizeof ptr, "/constraints", i);

@@ -45,6 +45,13 @@ typedef enum case_shape {
 extern const char *const case_shape_keys[];
 #define CASE_SHAPE_KINDS 7
 
+/* A stress field {"value", "gradient", "reference"}: the value at height
+ * `reference` (y in 2D, z in 3D) and its change per metre of height, in
+ * the layout of the `stress` output; Pa (case_initial_stress.c). */
+typedef struct case_stress_field {
+    double value[6], gradient[6], reference;
+} case_stress_field;
+
 typedef struct case_part {
     char name[CASE_NAME];
     int material;            /* index into case_doc.materials, -1 if unknown */
@@ -61,7 +68,7 @@ typedef struct case_part {
     fdem_mesh mesh;          /* 2D; MESH, GMSH: read in pass 1; others: pass 3 */
     fdem_tet_mesh tet_mesh;  /* 3D, the same */
     int has_stress0;         /* "initial_stress" read without a problem */
-    double stress0_value[6], stress0_gradient[6], stress0_reference; /* stress layout, Pa */
+    case_stress_field stress0;
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
     gmsh_groups groups;      /* GMSH: its named physical groups */
     int32_t *element_material; /* "materials": the material of each element, else NULL */
@@ -217,14 +224,22 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
-/* case_initial_stress.c: a part's "initial_stress" (pass 1), and handing
- * document part i's to the engine once it is model part `index` (pass 3; 0,
- * or -1 after a problem). */
+/* case_initial_stress.c: a stress field block at ptr ("initial_stress",
+ * "boundary_stress"; `what` names it in the message about an unknown key):
+ * 1 when read, 0 after a problem at each member at fault. */
+int case_read_stress_field(case_doc *doc, const json_t *block, const char *ptr, const char *what,
+                           case_stress_field *field);
+/* A field not finite, or above CASE_MAX_INITIAL_STRESS, anywhere between the
+ * heights height[0] and height[1] (the lowest and highest node of `body`,
+ * which the message names, as it names the field `what`) is a problem at
+ * ptr's "value" or "gradient", whichever makes it so: -1, else 0. */
+int case_check_stress_extent(case_doc *doc, const case_stress_field *field, const char *ptr,
+                             const char *what, const char *body, const double height[2]);
+/* A part's "initial_stress" (pass 1), and handing document part i's to the
+ * engine once it is model part `index` (pass 3; 0, or -1 after a problem);
+ * height: the lowest and highest node of the part (y in 2D, z in 3D). */
 void case_read_initial_stress(case_doc *doc, case_part *part, const json_t *block,
                               const char *ptr);
-/* height: the lowest and highest node of the part (y in 2D, z in 3D); a
- * stress not finite, or above CASE_MAX_INITIAL_STRESS, anywhere between
- * is a problem at the value or gradient that makes it so. */
 int case_add_initial_stress(case_doc *doc, fdem_model *model, int i, int index,
                             const double height[2]);
 /* case_materials.c: a fracture block and its variation (zero when it has
