@@ -476,7 +476,8 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     int has_amplitude = def->amplitude != NULL || def->amplitude_count != 0;
     if (has_amplitude && (def->kind == FDEM_CONSTRAINT_FIX || def->kind == FDEM_CONSTRAINT_ABSORB)) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k,
-                    "constraint %d: an amplitude scales a velocity, force, pressure, boundary stress or traction only", k);
+                    "constraint %d: an amplitude scales a velocity, force, pressure, boundary "
+                    "stress or traction only", k);
         return -1;
     }
     double *amplitude = NULL;
