@@ -8,7 +8,8 @@
  *    damaged, every element's stress within 1 %; its joints hold the
  *    stress's energy from t = 0 and the energy account closes;
  *  - the same with a stress that grows with depth as gravity asks (rollers
- *    at the sides and the base);
+ *    at the sides and the base), and with a graded, sheared stress held by
+ *    the matching boundary stress all round, at rest to round-off;
  *  - the strength test sees the in-situ traction: a tension 10 % above the
  *    tensile strength breaks the joints across it in tension within the
  *    first steps, 10 % below it breaks none;
@@ -211,6 +212,55 @@ static void jointed_gravity_column_stays_still(void)
     }
 }
 
+/* A jointed column under a graded, sheared in-situ stress balanced by
+ * gravity, held by nothing but the boundary stress of the same field all
+ * round (contract 6.1): every node's element, joints, weight and
+ * consistently lumped boundary load balance exactly, so it is at rest to
+ * round-off, as the continuous column of test_boundary_stress.c is. */
+static void jointed_column_in_a_boundary_stress_is_at_rest(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        const double size[3] = {1, dim == 2 ? 3 : 1, 3};
+        const int div[3] = {3, dim == 2 ? 9 : 3, 9};
+        int p;
+        fdem_model *m = jointed_block(dim, size, div, &p, 0);
+        const double g = 9.81, top = size[dim - 1];
+        double value[6] = {0}, gradient[6] = {0}, gv[3] = {0, 0, 0};
+        const double k0[3] = {0.5, dim == 2 ? 1 : 0.8, 1};
+        for (int d = 0; d < dim; d++) {
+            value[d] = -2e6 * k0[d];
+            gradient[d] = RHO * g * k0[d];
+        }
+        value[dim] = 0.4e6; /* 2D sxy; 3D syz, and sxz, sxy below */
+        if (dim == 3) value[4] = -0.3e6, value[5] = 0.2e6;
+        gv[dim - 1] = -g;
+        set_stress(m, p, value, gradient, top);
+        fdem_set_gravity_v(m, gv);
+        fdem_constraint_def all = {.select = FDEM_SELECT_PART, .part = p,
+                                   .kind = FDEM_CONSTRAINT_BOUNDARY_STRESS,
+                                   .stress_reference = top};
+        for (int k = 0; k < 6; k++) {
+            all.stress_value[k] = value[k];
+            all.stress_gradient[k] = gradient[k];
+        }
+        fdem_error err;
+        if (fdem_add_constraint(m, &all, &err) < 0) build_die("boundary stress", &err);
+        build_finalize(m, 0.5);
+        fdem_energy e0 = fdem_get_energy(m);
+        double stored = e0.elastic + e0.joint, *before = element_stresses(m), kinetic_max;
+        run_watched(m, 5 * 4 * top / wave_speed(), stored, &kinetic_max);
+        double change = stress_change(m, before, 0, 0);
+        CHECK(kinetic_max < 1e-15 * stored && change < 1e-9, "%dD: kinetic reached %.3g of the "
+              "stored energy, stresses changed by %.3g", dim, kinetic_max / stored, change);
+        CHECK(largest_damage(m) == 0, "%dD: a joint is damaged (%g)", dim, largest_damage(m));
+        fprintf(stderr, "  %dD jointed column in a boundary stress: kinetic peak %.3g of %.4g J, "
+                        "stress change %.3g %%\n", dim, kinetic_max / stored, stored,
+                100 * change);
+        free(before);
+        fdem_model_destroy(m);
+    }
+}
+
 /* n_x^2 of joint j's face at t = 0 (the squared x component of its unit
  * normal): the share of an in-situ sigma_xx its face carries as tension. */
 static double normal_x2(const fdem_model *m, int j)
@@ -351,4 +401,5 @@ static void threads_and_checkpoints_give_the_same_bits(void)
 }
 
 CHECK_MAIN(T(jointed_block_under_pressures_stays_still), T(jointed_gravity_column_stays_still),
+           T(jointed_column_in_a_boundary_stress_is_at_rest),
            T(strength_sees_the_in_situ_traction), T(threads_and_checkpoints_give_the_same_bits))
