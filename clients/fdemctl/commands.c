@@ -144,7 +144,7 @@ static void submit_format_bytes(double bytes, char *out, size_t size)
     else snprintf(out, size, "%.3g %s", bytes, units[unit]);
 }
 
-static int submit_print_sizing(const http_response *r)
+int ctl_print_sizing(const http_response *r)
 {
     json_t *z = json_loadb(r->body, r->length, 0, NULL);
     if (!json_is_object(z)) {
@@ -191,7 +191,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
     free(text);
     if (code) return code;
     if (dry_run) {
-        code = submit_print_sizing(&r);
+        code = ctl_print_sizing(&r);
         http_response_free(&r);
         return code;
     }

@@ -35,7 +35,7 @@ static const ctl_command ctl_commands[] = {
     {"events", cmd_events, "events ID [--since T]     fracture events: time, joint, position, mode, energy"},
     {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
     {"extend", cmd_extend, "extend ID END [--start]   run a finished or paused case on to a later end"},
-    {"clone",  cmd_clone,  "clone ID PATCH|- [--start] new case from a stored one + a JSON Merge Patch"},
+    {"clone",  cmd_clone,  "clone ID PATCH|- [--start|--dry-run] new case from a stored one + a merge or JSON Patch"},
     {"case",   cmd_case,   "case ID                   the case document as uploaded"},
     {"health", cmd_health, "health                    is the server alive"},
     {NULL, NULL, NULL},

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -530,6 +531,22 @@ static enum MHD_Result route_extend(struct MHD_Connection *conn, server_case *c,
     return rc;
 }
 
+/* 1 when the body says it is a JSON Patch (RFC 6902): Content-Type
+ * application/json-patch+json, parameters and case aside. Any other type,
+ * or none, is a JSON Merge Patch, as before JSON Patch was taken (curl's
+ * --data sends application/x-www-form-urlencoded). */
+static int routes_is_json_patch(struct MHD_Connection *conn)
+{
+    static const char json_patch[] = "application/json-patch+json";
+    const char *type = MHD_lookup_connection_value(conn, MHD_HEADER_KIND,
+                                                   MHD_HTTP_HEADER_CONTENT_TYPE);
+    if (!type)
+        return 0;
+    type += strspn(type, " \t");
+    size_t n = strcspn(type, "; \t");
+    return n == strlen(json_patch) && strncasecmp(type, json_patch, n) == 0;
+}
+
 /* The patched document then goes the way of any POST /cases body. */
 static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, const char *body,
                                    size_t size)
@@ -541,7 +558,8 @@ static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, 
     int status = 0;
     char err[640] = "";
     size_t length = 0;
-    char *doc = registry_clone_document(c, body, size, &length, &p, &status, err, sizeof err);
+    char *doc = registry_clone_document(c, body, size, routes_is_json_patch(conn), &length, &p,
+                                        &status, err, sizeof err);
     membudget_lease *lease = membudget_request_lease();
     enum MHD_Result rc;
     if (!doc && (status == 400 || status == 422))
