@@ -439,7 +439,9 @@ static const char USAGE_STATE[] =
     "  position/velocity/displacement [[x, y], ...] per node ([[x, y, z], ...]\n"
     "  in 3D; displacement = position - initial position), stress and strain\n"
     "  [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz, xz, xy),\n"
-    "  principal_stress [[s1, s2], ...] (3D: three) descending, damage per joint.\n";
+    "  principal_stress [[s1, s2], ...] (3D: three) descending with tension\n"
+    "  positive: the last column is the most compressive, sigma1 of rock\n"
+    "  mechanics (principal_stress_names), damage per joint.\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

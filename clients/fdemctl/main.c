@@ -31,7 +31,7 @@ static const ctl_command ctl_commands[] = {
     {"delete", cmd_delete, "delete ID                 remove a case and its files"},
     {"wait",   cmd_wait,   "wait ID [--interval S]    follow progress; exit 0 iff finished"},
     {"state",  cmd_state,  "state ID [--fields LIST]  current state as JSON"},
-    {"fragments", cmd_fragments, "fragments ID [--json]     fragments (mass, size, diameter...) and sieve curve"},
+    {"fragments", cmd_fragments, "fragments ID [--parts A,B] [--exclude-host] [--json] fragments and sieve curve"},
     {"events", cmd_events, "events ID [--since T]     fracture events: time, joint, position, mode, energy"},
     {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
     {"extend", cmd_extend, "extend ID END [--start]   run a finished or paused case on to a later end"},

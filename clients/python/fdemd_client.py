@@ -265,8 +265,11 @@ class Client:
             position - initial position), stress and strain [[xx, yy,
             xy], ...] per element (3D: xx, yy, zz, yz, xz, xy; strain is
             Green-Lagrange), principal_stress [[s1, s2], ...] (3D: three)
-            descending, damage per joint; docs/api.md, "GET
-            /cases/ID/state".
+            descending with tension positive, so the last column is the
+            most compressive, sigma1 of rock mechanics (the answer's
+            "principal_stress_names" is ["sigma3", "sigma1"], 3D
+            ["sigma3", "sigma2", "sigma1"]), damage per joint;
+            docs/api.md, "GET /cases/ID/state".
         """
         suffix = "/state"
         if fields:
@@ -275,18 +278,37 @@ class Client:
             suffix += "?fields=" + urllib.parse.quote(fields, safe=",")
         return self._json("GET", self._case_path(case_id, suffix))
 
-    def fragments(self, case_id):
+    def fragments(self, case_id, parts=None, exclude_host=False):
         """The pieces the case has broken into, at one step boundary.
 
+        Args:
+            parts: only the fragments of these parts (names, a list or a
+                comma-separated string); None: every part.
+            exclude_host: leave out the host body: every fragment that a
+                fix or velocity constraint holds (a fixed slope, a
+                supported rock mass, a platen) and the fragment holding
+                more than half the model's mass (the rock around an
+                excavation); their ids are in "host".
         Returns:
             {"step", "time", "fragments": [{"id", "elements", "mass", "size",
-            "diameter", "centroid", "velocity"}, ...], "distribution":
-            [{"diameter", "passing"}, ...]}: size is the area (2D, mass per
-            metre of thickness) or volume (3D), diameter that of the circle
-            or sphere of that size, and distribution the sieve curve (mass
-            fraction of fragments no larger than each diameter).
+            "diameter", "centroid", "velocity", "part", "held"}, ...],
+            "distribution": [{"diameter", "passing"}, ...]} (and "host"
+            with exclude_host): size is the area (2D, mass per metre of
+            thickness) or volume (3D), diameter that of the circle or
+            sphere of that size, part the index in the case's parts, held
+            whether a constraint holds it, and distribution the sieve curve
+            of the fragments listed (mass fraction of them no larger than
+            each diameter).
         """
-        return self._json("GET", self._case_path(case_id, "/fragments"))
+        query = []
+        if parts is not None:
+            if not isinstance(parts, str):
+                parts = ",".join(parts)
+            query.append("parts=" + urllib.parse.quote(parts, safe=","))
+        if exclude_host:
+            query.append("exclude_host=true")
+        suffix = "/fragments" + ("?" + "&".join(query) if query else "")
+        return self._json("GET", self._case_path(case_id, suffix))
 
     def events(self, case_id, since=None):
         """The fracture events of the case: one per joint that broke, in the

@@ -19,6 +19,7 @@
 
 #include "cases/case_stages.h"
 #include "download.h"
+#include "fragment_query.h"
 #include "state/events_json.h"
 #include "http.h"
 #include "cases/io_thread.h"
@@ -166,12 +167,14 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const list[] = {"state", NULL};
     static const char *const state[] = {"fields", NULL};
     static const char *const events[] = {"since", NULL};
+    static const char *const fragments[] = {"parts", "exclude_host", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
-    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events : none;
+    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events
+         : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
 }
 
 typedef struct routes_query_check {
@@ -383,7 +386,9 @@ static int routes_no_state(struct MHD_Connection *conn, server_case *c, const sn
 }
 
 static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_case *c,
-                                           unsigned fields, json_t *(*to_json)(const snapshot *))
+                                           unsigned fields,
+                                           json_t *(*to_json)(const snapshot *, const void *),
+                                           const void *how)
 {
     int status = 0;
     enum MHD_Result rc;
@@ -408,7 +413,7 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
      * the budget, and its pages go back to the OS once it is sent off. */
     membudget_lease lease = {0};
     membudget_meter_begin(&lease, 0);
-    json_t *o = to_json(s);
+    json_t *o = to_json(s, how);
     membudget_meter_end();
     snapshot_free(s);
     if (!o && membudget_meter_refused())
@@ -421,6 +426,17 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
         rc = http_reply_json(conn, 200, o, NULL);
     membudget_release(&lease);
     return rc;
+}
+
+static json_t *routes_state_json(const snapshot *s, const void *unused)
+{
+    (void)unused;
+    return state_to_json(s);
+}
+
+static json_t *routes_fragments_json(const snapshot *s, const void *selection)
+{
+    return fragments_to_json(s, selection);
 }
 
 static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
@@ -439,7 +455,33 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
         }
         problems_free(&p);
     }
-    return route_snapshot_json(conn, c, fields, state_to_json);
+    return route_snapshot_json(conn, c, fields, routes_state_json, NULL);
+}
+
+/* GET /cases/ID/fragments[?parts=a,b][&exclude_host=true] (contract 5.4,
+ * issue 33 item 6): the names of ?parts= are read from the case's
+ * document, which is heavy work. */
+static enum MHD_Result route_fragments(struct MHD_Connection *conn, server_case *c)
+{
+    fragment_selection sel = {0};
+    sel.exclude_host = routes_flag(conn, "exclude_host");
+    if (sel.exclude_host < 0)
+        return http_reply_problem(conn, 400, "Bad request", "?exclude_host= takes true or false",
+                                  NULL);
+    const char *parts = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "parts");
+    if (parts && !http_on_heavy_thread())
+        return http_defer_heavy(conn);
+    char detail[700];
+    int status = parts ? fragment_query_parts(c, parts, &sel, detail, sizeof detail) : 0;
+    if (status == 503)
+        return http_reply_unavailable(conn, detail, NULL);
+    if (status != 0)
+        return http_reply_problem(conn, (unsigned)status, status == 400 ? "Bad request"
+                                  : "Internal error", detail, NULL);
+    enum MHD_Result rc = route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, routes_fragments_json,
+                                             &sel);
+    fragment_query_free(&sel);
+    return rc;
 }
 
 /* GET /cases/ID/events?since=T (contract 5.4): the events in result.h5
@@ -595,7 +637,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_STATE:
         return route_state(conn, c);
     case ROUTE_CASE_FRAGMENTS:
-        return route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, fragments_to_json);
+        return route_fragments(conn, c);
     case ROUTE_CASE_EVENTS:
         return route_events(conn, c);
     case ROUTE_CASE_RESULT_H5:
