@@ -51,14 +51,14 @@ static json_t *query_read_parts(const server_case *c, char *detail, size_t detai
     return parts;
 }
 
-/* Part i's name as result.h5 gives it. */
-static void query_part_name(const json_t *parts, size_t i, char *out, size_t size)
+/* Part i's name as result.h5 gives it; `scratch` holds a made-up one. */
+static const char *query_part_name(const json_t *parts, size_t i, char *scratch, size_t size)
 {
     const json_t *name = json_object_get(json_array_get(parts, i), "name");
     if (json_is_string(name) && json_string_length(name) > 0)
-        snprintf(out, size, "%s", json_string_value(name));
-    else
-        snprintf(out, size, "part%zu", i);
+        return json_string_value(name);
+    snprintf(scratch, size, "part%zu", i);
+    return scratch;
 }
 
 /* "a", "b", "c" into out, for the sentence of an unknown name. */
@@ -66,10 +66,10 @@ static void query_list_names(const json_t *parts, char *out, size_t size)
 {
     out[0] = '\0';
     for (size_t i = 0; i < json_array_size(parts); i++) {
-        char name[128];
-        query_part_name(parts, i, name, sizeof name);
+        char scratch[32];
         size_t n = strlen(out);
-        snprintf(out + n, size - n, "%s\"%s\"", i ? ", " : "", name);
+        snprintf(out + n, size - n, "%s\"%.60s\"", i ? ", " : "",
+                 query_part_name(parts, i, scratch, sizeof scratch));
     }
 }
 
@@ -78,8 +78,8 @@ static int query_flag_part(const json_t *parts, const char *token, size_t n, uns
 {
     int found = -1;
     for (size_t i = 0; i < json_array_size(parts); i++) {
-        char name[128];
-        query_part_name(parts, i, name, sizeof name);
+        char scratch[32];
+        const char *name = query_part_name(parts, i, scratch, sizeof scratch);
         if (strlen(name) == n && strncmp(name, token, n) == 0) {
             flags[i] = 1;
             found = 0;

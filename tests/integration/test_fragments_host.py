@@ -18,16 +18,18 @@ MPa, sigma3, sigma2, sigma1."""
 import json
 import math
 import os
+import subprocess
 import sys
 import unittest
 
-from fdemd_harness import DaemonTestCase, fetched_result
+from fdemd_harness import SLOW, DaemonTestCase, fetched_result
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 from fdemd_client import Client  # noqa: E402
 
+PLOT = os.path.join(ROOT, "clients", "python", "plot_fragments.py")
 RHO = 2500.0
 MATERIALS = {"rock": {"density": RHO, "young": 1e10, "poisson": 0.25}}
 
@@ -159,6 +161,34 @@ class FragmentSelectionTests(DaemonTestCase):
         r = self.d.fdemctl("fragments", self.fall, "--parts", "slab")
         self.assertEqual(r.returncode, 1)
         self.assertIn('no part named "slab"', r.stderr)
+
+    def test_plot_fragments(self):
+        status, _, data = self.d.request("GET", "/cases/%s/result.h5" % self.fall)
+        self.assertEqual(status, 200)
+        path = os.path.join(self.tmp, "fall.h5")
+        with open(path, "wb") as f:
+            f.write(data)
+
+        def plot(*args):
+            return subprocess.run(["/usr/bin/python3", PLOT] + list(args) +
+                                  ["-o", os.path.join(self.tmp, "plot"), "--print"],
+                                  capture_output=True, text=True, timeout=120 * SLOW)
+        r = plot(path, "--parts", "block,boulder")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        drawn = json.loads(r.stdout)
+        self.assertEqual(drawn["fragments"], 2)
+        self.check_curve(drawn, [(diameter(0.01), 1 / 3), (diameter(0.02), 1.0)])
+        url = "http://127.0.0.1:%d" % self.d.port
+        r = plot("--server", url, "--case", self.fall, "--exclude-host")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(json.loads(r.stdout)["distribution"],
+                         self.fragments(self.fall, "?exclude_host=true")["distribution"])
+        r = plot(path, "--exclude-host")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("needs --server", r.stderr)
+        r = plot(path, "--parts", "slab")
+        self.assertNotEqual(r.returncode, 0)
+        self.assertIn("no part named 'slab'", r.stderr)
 
 
 class PrincipalStressNamesTests(DaemonTestCase):
