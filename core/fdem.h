@@ -354,11 +354,16 @@ const double *fdem_joint_damage(const fdem_model *model);
  * the initial area (2D) or volume (3D) of its elements, mass their
  * density times that (exactly the lumped node masses they hold), diameter
  * the circle (sphere) of that size, centroid and velocity the mass-weighted
- * means over its nodes at the current step. */
+ * means over its nodes at the current step, part the part of its elements
+ * (a fragment never spans two parts: they share no node and no joint) and
+ * held 1 when a fix or velocity constraint prescribes some component of
+ * the motion of one of its nodes (a fixed slope, a supported rock mass, a
+ * driven platen: a body the model holds, not a piece it broke off). */
 typedef struct fdem_fragment {
     int elements;
     double mass, size, diameter;
     double centroid[3], velocity[3]; /* dimension components used */
+    int part, held;
 } fdem_fragment;
 
 int fdem_fragment_labels(const fdem_model *model, int32_t *label);

@@ -144,7 +144,7 @@ static void submit_format_bytes(double bytes, char *out, size_t size)
     else snprintf(out, size, "%.3g %s", bytes, units[unit]);
 }
 
-static int submit_print_sizing(const http_response *r)
+int ctl_print_sizing(const http_response *r)
 {
     json_t *z = json_loadb(r->body, r->length, 0, NULL);
     if (!json_is_object(z)) {
@@ -191,7 +191,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
     free(text);
     if (code) return code;
     if (dry_run) {
-        code = submit_print_sizing(&r);
+        code = ctl_print_sizing(&r);
         http_response_free(&r);
         return code;
     }
@@ -439,7 +439,9 @@ static const char USAGE_STATE[] =
     "  position/velocity/displacement [[x, y], ...] per node ([[x, y, z], ...]\n"
     "  in 3D; displacement = position - initial position), stress and strain\n"
     "  [[xx, yy, xy], ...] per element (3D: xx, yy, zz, yz, xz, xy),\n"
-    "  principal_stress [[s1, s2], ...] (3D: three) descending, damage per joint.\n";
+    "  principal_stress [[s1, s2], ...] (3D: three) descending with tension\n"
+    "  positive: the last column is the most compressive, sigma1 of rock\n"
+    "  mechanics (principal_stress_names), damage per joint.\n";
 
 int cmd_state(const ctl_options *o, int argc, char **argv)
 {

@@ -41,6 +41,10 @@ typedef struct http_response {
  * `error` says why). Free the response with http_response_free(). */
 int http_request(const ctl_options *o, const char *method, const char *path,
                  const char *body, size_t body_length, http_response *out);
+/* The same with the body's Content-Type (http_request sends application/json). */
+int http_request_as(const ctl_options *o, const char *method, const char *path,
+                    const char *body, size_t body_length, const char *content_type,
+                    http_response *out);
 /* GET base+path streaming the body into `sink`; status and transport error
  * are reported as for http_request (the body is not kept). */
 int http_download(const ctl_options *o, const char *path, FILE *sink, http_response *out);
@@ -59,6 +63,9 @@ int ctl_report_failure(const ctl_options *o, const char *path, const http_respon
  * it and returns the exit code, else 0 with *out filled (caller frees). */
 int ctl_call(const ctl_options *o, const char *method, const char *path,
              const char *body, size_t body_length, long expect_status, http_response *out);
+int ctl_call_as(const ctl_options *o, const char *method, const char *path, const char *body,
+                size_t body_length, const char *content_type, long expect_status,
+                http_response *out);
 
 /* --- args.c ------------------------------------------------------------ */
 
@@ -88,6 +95,9 @@ static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_O
  * holds the exit code). The caller json_decref()s it. */
 struct json_t;
 struct json_t *ctl_get_status(const ctl_options *o, const char *id, int *code);
+/* Prints the sizing object of a dry run (POST /cases?dry_run=true, or a
+ * clone's); CTL_OK, or CTL_FAIL when the answer is not one. */
+int ctl_print_sizing(const http_response *r);
 /* A whole file (or stdin for "-"), NUL-terminated; NULL after saying why
  * (the caller exits CTL_USAGE: the file is the user's mistake, not the server's). */
 char *ctl_read_all(const char *path, size_t *length);

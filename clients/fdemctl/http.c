@@ -39,11 +39,15 @@ static size_t http_to_file(char *chunk, size_t size, size_t count, void *user)
     return fwrite(chunk, size, count, (FILE *)user) * size;
 }
 
-static struct curl_slist *http_headers(const ctl_options *o, int has_json_body)
+static struct curl_slist *http_headers(const ctl_options *o, const char *content_type)
 {
     struct curl_slist *h = NULL;
     h = curl_slist_append(h, "Accept: application/json, application/problem+json, */*");
-    if (has_json_body) h = curl_slist_append(h, "Content-Type: application/json");
+    if (content_type) {
+        char line[128];
+        snprintf(line, sizeof line, "Content-Type: %s", content_type);
+        h = curl_slist_append(h, line);
+    }
     if (o->token && o->token[0]) {
         char line[1024];
         snprintf(line, sizeof line, "Authorization: Bearer %s", o->token);
@@ -88,6 +92,13 @@ static int http_perform(CURL *c, const char *errbuf, http_response *out)
 int http_request(const ctl_options *o, const char *method, const char *path,
                  const char *body, size_t body_length, http_response *out)
 {
+    return http_request_as(o, method, path, body, body_length, "application/json", out);
+}
+
+int http_request_as(const ctl_options *o, const char *method, const char *path,
+                    const char *body, size_t body_length, const char *content_type,
+                    http_response *out)
+{
     char errbuf[CURL_ERROR_SIZE];
     body_buffer b = {0};
     memset(out, 0, sizeof *out);
@@ -95,7 +106,7 @@ int http_request(const ctl_options *o, const char *method, const char *path,
     if (!c) { snprintf(out->error, sizeof out->error, "out of memory"); return -1; }
 
     int is_post = strcmp(method, "POST") == 0;
-    struct curl_slist *h = http_headers(o, is_post && body);
+    struct curl_slist *h = http_headers(o, is_post && body ? content_type : NULL);
     curl_easy_setopt(c, CURLOPT_HTTPHEADER, h);
     if (is_post) {
         /* An empty POST still sends Content-Length: 0 (the server answers

@@ -60,7 +60,14 @@ int ctl_report_failure(const ctl_options *o, const char *path, const http_respon
 int ctl_call(const ctl_options *o, const char *method, const char *path,
              const char *body, size_t body_length, long expect_status, http_response *out)
 {
-    if (http_request(o, method, path, body, body_length, out) != 0)
+    return ctl_call_as(o, method, path, body, body_length, "application/json", expect_status, out);
+}
+
+int ctl_call_as(const ctl_options *o, const char *method, const char *path, const char *body,
+                size_t body_length, const char *content_type, long expect_status,
+                http_response *out)
+{
+    if (http_request_as(o, method, path, body, body_length, content_type, out) != 0)
         return ctl_report_failure(o, path, out);
     if (out->status != expect_status) {
         int code = ctl_report_failure(o, path, out);

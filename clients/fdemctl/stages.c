@@ -82,25 +82,46 @@ int cmd_extend(const ctl_options *o, int argc, char **argv)
 /* ------------------------------------------------------------------ clone */
 
 static const char USAGE_CLONE[] =
-    "usage: fdemctl clone ID PATCH|- [--start]\n"
-    "  Creates a new case from the stored document of case ID with a JSON Merge\n"
-    "  Patch (RFC 7396) applied: a file, or stdin for -. In the patch an object\n"
-    "  merges into the document, null removes a member, anything else replaces\n"
-    "  it; e.g. {\"name\": \"softer\", \"materials\": {\"rock\": {\"young\": 1e9}}}.\n"
+    "usage: fdemctl clone ID PATCH|- [--start | --dry-run]\n"
+    "  Creates a new case from the stored document of case ID with a patch\n"
+    "  applied: a file, or stdin for -. An object is a JSON Merge Patch (RFC\n"
+    "  7396): an object merges into the document, null removes a member,\n"
+    "  anything else replaces it; e.g. {\"name\": \"softer\", \"materials\":\n"
+    "  {\"rock\": {\"young\": 1e9}}}. An array is a JSON Patch (RFC 6902), sent as\n"
+    "  application/json-patch+json: operations that change one element of an\n"
+    "  array without resending it; e.g. [{\"op\": \"replace\", \"path\":\n"
+    "  \"/parts/0/material\", \"value\": \"granite\"}]. It is all or nothing: an\n"
+    "  operation that fails (a failed \"test\" too) creates nothing.\n"
     "  Prints the new case id. The patched case is checked as a submitted one:\n"
     "  its problems are printed as 'pointer: message' (pointers into the patched\n"
-    "  document) and exit 1.\n"
-    "  --start   start the new case at once\n";
+    "  document; for a failed JSON Patch operation /i, its index) and exit 1.\n"
+    "  --start    start the new case at once\n"
+    "  --dry-run  create nothing: check and size the clone as submit --dry-run\n"
+    "             does (nodes, steps, memory, result size, estimated time)\n";
+
+/* An array (first character past white space "[") is a JSON Patch. */
+static const char *clone_content_type(const char *patch)
+{
+    while (*patch == ' ' || *patch == '\t' || *patch == '\n' || *patch == '\r') patch++;
+    return *patch == '[' ? "application/json-patch+json" : "application/json";
+}
 
 int cmd_clone(const ctl_options *o, int argc, char **argv)
 {
-    int start = 0;
+    int start = 0, dry_run = 0;
     const char *args[2];
-    ctl_option_spec specs[] = {{"--start", NULL, NULL, &start}, {0}};
+    ctl_option_spec specs[] = {{"--start", NULL, NULL, &start},
+                               {"--dry-run", NULL, NULL, &dry_run}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_CLONE, args, 2, 2);
     if (n < 0) return ctl_args_exit(n);
+    if (start && dry_run) {
+        fprintf(stderr, "fdemctl clone: --dry-run creates nothing, so it cannot --start\n%s",
+                USAGE_CLONE);
+        return CTL_USAGE;
+    }
     char path[512];
-    if (http_case_path(path, sizeof path, args[0], start ? "/clone?start=true" : "/clone") != 0) {
+    const char *suffix = dry_run ? "/clone?dry_run=true" : start ? "/clone?start=true" : "/clone";
+    if (http_case_path(path, sizeof path, args[0], suffix) != 0) {
         fprintf(stderr, "fdemctl: case id '%s' is too long\n", args[0]);
         return CTL_USAGE;
     }
@@ -108,9 +129,15 @@ int cmd_clone(const ctl_options *o, int argc, char **argv)
     char *patch = ctl_read_all(args[1], &length);
     if (!patch) return CTL_USAGE;
     http_response r;
-    int code = ctl_call(o, "POST", path, patch, length, 201, &r);
+    int code = ctl_call_as(o, "POST", path, patch, length, clone_content_type(patch),
+                           dry_run ? 200 : 201, &r);
     free(patch);
     if (code) return code;
+    if (dry_run) {
+        code = ctl_print_sizing(&r);
+        http_response_free(&r);
+        return code;
+    }
     json_t *status = json_loadb(r.body, r.length, 0, NULL);
     http_response_free(&r);
     const char *id = json_string_value(json_object_get(status, "id"));

@@ -86,11 +86,11 @@ class Client:
 
     # ----------------------------------------------------------- transport
 
-    def _open(self, method, path, body=None):
+    def _open(self, method, path, body=None, content_type="application/json"):
         """Sends one request; returns the open response or raises FdemdError."""
         headers = {"Accept": "application/json, application/problem+json, */*"}
         if body is not None:
-            headers["Content-Type"] = "application/json"
+            headers["Content-Type"] = content_type
         if self.token:
             headers["Authorization"] = "Bearer " + self.token
         if method == "POST" and body is None:
@@ -108,9 +108,9 @@ class Client:
                 "could not reach the fdemd server at %s%s (%s); is it running?"
                 % (self.url, path, reason)) from None
 
-    def _json(self, method, path, body=None):
+    def _json(self, method, path, body=None, content_type="application/json"):
         """Request whose answer is JSON (None for 204)."""
-        with self._open(method, path, body) as response:
+        with self._open(method, path, body, content_type) as response:
             data = response.read()
             if response.status == 204 or not data:
                 return None
@@ -205,23 +205,44 @@ class Client:
                             json.dumps({"end": end}).encode("utf-8"))
         return self.start(case_id) if start else status
 
-    def clone(self, case_id, patch, start=False):
-        """Creates a new case from the stored document of `case_id` with the
-        JSON Merge Patch (RFC 7396) `patch` applied, and returns its id
-        (POST /cases/ID/clone). In the patch an object merges, None (null)
-        removes a member, anything else replaces it, e.g.
-        ``{"name": "softer", "materials": {"rock": {"young": 1e9}}}``.
+    def clone(self, case_id, patch, start=False, dry_run=False):
+        """Creates a new case from the stored document of `case_id` with
+        `patch` applied, and returns its id (POST /cases/ID/clone).
+
+        The patch is a JSON Merge Patch (RFC 7396) when it is an object: an
+        object merges, None (null) removes a member, anything else replaces
+        it, e.g. ``{"name": "softer", "materials": {"rock": {"young":
+        1e9}}}``. It is a JSON Patch (RFC 6902) when it is a list of
+        operations, sent as application/json-patch+json: it changes one
+        element of an array without resending the array (a mesh), e.g.
+        ``[{"op": "replace", "path": "/parts/0/material", "value":
+        "granite"}, {"op": "test", "path": "/constraints/1/velocity/0",
+        "value": -0.1}]``; it is atomic (a failing operation, a failed
+        "test" included, creates nothing).
 
         Args:
-            patch: a dict, bytes (its JSON text) or the path of a JSON file.
+            patch: a dict or list, bytes (its JSON text) or the path of a
+                JSON file (a text whose first character is "[" is a JSON
+                Patch).
             start: also start the new case.
+            dry_run: create nothing; return what the clone would be: the
+                sizing object of dry_run() (nodes, steps, memory_bytes,
+                estimated_seconds, ...), or the FdemdError its validation
+                gives.
         Raises:
             FdemdError: as submit() does, with pointers into the patched
-                document; 404 when `case_id` does not exist.
+                document; 422 at "/i" for JSON Patch operation i that fails;
+                404 when `case_id` does not exist.
         """
-        body = _case_body(patch)
-        path = self._case_path(case_id, "/clone" + ("?start=true" if start else ""))
-        status = self._json("POST", path, body)
+        if start and dry_run:
+            raise ValueError("a dry run creates nothing, so it cannot start")
+        body = json.dumps(patch).encode("utf-8") if isinstance(patch, list) else _case_body(patch)
+        json_patch = body.lstrip()[:1] == b"["
+        query = "?dry_run=true" if dry_run else "?start=true" if start else ""
+        status = self._json("POST", self._case_path(case_id, "/clone" + query), body,
+                            "application/json-patch+json" if json_patch else "application/json")
+        if dry_run:
+            return status
         if status.get("warning"):
             warnings.warn("case %s: %s" % (status["id"], status["warning"]), stacklevel=2)
         return status["id"]
@@ -244,8 +265,11 @@ class Client:
             position - initial position), stress and strain [[xx, yy,
             xy], ...] per element (3D: xx, yy, zz, yz, xz, xy; strain is
             Green-Lagrange), principal_stress [[s1, s2], ...] (3D: three)
-            descending, damage per joint; docs/api.md, "GET
-            /cases/ID/state".
+            descending with tension positive, so the last column is the
+            most compressive, sigma1 of rock mechanics (the answer's
+            "principal_stress_names" is ["sigma3", "sigma1"], 3D
+            ["sigma3", "sigma2", "sigma1"]), damage per joint;
+            docs/api.md, "GET /cases/ID/state".
         """
         suffix = "/state"
         if fields:
@@ -254,18 +278,37 @@ class Client:
             suffix += "?fields=" + urllib.parse.quote(fields, safe=",")
         return self._json("GET", self._case_path(case_id, suffix))
 
-    def fragments(self, case_id):
+    def fragments(self, case_id, parts=None, exclude_host=False):
         """The pieces the case has broken into, at one step boundary.
 
+        Args:
+            parts: only the fragments of these parts (names, a list or a
+                comma-separated string); None: every part.
+            exclude_host: leave out the host body: every fragment that a
+                fix or velocity constraint holds (a fixed slope, a
+                supported rock mass, a platen) and the fragment holding
+                more than half the model's mass (the rock around an
+                excavation); their ids are in "host".
         Returns:
             {"step", "time", "fragments": [{"id", "elements", "mass", "size",
-            "diameter", "centroid", "velocity"}, ...], "distribution":
-            [{"diameter", "passing"}, ...]}: size is the area (2D, mass per
-            metre of thickness) or volume (3D), diameter that of the circle
-            or sphere of that size, and distribution the sieve curve (mass
-            fraction of fragments no larger than each diameter).
+            "diameter", "centroid", "velocity", "part", "held"}, ...],
+            "distribution": [{"diameter", "passing"}, ...]} (and "host"
+            with exclude_host): size is the area (2D, mass per metre of
+            thickness) or volume (3D), diameter that of the circle or
+            sphere of that size, part the index in the case's parts, held
+            whether a constraint holds it, and distribution the sieve curve
+            of the fragments listed (mass fraction of them no larger than
+            each diameter).
         """
-        return self._json("GET", self._case_path(case_id, "/fragments"))
+        query = []
+        if parts is not None:
+            if not isinstance(parts, str):
+                parts = ",".join(parts)
+            query.append("parts=" + urllib.parse.quote(parts, safe=","))
+        if exclude_host:
+            query.append("exclude_host=true")
+        suffix = "/fragments" + ("?" + "&".join(query) if query else "")
+        return self._json("GET", self._case_path(case_id, suffix))
 
     def events(self, case_id, since=None):
         """The fracture events of the case: one per joint that broke, in the

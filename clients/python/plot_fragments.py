@@ -3,9 +3,9 @@
 history (fracture events) as two PNGs.
 
     /usr/bin/python3 clients/python/plot_fragments.py result.h5 [-o PREFIX] \\
-        [--snapshot -1] [--print]
+        [--snapshot -1] [--parts A,B] [--print]
     /usr/bin/python3 clients/python/plot_fragments.py --server URL --case ID \\
-        [-o PREFIX] [--token T] [--print]
+        [-o PREFIX] [--token T] [--parts A,B] [--exclude-host] [--print]
 
 writes PREFIX-sieve.png and PREFIX-events.png (PREFIX defaults to the
 result file's name without .h5, or to the case id).
@@ -22,6 +22,12 @@ result file's name without .h5, or to the case id).
           /cases/ID/events): cumulative count and cumulative dissipated
           energy against time, one step per event, as acoustic-emission
           catalogues are read.
+
+--parts keeps the fragments of the named parts (/mesh/part_names, or the
+case's part names on the server); --exclude-host (server only: which nodes
+a constraint holds is not in the file) leaves out the host body as GET
+/cases/ID/fragments?exclude_host=true does: the fragments a fix or velocity
+constraint holds, and one holding more than half the model's mass.
 
 --print writes the numbers drawn, as JSON, to stdout: {"dimension",
 "fragments", "distribution": [{"diameter", "passing"}, ...], "events":
@@ -70,8 +76,20 @@ def sieve_curve(diameter, mass):
     return [{"diameter": float(x), "passing": float(p)} for x, p in zip(d[last], below[last])]
 
 
-def fragments_from_file(f, snapshot):
-    """(dimension, fragment count, sieve curve) at one snapshot of a result."""
+def wanted_parts(f, parts):
+    """The indices in /mesh/part_names of the names in `parts` ("a,b")."""
+    names = [n.decode() if isinstance(n, bytes) else str(n) for n in f["/mesh/part_names"][...]]
+    wanted = [p for p in parts.split(",")]
+    unknown = [p for p in wanted if p not in names]
+    if unknown or not wanted:
+        raise SystemExit("--parts: no part named %s; the parts are %s"
+                         % (", ".join(repr(p) for p in unknown), ", ".join(map(repr, names))))
+    return [names.index(p) for p in wanted]
+
+
+def fragments_from_file(f, snapshot, parts=None):
+    """(dimension, fragment count, sieve curve) at one snapshot of a result,
+    of the fragments of `parts` ("a,b", None: all)."""
     dimension = int(f.attrs.get("dimension", 2))
     elements = f["/mesh/tetrahedra" if dimension == 3 else "/mesh/triangles"][...]
     x0 = f["/mesh/position0"][...]
@@ -92,7 +110,15 @@ def fragments_from_file(f, snapshot):
     node_piece = np.empty(len(node_mass), dtype=np.int64)
     node_piece[elements.ravel()] = np.repeat(label, elements.shape[1])
     mass = np.bincount(node_piece, weights=node_mass, minlength=count)
-    return dimension, count, sieve_curve(equivalent_diameter(size, dimension), mass)
+    keep = np.ones(count, dtype=bool)
+    if parts is not None:
+        part = np.zeros(count, dtype=np.int64)
+        part[label] = f["/mesh/element_part"][...]  # a fragment lies in one part
+        keep = np.isin(part, wanted_parts(f, parts))
+    if not keep.any():
+        return dimension, 0, []
+    return (dimension, int(keep.sum()),
+            sieve_curve(equivalent_diameter(size[keep], dimension), mass[keep]))
 
 
 def events_from_file(f):
@@ -105,7 +131,7 @@ def events_from_file(f):
 def from_server(args):
     from fdemd_client import Client
     client = Client(args.server, token=args.token)
-    pieces = client.fragments(args.case)
+    pieces = client.fragments(args.case, parts=args.parts, exclude_host=args.exclude_host)
     events = client.events(args.case)["events"]
     dimension = len(pieces["fragments"][0]["centroid"]) if pieces["fragments"] else 2
     return (dimension, len(pieces["fragments"]), pieces["distribution"],
@@ -161,13 +187,20 @@ def main(argv=None):
     parser.add_argument("-o", "--output", help="PNG prefix: PREFIX-sieve.png, PREFIX-events.png")
     parser.add_argument("--snapshot", type=int, default=-1,
                         help="snapshot of the result file for the sieve curve (default: last)")
+    parser.add_argument("--parts", help="only the fragments of these parts (comma-separated names)")
+    parser.add_argument("--exclude-host", action="store_true",
+                        help="leave out the host body (held fragments and one holding more than "
+                             "half the model's mass; with --server only)")
     parser.add_argument("--print", action="store_true", help="print the numbers as JSON")
     args = parser.parse_args(argv)
+    if args.exclude_host and args.result:
+        parser.error("--exclude-host needs --server and --case: which nodes a constraint holds "
+                     "is not in the result file")
     if bool(args.result) == bool(args.server or args.case) or bool(args.server) != bool(args.case):
         parser.error("give either a result file or both --server and --case")
     if args.result:
         with open_result(args.result) as f:
-            dimension, count, curve = fragments_from_file(f, args.snapshot)
+            dimension, count, curve = fragments_from_file(f, args.snapshot, args.parts)
             time, energy = events_from_file(f)
             title = str(f.attrs.get("name", "")) or os.path.basename(args.result)
         prefix = args.output or os.path.splitext(args.result)[0]

@@ -1,8 +1,9 @@
 /*
  * fragments.c - what a fragmentation engineer measures of a broken model:
  * its pieces (connected through shared nodes or intact joints), each
- * piece's mass, size, equivalent diameter, centroid and velocity, and the
- * sieve curve of the pieces' sizes (contract 5.4).
+ * piece's mass, size, equivalent diameter, centroid and velocity, its part
+ * and whether a constraint holds it (so a reader can leave the host body
+ * out), and the sieve curve of the pieces' sizes (contract 5.4).
  *
  * Pieces come from joint_fragment_labels (union-find over intact joints;
  * an unbroken part is one piece), renumbered here in the order of each
@@ -63,6 +64,7 @@ int fdem_fragments(const fdem_model *m, fdem_fragment **out)
     for (int e = 0; e < E; e++) {
         fdem_fragment *p = &f[label[e]];
         double size = element_size0(m, e);
+        if (p->elements == 0) p->part = m->elem_part[e];
         p->elements++;
         p->size += size;
         p->mass += m->materials[element_material(m, e)].def.density * size;
@@ -80,6 +82,7 @@ int fdem_fragments(const fdem_model *m, fdem_fragment **out)
         fdem_fragment *p = &f[node_piece[i]];
         double mass = m->mass[i];
         node_mass[node_piece[i]] += mass;
+        if (m->dof_owned && m->dof_owned[i]) p->held = 1; /* a fix or velocity owns a component */
         for (int d = 0; d < D; d++) {
             p->centroid[d] += mass * m->pos[(size_t)D * (size_t)i + (size_t)d];
             p->velocity[d] += mass * m->vel[(size_t)D * (size_t)i + (size_t)d];

@@ -12,7 +12,7 @@
  * Folder proto/json/, plain JSON and problem reporting, which know nothing
  * of cases or the engine: owns this header (problem lists with JSON
  * Pointers, problems.c), the nesting check of a JSON text before it is
- * parsed (json_depth.h) and merge patch with the exact-number dump
+ * parsed (json_depth.h) and merge patch, JSON Patch and the exact-number dump
  * (json_patch.h). May call jansson and the C library only. Called by
  * proto/case/, server/ and the unit tests.
  */

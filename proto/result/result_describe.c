@@ -1,8 +1,10 @@
 /*
  * result_describe.c - what makes result.h5 self-describing (contract 5.4):
- * the case document as the root's string attribute `case`, and the names
+ * the case document as the root's string attribute `case`, the names
  * behind the indices of /mesh/node_part, /mesh/element_part (part_names)
- * and of the materials (material_names).
+ * and of the materials (material_names), and the order of the columns of
+ * /snapshots/principal_stress, named for a rock mechanic (attributes
+ * `order` and `rock_mechanics_names`: sigma1 is the most compressive).
  *
  * Why the names are read from the document here rather than kept by the
  * builder: the document is what the file stores anyway, and the builder
@@ -131,6 +133,36 @@ int result_describe(hid_t file, const char *text, size_t length, char *err, size
     }
     int rc = write_names(file, root, err, errlen);
     json_decref(root);
+    return rc;
+}
+
+/* The columns of /snapshots/principal_stress are descending with tension
+ * positive, the engine's sign, so the first is the most tensile; a rock
+ * mechanic counts compression positive and calls the most compressive
+ * sigma1. Both readings are written on the dataset, so neither has to be
+ * guessed: a sentence (`order`) and the rock-mechanics name of each column
+ * (`rock_mechanics_names`, fixed-length strings for Octave's sake; 2D: the
+ * in-plane major and minor stresses are sigma1 and sigma3, as in RS2). */
+int result_describe_principal_stress(hid_t dataset, int dimension)
+{
+    static const char order[] =
+        "descending, tension positive: the first column is the most tensile (least "
+        "compressive) principal stress, the last column the most compressive, which is sigma1 "
+        "in rock mechanics' convention (compression positive); see rock_mechanics_names";
+    static const char names2[] = "sigma3\0sigma1", names3[] = "sigma3\0sigma2\0sigma1";
+    if (write_string_attribute(dataset, "order", order) < 0) return -1;
+    hsize_t dims[1] = {(hsize_t)dimension};
+    hid_t type = H5Tcopy(H5T_C_S1);
+    hid_t space = H5Screate_simple(1, dims, NULL);
+    hid_t attr = H5I_INVALID_HID;
+    int rc = -1;
+    if (type >= 0 && space >= 0 && H5Tset_size(type, 7) >= 0 &&
+        H5Tset_strpad(type, H5T_STR_NULLPAD) >= 0)
+        attr = H5Acreate2(dataset, "rock_mechanics_names", type, space, H5P_DEFAULT, H5P_DEFAULT);
+    if (attr >= 0 && H5Awrite(attr, type, dimension == 3 ? names3 : names2) >= 0) rc = 0;
+    if (attr >= 0) H5Aclose(attr);
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
     return rc;
 }
 

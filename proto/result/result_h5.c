@@ -399,6 +399,12 @@ static int create_snapshot_series(result_file *f, char *err, size_t errlen)
             result_fail(err, errlen, "cannot create /snapshots/%s", series_names[k]);
             rc = -1;
         }
+    const series *principal = &f->ds[SERIES_PRINCIPAL_STRESS];
+    if (rc == 0 && principal->rank &&
+        result_describe_principal_stress(principal->id, (int)principal->row[1]) < 0) {
+        result_fail(err, errlen, "cannot describe /snapshots/principal_stress");
+        rc = -1;
+    }
     H5Gclose(group);
     return rc;
 }

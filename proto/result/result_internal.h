@@ -93,6 +93,9 @@ int result_release(result_file *f);
 /* The root attribute `case` (the document) and /mesh/part_names,
  * /mesh/material_names; nothing when text is NULL (result_describe.c). */
 int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
+/* The attributes `order` and `rock_mechanics_names` of the principal
+ * stress dataset (result_describe.c); 0 or -1. */
+int result_describe_principal_stress(hid_t dataset, int dimension);
 int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
 
 /* The /events group, empty, in a new file; in a reopened one, its events

@@ -65,6 +65,15 @@ static int set_or_fail_append(json_t *array, json_t *value)
     return json_array_append_new(array, value);
 }
 
+/* The rock-mechanics name of each principal_stress column: the columns
+ * are descending with tension positive, so the last, the most compressive,
+ * is sigma1 (as the attribute rock_mechanics_names of result.h5 says). */
+static json_t *principal_names_json(int dimension)
+{
+    return dimension == 3 ? json_pack("[sss]", "sigma3", "sigma2", "sigma1")
+                          : json_pack("[ss]", "sigma3", "sigma1");
+}
+
 json_t *state_to_json(const snapshot *s)
 {
     if (!s) return NULL;
@@ -83,9 +92,11 @@ json_t *state_to_json(const snapshot *s)
         rc |= set_or_fail(obj, "damage", list_to_json(s->damage, s->joints));
     if ((s->fields & CASE_FIELD_STRAIN) && s->strain)
         rc |= set_or_fail(obj, "strain", rows_to_json(s->strain, s->elements, s->stress_components));
-    if ((s->fields & CASE_FIELD_PRINCIPAL_STRESS) && s->principal_stress)
+    if ((s->fields & CASE_FIELD_PRINCIPAL_STRESS) && s->principal_stress) {
         rc |= set_or_fail(obj, "principal_stress",
                           rows_to_json(s->principal_stress, s->elements, s->dimension));
+        rc |= set_or_fail(obj, "principal_stress_names", principal_names_json(s->dimension));
+    }
     if ((s->fields & CASE_FIELD_DISPLACEMENT) && s->displacement)
         rc |= set_or_fail(obj, "displacement",
                           rows_to_json(s->displacement, s->nodes, s->dimension));
@@ -96,7 +107,8 @@ json_t *state_to_json(const snapshot *s)
     return obj;
 }
 
-/* {"id", "elements", "mass", "size", "diameter", "centroid", "velocity"} */
+/* {"id", "elements", "mass", "size", "diameter", "centroid", "velocity",
+ * "part", "held"} */
 static json_t *fragment_to_json(const fdem_fragment *f, int id, int dimension)
 {
     json_t *o = json_object();
@@ -109,6 +121,8 @@ static json_t *fragment_to_json(const fdem_fragment *f, int id, int dimension)
     rc |= set_or_fail(o, "diameter", number_or_null(f->diameter));
     rc |= set_or_fail(o, "centroid", list_to_json(f->centroid, dimension));
     rc |= set_or_fail(o, "velocity", list_to_json(f->velocity, dimension));
+    rc |= set_or_fail(o, "part", json_integer(f->part));
+    rc |= set_or_fail(o, "held", json_boolean(f->held));
     if (rc != 0) {
         json_decref(o);
         return NULL;
@@ -141,21 +155,66 @@ static json_t *distribution_to_json(const fdem_fragment *f, int count)
     return array;
 }
 
-json_t *fragments_to_json(const snapshot *s)
+static int fragment_of_wanted_part(const fdem_fragment *f, const fragment_selection *sel)
+{
+    return !sel || !sel->parts || (f->part >= 0 && f->part < sel->part_count && sel->parts[f->part]);
+}
+
+/* The host rule (state_json.h): held, or more than half the model's mass. */
+static int fragment_is_host(const fdem_fragment *f, double model_mass)
+{
+    return f->held || f->mass > 0.5 * model_mass;
+}
+
+/* Which fragments are listed (1), left out as the host (-1) or by part
+ * (0), into `listed`; returns how many are listed. */
+static int fragments_select(const snapshot *s, const fragment_selection *sel, int *listed)
+{
+    double model_mass = 0;
+    for (int k = 0; k < s->fragment_count; k++) model_mass += s->fragments[k].mass;
+    int count = 0;
+    for (int k = 0; k < s->fragment_count; k++) {
+        const fdem_fragment *f = &s->fragments[k];
+        listed[k] = !fragment_of_wanted_part(f, sel) ? 0
+                  : sel && sel->exclude_host && fragment_is_host(f, model_mass) ? -1 : 1;
+        count += listed[k] == 1;
+    }
+    return count;
+}
+
+json_t *fragments_to_json(const snapshot *s, const fragment_selection *sel)
 {
     if (!s || !(s->fields & SNAPSHOT_FRAGMENTS)) return NULL;
+    size_t n = (size_t)(s->fragment_count > 0 ? s->fragment_count : 1);
+    int *listed = malloc(n * sizeof *listed);
+    fdem_fragment *kept = malloc(n * sizeof *kept);
     json_t *obj = json_object(), *list = json_array();
-    int rc = obj && list ? 0 : -1;
-    for (int k = 0; k < s->fragment_count && rc == 0; k++)
-        rc = set_or_fail_append(list, fragment_to_json(&s->fragments[k], k, s->dimension));
+    json_t *host = sel && sel->exclude_host ? json_array() : NULL;
+    int rc = obj && list && listed && kept && (host || !(sel && sel->exclude_host)) ? 0 : -1;
+    int count = rc == 0 ? fragments_select(s, sel, listed) : 0, at = 0;
+    for (int k = 0; k < s->fragment_count && rc == 0; k++) {
+        if (listed[k] == 1) {
+            kept[at++] = s->fragments[k];
+            rc = set_or_fail_append(list, fragment_to_json(&s->fragments[k], k, s->dimension));
+        } else if (listed[k] < 0) {
+            rc = set_or_fail_append(host, json_integer(k));
+        }
+    }
     if (rc == 0) {
         rc |= set_or_fail(obj, "step", json_integer((json_int_t)s->step));
         rc |= set_or_fail(obj, "time", number_or_null(s->time));
         rc |= set_or_fail(obj, "fragments", list);
         list = NULL;
-        rc |= set_or_fail(obj, "distribution", distribution_to_json(s->fragments, s->fragment_count));
+        rc |= set_or_fail(obj, "distribution", distribution_to_json(kept, count));
+        if (host) {
+            rc |= set_or_fail(obj, "host", host);
+            host = NULL;
+        }
     }
     json_decref(list);
+    json_decref(host);
+    free(listed);
+    free(kept);
     if (rc != 0) {
         json_decref(obj);
         return NULL;

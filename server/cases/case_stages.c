@@ -356,26 +356,41 @@ int registry_extend(server_case *c, const char *body, size_t size, problems *p, 
 
 /* ----------------------------------------------------------------- clone */
 
-static char *stages_clone_document(server_case *c, const char *body, size_t size, size_t *length,
-                              problems *p, int *status, char *err, size_t errlen)
+/* 0 when `patch` has the form its content type asks for; else 422 in p. */
+static int stages_check_patch_form(const json_t *patch, int json_patch, problems *p)
+{
+    if (json_patch ? json_is_array(patch) : json_is_object(patch))
+        return 0;
+    /* RFC 7396 would let a number or null replace the whole document, which
+     * can never be a case; it is valid JSON, so not "Malformed JSON" but a
+     * 422 that says what a patch must be. */
+    const char *kind = json_is_null(patch) ? "null" : json_is_array(patch) ? "an array"
+                     : json_is_object(patch) ? "an object" : json_is_string(patch) ? "a string"
+                     : json_is_boolean(patch) ? "a boolean" : "a number";
+    snprintf(p->title, sizeof p->title, "Invalid patch");
+    if (json_patch)
+        problems_add(p, 422, "", "a clone's body with Content-Type application/json-patch+json "
+                     "is a JSON Patch (RFC 6902), an array of operations (e.g. [{\"op\": "
+                     "\"replace\", \"path\": \"/name\", \"value\": \"copy\"}]), not %s", kind);
+    else
+        problems_add(p, 422, "", "a clone's body is a JSON Merge Patch of the case document, "
+                     "which must be an object (e.g. {\"name\": \"copy\"}), not %s%s", kind,
+                     json_is_array(patch) ? "; send a JSON Patch (RFC 6902) array with "
+                     "Content-Type: application/json-patch+json" : "");
+    return 422;
+}
+
+static char *stages_clone_document(server_case *c, const char *body, size_t size, int json_patch,
+                                   size_t *length, problems *p, int *status, char *err,
+                                   size_t errlen)
 {
     json_t *patch = stages_parse(body, size, JSON_DECODE_ANY, p);
     if (!patch) {
         *status = 400;
         return NULL;
     }
-    /* RFC 7396 would let a number or null replace the whole document, which
-     * can never be a case; it is valid JSON, so not "Malformed JSON" but a
-     * 422 that says what a patch must be. */
-    if (!json_is_object(patch)) {
-        snprintf(p->title, sizeof p->title, "Invalid patch");
-        problems_add(p, 422, "", "a clone's body is a JSON Merge Patch of the case document, "
-                                 "which must be an object (e.g. {\"name\": \"copy\"}), not %s",
-                     json_is_null(patch) ? "null" : json_is_array(patch) ? "an array"
-                     : json_is_string(patch) ? "a string" : json_is_boolean(patch) ? "a boolean"
-                                                                          : "a number");
+    if ((*status = stages_check_patch_form(patch, json_patch, p)) != 0) {
         json_decref(patch);
-        *status = 422;
         return NULL;
     }
     *status = 500;
@@ -384,9 +399,14 @@ static char *stages_clone_document(server_case *c, const char *body, size_t size
         *status = 404;
     else
         doc = stages_load_document(c, err, errlen);
-    json_t *patched = doc ? json_merge_patch(doc, patch) : NULL;
+    if (json_patch)
+        snprintf(p->title, sizeof p->title, "Invalid patch");
+    json_t *patched = !doc ? NULL : json_patch ? json_patch_apply(doc, patch, p)
+                                               : json_merge_patch(doc, patch);
+    if (doc && !patched && p->count)
+        *status = 422; /* an operation failed (json_patch.h): nothing is created */
     char *text = patched ? json_dump_document(patched, length) : NULL;
-    if (doc && !text)
+    if (doc && !text && *status == 500)
         snprintf(err, errlen, "out of memory patching the case document");
     json_decref(patched);
     json_decref(doc);
@@ -397,15 +417,16 @@ static char *stages_clone_document(server_case *c, const char *body, size_t size
 /* The patch's tree, the stored document's, their merge and its text can
  * be many times the patch (issue 30: a 1 MB patch became 1 GB), so all of
  * it is metered against the request's lease; 503 when the budget refuses. */
-char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
-                              problems *p, int *status, char *err, size_t errlen)
+char *registry_clone_document(server_case *c, const char *body, size_t size, int json_patch,
+                              size_t *length, problems *p, int *status, char *err, size_t errlen)
 {
     membudget_lease own = {0};
     membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
     membudget_meter_begin(lease, lease->bytes);
-    char *text = stages_clone_document(c, body, size, length, p, status, err, errlen);
+    char *text = stages_clone_document(c, body, size, json_patch, length, p, status, err,
+                                       errlen);
     membudget_meter_end();
-    if (!text && membudget_meter_refused()) {
+    if (!text && *status != 422 && membudget_meter_refused()) {
         *status = 503;
         snprintf(err, errlen, "patching the case document would take the daemon past its "
                  "memory budget (--max-memory) now; try again later");

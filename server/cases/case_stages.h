@@ -2,7 +2,7 @@
  * case_stages.h - a case in stages (contract 5.3 "Continue and clone"):
  * POST /cases/ID/extend runs a finished or paused case on to a later end
  * in the same files; POST /cases/ID/clone makes a new case from a stored
- * one and a JSON Merge Patch.
+ * one and a JSON Merge Patch (RFC 7396) or a JSON Patch (RFC 6902).
  *
  * Contract:
  *  - registry_extend(): body {"end": t}. 0 when the case is now paused with
@@ -23,11 +23,14 @@
  *    agreeing); a step that fails again leaves the record for the next
  *    start-up and the case as loaded.
  *  - registry_clone_document(): the stored case.json of `c` with the patch
- *    merged in (RFC 7396), as text to give to registry_create() (which then
- *    validates it, with pointers into this patched document). NULL with
- *    *status 400 (patch not JSON, in `p`), 422 (the patch is not an
- *    object, in `p`), 404, 503 (the work would pass --max-memory; it is
- *    metered against the request's lease) or 500 (err).
+ *    merged in (RFC 7396), or with `json_patch` the JSON Patch (RFC 6902)
+ *    applied, as text to give to registry_create() (which then validates
+ *    it, with pointers into this patched document). NULL with *status 400
+ *    (patch not JSON, in `p`), 422 (in `p`: a merge patch that is not an
+ *    object, a JSON Patch that is not an array, has malformed operations
+ *    or one that fails, a `test` included: json_patch_apply()), 404, 503
+ *    (the work would pass --max-memory; it is metered against the
+ *    request's lease) or 500 (err).
  */
 #ifndef FDEMD_CASE_STAGES_H
 #define FDEMD_CASE_STAGES_H
@@ -39,7 +42,7 @@
 int registry_extend(server_case *c, const char *body, size_t size, problems *p, char *msg,
                     size_t msglen);
 void registry_extend_recover(server_case *c);
-char *registry_clone_document(server_case *c, const char *body, size_t size, size_t *length,
-                              problems *p, int *status, char *err, size_t errlen);
+char *registry_clone_document(server_case *c, const char *body, size_t size, int json_patch,
+                              size_t *length, problems *p, int *status, char *err, size_t errlen);
 
 #endif

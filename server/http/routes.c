@@ -13,11 +13,13 @@
 #include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "cases/case_stages.h"
 #include "download.h"
+#include "fragment_query.h"
 #include "state/events_json.h"
 #include "http.h"
 #include "cases/io_thread.h"
@@ -165,12 +167,14 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const list[] = {"state", NULL};
     static const char *const state[] = {"fields", NULL};
     static const char *const events[] = {"since", NULL};
+    static const char *const fragments[] = {"parts", "exclude_host", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
-    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events : none;
+    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events
+         : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
 }
 
 typedef struct routes_query_check {
@@ -382,7 +386,9 @@ static int routes_no_state(struct MHD_Connection *conn, server_case *c, const sn
 }
 
 static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_case *c,
-                                           unsigned fields, json_t *(*to_json)(const snapshot *))
+                                           unsigned fields,
+                                           json_t *(*to_json)(const snapshot *, const void *),
+                                           const void *how)
 {
     int status = 0;
     enum MHD_Result rc;
@@ -407,7 +413,7 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
      * the budget, and its pages go back to the OS once it is sent off. */
     membudget_lease lease = {0};
     membudget_meter_begin(&lease, 0);
-    json_t *o = to_json(s);
+    json_t *o = to_json(s, how);
     membudget_meter_end();
     snapshot_free(s);
     if (!o && membudget_meter_refused())
@@ -420,6 +426,17 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
         rc = http_reply_json(conn, 200, o, NULL);
     membudget_release(&lease);
     return rc;
+}
+
+static json_t *routes_state_json(const snapshot *s, const void *unused)
+{
+    (void)unused;
+    return state_to_json(s);
+}
+
+static json_t *routes_fragments_json(const snapshot *s, const void *selection)
+{
+    return fragments_to_json(s, selection);
 }
 
 static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
@@ -438,7 +455,33 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
         }
         problems_free(&p);
     }
-    return route_snapshot_json(conn, c, fields, state_to_json);
+    return route_snapshot_json(conn, c, fields, routes_state_json, NULL);
+}
+
+/* GET /cases/ID/fragments[?parts=a,b][&exclude_host=true] (contract 5.4,
+ * issue 33 item 6): the names of ?parts= are read from the case's
+ * document, which is heavy work. */
+static enum MHD_Result route_fragments(struct MHD_Connection *conn, server_case *c)
+{
+    fragment_selection sel = {0};
+    sel.exclude_host = routes_flag(conn, "exclude_host");
+    if (sel.exclude_host < 0)
+        return http_reply_problem(conn, 400, "Bad request", "?exclude_host= takes true or false",
+                                  NULL);
+    const char *parts = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "parts");
+    if (parts && !http_on_heavy_thread())
+        return http_defer_heavy(conn);
+    char detail[700];
+    int status = parts ? fragment_query_parts(c, parts, &sel, detail, sizeof detail) : 0;
+    if (status == 503)
+        return http_reply_unavailable(conn, detail, NULL);
+    if (status != 0)
+        return http_reply_problem(conn, (unsigned)status, status == 400 ? "Bad request"
+                                  : "Internal error", detail, NULL);
+    enum MHD_Result rc = route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, routes_fragments_json,
+                                             &sel);
+    fragment_query_free(&sel);
+    return rc;
 }
 
 /* GET /cases/ID/events?since=T (contract 5.4): the events in result.h5
@@ -530,6 +573,22 @@ static enum MHD_Result route_extend(struct MHD_Connection *conn, server_case *c,
     return rc;
 }
 
+/* 1 when the body says it is a JSON Patch (RFC 6902): Content-Type
+ * application/json-patch+json, parameters and case aside. Any other type,
+ * or none, is a JSON Merge Patch, as before JSON Patch was taken (curl's
+ * --data sends application/x-www-form-urlencoded). */
+static int routes_is_json_patch(struct MHD_Connection *conn)
+{
+    static const char json_patch[] = "application/json-patch+json";
+    const char *type = MHD_lookup_connection_value(conn, MHD_HEADER_KIND,
+                                                   MHD_HTTP_HEADER_CONTENT_TYPE);
+    if (!type)
+        return 0;
+    type += strspn(type, " \t");
+    size_t n = strcspn(type, "; \t");
+    return n == strlen(json_patch) && strncasecmp(type, json_patch, n) == 0;
+}
+
 /* The patched document then goes the way of any POST /cases body. */
 static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, const char *body,
                                    size_t size)
@@ -541,7 +600,8 @@ static enum MHD_Result route_clone(struct MHD_Connection *conn, server_case *c, 
     int status = 0;
     char err[640] = "";
     size_t length = 0;
-    char *doc = registry_clone_document(c, body, size, &length, &p, &status, err, sizeof err);
+    char *doc = registry_clone_document(c, body, size, routes_is_json_patch(conn), &length, &p,
+                                        &status, err, sizeof err);
     membudget_lease *lease = membudget_request_lease();
     enum MHD_Result rc;
     if (!doc && (status == 400 || status == 422))
@@ -577,7 +637,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_STATE:
         return route_state(conn, c);
     case ROUTE_CASE_FRAGMENTS:
-        return route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, fragments_to_json);
+        return route_fragments(conn, c);
     case ROUTE_CASE_EVENTS:
         return route_events(conn, c);
     case ROUTE_CASE_RESULT_H5:

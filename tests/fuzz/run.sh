@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses with clang + ASan/UBSan against the core,
 # proto and server sources they need, seeds their corpora and runs each for
-# its share of FUZZ_SECONDS (default 60 in all; the case parser gets two
-# thirds, the HTTP request path one third, so CI time does not grow):
+# its share of FUZZ_SECONDS (default 60 in all; the case parser gets a
+# half, JSON Patch a sixth, the HTTP request path a third, so CI time does
+# not grow):
 #   fuzz_case  case_build() and gmsh_read() on any bytes; seeds: examples,
 #              tests/data/*.msh (raw and wrapped as gmsh parts), inline docs;
+#   fuzz_json_patch  a document, a newline and a JSON Patch (RFC 6902): a
+#              result or 422 problems, the target never changed; seeds: the
+#              RFC's examples and the bundled example patch;
 #   fuzz_http  a raw request: header block, framing checks, ?fields=, and the
 #              body as POST /cases; seeds: inline requests.
 # Exits non-zero on a crash, leak or timeout; the reproducer is left in
@@ -13,12 +17,14 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 
 seconds=${FUZZ_SECONDS:-60}
-case_seconds=$(( seconds * 2 / 3 > 0 ? seconds * 2 / 3 : 1 ))
-http_seconds=$(( seconds - case_seconds > 0 ? seconds - case_seconds : 1 ))
+case_seconds=$(( seconds / 2 > 0 ? seconds / 2 : 1 ))
+patch_seconds=$(( seconds / 6 > 0 ? seconds / 6 : 1 ))
+http_seconds=$(( seconds - case_seconds - patch_seconds > 0 ? seconds - case_seconds - patch_seconds : 1 ))
 out=build/fuzz
 corpus=$out/corpus
 http_corpus=$out/corpus-http
-mkdir -p "$out" "$corpus" "$http_corpus"
+patch_corpus=$out/corpus-json-patch
+mkdir -p "$out" "$corpus" "$http_corpus" "$patch_corpus"
 
 # core/ without the OpenMP pragmas' runtime: -fopenmp is not needed for
 # correctness and libFuzzer + libomp threads only slow the fuzzer down.
@@ -30,6 +36,9 @@ engine=$(find core proto -name '*.c' | sort)
 # shellcheck disable=SC2086
 clang $cflags -Icore -Iproto tests/fuzz/fuzz_case.c $engine $pkg -lm \
       -o "$out/fuzz_case"
+# shellcheck disable=SC2086
+clang $cflags -Iproto tests/fuzz/fuzz_json_patch.c proto/json/*.c $pkg -lm \
+      -o "$out/fuzz_json_patch"
 # shellcheck disable=SC2086
 clang $cflags -Icore -Iproto -Iserver tests/fuzz/fuzz_http.c server/http/http_frame.c $engine \
       $pkg -lm -o "$out/fuzz_http"
@@ -76,6 +85,16 @@ JSON
 printf '{"time": {"end": 1e999}}' > "$corpus/inline-overflow.json"
 printf '[[[[[[[[[[' > "$corpus/inline-deep.json"
 
+# JSON Patch seeds: a document, a newline, a patch (RFC 6902 appendix A).
+printf '%s\n%s' '{"foo":["bar","baz"],"a/b":1,"m~n":{"x":[1,2]}}' \
+    '[{"op":"add","path":"/foo/1","value":"qux"},{"op":"remove","path":"/a~1b"},{"op":"test","path":"/m~0n/x/1","value":2.0}]' \
+    > "$patch_corpus/ops"
+printf '%s\n%s' '{"foo":{"bar":"baz","waldo":"fred"},"qux":{"corge":"grault"}}' \
+    '[{"op":"move","from":"/foo/waldo","path":"/qux/thud"},{"op":"copy","from":"/qux","path":"/foo/-"},{"op":"replace","path":"","value":[]}]' \
+    > "$patch_corpus/move-copy"
+{ head -c 2000 "$corpus/inline-mesh.json" | tr -d '\n'; printf '\n'; tr -d '\n' < examples/uniaxial-compression.weaker.json-patch; } \
+    > "$patch_corpus/case"
+
 # HTTP seeds: well-formed requests and each framing the gate refuses.
 body=$(cat "$corpus/inline-rect.json")
 printf 'POST /cases?start=true HTTP/1.1\r\nHost: x\r\nContent-Length: %d\r\n\r\n%s' \
@@ -102,4 +121,5 @@ run() {
   echo "fuzz: $target: no crash in ${secs}s"
 }
 run fuzz_case "$case_seconds" "$corpus" -dict=tests/fuzz/case.dict
+run fuzz_json_patch "$patch_seconds" "$patch_corpus" -dict=tests/fuzz/case.dict
 run fuzz_http "$http_seconds" "$http_corpus" -dict=tests/fuzz/http.dict

@@ -3,7 +3,8 @@
  * what they must add up to: a fracturing bar pulled apart breaks into
  * pieces whose masses sum to the model's mass (1e-9), whose count is the
  * status count, whose momenta sum to the model's, and which no intact joint
- * crosses; two separate 3D boxes are two fragments with the box's mass,
+ * crosses, and exactly the pieces at its pulled ends are held; two
+ * separate 3D boxes are two fragments, one per part, with the box's mass,
  * volume, equivalent sphere, centre and velocity; a sieve curve of known
  * pieces has the mass fractions by hand.
  */
@@ -103,6 +104,24 @@ static void pieces_of_a_broken_bar_add_up(void)
         crossing += label[ea] != label[eb];
     }
     CHECK(crossing == 0, "%d intact joints join two fragments", crossing);
+    /* held: exactly the pieces with a node at a pulled end (x = 0 or 0.1
+     * at t = 0, where the velocity constraints select) */
+    int *end_piece = calloc((size_t)n, sizeof(int));
+    const double *x0 = fdem_initial_positions(m);
+    for (int e = 0; e < counts.elements; e++)
+        for (int c = 0; c < 3; c++) {
+            double x = x0[2 * tri[3 * e + c]];
+            if (fabs(x) < 1e-9 || fabs(x - 0.1) < 1e-9) end_piece[label[e]] = 1;
+        }
+    int held = 0;
+    for (int k = 0; k < n; k++) {
+        CHECK(f[k].held == end_piece[k], "fragment %d: held %d, at a pulled end %d", k, f[k].held,
+              end_piece[k]);
+        CHECK(f[k].part == 0, "fragment %d: part %d of a one-part model", k, f[k].part);
+        held += f[k].held;
+    }
+    CHECK(held == 2, "%d pieces held, want the two ends", held);
+    free(end_piece);
     free(label);
     free(f);
     fdem_model_destroy(m);
@@ -133,6 +152,7 @@ static void separate_boxes_are_fragments(void)
     double V = 0.2 * 0.1 * 0.1;
     for (int b = 0; b < 2 && n == 2; b++) {
         CHECK(f[b].elements == 12, "elements %d", f[b].elements);
+        CHECK(f[b].part == b && f[b].held == 0, "box %d: part %d, held %d", b, f[b].part, f[b].held);
         CHECK_REL(f[b].size, V, 1e-12);
         CHECK_REL(f[b].mass, 2000 * V, 1e-12);
         CHECK_REL(f[b].diameter, cbrt(6 * V / M_PI), 1e-12);
