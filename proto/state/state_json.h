@@ -7,7 +7,10 @@
  * in 3D) and damage as a number per joint; only the fields present in the
  * snapshot; strain like stress, principal_stress as `dimension` numbers per
  * element, descending, and displacement (position - initial position) like
- * position.
+ * position. A case with stages (contract 6.1) always gets "active": one
+ * flag a element, 1 still there, 0 excavated (whatever the fields), so a
+ * client drawing the state can leave the excavated elements out; the
+ * daemon adds "stage" to such a state (it knows the names).
  *
  * Folder: proto/state/ (its contract: snapshot.h).
  */
