@@ -88,6 +88,9 @@ static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_O
  * holds the exit code). The caller json_decref()s it. */
 struct json_t;
 struct json_t *ctl_get_status(const ctl_options *o, const char *id, int *code);
+/* The status' "stage" as `1 "excavate"` (index, then the name), or ""
+ * for a case without stages (contract 6.1). */
+void ctl_stage_text(json_t *status, char *out, size_t size);
 /* A whole file (or stdin for "-"), NUL-terminated; NULL after saying why
  * (the caller exits CTL_USAGE: the file is the user's mistake, not the server's). */
 char *ctl_read_all(const char *path, size_t *length);
