@@ -85,6 +85,29 @@ def hole_elements(f, hole):
     return np.all((c >= lo) & (c <= hi), axis=1)
 
 
+def hole_size(f, hole):
+    """Area (2D) or volume (3D) of the elements with their centroid in the hole."""
+    x0 = f["/mesh/position0"][...]
+    solid = "tetrahedra" in f["/mesh"]
+    cells = f["/mesh/tetrahedra" if solid else "/mesh/triangles"][...]
+    corners = x0[cells[hole_elements(f, hole)]]
+    edges = corners[:, 1:] - corners[:, :1]
+    if solid:
+        return np.abs(np.linalg.det(edges)).sum() / 6
+    return np.abs(np.cross(edges[:, 0], edges[:, 1])).sum() / 2
+
+
+def strain_energy_density(dimension, young=1e10, poisson=0.25):
+    """Of the hydrostatic in-situ STRESS: 3D s^2 3(1 - 2 nu)/(2E); 2D plane
+    strain, where szz = nu (sxx + syy) = 2 nu s, (1/2E)(sxx^2 + syy^2 + szz^2
+    - 2 nu (sxx syy + syy szz + szz sxx))."""
+    s, nu = STRESS, poisson
+    if dimension == 3:
+        return 3 * s * s * (1 - 2 * nu) / (2 * young)
+    z = 2 * nu * s
+    return (2 * s * s + z * z - 2 * nu * (s * s + 2 * s * z)) / (2 * young)
+
+
 def read_snapshots(daemon, case_id):
     with fetched_result(daemon, case_id) as f:
         return {name: f["/snapshots/" + name][...] for name in f["/snapshots"]}
@@ -150,6 +173,14 @@ class ExcavationTests(DaemonTestCase):
         self.assertEqual(status, 200, state)
         self.assertEqual(state["stage"], {"index": 1, "name": "excavate"})
         self.assertEqual(state["active"], [int(a) for a in last_active])
+        # at rest in stage 0 (the rollers carry the stress), the hole takes
+        # away exactly its in-situ strain energy: the status' account
+        with fetched_result(self.d, st["id"]) as f:
+            taken = strain_energy_density(dimension) * hole_size(f, hole)
+        print("  %dD: excavated %.12g J, closed form %.12g J (%.1e); residual %.3g J"
+              % (dimension, st["energy"]["excavated"], taken,
+                 st["energy"]["excavated"] / taken - 1, st["energy"]["residual"]), flush=True)
+        self.assertAlmostEqual(st["energy"]["excavated"] / taken, 1.0, delta=1e-9)
         return st
 
     def test_2d_stage_status_result_and_sidecar(self):
