@@ -540,6 +540,26 @@ static void same_bits_on_threads_and_across_a_checkpoint(void)
         run_to(one.m, SMALL_END);
         run_to(two.m, SMALL_END);
         CHECK(same_bits(one.m, two.m), "%dD: two threads differ from one", dim);
+        /* a checkpoint from before the excavation, restored into a fresh
+         * model and into one that has excavated already */
+        run_to(first.m, 0.5 * T_EXCAVATE);
+        size_t early_size = fdem_checkpoint_size(first.m);
+        unsigned char *early = malloc(early_size);
+        CHECK(fdem_checkpoint_write(first.m, early, early_size) == 0, "write before");
+        tunnel fresh = tunnel_build(&s, SMALL_END);
+        fdem_error early_err;
+        if (fdem_checkpoint_read(fresh.m, early, early_size, &early_err))
+            build_die("restore before", &early_err);
+        run_to(fresh.m, SMALL_END);
+        CHECK(same_bits(fresh.m, one.m), "%dD: restored from before the excavation, differs", dim);
+        if (fdem_checkpoint_read(fresh.m, early, early_size, &early_err))
+            build_die("restore back", &early_err);
+        CHECK(fdem_element_active(fresh.m) == NULL, "%dD: restored back, still excavated", dim);
+        run_to(fresh.m, SMALL_END);
+        CHECK(same_bits(fresh.m, one.m), "%dD: restored back to before the excavation, differs",
+              dim);
+        free(early);
+        tunnel_free(&fresh);
         run_to(first.m, T_EXCAVATE + 0.5 * SMALL_RELAX); /* during the release */
         CHECK(fdem_element_active(first.m) != NULL, "%dD: not excavated yet", dim);
         size_t size = fdem_checkpoint_size(first.m);
