@@ -258,9 +258,9 @@ int fdem_add_constraint(fdem_model *model, const fdem_constraint_def *def, fdem_
  * less than one step). The unloading force is f_exc (1 - s), s = (t -
  * t_start) / relax clamped to [0, 1], t the start time of each step and
  * t_start that of the stage's first step (docs/physics.md "Excavation").
- * Before finalize, in stage order. Returns the stage index or -1 (end not
- * finite or not after the previous stage's, relax negative or not finite,
- * an element index out of range). */
+ * After the parts and before finalize, in stage order. Returns the stage
+ * index or -1 (end not finite or not after the previous stage's, relax
+ * negative or not finite, an element index out of range). */
 typedef struct fdem_stage_def {
     double end;
     double relax;

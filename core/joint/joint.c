@@ -221,7 +221,9 @@ void joint_mark_broken_vertices(fdem_model *m)
     if (!m->joint_count) return;
     memset(m->vertex_broken, 0, (size_t)m->node_count);
     for (int j = 0; j < m->joint_count; j++) {
-        if (m->joint_damage[j] < 1.0) continue;
+        /* an excavated joint opens no crack: the elements around its
+         * vertices that remain are still glued (element_on_crack) */
+        if (m->joint_damage[j] < 1.0 || (m->elem_active && joint_is_excavated(m, j))) continue;
         const int32_t *n = m->joint_node + 2 * m->dim * (size_t)j;
         for (int i = 0; i < m->dim; i++) m->vertex_broken[m->node_origin[n[i]]] = 1;
     }
@@ -240,7 +242,15 @@ static int element_on_crack(const fdem_model *m, int e)
     const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
     int on = 0;
     for (int i = 0; i < K; i++) on |= m->vertex_broken[m->node_origin[n[i]]];
-    return on;
+    if (on || !m->elem_active) return on;
+    /* a face on an excavated opening is exposed as a crack's is: the
+     * elements across the opening may meet if it closes */
+    const int faces = m->dim + 1;
+    for (int c = 0; c < faces; c++) {
+        int j = m->elem_joint[faces * e + c];
+        if (j >= 0 && joint_is_excavated(m, j)) return 1;
+    }
+    return 0;
 }
 
 /* True when contact between a and b (of one fracturing part) can be left

@@ -189,6 +189,14 @@ int excavation_refresh(fdem_model *m)
     int any = 0;
     for (int k = 0; k < m->stages_started; k++) any |= m->stages[k].excavate_count > 0;
     if (!any && !m->elem_active) return 0;
+    if (!any) { /* a checkpoint from before the first excavation: all back, as finalize left it */
+        free(m->elem_active);
+        free(m->node_frozen);
+        m->elem_active = m->node_frozen = NULL;
+        lump_active_masses(m);
+        if (m->elem_stress0) m->stress0_energy = initial_stress_energy(m);
+        return 0;
+    }
     if (!m->elem_active) {
         m->elem_active = malloc((size_t)m->elem_count);
         m->node_frozen = calloc((size_t)m->node_count, 1);

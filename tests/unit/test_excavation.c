@@ -540,6 +540,26 @@ static void same_bits_on_threads_and_across_a_checkpoint(void)
         run_to(one.m, SMALL_END);
         run_to(two.m, SMALL_END);
         CHECK(same_bits(one.m, two.m), "%dD: two threads differ from one", dim);
+        /* a checkpoint from before the excavation, restored into a fresh
+         * model and into one that has excavated already */
+        run_to(first.m, 0.5 * T_EXCAVATE);
+        size_t early_size = fdem_checkpoint_size(first.m);
+        unsigned char *early = malloc(early_size);
+        CHECK(fdem_checkpoint_write(first.m, early, early_size) == 0, "write before");
+        tunnel fresh = tunnel_build(&s, SMALL_END);
+        fdem_error early_err;
+        if (fdem_checkpoint_read(fresh.m, early, early_size, &early_err))
+            build_die("restore before", &early_err);
+        run_to(fresh.m, SMALL_END);
+        CHECK(same_bits(fresh.m, one.m), "%dD: restored from before the excavation, differs", dim);
+        if (fdem_checkpoint_read(fresh.m, early, early_size, &early_err))
+            build_die("restore back", &early_err);
+        CHECK(fdem_element_active(fresh.m) == NULL, "%dD: restored back, still excavated", dim);
+        run_to(fresh.m, SMALL_END);
+        CHECK(same_bits(fresh.m, one.m), "%dD: restored back to before the excavation, differs",
+              dim);
+        free(early);
+        tunnel_free(&fresh);
         run_to(first.m, T_EXCAVATE + 0.5 * SMALL_RELAX); /* during the release */
         CHECK(fdem_element_active(first.m) != NULL, "%dD: not excavated yet", dim);
         size_t size = fdem_checkpoint_size(first.m);
@@ -592,6 +612,110 @@ static void energy_closes_through_the_excavation(void)
                   s.relax, e.residual, scale);
             tunnel_free(&t);
         }
+}
+
+/* --------------------------------------------------- joints and contact */
+
+/* A fracturing block on a fixed base, loaded by gravity for a while, with
+ * the elements of its upper middle excavated; the twin excavates nothing.
+ * In a fracturing part every element has nodes of its own, so the
+ * remaining nodes keep their masses, and at the excavation step (s = 0)
+ * the unloading forces stand in for what the removed elements pulled
+ * through their joints: the remaining nodes' velocity change over that
+ * step is the twin's to round-off (an excavated joint opens no crack, so
+ * no contact appears between the remaining elements around it). Without
+ * the joints' share in the unloading forces the change is off by 3-4
+ * times the largest change (measured by leaving it out). */
+static void fracturing_block_keeps_its_forces(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *twin[2];
+        const double t_dig = 1e-3; /* about three wave transits: the joints carry the weight */
+        for (int k = 0; k < 2; k++) {
+            fdem_model *m = fdem_model_create();
+            fdem_error err;
+            if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
+            int mat = build_fracturing_rock(m, 0);
+            const double size[3] = {1, 1, 1};
+            const int div[3] = {4, 4, 2};
+            build_box_part(m, mat, dim, size, div, 1);
+            fdem_constraint_def base = {0};
+            base.select = FDEM_SELECT_BOX;
+            for (int d = 0; d < dim; d++) {
+                base.box[d] = -1;
+                base.box[dim + d] = 2;
+            }
+            base.box[dim + dim - 1] = 1e-9;
+            base.kind = FDEM_CONSTRAINT_FIX;
+            base.fix_x = base.fix_y = base.fix_z = 1;
+            add_constraint(m, &base);
+            const double g[3] = {0, dim == 2 ? -2000 : 0, dim == 3 ? -2000 : 0};
+            fdem_set_gravity_v(m, g);
+            int32_t *dig = malloc(sizeof(int32_t) * (size_t)m->elem_count);
+            int count = 0;
+            for (int e = 0; e < m->elem_count && k == 0; e++) {
+                double c[3] = {0, 0, 0};
+                const int32_t *n = m->elem_node + (size_t)(dim + 1) * (size_t)e;
+                for (int q = 0; q <= dim; q++)
+                    for (int d = 0; d < dim; d++) c[d] += m->pos0[dim * n[q] + d] / (dim + 1);
+                if (c[0] > 0.25 && c[0] < 0.75 && c[dim - 1] > 0.5) dig[count++] = e;
+            }
+            fdem_stage_def s0 = {.end = t_dig}, s1 = {.end = 1, .relax = 1, .excavate = dig,
+                                                      .excavate_count = count};
+            fdem_add_stage(m, &s0, &err);
+            if (fdem_add_stage(m, &s1, &err) < 0) build_die("stage", &err);
+            free(dig);
+            build_finalize(m, 0.5);
+            twin[k] = m;
+        }
+        fdem_model *a = twin[0], *b = twin[1];
+        fdem_error err;
+        while (fdem_get_time(a) < t_dig) {
+            fdem_step(a, &err);
+            fdem_step(b, &err);
+        }
+        CHECK(same_bits(a, b), "%dD: the twins differ before the excavation", dim);
+        const size_t n = (size_t)dim * (size_t)a->node_count;
+        double *va = malloc(sizeof(double) * n), *vb = malloc(sizeof(double) * n);
+        memcpy(va, a->vel, sizeof(double) * n);
+        memcpy(vb, b->vel, sizeof(double) * n);
+        fdem_step(a, &err);
+        fdem_step(b, &err);
+        CHECK(fdem_element_active(a) && !fdem_element_active(b), "%dD: excavated the wrong one",
+              dim);
+        double worst = 0, scale = 0;
+        for (int i = 0; i < a->node_count; i++) {
+            if (a->node_frozen[i]) continue;
+            for (int d = 0; d < dim; d++) {
+                size_t q = (size_t)dim * (size_t)i + (size_t)d;
+                worst = fmax(worst, fabs((a->vel[q] - va[q]) - (b->vel[q] - vb[q])));
+                scale = fmax(scale, fabs(b->vel[q] - vb[q]));
+            }
+        }
+        printf("  %dD: velocity change at the excavation step off the twin's by %.3g of %.3g m/s "
+               "(%.2g), %d joints, %d touching pairs (twin %d)\n", dim, worst, scale, worst / scale,
+               a->joint_count, fdem_get_counts(a).contacts, fdem_get_counts(b).contacts);
+        CHECK(scale > 0 && worst < 1e-6 * scale, "%dD: off by %g of %g", dim, worst, scale);
+        CHECK(fdem_get_counts(a).broken_joints == 0 && fdem_event_count(a) == 0,
+              "%dD: excavated joints counted as broken (%d) or events (%d)", dim,
+              fdem_get_counts(a).broken_joints, fdem_event_count(a));
+        CHECK(fdem_get_counts(a).fragments == 1, "%dD: %d fragments", dim,
+              fdem_get_counts(a).fragments);
+        int32_t *label = malloc(sizeof(int32_t) * (size_t)a->elem_count);
+        CHECK(fdem_fragment_labels(a, label) == 1, "%dD: labels", dim);
+        int minus = 0, inactive = 0;
+        for (int e = 0; e < a->elem_count; e++) {
+            minus += label[e] == -1;
+            inactive += !fdem_element_active(a)[e];
+        }
+        CHECK(inactive > 0 && minus == inactive, "%dD: %d labels -1 for %d excavated", dim, minus,
+              inactive);
+        free(label);
+        free(va);
+        free(vb);
+        fdem_model_destroy(a);
+        fdem_model_destroy(b);
+    }
 }
 
 /* ------------------------------------------------------- stage-only loads */
@@ -693,5 +817,6 @@ static void bad_stages_are_refused(void)
 
 CHECK_MAIN(T(kirsch_2d_k0_1_5_slow), T(kirsch_2d_k0_1_slow), T(kirsch_2d_sudden_settles_alike),
            T(kirsch_3d_plane_strain), T(same_bits_on_threads_and_across_a_checkpoint),
-           T(energy_closes_through_the_excavation), T(stage_only_constraints_act_in_their_stage),
+           T(energy_closes_through_the_excavation), T(fracturing_block_keeps_its_forces),
+           T(stage_only_constraints_act_in_their_stage),
            T(bad_stages_are_refused))
