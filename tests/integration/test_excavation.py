@@ -292,8 +292,28 @@ class ExcavationTests(DaemonTestCase):
 
 
 class PauseRestartTests(unittest.TestCase):
-    """Paused during the relaxation and the daemon restarted: the same bits
-    at the end as the uninterrupted run."""
+    """Paused during the relaxation and the daemon restarted, or stepped on
+    two threads: the same bits as the uninterrupted run on one."""
+
+    def test_two_threads_give_the_same_bits(self):
+        runs = []
+        for dimension in (2, 3):
+            for threads in (1, 2):
+                d = Daemon(args=["--threads", str(threads)]).start()
+                try:
+                    case = excavation_case("threads", dimension=dimension,
+                                           divisions=12 if dimension == 2 else 4)
+                    case_id = d.create(case, start=True)["id"]
+                    st = d.wait_state(case_id, ("finished", "failed"), timeout=120)
+                    self.assertEqual(st["state"], "finished", st.get("error"))
+                    runs.append(read_snapshots(d, case_id))
+                finally:
+                    d.close()
+        for one, two in (runs[0:2], runs[2:4]):
+            self.assertEqual(sorted(one), sorted(two))
+            for name in one:
+                np.testing.assert_array_equal(one[name], two[name], err_msg=name)
+            self.assertEqual(list(np.unique(one["stage"])), [0, 1])
 
     def test_pause_and_restart_give_the_same_bits(self):
         d = Daemon().start()
