@@ -195,6 +195,36 @@ class ExcavationTests(DaemonTestCase):
     def test_3d_stage_status_result_and_sidecar(self):
         self.check_excavation(3, 4, HOLE_3D)
 
+    def test_plot_result_leaves_excavated_elements_out(self):
+        """plot_result.py masks the excavated triangles (2D) and draws the
+        surface of the elements still there (3D: the cavity's walls show),
+        and writes its PNG."""
+        import h5py
+        import plot_result
+        for dimension, divisions, hole in ((2, 12, HOLE_2D), (3, 4, HOLE_3D)):
+            st = self.run_finished(excavation_case("plot-%dd" % dimension, dimension=dimension,
+                                                   divisions=divisions))
+            path = os.path.join(self.tmp, st["id"] + ".h5")
+            status, _, data = self.d.request("GET", "/cases/%s/result.h5" % st["id"])
+            with open(path, "wb") as f:
+                f.write(data)
+            with h5py.File(path, "r") as f:
+                gone = hole_elements(f, hole)
+                if dimension == 2:
+                    tri, _, _ = plot_result.snapshot_triangulation(f, -1)
+                    np.testing.assert_array_equal(tri.mask, gone)
+                    self.assertFalse(plot_result.snapshot_triangulation(f, 0)[0].mask.any())
+                else:
+                    faces, element = plot_result.surface_of_snapshot(f, -1)
+                    self.assertFalse(gone[element].any())
+                    whole, _ = plot_result.surface_of_snapshot(f, 0)
+                    self.assertGreater(len(faces), len(whole))  # the cavity's walls
+            out = subprocess.run([sys.executable, os.path.join(ROOT, "clients", "python",
+                                                               "plot_result.py"),
+                                  path, "-o", path + ".png"], capture_output=True, text=True)
+            self.assertEqual(out.returncode, 0, out.stderr)
+            self.assertGreater(os.path.getsize(path + ".png"), 1000)
+
     def pvload(self, reader, xdmf, *extra):
         out = subprocess.run([PVPYTHON, os.path.join(HERE, "paraview_load.py"), reader, xdmf]
                              + list(extra), capture_output=True, text=True, timeout=300)
