@@ -279,9 +279,12 @@ class ExcavationTests(DaemonTestCase):
         self.assertNotIn("stage", out.stdout)
 
     def test_extend_runs_the_last_stage_on(self):
+        """An extend rewrites the last stage's end, and the continued run is
+        bit for bit the one asked for the new end from the start."""
         d = self.d
         case = excavation_case("extended", end=0.001)
         st = self.run_finished(case)
+        before = read_snapshots(d, st["id"])
         status, body = d.json("POST", "/cases/%s/extend" % st["id"], {"end": 0.0015})
         self.assertEqual(status, 200, body)
         doc = d.json("GET", "/cases/%s/case" % st["id"])[1]
@@ -291,7 +294,17 @@ class ExcavationTests(DaemonTestCase):
         st = d.wait_state(st["id"], ("finished", "failed"), timeout=120)
         self.assertEqual((st["state"], st["time"]), ("finished", 0.0015), st.get("error"))
         self.assertEqual(st["stage"], {"index": 1, "name": "excavate"})
-        self.assertEqual(read_snapshots(d, st["id"])["stage"][-1], 1)
+        after = read_snapshots(d, st["id"])
+        self.assertEqual(after["stage"][-1], 1)
+        case["name"] = "straight"
+        case["stages"][1]["end"] = 0.0015
+        straight = read_snapshots(d, self.run_finished(case)["id"])
+        n = len(before["time"])
+        later = straight["time"] > 0.001
+        self.assertEqual(len(after["time"]), n + int(later.sum()))
+        for name, rows in before.items():
+            np.testing.assert_array_equal(after[name][:n], rows, err_msg=name)
+            np.testing.assert_array_equal(after[name][n:], straight[name][later], err_msg=name)
 
     def test_bad_stages_are_one_422_with_pointers(self):
         case = excavation_case("bad")
