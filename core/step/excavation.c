@@ -3,8 +3,9 @@
  * by the unloading method of tunnelling codes: at that moment the removed
  * elements exert nodal forces f_exc on the nodes they share with the
  * remaining body (their internal forces, with the in-situ pre-stress; the
- * forces of the joints between a removed and a remaining element; those of
- * contact pairs between them); the elements go, and f_exc (1 - s) is
+ * weight of their share of those nodes' lumped mass; the forces of the
+ * joints between a removed and a remaining element; those of contact pairs
+ * between them); the elements go, and f_exc (1 - s) is
  * applied in their place as an external force, s ramping from 0 to 1 over
  * the stage's relax (stages.c). So the remaining body is in the state it
  * was, and the release of f_exc, slow or sudden, is what loads it.
@@ -242,6 +243,19 @@ static int ramp_from(fdem_model *m, int k, const double *f)
     return 0;
 }
 
+/* The weight of the mass that left a node that stays (old - new, times
+ * this step's gravity) is part of what the removed elements put on it:
+ * added to f, it is released with the rest. */
+static void removed_weight(const fdem_model *m, const double *old_mass, double *f)
+{
+    const int D = m->dim;
+    for (int i = 0; i < m->node_count; i++) {
+        double gone = old_mass[i] - m->mass[i];
+        if (gone == 0 || m->node_frozen[i]) continue;
+        for (int d = 0; d < D; d++) f[(size_t)D * (size_t)i + (size_t)d] += gone * m->gravity[d];
+    }
+}
+
 /* The mass that left each node (old - new) takes its kinetic energy
  * (returned) and the work gravity did on it so far (energy.c); frozen
  * nodes stop. */
@@ -299,6 +313,7 @@ int excavation_start(fdem_model *m, int k, fdem_error *err)
         failed |= excavation_refresh(m);
         m->stages_started--;
         if (!failed) {
+            removed_weight(m, old_mass, f);
             if (m->elem_stress0) energy += locked - m->stress0_energy;
             energy += mass_left(m, old_mass);
             joints_on_removed_let_go(m);
