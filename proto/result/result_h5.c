@@ -60,7 +60,7 @@
 
 const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
-    "displacement", "stage", "active", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
+    "displacement", "stage", "active", "excavated_energy", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
 };
@@ -259,8 +259,9 @@ hid_t series_mem_type(int kind)
 /* Which datasets this model has and their per-snapshot shape. Damage is
  * stored whenever the model has joints (contract: "when some part
  * fractures"), the fragment id of every element always (contract 5.4), the
- * stage and every element's active flag whenever the case has stages
- * (contract 6.1), the node and element fields only when requested. */
+ * stage, every element's active flag and the excavated energy account
+ * whenever the case has stages (contract 6.1), the node and element fields
+ * only when requested. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
@@ -292,6 +293,7 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         s->row[1] = (hsize_t)shapes[i].width;
     }
     ds[SERIES_STAGE].rank = staged ? 1 : 0; /* one number a snapshot, like step */
+    ds[SERIES_EXCAVATED].rank = staged ? 1 : 0;
 }
 
 /* Chunk shape, see the comment at the top of the file. */
@@ -352,6 +354,7 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_DISPLACEMENT: return s->displacement;
     case SERIES_STAGE: return &s->stage;
     case SERIES_ACTIVE: return s->active;
+    case SERIES_EXCAVATED: return &s->energy.excavated;
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;

@@ -277,6 +277,14 @@ static void xdmf_series_attributes(const xdmf_ctx *x)
                 x->h5, series_names[kind]);
         fprintf(x->out, "      </Attribute>\n");
     }
+    if (x->staged) { /* written for cases with stages only */
+        fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
+                "Center=\"Grid\">\n", series_names[SERIES_EXCAVATED]);
+        fprintf(x->out, "        <DataItem Dimensions=\"%d 1\" NumberType=\"Float\" "
+                "Precision=\"8\" Format=\"HDF\">%s:/snapshots/%s</DataItem>\n", x->snapshots,
+                x->h5, series_names[SERIES_EXCAVATED]);
+        fprintf(x->out, "      </Attribute>\n");
+    }
     if (x->constraints <= 0) return;
     fprintf(x->out, "      <Attribute Name=\"constraint_force\" AttributeType=\"Matrix\" "
             "Center=\"Grid\">\n");

@@ -181,6 +181,8 @@ class ExcavationTests(DaemonTestCase):
               % (dimension, st["energy"]["excavated"], taken,
                  st["energy"]["excavated"] / taken - 1, st["energy"]["residual"]), flush=True)
         self.assertAlmostEqual(st["energy"]["excavated"] / taken, 1.0, delta=1e-9)
+        self.assertEqual(read_snapshots(d, st["id"])["excavated_energy"][-1],
+                         st["energy"]["excavated"])
         return st
 
     def test_2d_stage_status_result_and_sidecar(self):
@@ -273,6 +275,7 @@ class ExcavationTests(DaemonTestCase):
         snapshots = read_snapshots(self.d, st["id"])
         self.assertNotIn("stage", snapshots)
         self.assertNotIn("active", snapshots)
+        self.assertNotIn("excavated_energy", snapshots)
         state = self.d.json("GET", "/cases/%s/state" % st["id"])[1]
         self.assertEqual(set(state), {"step", "time", "position", "velocity"})
         out = self.d.fdemctl("status", st["id"])

@@ -30,6 +30,7 @@ SERIES = {  # dataset -> key in the expected snapshot
     "kinetic_energy": "kinetic_energy", "elastic_energy": "elastic_energy",
     "fragment": "fragment", "strain": "strain", "principal_stress": "principal_stress",
     "displacement": "displacement", "stage": "stage", "active": "active",
+    "excavated_energy": "excavated_energy",
 }
 
 

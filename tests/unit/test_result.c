@@ -125,6 +125,7 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
     if (fdem_stage_index(m) >= 0) {
         json_array_append_new(series, json_string("stage"));
         json_array_append_new(series, json_string("active"));
+        json_array_append_new(series, json_string("excavated_energy"));
     }
 
     return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
@@ -144,7 +145,10 @@ static void expect_snapshot(json_t *doc, const snapshot *s)
     json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
     json_object_set_new(j, "fragment", ints_rows(s->fragment, s->elements, 0));
     json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
-    if (s->active) json_object_set_new(j, "stage", json_integer(s->stage)); /* active: state */
+    if (s->active) { /* a model with stages ("active" is in the state JSON) */
+        json_object_set_new(j, "stage", json_integer(s->stage));
+        json_object_set_new(j, "excavated_energy", json_real(s->energy.excavated));
+    }
     json_array_append_new(json_object_get(doc, "snapshots"), j);
 }
 
