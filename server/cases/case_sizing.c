@@ -66,7 +66,7 @@ static double sizing_snapshots(const case_info *info, double t0, double dt, doub
  * snapshot the requested node and element fields, damage when there are
  * joints, the fragment id of every element, the constraint forces, the
  * scalar series (step, time and the energy accounts) and, with stages, the
- * stage and every element's active flag. HDF5's own metadata,
+ * stage, every element's active flag and the excavated energy. HDF5's own metadata,
  * part-filled chunks and the case document with its names come on top. */
 static double sizing_result_bytes(const fdem_model *model, const case_info *info, double snapshots)
 {
@@ -88,8 +88,8 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
         row += elements * dim * 8;
     if (info->fields & CASE_FIELD_DISPLACEMENT)
         row += nodes * dim * 8;
-    if (info->stage_count > 0) /* /snapshots/stage and /snapshots/active */
-        row += 4 + elements;
+    if (info->stage_count > 0) /* /snapshots/stage, active and excavated_energy */
+        row += 4 + elements + 8;
     return mesh + snapshots * row;
 }
 
