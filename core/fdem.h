@@ -244,12 +244,44 @@ typedef struct fdem_constraint_def {
      * is a(t) = 1. fdem_add_constraint copies it. */
     const double *amplitude;
     int amplitude_count;
+    /* Stages (fdem_add_stage): 0 acts throughout; k + 1 acts only while
+     * stage k runs (zero-initialised defs act throughout). Outside its stage
+     * a constraint prescribes and applies nothing and reports a zero force.
+     * Not for ABSORB (fdem_add_constraint refuses it). */
+    int only_stage;
 } fdem_constraint_def;
 
 /* Returns the constraint index or -1 (e.g. a selection with no node).
  * Node selection happens at fdem_model_finalize(), so constraints may be
  * added before or after the parts they select. */
 int fdem_add_constraint(fdem_model *model, const fdem_constraint_def *def, fdem_error *err);
+
+/* A stage (contract 6.1): runs from the end of the stage before (or 0)
+ * to `end`. At its start the elements listed in `excavate` (model element
+ * indices, copied) are removed and the nodal forces they exerted on the
+ * remaining body at that moment are applied and ramped linearly to zero
+ * over `relax` seconds (0: removed at once).
+ *
+ * The clock: a step belongs to stage k when its start time t satisfies
+ * end(k-1) <= t < end(k) (stage 0 from t = 0; the last stage also takes
+ * every step after its end, e.g. after an extend). Stage k starts with the
+ * first step whose start time is >= end(k-1): its excavation is done at
+ * the start of that step, on the positions the step starts from, so it
+ * happens on the same step on any thread count and across checkpoints
+ * (steps are not cut to land on stage ends; the stage boundary is late by
+ * less than one step). The unloading force is f_exc (1 - s), s = (t -
+ * t_start) / relax clamped to [0, 1], t the start time of each step and
+ * t_start that of the stage's first step (docs/physics.md "Excavation").
+ * After the parts and before finalize, in stage order. Returns the stage
+ * index or -1 (end not finite or not after the previous stage's, relax
+ * negative or not finite, an element index out of range). */
+typedef struct fdem_stage_def {
+    double end;
+    double relax;
+    const int32_t *excavate;
+    int excavate_count;
+} fdem_stage_def;
+int fdem_add_stage(fdem_model *model, const fdem_stage_def *def, fdem_error *err);
 
 /* Lumps masses, builds element and contact data, selects constraint nodes,
  * computes the stable step. Returns 0 or -1. */
@@ -287,7 +319,7 @@ int fdem_step(fdem_model *model, fdem_error *err);
  * at the start of the last step, where the elastic energy is evaluated (see
  * energy.c for why that instant). residual is their balance:
  *   kinetic + elastic + joint + contact + friction + fracture + damping
- *   - gravity_work - external_work - (kinetic + elastic at t = 0),
+ *   + excavated - gravity_work - external_work - (kinetic + elastic at t = 0),
  * zero but for the time discretisation of non-linear forces. */
 typedef struct fdem_energy {
     double kinetic;       /* 1/2 sum m v(t - h/2) . v(t + h/2): the central-difference kinetic
@@ -306,8 +338,15 @@ typedef struct fdem_energy {
     double damping;       /* dissipated by viscous damping of elements and by absorbing
                              boundaries' dashpots (>= 0) */
     double gravity_work;  /* work done by gravity */
-    double external_work; /* work of applied forces, pressures and constraint reactions */
+    double external_work; /* work of applied forces, pressures and constraint reactions,
+                             and of the unloading forces of excavations */
     double residual;      /* the balance above */
+    double excavated;     /* what excavated elements took with them when removed: their
+                             strain energy (in-situ stress included), the kinetic energy
+                             of the mass that left with them and the energy of the joints
+                             they were on; added to the balance like a dissipation, and
+                             the work gravity did on the removed mass stays in
+                             gravity_work */
 } fdem_energy;
 
 typedef struct fdem_counts {
@@ -324,6 +363,16 @@ int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);
 fdem_counts fdem_get_counts(const fdem_model *model);
 fdem_energy fdem_get_energy(const fdem_model *model);
+
+/* The stage the last step belonged to (0 before the first step), or -1
+ * for a model without stages. */
+int fdem_stage_index(const fdem_model *model);
+/* elem_count flags, 1 active and 0 excavated, or NULL while every element
+ * is active (no stage has removed any yet). Excavated elements exert no
+ * force, take part in no contact, their joints hold nothing (damage reads
+ * 1, but they are no fracture events and not counted as broken), and the
+ * nodes only they held stand still with no mass. */
+const uint8_t *fdem_element_active(const fdem_model *model);
 
 /* Node arrays, `dimension` doubles per node, engine order. */
 const double *fdem_positions(const fdem_model *model);
@@ -349,13 +398,14 @@ const double *fdem_joint_damage(const fdem_model *model);
  * intact joints. fdem_fragment_labels writes each element's fragment id
  * into label[elements]: ids 0 .. count-1, numbered in the order of each
  * fragment's first element, so they do not depend on how the pieces were
- * found; returns count, or -1 when out of memory. fdem_fragments returns
- * the same count and sets *out (free() it) to one record per id: size is
- * the initial area (2D) or volume (3D) of its elements, mass their
- * density times that (exactly the lumped node masses they hold), diameter
- * the circle (sphere) of that size, centroid and velocity the mass-weighted
- * means over its nodes at the current step, part the part of its elements
- * (a fragment never spans two parts: they share no node and no joint) and
+ * found (an excavated element is in no fragment: label -1); returns
+ * count, or -1 when out of memory. fdem_fragments returns the same count
+ * and sets *out (free() it) to one record per id: size is the initial
+ * area (2D) or volume (3D) of its elements, mass their density times that
+ * (exactly the lumped node masses they hold), diameter the circle
+ * (sphere) of that size, centroid and velocity the mass-weighted means
+ * over its nodes at the current step, part the part of its elements (a
+ * fragment never spans two parts: they share no node and no joint) and
  * held 1 when a fix or velocity constraint prescribes some component of
  * the motion of one of its nodes (a fixed slope, a supported rock mass, a
  * driven platen: a body the model holds, not a piece it broke off). */
@@ -447,7 +497,7 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
 /* The format version a checkpoint buffer says it is in (1 to the current
  * one, FDEM_CHECKPOINT_VERSION), or -1 when it does not start like one. */
-#define FDEM_CHECKPOINT_VERSION 7
+#define FDEM_CHECKPOINT_VERSION 8
 int fdem_checkpoint_version(const void *buf, size_t size);
 
 /* Seconds spent in each stage of fdem_step() since the model was built

@@ -321,6 +321,17 @@ static void status_print_others(json_t *s)
     }
 }
 
+void ctl_stage_text(json_t *status, char *out, size_t size)
+{
+    json_t *stage = json_object_get(status, "stage");
+    json_t *index = json_object_get(stage, "index");
+    const char *name = json_string_value(json_object_get(stage, "name"));
+    if (json_is_integer(index))
+        snprintf(out, size, "%lld \"%.64s\"", json_integer_value(index), name ? name : "");
+    else
+        snprintf(out, size, "%s", "");
+}
+
 static void status_print_table(json_t *s)
 {
     printf("%-14s%s\n", "id", status_text(s, "id", "?"));
@@ -329,6 +340,9 @@ static void status_print_table(json_t *s)
     printf("%-14s%.1f %%  (t = %.6g of %.6g s)\n", "progress", 100.0 * status_number(s, "progress"),
            status_number(s, "time"), status_number(s, "end_time"));
     printf("%-14s%lld\n", "step", json_integer_value(json_object_get(s, "step")));
+    char stage[96];
+    ctl_stage_text(s, stage, sizeof stage);
+    if (stage[0]) printf("%-14s%s\n", "stage", stage);
     printf("%-14s%.4g s\n", "dt", status_number(s, "dt"));
     printf("%-14s%lld nodes, %lld elements, %lld joints (%lld broken)\n", "mesh",
            json_integer_value(json_object_get(s, "nodes")),

@@ -98,6 +98,9 @@ struct json_t *ctl_get_status(const ctl_options *o, const char *id, int *code);
 /* Prints the sizing object of a dry run (POST /cases?dry_run=true, or a
  * clone's); CTL_OK, or CTL_FAIL when the answer is not one. */
 int ctl_print_sizing(const http_response *r);
+/* The status' "stage" as `1 "excavate"` (index, then the name), or ""
+ * for a case without stages (contract 6.1). */
+void ctl_stage_text(json_t *status, char *out, size_t size);
 /* A whole file (or stdin for "-"), NUL-terminated; NULL after saying why
  * (the caller exits CTL_USAGE: the file is the user's mistake, not the server's). */
 char *ctl_read_all(const char *path, size_t *length);

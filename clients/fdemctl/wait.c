@@ -28,6 +28,7 @@ typedef struct wait_progress {
     double progress, time, end_time, steps_per_second, dt;
     long long step;
     const char *state;
+    char stage[112]; /* "  stage 1 \"excavate\"" for a case with stages, else "" */
 } wait_progress;
 
 static double wait_now(void)
@@ -54,6 +55,9 @@ static wait_progress wait_read(json_t *s)
     p.step = json_integer_value(json_object_get(s, "step"));
     p.state = json_string_value(json_object_get(s, "state"));
     if (!p.state) p.state = "?";
+    char stage[96];
+    ctl_stage_text(s, stage, sizeof stage);
+    snprintf(p.stage, sizeof p.stage, "%s%s", stage[0] ? "  stage " : "", stage);
     if (!(p.progress >= 0)) p.progress = 0;
     if (p.progress > 1) p.progress = 1;
     /* 100 % is shown for a finished case only: one that has stepped to its
@@ -87,9 +91,9 @@ static void wait_draw_bar(FILE *tty, const wait_progress *p)
     bar[WAIT_BAR_WIDTH] = '\0';
     wait_format_eta(eta, sizeof eta, wait_eta(p));
     /* \033[K clears what a longer previous line left behind. */
-    fprintf(tty, "\r[%s] %5.1f%%  step %lld  t %.4g/%.4g s  %.3g steps/s  ETA %s  %s\033[K",
+    fprintf(tty, "\r[%s] %5.1f%%  step %lld  t %.4g/%.4g s  %.3g steps/s  ETA %s  %s%s\033[K",
             bar, 100 * p->progress, p->step, p->time, p->end_time, p->steps_per_second,
-            eta, p->state);
+            eta, p->state, p->stage);
     fflush(tty);
 }
 
@@ -97,8 +101,8 @@ static void wait_print_line(const wait_progress *p)
 {
     char eta[32];
     wait_format_eta(eta, sizeof eta, wait_eta(p));
-    printf("%-8s %5.1f%%  step %lld  t %.6g/%.6g s  %.3g steps/s  ETA %s\n", p->state,
-           100 * p->progress, p->step, p->time, p->end_time, p->steps_per_second, eta);
+    printf("%-8s %5.1f%%  step %lld  t %.6g/%.6g s  %.3g steps/s  ETA %s%s\n", p->state,
+           100 * p->progress, p->step, p->time, p->end_time, p->steps_per_second, eta, p->stage);
     fflush(stdout);
 }
 

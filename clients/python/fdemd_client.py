@@ -25,7 +25,7 @@ import warnings
 import urllib.parse
 import urllib.request
 
-__all__ = ["Client", "FdemdError", "FdemdConnectionError", "DEFAULT_URL"]
+__all__ = ["Client", "FdemdError", "FdemdConnectionError", "DEFAULT_URL", "stage_label"]
 
 DEFAULT_URL = "http://127.0.0.1:8080"
 TERMINAL_STATES = ("finished", "failed", "stopped")
@@ -171,8 +171,16 @@ class Client:
         return self._json("GET", path)["cases"]
 
     def status(self, case_id):
-        """The status object of one case (state, step, time, progress, ...)."""
+        """The status object of one case (state, step, time, progress,
+        stage, ...); "stage" is {"index", "name"} of the stage the case is
+        in, None for a case without "stages" (see stage_label)."""
         return self._json("GET", self._case_path(case_id))
+
+    def stage(self, case_id):
+        """(index, name) of the stage the case is in, None for a case
+        without "stages" (docs/case-format.md, "Stages and excavation")."""
+        s = self.status(case_id).get("stage")
+        return None if s is None else (s["index"], s["name"])
 
     def start(self, case_id):
         """created or paused -> running; returns the status."""
@@ -269,7 +277,9 @@ class Client:
             most compressive, sigma1 of rock mechanics (the answer's
             "principal_stress_names" is ["sigma3", "sigma1"], 3D
             ["sigma3", "sigma2", "sigma1"]), damage per joint;
-            docs/api.md, "GET /cases/ID/state".
+            docs/api.md, "GET /cases/ID/state". A case with stages also
+            has "stage" {"index", "name"} and "active": one flag a
+            element, 1 still there, 0 excavated.
         """
         suffix = "/state"
         if fields:
@@ -410,6 +420,14 @@ class Client:
 
 
 # ---------------------------------------------------------------- helpers
+
+def stage_label(status):
+    """A status object's stage as text: 'stage 1 "excavate"', or "" for a
+    case without stages; e.g. Client.wait(case_id, callback=lambda s:
+    print(s["progress"], stage_label(s)))."""
+    s = status.get("stage")
+    return "" if not s else 'stage %d "%s"' % (s["index"], s["name"])
+
 
 def _case_body(case):
     """The JSON text of a case given as a dict, bytes or a file path."""

@@ -43,6 +43,9 @@ stress inside a body does not show.
 --component xx|yy|xy (3D also zz|yz|xz) colours by that Cauchy stress
 component instead of von Mises, on a diverging scale centred on zero.
 
+The elements a case with stages has excavated by the snapshot
+(/snapshots/active 0) are left out, in 2D and 3D.
+
 The default field is stress when the file has it, else velocity, else
 displacement.
 The file may still be written by a running case: it is opened plainly first,
@@ -214,7 +217,7 @@ def draw_stress(ax, f, tri, s, args):
     if args.component:
         values, label = stress_component(f, s, 2, args.component)
         art = ax.tripcolor(tri, facecolors=values, cmap="coolwarm")
-        art.set_clim(*symmetric_limits(values))
+        art.set_clim(*symmetric_limits(values if tri.mask is None else values[~tri.mask]))
         return art, label
     stress = require(f, "/snapshots/stress", 'add "stress" to output.fields')[s]
     vm = von_mises_plane_strain(stress, element_poisson(f, args.case, args.poisson))
@@ -267,11 +270,29 @@ def title(f, args, s, count, where):
     return "%s   t = %.4g s   (snapshot %d of %d, %s)" % (name, t, s + 1, count, where)
 
 
+def active_elements(f, s):
+    """Which elements are still there in snapshot s: /snapshots/active of a
+    case with stages (0 once excavated), None when every element is."""
+    if "/snapshots/active" not in f:
+        return None
+    return f["/snapshots/active"][s] != 0
+
+
+def snapshot_triangulation(f, s):
+    """The triangles of snapshot s at its positions, the excavated ones
+    masked out (drawn neither filled nor as edges)."""
+    xy, where = snapshot_positions(f, s)
+    tri = Triangulation(xy[:, 0], xy[:, 1], f["/mesh/triangles"][:])
+    active = active_elements(f, s)
+    if active is not None:
+        tri.set_mask(~active)
+    return tri, xy, where
+
+
 def plot_2d(f, args, field):
     s, count = snapshot_index(f, args.snapshot)
     triangles = f["/mesh/triangles"][:]
-    xy, where = snapshot_positions(f, s)
-    tri = Triangulation(xy[:, 0], xy[:, 1], triangles)
+    tri, xy, where = snapshot_triangulation(f, s)
 
     width = np.ptp(xy[:, 0]) or 1.0
     height = np.ptp(xy[:, 1]) or 1.0
@@ -329,11 +350,19 @@ def boundary_faces(tetrahedra, held_joints=None):
 
 
 def surface_of_snapshot(f, s):
-    """The boundary faces of snapshot s: joints with damage below 1 hold."""
+    """The boundary faces of snapshot s: joints with damage below 1 hold;
+    of a case with stages, the surface of the elements not excavated (an
+    excavation's walls show)."""
     held = None
     if "/mesh/joints" in f and "/snapshots/damage" in f:
         held = f["/mesh/joints"][:][f["/snapshots/damage"][s] < 1.0]
-    return boundary_faces(f["/mesh/tetrahedra"][:], held)
+    tetrahedra = f["/mesh/tetrahedra"][:]
+    active = active_elements(f, s)
+    if active is None:
+        return boundary_faces(tetrahedra, held)
+    kept = np.flatnonzero(active)
+    faces, element = boundary_faces(tetrahedra[kept], held)
+    return faces, kept[element]
 
 
 def face_stress(f, s, element, args):

@@ -29,6 +29,10 @@ int fdem_fragment_labels(const fdem_model *m, int32_t *label)
     for (int e = 0; e < E; e++) root_id[e] = -1;
     int count = 0;
     for (int e = 0; e < E; e++) {
+        if (!element_is_active(m, e)) {
+            label[e] = -1; /* excavated: in no fragment */
+            continue;
+        }
         int32_t root = label[e];
         if (root_id[root] < 0) root_id[root] = count++;
         label[e] = root_id[root];
@@ -61,7 +65,9 @@ int fdem_fragments(const fdem_model *m, fdem_fragment **out)
         free(node_piece);
         return -1;
     }
+    for (int i = 0; i < N; i++) node_piece[i] = -1;
     for (int e = 0; e < E; e++) {
+        if (label[e] < 0) continue; /* excavated */
         fdem_fragment *p = &f[label[e]];
         double size = element_size0(m, e);
         if (p->elements == 0) p->part = m->elem_part[e];
@@ -70,7 +76,8 @@ int fdem_fragments(const fdem_model *m, fdem_fragment **out)
         p->mass += m->materials[element_material(m, e)].def.density * size;
         for (int c = 0; c < K; c++) node_piece[m->elem_node[(size_t)K * (size_t)e + (size_t)c]] = label[e];
     }
-    /* every node belongs to some element, and all of an element's nodes to its piece */
+    /* every node belongs to some element, and all of an element's nodes to
+     * its piece; a node only excavated elements held belongs to none */
     double *node_mass = calloc((size_t)(count ? count : 1), sizeof(double));
     if (!node_mass) {
         free(f);
@@ -79,6 +86,7 @@ int fdem_fragments(const fdem_model *m, fdem_fragment **out)
         return -1;
     }
     for (int i = 0; i < N; i++) {
+        if (node_piece[i] < 0) continue;
         fdem_fragment *p = &f[node_piece[i]];
         double mass = m->mass[i];
         node_mass[node_piece[i]] += mass;

@@ -65,6 +65,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
+    stages_free(m);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     joint_sweep_free(&m->joint_sweep);
@@ -471,6 +472,17 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     }
     if (def->select == FDEM_SELECT_VERTICES && (def->vertex_count < 1 || !def->vertices)) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k, "constraint %d selects an empty list of vertices", k);
+        return -1;
+    }
+    if (def->only_stage < 0) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    "constraint %d: only_stage is %d; 0 acts throughout, k + 1 during stage k only",
+                    k, def->only_stage);
+        return -1;
+    }
+    if (def->only_stage && def->kind == FDEM_CONSTRAINT_ABSORB) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    "constraint %d: an absorbing boundary acts throughout, not during one stage", k);
         return -1;
     }
     int has_amplitude = def->amplitude != NULL || def->amplitude_count != 0;

@@ -207,5 +207,11 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += scatter_plan_bytes(&m->elem_plan) + joint_sweep_bytes(&m->joint_sweep) +
          scatter_plan_bytes(&m->node_plan);
     b += contact_memory_bytes(&m->contact);
+    /* stages: their lists to excavate and ramps; elem_active, node_frozen */
+    b += (size_t)m->stage_capacity * sizeof(run_stage);
+    for (int k = 0; k < m->stage_count; k++)
+        b += (size_t)m->stages[k].excavate_count * sizeof(int32_t) +
+             (size_t)m->stages[k].ramp_count * (sizeof(int32_t) + D * sizeof(double));
+    if (m->elem_active) b += (size_t)m->elem_count + (size_t)m->node_count;
     return b;
 }

@@ -36,6 +36,27 @@ typedef struct checkpoint_header_v1 {
     double contact_work, damping_work, external_work;
 } checkpoint_header_v1;
 
+/* The energy accounts as a header holds them: fdem_energy as it was up to
+ * version 7 (version 8 added `excavated`, which the stage section holds),
+ * so the header keeps its layout. */
+typedef struct checkpoint_energy {
+    double kinetic, elastic, joint, contact, friction, fracture, damping, gravity_work,
+        external_work, residual;
+} checkpoint_energy;
+
+static checkpoint_energy checkpoint_energy_of(const fdem_energy *e)
+{
+    return (checkpoint_energy){e->kinetic, e->elastic, e->joint, e->contact, e->friction,
+                               e->fracture, e->damping, e->gravity_work, e->external_work,
+                               e->residual};
+}
+
+static fdem_energy energy_of_checkpoint(const checkpoint_energy *c, double excavated)
+{
+    return (fdem_energy){c->kinetic, c->elastic, c->joint, c->contact, c->friction, c->fracture,
+                         c->damping, c->gravity_work, c->external_work, c->residual, excavated};
+}
+
 /* Version 2 adds what makes a restored run continue bit for bit: the last
  * detection's positions and the largest displacement since (so detection
  * reruns at the same steps with the same pairs), the stick springs, and
@@ -49,7 +70,7 @@ typedef struct checkpoint_header {
     int64_t spring_records;
     int32_t has_viscous;
     int32_t dimension;       /* 0 in files written before 3D: 2 */
-    fdem_energy energy;      /* the accounts at the checkpoint, shown until the next step */
+    checkpoint_energy energy; /* the accounts at the checkpoint, shown until the next step */
     /* version 3: the friction of intact joints (0 from a version 2 file,
      * written before joints booked any) */
     double joint_friction_energy;
@@ -60,7 +81,9 @@ typedef struct checkpoint_header {
     int64_t pending_events;
     /* version 6: time's compensation (model_time_after; 0 from earlier
      * files, whose time was summed plainly). Version 7: the same header;
-     * the slip each joint point keeps (joint_law.h) follows the events. */
+     * the slip each joint point keeps (joint_law.h) follows the events.
+     * Version 8: the same header; a model with stages has its stage
+     * section (step/stages.c) after the slip. */
     double time_carry;
 } checkpoint_header;
 
@@ -95,7 +118,7 @@ size_t fdem_checkpoint_size(const fdem_model *m)
     return sizeof(checkpoint_header) +
            checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
                                 contact_history_checkpoint_size(&m->contact)) +
-           events_checkpoint_size(m) + checkpoint_slip_size(m);
+           events_checkpoint_size(m) + checkpoint_slip_size(m) + stages_checkpoint_size(m);
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
@@ -119,7 +142,8 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     h.has_viscous = m->elem_viscous != NULL;
     h.dimension = m->dim;
     h.spring_records = (int64_t)(spring_bytes / contact_record_bytes(&m->contact));
-    h.energy = fdem_get_energy(m);
+    fdem_energy energy = fdem_get_energy(m);
+    h.energy = checkpoint_energy_of(&energy);
     h.pending_events = m->event_count;
     h.time_carry = m->time_carry;
     unsigned char *p = buf;
@@ -146,6 +170,8 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     events_checkpoint_write(m, p);
     p += events_checkpoint_size(m);
     if (m->joint_count) memcpy(p, m->joint_slip, checkpoint_slip_size(m));
+    p += m->joint_count ? checkpoint_slip_size(m) : 0;
+    stages_checkpoint_write(m, p);
     return 0;
 }
 
@@ -244,7 +270,10 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
                         sizeof(fdem_event) * (size_t)h.pending_events;
         if (h1.version >= 7) expected += checkpoint_slip_size(m);
     }
-    if (size != expected) {
+    /* the stage section's size depends on its ramps: it is checked as it
+     * is read, and takes what follows the fixed part */
+    size_t stage_bytes = h1.version >= 8 && m->stage_count && size > expected ? size - expected : 0;
+    if (size != expected + stage_bytes || (h1.version >= 8 && m->stage_count && !stage_bytes)) {
         model_error(err, FDEM_ITEM_NONE, -1, "checkpoint has %zu bytes, expected %zu", size,
                     expected);
         return -1;
@@ -275,6 +304,17 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         else
             memset(m->joint_slip, 0, checkpoint_slip_size(m));
     }
+    /* the stages before the counts below: they leave excavated joints out */
+    size_t stage_used = 0;
+    if (stage_bytes &&
+        (stages_checkpoint_read(m, events + events_checkpoint_size(m) +
+                                       (m->joint_count ? checkpoint_slip_size(m) : 0),
+                                stage_bytes, &stage_used, err) ||
+         stage_used != stage_bytes)) {
+        if (stage_used != stage_bytes)
+            model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's stage section does not fit");
+        return -1;
+    }
     size_t nb = sizeof(double) * (size_t)m->dim * (size_t)m->node_count;
     size_t vb = sizeof(double) * (size_t)model_stress_comps(m) * (size_t)m->elem_count;
     memcpy(m->pos, p, nb);
@@ -296,8 +336,9 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     m->fracture_energy = h.fracture_energy;
     m->joint_friction_energy = h.joint_friction_energy;
     m->broken_joints = 0;
-    for (int j = 0; j < m->joint_count; j++) m->broken_joints += m->joint_damage[j] >= 1.0;
-    if (m->joint_count) m->fragments = joint_fragment_count(m);
+    for (int j = 0; j < m->joint_count; j++)
+        m->broken_joints += m->joint_damage[j] >= 1.0 && !joint_is_excavated(m, j);
+    if (m->joint_count || m->elem_active) m->fragments = joint_fragment_count(m);
     memset(m->force, 0, nb);
     m->fixed_valid = 0; /* computed again from the restored positions: the same bits */
     if (h1.version == 1 || !h.has_detection) {
@@ -326,7 +367,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     } else {
         m->elastic_energy = h.energy.elastic;
         m->joint_energy = h.energy.joint;
-        m->restored_energy = h.energy;
+        m->restored_energy = energy_of_checkpoint(&h.energy, m->excavated_energy);
         m->restored_energy_valid = 1;
         energy_gravity_restored(m, h.energy.gravity_work);
     }

@@ -456,6 +456,22 @@ static void contact_drop_joined(fdem_model *m)
     contact_pairs_fit(&cs->pairs);
 }
 
+/* Candidate pair k's force now, both roles, into out (pair_out numbers),
+ * on a copy of its stick springs: nothing in m changes. 1 if they touch. */
+int contact_pair_force_now(const fdem_model *m, size_t k, double *out)
+{
+    const contact_state *cs = &m->contact;
+    int a = cs->pairs.a[k], b = cs->pairs.b[k];
+    double ba[6] = {0}, bb[6] = {0}, springs[CONTACT_SLOTS_MAX] = {0};
+    element_box(m, a, ba);
+    element_box(m, b, bb);
+    if (!boxes_overlap(ba, bb, m->dim)) return 0;
+    int32_t set = k < cs->pair_capacity ? cs->spring_of[k] : -1;
+    if (set >= 0)
+        memcpy(springs, cs->slip + (size_t)cs->slots * (size_t)set, sizeof(double) * (size_t)cs->slots);
+    return contact_pair_force(m, a, b, m->dt_prev, springs, out, NULL);
+}
+
 /* Candidate pairs from the bounding circles or spheres of the elements at
  * `pos` (the current positions, or a checkpoint's positions at its last
  * detection), with the stick springs of the pairs that stay. */
@@ -476,6 +492,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
                              : nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r,
                                           cs->body, &cs->pairs);
     if (failed) return -1;
+    if (m->elem_active) contact_drop_excavated(m);
     if (m->joint_count) contact_drop_joined(m);
     if (contact_history_take_back(cs)) return -1;
     cs->active_count = contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, cs->active);

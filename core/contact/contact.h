@@ -28,6 +28,13 @@ double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m);
 int contact_restore_detection(fdem_model *m);
 size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
+int contact_pair_force_now(const fdem_model *m, size_t k, double *out);
+
+/* contact_excavation.c: the forces of the candidate pairs between removed
+ * and remaining elements on the remaining ones, added to f (dim per node;
+ * returns 0); the candidate pairs of excavated elements dropped */
+int contact_excavation_forces(fdem_model *m, const uint8_t *removed, double *f);
+void contact_drop_excavated(fdem_model *m);
 
 /* contact_history.c */
 int contact_history_reserve(contact_state *cs, size_t pairs);

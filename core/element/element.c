@@ -8,6 +8,8 @@
  * triangles, element_tet_model.c for tetrahedra. What the two share (the
  * walk, the sums, how damping is booked) lives here, once.
  */
+#include <string.h>
+
 #include "model/model.h"
 #include "element.h"
 
@@ -45,6 +47,24 @@ static void forces_by_part_runs(fdem_model *m, int begin, int end, double sums[S
     }
 }
 
+/* With excavated elements (elem_active): the runs of active elements of
+ * a block, each as forces_by_part_runs does a block; the excavated ones
+ * are skipped (step/excavation.c). Only such models take this path. */
+static void forces_of_active_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    const uint8_t *active = m->elem_active;
+    for (int e = begin; e < end;) {
+        if (!active[e]) {
+            e++;
+            continue;
+        }
+        int stop = e + 1;
+        while (stop < end && active[stop]) stop++;
+        forces_by_part_runs(m, e, stop, sums);
+        e = stop;
+    }
+}
+
 /* Runs the element blocks through the model's scatter plan (threads side
  * by side within a colour). A block hands back the strain energy (sums[0])
  * and the power of the viscous stresses with the velocities before this
@@ -58,17 +78,23 @@ void element_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
     const int kept = fixed_parts_kept(m);
-    scatter_block_fn run = m->elem_stress0 || kept ? forces_by_part_runs
-                           : m->dim == 3           ? tet_element_forces_range
-                                                   : tri_element_forces_range;
+    scatter_block_fn run = m->elem_active               ? forces_of_active_runs
+                           : m->elem_stress0 || kept ? forces_by_part_runs
+                           : m->dim == 3             ? tet_element_forces_range
+                                                     : tri_element_forces_range;
     scatter_plan_run(&m->elem_plan, m, m->threads, run, sums);
     double elastic = kept ? sums[0] + fixed_parts_forces(m) : sums[0];
     m->elastic_energy = m->elem_stress0 ? elastic + m->stress0_energy : elastic;
     m->damping_work -= 0.5 * (m->dt_prev + m->dt) * 0.5 * sums[1] + 0.5 * m->havg_last * sums[2];
 }
 
+/* An excavated element carries no stress. */
 void element_stress_one(const fdem_model *m, int e, double *out)
 {
+    if (!element_is_active(m, e)) {
+        memset(out, 0, sizeof(double) * (size_t)model_stress_comps(m));
+        return;
+    }
     if (m->dim == 3) tet_element_stress(m, e, out);
     else tri_element_stress(m, e, out);
 }

@@ -20,6 +20,9 @@
  * stiffness of a tensile pre-stress (1 for elements without) */
 int initial_stress_prepare(fdem_model *m, fdem_error *err);
 double initial_stress_dt_factor(const fdem_model *m, int e);
+/* the energy the in-situ stress holds at t = 0 in the active elements
+ * (stress0_energy, summed as initial_stress_prepare sums it) */
+double initial_stress_energy(const fdem_model *m);
 
 /* element.c: the element stage of either dimension (prepare, stable step,
  * forces through the scatter plan, stress), calling the kernels below */

@@ -122,6 +122,22 @@ int initial_stress_prepare(fdem_model *m, fdem_error *err)
     return 0;
 }
 
+double initial_stress_energy(const fdem_model *m)
+{
+    const int S = model_stress_comps(m);
+    double sum = 0;
+    for (int k = 0; k < m->stress0_def_count; k++) {
+        const part *p = &m->parts[m->stress0_defs[k].part];
+        const material *mat = &m->materials[p->material];
+        for (int e = p->elem_begin; e < p->elem_begin + p->elem_count; e++)
+            if (element_is_active(m, e))
+                sum += element_size0(m, e) *
+                       locked_energy_density(m->dim, m->elem_stress0 + (size_t)S * (size_t)e,
+                                             mat->lambda, mat->mu);
+    }
+    return sum;
+}
+
 /* A pre-stress sigma0 adds the geometric stiffness A grad(u) . sigma0 .
  * grad(u) (per unit size), at most sigma_1 |grad u|^2 for the largest
  * principal stress sigma_1 > 0; the elastic stiffness of the mode with the

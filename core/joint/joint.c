@@ -221,7 +221,9 @@ void joint_mark_broken_vertices(fdem_model *m)
     if (!m->joint_count) return;
     memset(m->vertex_broken, 0, (size_t)m->node_count);
     for (int j = 0; j < m->joint_count; j++) {
-        if (m->joint_damage[j] < 1.0) continue;
+        /* an excavated joint opens no crack: the elements around its
+         * vertices that remain are still glued (element_on_crack) */
+        if (m->joint_damage[j] < 1.0 || (m->elem_active && joint_is_excavated(m, j))) continue;
         const int32_t *n = m->joint_node + 2 * m->dim * (size_t)j;
         for (int i = 0; i < m->dim; i++) m->vertex_broken[m->node_origin[n[i]]] = 1;
     }
@@ -240,7 +242,15 @@ static int element_on_crack(const fdem_model *m, int e)
     const int32_t *n = m->elem_node + (size_t)K * (size_t)e;
     int on = 0;
     for (int i = 0; i < K; i++) on |= m->vertex_broken[m->node_origin[n[i]]];
-    return on;
+    if (on || !m->elem_active) return on;
+    /* a face on an excavated opening is exposed as a crack's is: the
+     * elements across the opening may meet if it closes */
+    const int faces = m->dim + 1;
+    for (int c = 0; c < faces; c++) {
+        int j = m->elem_joint[faces * e + c];
+        if (j >= 0 && joint_is_excavated(m, j)) return 1;
+    }
+    return 0;
 }
 
 /* True when contact between a and b (of one fracturing part) can be left
@@ -550,11 +560,31 @@ static int uf_find(int32_t *parent, int i)
 /* Labels every element with its piece (elements joined by intact joints;
  * a part that does not fracture is one piece): label[e] is the smallest
  * element of e's piece. Returns the number of pieces. */
+/* The first active element of part p (its piece's root once elements were
+ * excavated), or the part's first element when none is left. */
+static int part_root(const fdem_model *m, int p)
+{
+    const part *pt = &m->parts[p];
+    for (int e = pt->elem_begin; e < pt->elem_begin + pt->elem_count; e++)
+        if (element_is_active(m, e)) return e;
+    return pt->elem_begin;
+}
+
+/* An excavated element is a piece of its own that is not counted (its
+ * joints read broken: excavation.c). A part that does not fracture stays
+ * one piece however excavation cuts it. */
 int joint_fragment_labels(const fdem_model *m, int32_t *label)
 {
+    int root = -1, root_part = -1;
     for (int e = 0; e < m->elem_count; e++) {
         int p = m->elem_part[e];
-        label[e] = m->parts[p].fracture ? e : m->parts[p].elem_begin;
+        if (m->parts[p].fracture || !element_is_active(m, e)) {
+            label[e] = e;
+            continue;
+        }
+        if (p != root_part) root = m->elem_active ? part_root(m, p) : m->parts[p].elem_begin;
+        root_part = p;
+        label[e] = root;
     }
     for (int j = 0; j < m->joint_count; j++) {
         if (m->joint_damage[j] >= 1.0) continue;
@@ -564,7 +594,7 @@ int joint_fragment_labels(const fdem_model *m, int32_t *label)
     int count = 0;
     for (int e = 0; e < m->elem_count; e++) {
         label[e] = uf_find(label, e);
-        count += label[e] == e;
+        count += label[e] == e && element_is_active(m, e);
     }
     return count;
 }

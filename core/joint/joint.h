@@ -41,6 +41,14 @@ static inline void joint_totals_store(const joint_totals *t, double sums[SCATTER
 }
 
 
+/* Joint j is on an excavated element: it holds nothing (damage 1) but did
+ * not break (step/excavation.c). */
+static inline int joint_is_excavated(const fdem_model *m, int j)
+{
+    return !element_is_active(m, m->joint_elem[2 * j]) ||
+           !element_is_active(m, m->joint_elem[2 * j + 1]);
+}
+
 /* joint.c (the cohesive law itself, joint_softening included: joint_law.h) */
 /* The cohesive constants of a joint of strength s at stiffness k. */
 static inline joint_law joint_law_of(const joint_strength *s, double k)

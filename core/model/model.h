@@ -112,6 +112,21 @@ typedef struct constraint {
                                      model.bfacet_* */
 } constraint;
 
+/* A stage of the run (fdem_add_stage, step/stages.c): its end, its
+ * excavation (a sorted copy of the element indices) and, once started, the
+ * unloading ramp: the forces the removed elements exerted on the remaining
+ * nodes at that moment (excavation.c), applied times 1 - s. */
+typedef struct run_stage {
+    double end, relax;
+    int32_t *excavate;   /* sorted, without repeats */
+    int excavate_count;
+    double t_start;      /* the start time of its first step, once started */
+    int ramp_count;      /* nodes with an unloading force */
+    int32_t *ramp_node;  /* ascending */
+    double *ramp_force;  /* dim per ramp node */
+    double ramp_scale;   /* 1 - s of the current step (0 once the ramp is over) */
+} run_stage;
+
 /* Partial sums a scatter block hands back (see scatter_plan_run below). */
 #define SCATTER_SUMS 7
 #define SCATTER_MAX 5 /* sums[SCATTER_MAX] and on are maxima, not sums */
@@ -338,6 +353,18 @@ struct fdem_model {
                                     step (the last step's forces they need are not stored) */
     int restored_energy_valid;
 
+    /* stages (step/stages.c, step/excavation.c); stage_count == 0 without */
+    int stage_count, stage_capacity;
+    run_stage *stages;
+    int stages_started;      /* stages whose start (excavation) is done */
+    int stage_now;           /* the stage of the last step (0 before the first) */
+    uint8_t *elem_active;    /* per element, 1 active, 0 excavated; NULL until the first
+                                excavation */
+    uint8_t *node_frozen;    /* per node: only excavated elements held it (with elem_active) */
+    double excavated_energy; /* fdem_energy.excavated */
+    double gravity_work_removed; /* gravity's work on mass that left, up to its removal */
+    double ramp_power_old, ramp_power_new; /* the unloading forces' power, v before/after */
+
     contact_state contact;
     fdem_stage_times times;
 
@@ -400,6 +427,12 @@ static inline int model_part_stores_forces(const fdem_model *m, const part *p)
 static inline double element_size0(const fdem_model *m, int e)
 {
     return m->dim == 3 ? m->tet[e].volume0 : m->elem[e].area0;
+}
+
+/* Element e has not been excavated. */
+static inline int element_is_active(const fdem_model *m, int e)
+{
+    return !m->elem_active || m->elem_active[e];
 }
 
 static inline double element_eta(const fdem_model *m, int e)

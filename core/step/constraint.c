@@ -88,6 +88,10 @@ void constraint_set_time(fdem_model *m, double velocity_time)
     }
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
+        if (!constraint_active(m, c)) { /* outside its stage: applies nothing */
+            memset(c->value_now, 0, sizeof c->value_now);
+            continue;
+        }
         if (!c->amplitude) {
             memcpy(c->value_now, c->def.value, sizeof c->value_now);
             continue;
@@ -97,6 +101,46 @@ void constraint_set_time(fdem_model *m, double velocity_time)
         for (int d = 0; d < 3; d++) c->value_now[d] = c->def.value[d] * a;
         c->amplitude_now = a;
     }
+}
+
+/* Each prescribed dof to the last constraint (in case order) that
+ * prescribes it among those acting in the stage now (constraint_active);
+ * a node only excavated elements held (node_frozen) has every dof owned,
+ * by no constraint, so it stands still. Called at finalize and whenever
+ * the stage or the excavated elements change (stages.c). */
+int constraint_assign_dofs(fdem_model *m)
+{
+    const int D = m->dim;
+    int32_t *owner = malloc(sizeof(int32_t) * (size_t)D * (size_t)(m->node_count ? m->node_count : 1));
+    if (!owner) return -1;
+    for (int i = 0; i < D * m->node_count; i++) owner[i] = -1;
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        unsigned dofs = constraint_active(m, c) ? constraint_dofs(m, c) : 0;
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            if (m->node_frozen && m->node_frozen[i]) continue;
+            for (int d = 0; d < D; d++)
+                if (dofs & (1u << d)) owner[D * i + d] = k;
+        }
+    }
+    memset(m->dof_owned, 0, (size_t)m->node_count);
+    for (int k = 0; k < m->constraint_count; k++) {
+        const constraint *c = &m->constraints[k];
+        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
+            int i = m->cnode[e];
+            unsigned own = 0;
+            for (int d = 0; d < D; d++)
+                if (owner[D * i + d] == k) own |= 1u << d;
+            m->cdof[e] = (uint8_t)own;
+            m->dof_owned[i] |= m->cdof[e];
+        }
+    }
+    free(owner);
+    if (m->node_frozen)
+        for (int i = 0; i < m->node_count; i++)
+            if (m->node_frozen[i]) m->dof_owned[i] = (uint8_t)((1u << D) - 1);
+    return 0;
 }
 
 int constraint_select(fdem_model *m, fdem_error *err)
@@ -135,37 +179,21 @@ int constraint_select(fdem_model *m, fdem_error *err)
     const int D = m->dim;
     m->constraint_force_out = calloc((size_t)D * (size_t)(m->constraint_count ? m->constraint_count : 1),
                                      sizeof(double));
-    int32_t *owner = malloc(sizeof(int32_t) * (size_t)D * (size_t)m->node_count);
-    if (!m->cnode || !m->cdof || !m->dof_owned || !m->constraint_force_out || !owner) {
-        free(owner);
+    if (!m->cnode || !m->cdof || !m->dof_owned || !m->constraint_force_out) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for constraints");
         return -1;
     }
     m->cnode_count = total;
-    for (int i = 0; i < D * m->node_count; i++) owner[i] = -1;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
-        unsigned dofs = constraint_dofs(m, c);
         int at = c->entry_begin;
-        for (int i = 0; i < m->node_count; i++) {
-            if (!constraint_selects(m, c, i)) continue;
-            m->cnode[at++] = i;
-            for (int d = 0; d < D; d++)
-                if (dofs & (1u << d)) owner[D * i + d] = k;
-        }
+        for (int i = 0; i < m->node_count; i++)
+            if (constraint_selects(m, c, i)) m->cnode[at++] = i;
     }
-    for (int k = 0; k < m->constraint_count; k++) {
-        const constraint *c = &m->constraints[k];
-        for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) {
-            int i = m->cnode[e];
-            unsigned own = 0;
-            for (int d = 0; d < D; d++)
-                if (owner[D * i + d] == k) own |= 1u << d;
-            m->cdof[e] = (uint8_t)own;
-            m->dof_owned[i] |= m->cdof[e];
-        }
+    if (constraint_assign_dofs(m)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for constraints");
+        return -1;
     }
-    free(owner);
     /* Prescribed velocities hold from t = 0 on. */
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
@@ -283,9 +311,18 @@ void constraint_enforce(fdem_model *m, double h, double havg)
                 size_t i = (size_t)m->cnode[e], at = (size_t)D * i;
                 double power = 0;
                 for (int d = 0; d < D; d++) {
+                    double share = c->value_now[d] / c->entry_count;
+                    /* a prescribed dof moves at its prescribed velocity (0
+                     * when fixed): the support takes the force, and the
+                     * free update's acceleration is not its own (booking
+                     * it gave a fixed node work at rest) */
+                    if (m->dof_owned[i] & (1u << d)) {
+                        power += share * m->vel[at + d];
+                        continue;
+                    }
                     /* velocities were already advanced: v_old = v_new - a havg */
                     double a = (m->force[at + d] + (fc ? fc[at + d] : 0)) / m->mass[i] + m->gravity[d];
-                    power += c->value_now[d] / c->entry_count * (m->vel[at + d] - 0.5 * a * havg);
+                    power += share * (m->vel[at + d] - 0.5 * a * havg);
                 }
                 s.external_work += power * havg;
             }

@@ -105,6 +105,7 @@ static double constraints_last_half_step(const fdem_model *m)
             for (int d = 0; d < D; d++) power += c->force[d] * c->value_now[d];
         }
     }
+    power += m->ramp_power_new; /* excavations' unloading forces (stages.c) */
     return 0.5 * m->havg_last * power + boundary_load_last_half_step(m, 0);
 }
 
@@ -129,6 +130,32 @@ void energy_gravity_step(fdem_model *m, double havg)
     for (int d = 0; d < m->dim; d++)
         m->gravity_work_sum += m->gravity[d] * 0.5 * (m->momentum[d] + p[d]) * havg;
     memcpy(m->momentum, p, sizeof p);
+}
+
+/* Excavation took mass off the nodes (old_mass: before; m->mass: after),
+ * at the start of a step, where positions are x_n. Gravity's work on that
+ * mass up to now stays in the account: with a constant gravity the work is
+ * M g . (x_n - x_0) over the masses left, plus what it did on the mass
+ * that left (gravity_work_removed); with an amplitude the sum booked step
+ * by step already holds it, and the momentum it goes on from is that of
+ * the masses left. */
+void energy_mass_removed(fdem_model *m, const double *old_mass)
+{
+    const int D = m->dim;
+    if (m->gravity_amplitude) {
+        total_momentum(m, m->momentum);
+        return;
+    }
+    double work = 0;
+    for (int i = 0; i < m->node_count; i++) {
+        double gone = old_mass[i] - m->mass[i];
+        if (gone == 0) continue;
+        for (int d = 0; d < D; d++) {
+            size_t k = (size_t)D * (size_t)i + (size_t)d;
+            work += gone * m->gravity[d] * (m->pos[k] - m->pos0[k]);
+        }
+    }
+    m->gravity_work_removed += work;
 }
 
 /* After a checkpoint is read: the sum that reports the stored gravity work. */
@@ -184,9 +211,11 @@ fdem_energy fdem_get_energy(const fdem_model *m)
      * +0 (a model without contacts showed "contact -0") */
     en.contact = (0.5 * havg * contact_power - m->contact_work) - m->friction_energy;
     en.damping = m->damping_work + boundary_load_last_half_step(m, 1);
-    en.gravity_work = m->gravity_amplitude ? gravity_work_of_amplitude(m) : gravity_work;
+    en.gravity_work = m->gravity_amplitude ? gravity_work_of_amplitude(m)
+                                           : gravity_work + m->gravity_work_removed;
     en.external_work = m->external_work - constraints_last_half_step(m);
+    en.excavated = m->excavated_energy;
     en.residual = en.kinetic + en.elastic + en.joint + en.contact + en.friction + en.fracture +
-                  en.damping - en.gravity_work - en.external_work - initial;
+                  en.damping + en.excavated - en.gravity_work - en.external_work - initial;
     return en;
 }

@@ -413,6 +413,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     double h = m->dt, havg = 0.5 * (m->dt_prev + h);
     double t0 = stage_clock();
+    if (m->stage_count && stages_advance(m, err)) return -1;
     constraint_set_time(m, m->time + 0.5 * h);
     forces_clear(m);
     element_forces(m);
@@ -439,8 +440,10 @@ int fdem_step(fdem_model *m, fdem_error *err)
     double t2 = stage_clock();
     constraint_apply_forces(m);
     boundary_load_apply(m);
+    if (m->stages_started) stages_ramp_apply(m);
     int bad = central_difference_step(m);
     constraint_enforce(m, h, havg);
+    if (m->stages_started) stages_ramp_account(m, havg);
     boundary_load_account(m, havg);
     energy_gravity_step(m, havg);
     m->times.integration += stage_clock() - t2;

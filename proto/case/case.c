@@ -20,8 +20,8 @@
 #define CASE_DEFAULT_SAFETY 0.5
 
 static const char *const top_keys[] = {
-    "name", "dimension", "materials", "parts", "constraints", "gravity", "gravity_amplitude", "time", "output",
-    NULL,
+    "name", "dimension", "materials", "parts", "constraints", "stages", "gravity",
+    "gravity_amplitude", "time", "output", NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
@@ -69,19 +69,25 @@ static void case_read_dt(case_doc *doc, const json_t *dt)
         case_problem(doc, "/time/dt", "dt must be > 0, got %g", doc->dt);
 }
 
+/* With stages, time.end may be left out: the last stage's end is the end
+ * (case_check_stage_end reconciles the two after this). */
 static void case_read_time(case_doc *doc, const json_t *time)
 {
     doc->safety = CASE_DEFAULT_SAFETY;
     doc->dt_auto = 1;
+    int end_required = !doc->stages_given;
     if (!time) {
-        case_problem(doc, "", "missing required \"time\" {\"end\": seconds}");
+        if (end_required) case_problem(doc, "", "missing required \"time\" {\"end\": seconds}");
         return;
     }
     if (!case_expect_object(doc, time, "/time")) return;
     case_check_keys(doc, time, "/time", time_keys, "\"time\"");
-    if (case_number_member(doc, time, "/time", "end", 1, &doc->end_time) &&
-        !(doc->end_time > 0))
-        case_problem(doc, "/time/end", "end must be > 0, got %g", doc->end_time);
+    doc->end_given = json_object_get(time, "end") != NULL;
+    double end = 0;
+    if (case_number_member(doc, time, "/time", "end", end_required, &end) && doc->end_given) {
+        if (!(end > 0)) case_problem(doc, "/time/end", "end must be > 0, got %g", end);
+        else doc->end_time = end;
+    }
     case_read_dt(doc, json_object_get(time, "dt"));
     if (case_number_member(doc, time, "/time", "safety", 0, &doc->safety) &&
         !(doc->safety > 0 && doc->safety <= 1))
@@ -182,9 +188,12 @@ static void case_read(case_doc *doc, const json_t *root)
     else case_problem(doc, "", "missing required \"parts\" [...]");
     json_t *constraints = json_object_get(root, "constraints");
     if (constraints) case_read_constraints(doc, constraints);
+    json_t *stages = json_object_get(root, "stages");
+    if (stages) case_read_stages(doc, stages);
     case_read_gravity(doc, json_object_get(root, "gravity"));
     case_read_gravity_amplitude(doc, json_object_get(root, "gravity_amplitude"));
     case_read_time(doc, json_object_get(root, "time"));
+    case_check_stage_end(doc);
     case_read_output(doc, json_object_get(root, "output"));
 }
 
@@ -197,9 +206,7 @@ static int case_check_selections(case_doc *doc, const fdem_model *model)
     int ok = 1;
     for (int i = 0; i < doc->constraint_count; i++)
         if (fdem_constraint_node_count(model, i) <= 0) {
-            char ptr[CASE_POINTER];
-            pointer_join_index(ptr, sizeof ptr, "/constraints", i);
-            case_problem(doc, ptr, "the constraint selects no node");
+            case_problem(doc, doc->constraints[i].ptr, "the constraint selects no node");
             ok = 0;
         }
     return ok;
@@ -281,9 +288,15 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
     fdem_error err = {0};
     int ok = fdem_set_dimension(model, doc->dimension, &err) == 0;
     if (!ok) case_engine_problem(doc, &err, "/dimension");
-    /* parts and constraints both, whatever the other finds (one answer) */
+    /* parts and constraints both, whatever the other finds (one answer);
+     * stages select elements of the parts, and stage constraints name
+     * their stage, so the stages go in between */
     ok = ok && case_add_materials(doc, model) == 0;
-    ok = ok && (case_add_parts(doc, model) == 0) & (case_add_constraints(doc, model) == 0);
+    if (ok) {
+        int parts = case_add_parts(doc, model) == 0;
+        int stages = parts && case_add_stages(doc, model) == 0;
+        ok = parts & stages & (case_add_constraints(doc, model, stages) == 0);
+    }
     if (ok) {
         fdem_set_gravity_v(model, doc->gravity);
         ok = fdem_set_gravity_amplitude(model, doc->gravity_amplitude,
@@ -321,6 +334,15 @@ static void case_fill_info(const case_doc *doc, case_info *info)
     info->constraint_count = doc->constraint_count;
     info->fracture = 0;
     for (int i = 0; i < doc->part_count; i++) info->fracture |= doc->parts[i].fracture;
+    info->stage_count = doc->stage_count;
+    for (int k = 0; k < doc->stage_count; k++)
+        snprintf(info->stage_names[k], sizeof info->stage_names[k], "%s", doc->stages[k].name);
+}
+
+const char *case_stage_name(const case_info *info, int index)
+{
+    if (!info || index < 0 || index >= info->stage_count) return NULL;
+    return info->stage_names[index];
 }
 
 static json_t *case_parse(const char *text, size_t length, problems *out)

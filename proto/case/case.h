@@ -11,6 +11,11 @@
  *  - time.dt "auto" = safety x fdem_stable_dt(); a number above the stable
  *    step is rejected with 422 naming the stable value.
  *  - On success the model is finalized, its dt set, and `info` filled.
+ *  - "stages" (contract 6.1, case_stage.c): the engine gets each stage's
+ *    end, relax and excavated element indices (fdem_add_stage) and every
+ *    stage constraint with def.only_stage = k + 1, after the top-level
+ *    ones; info gets the stage names (the engine has none) and, when
+ *    time.end is left out, the last stage's end as end_time.
  *
  * Folder proto/case/, the case document -> engine model: owns this header
  * (case_build(), case_info, the CASE_FIELD_* bits, case_parse_fields()) and
@@ -53,6 +58,11 @@ enum case_field {
  * it stores) or its effect on the stable step is not finite. */
 #define CASE_MAX_INITIAL_STRESS 1e15
 #define CASE_DEFAULT_SNAPSHOTS 100
+/* Stages a case may have (contract 6.1 "Stages"), and the room for a
+ * stage's name with its NUL. The names live in case_info (the status and
+ * GET /state name the current stage), so both are bounded. */
+#define CASE_MAX_STAGES 256
+#define CASE_STAGE_NAME 64
 
 typedef struct case_info {
     char name[128];
@@ -65,7 +75,13 @@ typedef struct case_info {
     int part_count;
     int constraint_count;
     int fracture;           /* some part fractures */
+    int stage_count;        /* entries of "stages" (0: the case has none) */
+    char stage_names[CASE_MAX_STAGES][CASE_STAGE_NAME]; /* each stage's "name" */
 } case_info;
+
+/* The name of stage `index` of the case, or NULL when it has no such stage
+ * (index -1: the case has no stages). */
+const char *case_stage_name(const case_info *info, int index);
 
 fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
                        case_info *info, problems *out);

@@ -7,12 +7,19 @@
  * span), every value but a fix and an absorb optionally scaled by an
  * "amplitude" table in time.
  *
+ * The same reader serves the top-level list and each stage's own
+ * (contract 6.1: those act during their stage only, def.only_stage); every
+ * constraint keeps the pointer it was read at, so an engine error about
+ * engine constraint i (top-level ones first, then each stage's in stage
+ * order) is reported where the user wrote it.
+ *
  * Parts are read first, so a part selector is resolved to its index here and
  * a misspelt part name is reported with a suggestion. Whether a box selects
  * any node is only known once the model exists; the engine reports that at
  * finalize with the constraint's index, which case_engine_problem() maps
  * back to /constraints/N.
  */
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,26 +31,30 @@ static const char *const constraint_keys[] = {"part",     "group",    "box",
                                               "pressure", "absorb",   "boundary_stress",
                                               "traction", "amplitude", NULL};
 
-static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
-                                 const char *ptr)
+int case_part_by_name(case_doc *doc, const json_t *name, const char *ptr)
 {
-    def->select = FDEM_SELECT_PART;
     if (!json_is_string(name)) {
         case_problem(doc, ptr, "expected the name of a part, got %s", case_type_word(name));
-        return;
+        return -1;
     }
     const char *wanted = json_string_value(name);
     int found = case_names_find(doc->part_names, wanted);
-    if (found >= 0) {
-        def->part = found;
-        return;
-    }
+    if (found >= 0) return found;
     const char **names = malloc((size_t)(doc->part_count + 1) * sizeof *names);
     for (int i = 0; names && i < doc->part_count; i++) names[i] = doc->parts[i].name;
     char hint[96] = "";
     if (names) case_did_you_mean(doc, hint, sizeof hint, wanted, names, doc->part_count);
     free(names);
     case_problem(doc, ptr, "unknown part \"%.64s\"%s", wanted, hint);
+    return -1;
+}
+
+static void constraint_read_part(case_doc *doc, fdem_constraint_def *def, const json_t *name,
+                                 const char *ptr)
+{
+    def->select = FDEM_SELECT_PART;
+    int found = case_part_by_name(doc, name, ptr);
+    if (found >= 0) def->part = found;
 }
 
 /* {"part": P, "group": G}: the nodes of physical group G of gmsh part P. */
@@ -63,27 +74,33 @@ static const char *box_layout(int dimension)
     return dimension == 3 ? "[xmin, ymin, zmin, xmax, ymax, zmax]" : "[xmin, ymin, xmax, ymax]";
 }
 
-/* Lower bounds, then upper bounds: the engine's layout of def->box. */
-static void constraint_read_box(case_doc *doc, fdem_constraint_def *def, const json_t *box,
-                                const char *ptr)
+int case_read_box(case_doc *doc, const json_t *box, const char *ptr, double *out)
 {
     static const char *const axes = "xyz";
     int dim = doc->dimension;
-    def->select = FDEM_SELECT_BOX;
     if (!json_is_array(box) || json_array_size(box) != (size_t)(2 * dim)) {
         char got[160];
         case_problem(doc, ptr, "expected %s, got %s", box_layout(dim),
                      case_wrong_tuple(doc, box, 2, got, sizeof got));
-        return;
+        return 0;
     }
-    if (!case_read_vector(doc, box, ptr, 2 * dim, def->box)) return;
+    if (!case_read_vector(doc, box, ptr, 2 * dim, out)) return 0;
     for (int d = 0; d < dim; d++)
-        if (def->box[d] > def->box[dim + d]) {
+        if (out[d] > out[dim + d]) {
             case_problem(doc, ptr, "the box must be %s with %cmin <= %cmax, got %cmin = %g > "
                                    "%cmax = %g", box_layout(dim), axes[d], axes[d], axes[d],
-                         def->box[d], axes[d], def->box[dim + d]);
-            return;
+                         out[d], axes[d], out[dim + d]);
+            return 0;
         }
+    return 1;
+}
+
+/* Lower bounds, then upper bounds: the engine's layout of def->box. */
+static void constraint_read_box(case_doc *doc, fdem_constraint_def *def, const json_t *box,
+                                const char *ptr)
+{
+    def->select = FDEM_SELECT_BOX;
+    case_read_box(doc, box, ptr, def->box);
 }
 
 /* "\"x\" or \"y\"" / "\"x\", \"y\" or \"z\"" */
@@ -221,13 +238,14 @@ static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const j
     c->def.amplitude = c->amplitude;
 }
 
+/* The entry at c->ptr (index `index` of its list). */
 static void constraint_read(case_doc *doc, case_constraint *c, int index, const json_t *value)
 {
     static const char *const selectors[] = {"part", "box"};
     static const char *const actions[] = {"fix",    "velocity",        "force",   "pressure",
                                           "absorb", "boundary_stress", "traction"};
-    char ptr[CASE_POINTER], at[CASE_POINTER], what[32];
-    pointer_join_index(ptr, sizeof ptr, "/constraints", index);
+    const char *ptr = c->ptr;
+    char at[CASE_POINTER], what[32];
     if (!case_expect_object(doc, value, ptr)) return;
     snprintf(what, sizeof what, "constraint %d", index);
     case_check_keys(doc, value, ptr, constraint_keys, what);
@@ -265,6 +283,9 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         case_read_number(doc, a, at, &c->def.value[0]);
     } else if (action == 4) {
         constraint_read_absorb(doc, &c->def, a, at);
+        if (c->def.only_stage)
+            case_problem(doc, at, "an absorbing boundary acts throughout the run: give it in "
+                                  "the top-level \"constraints\", not in a stage's");
     } else if (action == 5) {
         constraint_read_boundary_stress(doc, &c->def, a, at);
     } else {
@@ -274,19 +295,33 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
     constraint_read_amplitude(doc, c, value, ptr);
 }
 
-void case_read_constraints(case_doc *doc, const json_t *constraints)
+void case_read_constraint_list(case_doc *doc, const json_t *list, const char *ptr,
+                               int only_stage)
 {
-    if (!case_expect_array(doc, constraints, "/constraints")) return;
-    size_t count = json_array_size(constraints);
+    if (!case_expect_array(doc, list, ptr)) return;
+    size_t count = json_array_size(list);
     if (count == 0) return;
-    doc->constraints = calloc(count, sizeof *doc->constraints);
-    if (!doc->constraints) {
-        case_problem(doc, "/constraints", "out of memory");
+    size_t total = (size_t)doc->constraint_count + count;
+    case_constraint *grown = total <= (size_t)INT32_MAX
+                                 ? realloc(doc->constraints, total * sizeof *grown)
+                                 : NULL;
+    if (!grown) {
+        case_problem(doc, ptr, "out of memory");
         return;
     }
-    doc->constraint_count = (int)count;
-    for (int i = 0; i < doc->constraint_count; i++)
-        constraint_read(doc, &doc->constraints[i], i, json_array_get(constraints, (size_t)i));
+    doc->constraints = grown;
+    for (size_t i = 0; i < count; i++) {
+        case_constraint *c = &doc->constraints[doc->constraint_count++];
+        memset(c, 0, sizeof *c);
+        c->def.only_stage = only_stage;
+        pointer_join_index(c->ptr, sizeof c->ptr, ptr, (long)i);
+        constraint_read(doc, c, (int)i, json_array_get(list, i));
+    }
+}
+
+void case_read_constraints(case_doc *doc, const json_t *constraints)
+{
+    case_read_constraint_list(doc, constraints, "/constraints", 0);
 }
 
 /* Lowest and highest initial node of the model (y in 2D, z in 3D), over
@@ -315,28 +350,30 @@ static int check_boundary_stress(case_doc *doc, const fdem_model *model, int i)
     f.reference = def->stress_reference;
     double height[2];
     model_height_range(model, height);
-    char base[CASE_POINTER], ptr[CASE_POINTER];
-    pointer_join_index(base, sizeof base, "/constraints", i);
-    pointer_join(ptr, sizeof ptr, base, "boundary_stress");
+    char ptr[CASE_POINTER];
+    pointer_join(ptr, sizeof ptr, doc->constraints[i].ptr, "boundary_stress");
     return case_check_stress_extent(doc, &f, ptr, "boundary stress", "the model", height);
 }
 
 /* Every constraint is checked even after one is refused (one answer names
  * each); such a model is never finalized. */
-int case_add_constraints(case_doc *doc, fdem_model *model)
+int case_add_constraints(case_doc *doc, fdem_model *model, int stages_added)
 {
     int rc = 0;
     for (int i = 0; i < doc->constraint_count; i++) {
+        const case_constraint *c = &doc->constraints[i];
+        if (c->def.only_stage && !stages_added) {
+            rc = -1;
+            continue;
+        }
         fdem_error err = {0};
         if (check_boundary_stress(doc, model, i) < 0) {
             rc = -1;
             continue;
         }
-        if (fdem_add_constraint(model, &doc->constraints[i].def, &err) < 0) {
-            char ptr[CASE_POINTER];
-            pointer_join_index(ptr, sizeof ptr, "/constraints", i);
+        if (fdem_add_constraint(model, &c->def, &err) < 0) {
             if (err.kind == FDEM_ITEM_CONSTRAINT) err.item = i; /* not shifted by a refusal */
-            case_engine_problem(doc, &err, ptr);
+            case_engine_problem(doc, &err, c->ptr);
             rc = -1;
         }
     }

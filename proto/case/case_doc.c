@@ -26,7 +26,7 @@ void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallb
         pointer_join_index(ptr, sizeof ptr, "/parts", err->item);
     else if (err->kind == FDEM_ITEM_CONSTRAINT && err->item >= 0 &&
              err->item < doc->constraint_count)
-        pointer_join_index(ptr, sizeof ptr, "/constraints", err->item);
+        snprintf(ptr, sizeof ptr, "%s", doc->constraints[err->item].ptr);
     case_problem(doc, ptr, "%s", err->message[0] ? err->message : "the engine refused the case");
 }
 
@@ -50,6 +50,7 @@ void case_doc_free(case_doc *doc)
     free(doc->materials);
     for (int i = 0; i < doc->constraint_count; i++) free(doc->constraints[i].amplitude);
     free(doc->constraints);
+    case_stages_free(doc);
     free(doc->gravity_amplitude);
     json_decref(doc->material_names);
     json_decref(doc->part_names);

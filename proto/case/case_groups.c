@@ -2,7 +2,8 @@
  * case_groups.c - what a case says by gmsh physical group (contract 5.3):
  * a part's "materials" (one bonded body, a material per group of
  * elements), its "discontinuities" (joint sets on groups of lines, 3D
- * surfaces) and the {"part", "group"} node selector of constraints.
+ * surfaces), the {"part", "group"} node selector of constraints and the
+ * group behind the element selector of a stage's "excavate" (6.1).
  *
  * The groups come from the gmsh reader (gmsh_groups.c) with the part's
  * mesh in pass 1, so every name is checked there and reported at its
@@ -209,6 +210,30 @@ int case_group_vertices(case_doc *doc, int part_index, const json_t *group, cons
             *count += part->groups.group[g].node_count;
         }
     return 0;
+}
+
+int case_group_with_elements(case_doc *doc, int part_index, const json_t *group,
+                             const char *ptr)
+{
+    if (!json_is_string(group)) {
+        case_problem(doc, ptr, "expected the name of a physical group, got %s",
+                     case_type_word(group));
+        return -1;
+    }
+    if (part_index < 0 || part_index >= doc->part_count) return -1; /* reported at "part" */
+    const case_part *part = &doc->parts[part_index];
+    const char *name = json_string_value(group);
+    if (part->shape != CASE_SHAPE_GMSH) {
+        case_problem(doc, ptr, "part \"%.64s\" is not a \"gmsh\" mesh, so it has no physical "
+                               "groups", part->name);
+        return -1;
+    }
+    int g = group_lookup(doc, part, name, part_mesh_dimension(doc), ptr);
+    if (g >= 0 && part->groups.group[g].element_count == 0) {
+        case_problem(doc, ptr, "the group \"%.64s\" has no element of the mesh", name);
+        return -1;
+    }
+    return g;
 }
 
 /* --------------------------------------------------------------- pass 3 */

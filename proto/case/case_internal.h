@@ -85,10 +85,29 @@ typedef struct case_joint_set {
 } case_joint_set;
 
 typedef struct case_constraint {
-    fdem_constraint_def def;
+    fdem_constraint_def def; /* def.only_stage: 0 top level, k + 1 in stage k's list */
     double *amplitude;       /* def.amplitude points here (case_amplitude.c) */
     int32_t *vertices;       /* {"part", "group"}: the group's nodes, owned */
+    char ptr[CASE_POINTER];  /* "/constraints/3" or "/stages/1/constraints/0" */
 } case_constraint;
+
+/* An element selector of a stage's "excavate" (case_stage.c): read in
+ * pass 1, turned into model element indices in pass 3. */
+typedef enum case_pick { CASE_PICK_NONE, CASE_PICK_PART, CASE_PICK_GROUP, CASE_PICK_BOX } case_pick;
+
+typedef struct case_element_selector {
+    case_pick kind;
+    int part;                /* PART, GROUP: index into case_doc.parts */
+    int group;               /* GROUP: index into that part's groups */
+    double box[6];           /* BOX: lower bounds, then upper bounds (element centroids) */
+} case_element_selector;
+
+typedef struct case_stage {
+    char name[CASE_STAGE_NAME];
+    double end, relax;
+    case_element_selector *excavate;
+    int excavate_count;
+} case_stage;
 
 typedef struct case_doc {
     problems *out;
@@ -108,6 +127,10 @@ typedef struct case_doc {
     unsigned fields;
     json_t *material_names;  /* name -> index into materials (case_names_add) */
     json_t *part_names;      /* name -> index into parts */
+    case_stage *stages;      /* "stages", in order (case_stage.c) */
+    int stage_count;
+    int stages_given;        /* "stages" was in the document */
+    int end_given;           /* time.end was in the document (stages may leave it out) */
     long typo_cells; /* edit-distance work spent on "did you mean" so far */
 } case_doc;
 
@@ -224,6 +247,24 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
+/* The index of the part named by `name` (a string), or -1 after a problem
+ * at ptr (with the closest part name, if any). */
+int case_part_by_name(case_doc *doc, const json_t *name, const char *ptr);
+/* A box [xmin, ymin, (zmin,) xmax, ymax, (zmax)] of the case's dimension
+ * with min <= max into out: 1, or 0 after a problem at ptr. */
+int case_read_box(case_doc *doc, const json_t *box, const char *ptr, double *out);
+/* The constraints array at `ptr` appended to doc->constraints with
+ * def.only_stage = only_stage (0: top level; k + 1: stage k's own). */
+void case_read_constraint_list(case_doc *doc, const json_t *list, const char *ptr,
+                               int only_stage);
+/* case_stage.c: "stages" (pass 1, after parts and constraints, before
+ * time); reconciling time.end with the last stage's end (after time);
+ * the stages handed to the engine (pass 3, after the parts; 0 or -1 after
+ * a problem); freeing them. */
+void case_read_stages(case_doc *doc, const json_t *stages);
+void case_check_stage_end(case_doc *doc);
+int case_add_stages(case_doc *doc, fdem_model *model);
+void case_stages_free(case_doc *doc);
 /* case_initial_stress.c: a stress field block at ptr ("initial_stress",
  * "boundary_stress"; `what` names it in the message about an unknown key):
  * 1 when read, 0 after a problem at each member at fault. */
@@ -255,6 +296,10 @@ void case_read_part_groups(case_doc *doc, case_part *part, const json_t *value,
                            const char *ptr);
 int case_group_vertices(case_doc *doc, int part, const json_t *group, const char *ptr,
                         int32_t **vertices, int *count);
+/* The index (into the part's groups) of the group named `group` of part
+ * `part` that has elements of the mesh's dimension, for an element
+ * selector; -1 after a problem at ptr. */
+int case_group_with_elements(case_doc *doc, int part, const json_t *group, const char *ptr);
 /* The groups' materials and joint sets of document part i, which is model
  * part `index` (i unless an earlier part was refused). */
 int case_add_part_groups(case_doc *doc, fdem_model *model, int i, int index);
@@ -265,7 +310,9 @@ void case_part_groups_free(case_part *part);
 double case_check_memory(case_doc *doc, size_t memory_limit);
 int case_add_materials(case_doc *doc, fdem_model *model);
 int case_add_parts(case_doc *doc, fdem_model *model);
-int case_add_constraints(case_doc *doc, fdem_model *model);
+/* stages_added: the stages are in the model, so stage constraints can go
+ * too (without them they are left out: the stages' problem is reported). */
+int case_add_constraints(case_doc *doc, fdem_model *model, int stages_added);
 
 /* case_probe.c: after pass 1 found problems, adds the /time/dt one a build
  * would find too, from a scratch model of the parts without problems. */

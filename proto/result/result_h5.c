@@ -60,7 +60,7 @@
 
 const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
-    "displacement", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
+    "displacement", "stage", "active", "excavated_energy", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
     "external_work", "time",
 };
@@ -242,26 +242,31 @@ static int write_mesh(hid_t file, const fdem_model *model, char *err, size_t err
 
 hid_t series_file_type(int kind)
 {
-    return kind == SERIES_STEP       ? H5T_STD_I64LE
-         : kind == SERIES_FRAGMENT   ? H5T_STD_I32LE
-                                     : H5T_IEEE_F64LE;
+    return kind == SERIES_STEP                             ? H5T_STD_I64LE
+         : kind == SERIES_FRAGMENT || kind == SERIES_STAGE ? H5T_STD_I32LE
+         : kind == SERIES_ACTIVE                           ? H5T_STD_U8LE
+                                                           : H5T_IEEE_F64LE;
 }
 
 hid_t series_mem_type(int kind)
 {
-    return kind == SERIES_STEP       ? H5T_NATIVE_INT64
-         : kind == SERIES_FRAGMENT   ? H5T_NATIVE_INT32
-                                     : H5T_NATIVE_DOUBLE;
+    return kind == SERIES_STEP                             ? H5T_NATIVE_INT64
+         : kind == SERIES_FRAGMENT || kind == SERIES_STAGE ? H5T_NATIVE_INT32
+         : kind == SERIES_ACTIVE                           ? H5T_NATIVE_UINT8
+                                                           : H5T_NATIVE_DOUBLE;
 }
 
 /* Which datasets this model has and their per-snapshot shape. Damage is
  * stored whenever the model has joints (contract: "when some part
  * fractures"), the fragment id of every element always (contract 5.4), the
- * node and element fields only when requested. */
+ * stage, every element's active flag and the excavated energy account
+ * whenever the case has stages (contract 6.1), the node and element fields
+ * only when requested. */
 void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fields)
 {
     fdem_counts c = fdem_get_counts(model);
     int dim = fdem_get_dimension(model);
+    int staged = fdem_stage_index(model) >= 0;
     for (int k = 0; k < SERIES_COUNT; k++) {
         ds[k].id = H5I_INVALID_HID;
         ds[k].rank = 1;
@@ -278,6 +283,7 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
          fdem_stress_components(model)},
         {SERIES_PRINCIPAL_STRESS, (fields & CASE_FIELD_PRINCIPAL_STRESS) != 0, c.elements, dim},
         {SERIES_DISPLACEMENT, (fields & CASE_FIELD_DISPLACEMENT) != 0, c.nodes, dim},
+        {SERIES_ACTIVE, staged, c.elements, 0},
         {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
@@ -286,6 +292,8 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         s->row[0] = (hsize_t)shapes[i].rows;
         s->row[1] = (hsize_t)shapes[i].width;
     }
+    ds[SERIES_STAGE].rank = staged ? 1 : 0; /* one number a snapshot, like step */
+    ds[SERIES_EXCAVATED].rank = staged ? 1 : 0;
 }
 
 /* Chunk shape, see the comment at the top of the file. */
@@ -344,6 +352,9 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_STRAIN: return s->strain;
     case SERIES_PRINCIPAL_STRESS: return s->principal_stress;
     case SERIES_DISPLACEMENT: return s->displacement;
+    case SERIES_STAGE: return &s->stage;
+    case SERIES_ACTIVE: return s->active;
+    case SERIES_EXCAVATED: return &s->energy.excavated;
     case SERIES_CONSTRAINT_FORCE: return s->constraint_force;
     case SERIES_KINETIC: return &s->energy.kinetic;
     case SERIES_ELASTIC: return &s->energy.elastic;

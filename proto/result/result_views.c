@@ -12,7 +12,8 @@
  * plain HDF DataItem. The views also present fields as ParaView wants them:
  * velocity and displacement padded to three components (z = 0 in 2D), and
  * stress and strain as full 3x3 tensors (row-major; the 2D ones with zz, xz
- * and yz zero), unmapped entries reading as the fill value 0.
+ * and yz zero), unmapped entries reading as the fill value 0. The element
+ * rows (fragment, and active for a case with stages) are plain copies.
  *
  * SWMR writing cannot create datasets, so the views are made when a case's
  * file is closed (finished, paused, stopped): result_finish() closes the
@@ -22,6 +23,7 @@
  */
 #include "result_internal.h"
 
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -58,6 +60,7 @@ static int view_shape_of(int kind, int width, int dimension, view_shape *v)
     case SERIES_PRINCIPAL_STRESS:
     case SERIES_DAMAGE:
     case SERIES_FRAGMENT:
+    case SERIES_ACTIVE:
         v->columns = width; /* a copy; 0 for the 1-D series */
         for (int k = 0; k < width && k < VIEW_MAX_COLUMNS; k++) v->source[k] = k;
         break;
@@ -102,13 +105,15 @@ static int view_create(hid_t group, const series *ds, const view_shape *v, int s
     hid_t type = series_mem_type(v->kind);
     const double zero = 0;
     const int32_t unrecorded = -1;
+    const uint8_t inactive = 0;
+    const void *fill = type == H5T_NATIVE_INT32   ? (const void *)&unrecorded
+                     : type == H5T_NATIVE_UINT8 ? (const void *)&inactive
+                                                : (const void *)&zero;
     hid_t vspace = H5Screate_simple(rank, vdims, NULL);
     hid_t sspace = H5Screate_simple(src->rank, sdims, NULL);
     hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
     int rc = vspace < 0 || sspace < 0 || dcpl < 0 ||
-                     H5Pset_fill_value(dcpl, type, type == H5T_NATIVE_INT32
-                                                       ? (const void *)&unrecorded
-                                                       : (const void *)&zero) < 0
+                     H5Pset_fill_value(dcpl, type, fill) < 0
                  ? -1
                  : 0;
     for (int k = 0; rc == 0 && k < (v->columns ? v->columns : 1); k++)

@@ -39,6 +39,9 @@
  *    ParaView's "Plot Data" draws them against time.
  *  - fragment (the fragment id of each element, an Int cell scalar),
  *    node_part and element_part (static, from /mesh) colour bodies.
+ *  - active (a case with stages, contract 6.1: 1 for an element still
+ *    there, 0 once excavated) is a UChar cell scalar, so ParaView's
+ *    Threshold (active >= 1) draws the body without its excavations.
  *  - where the geometry still is a HyperSlab (a running case), so is the
  *    topology (the whole of /mesh/triangles): the legacy reader caches a
  *    grid whose topology is a plain DataItem and then logs "Cannot find
@@ -67,6 +70,7 @@ typedef struct xdmf_ctx {
     int views;             /* snapshots with /xdmf views */
     long constraints;
     unsigned fields;
+    int staged;            /* the case has stages: /snapshots/active is written */
 } xdmf_ctx;
 
 static void xml_escape(char *out, size_t size, const char *in)
@@ -273,6 +277,14 @@ static void xdmf_series_attributes(const xdmf_ctx *x)
                 x->h5, series_names[kind]);
         fprintf(x->out, "      </Attribute>\n");
     }
+    if (x->staged) { /* written for cases with stages only */
+        fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
+                "Center=\"Grid\">\n", series_names[SERIES_EXCAVATED]);
+        fprintf(x->out, "        <DataItem Dimensions=\"%d 1\" NumberType=\"Float\" "
+                "Precision=\"8\" Format=\"HDF\">%s:/snapshots/%s</DataItem>\n", x->snapshots,
+                x->h5, series_names[SERIES_EXCAVATED]);
+        fprintf(x->out, "      </Attribute>\n");
+    }
     if (x->constraints <= 0) return;
     fprintf(x->out, "      <Attribute Name=\"constraint_force\" AttributeType=\"Matrix\" "
             "Center=\"Grid\">\n");
@@ -324,6 +336,13 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Int", 4, "fragment");
     else xdmf_scalar_row_item(x, s, x->elements, "Int", 4, "fragment");
     fprintf(x->out, "      </Attribute>\n");
+    if (x->staged) {
+        fprintf(x->out, "      <Attribute Name=\"active\" AttributeType=\"Scalar\" "
+                "Center=\"Cell\">\n");
+        if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "UChar", 1, "active");
+        else xdmf_scalar_row_item(x, s, x->elements, "UChar", 1, "active");
+        fprintf(x->out, "      </Attribute>\n");
+    }
     xdmf_series_attributes(x);
     fprintf(x->out, "      <Attribute Name=\"node_part\" AttributeType=\"Scalar\" "
             "Center=\"Node\">\n");
@@ -371,7 +390,8 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
                   .corners = fdem_nodes_per_element(model),
                   .stress_components = fdem_stress_components(model),
                   .snapshots = result_snapshot_count(f), .views = result_view_count(f),
-                  .constraints = counts.constraints, .fields = info->fields};
+                  .constraints = counts.constraints, .fields = info->fields,
+                  .staged = fdem_stage_index(model) >= 0};
     xml_escape(x.h5, sizeof x.h5, h5_name);
     char name[512];
     xml_escape(name, sizeof name, info->name[0] ? info->name : "fdem");

@@ -76,6 +76,21 @@ static int32_t *copy_fragment_labels(const fdem_model *model, size_t elements, i
     return label;
 }
 
+/* Every element's flag: the engine's, or all 1 while it keeps none (no
+ * element excavated yet). */
+static uint8_t *copy_active(const fdem_model *model, size_t elements, int *failed)
+{
+    uint8_t *active = malloc(elements ? elements : 1);
+    if (!active) {
+        *failed = 1;
+        return NULL;
+    }
+    const uint8_t *flags = fdem_element_active(model);
+    if (flags) memcpy(active, flags, elements);
+    else memset(active, 1, elements);
+    return active;
+}
+
 snapshot *snapshot_take(const fdem_model *model, unsigned fields)
 {
     if (!model) return NULL;
@@ -135,6 +150,8 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
     }
     s->constraint_force = copy_doubles(fdem_constraint_forces(model),
                                        dim * (size_t)counts.constraints, &failed);
+    s->stage = fdem_stage_index(model);
+    if (s->stage >= 0) s->active = copy_active(model, elements, &failed);
     if (failed) {
         snapshot_free(s);
         return NULL;
@@ -155,5 +172,6 @@ void snapshot_free(snapshot *s)
     free(s->fragment);
     free(s->fragments);
     free(s->constraint_force);
+    free(s->active);
     free(s);
 }

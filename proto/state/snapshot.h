@@ -12,6 +12,10 @@
  * The fragment id of every element is always copied (result.h5 stores it
  * with every snapshot, contract 5.4); the fragment records are computed only
  * when SNAPSHOT_FRAGMENTS is in `fields` (GET /cases/ID/fragments).
+ * A model with stages (contract 6.1) always has its stage index and the
+ * active flag of every element copied (result.h5 stores both with every
+ * snapshot of such a case); a model without them gets stage -1 and no
+ * flags, and costs nothing more.
  *
  * Folder proto/state/, a model's state on its way out of the engine: owns
  * this header (the copy, snapshot.c) and the JSON of GET /cases/ID/state
@@ -48,6 +52,8 @@ typedef struct snapshot {
     int fragment_count;
     double *constraint_force;   /* dimension * constraints */
     fdem_energy energy;
+    int stage;                  /* the stage the model is in, -1: the case has no stages */
+    uint8_t *active;            /* with stages: elements flags, 1 active, 0 excavated; else NULL */
 } snapshot;
 
 snapshot *snapshot_take(const fdem_model *model, unsigned fields);

@@ -38,6 +38,19 @@ static json_t *rows_to_json(const double *values, int rows, int width)
     return array;
 }
 
+/* [0, 1, 1, ...]: one flag a element. */
+static json_t *flags_to_json(const uint8_t *flags, int count)
+{
+    json_t *array = json_array();
+    if (!array) return NULL;
+    for (int i = 0; i < count; i++)
+        if (json_array_append_new(array, json_integer(flags[i])) < 0) {
+            json_decref(array);
+            return NULL;
+        }
+    return array;
+}
+
 static json_t *list_to_json(const double *values, int count)
 {
     json_t *array = json_array();
@@ -100,6 +113,8 @@ json_t *state_to_json(const snapshot *s)
     if ((s->fields & CASE_FIELD_DISPLACEMENT) && s->displacement)
         rc |= set_or_fail(obj, "displacement",
                           rows_to_json(s->displacement, s->nodes, s->dimension));
+    if (s->active) /* a case with stages: which elements are still there */
+        rc |= set_or_fail(obj, "active", flags_to_json(s->active, s->elements));
     if (rc != 0) {
         json_decref(obj);
         return NULL;

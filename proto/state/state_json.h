@@ -10,7 +10,10 @@
  * ["sigma3", "sigma1"] (3D: ["sigma3", "sigma2", "sigma1"]), the name of
  * each column in rock mechanics' convention, where sigma1 is the most
  * compressive; and displacement (position - initial position) like
- * position.
+ * position. A case with stages (contract 6.1) always gets "active": one
+ * flag a element, 1 still there, 0 excavated (whatever the fields), so a
+ * client drawing the state can leave the excavated elements out; the
+ * daemon adds "stage" to such a state (it knows the names).
  *
  * Folder: proto/state/ (its contract: snapshot.h).
  */

@@ -274,7 +274,8 @@ void case_model_drop(server_case *c)
     membudget_release(&c->reserve);
 }
 
-snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *status)
+snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *status,
+                                     char *stage_name, size_t stage_name_size)
 {
     membudget_lease lease = {0};
     *status = 503;
@@ -289,6 +290,8 @@ snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *statu
     snapshot *s = NULL;
     if (rc == CASE_MODEL_OK) {
         s = snapshot_take(model, fields);
+        const char *name = s ? case_stage_name(&info, s->stage) : NULL;
+        snprintf(stage_name, stage_name_size, "%s", name ? name : "");
         fdem_model_destroy(model);
     } else if (rc == CASE_MODEL_BROKEN) {
         fprintf(stderr, "fdemd: case %s: GET /state: %s\n", c->id, err);

@@ -77,6 +77,7 @@ void case_model_drop(server_case *c);
 void case_model_forget_resume(server_case *c);
 
 /* NULL with *status 503 (no memory now) or 409 (cannot be rebuilt). */
-snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *status);
+snapshot *case_model_state_from_disk(server_case *c, unsigned fields, int *status,
+                                     char *stage_name, size_t stage_name_size);
 
 #endif

@@ -79,6 +79,7 @@ server_case *case_new(void)
     c->last_snapshot_step = -1;
     c->last_checkpoint_step = -1;
     c->resume_rows_until = -1;
+    c->fig.stage = -1; /* no stages until a model or status.json says */
     return c;
 }
 

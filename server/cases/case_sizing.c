@@ -64,8 +64,9 @@ static double sizing_snapshots(const case_info *info, double t0, double dt, doub
 
 /* result.h5 as proto/result/result_h5.c lays it out: /mesh once, then per
  * snapshot the requested node and element fields, damage when there are
- * joints, the fragment id of every element, the constraint forces and the
- * scalar series (step, time and the energy accounts). HDF5's own metadata,
+ * joints, the fragment id of every element, the constraint forces, the
+ * scalar series (step, time and the energy accounts) and, with stages, the
+ * stage, every element's active flag and the excavated energy. HDF5's own metadata,
  * part-filled chunks and the case document with its names come on top. */
 static double sizing_result_bytes(const fdem_model *model, const case_info *info, double snapshots)
 {
@@ -87,6 +88,8 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
         row += elements * dim * 8;
     if (info->fields & CASE_FIELD_DISPLACEMENT)
         row += nodes * dim * 8;
+    if (info->stage_count > 0) /* /snapshots/stage, active and excavated_energy */
+        row += 4 + elements + 8;
     return mesh + snapshots * row;
 }
 

@@ -116,13 +116,36 @@ static int stages_extendable(server_case *c, case_state *was, char *msg, size_t 
     return status;
 }
 
+/* The last entry of a case's "stages" (contract 6.1), or NULL. */
+static json_t *stages_last_stage(json_t *doc)
+{
+    json_t *stages = json_object_get(doc, "stages");
+    size_t n = json_array_size(stages);
+    json_t *last = n ? json_array_get(stages, n - 1) : NULL;
+    return json_is_object(last) ? last : NULL;
+}
+
+/* The end a stored document says: time.end, or its last stage's end when
+ * it leaves time.end out; 0 when it says none. */
+static double stages_document_end(json_t *doc)
+{
+    json_t *time_end = json_object_get(json_object_get(doc, "time"), "end");
+    return json_number_value(time_end ? time_end : json_object_get(stages_last_stage(doc), "end"));
+}
+
 /* `doc` with time.end = end, and output.interval pinned when it was left
- * to its default. 0, or 409/422/500 with msg (422 also in p). */
+ * to its default. A case with stages ends with its last stage, which
+ * time.end may leave out and must agree with: that stage's end becomes
+ * the new end too (its last stage runs on; the engine puts the steps
+ * after a last stage's end in it). 0, or 409/422/500 with msg (422 also
+ * in p). */
 static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_t msglen)
 {
     json_t *time = json_object_get(doc, "time");
-    double old_end = json_number_value(json_object_get(time, "end"));
-    if (!json_is_object(time) || !(old_end > 0)) {
+    json_t *last = stages_last_stage(doc);
+    json_t *time_end = json_object_get(time, "end");
+    double old_end = stages_document_end(doc);
+    if (!(old_end > 0)) {
         snprintf(msg, msglen, "the stored case.json has no time.end");
         return 500;
     }
@@ -154,7 +177,8 @@ static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_
         return 422;
     }
     if ((!given && json_object_set_new(output, "interval", json_real(interval)) != 0) ||
-        json_object_set_new(time, "end", json_real(end)) != 0) {
+        (time_end && json_object_set_new(time, "end", json_real(end)) != 0) ||
+        (last && json_object_set_new(last, "end", json_real(end)) != 0)) {
         snprintf(msg, msglen, "out of memory rewriting the case document");
         return 500;
     }
@@ -225,7 +249,7 @@ static int stages_store_extension(server_case *c, double end, case_state was, in
     json_t *doc = stages_load_document(c, msg, msglen);
     if (!doc)
         return 500;
-    double stored_end = json_number_value(json_object_get(json_object_get(doc, "time"), "end"));
+    double stored_end = stages_document_end(doc);
     int stored = redo && stored_end >= end;
     int status = stored ? 0 : stages_set_end(doc, end, p, msg, msglen);
     size_t length = 0;

@@ -35,6 +35,13 @@ void case_set_snapshots(server_case *c, int snapshots)
     pthread_mutex_unlock(&c->lock);
 }
 
+void case_figures_stage(case_figures *fig, const fdem_model *model, const case_info *info)
+{
+    fig->stage = fdem_stage_index(model);
+    const char *name = case_stage_name(info, fig->stage);
+    snprintf(fig->stage_name, sizeof fig->stage_name, "%s", name ? name : "");
+}
+
 /* Figures straight from the model, for cases no worker is stepping. */
 void case_publish_from_model(server_case *c)
 {
@@ -49,6 +56,7 @@ void case_publish_from_model(server_case *c)
     fig.energy = fdem_get_energy(c->model);
     fig.snapshots = -1;
     fig.elapsed = -1;
+    case_figures_stage(&fig, c->model, &c->info);
     case_publish(c, &fig);
 }
 
@@ -67,6 +75,7 @@ static const struct { const char *key; size_t offset; } energy_accounts[] = {
     {"damping", offsetof(fdem_energy, damping)},
     {"gravity_work", offsetof(fdem_energy, gravity_work)},
     {"external_work", offsetof(fdem_energy, external_work)},
+    {"excavated", offsetof(fdem_energy, excavated)},
     {"residual", offsetof(fdem_energy, residual)},
 };
 #define ENERGY_ACCOUNT_COUNT (sizeof energy_accounts / sizeof energy_accounts[0])
@@ -75,8 +84,10 @@ void case_energy_from_json(fdem_energy *energy, const json_t *o)
 {
     for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++) {
         const json_t *v = json_object_get(o, energy_accounts[i].key);
+        /* a status.json from before stages has no "excavated": nothing was */
+        double missing = strcmp(energy_accounts[i].key, "excavated") == 0 && o && !v ? 0.0 : NAN;
         *(double *)((char *)energy + energy_accounts[i].offset) =
-            json_is_number(v) ? json_number_value(v) : NAN;
+            json_is_number(v) ? json_number_value(v) : missing;
     }
 }
 
@@ -115,6 +126,28 @@ static json_t *json_string_or_null(const char *s)
     return s[0] ? json_string(s) : json_null();
 }
 
+/* "stage": {"index", "name"} of a case with stages (contract 6.1), null
+ * without them. Written to status.json too: a case loaded from it shows
+ * its last stage without a model (case_stage_from_json). */
+static json_t *case_stage_json(const case_figures *f)
+{
+    if (f->stage < 0) return json_null();
+    json_t *o = json_object();
+    if (!o) return NULL;
+    json_object_set_new(o, "index", json_integer(f->stage));
+    json_object_set_new(o, "name", json_string(f->stage_name));
+    return o;
+}
+
+void case_stage_from_json(case_figures *f, const json_t *stage)
+{
+    const json_t *given = json_object_get(stage, "index");
+    json_int_t index = json_integer_value(given);
+    const char *name = json_string_value(json_object_get(stage, "name"));
+    f->stage = json_is_integer(given) && index >= 0 && index < CASE_MAX_STAGES ? (int)index : -1;
+    snprintf(f->stage_name, sizeof f->stage_name, "%s", f->stage >= 0 && name ? name : "");
+}
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);
@@ -149,6 +182,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "broken_joints", json_integer(f.counts.broken_joints));
     json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
     json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
+    json_object_set_new(o, "stage", case_stage_json(&f));
     json_object_set_new(o, "snapshots", json_integer(f.snapshots));
     json_object_set_new(o, "energy", energy ? energy : json_null());
     json_object_set_new(o, "steps_per_second",

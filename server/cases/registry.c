@@ -599,15 +599,18 @@ int case_holds_model(server_case *c)
     return held;
 }
 
-snapshot *case_take_state(server_case *c, unsigned fields, int *status)
+snapshot *case_take_state(server_case *c, unsigned fields, int *status, char *stage_name,
+                          size_t stage_name_size)
 {
     case_model_lock_to_read(c);
     snapshot *s = c->model ? snapshot_take(c->model, fields) : NULL;
     int held = c->model != NULL;
+    const char *name = s ? case_stage_name(&c->info, s->stage) : NULL;
+    snprintf(stage_name, stage_name_size, "%s", name ? name : "");
     case_model_unlock_read(c);
     *status = 503;
     if (!held)
-        s = case_model_state_from_disk(c, fields, status);
+        s = case_model_state_from_disk(c, fields, status, stage_name, stage_name_size);
     return s;
 }
 

@@ -67,6 +67,8 @@ typedef struct case_figures {
     double steps_per_second;
     int snapshots;
     double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
+    int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
+    char stage_name[CASE_STAGE_NAME];
 } case_figures;
 
 #define CASE_ID_LEN 16
@@ -181,9 +183,11 @@ int registry_stop(server_case *c, char *msg, size_t msglen);
 int registry_delete(server_case *c, char *msg, size_t msglen);
 
 /* The state at one step boundary: the running model's, else the last
- * checkpoint's (a temporary rebuild). NULL with *status 503 (memory short
+ * checkpoint's (a temporary rebuild), with the name of its stage in
+ * stage_name ("" without stages). NULL with *status 503 (memory short
  * now) or 409 (the stored case cannot be rebuilt). */
-snapshot *case_take_state(server_case *c, unsigned fields, int *status);
+snapshot *case_take_state(server_case *c, unsigned fields, int *status, char *stage_name,
+                          size_t stage_name_size);
 /* Whether the case holds its model now (running, or being stepped): its
  * state is then a copy, not a rebuild. Waits at most one step. */
 int case_holds_model(server_case *c);
@@ -212,6 +216,8 @@ void case_record_io_failure(server_case *c, const char *file, const char *reason
 
 /* Called by the worker and the I/O thread. */
 void case_publish(server_case *c, const case_figures *fig);
+/* fig->stage and fig->stage_name of `model`, the names from `info`. */
+void case_figures_stage(case_figures *fig, const fdem_model *model, const case_info *info);
 void case_set_snapshots(server_case *c, int snapshots);
 /* The worker's last words: sets the final state, frees its slot, persists
  * the status and starts queued cases (the worker then clears worker_active). */

@@ -22,6 +22,9 @@ int case_state_is_terminal(case_state s);
 void iso_time_now(char *out, size_t size);
 /* Figures of the case's model into its published figures. */
 void case_publish_from_model(server_case *c);
+/* The status' "stage" back into fig->stage and fig->stage_name (null or
+ * missing: -1, no stages). */
+void case_stage_from_json(case_figures *f, const json_t *stage);
 /* The status' energy object back into an fdem_energy (missing: NaN). */
 void case_energy_from_json(fdem_energy *energy, const json_t *o);
 

@@ -79,6 +79,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.steps_per_second = running ? clk->steps_per_second : 0.0;
     fig.snapshots = -1; /* owned by the I/O thread */
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
+    case_figures_stage(&fig, m, &c->info);
     case_publish(c, &fig);
 }
 

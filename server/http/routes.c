@@ -385,10 +385,21 @@ static int routes_no_state(struct MHD_Connection *conn, server_case *c, const sn
     return 1;
 }
 
+/* "stage": {"index", "name"} of the state of a case with stages (contract
+ * 6.1 names it in the status; GET /state says it too). A case without
+ * stages gets no "stage" here (its state stays as it was). */
+static int routes_set_stage(json_t *o, int stage, const char *name)
+{
+    if (stage < 0) return 0;
+    json_t *v = json_pack("{s:i, s:s}", "index", stage, "name", name);
+    return v ? json_object_set_new(o, "stage", v) : -1;
+}
+
+/* with_stage: the answer names the state's stage (GET /state). */
 static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_case *c,
                                            unsigned fields,
                                            json_t *(*to_json)(const snapshot *, const void *),
-                                           const void *how)
+                                           const void *how, int with_stage)
 {
     int status = 0;
     enum MHD_Result rc;
@@ -397,7 +408,8 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
     /* a case that holds no model rebuilds one from its checkpoint to be read */
     if (!http_on_heavy_thread() && !case_holds_model(c))
         return http_defer_heavy(conn);
-    snapshot *s = case_take_state(c, fields, &status);
+    char stage_name[CASE_STAGE_NAME] = "";
+    snapshot *s = case_take_state(c, fields, &status, stage_name, sizeof stage_name);
     if (!s && status == 503)
         return http_reply_unavailable(conn, "the state of a case that is not running is rebuilt "
                                       "from its checkpoint, and that would take the daemon past "
@@ -414,6 +426,10 @@ static enum MHD_Result route_snapshot_json(struct MHD_Connection *conn, server_c
     membudget_lease lease = {0};
     membudget_meter_begin(&lease, 0);
     json_t *o = to_json(s, how);
+    if (o && with_stage && routes_set_stage(o, s->stage, stage_name) != 0) {
+        json_decref(o);
+        o = NULL;
+    }
     membudget_meter_end();
     snapshot_free(s);
     if (!o && membudget_meter_refused())
@@ -455,7 +471,7 @@ static enum MHD_Result route_state(struct MHD_Connection *conn, server_case *c)
         }
         problems_free(&p);
     }
-    return route_snapshot_json(conn, c, fields, routes_state_json, NULL);
+    return route_snapshot_json(conn, c, fields, routes_state_json, NULL, 1);
 }
 
 /* GET /cases/ID/fragments[?parts=a,b][&exclude_host=true] (contract 5.4,
@@ -479,7 +495,7 @@ static enum MHD_Result route_fragments(struct MHD_Connection *conn, server_case 
         return http_reply_problem(conn, (unsigned)status, status == 400 ? "Bad request"
                                   : "Internal error", detail, NULL);
     enum MHD_Result rc = route_snapshot_json(conn, c, SNAPSHOT_FRAGMENTS, routes_fragments_json,
-                                             &sel);
+                                             &sel, 0);
     fragment_query_free(&sel);
     return rc;
 }

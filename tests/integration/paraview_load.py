@@ -3,17 +3,19 @@ with one of ParaView's XDMF readers and prints, as JSON, what the reader
 gives at the first and the last time step, plus every message VTK sent to
 its output window (an error or a warning fails the test).
 
-  pvpython paraview_load.py READER FILE.xdmf [WARP]
+  pvpython paraview_load.py READER FILE.xdmf [WARP | threshold:CELLARRAY]
 
 READER is XDMFReader (the legacy "XDMF Reader"), Xdmf3ReaderS or
 Xdmf3ReaderT. With WARP (a point vector array, e.g. displacement) the
 reader's output goes through Warp By Vector (scale 1) first, as a user
-would apply it, and the blocks described are the warped ones.
+would apply it, and the blocks described are the warped ones; with
+threshold:NAME it goes through Threshold on that cell array between 1 and
+1 (`active`: the body without its excavated elements).
 """
 import json
 import sys
 
-from paraview.simple import WarpByVector, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
+from paraview.simple import Threshold, WarpByVector, XDMFReader, Xdmf3ReaderS, Xdmf3ReaderT
 from vtkmodules.vtkCommonCore import vtkOutputWindow, vtkStringOutputWindow
 
 # Everything VTK reports (errors, warnings, the HDF5 layer's complaints
@@ -64,7 +66,10 @@ def main(reader_name, path, warp=None):
     times = reader.TimestepValues
     times = list(times) if hasattr(times, "__iter__") else [times]
     last = reader
-    if warp:
+    if warp and warp.startswith("threshold:"):
+        last = Threshold(Input=reader, Scalars=["CELLS", warp[len("threshold:"):]],
+                         LowerThreshold=1, UpperThreshold=1)
+    elif warp:
         last = WarpByVector(Input=reader, Vectors=["POINTS", warp], ScaleFactor=1.0)
     steps = []
     for index in (0, len(times) - 1):

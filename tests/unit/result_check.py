@@ -29,7 +29,8 @@ SERIES = {  # dataset -> key in the expected snapshot
     "stress": "stress", "damage": "damage", "constraint_force": "constraint_force",
     "kinetic_energy": "kinetic_energy", "elastic_energy": "elastic_energy",
     "fragment": "fragment", "strain": "strain", "principal_stress": "principal_stress",
-    "displacement": "displacement",
+    "displacement": "displacement", "stage": "stage", "active": "active",
+    "excavated_energy": "excavated_energy",
 }
 
 
@@ -77,8 +78,10 @@ def want_series(exp, name, snaps):
                                                   exp.get("dimension", 2))
     if name == "step":
         return np.array([s["step"] for s in snaps], dtype="i8")
-    if name == "fragment":
-        return np.array([s["fragment"] for s in snaps], dtype="i4")
+    if name in ("fragment", "stage"):
+        return np.array([s[name] for s in snaps], dtype="i4")
+    if name == "active":
+        return np.array([s["active"] for s in snaps], dtype="u1")
     return np.array([s[name] for s in snaps], dtype="f8")
 
 
@@ -240,6 +243,14 @@ def check_view(f, path, s, dim):
     need(got.shape == want.shape and np.array_equal(got, want), f"view {path} differs from its row")
 
 
+def dataitem_number_type(item):
+    """(NumberType, Precision) of an attribute's data: a HyperSlab's is on
+    its inner HDF item."""
+    if item.get("ItemType") == "HyperSlab":
+        item = item.findall("DataItem")[-1]
+    return item.get("NumberType"), item.get("Precision")
+
+
 def check_node_vector(a, item, n_nodes, dim):
     """velocity and displacement: a Node Vector, three components through a
     view (ParaView warps by it), `dim` through a HyperSlab of a running case."""
@@ -313,8 +324,12 @@ def check_xdmf(f, exp, xdmf_path, h5_name):
             need(dataitem_dims(item)[0] == rows, f"attribute {a.get('Name')} has wrong rows")
             if a.get("Name") in ("velocity", "displacement"):
                 check_node_vector(a, item, n_nodes, dim)
+            if a.get("Name") == "active":
+                need(a.get("Center") == "Cell" and dataitem_number_type(item) == ("UChar", "1"),
+                     f"active is {a.get('Center')} {dataitem_number_type(item)}, want a Cell "
+                     "UChar of 1 byte")
             attrs[a.get("Name")] = a.get("Center")
-        for field in ("velocity", "displacement"):
+        for field in ("velocity", "displacement", "active"):
             need((field in attrs) == (field in exp["series"]),
                  f"grid {s}: attribute {field} {'missing' if field in exp['series'] else 'unexpected'}")
         names = sorted(attrs)

@@ -1,8 +1,8 @@
 /*
  * result_fixture.h - a small real model for the snapshot and result tests:
  * a fixed 4x2 rock block under gravity and, optionally, a fracturing 2x1
- * slab above it (so the model has joints) pushed by a force constraint; and
- * a 3D box of tetrahedra for the 3D layout.
+ * slab above it (so the model has joints) pushed by a force constraint; a
+ * 3D box of tetrahedra for the 3D layout; and the block in two stages.
  * Small on purpose: the tests compare every number, and must stay fast.
  */
 #ifndef RESULT_FIXTURE_H
@@ -119,6 +119,37 @@ static fdem_model *fixture_model_3d(int constraints, case_info *info)
         return NULL;
     }
     fixture_info(m, info, "fixture box", 1, constraints ? 2 : 0, 0);
+    return m;
+}
+
+/* The 4x2 block of fixture_model, fixed at its base, in two stages
+ * (contract 6.1): "in-situ" ends at 1e-7 s, within the first step, and
+ * "dig" removes its two last triangles at the start of the second. */
+static inline fdem_model *fixture_model_staged(case_info *info)
+{
+    fdem_error err = {0};
+    fdem_model *m = fdem_model_create();
+    fdem_material_def rock = {.density = 2700, .young = 3e10, .poisson = 0.25};
+    int mat = m ? fdem_add_material(m, &rock, &err) : -1;
+    int ok = mat >= 0 && fixture_add_block(m, 0, 0, 0.4, 0.2, 4, 2, mat, 0, &err) >= 0;
+    const int32_t dig[2] = {14, 15};
+    fdem_stage_def first = {.end = 1e-7}, second = {.end = 1.0, .excavate = dig,
+                                                    .excavate_count = 2};
+    fdem_constraint_def fix = {.select = FDEM_SELECT_BOX, .box = {-1, -0.001, 1, 0.001},
+                               .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1};
+    ok = ok && fdem_add_stage(m, &first, &err) == 0 && fdem_add_stage(m, &second, &err) == 1 &&
+         fdem_add_constraint(m, &fix, &err) >= 0 && fdem_model_finalize(m, &err) >= 0;
+    if (!ok) {
+        fprintf(stderr, "  staged fixture model: %s\n", err.message);
+        fdem_model_destroy(m);
+        return NULL;
+    }
+    fixture_info(m, info, "staged", 1, 1, 0);
+    if (info) {
+        info->stage_count = 2;
+        snprintf(info->stage_names[0], sizeof info->stage_names[0], "in-situ");
+        snprintf(info->stage_names[1], sizeof info->stage_names[1], "dig");
+    }
     return m;
 }
 

@@ -197,7 +197,8 @@ static void checkpoint_carries_the_joints_friction(void)
      * slip its points keep) */
     size_t v2_header = sizeof(uint32_t) * 2 + 4 * sizeof(int32_t) + sizeof(int64_t) +
                        10 * sizeof(double) + sizeof(int64_t) + 2 * sizeof(int32_t) +
-                       sizeof(int64_t) + 2 * sizeof(int32_t) + sizeof(fdem_energy);
+                       sizeof(int64_t) + 2 * sizeof(int32_t) +
+                       10 * sizeof(double); /* the accounts as fdem_energy had them to version 7 */
     size_t cut = 2 * sizeof(double) + sizeof(int64_t);
     size_t tail = sizeof(double) * (size_t)a->joint_count +
                   sizeof(fdem_event) * (size_t)a->event_count +

@@ -122,6 +122,11 @@ static json_t *expect_new(const fdem_model *m, const case_info *info)
         json_array_append_new(series, json_string("principal_stress"));
     if (info->fields & CASE_FIELD_DISPLACEMENT)
         json_array_append_new(series, json_string("displacement"));
+    if (fdem_stage_index(m) >= 0) {
+        json_array_append_new(series, json_string("stage"));
+        json_array_append_new(series, json_string("active"));
+        json_array_append_new(series, json_string("excavated_energy"));
+    }
 
     return json_pack("{s:s, s:i, s:f, s:i, s:s, s:o, s:o, s:[]}", "name", info->name,
                      "dimension", dim, "dt", fdem_get_dt(m), "constraints", c.constraints,
@@ -140,6 +145,10 @@ static void expect_snapshot(json_t *doc, const snapshot *s)
     json_object_set_new(j, "kinetic_energy", json_real(s->energy.kinetic));
     json_object_set_new(j, "fragment", ints_rows(s->fragment, s->elements, 0));
     json_object_set_new(j, "elastic_energy", json_real(s->energy.elastic));
+    if (s->active) { /* a model with stages ("active" is in the state JSON) */
+        json_object_set_new(j, "stage", json_integer(s->stage));
+        json_object_set_new(j, "excavated_energy", json_real(s->energy.excavated));
+    }
     json_array_append_new(json_object_get(doc, "snapshots"), j);
 }
 
@@ -721,6 +730,41 @@ static void test_result_3d_layout_and_xdmf(void)
     run_end(&r);
 }
 
+/* A case in stages (contract 6.1): /snapshots/stage (S) i32 and
+ * /snapshots/active (S, E) u8, the stage of each row and 0 for the two
+ * triangles from the row after their removal on, read back by h5py under
+ * SWMR and closed, and the sidecar's `active` Cell UChar (a HyperSlab
+ * while open, a view once finished), the file reopened with them kept. */
+static void test_result_stages_layout_and_xdmf(void)
+{
+    run r;
+    memset(&r, 0, sizeof r);
+    if (run_start_with(&r, fixture_model_staged(&r.info), 0, "staged.h5") == 0) {
+        for (int i = 0; i < 3; i++) run_append(&r);
+        expect_save(r.expect, "staged.json");
+        json_t *rows = json_object_get(r.expect, "snapshots");
+        CHECK(json_integer_value(json_object_get(json_array_get(rows, 0), "stage")) == 0 &&
+              json_integer_value(json_object_get(json_array_get(rows, 2), "stage")) == 1,
+              "the rows do not span both stages");
+        json_t *last = json_object_get(json_array_get(rows, 2), "active");
+        CHECK(json_integer_value(json_array_get(last, 15)) == 0 &&
+              json_integer_value(json_array_get(last, 13)) == 1, "the last row's flags");
+        CHECK(run_checker("staged.h5", "staged.json", "swmr", NULL) == 0, "stages, swmr");
+        run_check_xdmf(&r, "staged.xdmf", "staged.h5", "staged.json", "stages xdmf");
+        run_finish(&r, "staged.h5");
+        run_check_xdmf(&r, "staged.xdmf", "staged.h5", "staged.json", "stages xdmf, views");
+        CHECK(result_close(r.file) == 0, "result_close");
+        char path[512];
+        tmp_path(path, sizeof path, "staged.h5");
+        r.file = result_reopen(path, r.model, &r.info, INT64_MAX, r.err, sizeof r.err);
+        CHECK(r.file && result_snapshot_count(r.file) == 3, "reopened: %s", r.err);
+        if (r.file) CHECK(result_close(r.file) == 0, "result_close");
+        r.file = NULL;
+        CHECK(run_checker("staged.h5", "staged.json", "plain", NULL) == 0, "stages, closed");
+    }
+    run_end(&r);
+}
+
 /* Displacement written without position, 2D and 3D: each snapshot's rows
  * are x - x0 as subtracted here from the engine's arrays (the file then
  * holds them, (S, N, dimension), checked by h5py), the sidecar names them
@@ -849,7 +893,7 @@ int main(int argc, char **argv)
         T(test_result_image_opens_plainly), T(test_result_image_checksum_matches_hdf5),
         T(test_result_check_file_refuses_damage), T(test_result_minimal_fields_without_constraints),
         T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),
-        T(test_result_displacement_without_position),
+        T(test_result_displacement_without_position), T(test_result_stages_layout_and_xdmf),
         T(test_result_bad_input_is_an_error),
         T(test_result_finish_on_a_full_disk_keeps_the_file_readable),
     };

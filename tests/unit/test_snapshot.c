@@ -225,8 +225,38 @@ static void test_snapshot_displacement_leaves_the_run_alone(void)
     fdem_model_destroy(alone);
 }
 
+/* A model with stages: its stage and every element's flag, a copy (all 1
+ * while the engine keeps no flags, the engine's once it does); a model
+ * without stages: stage -1 and no flags. */
+static void test_snapshot_stage_and_active(void)
+{
+    fdem_model *m = fixture_model_staged(NULL), *plain = fixture_model(0, 1, NULL);
+    CHECK(m && plain, "fixture models");
+    if (m && plain) {
+        int elements = fdem_get_counts(m).elements;
+        snapshot *s = snapshot_take(m, 0), *p = snapshot_take(plain, CASE_FIELD_POSITION);
+        CHECK(s && s->stage == 0 && s->active, "stage %d at t = 0", s ? s->stage : -2);
+        for (int e = 0; s && s->active && e < elements; e++)
+            CHECK(s->active[e] == 1, "element %d inactive at t = 0", e);
+        CHECK(p && p->stage == -1 && p->active == NULL, "a model without stages has a stage");
+        snapshot_free(s);
+        snapshot_free(p);
+        CHECK(fixture_step(m, 2) == 0, "stepping");
+        s = snapshot_take(m, 0);
+        const uint8_t *flags = fdem_element_active(m);
+        CHECK(s && s->stage == 1 && flags && s->active != flags, "stage %d after 2 steps",
+              s ? s->stage : -2);
+        for (int e = 0; s && flags && e < elements; e++)
+            CHECK(s->active[e] == flags[e] && flags[e] == (e < 14), "element %d: %d, engine %d",
+                  e, s->active[e], flags[e]);
+        snapshot_free(s);
+    }
+    fdem_model_destroy(m);
+    fdem_model_destroy(plain);
+}
+
 CHECK_MAIN(T(test_snapshot_copies_requested_fields), T(test_snapshot_is_a_copy),
            T(test_snapshot_stress_matches_engine), T(test_snapshot_damage_of_fracturing_model),
            T(test_snapshot_without_joints_has_no_damage), T(test_snapshot_of_a_3d_model),
            T(test_snapshot_displacement_is_position_minus_position0),
-           T(test_snapshot_displacement_leaves_the_run_alone))
+           T(test_snapshot_displacement_leaves_the_run_alone), T(test_snapshot_stage_and_active))
