@@ -497,8 +497,15 @@ static void bad_stages_are_refused(void)
     }
     fdem_constraint_def c = {0};
     c.select = FDEM_SELECT_PART;
+    c.kind = FDEM_CONSTRAINT_ABSORB;
+    c.only_stage = 1;
+    CHECK(fdem_add_constraint(m, &c, &err) < 0 && strstr(err.message, "absorbing"),
+          "a stage-only absorbing boundary: \"%s\"", err.message);
     c.kind = FDEM_CONSTRAINT_FIX;
     c.fix_x = 1;
+    c.only_stage = -1;
+    CHECK(fdem_add_constraint(m, &c, &err) < 0 && strstr(err.message, "only_stage"),
+          "only_stage -1: \"%s\"", err.message);
     c.only_stage = 3; /* stage 2: there is one stage */
     CHECK(fdem_add_constraint(m, &c, &err) == 0, "%s", err.message);
     CHECK(fdem_model_finalize(m, &err) < 0 && strstr(err.message, "stage 2"),
