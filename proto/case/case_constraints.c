@@ -62,27 +62,33 @@ static const char *box_layout(int dimension)
     return dimension == 3 ? "[xmin, ymin, zmin, xmax, ymax, zmax]" : "[xmin, ymin, xmax, ymax]";
 }
 
+int case_read_box(case_doc *doc, const json_t *value, const char *ptr, double box[6])
+{
+    static const char *const axes = "xyz";
+    int dim = doc->dimension;
+    if (!json_is_array(value) || json_array_size(value) != (size_t)(2 * dim)) {
+        char got[160];
+        case_problem(doc, ptr, "expected %s, got %s", box_layout(dim),
+                     case_wrong_tuple(doc, value, 2, got, sizeof got));
+        return 0;
+    }
+    if (!case_read_vector(doc, value, ptr, 2 * dim, box)) return 0;
+    for (int d = 0; d < dim; d++)
+        if (box[d] > box[dim + d]) {
+            case_problem(doc, ptr, "the box must be %s with %cmin <= %cmax, got %cmin = %g > "
+                                   "%cmax = %g", box_layout(dim), axes[d], axes[d], axes[d],
+                         box[d], axes[d], box[dim + d]);
+            return 0;
+        }
+    return 1;
+}
+
 /* Lower bounds, then upper bounds: the engine's layout of def->box. */
 static void constraint_read_box(case_doc *doc, fdem_constraint_def *def, const json_t *box,
                                 const char *ptr)
 {
-    static const char *const axes = "xyz";
-    int dim = doc->dimension;
     def->select = FDEM_SELECT_BOX;
-    if (!json_is_array(box) || json_array_size(box) != (size_t)(2 * dim)) {
-        char got[160];
-        case_problem(doc, ptr, "expected %s, got %s", box_layout(dim),
-                     case_wrong_tuple(doc, box, 2, got, sizeof got));
-        return;
-    }
-    if (!case_read_vector(doc, box, ptr, 2 * dim, def->box)) return;
-    for (int d = 0; d < dim; d++)
-        if (def->box[d] > def->box[dim + d]) {
-            case_problem(doc, ptr, "the box must be %s with %cmin <= %cmax, got %cmin = %g > "
-                                   "%cmax = %g", box_layout(dim), axes[d], axes[d], axes[d],
-                         def->box[d], axes[d], def->box[dim + d]);
-            return;
-        }
+    case_read_box(doc, box, ptr, def->box);
 }
 
 /* "\"x\" or \"y\"" / "\"x\", \"y\" or \"z\"" */

@@ -45,6 +45,21 @@ typedef enum case_shape {
 extern const char *const case_shape_keys[];
 #define CASE_SHAPE_KINDS 7
 
+/* A part's "fracture" given as a selector or a list of them (contract 6.1,
+ * case_region.c): each a box of element centroids or a gmsh element group. */
+#define CASE_MAX_REGION_SELECTORS 16
+
+typedef struct case_region_selector {
+    int group;               /* index into the part's groups, or -1: a box */
+    double box[6];           /* lower bounds, then upper bounds (dimension each) */
+} case_region_selector;
+
+typedef struct case_region {
+    int count;               /* 0: "fracture" is true or false */
+    int listed;              /* given as a list: selector k is at /parts/i/fracture/k */
+    case_region_selector selector[CASE_MAX_REGION_SELECTORS];
+} case_region;
+
 typedef struct case_part {
     char name[CASE_NAME];
     int material;            /* index into case_doc.materials, -1 if unknown */
@@ -65,6 +80,7 @@ typedef struct case_part {
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
     gmsh_groups groups;      /* GMSH: its named physical groups */
     int32_t *element_material; /* "materials": the material of each element, else NULL */
+    struct case_region region; /* "fracture" as selectors (case_region.c) */
     struct case_joint_set *joint_sets; /* "discontinuities" */
     int joint_set_count;
 } case_part;
@@ -217,6 +233,22 @@ void case_read_gmsh(case_doc *doc, case_part *part, const json_t *text, const ch
  * else at `fallback`. */
 void case_mesh_problem(case_doc *doc, int part, const fdem_error *err, const char *fallback);
 void case_read_constraints(case_doc *doc, const json_t *constraints);
+/* A box selector [xmin, ymin(, zmin), xmax, ymax(, zmax)] at ptr into box
+ * (lower bounds, then upper): 1, or 0 after a problem. */
+int case_read_box(case_doc *doc, const json_t *value, const char *ptr, double box[6]);
+/* case_region.c: a part's "fracture" when it is a selector or a list of
+ * them (after its shape and groups; `value` is the part's object; a mesh
+ * read in pass 1 is checked against the region when mesh_sound, i.e. it
+ * read without a problem), and the flag per element of part i's mesh (NULL
+ * while "fracture" is not a region): 0, or -1 after a problem at the
+ * selector that selects nothing. */
+void case_read_region(case_doc *doc, case_part *part, const json_t *value, const char *ptr,
+                      int mesh_sound);
+int case_region_mask(case_doc *doc, int i, uint8_t **mask);
+/* case_groups.c: the group of elements (of the mesh's dimension) named by
+ * `name` at ptr, or -1 after a problem there. */
+int case_element_group(case_doc *doc, const case_part *part, const json_t *name,
+                       const char *ptr);
 /* case_initial_stress.c: a part's "initial_stress" (pass 1), and handing
  * document part i's to the engine once it is model part `index` (pass 3; 0,
  * or -1 after a problem). */
