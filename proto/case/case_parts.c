@@ -165,8 +165,9 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     int region = json_is_object(fracture) || json_is_array(fracture);
     if (region) part->fracture = 1;
     else if (fracture && !json_is_boolean(fracture))
-        case_problem(doc, at, "expected true, false, a fracture region selector ({\"box\": "
-                              "[...]} or {\"group\": \"name\"}) or a list of them, got %s",
+        case_problem(doc, at, "expected true or false, or a fracture region: a selector "
+                              "({\"box\": [...]} or {\"group\": \"name\"}) or a list of them, "
+                              "got %s",
                      case_type_word(fracture));
     else if (fracture) part->fracture = json_is_true(fracture);
     if (part->fracture && part->material >= 0 && !doc->materials[part->material].def.has_fracture)

@@ -63,7 +63,7 @@ void case_read_region(case_doc *doc, case_part *part, const json_t *value, const
 {
     char at[CASE_POINTER];
     json_t *fracture = case_member(value, ptr, "fracture", at);
-    if (!fracture || json_is_boolean(fracture)) return; /* case_parts.c */
+    if (!json_is_object(fracture) && !json_is_array(fracture)) return; /* case_parts.c */
     case_region *r = &part->region;
     r->listed = json_is_array(fracture);
     size_t n = r->listed ? json_array_size(fracture) : 1;
