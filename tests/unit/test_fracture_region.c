@@ -10,8 +10,9 @@
  *  - a region of every element builds the whole fracturing part bit for
  *    bit (nodes, joints, their order); a region of none is refused;
  *  - a bar fracturing only in its middle, pulled apart, breaks there into
- *    two pieces, each end whole; on 1 and 2 threads the same bits, and a
- *    checkpoint restored into a new model runs on to the same bits;
+ *    two pieces, each end whole (2D and 3D); on 1 and 2 threads the same
+ *    bits, and a checkpoint restored into a new model runs on to the same
+ *    bits;
  *  - under a slowly ramped end force F the stress is the closed form
  *    sigma_xx = F / H in every element outside the region (and inside it):
  *    the far field is continuous and bonded to the region;
@@ -389,6 +390,70 @@ static void region_threads_and_checkpoint_keep_the_bits(void)
     fdem_model_destroy(d);
 }
 
+/* The same in 3D: a 0.6 x 0.1 x 0.1 m bar of 6 x 1 x 1 cubes (six
+ * tetrahedra each) fracturing in 0.2 <= x <= 0.4, its left face fixed, its
+ * right face pulled at 2 m/s: two pieces, each end whole, the same bits on
+ * 1 and 2 threads. */
+static fdem_model *pulled_bar_3d(int threads)
+{
+    fdem_tet_mesh mesh = {0};
+    fdem_error err = {0};
+    const double origin[3] = {0, 0, 0}, size[3] = {0.6, 0.1, 0.1};
+    const int div[3] = {6, 1, 1};
+    if (fdem_tet_mesh_box(origin, size, div, &mesh, &err)) build_die("box", &err);
+    test_mesh t = view_3d(&mesh);
+    const double box[6] = {0.2, -1, -1, 0.4, 1, 1};
+    uint8_t *mask = centroid_mask(&t, box);
+    fdem_model *m = region_model(&t, &mesh, mask, 0.1);
+    free(mask);
+    fdem_tet_mesh_free(&mesh);
+    fdem_constraint_def c = {0};
+    c.select = FDEM_SELECT_BOX;
+    const double left[6] = {-1, -1, -1, 1e-9, 1, 1}, right[6] = {0.6 - 1e-9, -1, -1, 2, 1, 1};
+    memcpy(c.box, left, sizeof left);
+    c.kind = FDEM_CONSTRAINT_FIX;
+    c.fix_x = c.fix_y = c.fix_z = 1;
+    if (fdem_add_constraint(m, &c, &err) < 0) build_die("fix", &err);
+    memcpy(c.box, right, sizeof right);
+    c.kind = FDEM_CONSTRAINT_VELOCITY;
+    c.fix_x = c.fix_y = c.fix_z = 0;
+    c.value[0] = 2.0;
+    c.free_y = c.free_z = 1;
+    if (fdem_add_constraint(m, &c, &err) < 0) build_die("pull", &err);
+    build_finalize(m, 0.5);
+    fdem_set_threads(m, threads);
+    return m;
+}
+
+static void region_bar_3d_breaks_only_inside(void)
+{
+    fdem_model *a = pulled_bar_3d(1), *b = pulled_bar_3d(2);
+    CHECK(a->joint_count > 0 && a->node_count < 4 * a->elem_count, "%d joints, %d nodes",
+          a->joint_count, a->node_count);
+    run_until(a, 6e-4);
+    run_until(b, 6e-4);
+    CHECK(memcmp(a->pos, b->pos, sizeof(double) * 3 * (size_t)a->node_count) == 0,
+          "1 and 2 threads differ");
+    CHECK(fdem_get_counts(a).broken_joints > 0, "the bar should have broken");
+    int32_t *label = malloc(sizeof(int32_t) * (size_t)a->elem_count);
+    joint_fragment_labels(a, label);
+    int left = -1, right = -1, stray = 0;
+    for (int e = 0; e < a->elem_count; e++) {
+        double cx = 0;
+        for (int k = 0; k < 4; k++) cx += 0.25 * a->pos0[3 * a->elem_node[4 * e + k]];
+        int *end = cx < 0.2 ? &left : cx > 0.4 ? &right : NULL;
+        if (!end) continue;
+        if (*end < 0) *end = label[e];
+        stray += label[e] != *end;
+    }
+    CHECK(stray == 0 && left >= 0 && right >= 0 && left != right,
+          "ends are pieces %d and %d, %d elements outside the region strayed", left, right,
+          stray);
+    free(label);
+    fdem_model_destroy(a);
+    fdem_model_destroy(b);
+}
+
 /* ------------------------------------------------------- the far field */
 
 /* F per unit thickness on the right end (a uniform traction), ramped as (1 - cos(pi t/T))/2
@@ -517,6 +582,7 @@ int main(int argc, char **argv)
         {"region_joints_and_nodes_3d", region_joints_and_nodes_3d},
         {"region_of_all_is_the_whole_part", region_of_all_is_the_whole_part},
         {"region_bar_breaks_only_inside", region_bar_breaks_only_inside},
+        {"region_bar_3d_breaks_only_inside", region_bar_3d_breaks_only_inside},
         {"region_threads_and_checkpoint_keep_the_bits", region_threads_and_checkpoint_keep_the_bits},
         {"region_far_field_is_continuous", region_far_field_is_continuous},
         {"region_pieces_and_contact", region_pieces_and_contact},
