@@ -169,8 +169,9 @@ int fdem_add_part_region_3d(fdem_model *model, const fdem_tet_mesh *mesh, int ma
 /* Bonded materials (contract 5.3): material[t] becomes the material of
  * element t of the part (in the order of the mesh given to fdem_add_part*);
  * the part stays one body. Before finalize. In a fracturing part every
- * material needs fracture parameters; a joint takes those of its first
- * element's material (unless a joint set says otherwise). */
+ * material needs fracture parameters (in a fracture region, those of the
+ * elements some joint joins); a joint takes those of its first element's
+ * material (unless a joint set says otherwise). */
 int fdem_set_element_materials(fdem_model *model, int part, const int32_t *material,
                                fdem_error *err);
 

@@ -429,6 +429,19 @@ int fdem_add_part_region_3d(fdem_model *m, const fdem_tet_mesh *mesh, int materi
     return add_part_3d(m, mesh, material_index, 1, in_region, err);
 }
 
+/* A flag per element of part p: some joint joins it (NULL without memory). */
+static uint8_t *part_jointed_elements(const fdem_model *m, const part *p)
+{
+    uint8_t *jointed = calloc((size_t)(p->elem_count ? p->elem_count : 1), 1);
+    if (!jointed) return NULL;
+    for (int j = 0; j < m->joint_count; j++)
+        for (int s = 0; s < 2; s++) {
+            int e = m->joint_elem[2 * j + s] - p->elem_begin;
+            if (e >= 0 && e < p->elem_count) jointed[e] = 1;
+        }
+    return jointed;
+}
+
 int fdem_set_element_materials(fdem_model *m, int part_index, const int32_t *material_of,
                                fdem_error *err)
 {
@@ -439,21 +452,32 @@ int fdem_set_element_materials(fdem_model *m, int part_index, const int32_t *mat
         return -1;
     }
     const part *p = &m->parts[part_index];
+    uint8_t *jointed = p->region ? part_jointed_elements(m, p) : NULL;
+    if (p->region && !jointed) {
+        model_error(err, FDEM_ITEM_PART, part_index, "out of memory");
+        return -1;
+    }
     for (int t = 0; t < p->elem_count; t++) {
         int mat = material_of[t];
         if (mat < 0 || mat >= m->material_count) {
             model_error(err, FDEM_ITEM_PART, part_index,
                         "element %d of part %d refers to material %d, which does not exist", t,
                         part_index, mat);
+            free(jointed);
             return -1;
         }
-        if (p->fracture && !m->materials[mat].def.has_fracture) {
+        /* a joint takes its strengths from its elements' materials: in a
+         * fracture region only the elements with a joint need them */
+        if (p->fracture && !m->materials[mat].def.has_fracture && (!jointed || jointed[t])) {
             model_error(err, FDEM_ITEM_MATERIAL, mat,
                         "part %d fractures, so material %d of its element %d needs fracture "
-                        "parameters", part_index, mat, t);
+                        "parameters%s", part_index, mat, t,
+                        jointed ? " (the element lies in the fracture region)" : "");
+            free(jointed);
             return -1;
         }
     }
+    free(jointed);
     for (int t = 0; t < p->elem_count; t++) {
         int e = p->elem_begin + t;
         if (m->dim == 3) m->tet[e].material = material_of[t];

@@ -98,7 +98,8 @@ static void read_group_material(case_doc *doc, case_part *part, int count, const
         case_problem(doc, ptr, "unknown material \"%.64s\"", json_string_value(value));
         return;
     }
-    if (part->fracture && !doc->materials[mat].def.has_fracture)
+    /* in a fracture region only its elements need one: the engine knows them */
+    if (part->fracture && !part->fracture_region && !doc->materials[mat].def.has_fracture)
         case_problem(doc, ptr, "the part fractures, so material \"%.64s\" needs a "
                                "\"fracture\" block", json_string_value(value));
     if (g < 0 || !part->element_material) return;

@@ -64,6 +64,7 @@ typedef struct case_part {
     char name[CASE_NAME];
     int material;            /* index into case_doc.materials, -1 if unknown */
     int fracture;
+    int fracture_region;     /* "fracture" is a selector or a list (case_region.c) */
     int has_velocity;
     double velocity[3];      /* `dimension` components */
     case_shape shape;

@@ -163,7 +163,7 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
     json_t *fracture = case_member(value, ptr, "fracture", at);
     /* a selector or a list of them: a fracture region (case_region.c) */
     int region = json_is_object(fracture) || json_is_array(fracture);
-    if (region) part->fracture = 1;
+    if (region) part->fracture = part->fracture_region = 1;
     else if (fracture && !json_is_boolean(fracture))
         case_problem(doc, at, "expected true or false, or a fracture region: a selector "
                               "({\"box\": [...]} or {\"group\": \"name\"}) or a list of them, "

@@ -140,6 +140,18 @@ class FractureRegionTest(DaemonTestCase):
         self.assertGreater(got["joints"], 0)
         self.assertLess(got["joints"], all_joints["joints"])
 
+    def test_group_materials_outside_the_region_need_no_fracture(self):
+        case = bar_case({"group": "stiff"})
+        del case["parts"][0]["rectangle"]
+        case["parts"][0]["gmsh"] = read("tests/data/bar_groups_v41.msh")
+        case["parts"][0]["materials"] = {"soft": "plain"}
+        case["materials"]["plain"] = {"density": 2000, "young": 1e9, "poisson": 0.2}
+        case["constraints"] = []
+        self.assertGreater(self.dry(case)["joints"], 0)
+        case["parts"][0]["fracture"] = {"group": "soft"}
+        p = self.problems(case)
+        self.assertTrue(any("fracture region" in m for m in p.values()), p)
+
     def test_pulled_bar_breaks_inside_its_region(self):
         box = [0.8, -1, 1.2, 1]
         st, path = self.run_case(bar_case({"box": box}))

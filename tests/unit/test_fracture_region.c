@@ -575,6 +575,37 @@ static void region_pieces_and_contact(void)
     fdem_model_destroy(m);
 }
 
+/* Bonded materials in a region part: a joint takes its strengths from its
+ * elements' materials, so the elements outside the region (a lining, a
+ * far field) may have a material without fracture parameters; one inside
+ * may not. */
+static void region_materials_outside_need_no_fracture(void)
+{
+    fdem_mesh mesh;
+    fdem_error err;
+    if (fdem_mesh_rectangle(0, 0, 6, 6, 6, 6, &mesh, &err)) build_die("rectangle", &err);
+    test_mesh t = view_2d(&mesh);
+    const double box[4] = {1, 1, 5, 5};
+    uint8_t *mask = centroid_mask(&t, box);
+    fdem_model *m = region_model(&t, &mesh, mask, 0);
+    int plain = build_material(m, 2400, 2e10, 0.2, 0, 0.5);
+    int32_t *mat = malloc(sizeof(int32_t) * (size_t)t.elem_count);
+    int inside = -1;
+    for (int e = 0; e < t.elem_count; e++) {
+        mat[e] = mask[e] ? 0 : plain;
+        if (mask[e] && inside < 0) inside = e;
+    }
+    CHECK(fdem_set_element_materials(m, 0, mat, &err) == 0, "outside: %s", err.message);
+    mat[inside] = plain;
+    CHECK(fdem_set_element_materials(m, 0, mat, &err) < 0 &&
+              strstr(err.message, "fracture region"),
+          "an element inside without fracture parameters was accepted");
+    fdem_model_destroy(m);
+    free(mat);
+    free(mask);
+    fdem_mesh_free(&mesh);
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -586,6 +617,7 @@ int main(int argc, char **argv)
         {"region_threads_and_checkpoint_keep_the_bits", region_threads_and_checkpoint_keep_the_bits},
         {"region_far_field_is_continuous", region_far_field_is_continuous},
         {"region_pieces_and_contact", region_pieces_and_contact},
+        {"region_materials_outside_need_no_fracture", region_materials_outside_need_no_fracture},
     };
     return check_run(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }
