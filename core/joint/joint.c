@@ -273,9 +273,10 @@ int joint_fan_holds(const fdem_model *m, int a, int b)
     const int32_t *nb = m->elem_node + (size_t)K * (size_t)b;
     for (int i = 0; i < K; i++) {
         int32_t v = m->node_origin[na[i]];
-        if (m->vertex_broken[v]) { /* only one node both hold glues them now */
-            for (int k = 0; k < K; k++)
-                if (nb[k] == na[i]) return 1;
+        if (m->vertex_broken[v]) { /* only a node both hold glues them now */
+            if (m->elem_piece0) /* a fracture region's, where elements share nodes */
+                for (int k = 0; k < K; k++)
+                    if (nb[k] == na[i]) return 1;
             continue;
         }
         for (int k = 0; k < K; k++)
