@@ -149,11 +149,29 @@ int fdem_add_part(fdem_model *model, const fdem_mesh *mesh, int material,
 int fdem_add_part_3d(fdem_model *model, const fdem_tet_mesh *mesh, int material,
                      int fracture, fdem_error *err);
 
+/* Fracture in a region (contract 6.1): a fracturing part whose joints go
+ * only on the interior edges (3D: faces) whose two elements both have
+ * in_region[t] != 0 (one flag per triangle or tetrahedron of `mesh`, in
+ * its order; the caller decides membership, e.g. by centroid). The rest
+ * stays one continuous body, bonded to the region: a mesh vertex gets one
+ * node per class of its elements joined around it through edges (faces)
+ * that carry no joint, so elements outside the region share their nodes
+ * as in a part that does not fracture, and a vertex inside it has a node
+ * per element as in a whole fracturing part. The material needs fracture
+ * parameters. Every flag set builds exactly the part fdem_add_part(...,
+ * fracture 1) builds (the same nodes, joints and order); no flag set is an
+ * error. Returns the part index or -1. */
+int fdem_add_part_region(fdem_model *model, const fdem_mesh *mesh, int material,
+                         const uint8_t *in_region, fdem_error *err);
+int fdem_add_part_region_3d(fdem_model *model, const fdem_tet_mesh *mesh, int material,
+                            const uint8_t *in_region, fdem_error *err);
+
 /* Bonded materials (contract 5.3): material[t] becomes the material of
  * element t of the part (in the order of the mesh given to fdem_add_part*);
  * the part stays one body. Before finalize. In a fracturing part every
- * material needs fracture parameters; a joint takes those of its first
- * element's material (unless a joint set says otherwise). */
+ * material needs fracture parameters (in a fracture region, those of the
+ * elements some joint joins); a joint takes those of its first element's
+ * material (unless a joint set says otherwise). */
 int fdem_set_element_materials(fdem_model *model, int part, const int32_t *material,
                                fdem_error *err);
 

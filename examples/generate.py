@@ -413,3 +413,29 @@ dump("tunnel", {
                      "amplitude": [[0, 1], [0.01, 0]]}],
     "time": {"end": 0.015, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.0005, "fields": ["position", "stress"]}})
+
+# Fracture in a region (contract 6.1): a 10 m opening in a 30 m square of
+# rock (tunnel-region.geo) loaded on its edges by a pressure ramped to
+# 15 MPa over 10 ms and held (edges absorbing). The hoop stress at the
+# wall rises towards 2 p = 30 MPa, above the joints' Mohr-Coulomb strength
+# 2 c cos(phi) / (1 - sin(phi)) = 23 MPa, and falls to 20 MPa at r = 9 m:
+# the rock can break only in the annulus 5 m < r < 9 m (the group "near
+# field"); the far field stays one continuous body bonded to it.
+B = 15.0
+far = [[-B - 0.1, -B - 0.1, -B + 0.1, B + 0.1], [B - 0.1, -B - 0.1, B + 0.1, B + 0.1],
+       [-B - 0.1, -B - 0.1, B + 0.1, -B + 0.1], [-B - 0.1, B - 0.1, B + 0.1, B + 0.1]]
+dump("tunnel-region", {
+    "name": "tunnel-region",
+    "materials": {"rock": {"density": 2600, "young": 2e10, "poisson": 0.25, "damping": 0.2,
+                           "friction": 0.5,
+                           "fracture": {"tensile_strength": 2e6, "cohesion": 6e6,
+                                        "friction_angle": 35, "energy_I": 50,
+                                        "energy_II": 250}}},
+    "parts": [{"name": "rock mass", "material": "rock",
+               "fracture": {"group": "near field"},
+               "gmsh": gmsh_text(os.path.join(OUT, "tunnel-region.geo"))}],
+    "constraints": [{"box": box, "pressure": 15e6, "amplitude": [[0, 0], [0.01, 1]]}
+                    for box in far] +
+                   [{"box": box, "absorb": True} for box in far],
+    "time": {"end": 0.02, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.001, "fields": ["position", "stress", "damage"]}})

@@ -62,7 +62,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_node); free(m->joint_damage); free(m->joint_offset); free(m->joint_elem); free(m->joint_h);
     free(m->joint_slip); free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
-    free(m->elem_joint); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
+    free(m->elem_joint); free(m->elem_piece0); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     stages_free(m);
@@ -206,14 +206,25 @@ static int part_check(fdem_model *m, int material_index, int fracture, int dim, 
     return 0;
 }
 
+/* The nodes of a part: its mesh's own (corner NULL, a part that does not
+ * fracture), or `count` nodes with corner[K t + c] the node (0-based in the
+ * part) of corner c of element t (joint_region_nodes). */
+typedef struct part_nodes {
+    const int32_t *corner;
+    int count;
+    int region;
+} part_nodes;
+
 /* Appends a validated mesh as part k: node coordinates (dim a node) and
- * element node lists (elem_nodes an element). A fracturing part gives every
- * element its own nodes (joints join them). */
+ * element node lists (elem_nodes an element). A fracturing part gives
+ * each class of a vertex's corners its own node (joints join them). */
 static int part_append(fdem_model *m, const double *coords, int node_count, const int32_t *elems,
-                       int elem_count, int material_index, int fracture, fdem_error *err)
+                       int elem_count, int material_index, const part_nodes *nodes,
+                       fdem_error *err)
 {
     int k = m->part_count, D = m->dim, K = m->elem_nodes;
-    int add_nodes = fracture ? K * elem_count : node_count;
+    int fracture = nodes->corner != NULL;
+    int add_nodes = fracture ? nodes->count : node_count;
     if (grow((void **)&m->parts, &m->part_capacity, k + 1, sizeof *m->parts) ||
         reserve_nodes(m, m->node_count + add_nodes) ||
         reserve_elements(m, m->elem_count + elem_count)) {
@@ -229,9 +240,10 @@ static int part_append(fdem_model *m, const double *coords, int node_count, cons
     m->part_velocity[3 * k] = m->part_velocity[3 * k + 1] = m->part_velocity[3 * k + 2] = 0;
 
     part *p = &m->parts[k];
+    memset(p, 0, sizeof *p);
     p->material = material_index;
     p->fracture = fracture;
-    p->stressed = 0;
+    p->region = fracture && nodes->region;
     p->node_begin = m->node_count;
     p->node_count = add_nodes;
     p->elem_begin = m->elem_count;
@@ -250,7 +262,7 @@ static int part_append(fdem_model *m, const double *coords, int node_count, cons
         }
         for (int c = 0; c < K; c++) {
             int src = elems[K * t + c];
-            int dst = fracture ? m->node_count + K * t + c : m->node_count + src;
+            int dst = m->node_count + (fracture ? nodes->corner[K * t + c] : src);
             hot_node[c] = dst;
             m->elem_node[(size_t)K * (size_t)e + (size_t)c] = dst;
             m->node_origin[dst] = m->node_count + src;
@@ -270,6 +282,54 @@ static int part_append(fdem_model *m, const double *coords, int node_count, cons
     m->elem_count += elem_count;
     m->part_count++;
     return 0;
+}
+
+/* A region flag per element, or NULL for the whole part (none given, or
+ * every flag set: the same part as a whole fracturing one); *bad is set
+ * when no flag is. */
+static const uint8_t *region_or_whole(const uint8_t *in_region, int elem_count, int *bad)
+{
+    *bad = 0;
+    if (!in_region) return NULL;
+    int inside = 0;
+    for (int t = 0; t < elem_count; t++) inside += in_region[t] != 0;
+    *bad = inside == 0;
+    return inside == elem_count ? NULL : in_region;
+}
+
+/* Appends a validated mesh of either dimension as a part: its nodes
+ * (joint_region_nodes for a fracturing part), then its joints. */
+static int part_add_mesh(fdem_model *m, const double *coords, int node_count,
+                         const int32_t *elems, int elem_count, int material_index, int fracture,
+                         const uint8_t *in_region, fdem_error *err)
+{
+    int k = m->part_count, K = m->elem_nodes, bad;
+    const uint8_t *region = fracture ? region_or_whole(in_region, elem_count, &bad) : NULL;
+    if (fracture && bad) {
+        model_error(err, FDEM_ITEM_PART, k,
+                    "part %d: its fracture region holds none of its %d %s (by centroid)", k,
+                    elem_count, m->dim == 3 ? "tetrahedra" : "triangles");
+        return -1;
+    }
+    part_nodes nodes = {NULL, 0, region != NULL};
+    int32_t *corner = NULL;
+    if (fracture) {
+        corner = malloc(sizeof(int32_t) * (size_t)K * (size_t)elem_count);
+        if (!corner) {
+            model_error(err, FDEM_ITEM_PART, k, "out of memory for part %d", k);
+            return -1;
+        }
+        if (joint_region_nodes(elems, elem_count, K, region, corner, &nodes.count, k, err)) {
+            free(corner);
+            return -1;
+        }
+        nodes.corner = corner;
+    }
+    int failed = part_append(m, coords, node_count, elems, elem_count, material_index, &nodes, err);
+    free(corner);
+    if (failed || !fracture) return failed ? -1 : 0;
+    return m->dim == 3 ? joint_build_part_3d(m, k, elems, elem_count, region, err)
+                       : joint_build_part(m, k, elems, elem_count, region, err);
 }
 
 /* A private copy of a mesh's arrays (dim numbers a node, m->elem_nodes
@@ -304,8 +364,8 @@ static int part_copy_arrays(fdem_model *m, const double *coords, int node_count,
     return 0;
 }
 
-int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
-                  fdem_error *err)
+static int add_part_2d(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
+                       const uint8_t *in_region, fdem_error *err)
 {
     int k = m->part_count;
     fdem_mesh copy = {mesh->node_count, mesh->triangle_count, NULL, NULL};
@@ -314,15 +374,14 @@ int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int 
                          &copy.tri, err))
         return -1;
     int failed = fdem_mesh_validate(&copy, NULL, err) ||
-                 part_append(m, copy.xy, copy.node_count, copy.tri, copy.triangle_count,
-                             material_index, fracture, err) ||
-                 (fracture && joint_build_part(m, k, copy.tri, copy.triangle_count, err));
+                 part_add_mesh(m, copy.xy, copy.node_count, copy.tri, copy.triangle_count,
+                               material_index, fracture, in_region, err);
     fdem_mesh_free(&copy);
     return failed ? -1 : k;
 }
 
-int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_index, int fracture,
-                     fdem_error *err)
+static int add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_index, int fracture,
+                       const uint8_t *in_region, fdem_error *err)
 {
     int k = m->part_count;
     if (part_check(m, material_index, fracture, 3, err)) return -1;
@@ -331,11 +390,57 @@ int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_inde
                          &copy.tet, err))
         return -1;
     int failed = fdem_tet_mesh_validate(&copy, NULL, err) ||
-                 part_append(m, copy.xyz, copy.node_count, copy.tet, copy.tet_count,
-                             material_index, fracture, err) ||
-                 (fracture && joint_build_part_3d(m, k, copy.tet, copy.tet_count, err));
+                 part_add_mesh(m, copy.xyz, copy.node_count, copy.tet, copy.tet_count,
+                               material_index, fracture, in_region, err);
     fdem_tet_mesh_free(&copy);
     return failed ? -1 : k;
+}
+
+int fdem_add_part(fdem_model *m, const fdem_mesh *mesh, int material_index, int fracture,
+                  fdem_error *err)
+{
+    return add_part_2d(m, mesh, material_index, fracture, NULL, err);
+}
+
+int fdem_add_part_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_index, int fracture,
+                     fdem_error *err)
+{
+    return add_part_3d(m, mesh, material_index, fracture, NULL, err);
+}
+
+int fdem_add_part_region(fdem_model *m, const fdem_mesh *mesh, int material_index,
+                         const uint8_t *in_region, fdem_error *err)
+{
+    if (!in_region) {
+        model_error(err, FDEM_ITEM_PART, m->part_count, "part %d: no fracture region given",
+                    m->part_count);
+        return -1;
+    }
+    return add_part_2d(m, mesh, material_index, 1, in_region, err);
+}
+
+int fdem_add_part_region_3d(fdem_model *m, const fdem_tet_mesh *mesh, int material_index,
+                            const uint8_t *in_region, fdem_error *err)
+{
+    if (!in_region) {
+        model_error(err, FDEM_ITEM_PART, m->part_count, "part %d: no fracture region given",
+                    m->part_count);
+        return -1;
+    }
+    return add_part_3d(m, mesh, material_index, 1, in_region, err);
+}
+
+/* A flag per element of part p: some joint joins it (NULL without memory). */
+static uint8_t *part_jointed_elements(const fdem_model *m, const part *p)
+{
+    uint8_t *jointed = calloc((size_t)(p->elem_count ? p->elem_count : 1), 1);
+    if (!jointed) return NULL;
+    for (int j = 0; j < m->joint_count; j++)
+        for (int s = 0; s < 2; s++) {
+            int e = m->joint_elem[2 * j + s] - p->elem_begin;
+            if (e >= 0 && e < p->elem_count) jointed[e] = 1;
+        }
+    return jointed;
 }
 
 int fdem_set_element_materials(fdem_model *m, int part_index, const int32_t *material_of,
@@ -348,21 +453,32 @@ int fdem_set_element_materials(fdem_model *m, int part_index, const int32_t *mat
         return -1;
     }
     const part *p = &m->parts[part_index];
+    uint8_t *jointed = p->region ? part_jointed_elements(m, p) : NULL;
+    if (p->region && !jointed) {
+        model_error(err, FDEM_ITEM_PART, part_index, "out of memory");
+        return -1;
+    }
     for (int t = 0; t < p->elem_count; t++) {
         int mat = material_of[t];
         if (mat < 0 || mat >= m->material_count) {
             model_error(err, FDEM_ITEM_PART, part_index,
                         "element %d of part %d refers to material %d, which does not exist", t,
                         part_index, mat);
+            free(jointed);
             return -1;
         }
-        if (p->fracture && !m->materials[mat].def.has_fracture) {
+        /* a joint takes its strengths from its elements' materials: in a
+         * fracture region only the elements with a joint need them */
+        if (p->fracture && !m->materials[mat].def.has_fracture && (!jointed || jointed[t])) {
             model_error(err, FDEM_ITEM_MATERIAL, mat,
                         "part %d fractures, so material %d of its element %d needs fracture "
-                        "parameters", part_index, mat, t);
+                        "parameters%s", part_index, mat, t,
+                        jointed ? " (the element lies in the fracture region)" : "");
+            free(jointed);
             return -1;
         }
     }
+    free(jointed);
     for (int t = 0; t < p->elem_count; t++) {
         int e = p->elem_begin + t;
         if (m->dim == 3) m->tet[e].material = material_of[t];

@@ -195,6 +195,7 @@ size_t fdem_memory_bytes(const fdem_model *m)
     if (m->joint_strength_of) b += (size_t)m->joint_count * sizeof(int32_t);
     b += (size_t)m->event_capacity * sizeof(fdem_event);
     if (m->joint_count) b += (size_t)m->elem_count * ((size_t)D + 1) * sizeof(int32_t);
+    if (m->elem_piece0) b += (size_t)m->elem_count * sizeof(int32_t);
     b += (size_t)m->joint_strength_count * sizeof(joint_strength);
     /* constraint entries (node, dofs), their records and forces out */
     b += (size_t)m->cnode_count * (sizeof(int32_t) + 1);

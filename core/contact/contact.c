@@ -568,6 +568,10 @@ int contact_init(fdem_model *m, fdem_error *err)
         int p = m->elem_part[e];
         cs->body[e] = m->parts[p].fracture ? m->part_count + e : p;
     }
+    if (joint_region_bodies(m, cs->body)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
+        return -1;
+    }
     double rmax = 0;
     for (int e = 0; e < m->elem_count; e++) {
         double c[3], r;

@@ -84,10 +84,11 @@ int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err)
 }
 
 /* Adds a joint on every edge shared by two triangles of the fracturing part
- * whose elements start at elem_begin; tri holds the part's original
- * (validated, counter-clockwise) connectivity. */
+ * whose elements start at elem_begin (both in the region, when in_region is
+ * given); tri holds the part's original (validated, counter-clockwise)
+ * connectivity. */
 int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
-                     fdem_error *err)
+                     const uint8_t *in_region, fdem_error *err)
 {
     size_t ne = 3 * (size_t)triangle_count;
     edge_ref *edges = joint_build_scratch(sizeof *edges * ne, part_index, err);
@@ -105,7 +106,7 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
     int shared = 0;
     for (size_t k = 0; k + 1 < ne; k++)
         if (edges[k].lo == edges[k + 1].lo && edges[k].hi == edges[k + 1].hi) shared++;
-
+    /* room for a joint on every shared edge: a region's are fewer */
     int J0 = m->joint_count, J = J0 + shared;
     if (joint_reserve(m, J, part_index, err)) {
         free(edges);
@@ -123,6 +124,10 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
                         "edge %d-%d of part %d is shared by more than two triangles", lo, hi,
                         part_index);
             return -1;
+        }
+        if (in_region && !(in_region[a->tri] && in_region[b->tri])) {
+            k++; /* no joint: the two triangles share these nodes (joint_region.c) */
+            continue;
         }
         int ea = p->elem_begin + a->tri, eb = p->elem_begin + b->tri;
         /* face A runs a0 -> a1 counter-clockwise in A; b0, b1 are the
@@ -142,7 +147,7 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
         j++;
         k++;
     }
-    m->joint_count = J;
+    m->joint_count = j;
     free(edges);
     return 0;
 }
@@ -150,6 +155,7 @@ int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int tria
 /* Per-joint data derived at finalize: stiffness length, element map. */
 int joint_prepare(fdem_model *m, fdem_error *err)
 {
+    if (joint_region_pieces(m, err)) return -1;
     if (!m->joint_count) return m->joint_set_count ? joint_strengths_assign(m, err) : 0;
     size_t J = (size_t)m->joint_count;
     m->joint_damage = calloc(J, sizeof(double));
@@ -230,9 +236,11 @@ void joint_mark_broken_vertices(fdem_model *m)
 }
 
 /* True when a and b (of one fracturing part) are glued together: an intact
- * joint joins them, or they share a mesh vertex around which every joint is
- * intact. Such a fan of triangles moves as one piece; its members overlap
- * only by the joints' own elastic compliance, which the joints resist.
+ * joint joins them, they share a mesh vertex around which every joint is
+ * intact, or they share a node (a fracture region's elements outside its
+ * joints do, as in a part that does not fracture). Such a fan of triangles
+ * moves as one piece; its members overlap only by the joints' own elastic
+ * compliance, which the joints resist.
  * Leaving these pairs out of contact keeps an intact fracturing block as
  * cheap as its joints instead of paying for about a dozen touching-at-a-
  * point pairs per triangle. Valid after joint_mark_broken_vertices. */
@@ -275,7 +283,12 @@ int joint_fan_holds(const fdem_model *m, int a, int b)
     const int32_t *nb = m->elem_node + (size_t)K * (size_t)b;
     for (int i = 0; i < K; i++) {
         int32_t v = m->node_origin[na[i]];
-        if (m->vertex_broken[v]) continue;
+        if (m->vertex_broken[v]) { /* only a node both hold glues them now */
+            if (m->elem_piece0) /* a fracture region's, where elements share nodes */
+                for (int k = 0; k < K; k++)
+                    if (nb[k] == na[i]) return 1;
+            continue;
+        }
         for (int k = 0; k < K; k++)
             if (m->node_origin[nb[k]] == v) return 1;
     }
@@ -557,9 +570,6 @@ static int uf_find(int32_t *parent, int i)
     return i;
 }
 
-/* Labels every element with its piece (elements joined by intact joints;
- * a part that does not fracture is one piece): label[e] is the smallest
- * element of e's piece. Returns the number of pieces. */
 /* The first active element of part p (its piece's root once elements were
  * excavated), or the part's first element when none is left. */
 static int part_root(const fdem_model *m, int p)
@@ -570,7 +580,10 @@ static int part_root(const fdem_model *m, int p)
     return pt->elem_begin;
 }
 
-/* An excavated element is a piece of its own that is not counted (its
+/* Labels every element with its piece (elements joined by intact joints
+ * or shared nodes; a part that does not fracture is one piece): label[e] is
+ * the smallest active element of e's piece. Returns the number of pieces.
+ * An excavated element is a piece of its own that is not counted (its
  * joints read broken: excavation.c). A part that does not fracture stays
  * one piece however excavation cuts it. */
 int joint_fragment_labels(const fdem_model *m, int32_t *label)
@@ -578,7 +591,16 @@ int joint_fragment_labels(const fdem_model *m, int32_t *label)
     int root = -1, root_part = -1;
     for (int e = 0; e < m->elem_count; e++) {
         int p = m->elem_part[e];
-        if (m->parts[p].fracture || !element_is_active(m, e)) {
+        if (m->elem_piece0 && element_is_active(m, e)) {
+            /* elem_piece0[e] <= e is the first element of e's piece; once
+             * it was excavated, its slot holds the piece's first active
+             * element, which every later one then joins */
+            int r = m->elem_piece0[e];
+            if (r != e && !element_is_active(m, r) && label[r] == r) label[r] = e;
+            label[e] = r == e ? e : label[r];
+            continue;
+        }
+        if (m->parts[p].fracture || m->elem_piece0 || !element_is_active(m, e)) {
             label[e] = e;
             continue;
         }

@@ -77,8 +77,9 @@ static inline void joint_add_offsets_2d(const double offset[4], double tx, doubl
 }
 void *joint_build_scratch(size_t bytes, int part_index, fdem_error *err);
 int joint_reserve(fdem_model *m, int J, int part_index, fdem_error *err);
+/* in_region: NULL, or a flag per element (joints only between two set ones) */
 int joint_build_part(fdem_model *m, int part_index, const int32_t *tri, int triangle_count,
-                     fdem_error *err);
+                     const uint8_t *in_region, fdem_error *err);
 int joint_prepare(fdem_model *m, fdem_error *err);
 double joint_stable_dt(const fdem_model *m);
 int joint_holds(const fdem_model *m, int a, int b);
@@ -105,9 +106,22 @@ int events_checkpoint_read(fdem_model *m, const unsigned char *p, int64_t count)
 int joint_strengths_assign(fdem_model *m, fdem_error *err);
 void joint_sets_free(fdem_model *m);
 double weibull_factor(uint64_t seed, uint64_t index, double modulus);
+/* joint_region.c: fracture in a region. The node (0-based within the part)
+ * of each of the K elem_count corners of a part's elements: one per class
+ * of a vertex's corners joined through faces without a joint (in_region
+ * NULL: every element keeps its own, node K t + c); *node_count their
+ * number. 0, or -1 with err filled. */
+int joint_region_nodes(const int32_t *elems, int elem_count, int K, const uint8_t *in_region,
+                       int32_t *corner_node, int *node_count, int part_index, fdem_error *err);
+/* model.elem_piece0 when some part fractures in a region (at finalize). */
+int joint_region_pieces(fdem_model *m, fdem_error *err);
+/* Contact detection's body per element (contact.c set a fracturing part's
+ * to part_count + e): a region's elements with no vertex on a joint get
+ * their part's number. 0, or -1 without memory. */
+int joint_region_bodies(const fdem_model *m, int32_t *body);
 /* joint_tet_model.c: the 3D geometry of joints (6 nodes, a face each) */
 int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
-                        fdem_error *err);
+                        const uint8_t *in_region, fdem_error *err);
 double joint_stable_dt_3d(const fdem_model *m);
 void joint_forces_range_3d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);
 int joint_forces_one_3d(fdem_model *m, int j, joint_totals *t, double fa[JOINT_FACE_VALUES]);

@@ -29,7 +29,8 @@
  *
  * A cut with more slots than an eighth of the joints (many threads on a
  * small mesh) is cut again into fewer ranges; a model whose joints touch
- * other elements' nodes, or a cut that finds no memory, runs on one thread.
+ * other elements' nodes (a fracture region's), or a cut that finds no
+ * memory, runs on one thread.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -108,11 +109,16 @@ size_t joint_sweep_bytes(const joint_sweep *s)
            slots * (sizeof(int32_t) + JOINT_FACE_VALUES * sizeof(double) + 1);
 }
 
-/* Whether every joint touches only nodes of its two elements, the premise
- * of owning by element. */
+/* Whether every joint touches only nodes of its two elements, and those
+ * nodes no other element's, the premise of owning by element. A fracture
+ * region's elements share the nodes where no joint splits a vertex, so
+ * two ranges could add to one node: such a model walks its joints on one
+ * thread. */
 static int joints_keep_to_their_elements(const fdem_model *m)
 {
     const int D = m->dim, K = m->elem_nodes;
+    for (int k = 0; k < m->part_count; k++)
+        if (m->parts[k].region) return 0;
     for (int j = 0; j < m->joint_count; j++)
         for (int face = 0; face < 2; face++) {
             const int32_t *own = m->elem_node + (size_t)K * (size_t)m->joint_elem[2 * j + face];

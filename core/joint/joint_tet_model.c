@@ -76,10 +76,10 @@ static int pair_compare(const void *pa, const void *pb)
 }
 
 /* Adds a joint on every face shared by two tetrahedra of the fracturing
- * part part_index; tet holds its original (validated, positively oriented)
- * connectivity. */
+ * part part_index (both in the region, when in_region is given); tet holds
+ * its original (validated, positively oriented) connectivity. */
 int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int tet_count,
-                        fdem_error *err)
+                        const uint8_t *in_region, fdem_error *err)
 {
     size_t nf = 4 * (size_t)tet_count;
     face_ref *faces = joint_build_scratch(sizeof *faces * nf, part_index, err);
@@ -120,7 +120,9 @@ int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int t
     int n_pairs = 0;
     for (size_t k = 0; k + 1 < nf; k++) {
         if (!same_face(&faces[k], &faces[k + 1])) continue;
-        pairs[n_pairs++] = (joint_pair_ref){faces[k].tet, faces[k + 1].tet, k};
+        /* outside the region the two tetrahedra share nodes (joint_region.c) */
+        if (!in_region || (in_region[faces[k].tet] && in_region[faces[k + 1].tet]))
+            pairs[n_pairs++] = (joint_pair_ref){faces[k].tet, faces[k + 1].tet, k};
         k++;
     }
     qsort(pairs, (size_t)n_pairs, sizeof *pairs, pair_compare);
@@ -129,7 +131,7 @@ int joint_build_part_3d(fdem_model *m, int part_index, const int32_t *tet, int t
         const face_ref *a = &faces[pairs[i].face];
         joint_set_3d(m, J0 + i, tet, a, a + 1, begin + a->tet, begin + a[1].tet);
     }
-    m->joint_count = J;
+    m->joint_count = J0 + n_pairs;
     free(pairs);
     free(faces);
     return 0;

@@ -71,7 +71,10 @@ typedef struct joint_set {
 
 typedef struct part {
     int material;
-    int fracture;
+    int fracture;        /* has joints: on every interior face, or only inside a region */
+    int region;          /* fracture in a region (joint_region.c): its elements share the
+                            nodes of every vertex no joint splits; 0 when every element
+                            keeps its own nodes (a whole fracturing part) */
     int stressed;        /* has an in-situ stress (initial_stress.c) */
     int fixed;           /* held still as a whole: its element forces are kept (fixed_part.c) */
     int node_begin, node_count;
@@ -295,6 +298,9 @@ struct fdem_model {
     joint_slip *joint_slip;  /* dim per joint, one per integration point: the plastic slide
                                 and slip path each keeps (joint_law.h); zero while undamaged */
     int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
+    int32_t *elem_piece0;    /* with a fracture region: per element, the first element of
+                                those it is joined to through shared nodes (the pieces before
+                                any joint counts; joint_region.c); NULL without one */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
                                 refreshed at each contact detection */
     double *joint_fracture;  /* per joint: what its damage growth dissipated so far (the
@@ -417,10 +423,10 @@ static inline double model_time_after(const fdem_model *m, double h, double *car
 /* A part whose elements' forces are stored, not added, at each step: a
  * fracturing part in 3D, where every element has nodes of its own, so the
  * step need not zero their forces first (element_tet_model.c; the triangle
- * kernel adds everywhere). */
+ * kernel adds everywhere). A fracture region shares nodes: it adds. */
 static inline int model_part_stores_forces(const fdem_model *m, const part *p)
 {
-    return m->dim == 3 && p->fracture;
+    return m->dim == 3 && p->fracture && !p->region;
 }
 
 /* Initial area (2D) or volume (3D), set by element_prepare. */

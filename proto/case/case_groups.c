@@ -62,6 +62,28 @@ static int group_lookup(case_doc *doc, const case_part *part, const char *name, 
     return -1;
 }
 
+int case_element_group(case_doc *doc, const case_part *part, const json_t *name,
+                       const char *ptr)
+{
+    if (!json_is_string(name)) {
+        case_problem(doc, ptr, "expected the name of a physical group, got %s",
+                     case_type_word(name));
+        return -1;
+    }
+    if (part->shape != CASE_SHAPE_GMSH) {
+        case_problem(doc, ptr, "\"group\" names a physical group of a \"gmsh\" mesh; this part "
+                               "has none");
+        return -1;
+    }
+    int g = group_lookup(doc, part, json_string_value(name), part_mesh_dimension(doc), ptr);
+    if (g >= 0 && part->groups.group[g].element_count == 0) {
+        case_problem(doc, ptr, "the group \"%.64s\" has no element of the mesh",
+                     json_string_value(name));
+        return -1;
+    }
+    return g;
+}
+
 /* ------------------------------------------------------------ materials */
 
 static void read_group_material(case_doc *doc, case_part *part, int count, const char *name,
@@ -77,7 +99,8 @@ static void read_group_material(case_doc *doc, case_part *part, int count, const
         case_problem(doc, ptr, "unknown material \"%.64s\"", json_string_value(value));
         return;
     }
-    if (part->fracture && !doc->materials[mat].def.has_fracture)
+    /* in a fracture region only its elements need one: the engine knows them */
+    if (part->fracture && !part->fracture_region && !doc->materials[mat].def.has_fracture)
         case_problem(doc, ptr, "the part fractures, so material \"%.64s\" needs a "
                                "\"fracture\" block", json_string_value(value));
     if (g < 0 || !part->element_material) return;

@@ -52,10 +52,26 @@ typedef struct case_stress_field {
     double value[6], gradient[6], reference;
 } case_stress_field;
 
+/* A part's "fracture" given as a selector or a list of them (contract 6.1,
+ * case_region.c): each a box of element centroids or a gmsh element group. */
+#define CASE_MAX_REGION_SELECTORS 16
+
+typedef struct case_region_selector {
+    int group;               /* index into the part's groups, or -1: a box */
+    double box[6];           /* lower bounds, then upper bounds (dimension each) */
+} case_region_selector;
+
+typedef struct case_region {
+    int count;               /* 0: "fracture" is true or false */
+    int listed;              /* given as a list: selector k is at /parts/i/fracture/k */
+    case_region_selector selector[CASE_MAX_REGION_SELECTORS];
+} case_region;
+
 typedef struct case_part {
     char name[CASE_NAME];
     int material;            /* index into case_doc.materials, -1 if unknown */
     int fracture;
+    int fracture_region;     /* "fracture" is a selector or a list (case_region.c) */
     int has_velocity;
     double velocity[3];      /* `dimension` components */
     case_shape shape;
@@ -72,6 +88,7 @@ typedef struct case_part {
     double nodes, elements, joints; /* pass 2 estimates (doubles: no overflow) */
     gmsh_groups groups;      /* GMSH: its named physical groups */
     int32_t *element_material; /* "materials": the material of each element, else NULL */
+    struct case_region region; /* "fracture" as selectors (case_region.c) */
     struct case_joint_set *joint_sets; /* "discontinuities" */
     int joint_set_count;
 } case_part;
@@ -265,6 +282,19 @@ void case_read_stages(case_doc *doc, const json_t *stages);
 void case_check_stage_end(case_doc *doc);
 int case_add_stages(case_doc *doc, fdem_model *model);
 void case_stages_free(case_doc *doc);
+/* case_region.c: a part's "fracture" when it is a selector or a list of
+ * them (after its shape and groups; `value` is the part's object; a mesh
+ * read in pass 1 is checked against the region when mesh_sound, i.e. it
+ * read without a problem), and the flag per element of part i's mesh (NULL
+ * while "fracture" is not a region): 0, or -1 after a problem at the
+ * selector that selects nothing. */
+void case_read_region(case_doc *doc, case_part *part, const json_t *value, const char *ptr,
+                      int mesh_sound);
+int case_region_mask(case_doc *doc, int i, uint8_t **mask);
+/* case_groups.c: the group of elements (of the mesh's dimension) named by
+ * `name` at ptr, or -1 after a problem there. */
+int case_element_group(case_doc *doc, const case_part *part, const json_t *name,
+                       const char *ptr);
 /* case_initial_stress.c: a stress field block at ptr ("initial_stress",
  * "boundary_stress"; `what` names it in the message about an unknown key):
  * 1 when read, 0 after a problem at each member at fault. */

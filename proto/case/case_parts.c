@@ -1,6 +1,6 @@
 /*
  * case_parts.c - the "parts" array of a case: each part's name, material,
- * fracture flag, initial velocity and its one shape (pass 1), and turning
+ * fracture flag (or region: case_region.c), initial velocity and its one shape (pass 1), and turning
  * the shapes into engine parts (pass 3).
  *
  * Which shapes a part may have depends on the case's dimension: rectangle
@@ -161,11 +161,19 @@ static void part_read_flags(case_doc *doc, case_part *part, const json_t *value,
 {
     char at[CASE_POINTER];
     json_t *fracture = case_member(value, ptr, "fracture", at);
-    if (fracture && case_read_bool(doc, fracture, at, &part->fracture) && part->fracture) {
-        if (part->material >= 0 && !doc->materials[part->material].def.has_fracture)
-            case_problem(doc, at, "\"fracture\": true needs a \"fracture\" block in material "
-                                  "\"%.64s\"", doc->materials[part->material].name);
-    }
+    /* a selector or a list of them: a fracture region (case_region.c) */
+    int region = json_is_object(fracture) || json_is_array(fracture);
+    if (region) part->fracture = part->fracture_region = 1;
+    else if (fracture && !json_is_boolean(fracture))
+        case_problem(doc, at, "expected true or false, or a fracture region: a selector "
+                              "({\"box\": [...]} or {\"group\": \"name\"}) or a list of them, "
+                              "got %s",
+                     case_type_word(fracture));
+    else if (fracture) part->fracture = json_is_true(fracture);
+    if (part->fracture && part->material >= 0 && !doc->materials[part->material].def.has_fracture)
+        case_problem(doc, at, "%s needs a \"fracture\" block in material \"%.64s\"",
+                     region ? "a fracture region" : "\"fracture\": true",
+                     doc->materials[part->material].name);
     json_t *velocity = case_member(value, ptr, "velocity", at);
     if (velocity)
         part->has_velocity = case_read_axes(doc, velocity, at, part->velocity);
@@ -184,8 +192,11 @@ static void part_read(case_doc *doc, case_part *part, int index, const json_t *v
     part_read_name(doc, part, index, value, ptr);
     part_read_material(doc, part, value, ptr);
     part_read_flags(doc, part, value, ptr);
+    int before = doc->out->count + doc->out->dropped;
     part_read_shape(doc, part, value, ptr);
+    int mesh_sound = doc->out->count + doc->out->dropped == before;
     case_read_part_groups(doc, part, value, ptr);
+    case_read_region(doc, part, value, ptr, mesh_sound);
 }
 
 /* Names must be unique because constraints select parts by name. */
@@ -236,12 +247,18 @@ void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr)
         pointer_join(ptr, CASE_POINTER, base, case_shape_keys[shape - 1]);
 }
 
+/* The part as an engine part; a fracture region goes as a flag per element
+ * (in_region, NULL for none). */
 static int part_add_mesh(const case_doc *doc, fdem_model *model, case_part *part,
-                         fdem_error *err)
+                         const uint8_t *in_region, fdem_error *err)
 {
     if (doc->dimension == 3)
-        return fdem_add_part_3d(model, &part->tet_mesh, part->material, part->fracture, err);
-    return fdem_add_part(model, &part->mesh, part->material, part->fracture, err);
+        return in_region ? fdem_add_part_region_3d(model, &part->tet_mesh, part->material,
+                                                   in_region, err)
+                         : fdem_add_part_3d(model, &part->tet_mesh, part->material,
+                                            part->fracture, err);
+    return in_region ? fdem_add_part_region(model, &part->mesh, part->material, in_region, err)
+                     : fdem_add_part(model, &part->mesh, part->material, part->fracture, err);
 }
 
 /* Lowest and highest node of the part (y in 2D, z in 3D): where its
@@ -271,7 +288,14 @@ static int part_add(case_doc *doc, fdem_model *model, int i)
         case_problem(doc, ptr, "%s", err.message);
         return -1;
     }
-    int index = part_add_mesh(doc, model, part, &err);
+    uint8_t *in_region = NULL;
+    if (case_region_mask(doc, i, &in_region) < 0) {
+        fdem_mesh_free(&part->mesh);
+        fdem_tet_mesh_free(&part->tet_mesh);
+        return -1;
+    }
+    int index = part_add_mesh(doc, model, part, in_region, &err);
+    free(in_region);
     double height[2];
     part_height_range(doc, part, height);
     fdem_mesh_free(&part->mesh); /* the engine keeps its own copy */

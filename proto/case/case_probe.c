@@ -67,8 +67,13 @@ static int probe_doc_make(case_doc *doc, int from, case_doc *probe, problems *sc
     for (int i = 0; i < doc->part_count; i++) {
         if (!part_sound(doc, i, from)) continue;
         probe->parts[probe->part_count++] = doc->parts[i];
+        /* what the part owns moves over: both documents are freed */
         memset(&doc->parts[i].mesh, 0, sizeof doc->parts[i].mesh);
         memset(&doc->parts[i].tet_mesh, 0, sizeof doc->parts[i].tet_mesh);
+        memset(&doc->parts[i].groups, 0, sizeof doc->parts[i].groups);
+        doc->parts[i].element_material = NULL;
+        doc->parts[i].joint_sets = NULL;
+        doc->parts[i].joint_set_count = 0;
     }
     return probe->part_count > 0;
 }

@@ -155,6 +155,19 @@ class BadGroupsTest(unittest.TestCase):
                                {"distribution": "weibull", "modulus": -2}),
                      "/parts/0/discontinuities/interface/variation/modulus")
 
+    def test_dt_probe_of_a_grouped_part(self):
+        """A dt above the stable step with another problem makes the daemon
+        probe the sound parts (case_probe.c); a gmsh part with groups,
+        materials and joint sets went to the probe without its groups
+        changing hands, and both documents freed them (double free: the
+        daemon aborted)."""
+        case = with_edit(["constraints", 0, "part"], "no such part")
+        case["time"]["dt"] = 1.0
+        self.refused(case, "/constraints/0/part")
+        self.refused(case, "/time/dt", "stable")
+        status, _, _ = self.d.request("GET", "/cases")
+        self.assertEqual(status, 200)
+
 
 if __name__ == "__main__":
     unittest.main()

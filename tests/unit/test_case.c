@@ -309,6 +309,39 @@ static void wrong_types_are_named(void)
     expect_variant("/parts/0/material", "3", "/parts/0/material", "name of a material");
 }
 
+/* "fracture" as a region (contract 6.1, case_region.c): each bad selector
+ * at its pointer, and a good one builds fewer joints than the whole part. */
+static void fracture_regions_are_read(void)
+{
+    expect_variant("/parts/0/fracture", "{'box': [5, 5, 6, 6]}", "/parts/0/fracture",
+                   "outside the part"); /* a generated disc: checked in pass 3 */
+    expect_variant("/parts/2/fracture", "{'box': [5, 5, 6, 6]}", "/parts/2/fracture",
+                   "outside the part"); /* a given mesh: in pass 1 */
+    expect_variant("/parts/2/fracture", "[{'box': [0, 0, 3, 3]}, {'group': 'g'}]",
+                   "/parts/2/fracture/1", "gmsh");
+    expect_variant("/parts/0/fracture", "{'box': [1, 0, 0, 1]}", "/parts/0/fracture/box",
+                   "xmin <= xmax");
+    expect_variant("/parts/0/fracture", "{'box': [0, 0, 1]}", "/parts/0/fracture/box",
+                   "[xmin, ymin, xmax, ymax]");
+    expect_variant("/parts/0/fracture", "{}", "/parts/0/fracture", "exactly one");
+    expect_variant("/parts/0/fracture", "[]", "/parts/0/fracture", "1 to 16");
+    expect_variant("/parts/0/fracture", "[3]", "/parts/0/fracture/0", "selector");
+    expect_variant("/parts/1/fracture", "{'box': [-1, -1, 1, 1]}", "/parts/1/fracture",
+                   "\"fracture\" block in material \"steel\"");
+    json_t *doc = load(base_text);
+    edit(doc, "/parts/0/fracture", load("{'box': [-0.015, -0.015, 0.015, 0.015]}"));
+    fdem_model *region = expect_built(doc, NULL);
+    fdem_model *whole = expect_built(load(base_text), NULL);
+    if (region && whole) {
+        fdem_counts r = fdem_get_counts(region), w = fdem_get_counts(whole);
+        CHECK(r.joints > 0 && r.joints < w.joints, "region %d joints, whole %d", r.joints,
+              w.joints);
+        CHECK(r.nodes < w.nodes, "region %d nodes, whole %d", r.nodes, w.nodes);
+    }
+    fdem_model_destroy(region);
+    fdem_model_destroy(whole);
+}
+
 /* ---------------------------------------------------- material ranges */
 
 static void material_ranges(void)
@@ -745,7 +778,7 @@ static void parse_fields(void)
 CHECK_MAIN(T(valid_document_builds), T(defaults_apply), T(gmsh_part_builds),
            T(malformed_json_is_400), T(deep_nesting_is_400), T(duplicate_keys_are_400),
            T(overflowing_numbers_are_400), T(not_an_object), T(unknown_keys_are_named),
-           T(wrong_types_are_named), T(material_ranges), T(unknown_material_is_suggested),
+           T(wrong_types_are_named), T(fracture_regions_are_read), T(material_ranges), T(unknown_material_is_suggested),
            T(other_names_and_places_are_suggested),
            T(part_shapes), T(explicit_mesh_errors),
            T(bodies_overlapping_at_start), T(gmsh_errors), T(part_flags_and_names),
