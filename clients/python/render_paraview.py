@@ -1,15 +1,18 @@
 """render_paraview.py - draw one snapshot of an fdemd result.xdmf to a PNG
 with ParaView, coloured by any field, 2D or 3D.
 
-    xvfb-run -a pvpython clients/python/render_paraview.py RESULT.xdmf -o OUT.png \\
+    xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" \\
+        pvpython clients/python/render_paraview.py RESULT.xdmf -o OUT.png \\
         [--field NAME] [--component C] [--snapshot -1 | --time T] [--size 1200x900] \\
         [--warp SCALE] [--view ELEV,AZIM] [--list]
 
 It is run by pvpython (Debian: python3-paraview), not by python3. pvpython
 renders through X: on Debian its offscreen mode segfaults, so without a
 display run it under xvfb-run (Debian: xvfb, with xauth), which starts a
-virtual X server for the one command; the script refuses to start without
-$DISPLAY rather than crash.
+virtual X server for the one command: 24 bits deep (the default 8-bit
+screen has no OpenGL visual) and with -noreset (a server that resets when
+its last client leaves drops the connection pvpython opens next, now and
+then). The script refuses to start without $DISPLAY rather than crash.
 
 What it draws. The file's two blocks, `elements` (the triangles or
 tetrahedra, with their node and cell fields) and `joints` (every joint as
@@ -51,7 +54,7 @@ TENSOR = {n: i for i, n in enumerate(("xx", "xy", "xz", "yx", "yy", "yz", "zx", 
 PRINCIPAL = {"1": 0, "2": 1, "3": 2}
 BLOCKS = ("elements", "joints")
 GREY = [0.78, 0.78, 0.78]
-PLOT_WIDTH = 0.8  # of the image, left of the colour bar
+BAR_PIXELS = 180  # kept right of the body for the colour bar and its labels
 
 
 class UsageError(Exception):
@@ -176,8 +179,14 @@ def component_index(field, components, wanted):
 def require_display():
     if not os.environ.get("DISPLAY"):
         raise UsageError("no X display: pvpython renders through X (its offscreen mode "
-                         "segfaults on Debian); run it as\n  xvfb-run -a pvpython %s ..."
+                         "segfaults on Debian); run it as\n  xvfb-run -a -s \"-screen 0 "
+                         "1280x1024x24 -noreset\" pvpython %s ..."
                          % sys.argv[0])
+
+
+def plot_width(size):
+    """The fraction of the image left of the colour bar."""
+    return max(0.5, 1.0 - BAR_PIXELS / size[0])
 
 
 def place_camera(view, bounds, dimension, elev_azim, size):
@@ -187,10 +196,10 @@ def place_camera(view, bounds, dimension, elev_azim, size):
     extent = [bounds[2 * k + 1] - bounds[2 * k] for k in range(3)]
     reach = 10 * (max(extent) or 1.0)
     if dimension == 2:
-        free = PLOT_WIDTH * size[0] / size[1]  # width/height of the free area
+        free = plot_width(size) * size[0] / size[1]  # width/height of the free area
         half_height = 0.5 * max(extent[1], extent[0] / free) * 1.12 or 1.0
         # shift the focus right so that the body is centred in the free area
-        shift = half_height * (size[0] / size[1]) * (1 - PLOT_WIDTH)
+        shift = half_height * (size[0] / size[1]) * (1 - plot_width(size))
         view.InteractionMode = "2D"
         view.CameraParallelProjection = 1
         view.CameraFocalPoint = [center[0] + shift, center[1], center[2]]
@@ -207,7 +216,7 @@ def place_camera(view, bounds, dimension, elev_azim, size):
     view.ResetCamera(False)
 
 
-def style_scalar_bar(pv, lut, view, title):
+def style_scalar_bar(pv, lut, view, title, size):
     bar = pv.GetScalarBar(lut, view)
     bar.Title = title
     bar.ComponentTitle = ""
@@ -217,7 +226,7 @@ def style_scalar_bar(pv, lut, view, title):
     bar.HorizontalTitle = 1
     bar.WindowLocation = "Any Location"
     bar.Orientation = "Vertical"
-    bar.Position = [PLOT_WIDTH + 0.02, 0.08]
+    bar.Position = [plot_width(size) + 0.02, 0.08]
     bar.ScalarBarLength = 0.75
     bar.Visibility = 1
 
@@ -269,12 +278,17 @@ def render(pv, reader, facts, fields, time, args):
         lut.RescaleTransferFunction(0.0, 1.0)
     else:
         shown.RescaleTransferFunctionToDataRange(False, True)
-    style_scalar_bar(pv, lut, view, "%s %s\nt = %.6g s" % (field, label, time))
+    style_scalar_bar(pv, lut, view, "%s %s\nt = %.6g s" % (field, label, time),
+                     args.size)
 
     sources[block].UpdatePipeline(time)
     place_camera(view, sources[block].GetDataInformation().GetBounds(), facts["dimension"],
                  args.view, args.size)
     pv.SaveScreenshot(args.output, view, ImageResolution=args.size, TransparentBackground=0)
+    # Let go of the view (and its GL context) now: left to pvpython's exit,
+    # it is torn down in an order Xvfb answers with GLXBadContext, and the
+    # process exits 1 after writing a good PNG.
+    pv.Delete(view)
 
 
 def main(argv):
