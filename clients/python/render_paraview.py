@@ -214,6 +214,21 @@ def place_camera(view, bounds, dimension, elev_azim, size):
     view.CameraPosition = [c + reach * d for c, d in zip(center, direction)]
     view.CameraViewUp = [0, 0, 1]
     view.ResetCamera(False)
+    # ResetCamera fits the whole image: step back until the body fits left
+    # of the colour bar, and pan so that it is centred there
+    fraction = plot_width(size)
+    camera = view.GetActiveCamera()
+    camera.Dolly(fraction)
+    half_width = (camera.GetDistance() * math.tan(math.radians(camera.GetViewAngle()) / 2)
+                  * size[0] / size[1])
+    look = [f - p for f, p in zip(camera.GetFocalPoint(), camera.GetPosition())]
+    up = camera.GetViewUp()
+    right = [look[1] * up[2] - look[2] * up[1], look[2] * up[0] - look[0] * up[2],
+             look[0] * up[1] - look[1] * up[0]]
+    norm = math.sqrt(sum(r * r for r in right)) or 1.0
+    pan = [(1 - fraction) * half_width * r / norm for r in right]
+    camera.SetFocalPoint(*[f + d for f, d in zip(camera.GetFocalPoint(), pan)])
+    camera.SetPosition(*[p + d for p, d in zip(camera.GetPosition(), pan)])
 
 
 def style_scalar_bar(pv, lut, view, title, size):
