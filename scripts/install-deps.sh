@@ -9,7 +9,7 @@ packages=(
   libmicrohttpd-dev libjansson-dev libhdf5-dev libcurl4-openssl-dev zlib1g-dev
   hdf5-tools python3-h5py python3-numpy python3-matplotlib
   gmsh clang libclang-rt-14-dev wrk
-  python3-paraview octave
+  python3-paraview xvfb xauth octave
 )
 
 missing=()

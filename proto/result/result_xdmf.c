@@ -357,14 +357,18 @@ static void xdmf_grid(const xdmf_ctx *x, int s, double time)
     fprintf(x->out, "    </Grid>\n");
 }
 
-static void xdmf_document(const xdmf_ctx *x, const result_file *f, const char *name)
+/* The two temporal collections are named "elements" and "joints": the
+ * Xdmf3 readers name their blocks after them (the legacy reader numbers
+ * them), so a user, or a script's ExtractBlock, picks a block by what it
+ * holds; the case name is the root attribute `name` of result.h5. */
+static void xdmf_document(const xdmf_ctx *x, const result_file *f)
 {
     fprintf(x->out, "<?xml version=\"1.0\" ?>\n");
     fprintf(x->out, "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n");
     fprintf(x->out, "<Xdmf Version=\"2.0\">\n");
     fprintf(x->out, "  <Domain>\n");
-    fprintf(x->out, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
-            name);
+    fprintf(x->out, "  <Grid Name=\"elements\" GridType=\"Collection\" "
+            "CollectionType=\"Temporal\">\n");
     for (int s = 0; s < x->snapshots; s++) xdmf_grid(x, s, result_snapshot_time(f, s));
     fprintf(x->out, "  </Grid>\n");
     if (x->joints > 0) {
@@ -393,8 +397,6 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
                   .constraints = counts.constraints, .fields = info->fields,
                   .staged = fdem_stage_index(model) >= 0};
     xml_escape(x.h5, sizeof x.h5, h5_name);
-    char name[512];
-    xml_escape(name, sizeof name, info->name[0] ? info->name : "fdem");
 
     char tmp[4096];
     if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", xdmf_path) >= sizeof tmp) {
@@ -406,7 +408,7 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
         snprintf(err, errlen, "cannot create %s: %s", tmp, strerror(errno));
         return -1;
     }
-    xdmf_document(&x, f, name);
+    xdmf_document(&x, f);
     int failed = ferror(x.out) || fflush(x.out) != 0 || fsync(fileno(x.out)) != 0;
     int saved = errno;
     if (fclose(x.out) != 0) failed = 1;

@@ -1,6 +1,6 @@
 """Watching a 3D case never changes it (contract 5.1 "Output never changes
-the physics", README "--threads", "Data directory, persistence and
-restart"), end to end through the daemon, on the two kinds of 3D case the
+the physics", docs/daemon.md "--threads", "Data directory, persistence
+and restart"), end to end through the daemon, on the two kinds of 3D case the
 2D tests (test_trust.py, test_daemon.py, test_persistence.py) do not reach:
 
 - a fracturing Brazilian disc (examples/brazilian-disc-3d.json, 16 rim

@@ -7,8 +7,16 @@ stresses, joint damage, and the energy and constraint-force series as
 field data; and Warp By Vector with displacement moves the initial mesh of
 a case that writes no positions onto position0 + displacement.
 
+Also clients/python/render_paraview.py under xvfb-run, as docs/results.md
+tells users to run it: a 2D and a 3D result drawn to PNGs of the size asked
+for that are not blank, coloured by cell and point fields, damage and a
+warp; the blocks read back by name (elements, joints); an unknown field
+refused with the fields the file holds; no display refused with the way
+to get one.
+
 Runs paraview_load.py under pvpython; skipped (saying so) where pvpython
-is not installed (scripts/install-deps.sh installs python3-paraview)."""
+is not installed (scripts/install-deps.sh installs python3-paraview); with
+pvpython but without xvfb-run the render tests fail, saying what to install."""
 import io
 import json
 import os
@@ -16,9 +24,14 @@ import shutil
 import subprocess
 import tempfile
 import unittest
+import xml.etree.ElementTree as ET
 
 import h5py
+import matplotlib
 import numpy as np
+
+matplotlib.use("Agg")
+import matplotlib.image  # noqa: E402
 
 from fdemd_harness import Daemon, tiny_case
 
@@ -31,6 +44,12 @@ def snapshot_rows(h5_bytes):
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PVPYTHON = shutil.which("pvpython")
+XVFB_RUN = shutil.which("xvfb-run")
+RENDER = os.path.join(HERE, "..", "..", "clients", "python", "render_paraview.py")
+# as docs/results.md says: 24-bit (the default 8-bit screen has no GLX
+# visual) and -noreset (a server that resets when its last client leaves
+# drops the connection pvpython opens next, now and then)
+XVFB_ARGS = ["-a", "-s", "-screen 0 1280x1024x24 -noreset"]
 READERS = ("XDMFReader", "Xdmf3ReaderS", "Xdmf3ReaderT")
 VTK_TRIANGLE, VTK_TETRA = 5, 10
 FIELDS = ["position", "velocity", "stress", "strain", "principal_stress", "displacement"]
@@ -273,6 +292,110 @@ class ParaViewTest(unittest.TestCase):
                             np.array(block["point_data"]["displacement"]), pad3(u[s]), where)
                         np.testing.assert_allclose(np.array(block["points"]), pad3(x0 + u[s]),
                                                    rtol=0, atol=1e-15, err_msg=where)
+
+
+    # render_paraview.py
+
+    def render(self, key, name, *args, env=None, display=True):
+        """Runs render_paraview.py on result `key` into NAME.png: (the
+        completed process, the PNG path)."""
+        png = os.path.join(self.tmp, name + ".png")
+        command = [PVPYTHON, RENDER, os.path.join(self.results[key], "result.xdmf"),
+                   "-o", png] + list(args)
+        if display:
+            self.assertTrue(XVFB_RUN, "xvfb-run is missing: scripts/install-deps.sh installs "
+                                      "the Debian packages xvfb and xauth")
+            command = [XVFB_RUN] + XVFB_ARGS + command
+        out = subprocess.run(command, capture_output=True, text=True, timeout=300, env=env)
+        return out, png
+
+    def assert_drawn(self, out, png, size):
+        """The PNG exists, has the size asked for and is a picture: many
+        pixels that are not the white background, and varied ones."""
+        self.assertEqual(out.returncode, 0, out.stderr[-3000:])
+        self.assertTrue(os.path.exists(png), png)
+        image = matplotlib.image.imread(png)[:, :, :3]
+        self.assertEqual(image.shape[:2], (size[1], size[0]), png)
+        painted = np.any(image < 0.95, axis=2).mean()
+        self.assertGreater(painted, 0.2, "%s: %.3f of the pixels are not background"
+                           % (png, painted))
+        self.assertGreater(image.std(), 0.05, png)
+        colours = len(np.unique((image * 255).astype(np.uint8).reshape(-1, 3), axis=0))
+        self.assertGreater(colours, 50, png)
+        return image
+
+    def test_render_2d_by_cell_field_and_damage(self):
+        out, png = self.render(2, "2d-stress", "--field", "stress", "--component", "xx",
+                               "--size", "640x480")
+        self.assert_drawn(out, png, (640, 480))
+        out, png = self.render(2, "2d-damage", "--field", "damage", "--snapshot", "-1",
+                               "--size", "500x400")
+        image = self.assert_drawn(out, png, (500, 400))
+        # the joints over the grey body: some pixels are neither grey nor white
+        r, g, b = image[:, :, 0], image[:, :, 1], image[:, :, 2]
+        coloured = (np.maximum(np.maximum(r, g), b) - np.minimum(np.minimum(r, g), b)) > 0.2
+        self.assertGreater(coloured[:, :int(0.8 * 500)].mean(), 0.01)
+
+    def test_render_3d_by_point_field_warped(self):
+        # a point field on a case that stores no positions, warped
+        out, png = self.render("warp-3", "3d-displacement", "--field", "displacement",
+                               "--warp", "1000", "--size", "600x500")
+        self.assert_drawn(out, png, (600, 500))
+        out, png = self.render(3, "3d-principal", "--field", "principal_stress",
+                               "--component", "1", "--time", "0.0004", "--size", "400x400")
+        self.assert_drawn(out, png, (400, 400))
+
+    def test_render_warp_moves_the_picture(self):
+        """--warp 0 draws position0; --warp 10 moves the falling block
+        1.6 mm x 10 against its 0.1 m: the two pictures differ."""
+        images = []
+        for scale in ("0", "10"):
+            out, png = self.render("warp-2", "2d-warp-" + scale, "--field", "stress",
+                                   "--warp", scale, "--size", "400x300")
+            images.append(self.assert_drawn(out, png, (400, 300)))
+        self.assertGreater(np.abs(images[0] - images[1]).max(), 0.5)
+
+    def test_render_lists_the_blocks_by_name(self):
+        for dim in (2, 3):
+            xdmf = os.path.join(self.results[dim], "result.xdmf")
+            with open(xdmf) as f:
+                root = ET.parse(f).getroot()
+            self.assertEqual([g.get("Name") for g in root.findall("Domain/Grid")],
+                             ["elements", "joints"])
+            out = subprocess.run([PVPYTHON, RENDER, xdmf, "--list"], capture_output=True,
+                                 text=True, timeout=300)
+            self.assertEqual(out.returncode, 0, out.stderr[-3000:])
+            listing = json.loads(out.stdout.strip().splitlines()[-1])
+            self.assertEqual(listing["dimension"], dim)
+            # ParaView's legacy reader gives the blocks the collections' names
+            self.assertEqual(sorted(listing["blocks"]), ["elements", "joints"])
+            elements, joints = listing["blocks"]["elements"], listing["blocks"]["joints"]
+            self.assertEqual(elements["cell"]["stress"], 9)
+            self.assertEqual(elements["cell"]["principal_stress"], dim)
+            self.assertEqual(elements["point"]["displacement"], 3)
+            self.assertEqual(joints["cell"], {"damage": 1})
+
+    def test_render_refuses_an_unknown_field_listing_the_others(self):
+        out, png = self.render(2, "2d-unknown", "--field", "von_mises")
+        self.assertEqual(out.returncode, 2, out.stderr[-3000:])
+        self.assertFalse(os.path.exists(png))
+        message = out.stderr.strip().splitlines()[-1]
+        self.assertIn("unknown field 'von_mises'", message)
+        for name in ("displacement", "velocity", "stress", "strain", "principal_stress",
+                     "fragment", "element_part", "damage"):
+            self.assertIn(name, message)
+        out, png = self.render(2, "2d-component", "--field", "velocity", "--component", "xy")
+        self.assertEqual(out.returncode, 2, out.stderr[-3000:])
+        self.assertIn("velocity has 3 components", out.stderr)
+        self.assertFalse(os.path.exists(png))
+
+    def test_render_without_a_display_says_how(self):
+        env = {k: v for k, v in os.environ.items() if k != "DISPLAY"}
+        out, png = self.render(2, "2d-no-display", "--field", "stress", env=env,
+                               display=False)
+        self.assertEqual(out.returncode, 2, out.stderr[-3000:])
+        self.assertIn('xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" pvpython', out.stderr)
+        self.assertFalse(os.path.exists(png))
 
 
 if __name__ == "__main__":

@@ -278,6 +278,10 @@ def check_xdmf(f, exp, xdmf_path, h5_name):
     coll = root.find("Domain/Grid")
     need(coll.get("GridType") == "Collection" and coll.get("CollectionType") == "Temporal",
          "top grid is not a temporal collection")
+    # ParaView's block names: the elements, then the joints when there are any
+    blocks = [g.get("Name") for g in root.findall("Domain/Grid")]
+    want = ["elements", "joints"] if len(exp["mesh"].get("joints", [])) else ["elements"]
+    need(blocks == want, f"collections are named {blocks}, not {want}")
     grids = coll.findall("Grid")
     times = f["snapshots/time"][()]
     need(len(grids) == len(times), f"{len(grids)} grids for {len(times)} snapshots")
