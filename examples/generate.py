@@ -18,11 +18,11 @@ import tempfile
 OUT = os.path.dirname(os.path.abspath(__file__))
 
 
-def gmsh_text(geo):
+def gmsh_text(geo, dimension=2):
     """The ASCII msh 2.2 text gmsh makes from a .geo file."""
     with tempfile.TemporaryDirectory() as tmp:
         msh = os.path.join(tmp, "mesh.msh")
-        subprocess.run(["gmsh", "-2", "-format", "msh22", geo, "-o", msh],
+        subprocess.run(["gmsh", "-%d" % dimension, "-format", "msh22", geo, "-o", msh],
                        check=True, stdout=subprocess.DEVNULL)
         with open(msh) as f:
             return f.read()
@@ -439,3 +439,82 @@ dump("tunnel-region", {
                    [{"box": box, "absorb": True} for box in far],
     "time": {"end": 0.02, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.001, "fields": ["position", "stress", "damage"]}})
+
+
+# ------------------------------------------------- excavation in stages
+# Contract 6.1. A tunnel driven through jointed rock at about 570 m depth:
+# gravity, an in-situ stress that grows with depth (sigma_v = 15 MPa at the
+# tunnel's centre, K0 = 1.5), the far boundaries carrying that stress
+# (boundary_stress: one line per side, gradient included) over a roller
+# base. Fracture only in the annulus "near" around the opening (its joints
+# carry the in-situ stress from t = 0, so stage 1 is at rest), Weibull
+# strengths, two joint sets in the near field weaker than the rock. Stage 1
+# holds the rock as it is; stage 2 removes the tunnel's rock and ramps the
+# forces it exerted on the wall to zero over 10 ms (the unloading method):
+# the crown and invert, where Kirsch's hoop stress 3 sigma_h - sigma_v =
+# 52.5 MPa exceeds the rock's uniaxial strength 2 c cos phi / (1 - sin phi)
+# = 30.8 MPa, break into a damaged zone, and the joint sets cut a wedge in
+# the roof that gravity pulls down; the sidewalls (22.5 MPa) hold.
+RHO_G = 2700 * 9.81
+SIGMA_V, K0 = 15e6, 1.5
+
+
+def in_situ(dimension):
+    """sigma at the tunnel axis (height 0) and its gradient with height:
+    compression negative, so the stress grows less negative upwards."""
+    if dimension == 2:
+        return {"value": [-K0 * SIGMA_V, -SIGMA_V, 0],
+                "gradient": [K0 * RHO_G, RHO_G, 0], "reference": 0}
+    return {"value": [-K0 * SIGMA_V, -K0 * SIGMA_V, -SIGMA_V, 0, 0, 0],
+            "gradient": [K0 * RHO_G, K0 * RHO_G, RHO_G, 0, 0, 0], "reference": 0}
+
+
+def jointed_rock():
+    return {"density": 2700, "young": 2e10, "poisson": 0.25, "damping": 0.3, "friction": 0.6,
+            "fracture": {"tensile_strength": 4e6, "cohesion": 8e6, "friction_angle": 35,
+                         "energy_I": 50, "energy_II": 250,
+                         "variation": {"distribution": "weibull", "modulus": 8, "seed": 7}}}
+
+
+joint_set = {"tensile_strength": 0.2e6, "cohesion": 0.5e6, "friction_angle": 30,
+             "energy_I": 5, "energy_II": 25}
+
+dump("staged-tunnel", {
+    "name": "staged-tunnel",
+    "materials": {"rock": jointed_rock()},
+    "parts": [{"name": "rock mass", "material": "rock", "fracture": {"group": "near"},
+               "initial_stress": in_situ(2),
+               "gmsh": gmsh_text(os.path.join(OUT, "staged-tunnel.geo")),
+               "discontinuities": {"joints": joint_set}}],
+    "gravity": [0, -9.81],
+    "constraints": [{"part": "rock mass", "group": side, "boundary_stress": in_situ(2)}
+                    for side in ("left", "right", "top")] +
+                   [{"part": "rock mass", "group": "base", "fix": ["y"]}],
+    "stages": [{"name": "in-situ", "end": 0.002},
+               {"name": "excavate", "end": 0.04, "relax": 0.01,
+                "excavate": [{"part": "rock mass", "group": "excavation"}]}],
+    "time": {"end": 0.04, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.001, "fields": ["position", "displacement", "stress", "damage"]}})
+
+# The same in 3D: a drift of radius 1 m along y through a 12 x 1 x 12 m block
+# (z up), fracture in the shell r < 3 m, the two joint sets striking along
+# the drift, the two end faces on rollers (plane strain in the middle).
+dump("drift-3d", {
+    "name": "drift-3d",
+    "dimension": 3,
+    "materials": {"rock": jointed_rock()},
+    "parts": [{"name": "rock mass", "material": "rock", "fracture": {"group": "near"},
+               "initial_stress": in_situ(3),
+               "gmsh": gmsh_text(os.path.join(OUT, "drift-3d.geo"), 3),
+               "discontinuities": {"joints": joint_set}}],
+    "gravity": [0, 0, -9.81],
+    "constraints": [{"part": "rock mass", "group": side, "boundary_stress": in_situ(3)}
+                    for side in ("left", "right", "top")] +
+                   [{"part": "rock mass", "group": "base", "fix": ["z"]},
+                    {"part": "rock mass", "group": "front", "fix": ["y"]},
+                    {"part": "rock mass", "group": "back", "fix": ["y"]}],
+    "stages": [{"name": "in-situ", "end": 0.001},
+               {"name": "excavate", "end": 0.008, "relax": 0.003,
+                "excavate": [{"part": "rock mass", "group": "excavation"}]}],
+    "time": {"end": 0.008, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.0005, "fields": ["position", "displacement", "stress"]}})
