@@ -34,22 +34,9 @@
 #include <string.h>
 
 #include "kernel/joint_tet.h"
+#include "math/voigt.h"
 #include "model/model.h"
 #include "joint.h"
-
-/* sigma . n for a stress in the layout of fdem_element_stress. */
-static void traction_of(int dim, const double *s, const double *n, double *t)
-{
-    if (dim == 2) {
-        t[0] = s[0] * n[0] + s[2] * n[1];
-        t[1] = s[2] * n[0] + s[1] * n[1];
-        return;
-    }
-    /* sxx, syy, szz, syz, sxz, sxy */
-    t[0] = s[0] * n[0] + s[5] * n[1] + s[4] * n[2];
-    t[1] = s[5] * n[0] + s[1] * n[1] + s[3] * n[2];
-    t[2] = s[4] * n[0] + s[3] * n[1] + s[2] * n[2];
-}
 
 /* The frame of joint j's face A at its initial position, as the kernels
  * build it at a zero gap: frame[0] the normal out of A, then the
@@ -94,7 +81,7 @@ static void joint_offsets(const fdem_model *m, int j, const initial_stress_def *
     for (int i = 0; i < D; i++) {
         double s[6], t[3];
         initial_stress_at(def, S, m->pos0[(size_t)D * (size_t)n[i] + (size_t)(D - 1)], s);
-        traction_of(D, s, frame[0], t);
+        voigt_dot(D, s, frame[0], t);
         for (int a = 0; a < D; a++) {
             double along = 0;
             for (int c = 0; c < D; c++) along += t[c] * frame[a][c];

@@ -14,4 +14,15 @@ static inline int voigt_index(int dim, int i, int j)
     return dim == 3 ? v3[i][j] : v2[i][j];
 }
 
+/* out = sigma . n for a symmetric tensor sigma in Voigt layout: the
+ * traction on a plane of normal n (or, for an area vector n, the force). */
+static inline void voigt_dot(int dim, const double *sigma, const double *n, double *out)
+{
+    for (int i = 0; i < dim; i++) {
+        double t = 0;
+        for (int j = 0; j < dim; j++) t += sigma[voigt_index(dim, i, j)] * n[j];
+        out[i] = t;
+    }
+}
+
 #endif

@@ -276,11 +276,9 @@ static void boundary_stress_force(const fdem_model *m, const constraint *c, cons
     double dh = h / (D + 1) - def->stress_reference, sigma[6];
     for (int k = 0; k < S; k++)
         sigma[k] = c->amplitude_now * (def->stress_value[k] + def->stress_gradient[k] * dh);
-    for (int i = 0; i < D; i++) {
-        double t = 0;
-        for (int j = 0; j < D; j++) t += sigma[voigt_index(D, i, j)] * s[j];
-        f[i] = t / D;
-    }
+    double t[3];
+    voigt_dot(D, sigma, s, t);
+    for (int i = 0; i < D; i++) f[i] = t[i] / D;
 }
 
 /* The force on vertex a of facet j (nodes n, outward area vector s) from

@@ -71,8 +71,8 @@ int case_element_group(case_doc *doc, const case_part *part, const json_t *name,
         return -1;
     }
     if (part->shape != CASE_SHAPE_GMSH) {
-        case_problem(doc, ptr, "\"group\" names a physical group of a \"gmsh\" mesh; this part "
-                               "has none");
+        case_problem(doc, ptr, "part \"%.64s\" is not a \"gmsh\" mesh, so it has no physical "
+                               "groups", part->name);
         return -1;
     }
     int g = group_lookup(doc, part, json_string_value(name), part_mesh_dimension(doc), ptr);
@@ -238,25 +238,8 @@ int case_group_vertices(case_doc *doc, int part_index, const json_t *group, cons
 int case_group_with_elements(case_doc *doc, int part_index, const json_t *group,
                              const char *ptr)
 {
-    if (!json_is_string(group)) {
-        case_problem(doc, ptr, "expected the name of a physical group, got %s",
-                     case_type_word(group));
-        return -1;
-    }
     if (part_index < 0 || part_index >= doc->part_count) return -1; /* reported at "part" */
-    const case_part *part = &doc->parts[part_index];
-    const char *name = json_string_value(group);
-    if (part->shape != CASE_SHAPE_GMSH) {
-        case_problem(doc, ptr, "part \"%.64s\" is not a \"gmsh\" mesh, so it has no physical "
-                               "groups", part->name);
-        return -1;
-    }
-    int g = group_lookup(doc, part, name, part_mesh_dimension(doc), ptr);
-    if (g >= 0 && part->groups.group[g].element_count == 0) {
-        case_problem(doc, ptr, "the group \"%.64s\" has no element of the mesh", name);
-        return -1;
-    }
-    return g;
+    return case_element_group(doc, &doc->parts[part_index], group, ptr);
 }
 
 /* --------------------------------------------------------------- pass 3 */
