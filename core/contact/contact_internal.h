@@ -1,0 +1,72 @@
+/*
+ * contact_internal.h - what contact.c and contact_near.c share and no other
+ * folder needs: a dimension's pair-kernel record, the near-pair record the
+ * per-step walk streams, the element boxes (inline: the walk's box test is
+ * on its hot path), and the near list's two entry points.
+ */
+#ifndef FDEM_CONTACT_INTERNAL_H
+#define FDEM_CONTACT_INTERNAL_H
+
+#include "kernel/contact_pair.h"
+#include "model/model.h"
+
+/* A dimension's pair kernel and the numbers the shared stage sizes by. */
+typedef struct contact_kernel {
+    int slots;          /* stick springs per pair */
+    int pair_out;       /* forces on both elements' nodes, then the dissipation */
+    int (*pair_force)(const contact_pair_in *in, double *springs, double *out);
+    double dt_factor;   /* contact_stable_dt: dt_factor h sqrt(rho / p) */
+    double near_step;   /* the near list's reach (cs->near_reach) per unit buffer */
+} contact_kernel;
+
+/* A near pair: what the per-step walk reads of a candidate pair, in one
+ * record. sprung mirrors contact_pair_sprung for the pair, kept by the walk
+ * as it lets springs go or adopts them, so a pair apart without springs
+ * (nearly all) reads nothing else. */
+typedef struct near_pair {
+    double gap;      /* its boxes' gap when the list was built */
+    uint32_t pair;   /* its index among the candidate pairs */
+    int32_t a, b;    /* its elements */
+    int32_t sprung;  /* some stick spring of it holds a force */
+} near_pair;
+
+/* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
+static inline int boxes_overlap(const double *a, const double *b, int dim)
+{
+    int apart = a[1] < b[0] || b[1] < a[0] || a[3] < b[2] || b[3] < a[2];
+    if (dim == 3) apart |= a[5] < b[4] || b[5] < a[4];
+    return !apart;
+}
+
+/* D and K are constants where it is called (element_box), so each
+ * dimension gets its own unrolled copy of this one loop. */
+static inline __attribute__((always_inline)) void box_of_nodes(const double *p, const int32_t *n,
+                                                               int D, int K, double *b)
+{
+    for (int d = 0; d < D; d++) {
+        double lo = p[D * n[0] + d], hi = lo;
+        for (int c = 1; c < K; c++) {
+            double x = p[D * n[c] + d];
+            lo = min2(lo, x);
+            hi = max2(hi, x);
+        }
+        b[2 * d] = lo;
+        b[2 * d + 1] = hi;
+    }
+}
+
+static inline void element_box(const fdem_model *m, int e, double *b)
+{
+    if (m->dim == 3) box_of_nodes(m->pos, m->tet[e].node, 3, 4, b);
+    else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
+}
+
+/* contact_near.c: the elements of the near pairs (of every candidate pair
+ * when near is NULL), once each and in element order, into list (returns
+ * how many); and this step's boxes of the elements the near list needs,
+ * the list rebuilt first when due (0, or -1 when out of memory). */
+int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
+                             size_t count, int32_t *list);
+int contact_near_refresh(fdem_model *m);
+
+#endif

@@ -1,0 +1,158 @@
+/*
+ * contact_near.c - the near-pair list of the contact stage (both
+ * dimensions): which candidate pairs the per-step walk (contact.c) takes.
+ *
+ * Most candidate pairs are far from touching (coarse tetrahedra have loose
+ * bounding spheres: a sphere pile has ~25 candidates per element and well
+ * under one touching), so the per-step walk takes only the "near" pairs:
+ * when the list is built every node's place is kept (pos_near), and two
+ * boxes with a gap g then cannot overlap while no node is farther than r
+ * from its kept place, if g > 2 r. The near list holds the other pairs,
+ * in pair order, each with its gap and what the walk reads of it (its
+ * elements, whether it holds springs: near_pair), so the walk streams one
+ * array instead of looking each pair up in the candidate arrays, and is
+ * rebuilt when some node passes r; a pair it leaves out has its boxes apart now and until then, exactly
+ * what the box test would have found, so its springs go at the rebuild as
+ * they would have gone that step: the same bits as walking every pair.
+ * In the same way a near pair whose gap is over twice the farthest travel
+ * so far is apart without a look at its boxes, and only elements with such
+ * a pair closing get their box computed.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "contact.h"
+#include "contact_internal.h"
+
+/* The current box of each listed element: those in some candidate pair
+ * when the near list is rebuilt, else those in some near pair. Most
+ * candidate pairs do not touch (their bounding circles, inflated by the
+ * buffer, overlap; their elements do not): the box test then reads two
+ * boxes instead of two element records and their scattered nodes. */
+static void contact_boxes(fdem_model *m, const int32_t *list, int count)
+{
+    double *box = m->contact.box;
+    size_t width = 2 * (size_t)m->dim;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
+/* The same for the near pairs' elements whose boxes can touch another's:
+ * an element whose every near pair had a gap over near_apart keeps its
+ * box from before, which no pair reads (pair_evaluate). */
+static void contact_near_boxes(fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    const int32_t *list = cs->near_active;
+    const double *elem_gap = cs->elem_gap;
+    double *box = cs->box, apart = cs->near_apart;
+    size_t width = 2 * (size_t)m->dim;
+    int count = cs->near_active_count;
+#pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
+    schedule(static)
+    for (int k = 0; k < count; k++)
+        if (elem_gap[list[k]] <= apart) element_box(m, list[k], box + width * (size_t)list[k]);
+}
+
+/* The elements of the near pairs (of every candidate pair when near is
+ * NULL), once each and in element order (so that contact_boxes walks the
+ * mesh forwards), into list; returns how many. */
+int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
+                                    size_t count, int32_t *list)
+{
+    memset(cs->in_pair, 0, (size_t)elem_count);
+    for (size_t i = 0; i < count; i++) {
+        cs->in_pair[near ? near[i].a : cs->pairs.a[i]] = 1;
+        cs->in_pair[near ? near[i].b : cs->pairs.b[i]] = 1;
+    }
+    int listed = 0;
+    for (int e = 0; e < elem_count; e++)
+        if (cs->in_pair[e]) list[listed++] = e;
+    return listed;
+}
+
+/* The widest gap between two boxes along an axis (negative: they overlap
+ * on every axis). */
+static inline double boxes_gap(const double *a, const double *b, int dim)
+{
+    double gap = -INFINITY;
+    for (int d = 0; d < dim; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
+    return gap;
+}
+
+/* The near list is to be rebuilt: a detection or a restore made it stale,
+ * or some node has gone past its reach since it was built. */
+static int contact_near_due(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->near_stale) return 1;
+    double moved2 = cs->near_disp2; /* the integrator's (central_difference_pass) */
+    if (moved2 > cs->near_reach * cs->near_reach) return 1;
+    /* boxes move by no more than their nodes: a gap over twice the
+     * farthest travel since the list was built is still open (a hair over
+     * it, for rounding) */
+    cs->near_apart = 2.0 * sqrt(moved2) * (1 + 1e-9);
+    return 0;
+}
+
+/* The near list (see the top of this file) and its elements from this
+ * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
+ * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
+static int contact_near_rebuild(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count > UINT32_MAX) return -1;
+    double reach = cs->kernel->near_step * cs->buffer;
+    /* a hair over 2 reach, so rounding in the gap never leaves out a pair
+     * that could touch */
+    double limit = 2.0 * reach * (1 + 1e-9);
+    int dim = m->dim;
+    size_t width = 2 * (size_t)dim, count = 0;
+    for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
+    for (size_t k = 0; k < cs->pairs.count; k++) {
+        int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
+        double gap = boxes_gap(cs->box + width * (size_t)ea, cs->box + width * (size_t)eb, dim);
+        if (gap > limit) {
+            contact_springs_release(cs, k); /* apart now and until the next rebuild */
+            continue;
+        }
+        /* the list grows as it fills: it holds a tenth or so of the candidates */
+        if (count == cs->near_capacity &&
+            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near,
+                          CONTACT_FIRST_ROWS))
+            return -1;
+        cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb, contact_pair_sprung(cs, k)};
+        cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
+        cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
+    }
+    memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
+    cs->near_disp2 = 0;
+    cs->near_count = count;
+    cs->near_reach = reach;
+    cs->near_apart = 0;
+    cs->near_stale = 0;
+    cs->near_active_count =
+        contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
+    return 0;
+}
+
+/* This step's boxes of the elements the near list needs, the list rebuilt
+ * first when due (from the boxes of every candidate pair's elements).
+ * Returns 0, or -1 when out of memory. */
+int contact_near_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
+        cs->near_count = 0;
+        return 0;
+    }
+    if (!contact_near_due(m)) {
+        contact_near_boxes(m);
+        return 0;
+    }
+    contact_boxes(m, cs->active, cs->active_count);
+    return contact_near_rebuild(m);
+}
+
