@@ -129,10 +129,10 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     }
     dt = fmin(dt, contact_stable_dt(m));
     m->stable_dt = fmin(dt, joint_stable_dt(m));
-    /* After the stable step, so a case refused for its constraints can
-     * still be told whether its dt would do (one answer, every problem). */
     m->stage_now = 0; /* the stage of the first step: stage-only constraints of stage 0 hold */
     if (stages_validate(m, err)) return -1;
+    /* After the stable step, so a case refused for its constraints can
+     * still be told whether its dt would do (one answer, every problem). */
     constraint_set_time(m, 0);
     if (constraint_select(m, err)) return -1;
     if (boundary_load_select(m, err)) return -1;
