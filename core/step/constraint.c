@@ -90,10 +90,12 @@ void constraint_set_time(fdem_model *m, double velocity_time)
         constraint *c = &m->constraints[k];
         if (!constraint_active(m, c)) { /* outside its stage: applies nothing */
             memset(c->value_now, 0, sizeof c->value_now);
+            c->amplitude_now = 0; /* a boundary stress scales its field by it */
             continue;
         }
         if (!c->amplitude) {
             memcpy(c->value_now, c->def.value, sizeof c->value_now);
+            c->amplitude_now = 1;
             continue;
         }
         double t = c->def.kind == FDEM_CONSTRAINT_VELOCITY ? velocity_time : m->time;

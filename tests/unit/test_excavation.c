@@ -444,6 +444,16 @@ static void stage_only_constraints_act_in_their_stage(void)
         pull.value[0] = 1e3;
         pull.only_stage = 1;
         int c_force = fdem_add_constraint(m, &pull, &err);
+        /* boundary loads scale by the amplitude, not by value_now alone */
+        fdem_constraint_def field = pull, traction = pull;
+        field.kind = FDEM_CONSTRAINT_BOUNDARY_STRESS;
+        field.value[0] = 0;
+        field.stress_value[up] = -1e5;
+        int c_field = fdem_add_constraint(m, &field, &err);
+        traction.kind = FDEM_CONSTRAINT_TRACTION;
+        traction.value[0] = 0;
+        traction.value[up] = 2e3;
+        int c_traction = fdem_add_constraint(m, &traction, &err);
         fdem_stage_def s0 = {.end = 1e-3}, s1 = {.end = 2e-3};
         fdem_add_stage(m, &s0, &err);
         fdem_add_stage(m, &s1, &err);
@@ -453,6 +463,9 @@ static void stage_only_constraints_act_in_their_stage(void)
         CHECK(fdem_stage_index(m) == 0, "stage %d", fdem_stage_index(m));
         CHECK(f[D * c_force] == 1e3, "%dD: the stage-0 force reads %g", dim, f[D * c_force]);
         CHECK(f[D * c_vel + up] == 0, "%dD: the stage-1 velocity reacts in stage 0", dim);
+        CHECK(f[D * c_field + up] < 0 && f[D * c_traction + up] > 0,
+              "%dD: the stage-0 boundary stress and traction read %g and %g", dim,
+              f[D * c_field + up], f[D * c_traction + up]);
         double top_y0 = 0;
         int top_node = -1;
         for (int i = 0; i < m->node_count; i++)
@@ -463,6 +476,9 @@ static void stage_only_constraints_act_in_their_stage(void)
         CHECK(fdem_stage_index(m) == 1, "stage %d", fdem_stage_index(m));
         CHECK(f[D * c_force] == 0, "%dD: the stage-0 force acts in stage 1: %g", dim,
               f[D * c_force]);
+        CHECK(f[D * c_field + up] == 0 && f[D * c_traction + up] == 0,
+              "%dD: the stage-0 boundary stress and traction act in stage 1: %g, %g", dim,
+              f[D * c_field + up], f[D * c_traction + up]);
         CHECK(m->vel[D * top_node + up] == 0.01, "%dD: top moves at %g in stage 1", dim,
               m->vel[D * top_node + up]);
         double moved = m->pos[D * top_node + up] - top_y0;
