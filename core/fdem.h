@@ -377,6 +377,23 @@ typedef struct fdem_counts {
     long detections;   /* how many times detection ran */
 } fdem_counts;
 
+/* Elements passing into one another (contract 6.2 "Warnings"): a pair
+ * that touched with a node of one deeper inside the other than
+ * FDEM_PENETRATION_WARN of the smaller element's smallest height, each
+ * pair once, the first FDEM_PENETRATIONS_MAX of a run (core/contact/
+ * penetration.c). fdem_take_penetrations() hands out up to `max` found
+ * since the last call, and in *more (may be NULL) how many more were seen
+ * past the list since then. The check never changes the state. */
+#define FDEM_PENETRATION_WARN 0.25
+#define FDEM_PENETRATIONS_MAX 16
+typedef struct fdem_penetration {
+    int64_t step;    /* the step whose start found it */
+    double time;
+    int a, b;        /* element indices, a < b */
+    double depth;    /* fraction of the smaller element's smallest height */
+} fdem_penetration;
+int fdem_take_penetrations(fdem_model *model, fdem_penetration *out, int max, long *more);
+
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);
 fdem_counts fdem_get_counts(const fdem_model *model);

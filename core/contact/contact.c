@@ -330,6 +330,7 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *ou
     if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
     else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
     m->friction_energy += out[2 * m->dim * m->elem_nodes];
+    contact_penetration_check(m, e1, e2);
 }
 
 /* What a pair's evaluation asks of the spring pool (contact_history.c):

@@ -26,6 +26,11 @@ int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m);
+/* penetration.c: how deep two elements are inside one another, as a
+ * fraction of the smaller one's smallest height; a touching pair beyond
+ * FDEM_PENETRATION_WARN is kept once for fdem_take_penetrations(). */
+double contact_penetration(const fdem_model *m, int a, int b);
+void contact_penetration_check(fdem_model *m, int a, int b);
 int contact_restore_detection(fdem_model *m);
 size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
 int contact_pair_force_now(const fdem_model *m, size_t k, double *out);
