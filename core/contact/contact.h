@@ -26,8 +26,8 @@ int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m);
-/* penetration.c: how deep two elements are inside one another, as a
- * fraction of the smaller one's smallest height; a touching pair beyond
+/* penetration.c: how deep a node of either element is inside the other,
+ * as a fraction of that element's inradius; a touching pair beyond
  * FDEM_PENETRATION_WARN is kept once for fdem_take_penetrations(). */
 double contact_penetration(const fdem_model *m, int a, int b);
 void contact_penetration_check(fdem_model *m, int a, int b);

@@ -9,9 +9,11 @@
  *
  * The depth is the distance from the deepest node of either element to the
  * nearest face of the other it is inside (barycentric coordinates lambda_k
- * over their gradient's length), as a fraction of the smaller of the two
- * elements' smallest heights (1 / the largest gradient). Beyond
- * FDEM_PENETRATION_WARN each pair is kept once (the first
+ * over their gradient's length), as a fraction of that element's inradius
+ * (1 / the sum of the gradients' lengths): 0 at its faces, 1 at its
+ * incentre, whatever its shape (a smallest height would never be reached
+ * by a node inside a regular tetrahedron, whose inradius is a quarter of
+ * it). Beyond FDEM_PENETRATION_WARN each pair is kept once (the first
  * FDEM_PENETRATIONS_MAX of them; later ones only counted) for the owner to
  * take with fdem_take_penetrations(). Nothing here changes the state: it
  * is an observation, not carried by checkpoints (the daemon keeps the
@@ -59,19 +61,16 @@ static int element_gradients(const fdem_model *m, int e, double g[4][3], const d
 
 static double norm3(const double v[3]) { return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
 
-/* Smallest height of an element: 1 / its largest barycentric gradient. */
-static double smallest_height(const double g[4][3], int D)
-{
-    double largest = 0;
-    for (int k = 0; k <= D; k++) largest = fmax(largest, norm3(g[k]));
-    return 1 / largest;
-}
-
-/* How deep the nodes of element a are inside element b (0: none inside). */
+/* How deep the deepest node of element a is inside element b, as a
+ * fraction of b's inradius (1 / the sum of its gradients' lengths, the
+ * deepest any point of b can be): 0 for none inside, 1 at b's incentre. */
 static double nodes_depth(const fdem_model *m, int a, const double g[4][3], const double *p0)
 {
     const int D = m->dim;
     const int32_t *n = element_nodes(m, a);
+    double length[4], inradius = 0;
+    for (int k = 0; k <= D; k++) inradius += length[k] = norm3(g[k]);
+    inradius = 1 / inradius;
     double deepest = 0;
     for (int c = 0; c <= D; c++) {
         const double *x = m->pos + D * n[c];
@@ -82,10 +81,10 @@ static double nodes_depth(const fdem_model *m, int a, const double g[4][3], cons
             sum += lambda[k];
         }
         lambda[0] = 1 - sum;
-        for (int k = 0; k <= D; k++) depth = fmin(depth, lambda[k] / norm3(g[k]));
+        for (int k = 0; k <= D; k++) depth = fmin(depth, lambda[k] / length[k]);
         deepest = fmax(deepest, depth);
     }
-    return deepest;
+    return deepest / inradius;
 }
 
 double contact_penetration(const fdem_model *m, int a, int b)
@@ -93,9 +92,7 @@ double contact_penetration(const fdem_model *m, int a, int b)
     double ga[4][3], gb[4][3];
     const double *pa, *pb;
     if (!element_gradients(m, a, ga, &pa) || !element_gradients(m, b, gb, &pb)) return 0;
-    double h = fmin(smallest_height(ga, m->dim), smallest_height(gb, m->dim));
-    double depth = fmax(nodes_depth(m, a, gb, pb), nodes_depth(m, b, ga, pa));
-    return depth / h;
+    return fmax(nodes_depth(m, a, gb, pb), nodes_depth(m, b, ga, pa));
 }
 
 void contact_penetration_check(fdem_model *m, int a, int b)

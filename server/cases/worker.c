@@ -71,8 +71,8 @@ static void worker_take_warnings(server_case *c)
         char ptr[32], msg[300];
         snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
         snprintf(msg, sizeof msg, "elements %d and %d passed into one another at step %lld "
-                 "(t = %.6g s): a node %.2f of the smaller element's height deep (warned beyond "
-                 "%.2f); a body too fast or a penalty too soft for contact to stop it",
+                 "(t = %.6g s): a node %.2f of the other's inradius deep (warned beyond %.2f); a "
+                 "body too fast or a penalty too soft for contact to hold it",
                  pen[i].a, pen[i].b, (long long)pen[i].step, pen[i].time, pen[i].depth,
                  FDEM_PENETRATION_WARN);
         case_add_warning(c, ptr, msg);
