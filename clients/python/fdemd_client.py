@@ -178,10 +178,11 @@ class Client:
         return self._json("GET", self._case_path(case_id))
 
     def warnings(self, case_id):
-        """The case's warnings (contract 6.2): a list of {"pointer",
-        "message"}: values of its document far outside rock and steel (a
-        unit typed wrong), and what its run saw (elements passing into one
-        another, with the step and the two elements). Never a refusal."""
+        """The case's warnings (docs/api.md, the status object): a list
+        of {"pointer", "message"}: values of its document far outside rock
+        and steel (a unit typed wrong), and what its run saw (elements
+        passing into one another, with the step and the two elements).
+        Never a refusal."""
         return self.status(case_id).get("warnings", [])
 
     def stage(self, case_id):
