@@ -45,6 +45,18 @@ void case_add_warning(server_case *c, const char *pointer, const char *message)
     pthread_mutex_unlock(&c->lock);
 }
 
+int case_has_warning_starting(server_case *c, const char *start)
+{
+    size_t i, n = strlen(start);
+    const json_t *w;
+    int found = 0;
+    pthread_mutex_lock(&c->lock);
+    json_array_foreach(c->warnings, i, w)
+        found |= strncmp(json_string_value(json_object_get(w, "message")), start, n) == 0;
+    pthread_mutex_unlock(&c->lock);
+    return found;
+}
+
 void case_add_warnings(server_case *c, const problems *w)
 {
     for (int i = 0; i < w->count; i++)

@@ -68,13 +68,16 @@ static void worker_take_warnings(server_case *c)
     int n = fdem_take_penetrations(c->model, pen, FDEM_PENETRATIONS_MAX, &more);
     const int32_t *part = fdem_element_parts(c->model);
     for (int i = 0; i < n; i++) {
-        char ptr[32], msg[300];
+        char ptr[32], msg[300], pair[64];
+        /* the engine lists each pair once a run; a run resumed from a
+         * checkpoint may find a pair it had found before the restart */
+        snprintf(pair, sizeof pair, "elements %d and %d passed", pen[i].a, pen[i].b);
+        if (case_has_warning_starting(c, pair)) continue;
         snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
-        snprintf(msg, sizeof msg, "elements %d and %d passed into one another at step %lld "
-                 "(t = %.6g s): a node %.2f of the other's inradius deep (warned beyond %.2f); a "
-                 "body too fast or a penalty too soft for contact to hold it",
-                 pen[i].a, pen[i].b, (long long)pen[i].step, pen[i].time, pen[i].depth,
-                 FDEM_PENETRATION_WARN);
+        snprintf(msg, sizeof msg, "%s into one another at step %lld (t = %.6g s): a node "
+                 "%.2f of the other's inradius deep (warned beyond %.2f); a body too fast or a "
+                 "penalty too soft for contact to hold it", pair, (long long)pen[i].step,
+                 pen[i].time, pen[i].depth, FDEM_PENETRATION_WARN);
         case_add_warning(c, ptr, msg);
     }
     if (more > 0)
