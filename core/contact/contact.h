@@ -29,6 +29,7 @@ int contact_forces(fdem_model *m);
 /* penetration.c: how deep a node of either element is inside the other,
  * as a fraction of that element's inradius; a touching pair beyond
  * FDEM_PENETRATION_WARN is kept once for fdem_take_penetrations(). */
+#define CONTACT_PENETRATION_EVERY 8 /* steps between two looks (contact_pair_scatter) */
 double contact_penetration(const fdem_model *m, int a, int b);
 void contact_penetration_check(fdem_model *m, int a, int b);
 int contact_restore_detection(fdem_model *m);
