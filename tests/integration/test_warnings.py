@@ -80,7 +80,7 @@ class InputWarningTests(DaemonTestCase):
         young = [w for w in st["warnings"] if w["pointer"].endswith("young")][0]
         self.assertIn("40", young["message"])
         self.assertEqual(self.pointers(self.d.status(st["id"])), sorted(TYPO_POINTERS))
-        # each once: a start and a pause add nothing
+        # a dry run finds the same ones
         status, dry = self.d.json("POST", "/cases?dry_run=true", typo_case())
         self.assertEqual(status, 200, dry)
         self.assertEqual(self.pointers(dry), sorted(TYPO_POINTERS))
