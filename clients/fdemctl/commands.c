@@ -43,6 +43,17 @@ static const char *status_text(json_t *obj, const char *key, const char *fallbac
     return s ? s : fallback;
 }
 
+/* The status' or dry run's "warnings" (contract 6.2), one a line: where
+ * in the case (a JSON Pointer, "" for the whole case) and what. */
+static void print_warnings(FILE *f, json_t *s, const char *lead)
+{
+    size_t i;
+    json_t *w;
+    json_array_foreach(json_object_get(s, "warnings"), i, w)
+        fprintf(f, "%-14s%s: %s\n", lead, status_text(w, "pointer", ""),
+                status_text(w, "message", ""));
+}
+
 static double status_number(json_t *obj, const char *key)
 {
     return json_number_value(json_object_get(obj, key));
@@ -164,6 +175,7 @@ int ctl_print_sizing(const http_response *r)
     printf("%-18s%.3g s\n", "estimated time", status_number(z, "estimated_seconds"));
     const char *warning = status_text(z, "warning", NULL);
     if (warning) fprintf(stderr, "fdemctl: warning: %s\n", warning);
+    print_warnings(stderr, z, "fdemctl: warning");
     json_decref(z);
     return CTL_OK;
 }
@@ -201,6 +213,7 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
     if (id) printf("%s\n", id);
     else fprintf(stderr, "fdemctl: the server created the case but sent no id\n");
     if (warning) fprintf(stderr, "fdemctl: warning: %s\n", warning);
+    print_warnings(stderr, status, "fdemctl: warning");
     json_decref(status);
     http_response_free(&r);
     return id ? CTL_OK : CTL_FAIL;
@@ -356,6 +369,7 @@ static void status_print_table(json_t *s)
     status_print_others(s);
     const char *error = status_text(s, "error", NULL);
     if (error) printf("%-14s%s\n", "error", error);
+    print_warnings(stdout, s, "warning");
 }
 
 int cmd_status(const ctl_options *o, int argc, char **argv)

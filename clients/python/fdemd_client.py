@@ -154,8 +154,9 @@ class Client:
             case: as for submit().
         Returns:
             {"nodes", "elements", "joints", "dt", "steps", "snapshots",
-            "memory_bytes", "result_bytes", "estimated_seconds"}, plus
-            "warning" when the case would run for hours.
+            "memory_bytes", "result_bytes", "estimated_seconds",
+            "warnings"} ([{"pointer", "message"}], values far outside rock
+            and steel), plus "warning" when the case would run for hours.
         Raises:
             FdemdError: as submit() does for an invalid case.
         """
@@ -175,6 +176,14 @@ class Client:
         stage, ...); "stage" is {"index", "name"} of the stage the case is
         in, None for a case without "stages" (see stage_label)."""
         return self._json("GET", self._case_path(case_id))
+
+    def warnings(self, case_id):
+        """The case's warnings (docs/api.md, the status object): a list
+        of {"pointer", "message"}: values of its document far outside rock
+        and steel (a unit typed wrong), and what its run saw (elements
+        passing into one another, with the step and the two elements).
+        Never a refusal."""
+        return self.status(case_id).get("warnings", [])
 
     def stage(self, case_id):
         """(index, name) of the stage the case is in, None for a case

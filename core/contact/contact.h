@@ -26,6 +26,12 @@ int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
 int contact_forces(fdem_model *m);
+/* penetration.c: how deep a node of either element is inside the other,
+ * as a fraction of that element's inradius; a touching pair beyond
+ * FDEM_PENETRATION_WARN is kept once for fdem_take_penetrations(). */
+#define CONTACT_PENETRATION_EVERY 8 /* steps between two looks (contact_pair_scatter) */
+double contact_penetration(const fdem_model *m, int a, int b);
+void contact_penetration_check(fdem_model *m, int a, int b);
 int contact_restore_detection(fdem_model *m);
 size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
 int contact_pair_force_now(const fdem_model *m, size_t k, double *out);

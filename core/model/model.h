@@ -189,6 +189,10 @@ typedef struct contact_state {
     int need_detect;
     long detections;
     int touching;            /* pairs with non-zero force in the last step */
+    fdem_penetration pen[FDEM_PENETRATIONS_MAX]; /* pairs found passing into one another,
+                                each once (penetration.c); not checkpointed: an observation */
+    int pen_count, pen_taken; /* found, handed out by fdem_take_penetrations */
+    long pen_more;           /* found beyond pen[] since the last take */
     double *cx, *cy, *cz, *r; /* bounding circles (cz NULL) or spheres, one per element */
     double *pos_detect;      /* node positions at the last detection */
     double *force;           /* contact force per node (kept apart for its work) */

@@ -99,6 +99,11 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
                              case_memory_gate gate, void *gate_ctx,
                              case_info *info, problems *out);
 
+/* Adds to `out` (status left 0) the values of an accepted case document
+ * far outside rock and steel, each once at its JSON Pointer (contract 6.2
+ * "Warnings", case_warnings.c); returns how many. Never a refusal. */
+int case_warnings(const char *text, size_t length, problems *out);
+
 /* Parses "position,velocity,..." (the ?fields= of GET /state) into
  * CASE_FIELD_* bits; unknown names are added to `out` (400). */
 unsigned case_parse_fields(const char *csv, problems *out);

@@ -88,6 +88,7 @@ static void case_free(server_case *c)
     if (c->model)
         fdem_model_destroy(c->model);
     membudget_release(&c->reserve);
+    json_decref(c->warnings);
     pthread_mutex_destroy(&c->lock);
     pthread_cond_destroy(&c->cv);
     pthread_mutex_destroy(&c->ctl_lock);

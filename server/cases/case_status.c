@@ -192,6 +192,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "started", json_string_or_null(started));
     json_object_set_new(o, "finished_at", json_string_or_null(finished_at));
     json_object_set_new(o, "elapsed", json_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
+    json_object_set_new(o, "warnings", case_warnings_json(c));
     return o;
 }
 

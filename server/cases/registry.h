@@ -118,6 +118,7 @@ typedef struct server_case {
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
 
+    json_t *warnings;          /* contract 6.2 "warnings" (`lock`, case_warnings.c) */
     int stop_pending;          /* a stop is making `stopped` durable: the queue skips the
                                   case meanwhile (`lock`) */
     int paused_by_shutdown;    /* running or queued when the daemon stopped (`lock`):

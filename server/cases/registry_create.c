@@ -87,6 +87,17 @@ static int case_publish_dir(server_case *c, const char *final_dir, char *err, si
     return 0;
 }
 
+/* The document's warnings (values far outside rock and steel) join the
+ * new case before its first status.json is written. */
+static void registry_warn_upload(server_case *c, const char *body, size_t size)
+{
+    problems w;
+    problems_init(&w);
+    case_warnings(body, size, &w);
+    case_add_warnings(c, &w);
+    problems_free(&w);
+}
+
 /* The model of an uploaded case, or NULL with `p` and *http_status. */
 static fdem_model *registry_build_upload(const char *body, size_t size, membudget_lease *lease,
                                          case_info *info, double *model_bytes, problems *p,
@@ -131,6 +142,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     c->model = model;
     c->info = info;
     c->state = CASE_CREATED;
+    registry_warn_upload(c, body, size);
     iso_time_now(c->created, sizeof c->created);
     *http_status = 500;
     char final_dir[sizeof c->dir];
@@ -220,6 +232,11 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
                         &sizing);
         fdem_model_destroy(model);
         answer = case_sizing_json(&sizing);
+        problems w;
+        problems_init(&w);
+        case_warnings(body, size, &w);
+        if (answer) json_object_set_new(answer, "warnings", problems_warnings_json(&w));
+        problems_free(&w);
         *http_status = 200;
     }
     membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);

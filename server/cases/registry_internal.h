@@ -28,6 +28,18 @@ void case_stage_from_json(case_figures *f, const json_t *stage);
 /* The status' energy object back into an fdem_energy (missing: NaN). */
 void case_energy_from_json(fdem_energy *energy, const json_t *o);
 
+/* case_warnings.c: the case's "warnings" (contract 6.2), each kept once
+ * (pointer and message), at most 100; a JSON copy for the status; read
+ * back from status.json's "warnings"; a problem list as such an array. */
+void case_add_warning(server_case *c, const char *pointer, const char *message);
+void case_add_warnings(server_case *c, const problems *w);
+/* Whether some warning's message starts with `start` (a pair of elements
+ * found again after a restart, at another step, is not listed twice). */
+int case_has_warning_starting(server_case *c, const char *start);
+json_t *case_warnings_json(server_case *c);
+void case_warnings_from_json(server_case *c, const json_t *list);
+json_t *problems_warnings_json(const problems *w);
+
 /* case_status.c: the status object as it would be in another state (to
  * make that state durable before it is shown), and its atomic write to
  * status.json (0, or -1 with the reason). */

@@ -99,8 +99,10 @@ static case_state case_load_status(server_case *c, const char *path, int *broken
     const char *finished_at = st ? json_string_value(json_object_get(st, "finished_at")) : NULL;
     snprintf(c->started, sizeof c->started, "%s", started ? started : "");
     snprintf(c->finished_at, sizeof c->finished_at, "%s", finished_at ? finished_at : "");
-    if (st)
+    if (st) {
         case_load_figures(c, st);
+        case_warnings_from_json(c, json_object_get(st, "warnings"));
+    }
     case_state was = c->state;
     if (c->state == CASE_PAUSED && json_is_true(json_object_get(st, "paused_by_shutdown")))
         was = CASE_RUNNING;

@@ -21,6 +21,7 @@
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
+#include "registry_internal.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
@@ -57,6 +58,32 @@ static double worker_next_output(const server_case *c, double t)
     return (k + 1.0) * interval;
 }
 
+/* Elements the engine found passing into one another since the last
+ * publish become status warnings (contract 6.2), at the part of the first
+ * element, each pair once; their step is in the message. */
+static void worker_take_warnings(server_case *c)
+{
+    fdem_penetration pen[FDEM_PENETRATIONS_MAX];
+    long more = 0;
+    int n = fdem_take_penetrations(c->model, pen, FDEM_PENETRATIONS_MAX, &more);
+    const int32_t *part = fdem_element_parts(c->model);
+    for (int i = 0; i < n; i++) {
+        char ptr[32], msg[300], pair[64];
+        /* the engine lists each pair once a run; a run resumed from a
+         * checkpoint may find a pair it had found before the restart */
+        snprintf(pair, sizeof pair, "elements %d and %d passed", pen[i].a, pen[i].b);
+        if (case_has_warning_starting(c, pair)) continue;
+        snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
+        snprintf(msg, sizeof msg, "%s into one another at step %lld (t = %.6g s): a node "
+                 "%.2f of the other's inradius deep (warned beyond %.2f); a body too fast or a "
+                 "penalty too soft for contact to hold it", pair, (long long)pen[i].step,
+                 pen[i].time, pen[i].depth, FDEM_PENETRATION_WARN);
+        case_add_warning(c, ptr, msg);
+    }
+    if (more > 0)
+        case_add_warning(c, "", "more element pairs passed into one another than are listed");
+}
+
 /* Called with model_lock held (the figures must belong to one step). */
 static void worker_publish(server_case *c, worker_clock *clk, double now, int running)
 {
@@ -81,6 +108,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
     case_figures_stage(&fig, m, &c->info);
     case_publish(c, &fig);
+    worker_take_warnings(c);
 }
 
 /* Lets pending GET /state requests take model_lock before the next step. */
