@@ -172,6 +172,42 @@ class HistoryThroughDaemon(DaemonTestCase):
                 pointers = [e["pointer"] for e in body["errors"]]
                 self.assertEqual(pointers, ["/history/points/1/at"], body)
 
+    def test_clients(self):
+        """fdemctl history --csv, Client.history(since), plot_history.py: the same rows."""
+        from fdemd_client import Client
+        case_id, _, body, path = self.runs[2]
+        csv = os.path.join(self.tmp, "history.csv")
+        run = self.d.fdemctl("history", case_id, "--csv", csv)
+        self.assertEqual(run.returncode, 0, run.stderr)
+        table = np.genfromtxt(csv, delimiter=",", names=True)
+        self.assertEqual(len(table), len(body["rows"]))
+        self.assertIn("tip_ux", table.dtype.names)
+        self.assertTrue(np.allclose(table["c1_fx"], [r["constraint_force"][1][0]
+                                                     for r in body["rows"]], rtol=1e-15))
+        self.assertTrue(np.allclose(table["residual"], [r["energy"]["residual"]
+                                                        for r in body["rows"]], rtol=1e-15))
+        url = "http://127.0.0.1:%d" % self.d.port
+        client = Client(url, token=self.d.default_token)
+        rows = client.history(case_id)["rows"]
+        self.assertEqual([r["time"] for r in rows], [r["time"] for r in body["rows"][1:]])
+        columns = Client.history_columns(client.history(case_id, since=None))
+        self.assertEqual(columns["constraint_force"].shape, (len(body["rows"]), 2, 2))
+        png = os.path.join(self.tmp, "history.png")
+        import subprocess
+        for source in ([path], ["--server", url, "--case", case_id]
+                       + (["--token", self.d.default_token] if self.d.default_token else [])):
+            run = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "clients", "python",
+                                                                    "plot_history.py")]
+                                 + source + ["-o", png, "--print"],
+                                 capture_output=True, text=True, timeout=120)
+            self.assertEqual(run.returncode, 0, run.stderr)
+            import json
+            drawn = json.loads(run.stdout)
+            self.assertEqual(drawn["axis"], "x")
+            self.assertEqual(len(drawn["force"]), len(body["rows"]))
+            with open(png, "rb") as f:
+                self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+
     def test_without_history_a_row_per_snapshot(self):
         st = self.d.create(bar(2, history=False), start=True)
         st = self.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=120)
