@@ -22,7 +22,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, DaemonTestCase
+from fdemd_harness import ROOT, Daemon, DaemonTestCase
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
@@ -216,6 +216,54 @@ class HistoryThroughDaemon(DaemonTestCase):
         self.assertEqual(status, 200)
         self.assertEqual(len(body["rows"]), st["snapshots"])
         self.assertEqual(body["names"], [])
+
+
+class HistorySurvivesARestart(unittest.TestCase):
+    """Paused mid-run, the daemon restarted, resumed: the history rows are
+    those of the same case run without a pause, to the bit; an extended
+    case goes on appending rows after its old end, time only growing."""
+
+    def test_pause_restart_resume_and_extend(self):
+        d = Daemon().start()
+        try:
+            case = bar(2)
+            case["output"]["interval"] = END / 400  # ~400 fsynced snapshots: time to pause
+            reference = d.create(case, start=True)["id"]
+            d.wait_state(reference, "finished", timeout=120)
+            expected = d.json("GET", "/cases/%s/history?since=-1" % reference)[1]["rows"]
+
+            case_id = d.create(case, start=True)["id"]
+            d.wait(case_id, lambda s: s["time"] > 0.2 * END or s["state"] != "running",
+                   timeout=60, what="a fifth of the run")
+            status, _ = d.json("POST", "/cases/%s/pause" % case_id)
+            paused = status == 200
+            if paused:
+                d.wait_state(case_id, "paused")
+                before = d.json("GET", "/cases/%s/history?since=-1" % case_id)[1]["rows"]
+                self.assertEqual(before, expected[:len(before)])
+                print("  paused with %d of %d rows written" % (len(before), len(expected)))
+            self.assertEqual(d.stop()[0], 0, d.log_tail())
+            d.start()
+            if paused:
+                self.assertEqual(d.status(case_id)["state"], "paused")
+                d.json("POST", "/cases/%s/start" % case_id)
+            d.wait_state(case_id, "finished", timeout=120)
+            rows = d.json("GET", "/cases/%s/history?since=-1" % case_id)[1]["rows"]
+            self.assertEqual(rows, expected)
+
+            status, body = d.json("POST", "/cases/%s/extend" % case_id, {"end": 1.5 * END})
+            self.assertIn(status, (200, 201, 202), body)
+            d.json("POST", "/cases/%s/start" % case_id)
+            d.wait_state(case_id, "finished", timeout=120)
+            longer = d.json("GET", "/cases/%s/history?since=-1" % case_id)[1]["rows"]
+            times = [r["time"] for r in longer]
+            self.assertEqual(longer[:len(expected)], expected)
+            self.assertTrue(all(b > a for a, b in zip(times, times[1:])), times)
+            self.assertAlmostEqual(times[-1], 1.5 * END, delta=1e-12)
+            self.assertGreaterEqual(len(longer), int(round(1.5 * END / INTERVAL)))
+            self.assertEqual(d.stop()[0], 0, d.log_tail())
+        finally:
+            d.close()
 
 
 if __name__ == "__main__":
