@@ -84,9 +84,10 @@ int result_append_history(result_file *f, history_row *const *rows, int count, c
                           size_t errlen);
 /* The history rows with time > since of an open result file (f) or of the
  * closed file at path (f NULL; a file written before history has none):
- * *out gets *count rows; free them with result_free_history(). */
+ * *out gets *count rows; free them with result_free_history(); `names`
+ * the point names of /history/points (count 0 without). */
 int result_read_history(result_file *f, const char *path, double since, history_row ***out,
-                        int *count, char *err, size_t errlen);
+                        int *count, history_names *names, char *err, size_t errlen);
 void result_free_history(history_row **rows, int count);
 int result_flush(result_file *f, char *err, size_t errlen);
 int result_check_file(const char *path, char *err, size_t errlen);

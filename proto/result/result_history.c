@@ -290,6 +290,33 @@ int history_reopen(result_file *f, const fdem_model *model, const case_info *inf
 
 /* --------------------------------------------------------------- reading */
 
+/* The attribute `names` of /history/points into `names` (count 0 when it
+ * cannot be read: the rows are still served). */
+static void hist_read_names(hid_t file, history_names *names)
+{
+    names->count = 0;
+    hid_t points = H5Gopen2(file, "history/points", H5P_DEFAULT);
+    hid_t attr = points >= 0 ? H5Aopen(points, "names", H5P_DEFAULT) : H5I_INVALID_HID;
+    hid_t space = attr >= 0 ? H5Aget_space(attr) : H5I_INVALID_HID;
+    hid_t type = utf8_string_type(); /* as written: HDF5 converts no character set */
+    hssize_t n = space >= 0 ? H5Sget_simple_extent_npoints(space) : 0;
+    if (type >= 0 && n > 0 && n <= CASE_MAX_HISTORY_POINTS) {
+        char *text[CASE_MAX_HISTORY_POINTS] = {0};
+        if (H5Aread(attr, type, text) >= 0) {
+            for (hssize_t i = 0; i < n; i++) {
+                snprintf(names->name[i], sizeof names->name[i], "%s", text[i] ? text[i] : "");
+                H5free_memory(text[i]);
+            }
+            names->count = (int)n;
+        }
+    }
+    if (type >= 0) H5Tclose(type);
+    if (space >= 0) H5Sclose(space);
+    if (attr >= 0) H5Aclose(attr);
+    if (points >= 0) H5Gclose(points);
+    H5Eclear2(H5E_DEFAULT);
+}
+
 static void rows_free(history_row **rows, int count)
 {
     for (int i = 0; rows && i < count; i++) history_free(rows[i]);
@@ -330,13 +357,18 @@ static int hist_read(result_file *f, double since, history_row ***out, int *coun
 }
 
 int result_read_history(result_file *f, const char *path, double since, history_row ***out,
-                        int *count, char *err, size_t errlen)
+                        int *count, history_names *names, char *err, size_t errlen)
 {
     h5_quiet();
     if (err && errlen) err[0] = '\0';
     *out = NULL;
     *count = 0;
-    if (f) return f->history[HIST_TIME] >= 0 ? hist_read(f, since, out, count, err, errlen) : 0;
+    names->count = 0;
+    if (f) {
+        if (f->history[HIST_TIME] < 0) return 0;
+        hist_read_names(f->file, names);
+        return hist_read(f, since, out, count, err, errlen);
+    }
     hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     if (file < 0) {
         result_fail(err, errlen, "cannot open %s to read its history", path);
@@ -344,6 +376,7 @@ int result_read_history(result_file *f, const char *path, double since, history_
     }
     int rc = 0;
     if (H5Lexists(file, "history", H5P_DEFAULT) > 0) { /* else written before history */
+        hist_read_names(file, names);
         result_file *r = result_alloc();
         rc = r && hist_open(r, file) == 0 ? hist_read(r, since, out, count, err, errlen) : -1;
         if (rc < 0 && err && errlen && !err[0])

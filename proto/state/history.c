@@ -111,12 +111,11 @@ static json_t *row_json(const history_row *r)
                      "energy", energy);
 }
 
-json_t *history_rows_json(history_row *const *rows, int count, const char (*names)[64],
-                          int name_count)
+json_t *history_rows_json(history_row *const *rows, int count, const history_names *names)
 {
     json_t *list = json_array(), *point_names = json_array();
-    for (int p = 0; point_names && names && p < name_count; p++)
-        json_array_append_new(point_names, json_string(names[p]));
+    for (int p = 0; point_names && names && p < names->count; p++)
+        json_array_append_new(point_names, json_string(names->name[p]));
     for (int i = 0; list && i < count; i++) json_array_append_new(list, row_json(rows[i]));
     return json_pack("{s:o, s:o}", "names", point_names, "rows", list);
 }

@@ -19,6 +19,7 @@
 
 #include <jansson.h>
 #include <stdint.h>
+#include "case/case.h"
 #include "fdem.h"
 
 /* The energy accounts of a row, by name (the status' names, contract 5.1). */
@@ -36,6 +37,12 @@ typedef struct history_row {
     double energy[HISTORY_ENERGY_TERMS];
 } history_row;
 
+/* The monitoring points' names, as /history/points stores them. */
+typedef struct history_names {
+    int count;
+    char name[CASE_MAX_HISTORY_POINTS][CASE_HISTORY_NAME];
+} history_names;
+
 /* A row of `model` now, following the nodes `point_nodes[points]`; NULL when
  * out of memory. One allocation: free with history_free(). */
 history_row *history_take(const fdem_model *model, const int32_t *point_nodes, int points);
@@ -43,10 +50,9 @@ history_row *history_take(const fdem_model *model, const int32_t *point_nodes, i
 history_row *history_alloc(int dimension, int points, int constraints);
 void history_free(history_row *row);
 
-/* {"names": [names[0..name_count)], "rows": [{"time", "step", "points": {"displacement",
+/* {"names": [names->name...], "rows": [{"time", "step", "points": {"displacement",
  * "velocity"}, "constraint_force", "constraint_displacement", "energy":
  * {term: J}}]} of rows[0..count); NULL when out of memory. */
-json_t *history_rows_json(history_row *const *rows, int count, const char (*names)[64],
-                          int name_count);
+json_t *history_rows_json(history_row *const *rows, int count, const history_names *names);
 
 #endif

@@ -37,6 +37,7 @@ typedef struct io_job {
     double since;           /* IO_EVENTS, IO_HISTORY_READ */
     history_row **rows;     /* IO_HISTORY: written; IO_HISTORY_READ: the answer */
     int row_count;
+    history_names *names;   /* IO_HISTORY_READ: the point names (the caller's) */
     void *ckpt;
     size_t ckpt_size;
     const char *ckpt_name;     /* IO_APPEND: NULL = checkpoint.bin */
@@ -347,8 +348,8 @@ static void io_do_history_read(io_job *j)
         j->rc = 0;
         return;
     }
-    j->rc = result_read_history(c->result, path, j->since, &j->rows, &j->row_count, j->err,
-                                sizeof j->err);
+    j->rc = result_read_history(c->result, path, j->since, &j->rows, &j->row_count, j->names,
+                                j->err, sizeof j->err);
 }
 
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
@@ -629,17 +630,19 @@ void io_append_history(server_case *c, history_row **rows, int count)
     io_enqueue(j);
 }
 
-int io_read_history(server_case *c, double since, history_row ***out, int *count, char *err,
-                    size_t errlen)
+int io_read_history(server_case *c, double since, history_row ***out, int *count,
+                    history_names *names, char *err, size_t errlen)
 {
     *out = NULL;
     *count = 0;
+    names->count = 0;
     io_job *j = io_job_new(IO_HISTORY_READ, c);
     if (!j) {
         snprintf(err, errlen, "out of memory");
         return -1;
     }
     j->since = since;
+    j->names = names;
     int rc = io_run_and_wait(j);
     if (rc == 0) {
         *out = j->rows;

@@ -579,13 +579,13 @@ static enum MHD_Result route_history(struct MHD_Connection *conn, server_case *c
     history_row **rows = NULL;
     int count = 0;
     char err[700] = "";
-    if (io_read_history(c, since, &rows, &count, err, sizeof err) != 0)
+    history_names names;
+    if (io_read_history(c, since, &rows, &count, &names, err, sizeof err) != 0)
         return http_reply_problem(conn, 500, "Internal error", err, NULL);
     /* about 100 bytes of JSON tree per number, charged to the budget */
     membudget_lease lease = {0};
     membudget_meter_begin(&lease, 0);
-    json_t *o = history_rows_json(rows, count, c->info.history_names,
-                                  c->info.history_point_count);
+    json_t *o = history_rows_json(rows, count, &names);
     membudget_meter_end();
     result_free_history(rows, count);
     if (!o && membudget_meter_refused())

@@ -248,8 +248,9 @@ class HistorySurvivesARestart(unittest.TestCase):
                 self.assertEqual(d.status(case_id)["state"], "paused")
                 d.json("POST", "/cases/%s/start" % case_id)
             d.wait_state(case_id, "finished", timeout=120)
-            rows = d.json("GET", "/cases/%s/history?since=-1" % case_id)[1]["rows"]
-            self.assertEqual(rows, expected)
+            after = d.json("GET", "/cases/%s/history?since=-1" % case_id)[1]
+            self.assertEqual(after["rows"], expected)
+            self.assertEqual(after["names"], ["tip", "middle"])  # from the file, after a restart
 
             status, body = d.json("POST", "/cases/%s/extend" % case_id, {"end": 1.5 * END})
             self.assertIn(status, (200, 201, 202), body)
