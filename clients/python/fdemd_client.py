@@ -342,7 +342,7 @@ class Client:
         return self._json("GET", self._case_path(case_id, suffix))
 
     def history(self, case_id, since=0):
-        """The history rows of the case (contract 6.2; docs/api.md, "GET
+        """The history rows of the case (docs/api.md, "GET
         /cases/ID/history"): one per history interval (or per snapshot for a
         case without "history"), those with time > since: the default 0
         leaves out the row at t = 0, None gives every row.

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """plot_history.py - what a lab or tunnel engineer plots first from a run's
-history output (contract 6.2): load against displacement and the energy
+history output (docs/results.md, "History"): load against displacement and the energy
 balance, as one PNG with two panels.
 
     /usr/bin/python3 clients/python/plot_history.py result.h5 [-o OUT.png] \\
