@@ -516,6 +516,10 @@ const double *fdem_constraint_forces(const fdem_model *model);
  * after a finalize that failed on a constraint selecting no node (then 0
  * for each such one); -1 for a constraint finalize did not count. */
 int fdem_constraint_node_count(const fdem_model *model, int c);
+/* The fdem_constraint_node_count() nodes of constraint c, ascending (valid
+ * after finalize; NULL for an unknown c or one that selected none): what
+ * its mean displacement is taken over (history output, contract 6.2). */
+const int32_t *fdem_constraint_nodes(const fdem_model *model, int c);
 
 /* Parts placed inside each other at t = 0 (after finalize; see
  * start_overlap.c): 1 with a point (dimension numbers) of part *inner that

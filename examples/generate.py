@@ -190,7 +190,11 @@ dump("brazilian-disc-3d", {
     "constraints": [{"part": "top", "velocity": [0, -0.1, 0]},
                     {"part": "bottom", "velocity": [0, 0.1, 0]}],
     "time": {"end": 0.0004, "dt": "auto", "safety": 0.5},
-    "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]}})
+    "output": {"interval": 5e-6, "fields": ["position", "velocity", "stress", "damage"]},
+    # the platen load curve at 1 us (400 rows of a few numbers, not snapshots)
+    "history": {"interval": 1e-6,
+                "points": [{"name": "centre", "at": [0, 0, 0]},
+                           {"name": "crown", "at": [0, 0.024, 0]}]}})
 # uniaxial-compression.json's specimen extruded 25 mm along z (a square
 # prism, the load along y as in 2D), of the built-in box mesh (coarse: 3
 # cells across, so that it runs in about a minute and a half), between two

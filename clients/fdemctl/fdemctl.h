@@ -126,5 +126,6 @@ int cmd_clone(const ctl_options *o, int argc, char **argv);
 int ctl_show_list(const ctl_options *o, const char *path, int raw, const char *key,
                   const char *what, void (*print)(const json_t *body));
 int cmd_events(const ctl_options *o, int argc, char **argv);
+int cmd_history(const ctl_options *o, int argc, char **argv);
 
 #endif

@@ -33,6 +33,7 @@ static const ctl_command ctl_commands[] = {
     {"state",  cmd_state,  "state ID [--fields LIST]  current state as JSON"},
     {"fragments", cmd_fragments, "fragments ID [--parts A,B] [--exclude-host] [--json] fragments and sieve curve"},
     {"events", cmd_events, "events ID [--since T]     fracture events: time, joint, position, mode, energy"},
+    {"history", cmd_history, "history ID [--since T] [--csv FILE] history rows as CSV (points, constraints, energy)"},
     {"fetch",  cmd_fetch,  "fetch ID [-o F] [--force] download result.h5 + .xdmf (as <name>.h5)"},
     {"extend", cmd_extend, "extend ID END [--start]   run a finished or paused case on to a later end"},
     {"clone",  cmd_clone,  "clone ID PATCH|- [--start|--dry-run] new case from a stored one + a merge or JSON Patch"},

@@ -350,6 +350,55 @@ class Client:
             suffix += "?since=" + repr(float(since))
         return self._json("GET", self._case_path(case_id, suffix))
 
+    def history(self, case_id, since=0):
+        """The history rows of the case (docs/api.md, "GET
+        /cases/ID/history"): one per history interval (or per snapshot for a
+        case without "history"), those with time > since: the default 0
+        leaves out the row at t = 0, None gives every row.
+
+        Returns:
+            {"names": [point names], "rows": [{"time", "step", "points":
+            {"displacement", "velocity"} (one vector per point),
+            "constraint_force", "constraint_displacement" (one vector per
+            constraint: its force and the mean displacement of its nodes),
+            "energy": {account: J}}, ...]}, plain lists (no numpy needed).
+            history_columns() turns it into columns, numpy arrays where
+            numpy exists.
+        """
+        suffix = "/history"
+        if since is not None:
+            suffix += "?since=" + repr(float(since))
+        return self._json("GET", self._case_path(case_id, suffix))
+
+    @staticmethod
+    def history_columns(history):
+        """Columns of a history() answer: {"time" (H), "step" (H),
+        "point_displacement" and "point_velocity" (H, P, dim),
+        "constraint_force" and "constraint_displacement" (H, C, dim),
+        "energy": {account: (H)}, "names"}: numpy arrays where numpy
+        exists, else nested lists."""
+        rows = history["rows"]
+        columns = {
+            "names": list(history.get("names", [])),
+            "time": [r["time"] for r in rows],
+            "step": [r["step"] for r in rows],
+            "point_displacement": [r["points"]["displacement"] for r in rows],
+            "point_velocity": [r["points"]["velocity"] for r in rows],
+            "constraint_force": [r["constraint_force"] for r in rows],
+            "constraint_displacement": [r["constraint_displacement"] for r in rows],
+            "energy": {k: [r["energy"][k] for r in rows]
+                       for k in (rows[0]["energy"] if rows else {})},
+        }
+        try:
+            import numpy as np
+        except ImportError:
+            return columns
+        for key in ("time", "step", "point_displacement", "point_velocity",
+                    "constraint_force", "constraint_displacement"):
+            columns[key] = np.asarray(columns[key], dtype=float if key != "step" else int)
+        columns["energy"] = {k: np.asarray(v, dtype=float) for k, v in columns["energy"].items()}
+        return columns
+
     def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
         """Polls until the case is finished, failed or stopped.
 

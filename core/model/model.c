@@ -99,3 +99,10 @@ int fdem_constraint_node_count(const fdem_model *m, int c)
     if (c < 0 || c >= m->constraint_count) return 0;
     return m->constraints[c].entry_count;
 }
+
+const int32_t *fdem_constraint_nodes(const fdem_model *m, int c)
+{
+    if (c < 0 || c >= m->constraint_count || m->constraints[c].entry_count <= 0 || !m->cnode)
+        return NULL;
+    return m->cnode + m->constraints[c].entry_begin;
+}

@@ -21,7 +21,7 @@
 
 static const char *const top_keys[] = {
     "name", "dimension", "materials", "parts", "constraints", "stages", "gravity",
-    "gravity_amplitude", "time", "output", NULL,
+    "gravity_amplitude", "time", "output", "history", NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
@@ -195,6 +195,9 @@ static void case_read(case_doc *doc, const json_t *root)
     case_read_time(doc, json_object_get(root, "time"));
     case_check_stage_end(doc);
     case_read_output(doc, json_object_get(root, "output"));
+    json_t *history = json_object_get(root, "history");
+    if (history) case_read_history(doc, history);
+    case_check_history_rows(doc);
 }
 
 /* ---------------------------------------------------------------- pass 3 */
@@ -315,7 +318,7 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
     /* Both checks, whatever the first finds: one answer names every problem. */
     if (ok)
         ok = case_check_selections(doc, model) & (case_choose_dt(doc, model, info) == 0) &
-             case_check_start_overlap(doc, model);
+             case_check_start_overlap(doc, model) & case_locate_history(doc, model);
     if (!ok) {
         fdem_model_destroy(model);
         return NULL;
@@ -337,6 +340,7 @@ static void case_fill_info(const case_doc *doc, case_info *info)
     info->stage_count = doc->stage_count;
     for (int k = 0; k < doc->stage_count; k++)
         snprintf(info->stage_names[k], sizeof info->stage_names[k], "%s", doc->stages[k].name);
+    case_fill_history_info(doc, info);
 }
 
 const char *case_stage_name(const case_info *info, int index)

@@ -29,6 +29,7 @@
 #define FDEM_CASE_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include "fdem.h"
 #include "json/problems.h"
 
@@ -63,6 +64,13 @@ enum case_field {
  * GET /state name the current stage), so both are bounded. */
 #define CASE_MAX_STAGES 256
 #define CASE_STAGE_NAME 64
+/* History output (contract 6.2, case_history.c): monitoring points a case
+ * may have, the room for a point's name with its NUL, and the rows an
+ * interval may ask for (as many as snapshots: each row is a few numbers
+ * per point and constraint). */
+#define CASE_MAX_HISTORY_POINTS 64
+#define CASE_HISTORY_NAME 64
+#define CASE_MAX_HISTORY_ROWS 1e6
 
 typedef struct case_info {
     char name[128];
@@ -77,6 +85,13 @@ typedef struct case_info {
     int fracture;           /* some part fractures */
     int stage_count;        /* entries of "stages" (0: the case has none) */
     char stage_names[CASE_MAX_STAGES][CASE_STAGE_NAME]; /* each stage's "name" */
+    /* "history": seconds between rows, 0 when the case has no "history"
+     * (rows are then taken at every snapshot); each point's name and the
+     * engine node nearest it at t = 0. */
+    double history_interval;
+    int history_point_count;
+    char history_names[CASE_MAX_HISTORY_POINTS][CASE_HISTORY_NAME];
+    int32_t history_nodes[CASE_MAX_HISTORY_POINTS];
 } case_info;
 
 /* The name of stage `index` of the case, or NULL when it has no such stage

@@ -126,6 +126,16 @@ typedef struct case_stage {
     int excavate_count;
 } case_stage;
 
+/* A "history" point (case_history.c): read in pass 1, its nearest node
+ * found in pass 3. */
+typedef struct case_history_point {
+    char name[CASE_HISTORY_NAME];
+    double at[3];
+    int node;                /* engine node nearest `at` at t = 0, -1 until located */
+    int sound;               /* read without a problem */
+    char ptr[CASE_POINTER];  /* "/history/points/2" */
+} case_history_point;
+
 typedef struct case_doc {
     problems *out;
     int dimension;           /* 2 or 3, read before everything that has vectors */
@@ -149,6 +159,10 @@ typedef struct case_doc {
     int stages_given;        /* "stages" was in the document */
     int end_given;           /* time.end was in the document (stages may leave it out) */
     long typo_cells; /* edit-distance work spent on "did you mean" so far */
+    int history_given;       /* "history" was in the document */
+    double history_interval;
+    case_history_point history_points[CASE_MAX_HISTORY_POINTS];
+    int history_point_count;
 } case_doc;
 
 /* case_amplitude.c: an amplitude table [[t, a], ...] at ptr, finite with
@@ -348,6 +362,14 @@ int case_add_constraints(case_doc *doc, fdem_model *model, int stages_added);
  * would find too, from a scratch model of the parts without problems. */
 void case_probe_dt(case_doc *doc, int from, size_t memory_limit, case_memory_gate gate,
                    void *gate_ctx);
+
+/* case_history.c: "history" (pass 1), its row count against time.end
+ * (after time), its points located in the built model (pass 3: 1, or 0
+ * after a problem at each point outside every body) and copied to info. */
+void case_read_history(case_doc *doc, const json_t *history);
+void case_check_history_rows(case_doc *doc);
+int case_locate_history(case_doc *doc, const fdem_model *model);
+void case_fill_history_info(const case_doc *doc, case_info *info);
 
 /* The pointer of part i's mesh source ("/parts/3/mesh" or "/parts/3/gmsh"). */
 void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr);

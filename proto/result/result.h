@@ -47,6 +47,7 @@
 #include <sys/types.h>
 #include "case/case.h"
 #include "fdem.h"
+#include "state/history.h"
 #include "state/snapshot.h"
 
 typedef struct result_file result_file;
@@ -77,6 +78,17 @@ int result_append_events(result_file *f, const fdem_event *events, int count, ch
  * file without /events). */
 int result_read_events(result_file *f, const char *path, double since, fdem_event **out,
                        int *count, int *dimension, char *err, size_t errlen);
+/* Appends history rows to /history (result_history.c, contract 6.2); rows
+ * at or before the last row's time (a replay) are skipped. */
+int result_append_history(result_file *f, history_row *const *rows, int count, char *err,
+                          size_t errlen);
+/* The history rows with time > since of an open result file (f) or of the
+ * closed file at path (f NULL; a file written before history has none):
+ * *out gets *count rows; free them with result_free_history(); `names`
+ * the point names of /history/points (count 0 without). */
+int result_read_history(result_file *f, const char *path, double since, history_row ***out,
+                        int *count, history_names *names, char *err, size_t errlen);
+void result_free_history(history_row **rows, int count);
 int result_flush(result_file *f, char *err, size_t errlen);
 int result_check_file(const char *path, char *err, size_t errlen);
 /* Copies the next piece of bytes [done, size) of src to the same place in

@@ -468,6 +468,7 @@ result_file *result_alloc(void)
     f->file = H5I_INVALID_HID;
     for (int k = 0; k < SERIES_COUNT; k++) f->ds[k].id = H5I_INVALID_HID;
     for (int k = 0; k < EVENT_SERIES; k++) f->events[k] = H5I_INVALID_HID;
+    for (int k = 0; k < HISTORY_SERIES; k++) f->history[k] = H5I_INVALID_HID;
     return f;
 }
 
@@ -485,6 +486,7 @@ int result_close_handles(result_file *f)
             if (H5Dclose(f->events[k]) < 0) rc = -1;
             f->events[k] = H5I_INVALID_HID;
         }
+    if (history_close_handles(f) < 0) rc = -1;
     if (f->file >= 0 && H5Fclose(f->file) < 0) rc = -1;
     f->file = H5I_INVALID_HID;
     return rc;
@@ -558,6 +560,7 @@ result_file *result_create_described(const char *path, const fdem_model *model,
     series_layout(f->ds, model, info->fields);
     if (create_snapshot_series(f, err, errlen) < 0) goto fail;
     if (events_create(f, fdem_get_dimension(model), err, errlen) < 0) goto fail;
+    if (history_create(f, model, info, err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;
     return f;
 fail:

@@ -56,6 +56,13 @@ enum event_series_kind { EVENT_JOINT, EVENT_POSITION, EVENT_MODE, EVENT_ENERGY, 
                          EVENT_SERIES };
 extern const char *const event_series_names[EVENT_SERIES];
 
+/* The /history datasets in append order: time, the commit marker, last
+ * (result_history.c); the energy terms in history_energy_names order. */
+enum history_series_kind { HIST_STEP, HIST_POINT_DISPLACEMENT, HIST_POINT_VELOCITY,
+                           HIST_CONSTRAINT_FORCE, HIST_CONSTRAINT_DISPLACEMENT, HIST_ENERGY,
+                           HIST_TIME = HIST_ENERGY + HISTORY_ENERGY_TERMS, HISTORY_SERIES };
+extern const char *const history_series_names[HISTORY_SERIES];
+
 struct result_file {
     hid_t file;
     series ds[SERIES_COUNT];
@@ -66,6 +73,10 @@ struct result_file {
     double *times; /* the time of each of them, for the XDMF sidecar */
     int times_capacity;
     int views;     /* snapshots with /xdmf views (result_views.c) */
+    hid_t history[HISTORY_SERIES];
+    hsize_t history_count; /* complete rows (= len(/history/time)) */
+    int history_dimension, history_points, history_constraints;
+    double history_last_time; /* of the last committed row, -inf before any */
 };
 
 /* "what: innermost HDF5 message" into err; clears the HDF5 error stack. */
@@ -106,6 +117,16 @@ int start_swmr(result_file *f, const char *path, char *err, size_t errlen);
  * before SWMR writing starts. */
 int events_create(result_file *f, int dimension, char *err, size_t errlen);
 int events_reopen(result_file *f, const fdem_model *model, char *err, size_t errlen);
+
+/* The /history group, empty, in a new file; in a reopened one, its rows
+ * trimmed to those at steps <= keep_until_step (a file written before
+ * history gets it empty). Both before SWMR writing starts; and closing its
+ * datasets (result_history.c). */
+int history_create(result_file *f, const fdem_model *model, const case_info *info, char *err,
+                   size_t errlen);
+int history_reopen(result_file *f, const fdem_model *model, const case_info *info,
+                   int64_t keep_until_step, char *err, size_t errlen);
+int history_close_handles(result_file *f);
 
 /* Creates /snapshots/<series_names[kind]> empty and extendible (result_h5.c). */
 int series_create(hid_t group, int kind, series *s);

@@ -203,6 +203,7 @@ result_file *result_reopen(const char *path, const fdem_model *model,
     if (committed_snapshots(f, keep_until_step, &keep, err, errlen) < 0) goto fail;
     if (truncate_series(f, keep, err, errlen) < 0) goto fail;
     if (events_reopen(f, model, err, errlen) < 0) goto fail;
+    if (history_reopen(f, model, info, keep_until_step, err, errlen) < 0) goto fail;
     if (start_swmr(f, path, err, errlen) < 0) goto fail;
     return f;
 fail:

@@ -24,7 +24,8 @@
 #include "store/persist.h"
 
 typedef enum io_job_kind {
-    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_QUIT,
+    IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_HISTORY,
+    IO_HISTORY_READ, IO_QUIT,
 } io_job_kind;
 
 typedef struct io_job {
@@ -33,7 +34,10 @@ typedef struct io_job {
     snapshot *snap;
     fdem_event *events;     /* IO_APPEND: written first; IO_EVENTS: the answer */
     int event_count, dimension;
-    double since;           /* IO_EVENTS */
+    double since;           /* IO_EVENTS, IO_HISTORY_READ */
+    history_row **rows;     /* IO_HISTORY: written; IO_HISTORY_READ: the answer */
+    int row_count;
+    history_names *names;   /* IO_HISTORY_READ: the point names (the caller's) */
     void *ckpt;
     size_t ckpt_size;
     const char *ckpt_name;     /* IO_APPEND: NULL = checkpoint.bin */
@@ -321,6 +325,33 @@ static void io_do_events(io_job *j)
                                &j->dimension, j->err, sizeof j->err);
 }
 
+static void io_do_history(io_job *j)
+{
+    server_case *c = j->c;
+    if (!j->row_count || !c->result || c->deleted || atomic_load(&c->io_failed))
+        return;
+    char err[256] = "";
+    if (result_append_history(c->result, j->rows, j->row_count, err, sizeof err) != 0) {
+        case_record_io_failure(c, "result.h5", err);
+        io_close_after_failure(c);
+    }
+}
+
+/* The history rows of the open file, or of the one on disk; none before it exists. */
+static void io_do_history_read(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+        j->rc = 0;
+        return;
+    }
+    j->rc = result_read_history(c->result, path, j->since, &j->rows, &j->row_count, j->names,
+                                j->err, sizeof j->err);
+}
+
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
  * checkpoint.bin and status.json, fsynced), a moving average over the
  * recent snapshot jobs: what a dry run charges per snapshot. */
@@ -368,6 +399,8 @@ static void io_run_job(io_job *j)
     case IO_FETCH: io_do_fetch(j); break;
     case IO_DESCRIBE: io_do_describe(j); break;
     case IO_EVENTS: io_do_events(j); break;
+    case IO_HISTORY: io_do_history(j); break;
+    case IO_HISTORY_READ: io_do_history_read(j); break;
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
@@ -379,6 +412,7 @@ static void io_job_free(io_job *j)
     if (j->snap)
         snapshot_free(j->snap);
     free(j->events);
+    result_free_history(j->rows, j->row_count);
     free(j->ckpt);
     if (j->c)
         case_release(j->c);
@@ -582,6 +616,44 @@ void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s,
                size_t ckpt_size)
 {
     io_queue_append(c, events, event_count, s, ckpt, ckpt_size, NULL);
+}
+
+void io_append_history(server_case *c, history_row **rows, int count)
+{
+    io_job *j = io_job_new(IO_HISTORY, c);
+    if (!j) {
+        result_free_history(rows, count);
+        return;
+    }
+    j->rows = rows;
+    j->row_count = count;
+    io_enqueue(j);
+}
+
+int io_read_history(server_case *c, double since, history_row ***out, int *count,
+                    history_names *names, char *err, size_t errlen)
+{
+    *out = NULL;
+    *count = 0;
+    names->count = 0;
+    io_job *j = io_job_new(IO_HISTORY_READ, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return -1;
+    }
+    j->since = since;
+    j->names = names;
+    int rc = io_run_and_wait(j);
+    if (rc == 0) {
+        *out = j->rows;
+        *count = j->row_count;
+        j->rows = NULL;
+        j->row_count = 0;
+    } else {
+        snprintf(err, errlen, "%s", j->err);
+    }
+    io_job_free(j);
+    return rc;
 }
 
 void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,

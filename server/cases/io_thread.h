@@ -44,6 +44,16 @@ void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s,
  * err when the file cannot be read. */
 int io_read_events(server_case *c, double since, fdem_event **out, int *count, int *dimension,
                    char *err, size_t errlen);
+/* Appends history rows (contract 6.2) to result.h5 after the jobs queued
+ * before it; takes ownership of `rows` and each row, returns at once. The
+ * worker queues a checkpoint's rows before it, so a restart that cuts
+ * /history back to the checkpoint's step loses none it keeps. */
+void io_append_history(server_case *c, history_row **rows, int count);
+/* The case's history rows with time > since from result.h5 (as
+ * io_read_events): *out (free with result_free_history), *count and the
+ * point names the file holds. */
+int io_read_history(server_case *c, double since, history_row ***out, int *count,
+                    history_names *names, char *err, size_t errlen);
 /* Writes the events (as io_append), then `ckpt` as DIR/ID/<name> (a string
  * literal), after the jobs queued before it; takes ownership, returns at once. */
 void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,

@@ -134,6 +134,11 @@ typedef struct server_case {
                                   old end, whose row (this step) is kept (case_model.h) */
     double next_output;
     int64_t last_snapshot_step, last_checkpoint_step;
+    /* history rows (contract 6.2, worker_history.c): the next row's time
+     * (with a "history" interval) and the rows taken but not yet queued */
+    double next_history;
+    history_row **history_pending;
+    int history_pending_count, history_pending_capacity;
 } server_case;
 
 /* Lists the stored cases from their status.json; the rebuild that checks

@@ -22,6 +22,7 @@
 #include "case_sizing.h"
 #include "io_thread.h"
 #include "registry_internal.h"
+#include "worker_history.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
@@ -231,6 +232,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
         }
+        worker_history_after_step(c, cut ? end - t0 : dt, snap != NULL, done);
         /* Every snapshot comes with a checkpoint, so that a restart never
          * drops a snapshot the status has reported (a restart resumes at the
          * last checkpoint and drops the rows after it); --checkpoint-every
@@ -245,6 +247,9 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             worker_publish(c, clk, now, 1);
         pthread_mutex_unlock(&c->model_lock);
 
+        /* a checkpoint's rows go before it (worker_history.h) */
+        if (ckpt || worker_history_batch_full(c))
+            worker_history_flush(c);
         if (snap || ckpt) {
             io_append(c, events, event_count, snap, ckpt, ckpt_size);
             worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
@@ -258,8 +263,10 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
  * on disk so the command's answer never runs ahead of the files. */
 static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
 {
-    if (why == EXIT_ABANDON)
+    if (why == EXIT_ABANDON) {
+        worker_history_discard(c);
         return;
+    }
     snapshot *snap = NULL;
     void *ckpt = NULL;
     size_t ckpt_size = 0;
@@ -271,6 +278,7 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
     if (why == EXIT_STOP && step != c->last_snapshot_step) {
         snap = snapshot_take(c->model, c->info.fields);
         c->last_snapshot_step = step;
+        worker_history_after_step(c, fdem_get_dt(c->model), 1, 0);
     }
     if ((why == EXIT_PAUSE || why == EXIT_STOP) && step != c->last_checkpoint_step) {
         ckpt = checkpoint_file_take(c->model, &ckpt_size);
@@ -278,6 +286,7 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
     }
     worker_publish(c, clk, worker_now(), 0);
     pthread_mutex_unlock(&c->model_lock);
+    worker_history_flush(c);
     if (snap || ckpt || events)
         io_append(c, events, event_count, snap, ckpt, ckpt_size);
     worker_wait_io(c, 0);
@@ -341,6 +350,7 @@ static void *worker_main(void *arg)
                  (long long)fdem_get_step(c->model), fdem_get_time(c->model), c->info.end_time,
                  fdem_get_dt(c->model));
         c->next_output = worker_next_output(c, fdem_get_time(c->model));
+        worker_history_start(c);
         why = worker_loop(c, &clk);
         worker_wind_down(c, why, &clk);
         final_state = worker_final_state(why);

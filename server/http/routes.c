@@ -61,6 +61,7 @@ void routes_match(const char *url, route_match *out)
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
         {"fragments", ROUTE_CASE_FRAGMENTS}, {"extend", ROUTE_CASE_EXTEND},
         {"clone", ROUTE_CASE_CLONE}, {"events", ROUTE_CASE_EVENTS},
+        {"history", ROUTE_CASE_HISTORY},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
@@ -173,7 +174,8 @@ static const char *const *routes_query_names(route_kind kind, const char *method
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
-    return kind == ROUTE_CASE_STATE ? state : kind == ROUTE_CASE_EVENTS ? events
+    return kind == ROUTE_CASE_STATE ? state
+         : kind == ROUTE_CASE_EVENTS || kind == ROUTE_CASE_HISTORY ? events
          : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
 }
 
@@ -512,21 +514,31 @@ static int routes_is_decimal(const char *text)
     return *text && strspn(text, "0123456789+-.eE") == strlen(text);
 }
 
+/* ?since=T of /events and /history: 0 with *since (-inf without it), or -1
+ * after the 400 is queued in *rc. */
+static int routes_since(struct MHD_Connection *conn, double *since, const char **text,
+                        enum MHD_Result *rc)
+{
+    *text = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "since");
+    *since = -INFINITY;
+    if (!*text) return 0;
+    char *end = NULL;
+    errno = 0;
+    *since = routes_is_decimal(*text) ? strtod(*text, &end) : NAN;
+    if (end && !*end && errno != ERANGE && isfinite(*since)) return 0;
+    char detail[160];
+    snprintf(detail, sizeof detail, "?since= takes a finite decimal time in seconds "
+             "(e.g. 0.0015 or 1.5e-3); not \"%.64s\"", *text);
+    *rc = http_reply_problem(conn, 400, "Bad request", detail, NULL);
+    return -1;
+}
+
 static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
 {
-    const char *text = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "since");
+    const char *text = NULL;
     double since = -INFINITY;
-    if (text) {
-        char *end = NULL;
-        errno = 0;
-        since = routes_is_decimal(text) ? strtod(text, &end) : NAN;
-        if (!end || *end || errno == ERANGE || !isfinite(since)) {
-            char detail[160];
-            snprintf(detail, sizeof detail, "?since= takes a finite decimal time in seconds "
-                     "(e.g. 0.0015 or 1.5e-3); not \"%.64s\"", text);
-            return http_reply_problem(conn, 400, "Bad request", detail, NULL);
-        }
-    }
+    enum MHD_Result bad;
+    if (routes_since(conn, &since, &text, &bad) != 0) return bad;
     fdem_event *events = NULL;
     int count = 0, dimension = 0;
     char err[700] = "";
@@ -548,6 +560,38 @@ static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
         rc = http_reply_unavailable(conn, "the JSON form of these events would take the daemon "
                                     "past its memory budget (--max-memory) now; ask for fewer "
                                     "with ?since=", NULL);
+    else if (!o)
+        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
+    else
+        rc = http_reply_json(conn, 200, o, NULL);
+    membudget_release(&lease);
+    return rc;
+}
+
+/* GET /cases/ID/history?since=T (contract 6.2): the history rows in
+ * result.h5 with time > T (all without ?since), with the point names. */
+static enum MHD_Result route_history(struct MHD_Connection *conn, server_case *c)
+{
+    const char *text = NULL;
+    double since = -INFINITY;
+    enum MHD_Result rc;
+    if (routes_since(conn, &since, &text, &rc) != 0) return rc;
+    history_row **rows = NULL;
+    int count = 0;
+    char err[700] = "";
+    history_names names;
+    if (io_read_history(c, since, &rows, &count, &names, err, sizeof err) != 0)
+        return http_reply_problem(conn, 500, "Internal error", err, NULL);
+    /* about 100 bytes of JSON tree per number, charged to the budget */
+    membudget_lease lease = {0};
+    membudget_meter_begin(&lease, 0);
+    json_t *o = history_rows_json(rows, count, &names);
+    membudget_meter_end();
+    result_free_history(rows, count);
+    if (!o && membudget_meter_refused())
+        rc = http_reply_unavailable(conn, "the JSON form of these history rows would take the "
+                                    "daemon past its memory budget (--max-memory) now; ask for "
+                                    "fewer with ?since=", NULL);
     else if (!o)
         rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
     else
@@ -656,6 +700,8 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return route_fragments(conn, c);
     case ROUTE_CASE_EVENTS:
         return route_events(conn, c);
+    case ROUTE_CASE_HISTORY:
+        return route_history(conn, c);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c, strcmp(method, "HEAD") == 0);
     case ROUTE_CASE_RESULT_XDMF:

@@ -77,8 +77,11 @@ def file_items(f):
 
     def attrs(name, obj):
         for key, value in obj.attrs.items():
+            value = np.asarray(value) if not isinstance(value, (str, bytes)) else value
+            # an array of strings (/history/points@names) holds objects: its
+            # bytes are pointers, so it compares by its text
             items[name + "@" + key] = repr(value) if isinstance(value, (str, bytes)) \
-                else np.asarray(value).tobytes()
+                else repr(value.tolist()) if value.dtype == object else value.tobytes()
 
     def visit(name, obj):
         if isinstance(obj, h5py.Dataset):
