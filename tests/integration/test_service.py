@@ -19,8 +19,9 @@ from fdemd_harness import ROOT, Daemon, DaemonTestCase, boom_case, tiny_case
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 import fdemd_client  # noqa: E402
 
+# "warnings" (contract 6.2) is always there, empty for a plausible case
 SIZING_KEYS = {"nodes", "elements", "joints", "dt", "steps", "snapshots", "memory_bytes",
-               "result_bytes", "estimated_seconds"}
+               "result_bytes", "estimated_seconds", "warnings"}
 STATES = ("created", "queued", "running", "paused", "finished", "stopped", "failed")
 LONG = 1e3  # simulated seconds: never finishes within a test
 
@@ -132,6 +133,7 @@ class ServiceTest(DaemonTestCase):
         self.assertNotIn("location", headers)
         z = json.loads(data)
         self.assertEqual(set(z), SIZING_KEYS)
+        self.assertEqual(z["warnings"], [])
         self.assertEqual((z["nodes"], z["elements"], z["joints"]), (121, 200, 0))
         self.assertGreater(z["memory_bytes"], 0)
         self.assertGreater(z["result_bytes"], 0)
