@@ -65,7 +65,9 @@ rm -rf "$unit_out"
 if [ "${UNIT_ONLY:-0}" != 1 ] && [ -d tests/integration ]; then
   echo "== integration"
   t0=$(date +%s)
-  if ! FDEMD_BIN="$BIN/fdemd" FDEMCTL_BIN="$BIN/fdemctl" "$PYTHON" tests/integration/run.py 2>&1 | tee -a "$log"; then
+  # modules in $jobs processes side by side (tests/integration/run.py)
+  if ! INTEGRATION_JOBS=${INTEGRATION_JOBS:-$jobs} FDEMD_BIN="$BIN/fdemd" FDEMCTL_BIN="$BIN/fdemctl" \
+       "$PYTHON" tests/integration/run.py 2>&1 | tee -a "$log"; then
     status=1
   fi
   [ "${PIPESTATUS[0]}" -ne 0 ] && status=1

@@ -177,11 +177,15 @@ void case_model_forget_resume(server_case *c)
 }
 
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
-                                    case_info *info, problems *p, double *model_bytes)
+                                    case_info *info, problems *p, double *model_bytes,
+                                    problems *warnings)
 {
     size_t kept = case_model_document_cost(size);
     case_model_gate_ctx gate = {lease, kept, 0};
     membudget_meter_begin(lease, lease->bytes > kept ? lease->bytes - kept : 0);
+    /* the warnings' own parse, metered like the build's and freed before
+     * it, so the two JSON trees of one upload are never held at once */
+    if (warnings) case_warnings(body, size, warnings);
     fdem_model *model = case_build_gated(body, size, registry_config()->max_case_memory,
                                          case_model_gate, &gate, info, p);
     membudget_meter_end();

@@ -66,7 +66,8 @@ int case_model_gate(void *ctx, double estimate);
  * Memory short now is one problem with status 503. model_bytes (may be
  * NULL) gets the builder's estimate of the model (proto/case/case_memory.c). */
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
-                                    case_info *info, problems *p, double *model_bytes);
+                                    case_info *info, problems *p, double *model_bytes,
+                                    problems *warnings);
 case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_model **model,
                                case_info *info, char *err, size_t errlen);
 /* 0, or -1 with err when no result file could be opened or made. */

@@ -87,24 +87,15 @@ static int case_publish_dir(server_case *c, const char *final_dir, char *err, si
     return 0;
 }
 
-/* The document's warnings (values far outside rock and steel) join the
- * new case before its first status.json is written. */
-static void registry_warn_upload(server_case *c, const char *body, size_t size)
-{
-    problems w;
-    problems_init(&w);
-    case_warnings(body, size, &w);
-    case_add_warnings(c, &w);
-    problems_free(&w);
-}
-
-/* The model of an uploaded case, or NULL with `p` and *http_status. */
+/* The model of an uploaded case, or NULL with `p` and *http_status; the
+ * document's warnings (values far outside rock and steel) into `warnings`. */
 static fdem_model *registry_build_upload(const char *body, size_t size, membudget_lease *lease,
                                          case_info *info, double *model_bytes, problems *p,
-                                         int *http_status)
+                                         int *http_status, problems *warnings)
 {
     memset(info, 0, sizeof *info);
-    fdem_model *model = case_model_build_upload(body, size, lease, info, p, model_bytes);
+    fdem_model *model = case_model_build_upload(body, size, lease, info, p, model_bytes,
+                                                warnings);
     if (!model) {
         *http_status = p->status ? p->status : 422;
         if (p->count == 0)
@@ -128,12 +119,17 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
 {
     case_info info;
     double model_bytes = 0;
+    problems w;
+    problems_init(&w);
     fdem_model *model = registry_build_upload(body, size, lease, &info, &model_bytes, p,
-                                              http_status);
-    if (!model)
+                                              http_status, &w);
+    if (!model) {
+        problems_free(&w);
         return NULL;
+    }
     server_case *c = case_new();
     if (!c) {
+        problems_free(&w);
         fdem_model_destroy(model);
         *http_status = 500;
         snprintf(err, errlen, "out of memory");
@@ -142,7 +138,9 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     c->model = model;
     c->info = info;
     c->state = CASE_CREATED;
-    registry_warn_upload(c, body, size);
+    /* they join the case before its first status.json is written */
+    case_add_warnings(c, &w);
+    problems_free(&w);
     iso_time_now(c->created, sizeof c->created);
     *http_status = 500;
     char final_dir[sizeof c->dir];
@@ -223,8 +221,10 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
     membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
     case_info info;
     double model_bytes = 0;
+    problems w;
+    problems_init(&w);
     fdem_model *model = registry_build_upload(body, size, lease, &info, &model_bytes, p,
-                                              http_status);
+                                              http_status, &w);
     json_t *answer = NULL;
     if (model) {
         case_sizing sizing;
@@ -232,13 +232,10 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
                         &sizing);
         fdem_model_destroy(model);
         answer = case_sizing_json(&sizing);
-        problems w;
-        problems_init(&w);
-        case_warnings(body, size, &w);
         if (answer) json_object_set_new(answer, "warnings", problems_warnings_json(&w));
-        problems_free(&w);
         *http_status = 200;
     }
+    problems_free(&w);
     membudget_shrink(lease, lease->bytes > size ? lease->bytes - size : 0);
     membudget_release(&own);
     return answer;

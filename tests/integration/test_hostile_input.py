@@ -140,7 +140,7 @@ class TokenTest(DaemonTestCase):
         self.assertIn(b"WWW-Authenticate: Bearer", head)
         self.assertIn("NUL", problem["detail"])
         reply, _ = raw_exchange(self.d.port, b"GET /cases HTTP/1.1\r\nHost: x\r\n"
-                                b"Authorization: Bearer T\r\n\r\n")
+                                b"Authorization: Bearer T\r\nConnection: close\r\n\r\n")
         self.assertEqual(status_of(reply), 200, reply[:200])
 
 
