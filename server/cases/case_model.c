@@ -176,6 +176,11 @@ void case_model_forget_resume(server_case *c)
         persist_fsync_dir(c->dir);
 }
 
+/* Documents up to this size get their warnings (a second parse of the
+ * document; above it, one upload would hold two trees' worth of memory
+ * in its allocator: test_memory's concurrent uploads). */
+#define CASE_MODEL_WARNED_BYTES ((size_t)2 << 20)
+
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
                                     case_info *info, problems *p, double *model_bytes,
                                     problems *warnings)
@@ -185,7 +190,7 @@ fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lea
     membudget_meter_begin(lease, lease->bytes > kept ? lease->bytes - kept : 0);
     /* the warnings' own parse, metered like the build's and freed before
      * it, so the two JSON trees of one upload are never held at once */
-    if (warnings) case_warnings(body, size, warnings);
+    if (warnings && size <= CASE_MODEL_WARNED_BYTES) case_warnings(body, size, warnings);
     fdem_model *model = case_build_gated(body, size, registry_config()->max_case_memory,
                                          case_model_gate, &gate, info, p);
     membudget_meter_end();
