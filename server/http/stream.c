@@ -105,9 +105,9 @@ static ssize_t stream_next_locked(stream_client *s, char *buf, size_t max)
         free(s->out);
         s->out = NULL;
         s->out_length = s->out_sent = 0;
-        if (s->hung_up)
-            return MHD_CONTENT_READER_END_WITH_ERROR;
-        if (hub.closing)
+        /* a client gone gets the end too: ending it "with error" would
+         * log a line per client that went away */
+        if (hub.closing || s->hung_up)
             return MHD_CONTENT_READER_END_OF_STREAM;
         s->out_length = case_feed_read(&s->after, stream_only(s), STREAM_READ_BYTES, &s->out);
         if (s->out_length)

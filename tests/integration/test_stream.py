@@ -308,11 +308,24 @@ class StreamShutdown(unittest.TestCase):
             code, seconds = d.stop()
             self.assertEqual(code, 0, d.log_tail())
             self.assertLess(seconds, 5 * SLOW)
+            last = 0
             for s in streams:
-                while s.next() is not None:  # a chunked body cut short would raise
-                    pass
+                while True:  # a chunked body cut short would raise
+                    e = s.next()
+                    if e is None:
+                        break
+                    last = max(last, e[1])
                 s.close()
             self.assertIn("stopped", d.log_tail())
+            # ids go on growing after a restart: an old one is not mistaken for a new one
+            d.start()
+            s = Stream(d, last_event_id=last)
+            s.comment()
+            self.assertIn("events after id %d are no longer kept" % last, s.comment())
+            d.create(tiny_case("after the restart"))
+            self.assertGreater(s.next()[1], last)
+            s.close()
+            self.assertEqual(d.stop()[0], 0)
         finally:
             d.close()
 
