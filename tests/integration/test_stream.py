@@ -96,20 +96,34 @@ def ended(case_id):
     return lambda e: e[0] == "status" and e[2]["id"] == case_id and e[2]["state"] in TERMINAL
 
 
+def running_statuses(case_id, n):
+    """A predicate: the n-th status event of case_id while it runs."""
+    seen = [0]
+
+    def take(e):
+        if e[0] == "status" and e[2]["id"] == case_id and e[2]["state"] == "running":
+            seen[0] += 1
+        return seen[0] >= n
+    return take
+
+
 class StreamEvents(DaemonTestCase):
-    """One case run with a stream open from before its start; the tests
+    """One case run with a stream open from before its start, until the
+    stream has carried 8 of its running statuses, then stopped; the tests
     read what that stream carried."""
 
     @classmethod
     def setUpClass(cls):
         super().setUpClass()
         d = cls.d
-        cls.case = d.case_lasting(1.5, "streamed")
+        rate, dt = d.steps_per_second()
+        cls.case = tiny_case("streamed", end=1e3, interval=0.2 * rate * dt)  # ~5 snapshots/s
         s = Stream(d)
         cls.stream_status, cls.stream_type = s.status, s.headers.get("content-type")
-        st = d.create(cls.case, start=True)
-        cls.case_id = st["id"]
-        cls.events = s.until(ended(cls.case_id))
+        cls.case_id = d.create(cls.case, start=True)["id"]
+        cls.events = s.until(running_statuses(cls.case_id, 8))
+        d.request("POST", "/cases/%s/stop" % cls.case_id)
+        cls.events += s.until(ended(cls.case_id))
         cls.opening = s.comments[:1]
         s.close()
         cls.final = d.status(cls.case_id)
@@ -130,10 +144,8 @@ class StreamEvents(DaemonTestCase):
         statuses = self.mine("status")
         states = [s["state"] for s in statuses]
         self.assertEqual(states[0], "running")
-        self.assertEqual(states[-1], "finished")
+        self.assertEqual(states[-1], "stopped")
         running = [s for s in statuses if s["state"] == "running"]
-        # a 1.5 s run at up to 4 a second: several progress statuses
-        self.assertGreaterEqual(len(running), 3, states)
         steps = [s["step"] for s in running]
         self.assertEqual(steps, sorted(steps))
         self.assertGreater(steps[-1], steps[0])
@@ -144,10 +156,14 @@ class StreamEvents(DaemonTestCase):
 
     def test_at_most_four_status_events_a_second(self):
         running = [s for s in self.mine("status") if s["state"] == "running"][1:]
-        gaps = [b["elapsed"] - a["elapsed"] for a, b in zip(running, running[1:])]
-        # 0.25 s apart by the daemon's clock; the figures are taken a step
-        # before each event (a status every step would be < 1 ms apart)
-        self.assertTrue(gaps and min(gaps) > 0.2, gaps)
+        gaps = sorted(b["elapsed"] - a["elapsed"] for a, b in zip(running, running[1:]))
+        # 0.25 s apart by the daemon's clock; the figures are taken just
+        # before each event, so a worker descheduled in between shortens
+        # one gap and lengthens the next: the count and the median hold
+        # (unthrottled, the worker's figures would come every 0.05 s)
+        span = running[-1]["elapsed"] - running[0]["elapsed"]
+        self.assertLessEqual(len(gaps), 4 * span + 1, gaps)
+        self.assertGreater(gaps[len(gaps) // 2], 0.2, gaps)
 
     def test_snapshot_events(self):
         snaps = self.mine("snapshot")
@@ -155,7 +171,8 @@ class StreamEvents(DaemonTestCase):
         dt = self.final["dt"]
         # snapshot 0 is written when the case is created, before any stream saw it
         self.assertEqual([s["index"] for s in snaps], list(range(1, self.final["snapshots"])))
-        for s in snaps:
+        self.assertGreater(len(snaps), 2)
+        for s in snaps[:-1]:  # the last one is the stop's
             at = s["index"] * interval
             self.assertTrue(at - 1e-9 * interval <= s["time"] <= at + 1.0001 * dt, (s, at, dt))
         self.assertAlmostEqual(snaps[-1]["time"], self.final["time"], delta=1e-12)
@@ -208,13 +225,14 @@ class StreamFilterAndResume(DaemonTestCase):
 
     def test_resume_by_last_event_id_without_gap_or_duplicate(self):
         reference, first = Stream(self.d), Stream(self.d)
-        case_id = self.d.create(self.d.case_lasting(1.5, "resumed"), start=True)["id"]
+        case_id = self.d.create(tiny_case("resumed", end=1e3), start=True)["id"]
         before = [first.next() for _ in range(4)]
         first.close()
         last = before[-1][1]
         # events go on while no stream is open: wait until five more exist
         seen = reference.until(lambda e: e[1] >= last + 5)
         second = Stream(self.d, last_event_id=last)
+        self.d.request("POST", "/cases/%s/stop" % case_id)
         after = second.until(ended(case_id))
         seen += reference.until(lambda e: e[1] == after[-1][1]) if seen[-1][1] < after[-1][1] else []
         ids = [i for _, i, _ in before + after]
@@ -289,10 +307,10 @@ class StreamTimeout(DaemonTestCase):
 
     def test_a_stream_outlives_the_request_timeout(self):
         s = Stream(self.d)
-        case_id = self.d.create(self.d.case_lasting(2.5 * self.TIMEOUT, "long"), start=True)["id"]
-        events = s.until(ended(case_id))
-        self.assertEqual(events[-1][2]["state"], "finished")
-        self.assertGreater(events[-1][2]["elapsed"], self.TIMEOUT)
+        case_id = self.d.create(tiny_case("long", end=1e3), start=True)["id"]
+        s.until(lambda e: e[0] == "status" and e[2]["elapsed"] > 1.5 * self.TIMEOUT)
+        self.d.request("POST", "/cases/%s/stop" % case_id)
+        self.assertEqual(s.until(ended(case_id))[-1][2]["state"], "stopped")
         s.close()
 
 
@@ -348,8 +366,8 @@ class ClientsFollowTheStream(DaemonTestCase):
         # a poll an hour apart: only the stream can end this wait in time
         r = self.d.fdemctl("wait", case_id, "--interval", "3600", timeout=60)
         self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertIn("%s finished" % case_id, r.stdout)
-        self.assertGreater(r.stdout.count("running"), 1, r.stdout)
+        self.assertTrue(r.stdout.rstrip().endswith("snapshots"), r.stdout)
+        self.assertIn("%s finished" % case_id, r.stdout.splitlines()[-1])
 
     def test_python_client_wait(self):
         case_id = self.d.create(self.d.case_lasting(1.0, "py"), start=True)["id"]
@@ -357,7 +375,7 @@ class ClientsFollowTheStream(DaemonTestCase):
         seen = []
         final = client.wait(case_id, callback=seen.append, interval=3600, timeout=120 * SLOW)
         self.assertEqual(final["state"], "finished")
-        self.assertGreater(len(seen), 2)
+        self.assertEqual(seen[-1], final)
 
     def test_python_client_stream_resumes(self):
         client = fdemd_client.Client("http://127.0.0.1:%d" % self.d.port)
