@@ -22,6 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/fault_point.h"
 #include "io_thread.h"
@@ -300,7 +301,9 @@ static void stages_settle(server_case *c, double end)
     c->state = CASE_PAUSED;
     c->finished_at[0] = '\0';
     pthread_mutex_unlock(&c->lock);
-    if (case_persist_status(c) != 0)
+    int stored = case_persist_status(c) == 0;
+    case_feed_status(c);
+    if (!stored)
         return;
     fault_point("extend:status.json");
     stages_drop_intent(c);

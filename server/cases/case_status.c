@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "case_feed.h"
 #include "store/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
@@ -265,8 +266,10 @@ static void case_status_write_failed(server_case *c, const char *reason)
     }
     pthread_mutex_unlock(&c->lock);
     char again[128];
-    if (idle)
+    if (idle) {
         case_write_status_json(c, case_status_json(c), again, sizeof again);
+        case_feed_status(c);
+    }
 }
 
 int case_persist_status(server_case *c)

@@ -20,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/persist.h"
 
@@ -224,8 +225,10 @@ static void io_do_append(io_job *j)
      * is never cut back), so the count shows them too. */
     if (j->ckpt && !atomic_load(&c->io_failed))
         case_persist_status_counting(c, appended);
-    if (appended >= 0)
+    if (appended >= 0) {
         case_set_snapshots(c, appended);
+        case_feed_snapshot(c, appended - 1, j->snap->time);
+    }
     pthread_mutex_lock(&c->lock);
     c->io_pending--;
     pthread_cond_broadcast(&c->cv);

@@ -7,7 +7,8 @@
  *    and status.json (case_status.c); building, sizing and dropping models
  *    (case_model.c, case_sizing.c); extend and clone (case_stages.c); one
  *    worker thread per running case (worker.c); the one HDF5 I/O thread
- *    (io_thread.c). The state machine, the workers and the I/O thread call
+ *    (io_thread.c); the feed of case events GET /stream serves
+ *    (case_feed.c). The state machine, the workers and the I/O thread call
  *    each other: that circle stays inside this folder.
  *  - May call: store/ (persist.h, checkpoint_file.h, fault_point.h),
  *    common/ (config.h, memory_budget.h), proto/ and core/.
@@ -128,6 +129,7 @@ typedef struct server_case {
     _Atomic int unchecked;     /* loaded at start-up, its stored files not checked yet: the
                                   daemon listens first (registry_ensure_checked) */
     case_state stored_state;   /* the state status.json had at start-up (for the log) */
+    double feed_status_at;     /* its last status event (monotonic s; case_feed.c's lock) */
 
     /* worker-private */
     int64_t resume_rows_until; /* >= 0: resumed from the step before an extended case's

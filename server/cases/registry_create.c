@@ -15,6 +15,7 @@
 #include <sys/random.h>
 #include <sys/stat.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
@@ -188,6 +189,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
      * is acknowledged comes back after a crash). */
     if (start)
         case_persist_status(c);
+    case_feed_status(c);
     *http_status = 201;
     case_retain(c);
     return c;

@@ -18,6 +18,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "case_stages.h"
 #include "common/memory_budget.h"
@@ -228,14 +229,23 @@ void registry_ensure_checked(server_case *c)
     if (!atomic_load(&c->unchecked))
         return;
     pthread_mutex_lock(&c->ctl_lock);
+    int changed = 0;
     if (atomic_load(&c->unchecked)) {
+        pthread_mutex_lock(&c->lock);
+        case_state before = c->state;
+        pthread_mutex_unlock(&c->lock);
         c->load_broken = case_check_stored(c) != 0;
         if (!c->load_broken)
             case_persist_status(c);
         case_log_restored(c, c->stored_state);
         atomic_store(&c->unchecked, 0);
+        pthread_mutex_lock(&c->lock);
+        changed = c->state != before;
+        pthread_mutex_unlock(&c->lock);
     }
     pthread_mutex_unlock(&c->ctl_lock);
+    if (changed) /* the check found its files broken */
+        case_feed_status(c);
 }
 
 /* Start-up's rebuilds run here, after the daemon listens: three stored

@@ -17,6 +17,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
@@ -243,9 +244,12 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             c->last_checkpoint_step = fdem_get_step(m);
             clk->last_checkpoint = now;
         }
-        if (snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL)
+        int published = snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL;
+        if (published)
             worker_publish(c, clk, now, 1);
         pthread_mutex_unlock(&c->model_lock);
+        if (published)
+            case_feed_progress(c); /* at most CASE_FEED_STATUS_RATE a second */
 
         /* a checkpoint's rows go before it (worker_history.h) */
         if (ckpt || worker_history_batch_full(c))

@@ -25,6 +25,7 @@
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
 #include "state/state_json.h"
+#include "stream.h"
 
 /* ------------------------------------------------------------- matching */
 
@@ -68,6 +69,8 @@ void routes_match(const char *url, route_match *out)
     int n = routes_split(url, seg);
     if (n == 1 && strcmp(seg[0], "health") == 0)
         out->kind = ROUTE_HEALTH;
+    if (n == 1 && strcmp(seg[0], "stream") == 0)
+        out->kind = ROUTE_STREAM;
     if (n < 1 || strcmp(seg[0], "cases") != 0)
         return;
     if (n == 1) {
@@ -99,6 +102,7 @@ const char *routes_allowed(route_kind kind)
     case ROUTE_CASE: return "GET, HEAD, DELETE";
     case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
     case ROUTE_CASE_EXTEND: case ROUTE_CASE_CLONE: return "POST";
+    case ROUTE_STREAM: return "GET";
     default: return "GET, HEAD";
     }
 }
@@ -169,11 +173,14 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const state[] = {"fields", NULL};
     static const char *const events[] = {"since", NULL};
     static const char *const fragments[] = {"parts", "exclude_host", NULL};
+    static const char *const stream[] = {"case", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
+    if (kind == ROUTE_STREAM)
+        return stream;
     return kind == ROUTE_CASE_STATE ? state
          : kind == ROUTE_CASE_EVENTS || kind == ROUTE_CASE_HISTORY ? events
          : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
@@ -720,6 +727,8 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
 {
     if (m->kind == ROUTE_HEALTH)
         return route_health(conn);
+    if (m->kind == ROUTE_STREAM)
+        return stream_open(conn);
     if (m->kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? route_create_case(conn, body, body_size)
                                            : route_list_cases(conn);
