@@ -19,7 +19,7 @@
 #include <sys/stat.h>
 
 #include "case_model.h"
-#include "case_stages.h"
+#include "case_continue.h"
 #include "common/memory_budget.h"
 #include "store/persist.h"
 #include "registry.h"
