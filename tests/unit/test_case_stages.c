@@ -268,6 +268,55 @@ static void box_selecting_nothing(void)
                       "/stages/1/excavate/0", "selects no element");
 }
 
+/* A box that selects nothing, of an excavation or of a fracture region of
+ * a generated shape, is named in the same answer as the document's other
+ * problems (here a safety out of range), in 2D and 3D: the shapes are
+ * meshed for the check. They were named only once the rest was valid. */
+static void empty_boxes_with_the_other_problems(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        json_t *doc = load(
+            "{'materials': {'rock': {'density': 2500, 'young': 1e9, 'poisson': 0.25,"
+            "   'fracture': {'tensile_strength': 5e6, 'cohesion': 2e7, 'friction_angle': 30,"
+            "                'energy_I': 20, 'energy_II': 100}}},"
+            " 'parts': [{'name': 'block', 'material': 'rock',"
+            "            'rectangle': {'origin': [0, 0], 'size': [2, 1], 'divisions': [8, 4]}},"
+            "           {'name': 'lid', 'material': 'rock', 'fracture': {'box': [7, 7, 8, 8]},"
+            "            'rectangle': {'origin': [0, 2], 'size': [2, 0.5], 'divisions': [4, 1]}}],"
+            " 'stages': [{'end': 0.001},"
+            "            {'end': 0.002, 'excavate': [{'box': [0.5, 0.5, 1.5, 1.0]},"
+            "                                        {'box': [5, 5, 6, 6]}]}],"
+            " 'time': {'safety': 2}}");
+        if (dim == 3) {
+            edit(doc, "/dimension", json_integer(3));
+            for (int i = 0; i < 2; i++) {
+                char at[64];
+                json_object_del(json_array_get(json_object_get(doc, "parts"), (size_t)i),
+                                "rectangle");
+                snprintf(at, sizeof at, "/parts/%d/box", i);
+                edit(doc, at, load(i ? "{'origin': [0, 0, 2], 'size': [2, 1, 0.5], "
+                                       "'divisions': [4, 2, 1]}"
+                                     : "{'origin': [0, 0, 0], 'size': [2, 1, 1], "
+                                       "'divisions': [4, 2, 2]}"));
+            }
+            edit(doc, "/parts/1/fracture/box", load("[7, 7, 7, 8, 8, 8]"));
+            edit(doc, "/stages/1/excavate", load("[{'box': [0.5, 0, 0, 1.5, 1, 1]},"
+                                                 " {'box': [5, 5, 5, 6, 6, 6]}]"));
+        }
+        problems p;
+        build_refused(doc, GiB, &p);
+        CHECK(p.status == 422, "%dD: status %d", dim, p.status);
+        CHECK(has_problem(&p, "/time/safety", "(0, 1]"), "%dD: the safety", dim);
+        CHECK(has_problem(&p, "/stages/1/excavate/1", "selects no element"),
+              "%dD: the empty excavation box", dim);
+        CHECK(has_problem(&p, "/parts/1/fracture", "outside the part"),
+              "%dD: the empty region box", dim);
+        CHECK(p.count == 3, "%dD: %d problems, want 3", dim, p.count);
+        if (check_failures_in_test) dump_problems(&p);
+        problems_free(&p);
+    }
+}
+
 /* ------------------------------------------------------------------ 3D */
 
 static const char *base_3d =
@@ -339,4 +388,5 @@ CHECK_MAIN(T(stages_build_without_time_end), T(case_without_stages_has_none),
            T(time_end_must_agree), T(box_excavates_by_centroid),
            T(group_excavates_its_elements), T(an_element_goes_once),
            T(every_stage_problem_in_one_answer), T(stage_list_shapes),
-           T(box_selecting_nothing), T(stages_in_3d), T(bad_stages_in_3d))
+           T(box_selecting_nothing), T(empty_boxes_with_the_other_problems), T(stages_in_3d),
+           T(bad_stages_in_3d))
