@@ -205,6 +205,39 @@ static void an_element_goes_once(void)
     expect_doc(doc, GiB, 422, "/stages/1/excavate", "earlier stage");
 }
 
+/* A stage's pressure on the nodes around what it excavates (a box inside
+ * the block, so none of its edges is boundary at the start) loads the
+ * opening's wall from the excavation on: the middle of the opening's
+ * floor goes down against a twin without it. It used to select no
+ * boundary edge and be refused. */
+static void stage_pressure_on_the_opening(void)
+{
+    double drop[2] = {0, 0};
+    for (int k = 0; k < 2; k++) {
+        json_t *doc = load(base_2d);
+        edit(doc, "/stages/1/excavate/0/box", load("[0.5, 0.25, 1.5, 0.75]"));
+        edit(doc, "/stages/1/constraints", load(k ? "[]" : "[{'box': [0.49, 0.24, 1.51, 0.76], "
+                                                            "'pressure': 1e7}]"));
+        case_info info;
+        fdem_model *m = expect_built(doc, &info);
+        if (!m) return;
+        if (step_into_stage(m, 1) == 0)
+            for (int s = 0; s < 20; s++) {
+                fdem_error err;
+                fdem_step(m, &err);
+            }
+        const double *x = fdem_positions(m), *x0 = fdem_initial_positions(m);
+        for (int i = 0; i < fdem_get_counts(m).nodes; i++)
+            if (fabs(x0[2 * i] - 1.0) < 1e-9 && fabs(x0[2 * i + 1] - 0.25) < 1e-9)
+                drop[k] = x0[2 * i + 1] - x[2 * i + 1];
+        fdem_model_destroy(m);
+    }
+    printf("  the floor of the opening went down %.3g m with the pressure, %.3g m without\n",
+           drop[0], drop[1]);
+    CHECK(drop[0] > drop[1] + 1e-7, "the pressure did not push the floor: %g m against %g m",
+          drop[0], drop[1]);
+}
+
 /* ---------------------------------------------------------- refused */
 
 static void every_stage_problem_in_one_answer(void)
@@ -387,6 +420,7 @@ static void bad_stages_in_3d(void)
 CHECK_MAIN(T(stages_build_without_time_end), T(case_without_stages_has_none),
            T(time_end_must_agree), T(box_excavates_by_centroid),
            T(group_excavates_its_elements), T(an_element_goes_once),
-           T(every_stage_problem_in_one_answer), T(stage_list_shapes),
+           T(stage_pressure_on_the_opening), T(every_stage_problem_in_one_answer),
+           T(stage_list_shapes),
            T(box_selecting_nothing), T(empty_boxes_with_the_other_problems), T(stages_in_3d),
            T(bad_stages_in_3d))
