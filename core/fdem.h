@@ -430,9 +430,13 @@ const int32_t *fdem_tetrahedra(const fdem_model *model);
 const int32_t *fdem_element_parts(const fdem_model *model);
 /* Joint arrays (2 dim node indices per joint: a0, a1 (, a2) on one face,
  * b0, b1 (, b2) the matching nodes of the other, a_i opposite b_i), and
- * damage 0..1 per joint. NULL when no joints. */
+ * the engine's damage per joint: 0..1, but above 1 for a joint a stage
+ * excavated (it holds nothing). NULL when no joints. fdem_copy_joint_damage
+ * writes the damage to show, 0..1, into out[joints]: an excavated joint's
+ * as it was when excavated (fdem_element_active says which are gone). */
 const int32_t *fdem_joints(const fdem_model *model);
 const double *fdem_joint_damage(const fdem_model *model);
+void fdem_copy_joint_damage(const fdem_model *model, double *out);
 
 /* Fragments (contract 5.4): pieces connected through shared nodes or
  * intact joints. fdem_fragment_labels writes each element's fragment id

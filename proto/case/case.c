@@ -4,7 +4,8 @@
  *
  * This file owns the order of things: parse, read every section (pass 1,
  * case_materials.c, case_parts.c, case_constraints.c and the small sections
- * here), estimate memory (pass 2, case_memory.c), build and finalize the
+ * here), estimate memory (pass 2, case_memory.c), check the boxes that
+ * need generated meshes with the other problems (case_boxes.c), build and finalize the
  * model (pass 3), then choose the time step. Engine errors are mapped to
  * JSON Pointers (only the case knows which document item became which
  * engine index) in case_doc.c, which the sections share; no case file calls
@@ -403,12 +404,15 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
     char **names = case_copy_names(&doc);
     json_decref(root);
     if (!names) case_problem(&doc, "", "out of memory");
-    if (out->count + out->dropped != before)
+    if (out->count + out->dropped != before) {
+        case_check_boxes(&doc, before, memory_limit);
         case_probe_dt(&doc, before, memory_limit, gate, gate_ctx);
-    else if (gate && gate(gate_ctx, bytes) != 0) {
+    } else if (gate && gate(gate_ctx, bytes) != 0) {
         snprintf(out->title, sizeof out->title, "Service unavailable");
         problems_add(out, 503, "", "the daemon has no memory to spare for this model now "
                                    "(--max-memory); try again later");
+    } else {
+        case_check_boxes(&doc, before, memory_limit); /* the boxes of the shapes meshed now */
     }
     fdem_model *model = NULL;
     if (out->count + out->dropped == before) model = case_build_model(&doc, info);

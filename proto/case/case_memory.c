@@ -121,6 +121,12 @@ static void memory_describe(double nodes, double elements, double joints, char *
         snprintf(out + n, size - (size_t)n, ", %.3g joints", joints);
 }
 
+double case_part_bytes(const case_doc *doc, case_part *part)
+{
+    memory_part_counts(part, doc->dimension);
+    return memory_bytes(doc->dimension, part->nodes, part->elements, part->joints, 1);
+}
+
 double case_check_memory(case_doc *doc, size_t memory_limit)
 {
     double nodes = 0, elements = 0, joints = 0;

@@ -145,7 +145,11 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
         else s->fields |= SNAPSHOT_FRAGMENTS;
     }
     if (counts.joints > 0) {
-        s->damage = copy_doubles(fdem_joint_damage(model), (size_t)counts.joints, &failed);
+        /* an excavated joint shows the damage it had then (not 1: it did
+         * not break); /snapshots/active says it is gone */
+        s->damage = malloc((size_t)counts.joints * sizeof *s->damage);
+        if (s->damage) fdem_copy_joint_damage(model, s->damage);
+        else failed = 1;
         if (s->damage && (fields & CASE_FIELD_DAMAGE)) s->fields |= CASE_FIELD_DAMAGE;
     }
     s->constraint_force = copy_doubles(fdem_constraint_forces(model),

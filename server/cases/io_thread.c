@@ -313,14 +313,21 @@ static void io_do_fetch(io_job *j)
     j->rc = 0;
 }
 
+/* A read of result.h5 has nothing to read yet: no file is open and none
+ * is on disk (the case has written nothing). Its path goes to `path`. */
+static int io_result_absent(const server_case *c, char *path, size_t size)
+{
+    snprintf(path, size, "%s/result.h5", c->dir);
+    struct stat st;
+    return !c->result && stat(path, &st) != 0 && errno == ENOENT;
+}
+
 /* The events of the open file, or of the one on disk; none before it exists. */
 static void io_do_events(io_job *j)
 {
     server_case *c = j->c;
     char path[1200];
-    snprintf(path, sizeof path, "%s/result.h5", c->dir);
-    struct stat st;
-    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+    if (io_result_absent(c, path, sizeof path)) {
         j->rc = 0;
         return;
     }
@@ -345,9 +352,7 @@ static void io_do_history_read(io_job *j)
 {
     server_case *c = j->c;
     char path[1200];
-    snprintf(path, sizeof path, "%s/result.h5", c->dir);
-    struct stat st;
-    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+    if (io_result_absent(c, path, sizeof path)) {
         j->rc = 0;
         return;
     }

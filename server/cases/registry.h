@@ -5,7 +5,7 @@
  *    upload (registry_create.c) and loading a stored case
  *    (registry_load.c, registry_internal.h between them); status objects
  *    and status.json (case_status.c); building, sizing and dropping models
- *    (case_model.c, case_sizing.c); extend and clone (case_stages.c); one
+ *    (case_model.c, case_sizing.c); extend and clone (case_continue.c); one
  *    worker thread per running case (worker.c); the one HDF5 I/O thread
  *    (io_thread.c); the feed of case events GET /stream serves
  *    (case_feed.c). The state machine, the workers and the I/O thread call

@@ -20,7 +20,7 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "case_stages.h"
+#include "case_continue.h"
 #include "common/memory_budget.h"
 #include "store/persist.h"
 #include "registry.h"

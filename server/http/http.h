@@ -7,7 +7,7 @@
  *    one function per API route (routes.c); result.h5 downloads
  *    (download.c); the threads for requests that build a model
  *    (heavy_work.c); GET /stream's event streams (stream.c).
- *  - May call: cases/ (registry.h, case_stages.h, io_thread.h), common/
+ *  - May call: cases/ (registry.h, case_continue.h, io_thread.h), common/
  *    (config.h, memory_budget.h), proto/ and core/.
  *  - Called by: main.c only (http_start, http_stop). Nothing in cases/,
  *    store/ or common/ calls back into this folder.

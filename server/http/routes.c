@@ -17,7 +17,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cases/case_stages.h"
+#include "cases/case_continue.h"
 #include "download.h"
 #include "fragment_query.h"
 #include "state/events_json.h"
@@ -540,6 +540,28 @@ static int routes_since(struct MHD_Connection *conn, double *since, const char *
     return -1;
 }
 
+/* The tail of a JSON answer built under the memory meter (the tree o
+ * charged to the budget through lease): 200 with it, else 503 when the
+ * budget refused it (`what` names the items, "these events"), else 500;
+ * the lease is released either way. */
+static enum MHD_Result routes_reply_metered(struct MHD_Connection *conn, json_t *o,
+                                            membudget_lease *lease, const char *what)
+{
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused()) {
+        char detail[200];
+        snprintf(detail, sizeof detail, "the JSON form of %s would take the daemon past its "
+                 "memory budget (--max-memory) now; ask for fewer with ?since=", what);
+        rc = http_reply_unavailable(conn, detail, NULL);
+    } else if (!o) {
+        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
+    } else {
+        rc = http_reply_json(conn, 200, o, NULL);
+    }
+    membudget_release(lease);
+    return rc;
+}
+
 static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
 {
     const char *text = NULL;
@@ -562,17 +584,7 @@ static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
     json_t *o = events_to_json(events, count, dimension, text ? &since : NULL);
     membudget_meter_end();
     free(events);
-    enum MHD_Result rc;
-    if (!o && membudget_meter_refused())
-        rc = http_reply_unavailable(conn, "the JSON form of these events would take the daemon "
-                                    "past its memory budget (--max-memory) now; ask for fewer "
-                                    "with ?since=", NULL);
-    else if (!o)
-        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
-    else
-        rc = http_reply_json(conn, 200, o, NULL);
-    membudget_release(&lease);
-    return rc;
+    return routes_reply_metered(conn, o, &lease, "these events");
 }
 
 /* GET /cases/ID/history?since=T (contract 6.2): the history rows in
@@ -595,16 +607,7 @@ static enum MHD_Result route_history(struct MHD_Connection *conn, server_case *c
     json_t *o = history_rows_json(rows, count, &names);
     membudget_meter_end();
     result_free_history(rows, count);
-    if (!o && membudget_meter_refused())
-        rc = http_reply_unavailable(conn, "the JSON form of these history rows would take the "
-                                    "daemon past its memory budget (--max-memory) now; ask for "
-                                    "fewer with ?since=", NULL);
-    else if (!o)
-        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
-    else
-        rc = http_reply_json(conn, 200, o, NULL);
-    membudget_release(&lease);
-    return rc;
+    return routes_reply_metered(conn, o, &lease, "these history rows");
 }
 
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
