@@ -30,7 +30,7 @@ static void usage(FILE *out)
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
             "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
             "             [--checkpoint-every SECONDS] [--max-connections-per-ip N]\n"
-            "             [--request-timeout SECONDS]\n"
+            "             [--request-timeout SECONDS] [--web DIR]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -44,6 +44,7 @@ static void usage(FILE *out)
             "  --max-connections-per-ip N  open connections per client address (default 16)\n"
             "  --request-timeout SECONDS   a request must arrive whole (headers and body)\n"
             "                          within this time, or is cut (default 30)\n"
+            "  --web DIR               the web page's files (default: web/ beside bin/)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -117,7 +118,7 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
     enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY,
-           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT };
+           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_WEB };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
@@ -127,6 +128,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
         {"max-connections-per-ip", required_argument, 0, OPT_MAX_CONNECTIONS_PER_IP},
         {"request-timeout", required_argument, 0, OPT_REQUEST_TIMEOUT},
+        {"web", required_argument, 0, OPT_WEB},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -188,6 +190,10 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case OPT_REQUEST_TIMEOUT:
             if (parse_int(optarg, 1, &request_timeout)) bad = "--request-timeout takes a positive number of seconds";
             cfg->request_timeout = request_timeout;
+            break;
+        case OPT_WEB:
+            if (!*optarg || strlen(optarg) >= sizeof cfg->web_dir) bad = "--web takes a directory path";
+            else strcpy(cfg->web_dir, optarg);
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

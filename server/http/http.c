@@ -27,6 +27,7 @@
 #include "http_frame.h"
 #include "json/json_depth.h"
 #include "routes.h"
+#include "web.h"
 
 #define HTTP_THREADS 4
 #define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity while a response is sent */
@@ -108,6 +109,12 @@ static struct MHD_Response *http_text_response(char *text, const char *content_t
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
     return resp;
+}
+
+enum MHD_Result http_reply_response(struct MHD_Connection *conn, unsigned status,
+                                    struct MHD_Response *resp)
+{
+    return http_queue(conn, status, resp);
 }
 
 enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, json_t *body,
@@ -287,7 +294,10 @@ static enum MHD_Result http_reply_owed(struct MHD_Connection *conn, const http_r
 static int http_check_headers(struct MHD_Connection *conn, const char *url, const char *method,
                               http_request *r, enum MHD_Result *rc)
 {
-    const char *unauthorized = r->route.kind != ROUTE_HEALTH ? http_unauthorized_reason(conn) : NULL;
+    /* /health and the page's own files need no token: the page must load
+     * to ask for it, and its files hold no data (web.h). */
+    int open_route = r->route.kind == ROUTE_HEALTH || r->route.kind == ROUTE_WEB;
+    const char *unauthorized = !open_route ? http_unauthorized_reason(conn) : NULL;
     if (unauthorized) {
         *rc = http_reply_unauthorized(conn, unauthorized);
         return 1;
@@ -725,6 +735,9 @@ int http_start(const fdemd_config *cfg)
 {
     http_cfg = cfg;
     int port = 0;
+    if (web_init(cfg->web_dir) != 0)
+        fprintf(stderr, "fdemd: no web page: %s is not a folder (--web DIR); GET / answers 404\n",
+                cfg->web_dir[0] ? cfg->web_dir : "web/ beside bin/");
     if (heavy_work_start() != 0)
         return -1;
     int listen_fd = http_listen(cfg, &port);
