@@ -28,6 +28,7 @@ export class CaseView {
     this.events = [];
     this.plotsAt = 0;
     this.closed = false;
+    this.available = null;      // the fields the case writes, from the first frame
     $("view-title").textContent = `${status.name} (${id}), ${status.dimension}D`;
     const three = status.dimension === 3;
     $("view2d").hidden = three;
@@ -45,7 +46,7 @@ export class CaseView {
       sieve: new Plot($("plot-sieve"), "Sieve curve", "diameter (m)", "passing", { logX: true }),
     };
     this.listeners = [
-      [$("field"), "change", () => this.redraw()],
+      [$("field"), "change", () => this.fieldChanged()],
       [$("scale"), "change", () => this.redraw()],
       [$("snapshot"), "change", () => { $("follow").checked = false; this.load(Number($("snapshot").value)); }],
       [$("follow"), "change", () => { if ($("follow").checked) this.load(-1); }],
@@ -54,8 +55,24 @@ export class CaseView {
     $("events").querySelector("tbody").textContent = "";
     $("field").textContent = "";
     this.showParentDiff(parent);
-    this.load(-1);
-    this.refreshPlots(true);
+    // the frame first: the sieve curve of a case that is not running
+    // rebuilds its model, which would compete with it for the machine
+    this.start().then(() => this.refreshPlots(true));
+  }
+
+  // Which fields the case writes: those of a frame, and velocity when the
+  // document asks for it (its output.fields, ["position", "velocity"] by
+  // default); the first frame then carries all but velocity, 5 MB of a
+  // 1e5-tetrahedron frame that only one colour needs.
+  async start() {
+    let velocity = true;
+    try {
+      const doc = await this.guarded(() => api.json("GET", `/cases/${this.id}/case`));
+      const fields = doc && doc.output && doc.output.fields;
+      velocity = !Array.isArray(fields) || fields.includes("velocity");
+    } catch (e) { /* a frame with every field tells */ }
+    this.velocity = velocity;
+    await this.load(-1);
   }
 
   close() {
@@ -72,17 +89,23 @@ export class CaseView {
     this.loading = true;
     try {
       const t0 = performance.now();
-      const query = index >= 0 ? `?snapshot=${index}` : "";
-      const buffer = await this.guarded(() => api.bytes(`/cases/${this.id}/mesh.bin${query}`));
+      const buffer = await this.guarded(() => api.bytes(this.frameUrl(index)));
       if (buffer && !this.closed) {
+        const t1 = performance.now();
         this.frame = decodeFrame(buffer);
+        if (!this.available) {
+          this.available = Object.keys(this.frame.fields);
+          if (this.velocity && !this.available.includes("velocity")) this.available.push("velocity");
+        }
         this.fillFieldMenu();
         const drawn = this.redraw();
-        const ms = performance.now() - t0;
+        const t2 = performance.now(), ms = t2 - t0;
         const f = this.frame;
         $("frame-info").textContent = `snapshot ${f.index} of ${f.snapshots - 1}, t = ${f.time.toPrecision(4)} s, ` +
-          `step ${f.step}; ${(buffer.byteLength / 1048576).toFixed(1)} MiB loaded and drawn in ${ms.toFixed(0)} ms`;
+          `step ${f.step}; ${(buffer.byteLength / 1048576).toFixed(1)} MiB loaded in ${(t1 - t0).toFixed(0)} ms, ` +
+          `drawn in ${(t2 - t1).toFixed(0)} ms`;
         document.body.dataset.frameMs = ms.toFixed(1);
+        document.body.dataset.frameFetchMs = (t1 - t0).toFixed(1);
         document.body.dataset.frameIndex = String(f.index);
         document.body.dataset.frameDrawn = drawn ? "yes" : "no";
         $("snapshot").max = String(f.snapshots - 1);
@@ -100,8 +123,28 @@ export class CaseView {
     }
   }
 
+  // The first frame carries every field, to learn which the case writes;
+  // later ones only what the chosen colour needs, with the damage (cracks)
+  // and fragment ids: a 1e5-tetrahedron velocity field alone is 5 MB.
+  frameUrl(index) {
+    const q = [];
+    if (index >= 0) q.push(`snapshot=${index}`);
+    if (!this.available)
+      q.push("fields=stress,principal_stress,damage,fragment");
+    else {
+      const key = $("field").value, want = new Set(["damage", "fragment"]);
+      if (key === "vonmises" || key.startsWith("stress:")) want.add("stress");
+      if (key.startsWith("principal:")) want.add("principal_stress");
+      if (key === "velocity") want.add("velocity");
+      q.push("fields=" + [...want].filter(n => this.available.includes(n)).join(","));
+    }
+    return `/cases/${this.id}/mesh.bin` + (q.length ? "?" + q.join("&") : "");
+  }
+
   fillFieldMenu() {
-    const menu = $("field"), keep = menu.value, choices = fieldChoices(this.frame);
+    if (this.menuFilled) return; // later frames carry fewer fields: keep the first's menu
+    this.menuFilled = true;
+    const menu = $("field"), keep = menu.value, choices = fieldChoices(this.frame, this.available);
     const current = [...menu.options].map(o => o.value).join(",");
     if (current === choices.map(c => c.key).join(",")) return;
     menu.textContent = "";
@@ -109,6 +152,16 @@ export class CaseView {
     const preferred = choices.some(c => c.key === keep) ? keep
       : choices.some(c => c.key === "vonmises") ? "vonmises" : choices[0].key;
     menu.value = preferred;
+  }
+
+  // A colour the frame in hand cannot give (its fields were narrowed to the
+  // previous choice) needs the frame again with that field.
+  fieldChanged() {
+    const key = $("field").value, f = this.frame;
+    const need = key === "vonmises" || key.startsWith("stress:") ? "stress"
+      : key.startsWith("principal:") ? "principal_stress" : key === "velocity" ? "velocity" : null;
+    if (f && need && !f.fields[need]) this.load($("follow").checked ? -1 : f.index);
+    else this.redraw();
   }
 
   redraw() {

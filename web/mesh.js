@@ -40,16 +40,17 @@ export function decodeFrame(buffer) {
 const STRESS_2D = ["σxx", "σyy", "σxy"];
 const STRESS_3D = ["σxx", "σyy", "σzz", "σyz", "σxz", "σxy"];
 
-// What the field menu offers for a frame: [{key, label}], in menu order.
-export function fieldChoices(f) {
-  const out = [], has = n => f.fields[n] !== undefined;
-  const names = f.dimension === 3 ? STRESS_3D : STRESS_2D;
+// What the field menu offers for a frame whose case writes the fields
+// `names` (default: those of the frame): [{key, label}], in menu order.
+export function fieldChoices(f, names) {
+  const out = [], has = n => (names ? names.includes(n) : f.fields[n] !== undefined);
+  const components = f.dimension === 3 ? STRESS_3D : STRESS_2D;
   if (has("stress")) {
     out.push({ key: "vonmises", label: f.dimension === 3 ? "von Mises stress" : "von Mises stress (in-plane)" });
-    names.forEach((n, c) => out.push({ key: "stress:" + c, label: n }));
+    components.forEach((n, c) => out.push({ key: "stress:" + c, label: n }));
   }
   if (has("principal_stress")) {
-    const w = f.fields.principal_stress.width;
+    const w = f.dimension;
     for (let c = 0; c < w; c++)
       out.push({ key: "principal:" + c, label: `principal stress ${c + 1} of ${w} (tension +)` });
   }

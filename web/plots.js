@@ -16,6 +16,18 @@ function tick(v) {
   return a === 0 ? "0" : a >= 1e4 || a < 1e-2 ? v.toExponential(1) : String(Number(v.toPrecision(3)));
 }
 const ticks = (u, splits) => splits.map(tick);
+// The x range, widened when it is (nearly) one value: uPlot's tick loop
+// never ends on a range below the precision of its numbers (a sieve
+// curve of equal fragments threw "Invalid array length").
+function xRange(u, min, max) {
+  const span = Math.max(Math.abs(min), Math.abs(max));
+  if (max - min > 1e-6 * span) return [min, max];
+  const d = span > 0 ? 0.05 * span : 1;
+  return [min - d, max + d];
+}
+// A logarithmic x axis drawn as log10 on a linear scale (uPlot's own log
+// scale drew nothing for a four-point sieve curve), labelled in decades.
+const decadeTicks = (u, splits) => splits.map(v => (v === null || v === undefined ? "" : tick(10 ** v)));
 
 function increasing(xs) {
   for (let i = 1; i < xs.length; i++) if (!(xs[i] >= xs[i - 1])) return false;
@@ -40,10 +52,12 @@ export class Plot {
 
   set(series) {
     series = series.filter(s => s.x.length > 0);
-    let xLabel = this.xLabel;
+    if (this.options.logX)
+      series = series.map(s => ({ label: s.label, x: s.x.map(Math.log10), y: s.y }));
+    let xLabel = series.length && series[0].xLabel ? series[0].xLabel : this.xLabel;
     if (series.some(s => !increasing(s.x))) {
       series = series.map(s => ({ label: s.label, x: s.x.map((_, i) => i), y: s.y }));
-      xLabel = "row (x went back: " + this.xLabel + " is not monotonic)";
+      xLabel = "row (x went back: " + xLabel + " is not monotonic)";
     }
     const data = series.length === 0 ? [[], []]
       : series.length === 1 ? [Float64Array.from(series[0].x), Float64Array.from(series[0].y)]
@@ -61,15 +75,22 @@ export class Plot {
     const width = Math.max(300, this.el.clientWidth || 480);
     this.plot = new uPlot({
       title: this.title, width, height: this.options.height || 240,
-      scales: { x: { time: false, distr: this.options.logX ? 3 : 1 } },
-      axes: [{ label: xLabel, values: ticks }, { label: this.yLabel, size: 70, values: ticks }],
-      series: [{ label: this.xLabel }].concat((series.length ? series : [{ label: "no data" }])
+      scales: { x: { time: false, range: xRange } },
+      axes: [{ label: xLabel, values: this.options.logX ? decadeTicks : ticks },
+             { label: this.yLabel, size: 70, values: ticks }],
+      series: [this.xSeries(xLabel)].concat((series.length ? series : [{ label: "no data" }])
         .map((s, i) => ({ label: s.label, stroke: COLOURS[i % COLOURS.length], width: 1.5,
                           spanGaps: true, points: { show: false } }))),
       legend: { live: true },
     }, data, this.el);
     this.plot.root.dataset.points = points;
     this.plot.root.dataset.y = this.yLabel;
+  }
+
+  xSeries(label) {
+    const s = { label };
+    if (this.options.logX) s.value = (u, v) => tick(v === null || v === undefined ? v : 10 ** v);
+    return s;
   }
 
   points() { return this.plot ? Number(this.plot.root.dataset.points) : 0; }
@@ -93,8 +114,9 @@ export function loadDisplacement(history) {
   const [c, k] = travel > 0 ? moved : loaded, axis = "xyz"[k];
   const y = rows.map(r => r.constraint_force[c][k]);
   if (travel > 0)
-    return [{ label: `constraint ${c}: F${axis} against u${axis}`, x: rows.map(r => r.constraint_displacement[c][k]), y }];
-  return [{ label: `constraint ${c} (fixed): F${axis} against time`, x: rows.map(r => r.time), y }];
+    return [{ label: `constraint ${c}: F${axis} against u${axis}`, xLabel: `u${axis} (m)`,
+              x: rows.map(r => r.constraint_displacement[c][k]), y }];
+  return [{ label: `constraint ${c} (fixed): F${axis}`, xLabel: "time (s)", x: rows.map(r => r.time), y }];
 }
 
 export function energies(history) {

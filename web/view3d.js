@@ -1,11 +1,14 @@
-// view3d.js - a 3D snapshot in WebGL through three.js: every face of every
-// tetrahedron, flat-coloured by its element, lit so the shape reads, with
-// broken joints outlined as cracks; the camera orbits with the mouse.
+// view3d.js - a 3D snapshot in WebGL through three.js: the outer faces of
+// the tetrahedra and the faces of broken joints (the crack surfaces),
+// flat-coloured by their element, lit so the shape reads, with broken
+// joints outlined as cracks; the camera orbits with the mouse.
 //
-// Every face is drawn rather than only the outer skin: a fracturing part
-// has its own nodes per tetrahedron, so the skin cannot be told from node
-// ids, and a crack that opens should show the faces inside it. The depth
-// test hides the rest (4e5 triangles for 1e5 tetrahedra, easy for a GPU).
+// A fracturing part has nodes of its own per tetrahedron, so the skin
+// cannot be told from node ids: nodes that started at one point are first
+// made one vertex (a hash of their initial coordinates' bits), and a face
+// is outer when no other tetrahedron has the same three vertices. For
+// 1e5 tetrahedra that leaves ~2 % of the 4e5 faces, which is what makes
+// a software-rendered (headless) frame take a second instead of several.
 // The drawing buffer is kept so the page's tests can read its pixels.
 
 import * as THREE from "./vendor/three/three.module.js";
@@ -13,6 +16,71 @@ import { OrbitControls } from "./vendor/three/OrbitControls.js";
 import { brokenJoints, deformedPositions, elementColours } from "./mesh.js";
 
 const FACES = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]; // outward for positive volume
+
+// One vertex id per initial position: nodes with the same initial
+// coordinates (bit for bit) share it. Open addressing on the bits.
+function vertexIds(f) {
+  const n = f.nodes, bits = new Uint32Array(f.position0.buffer, f.position0.byteOffset, 3 * n);
+  let size = 1;
+  while (size < 2 * n) size <<= 1;
+  const table = new Int32Array(size).fill(-1), id = new Int32Array(n);
+  let count = 0;
+  for (let i = 0; i < n; i++) {
+    const a = bits[3 * i], b = bits[3 * i + 1], c = bits[3 * i + 2];
+    let h = (Math.imul(a, 0x9e3779b1) ^ Math.imul(b, 0x85ebca77) ^ Math.imul(c, 0xc2b2ae3d)) & (size - 1);
+    for (;;) {
+      const j = table[h];
+      if (j < 0) { table[h] = i; id[i] = count++; break; }
+      if (bits[3 * j] === a && bits[3 * j + 1] === b && bits[3 * j + 2] === c) { id[i] = id[j]; break; }
+      h = (h + 1) & (size - 1);
+    }
+  }
+  return { id, count };
+}
+
+// A face's key from its three vertex ids, the same whatever their order.
+function faceKey(v, count, a, b, c) {
+  let p = v[a], q = v[b], r = v[c], t;
+  if (p > q) { t = p; p = q; q = t; }
+  if (q > r) { t = q; q = r; r = t; }
+  if (p > q) { t = p; p = q; q = t; }
+  return (p * count + q) * count + r;
+}
+
+// [element, face] pairs of the outer faces (every face when the keys would
+// not be exact doubles, past 2e5 distinct vertices).
+function outerFaces(f) {
+  const { id, count } = vertexIds(f), E = f.elements, out = [];
+  if (count ** 3 > Number.MAX_SAFE_INTEGER) {
+    for (let e = 0; e < E; e++) for (let k = 0; k < 4; k++) out.push(e, k);
+    return { faces: Int32Array.from(out), id, count };
+  }
+  const seen = new Map();
+  for (let e = 0; e < E; e++)
+    for (let k = 0; k < 4; k++) {
+      const F = FACES[k], key = faceKey(id, count, f.cells[4 * e + F[0]], f.cells[4 * e + F[1]], f.cells[4 * e + F[2]]);
+      seen.set(key, seen.has(key) ? -1 : 4 * e + k);
+    }
+  for (const v of seen.values()) if (v >= 0) out.push(v >> 2, v & 3);
+  return { faces: Int32Array.from(out), id, count };
+}
+
+// [element, face] pairs of the faces on broken joints (both sides).
+function crackFaces(f, skin, broken) {
+  if (!broken.length || skin.count ** 3 > Number.MAX_SAFE_INTEGER) return new Int32Array(0);
+  const keys = new Set(), out = [];
+  for (const j of broken) {
+    const a = f.jointNodes.subarray(6 * j, 6 * j + 3);
+    keys.add(faceKey(skin.id, skin.count, a[0], a[1], a[2]));
+  }
+  for (let e = 0; e < f.elements; e++)
+    for (let k = 0; k < 4; k++) {
+      const F = FACES[k];
+      if (keys.has(faceKey(skin.id, skin.count, f.cells[4 * e + F[0]], f.cells[4 * e + F[1]], f.cells[4 * e + F[2]])))
+        out.push(e, k);
+    }
+  return Int32Array.from(out);
+}
 
 export class View3D {
   constructor(canvas) {
@@ -54,20 +122,29 @@ export class View3D {
     this.renderer.render(this.scene, this.camera);
   }
 
+  // The outer faces depend on the mesh only: kept while it stays the same.
+  skin(f) {
+    const key = `${f.nodes}:${f.elements}`;
+    if (!this.skinCache || this.skinCache.key !== key) this.skinCache = { key, skin: outerFaces(f) };
+    return this.skinCache.skin;
+  }
+
   draw(f, key, scale) {
-    const x = deformedPositions(f, scale), col = elementColours(f, key);
-    const pos = new Float32Array(f.elements * 36), rgb = new Float32Array(f.elements * 36);
+    const x = deformedPositions(f, scale), col = elementColours(f, key), skin = this.skin(f);
+    const broken = brokenJoints(f), cracked = crackFaces(f, skin, broken);
+    const faces = skin.faces.length + cracked.length;
+    const pos = new Float32Array(faces / 2 * 9), rgb = new Float32Array(faces / 2 * 9);
     let o = 0;
-    for (let e = 0; e < f.elements; e++) {
-      const r = col.rgb[3 * e] / 255, g = col.rgb[3 * e + 1] / 255, b = col.rgb[3 * e + 2] / 255;
-      for (const face of FACES)
-        for (const v of face) {
+    for (const list of [skin.faces, cracked])
+      for (let i = 0; i < list.length; i += 2) {
+        const e = list[i], r = col.rgb[3 * e] / 255, g = col.rgb[3 * e + 1] / 255, b = col.rgb[3 * e + 2] / 255;
+        for (const v of FACES[list[i + 1]]) {
           const n = f.cells[4 * e + v];
           pos[o] = x[3 * n]; pos[o + 1] = x[3 * n + 1]; pos[o + 2] = x[3 * n + 2];
           rgb[o] = r; rgb[o + 1] = g; rgb[o + 2] = b;
           o += 3;
         }
-    }
+      }
     this.clear();
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute("position", new THREE.BufferAttribute(pos, 3));
@@ -75,7 +152,7 @@ export class View3D {
     geometry.computeVertexNormals();
     this.mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ vertexColors: true }));
     this.scene.add(this.mesh);
-    this.cracks = this.crackLines(f, x);
+    this.cracks = this.crackLines(f, x, broken);
     if (this.cracks) this.scene.add(this.cracks);
     if (!this.framed) this.frame(geometry);
     this.render();
@@ -83,8 +160,7 @@ export class View3D {
   }
 
   // The edges of each broken joint's first face, in black.
-  crackLines(f, x) {
-    const broken = brokenJoints(f);
+  crackLines(f, x, broken) {
     if (!broken.length) return null;
     const pos = new Float32Array(broken.length * 18);
     let o = 0;
