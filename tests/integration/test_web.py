@@ -327,6 +327,18 @@ class WebBrowserTest(unittest.TestCase):
             os.makedirs(self.shots, exist_ok=True)
             self.browser.save_screenshot(os.path.join(self.shots, "web-%s.png" % name))
 
+    def daemon_streams(self):
+        """Whether the daemon answers GET /stream with an event stream
+        (contract 6.3; the page polls without it)."""
+        conn = self.d.connection(timeout=5)
+        try:
+            conn.request("GET", "/stream", headers={"Authorization": "Bearer " + TOKEN})
+            resp = conn.getresponse()
+            return resp.status == 200 and resp.getheader("Content-Type", "").startswith(
+                "text/event-stream")
+        finally:
+            conn.close()
+
     def row(self, case_id):
         return "document.querySelector('#cases tr[data-id=\"%s\"]')" % case_id
 
@@ -345,6 +357,10 @@ class WebBrowserTest(unittest.TestCase):
         self.wait_for("return %s !== null" % self.row(self.long["id"]), "the list")
         for st in (self.box, self.frac):
             self.wait_for("return %s !== null" % self.row(st["id"]), "case " + st["id"])
+        # live through the stream when the daemon has one, else by polling
+        mode = "live (stream)" if self.daemon_streams() else "live (polling every 1 s)"
+        self.wait_for("return document.getElementById('mode').textContent === %s" % json.dumps(mode),
+                      "the page to say " + mode)
 
         # 2. progress advancing without a reload
         progress = "return Number(%s.querySelector('progress').value)" % self.row(self.long["id"])
