@@ -403,7 +403,31 @@ class WebBrowserTest(unittest.TestCase):
         self.assertGreater(colours, 5, "the 3D canvas has one colour")
         self.shot("3d", "case-view")
 
-        # 6. compare: two cases on one plot
+        # 6. a clone: the document edited, its diff against the parent shown,
+        # the new case made from it and showing the same diff
+        self.click('#cases tr[data-id="%s"] button[data-command="clone"]' % self.frac["id"])
+        self.wait_for("return !document.getElementById('clone-panel').hidden && "
+                      "document.getElementById('clone-text').value.includes('tensile_strength')",
+                      "the clone editor")
+        b.execute_script("const t = document.getElementById('clone-text');"
+                         "const doc = JSON.parse(t.value); doc.materials.rock.fracture.tensile_strength = 2e5;"
+                         "doc.name = 'frac stronger'; t.value = JSON.stringify(doc, null, 2);"
+                         "t.dispatchEvent(new Event('input'));")
+        diff = b.execute_script("return document.getElementById('clone-diff').textContent")
+        self.assertIn("~ /materials/rock/fracture/tensile_strength: 100000 -> 200000", diff)
+        self.assertIn('~ /name: "frac" -> "frac stronger"', diff)
+        known = {c["id"] for c in self.d.json("GET", "/cases")[1]["cases"]}
+        self.click("#clone-go")
+        clone = self.wait_for("return document.getElementById('parent-diff').textContent"
+                              ".includes('tensile_strength') && document.getElementById('view-title')"
+                              ".textContent", "the clone's view with its diff")
+        new = [c for c in self.d.json("GET", "/cases")[1]["cases"] if c["id"] not in known]
+        self.assertEqual(len(new), 1, clone)
+        status, doc = self.d.json("GET", "/cases/%s/case" % new[0]["id"])
+        self.assertEqual(doc["materials"]["rock"]["fracture"]["tensile_strength"], 2e5)
+        self.assertEqual(new[0]["name"], "frac stronger")
+
+        # 7. compare: two cases on one plot
         for st in (self.frac, self.weaker):
             self.click('#cases tr[data-id="%s"] input[type=checkbox]' % st["id"])
         self.click('button[data-tab="compare"]')
@@ -420,7 +444,7 @@ class WebBrowserTest(unittest.TestCase):
             "return document.querySelector('#plot-compare .uplot').dataset.points")), 4)
         self.shot("compare")
 
-        # 7. nothing from another host, the token in no URL, no CSP refusal
+        # 8. nothing from another host, the token in no URL, no CSP refusal
         urls = []
         for entry in b.get_log("performance"):
             msg = json.loads(entry["message"])["message"]
