@@ -427,7 +427,24 @@ class WebBrowserTest(unittest.TestCase):
         self.assertEqual(doc["materials"]["rock"]["fracture"]["tensile_strength"], 2e5)
         self.assertEqual(new[0]["name"], "frac stronger")
 
-        # 7. compare: two cases on one plot
+        # 7. submit: pasted, sized by a dry run first, then stored
+        self.click('button[data-tab="submit"]')
+        self.assertTrue(b.execute_script("return document.getElementById('submit-go').disabled"))
+        b.execute_script("const t = document.getElementById('submit-text'); t.value = arguments[0];"
+                         "t.dispatchEvent(new Event('input'));",
+                         json.dumps(tiny_case("pasted", divisions=(4, 4))))
+        self.click("#submit-dry")
+        sizing = self.wait_for("const r = document.getElementById('submit-result').textContent;"
+                               "return r.startsWith('dry run') && r", "the dry run")
+        self.assertIn("32 elements", sizing)
+        self.assertIn("estimated", sizing)
+        self.click("#submit-go")
+        stored = self.wait_for("const r = document.getElementById('submit-result').textContent;"
+                               "return r.startsWith('stored as') && r", "the stored case")
+        self.assertEqual(self.d.status(stored.split()[2])["name"], "pasted")
+        self.click('button[data-tab="cases"]')
+
+        # 8. compare: two cases on one plot
         for st in (self.frac, self.weaker):
             self.click('#cases tr[data-id="%s"] input[type=checkbox]' % st["id"])
         self.click('button[data-tab="compare"]')
@@ -444,7 +461,7 @@ class WebBrowserTest(unittest.TestCase):
             "return document.querySelector('#plot-compare .uplot').dataset.points")), 4)
         self.shot("compare")
 
-        # 8. nothing from another host, the token in no URL, no CSP refusal
+        # 9. nothing from another host, the token in no URL, no CSP refusal
         urls = []
         for entry in b.get_log("performance"):
             msg = json.loads(entry["message"])["message"]
