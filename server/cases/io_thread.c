@@ -26,7 +26,7 @@
 
 typedef enum io_job_kind {
     IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_HISTORY,
-    IO_HISTORY_READ, IO_QUIT,
+    IO_HISTORY_READ, IO_FRAME, IO_QUIT,
 } io_job_kind;
 
 typedef struct io_job {
@@ -39,6 +39,8 @@ typedef struct io_job {
     history_row **rows;     /* IO_HISTORY: written; IO_HISTORY_READ: the answer */
     int row_count;
     history_names *names;   /* IO_HISTORY_READ: the point names (the caller's) */
+    const result_frame_request *frame_request; /* IO_FRAME: what to read */
+    unsigned char *frame;   /* IO_FRAME: the answer (j->size bytes) */
     void *ckpt;
     size_t ckpt_size;
     const char *ckpt_name;     /* IO_APPEND: NULL = checkpoint.bin */
@@ -360,6 +362,22 @@ static void io_do_history_read(io_job *j)
                                 j->err, sizeof j->err);
 }
 
+/* A snapshot as the page's binary frame, from the open file or the one on disk. */
+static void io_do_frame(io_job *j)
+{
+    server_case *c = j->c;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/result.h5", c->dir);
+    struct stat st;
+    if (!c->result && stat(path, &st) != 0 && errno == ENOENT) {
+        snprintf(j->err, sizeof j->err, "the case has no result file (yet)");
+        j->rc = 404;
+        return;
+    }
+    j->rc = result_read_frame(c->result, path, j->frame_request, &j->frame, &j->size, j->err,
+                              sizeof j->err);
+}
+
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
  * checkpoint.bin and status.json, fsynced), a moving average over the
  * recent snapshot jobs: what a dry run charges per snapshot. */
@@ -409,6 +427,7 @@ static void io_run_job(io_job *j)
     case IO_EVENTS: io_do_events(j); break;
     case IO_HISTORY: io_do_history(j); break;
     case IO_HISTORY_READ: io_do_history_read(j); break;
+    case IO_FRAME: io_do_frame(j); break;
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
@@ -422,6 +441,7 @@ static void io_job_free(io_job *j)
     free(j->events);
     result_free_history(j->rows, j->row_count);
     free(j->ckpt);
+    free(j->frame);
     if (j->c)
         case_release(j->c);
     free(j);
@@ -718,6 +738,29 @@ int io_read_events(server_case *c, double since, fdem_event **out, int *count, i
         *count = j->event_count;
         *dimension = j->dimension;
         j->events = NULL;
+    } else {
+        snprintf(err, errlen, "%s", j->err);
+    }
+    io_job_free(j);
+    return rc;
+}
+
+int io_read_frame(server_case *c, const result_frame_request *q, unsigned char **out,
+                  size_t *size, char *err, size_t errlen)
+{
+    *out = NULL;
+    *size = 0;
+    io_job *j = io_job_new(IO_FRAME, c);
+    if (!j) {
+        snprintf(err, errlen, "out of memory");
+        return 503;
+    }
+    j->frame_request = q;
+    int rc = io_run_and_wait(j);
+    if (rc == 0) {
+        *out = j->frame;
+        *size = j->size;
+        j->frame = NULL;
     } else {
         snprintf(err, errlen, "%s", j->err);
     }

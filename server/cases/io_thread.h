@@ -54,6 +54,11 @@ void io_append_history(server_case *c, history_row **rows, int count);
  * point names the file holds. */
 int io_read_history(server_case *c, double since, history_row ***out, int *count,
                     history_names *names, char *err, size_t errlen);
+/* Snapshot q->snapshot of the case's result.h5 as the web page's binary
+ * frame (result_read_frame): *out (free() it), *size. 0; 404 (no file, no
+ * such snapshot), 503 (memory) or -1 (unreadable file) with err. */
+int io_read_frame(server_case *c, const result_frame_request *q, unsigned char **out,
+                  size_t *size, char *err, size_t errlen);
 /* Writes the events (as io_append), then `ckpt` as DIR/ID/<name> (a string
  * literal), after the jobs queued before it; takes ownership, returns at once. */
 void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,

@@ -31,6 +31,7 @@ typedef struct fdemd_config {
     int max_connections_per_ip; /* open connections per client address */
     double request_timeout;   /* s for a whole request, headers and body */
     int max_streams;          /* GET /stream streams open at once */
+    char web_dir[1024];       /* --web: the page's files; "" = web/ beside bin/ */
 } fdemd_config;
 
 #endif

@@ -28,6 +28,7 @@
 #include "json/json_depth.h"
 #include "routes.h"
 #include "stream.h"
+#include "web.h"
 
 #define HTTP_THREADS 4
 #define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity while a response is sent */
@@ -109,6 +110,12 @@ static struct MHD_Response *http_text_response(char *text, const char *content_t
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
     return resp;
+}
+
+enum MHD_Result http_reply_response(struct MHD_Connection *conn, unsigned status,
+                                    struct MHD_Response *resp)
+{
+    return http_queue(conn, status, resp);
 }
 
 enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, json_t *body,
@@ -304,7 +311,10 @@ static enum MHD_Result http_reply_owed(struct MHD_Connection *conn, const http_r
 static int http_check_headers(struct MHD_Connection *conn, const char *url, const char *method,
                               http_request *r, enum MHD_Result *rc)
 {
-    const char *unauthorized = r->route.kind != ROUTE_HEALTH ? http_unauthorized_reason(conn) : NULL;
+    /* /health and the page's own files need no token: the page must load
+     * to ask for it, and its files hold no data (web.h). */
+    int open_route = r->route.kind == ROUTE_HEALTH || r->route.kind == ROUTE_WEB;
+    const char *unauthorized = !open_route ? http_unauthorized_reason(conn) : NULL;
     if (unauthorized) {
         *rc = http_reply_unauthorized(conn, unauthorized);
         return 1;
@@ -742,6 +752,9 @@ int http_start(const fdemd_config *cfg)
 {
     http_cfg = cfg;
     int port = 0;
+    if (web_init(cfg->web_dir) != 0)
+        fprintf(stderr, "fdemd: no web page: %s is not a folder (--web DIR); GET / answers 404\n",
+                cfg->web_dir[0] ? cfg->web_dir : "web/ beside bin/");
     if (heavy_work_start() != 0)
         return -1;
     if (stream_start(cfg->max_streams) != 0) {

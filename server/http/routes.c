@@ -20,12 +20,14 @@
 #include "cases/case_continue.h"
 #include "download.h"
 #include "fragment_query.h"
+#include "mesh_frame.h"
 #include "state/events_json.h"
 #include "http.h"
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
 #include "state/state_json.h"
 #include "stream.h"
+#include "web.h"
 
 /* ------------------------------------------------------------- matching */
 
@@ -62,10 +64,15 @@ void routes_match(const char *url, route_match *out)
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
         {"fragments", ROUTE_CASE_FRAGMENTS}, {"extend", ROUTE_CASE_EXTEND},
         {"clone", ROUTE_CASE_CLONE}, {"events", ROUTE_CASE_EVENTS},
-        {"history", ROUTE_CASE_HISTORY},
+        {"history", ROUTE_CASE_HISTORY}, {"mesh.bin", ROUTE_CASE_MESH},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
+    if (web_path(url)) { /* the page's files: web.c checks the rest of the path */
+        out->kind = ROUTE_WEB;
+        out->url = url;
+        return;
+    }
     int n = routes_split(url, seg);
     if (n == 1 && strcmp(seg[0], "health") == 0)
         out->kind = ROUTE_HEALTH;
@@ -174,6 +181,7 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const events[] = {"since", NULL};
     static const char *const fragments[] = {"parts", "exclude_host", NULL};
     static const char *const stream[] = {"case", NULL};
+    static const char *const mesh[] = {"snapshot", "fields", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
@@ -183,7 +191,8 @@ static const char *const *routes_query_names(route_kind kind, const char *method
         return stream;
     return kind == ROUTE_CASE_STATE ? state
          : kind == ROUTE_CASE_EVENTS || kind == ROUTE_CASE_HISTORY ? events
-         : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
+         : kind == ROUTE_CASE_FRAGMENTS ? fragments
+         : kind == ROUTE_CASE_MESH ? mesh : none;
 }
 
 typedef struct routes_query_check {
@@ -712,6 +721,8 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return route_events(conn, c);
     case ROUTE_CASE_HISTORY:
         return route_history(conn, c);
+    case ROUTE_CASE_MESH:
+        return mesh_frame_reply(conn, c);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c, strcmp(method, "HEAD") == 0);
     case ROUTE_CASE_RESULT_XDMF:
@@ -732,6 +743,8 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
         return route_health(conn);
     if (m->kind == ROUTE_STREAM)
         return stream_open(conn);
+    if (m->kind == ROUTE_WEB)
+        return web_reply(conn, m->url);
     if (m->kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? route_create_case(conn, body, body_size)
                                            : route_list_cases(conn);
