@@ -148,6 +148,13 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
         s->damage = copy_doubles(fdem_joint_damage(model), (size_t)counts.joints, &failed);
         if (s->damage && (fields & CASE_FIELD_DAMAGE)) s->fields |= CASE_FIELD_DAMAGE;
     }
+    if (counts.joints > 0 && fdem_get_fluid(model).enabled) {
+        s->fluid_pressure = copy_doubles(fdem_fluid_pressure(model), (size_t)counts.joints,
+                                         &failed);
+        s->aperture = malloc(sizeof(double) * (size_t)counts.joints);
+        if (s->aperture) fdem_fluid_apertures(model, s->aperture);
+        else failed = 1;
+    }
     s->constraint_force = copy_doubles(fdem_constraint_forces(model),
                                        dim * (size_t)counts.constraints, &failed);
     s->stage = fdem_stage_index(model);
@@ -166,6 +173,8 @@ void snapshot_free(snapshot *s)
     free(s->velocity);
     free(s->stress);
     free(s->damage);
+    free(s->fluid_pressure);
+    free(s->aperture);
     free(s->strain);
     free(s->principal_stress);
     free(s->displacement);
