@@ -73,6 +73,12 @@ typedef struct fluid_net {
     uint8_t *open;       /* in the network this step */
     int link_count;
     fluid_link *links;
+    int32_t *link_begin;  /* joints + 1 offsets into link_of: each cavity's links */
+    int32_t *link_of;     /* 2 per link, cavity by cavity */
+    /* this step's network, so the flow costs what is open, not the model:
+     * the open cavities in joint order and the links between two of them */
+    int open_count, active_count;
+    int32_t *open_list, *active;
     /* sources: joints touching an "inject" constraint's nodes */
     int source_count;
     int32_t *source_joint, *source_constraint;

@@ -50,8 +50,8 @@ static double fluid_power(const fdem_model *m)
     const fluid_net *f = m->fluid;
     const int D = m->dim;
     double power = 0;
-    for (int j = 0; j < f->joints; j++) {
-        if (!f->open[j]) continue;
+    for (int k = 0; k < f->open_count; k++) {
+        const int j = f->open_list[k];
         const int32_t *n = m->joint_node + 2 * (size_t)D * (size_t)j;
         const double *F = f->force + (size_t)D * (size_t)j;
         double p = 0;
@@ -69,6 +69,7 @@ static void cavities_measure(fdem_model *m, int with_forces)
 {
     fluid_net *f = m->fluid;
     const int D = m->dim;
+    f->open_count = 0;
     for (int j = 0; j < f->joints; j++) {
         int open = (f->wet[j] || m->joint_damage[j] > 0) &&
                    !(m->elem_active && joint_is_excavated(m, j));
@@ -78,6 +79,7 @@ static void cavities_measure(fdem_model *m, int with_forces)
             f->pressure[j] = 0;
             continue;
         }
+        f->open_list[f->open_count++] = j;
         fluid_face face;
         fluid_face_of(m, j, &face);
         f->aperture[j] = fmax(face.opening, f->aperture0[j]);
@@ -96,25 +98,33 @@ static void cavities_measure(fdem_model *m, int with_forces)
     }
 }
 
-/* Link conductances of this step and the flow's stable step. */
+/* The links between two open cavities (each once, from its first end, in
+ * the order of the open list), their conductances, and the flow's stable
+ * step. */
 static void links_conduct(fluid_net *f)
 {
     const double inv = 1.0 / (12 * f->viscosity);
-    for (int j = 0; j < f->joints; j++) f->outgoing[j] = 0;
-    for (int l = 0; l < f->link_count; l++) {
-        const fluid_link *k = &f->links[l];
-        double c = 0;
-        if (f->open[k->a] && f->open[k->b]) {
-            double a = 0.5 * (f->aperture[k->a] + f->aperture[k->b]);
-            c = k->geometry * a * a * a * inv;
+    f->active_count = 0;
+    for (int k = 0; k < f->open_count; k++) f->outgoing[f->open_list[k]] = 0;
+    for (int k = 0; k < f->open_count; k++) {
+        const int i = f->open_list[k];
+        for (int32_t e = f->link_begin[i]; e < f->link_begin[i + 1]; e++) {
+            const int l = f->link_of[e];
+            const fluid_link *link = &f->links[l];
+            if (link->a != i || !f->open[link->b]) continue;
+            double a = 0.5 * (f->aperture[link->a] + f->aperture[link->b]);
+            double c = link->geometry * a * a * a * inv;
+            f->conductance[l] = c;
+            f->outgoing[link->a] += c;
+            f->outgoing[link->b] += c;
+            f->active[f->active_count++] = l;
         }
-        f->conductance[l] = c;
-        f->outgoing[k->a] += c;
-        f->outgoing[k->b] += c;
     }
     double step = INFINITY;
-    for (int j = 0; j < f->joints; j++)
+    for (int k = 0; k < f->open_count; k++) {
+        const int j = f->open_list[k];
         if (f->outgoing[j] > 0) step = fmin(step, f->volume[j] / (f->bulk_modulus * f->outgoing[j]));
+    }
     f->flow_step = step;
 }
 
@@ -136,24 +146,25 @@ static inline double link_drop(const fdem_model *m, const fluid_net *f, const fl
 /* One subcycle of dt: sources, flow, the pressures after it. */
 static void flow_subcycle(fdem_model *m, fluid_net *f, double dt, int gravity)
 {
-    for (int j = 0; j < f->joints; j++) f->inflow[j] = 0;
+    for (int k = 0; k < f->open_count; k++) f->inflow[f->open_list[k]] = 0;
     for (int s = 0; s < f->source_count; s++) {
         const constraint *c = &m->constraints[f->source_constraint[s]];
+        if (!f->open[f->source_joint[s]]) continue; /* excavated: no cavity to feed */
         double v = c->value_now[0] * f->source_share[s] * dt;
         f->inflow[f->source_joint[s]] += v;
         f->injected += v;
     }
-    for (int l = 0; l < f->link_count; l++) {
+    for (int a = 0; a < f->active_count; a++) {
+        const int l = f->active[a];
         double c = f->conductance[l];
-        if (c == 0) continue;
         const fluid_link *k = &f->links[l];
         double drop = link_drop(m, f, k, gravity), q = c * drop * dt;
         f->inflow[k->a] -= q;
         f->inflow[k->b] += q;
         f->dissipation += q * drop;
     }
-    for (int j = 0; j < f->joints; j++) {
-        if (!f->open[j]) continue;
+    for (int k = 0; k < f->open_count; k++) {
+        const int j = f->open_list[k];
         f->fluid[j] += f->inflow[j];
         f->pressure[j] = cavity_pressure(f, j);
     }
@@ -218,7 +229,7 @@ fdem_fluid_status fdem_get_fluid(const fdem_model *m)
     /* before the first step: what the step chosen now will take */
     s.subcycles = m->step == 0 && f->flow_step < m->dt ? (int)fmin(ceil(m->dt / f->flow_step), 1e9)
                                                         : f->subcycles;
-    for (int j = 0; j < f->joints; j++) s.open_joints += f->open[j];
+    s.open_joints = f->open_count;
     return s;
 }
 

@@ -50,6 +50,7 @@ void fluid_free(fdem_model *m)
     free(f->fluid); free(f->pressure); free(f->volume); free(f->aperture); free(f->aperture0);
     free(f->floor); free(f->centre); free(f->force); free(f->inflow); free(f->conductance);
     free(f->outgoing); free(f->wet); free(f->open); free(f->links);
+    free(f->link_begin); free(f->link_of); free(f->open_list); free(f->active);
     free(f->source_joint); free(f->source_constraint); free(f->source_share);
     free(f);
     m->fluid = NULL;
@@ -60,8 +61,8 @@ size_t fluid_memory_bytes(const fdem_model *m)
     const fluid_net *f = m->fluid;
     if (!f) return 0;
     size_t D = (size_t)m->dim, J = (size_t)f->joints;
-    return sizeof *f + J * ((7 + 2 * D) * sizeof(double) + 2) +
-           (size_t)f->link_count * (sizeof(fluid_link) + sizeof(double)) +
+    return sizeof *f + J * ((7 + 2 * D) * sizeof(double) + 2 + 2 * sizeof(int32_t)) +
+           (size_t)f->link_count * (sizeof(fluid_link) + sizeof(double) + 3 * sizeof(int32_t)) +
            (size_t)f->source_count * (2 * sizeof(int32_t) + sizeof(double));
 }
 
@@ -136,7 +137,25 @@ static int links_build(fdem_model *m, fluid_net *f)
     free(keys);
     f->link_count = (int)links;
     f->conductance = malloc(sizeof(double) * (links ? links : 1));
-    return f->conductance ? 0 : -1;
+    f->active = malloc(sizeof(int32_t) * (links ? links : 1));
+    f->link_begin = calloc((size_t)J + 1, sizeof(int32_t));
+    f->link_of = malloc(sizeof(int32_t) * 2 * (links ? links : 1));
+    if (!f->conductance || !f->active || !f->link_begin || !f->link_of) return -1;
+    /* each cavity's links, in link order (counting sort) */
+    for (size_t l = 0; l < links; l++) {
+        f->link_begin[f->links[l].a + 1]++;
+        f->link_begin[f->links[l].b + 1]++;
+    }
+    for (int j = 0; j < J; j++) f->link_begin[j + 1] += f->link_begin[j];
+    int32_t *fill = malloc(sizeof(int32_t) * (size_t)(J ? J : 1));
+    if (!fill) return -1;
+    memcpy(fill, f->link_begin, sizeof(int32_t) * (size_t)J);
+    for (size_t l = 0; l < links; l++) {
+        f->link_of[fill[f->links[l].a]++] = (int32_t)l;
+        f->link_of[fill[f->links[l].b]++] = (int32_t)l;
+    }
+    free(fill);
+    return 0;
 }
 
 /* The joints touching each "inject" constraint's nodes, each its share. */
@@ -257,7 +276,8 @@ int fluid_prepare(fdem_model *m, fdem_error *err)
     f->force = calloc(room * D, sizeof(double));
     f->wet = calloc(room, 1);
     f->open = calloc(room, 1);
-    if (!ok || !f->centre || !f->force || !f->wet || !f->open) {
+    f->open_list = malloc(sizeof(int32_t) * room);
+    if (!ok || !f->centre || !f->force || !f->wet || !f->open || !f->open_list) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the fluid network");
         return -1;
     }
