@@ -243,6 +243,42 @@ static void wet_joint_slides_at_effective_stress(void)
     CHECK_REL(wet, want_wet, 0.03);
 }
 
+/* ------------------------------------------------------- at rest */
+
+/* A fracturing block under an in-situ stress held by the matching
+ * boundary stress, its joints holding a pore pressure: the joints carry
+ * the effective traction sigma.n + p n from t = 0 and the fluid the rest,
+ * so the block is at rest (contract 6.1 with 6.4). */
+static void pore_pressure_starts_at_rest(void)
+{
+    json_t *doc = load(network_2d);
+    edit(doc, "/constraints/0",
+         load("{'box': [-1, -1, 1, 1], 'boundary_stress': {'value': [-2e6, -3e6, 0]}}"));
+    edit(doc, "/parts/0/initial_stress", load("{'value': [-2e6, -3e6, 0]}"));
+    edit(doc, "/materials/rock/fracture/pore_pressure", load("{'value': 5e5}"));
+    edit(doc, "/materials/rock/damping", json_real(0));
+    fdem_model *m = expect_built(doc, NULL);
+    if (!m) return;
+    fdem_fluid_status f0 = fdem_get_fluid(m);
+    run(m, 400);
+    fdem_energy e = fdem_get_energy(m);
+    fdem_fluid_status f = fdem_get_fluid(m);
+    const double *p = fdem_fluid_pressure(m), *damage = fdem_joint_damage(m);
+    double most = 0, worst = 0;
+    for (int j = 0; j < fdem_get_counts(m).joints; j++) {
+        most = fmax(most, fabs(p[j] - 5e5));
+        worst = fmax(worst, damage[j]);
+    }
+    fprintf(stderr, "  kinetic %.3g J of elastic %.3g J, joint %.3g J; pressure off by %.3g Pa at "
+                    "most; %d open joints; largest damage %.3g\n",
+            e.kinetic, e.elastic, e.joint, most, f.open_joints, worst);
+    CHECK(f0.open_joints == fdem_get_counts(m).joints, "every joint wet");
+    CHECK(e.kinetic < 1e-12 * e.elastic, "at rest: kinetic %.3g", e.kinetic);
+    CHECK(most < 1e-6 * 5e5, "pressure held");
+    CHECK(worst == 0, "no joint damaged");
+    fdem_model_destroy(m);
+}
+
 /* ------------------------------------------------------- bad input */
 
 static void fluid_bad_input(void)
@@ -284,4 +320,5 @@ static void fluid_bad_input(void)
 }
 
 CHECK_MAIN(T(fluid_network_2d), T(fluid_network_3d), T(fluid_same_bits_2d), T(fluid_same_bits_3d),
-           T(wet_joint_slides_at_effective_stress), T(fluid_bad_input))
+           T(wet_joint_slides_at_effective_stress), T(pore_pressure_starts_at_rest),
+           T(fluid_bad_input))
