@@ -619,6 +619,10 @@ size_t fdem_memory_estimate_of(const fdem_counts *counts);
 /* What each thread of a case run on more than one may add (its contact
  * touch lists, one per thread, the first's included). */
 size_t fdem_memory_per_thread(int dimension);
+/* What fluid in the fractures adds to a model with this many joints (an
+ * upper bound: every joint's cavity, links of the densest meshes, one
+ * injection's sources, finalize's scratch; core/fluid/fluid_network.c). */
+size_t fdem_fluid_memory_estimate(int dimension, long joints);
 
 #ifdef __cplusplus
 }

@@ -66,6 +66,22 @@ size_t fluid_memory_bytes(const fdem_model *m)
            (size_t)f->source_count * (2 * sizeof(int32_t) + sizeof(double));
 }
 
+/* Links per joint in the densest meshes measured: a 2D vertex joins about
+ * six joints (15 links, a vertex per three joints: 5 a joint), a 3D edge
+ * about five faces (10 links, 3/5 of an edge a joint: 6 a joint); priced
+ * at 8. */
+#define FLUID_LINKS_PER_JOINT 8
+
+size_t fdem_fluid_memory_estimate(int dimension, long joints)
+{
+    size_t D = dimension == 3 ? 3 : 2, J = joints > 0 ? (size_t)joints : 0;
+    size_t cavity = (7 + 2 * D) * sizeof(double) + 2 + 2 * sizeof(int32_t);
+    size_t link = sizeof(fluid_link) + sizeof(double) + 3 * sizeof(int32_t);
+    size_t sources = 2 * sizeof(int32_t) + sizeof(double);
+    size_t scratch = 3 * sizeof(int32_t) * 3; /* key entries while the links are built */
+    return sizeof(fluid_net) + J * (cavity + FLUID_LINKS_PER_JOINT * link + sources + scratch);
+}
+
 /* The fracture parameters joint j takes: its set's, else its material's. */
 static const fdem_fracture_params *joint_params(const fdem_model *m, int j)
 {

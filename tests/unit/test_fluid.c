@@ -100,6 +100,10 @@ static void check_network(const char *doc, int steps)
     CHECK(fabs(e.residual) < 0.01 * e.fluid_work, "residual %.3g of fluid work %.3g", e.residual,
           e.fluid_work);
     CHECK(fabs(p[0]) + fabs(p[1]) + fabs(p[2]) <= 1e-9 * scale, "momentum");
+    /* the case builder admits a case on the estimate: the fluid's is in it */
+    size_t held = fdem_memory_bytes(m);
+    size_t priced = fdem_memory_estimate_of(&c) + fdem_fluid_memory_estimate(c.dimension, c.joints);
+    CHECK(held <= priced, "memory %zu bytes, estimated %zu", held, priced);
     fdem_model_destroy(m);
 }
 
