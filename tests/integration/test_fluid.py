@@ -5,7 +5,8 @@ holds the injected and stored volumes (equal, the block holding no fluid at
 t = 0) and a source pressure; energy gains fluid_work and
 fluid_dissipation and the residual stays below 1 % of the fluid's work;
 result.h5 has /snapshots/fluid_pressure and /snapshots/aperture (S, J),
-result.xdmf shows them on the joints block; bad input is one 422 with a
+result.xdmf shows them on the joints block, fdemctl status prints a
+`fluid` line; bad input is one 422 with a
 problem at each pointer. Waits for states, never for wall time."""
 import json
 import os
@@ -76,6 +77,10 @@ class FluidTest(DaemonTestCase):
                 self.assertEqual(f["/snapshots/" + name].shape, (snaps, joints))
             self.assertGreater(f["/snapshots/fluid_pressure"][-1].max(), 0)
             self.assertGreaterEqual(f["/snapshots/aperture"][-1].min(), 1e-4)
+        shown = self.d.fdemctl("status", st["id"])
+        self.assertEqual(shown.returncode, 0, shown.stderr)
+        self.assertIn("source pressure", [l for l in shown.stdout.splitlines()
+                                          if l.startswith("fluid")][0])
         status, _, xdmf = self.d.request("GET", "/cases/%s/result.xdmf" % st["id"])
         self.assertEqual(status, 200)
         self.assertIn(b'Name="fluid_pressure"', xdmf)
