@@ -108,7 +108,7 @@ static void joint_offsets(const fdem_model *m, int j, const initial_stress_def *
         for (int a = 0; a < D; a++) {
             double along = 0;
             for (int c = 0; c < D; c++) along += t[c] * frame[a][c];
-            if (a == 0) along += pore;
+            if (a == 0 && pore != 0) along += pore; /* without: the same bits as before */
             o[D * i + a] = along / k;
         }
     }
