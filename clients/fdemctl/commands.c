@@ -363,6 +363,13 @@ static void status_print_table(json_t *s)
            json_integer_value(json_object_get(s, "joints")),
            json_integer_value(json_object_get(s, "broken_joints")));
     printf("%-14s%lld\n", "contacts", json_integer_value(json_object_get(s, "contacts")));
+    json_t *fluid = json_object_get(s, "fluid"); /* contract 6.4, null without fluid */
+    if (json_is_object(fluid))
+        printf("%-14sinjected %.4g, stored %.4g, source pressure %.4g Pa, flow step %.3g s x %lld\n",
+               "fluid", status_number(fluid, "injected_volume"),
+               status_number(fluid, "stored_volume"), status_number(fluid, "source_pressure"),
+               status_number(fluid, "fluid_step"),
+               json_integer_value(json_object_get(fluid, "fluid_subcycles")));
     printf("%-14s%lld\n", "snapshots", json_integer_value(json_object_get(s, "snapshots")));
     status_print_energy(s);
     printf("%-14s%.4g steps/s\n", "speed", status_number(s, "steps_per_second"));

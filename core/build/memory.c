@@ -17,6 +17,7 @@
 
 #include "contact/contact.h"
 #include "joint/joint.h"
+#include "fluid/fluid.h"
 #include "model/model.h"
 #include "nbs/nbs.h"
 #include "build.h"
@@ -216,5 +217,6 @@ size_t fdem_memory_bytes(const fdem_model *m)
         b += (size_t)m->stages[k].excavate_count * sizeof(int32_t) +
              (size_t)m->stages[k].ramp_count * (sizeof(int32_t) + D * sizeof(double));
     if (m->elem_active) b += (size_t)m->elem_count + (size_t)m->node_count;
+    b += fluid_memory_bytes(m);
     return b;
 }

@@ -380,6 +380,7 @@ struct fdem_model {
 
     contact_state contact;
     fdem_stage_times times;
+    struct fluid_net *fluid; /* fluid in the fractures (fluid/fluid.h); NULL without */
 
     /* threads for the per-step loops; the plans fix the summation order so
      * that the result does not depend on the thread count */

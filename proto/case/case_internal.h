@@ -163,7 +163,17 @@ typedef struct case_doc {
     double history_interval;
     case_history_point history_points[CASE_MAX_HISTORY_POINTS];
     int history_point_count;
+    int has_fluid;           /* "fluid" was in the document (case_fluid.c) */
+    fdem_fluid_def fluid;
 } case_doc;
+
+/* case_fluid.c: the top-level "fluid" (read before the materials and
+ * constraints, which ask whether there is one), the hydraulic members of
+ * fracture parameters, and the cross-section checks after the parts. */
+void case_read_fluid(case_doc *doc, const json_t *fluid);
+void case_read_fracture_fluid(case_doc *doc, const json_t *value, const char *ptr,
+                              fdem_fracture_params *f);
+void case_check_fluid(case_doc *doc);
 
 /* case_amplitude.c: an amplitude table [[t, a], ...] at ptr, finite with
  * strictly increasing times: the pairs (free() them) and their count, or

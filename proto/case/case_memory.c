@@ -137,6 +137,8 @@ double case_check_memory(case_doc *doc, size_t memory_limit)
         joints += doc->parts[i].joints;
     }
     double bytes = memory_bytes(doc->dimension, nodes, elements, joints, doc->part_count);
+    if (doc->has_fluid) /* contract 6.4: the fluid network over the joints */
+        bytes += (double)fdem_fluid_memory_estimate(doc->dimension, 1000) * (joints / 1000);
     char need[32], limit[32], counts[96];
     memory_format(bytes, need, sizeof need);
     memory_describe(nodes, elements, joints, counts, sizeof counts);

@@ -90,6 +90,8 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
         row += nodes * dim * 8;
     if (info->stage_count > 0) /* /snapshots/stage, active and excavated_energy */
         row += 4 + elements + 8;
+    if (fdem_get_fluid(model).enabled) /* /snapshots/fluid_pressure and aperture */
+        row += joints * 2 * 8;
     return mesh + snapshots * row;
 }
 
@@ -131,6 +133,10 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->snapshots = sizing_snapshots(info, fdem_get_time(model), out->dt, out->steps);
     out->memory_bytes = (double)case_model_cost(model_bytes);
     out->result_bytes = sizing_result_bytes(model, info, out->snapshots);
+    fdem_fluid_status fluid = fdem_get_fluid(model);
+    out->fluid = fluid.enabled;
+    out->fluid_step = fluid.flow_step;
+    out->fluid_subcycles = fluid.subcycles;
     fdem_set_threads(model, threads);
     out->steps_per_second = sizing_probe(model, out->steps);
     /* Snapshots are written on the I/O thread while the worker steps on:
@@ -187,6 +193,10 @@ json_t *case_sizing_json(const case_sizing *s)
     json_object_set_new(o, "memory_bytes", sizing_count_json(s->memory_bytes));
     json_object_set_new(o, "result_bytes", sizing_count_json(ceil(s->result_bytes)));
     json_object_set_new(o, "estimated_seconds", sizing_number_json(s->estimated_seconds));
+    if (s->fluid) { /* the flow's step: null while no fluid can flow yet */
+        json_object_set_new(o, "fluid_step", sizing_number_json(s->fluid_step));
+        json_object_set_new(o, "fluid_subcycles", json_integer(s->fluid_subcycles));
+    }
     char warning[400];
     if (case_sizing_warning(s, warning, sizeof warning))
         json_object_set_new(o, "warning", json_string(warning));

@@ -36,6 +36,9 @@ typedef struct case_sizing {
     double memory_bytes, result_bytes;
     double steps_per_second;  /* measured on the model */
     double estimated_seconds;
+    int fluid;                /* the case has fluid (contract 6.4): then fluid_step and */
+    double fluid_step;        /* fluid_subcycles, the flow's stable step and how many */
+    int fluid_subcycles;      /* flow steps a mechanical step takes, at t = 0 */
 } case_sizing;
 
 int sizing_is_last_step(double t0, double dt, double end);
@@ -46,7 +49,8 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
                          int threads, double snapshot_seconds, case_sizing *out);
 /* The dry run's answer: {"nodes", "elements", "joints", "dt", "steps",
  * "snapshots", "memory_bytes", "result_bytes", "estimated_seconds"} (and
- * "warning" for a long run). */
+ * "warning" for a long run; "fluid_step" and "fluid_subcycles" for a case
+ * with fluid). */
 json_t *case_sizing_json(const case_sizing *s);
 /* "this case will run for about 5.2 hours (...)" into out, or "" when it
  * is not long; returns whether there is a warning. */

@@ -55,6 +55,7 @@ void case_publish_from_model(server_case *c)
     fig.dt = fdem_get_dt(c->model);
     fig.counts = fdem_get_counts(c->model);
     fig.energy = fdem_get_energy(c->model);
+    fig.fluid = fdem_get_fluid(c->model);
     fig.snapshots = -1;
     fig.elapsed = -1;
     case_figures_stage(&fig, c->model, &c->info);
@@ -149,6 +150,22 @@ void case_stage_from_json(case_figures *f, const json_t *stage)
     snprintf(f->stage_name, sizeof f->stage_name, "%s", f->stage >= 0 && name ? name : "");
 }
 
+/* "fluid" (contract 6.4): null without fluid; the flow's step and subcycle
+ * count beside the contract's three (docs/api.md). */
+static json_t *case_fluid_json(const fdem_fluid_status *f)
+{
+    if (!f->enabled) return json_null();
+    json_t *o = json_object();
+    if (!o) return NULL;
+    json_object_set_new(o, "injected_volume", json_number_or_null(f->injected_volume));
+    json_object_set_new(o, "stored_volume", json_number_or_null(f->stored_volume));
+    json_object_set_new(o, "source_pressure", json_number_or_null(f->source_pressure));
+    json_object_set_new(o, "fluid_step", json_number_or_null(f->flow_step));
+    json_object_set_new(o, "fluid_subcycles", json_integer(f->subcycles));
+    json_object_set_new(o, "open_joints", json_integer(f->open_joints));
+    return o;
+}
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);
@@ -167,6 +184,11 @@ json_t *case_status_json(server_case *c)
         json_object_set_new(energy, energy_accounts[i].key,
                             json_number_or_null(*(const double *)((const char *)&f.energy +
                                                                   energy_accounts[i].offset)));
+    if (energy && f.fluid.enabled) {
+        json_object_set_new(energy, "fluid_work", json_number_or_null(f.energy.fluid_work));
+        json_object_set_new(energy, "fluid_dissipation",
+                            json_number_or_null(f.energy.fluid_dissipation));
+    }
     json_t *o = json_object();
     json_object_set_new(o, "id", json_string(c->id));
     json_object_set_new(o, "name", json_string(c->info.name));
@@ -184,6 +206,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
     json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
     json_object_set_new(o, "stage", case_stage_json(&f));
+    json_object_set_new(o, "fluid", case_fluid_json(&f.fluid));
     json_object_set_new(o, "snapshots", json_integer(f.snapshots));
     json_object_set_new(o, "energy", energy ? energy : json_null());
     json_object_set_new(o, "steps_per_second",

@@ -70,6 +70,7 @@ typedef struct case_figures {
     double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
     int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
     char stage_name[CASE_STAGE_NAME];
+    fdem_fluid_status fluid;   /* contract 6.4; enabled 0 without fluid */
 } case_figures;
 
 #define CASE_ID_LEN 16

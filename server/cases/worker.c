@@ -97,6 +97,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.dt = fdem_get_dt(m);
     fig.counts = fdem_get_counts(m);
     fig.energy = fdem_get_energy(m);
+    fig.fluid = fdem_get_fluid(m);
     clk->last_publish = now;
     double wall = now - clk->speed_since;
     if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_speed > 100))

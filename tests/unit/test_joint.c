@@ -19,7 +19,7 @@ static int fracture_material(fdem_model *m, double penalty_factor)
     d.poisson = 0.0;
     d.penalty = penalty_factor * d.young;
     d.has_fracture = 1;
-    d.fracture = (fdem_fracture_params){1e6, 3e6, 30, 10, 50};
+    d.fracture = (fdem_fracture_params){.tensile_strength = 1e6, .cohesion = 3e6, .friction_angle = 30, .energy_I = 10, .energy_II = 50};
     fdem_error err;
     int k = fdem_add_material(m, &d, &err);
     if (k < 0) build_die("material", &err);
