@@ -399,6 +399,14 @@ typedef struct fdem_penetration {
 } fdem_penetration;
 int fdem_take_penetrations(fdem_model *model, fdem_penetration *out, int max, long *more);
 
+/* For run-time estimates only, on a model that is thrown away afterwards
+ * (core/joint/joint_crack.c): breaks every intact joint between two active
+ * elements whose centroids lie on either side of the plane
+ * normal . x = offset (normal: `dimension` numbers), as a crack along it
+ * would, with no fracture event and no energy booked. Returns how many
+ * broke, or -1 out of memory. */
+int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
+
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);
 fdem_counts fdem_get_counts(const fdem_model *model);

@@ -1,0 +1,99 @@
+/*
+ * sizing_probe.c - the wall time of one step of a model on this machine
+ * (sizing_probe.h), measured so that it means the run's steps and not the
+ * first ones.
+ *
+ * The first steps of a fresh model are not like the rest: its arrays are
+ * touched for the first time (page faults), the caches are cold, the first
+ * contact detection runs, OpenMP starts its threads. One 50 ms sample of
+ * them gave 115 s and 3,300 s for two dry runs of one document, and 12x
+ * the measured run on a fracturing tunnel. So: a warm-up that is not timed,
+ * then several short windows, each its own figure, and their median: a
+ * window that a neighbour's process or a page fault slowed does not move
+ * it, and neither does the one window with a detection in it (detection
+ * reruns seldom, docs/physics.md).
+ */
+#include "sizing_probe.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* Untimed warm-up: at least this many steps and this long. */
+#define PROBE_WARM_STEPS 2
+#define PROBE_WARM_SECONDS 0.01
+/* Timed windows: each at least PROBE_WINDOW_SECONDS and one step, at most
+ * PROBE_WINDOW_STEPS steps. */
+#define PROBE_WINDOWS 7
+#define PROBE_WINDOW_SECONDS 0.008
+#define PROBE_WINDOW_STEPS 64
+/* Past PROBE_MIN_WINDOWS windows, no new one starts after this much of
+ * the probe: a model whose step takes 0.1 s is timed in under a second. */
+#define PROBE_MIN_WINDOWS 3
+#define PROBE_BUDGET_SECONDS 0.3
+
+double sizing_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int probe_step(fdem_model *model)
+{
+    fdem_error err;
+    memset(&err, 0, sizeof err);
+    return fdem_step(model, &err);
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Steps for at least `seconds` and `min_steps`, at most `max_steps`;
+ * the steps taken, -1 when one failed. */
+static int probe_run(fdem_model *model, double seconds, int min_steps, int max_steps,
+                     double *wall)
+{
+    double started = sizing_clock(), now = started;
+    int taken = 0;
+    while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
+        if (probe_step(model) != 0)
+            return -1;
+        taken++;
+        now = sizing_clock();
+    }
+    *wall = now - started;
+    return taken;
+}
+
+double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken)
+{
+    *taken = 0;
+    double wall, window[PROBE_WINDOWS], started = sizing_clock();
+    int room = steps_left < 1e9 ? (int)steps_left : 1000000000;
+    int warm = probe_run(model, PROBE_WARM_SECONDS, PROBE_WARM_STEPS,
+                         room < PROBE_WARM_STEPS ? room : 1000, &wall);
+    if (warm < 0)
+        return NAN;
+    *taken += warm;
+    room -= warm;
+    if (room <= 0) /* a run this short: its own steps are the figure */
+        return warm > 0 ? wall / warm : NAN;
+    int windows = 0;
+    while (windows < PROBE_WINDOWS && room > 0 &&
+           (windows < PROBE_MIN_WINDOWS || sizing_clock() - started < PROBE_BUDGET_SECONDS)) {
+        int n = probe_run(model, PROBE_WINDOW_SECONDS, 1,
+                          room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, &wall);
+        if (n < 0)
+            return NAN;
+        *taken += n;
+        room -= n;
+        window[windows++] = wall / n;
+    }
+    qsort(window, (size_t)windows, sizeof *window, compare_doubles);
+    return window[windows / 2];
+}
