@@ -40,8 +40,10 @@ typedef struct case_sizing {
     double snapshots;
     double memory_bytes, result_bytes;
     double steps_per_second;  /* the mean pace the estimate assumes */
-    double step_seconds;      /* wall seconds a step, measured on the model as built */
+    double step_seconds;      /* CPU seconds a step, measured on the model as built */
     double later_step_seconds; /* the same a tenth into the run (NAN: not reached) */
+    double load_factor;       /* wall / CPU seconds the run will see (sizing_load_factor) */
+    double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
     int cracked_joints;       /* joints the crack broke */
     double snapshot_copy_seconds; /* the worker's share of one snapshot */

@@ -107,7 +107,7 @@ static fdem_model *registry_build_upload(const char *body, size_t size, membudge
 static void registry_log_submitted(server_case *c, const case_sizing *z)
 {
     case_log(c, "submitted: %d nodes, %d elements, %d joints, dt = %.3g s, end = %.6g s, "
-             "%.4g steps, %.4g snapshots, about %.3g s to run (%.3g ms a step as built, "
+             "%.4g steps, %.4g snapshots, about %.3g s to run (%.3g ms of CPU a step as built, "
              "%.3g ms with %d joints cracked)", z->nodes, z->elements, z->joints,
              z->dt, c->info.end_time, z->steps, z->snapshots, z->estimated_seconds,
              1e3 * z->step_seconds, 1e3 * z->cracked_step_seconds, z->cracked_joints);

@@ -12,6 +12,16 @@
  * window that a neighbour's process or a page fault slowed does not move
  * it, and neither does the one window with a detection in it (detection
  * reruns seldom, docs/physics.md).
+ *
+ * A window is timed in CPU seconds of the stepping thread, which the other
+ * processes of a busy machine do not change (two dry runs at a load
+ * average of 14 on two cores gave 9.4 and 1.0 ms of wall time a step for
+ * one model). How much of the machine the run will get is a separate
+ * factor, from the one-minute load average: the run is one task more
+ * among those, on this many cores. Wall over CPU time of the windows
+ * themselves swung from 4.8 to 12.4 between two dry runs a minute apart at
+ * that load; the load average moves slowly, so that repeated dry runs
+ * agree, and it is what the run's next minutes will most likely see.
  */
 #include "sizing_probe.h"
 
@@ -19,6 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 /* Untimed warm-up: at least this many steps and this long. */
 #define PROBE_WARM_STEPS 2
@@ -40,6 +51,15 @@ double sizing_clock(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
+/* CPU seconds of the calling thread: what a step costs whatever else the
+ * machine is doing. */
+static double probe_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static int probe_step(fdem_model *model)
 {
     fdem_error err;
@@ -54,11 +74,11 @@ static int compare_doubles(const void *a, const void *b)
 }
 
 /* Steps for at least `seconds` and `min_steps`, at most `max_steps`;
- * the steps taken, -1 when one failed. */
+ * the steps taken, -1 when one failed; its wall and CPU time into `load`. */
 static int probe_run(fdem_model *model, double seconds, int min_steps, int max_steps,
-                     double *wall)
+                     sizing_load *load, double *cpu)
 {
-    double started = sizing_clock(), now = started;
+    double started = sizing_clock(), now = started, cpu0 = probe_cpu();
     int taken = 0;
     while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
         if (probe_step(model) != 0)
@@ -66,34 +86,53 @@ static int probe_run(fdem_model *model, double seconds, int min_steps, int max_s
         taken++;
         now = sizing_clock();
     }
-    *wall = now - started;
+    *cpu = probe_cpu() - cpu0;
+    load->wall += now - started;
+    load->cpu += *cpu;
     return taken;
 }
 
-double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken)
+double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken,
+                                 sizing_load *load)
 {
     *taken = 0;
-    double wall, window[PROBE_WINDOWS], started = sizing_clock();
+    double cpu, window[PROBE_WINDOWS], started = sizing_clock();
+    sizing_load warm_load = {0, 0};
     int room = steps_left < 1e9 ? (int)steps_left : 1000000000;
     int warm = probe_run(model, PROBE_WARM_SECONDS, PROBE_WARM_STEPS,
-                         room < PROBE_WARM_STEPS ? room : 1000, &wall);
+                         room < PROBE_WARM_STEPS ? room : 1000, &warm_load, &cpu);
     if (warm < 0)
         return NAN;
     *taken += warm;
     room -= warm;
-    if (room <= 0) /* a run this short: its own steps are the figure */
-        return warm > 0 ? wall / warm : NAN;
+    if (room <= 0) { /* a run this short: its own steps are the figure */
+        load->wall += warm_load.wall;
+        load->cpu += warm_load.cpu;
+        return warm > 0 ? cpu / warm : NAN;
+    }
     int windows = 0;
     while (windows < PROBE_WINDOWS && room > 0 &&
            (windows < PROBE_MIN_WINDOWS || sizing_clock() - started < PROBE_BUDGET_SECONDS)) {
         int n = probe_run(model, PROBE_WINDOW_SECONDS, 1,
-                          room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, &wall);
+                          room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, load, &cpu);
         if (n < 0)
             return NAN;
         *taken += n;
         room -= n;
-        window[windows++] = wall / n;
+        window[windows++] = cpu / n;
     }
     qsort(window, (size_t)windows, sizeof *window, compare_doubles);
     return window[windows / 2];
+}
+
+double sizing_load_factor(const sizing_load *load)
+{
+    (void)load;
+    double average[1];
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (getloadavg(average, 1) != 1 || !(average[0] >= 0) || cores < 1)
+        return 1.0;
+    /* the run is one more task among those the load average counts */
+    double factor = (average[0] + 1.0) / (double)cores;
+    return factor > 1.0 ? factor : 1.0;
 }

@@ -6,17 +6,29 @@
  *  - sizing_probe_step_seconds() steps the model (ADVANCES it: only a
  *    throwaway model) through an untimed warm-up and several short timed
  *    windows, at most steps_left steps in all (*taken says how many), and
- *    returns the median window's wall seconds per step: NAN when a step
- *    failed. It takes about 0.05 s for a small model, and on one whose
- *    step is slow a handful of steps (at least 5 when there are that many).
- *  - sizing_clock() is the monotonic clock it times with, in seconds.
+ *    returns the median window's CPU seconds per step of the stepping
+ *    thread: NAN when a step failed. The windows' wall and CPU seconds are
+ *    added to *load. It takes about 0.05 s for a small model, and on one
+ *    whose step is slow a handful of steps (at least 5 when there are
+ *    that many).
+ *  - sizing_load_factor() turns CPU seconds into the run's wall seconds
+ *    on this machine now: (one-minute load average + 1) / cores, at least
+ *    1 (1 when the load average cannot be read). *load (the windows' own
+ *    wall and CPU seconds) is kept for the figures of the dry run.
+ *  - sizing_clock() is the monotonic clock, in seconds.
  */
 #ifndef FDEMD_SIZING_PROBE_H
 #define FDEMD_SIZING_PROBE_H
 
 #include "fdem.h"
 
-double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken);
+typedef struct sizing_load {
+    double wall, cpu;   /* seconds, summed over timed windows */
+} sizing_load;
+
+double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken,
+                                 sizing_load *load);
+double sizing_load_factor(const sizing_load *load);
 double sizing_clock(void);
 
 #endif
