@@ -111,12 +111,12 @@ class EstimateTest(DaemonTestCase):
             rows.append("%-28s estimate %8.2f s, %8.2f s again (x%.2f); measured %8.2f s, "
                         "ratio %.2f" % (name, estimates[0], estimates[1], spread, measured,
                                         ratio))
+            print(rows[-1], file=sys.stderr, flush=True)
             if not 0.5 <= ratio <= 2.0:
                 bad.append("%s: measured/estimated %.2f" % (name, ratio))
             if spread > 1.3:
                 bad.append("%s: two dry runs differ by x%.2f" % (name, spread))
             self.client.delete(case_id)
-        print("\n" + "\n".join(rows), file=sys.stderr)
         self.assertEqual(bad, [])
 
     def test_status_keeps_the_estimate(self):
