@@ -415,10 +415,6 @@ fdem_energy fdem_get_energy(const fdem_model *model);
 /* The stage the last step belonged to (0 before the first step), or -1
  * for a model without stages. */
 int fdem_stage_index(const fdem_model *model);
-/* When the first stage that excavates starts (its elements go then), or
- * -1 when no stage excavates: the daemon's estimate expects the rock to
- * break from there on. */
-double fdem_first_excavation_time(const fdem_model *model);
 /* elem_count flags, 1 active and 0 excavated, or NULL while every element
  * is active (no stage has removed any yet). Excavated elements exert no
  * force, take part in no contact, their joints hold nothing (damage reads

@@ -135,13 +135,6 @@ void stages_free(fdem_model *m)
 
 int fdem_stage_index(const fdem_model *m) { return m->stage_count ? m->stage_now : -1; }
 
-double fdem_first_excavation_time(const fdem_model *m)
-{
-    for (int k = 0; k < m->stage_count; k++)
-        if (m->stages[k].excavate_count > 0) return k > 0 ? m->stages[k - 1].end : 0.0;
-    return -1.0;
-}
-
 const uint8_t *fdem_element_active(const fdem_model *m) { return m->elem_active; }
 
 /* 1 - s of stage k's ramp at time t (0 when it is over or has none). */

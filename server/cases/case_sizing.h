@@ -15,10 +15,12 @@
  *    snapshots (snapshot_seconds each, see io_snapshot_seconds). Stepping
  *    is priced from the model's own steps timed here (sizing_probe.h: a
  *    warm-up, then the median of short windows) at t = 0 and again a tenth
- *    into the run when that is quickly reached; for a fracturing model a
- *    quarter of the steps at the pace of the same model with a crack cut
- *    through its joints (fdem_break_joints_across); plus the worker's copy
- *    of each snapshot and its checkpoint. It ADVANCES and CRACKS the model:
+ *    into the run when that is quickly reached; for a fracturing model 2 %
+ *    of its joints broken through the whole run, each at the cost a joint
+ *    of a crack cut through the model adds to its step
+ *    (fdem_break_joints_across); plus the worker's copy of each snapshot
+ *    and its checkpoint. Steps are timed in CPU seconds and turned into
+ *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
  *    call it only on a model that is thrown away.
  */
 #ifndef FDEMD_CASE_SIZING_H
@@ -46,6 +48,7 @@ typedef struct case_sizing {
     double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
     int cracked_joints;       /* joints the crack broke */
+    double broken_joints;     /* joints priced as broken through the run */
     double snapshot_copy_seconds; /* the worker's share of one snapshot */
     double estimated_seconds;
 } case_sizing;
