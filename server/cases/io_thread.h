@@ -72,9 +72,11 @@ void io_close(server_case *c);
 int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
                     char *err, size_t errlen);
 void io_release_hold(server_case *c);
-/* Mean wall seconds of the recent snapshot writes (a result.h5 row with its
- * checkpoint and status, fsynced); before any, the seed given at start-up. */
-double io_snapshot_seconds(void);
+/* Wall seconds a snapshot of a model whose checkpoint is this large takes
+ * to write (a result.h5 row with its checkpoint and status, fsynced):
+ * latency + bytes x seconds per byte, both from recent snapshot writes;
+ * before any, the latency is the seed given at start-up. */
+double io_snapshot_seconds(double checkpoint_bytes);
 void io_seed_snapshot_seconds(double seconds);
 
 #endif

@@ -169,7 +169,8 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
      * status.json), then freed; a start builds it again from the stored
      * files, as every later start does. */
     case_sizing sizing;
-    case_sizing_measure(model, &info, model_bytes, registry_config()->threads, io_snapshot_seconds(),
+    case_sizing_measure(model, &info, model_bytes, registry_config()->threads,
+                        io_snapshot_seconds((double)fdem_checkpoint_size(model)),
                         &sizing);
     case_sizing_warning(&sizing, warning, warning_size);
     pthread_mutex_lock(&c->lock);
@@ -234,7 +235,8 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
     json_t *answer = NULL;
     if (model) {
         case_sizing sizing;
-        case_sizing_measure(model, &info, model_bytes, registry_config()->threads, io_snapshot_seconds(),
+        case_sizing_measure(model, &info, model_bytes, registry_config()->threads,
+                        io_snapshot_seconds((double)fdem_checkpoint_size(model)),
                         &sizing);
         fdem_model_destroy(model);
         answer = case_sizing_json(&sizing);
