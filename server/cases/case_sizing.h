@@ -14,7 +14,7 @@
  *    bytes, and a wall time: the slower of stepping and writing the
  *    snapshots (snapshot_seconds each, see io_snapshot_seconds). Stepping
  *    is priced from the model's own steps timed here (sizing_probe.h: a
- *    warm-up, then the median of short windows) at t = 0 and again a tenth
+ *    warm-up, then the median of short windows) at t = 0 and again up to 30 %
  *    into the run when that is quickly reached; for a fracturing model 2 %
  *    of its joints broken through the whole run, each at the cost a joint
  *    of a crack cut through the model adds to its step
@@ -43,7 +43,7 @@ typedef struct case_sizing {
     double memory_bytes, result_bytes;
     double steps_per_second;  /* the mean pace the estimate assumes */
     double step_seconds;      /* CPU seconds a step, measured on the model as built */
-    double later_step_seconds; /* the same a tenth into the run (NAN: not reached) */
+    double later_step_seconds; /* the same up to 30 % into the run (NAN: not timed) */
     double load_factor;       /* wall / CPU seconds the run will see (sizing_load_factor) */
     double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
