@@ -17,11 +17,13 @@
  * processes of a busy machine do not change (two dry runs at a load
  * average of 14 on two cores gave 9.4 and 1.0 ms of wall time a step for
  * one model). How much of the machine the run will get is a separate
- * factor, from the one-minute load average: the run is one task more
- * among those, on this many cores. Wall over CPU time of the windows
- * themselves swung from 4.8 to 12.4 between two dry runs a minute apart at
- * that load; the load average moves slowly, so that repeated dry runs
- * agree, and it is what the run's next minutes will most likely see.
+ * factor, the geometric mean of two figures. The one-minute load average
+ * (the run is one task more among those, on this many cores) moves
+ * slowly, so that repeated dry runs agree, but it also counts tasks
+ * waiting for the disk, which take no CPU (at a load of 18 on two cores it
+ * said 9.9 where the windows saw 5 to 8). Wall over CPU time of the
+ * windows themselves is what this process got just now, but it swung from
+ * 4.8 to 12.4 between two dry runs a minute apart at that load.
  */
 #include "sizing_probe.h"
 
@@ -127,12 +129,16 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
 
 double sizing_load_factor(const sizing_load *load)
 {
-    (void)load;
     double average[1];
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    double seen = load->cpu > 0 && load->wall > 0 ? load->wall / load->cpu : 1.0;
+    if (seen < 1.0)
+        seen = 1.0;
     if (getloadavg(average, 1) != 1 || !(average[0] >= 0) || cores < 1)
-        return 1.0;
+        return seen;
     /* the run is one more task among those the load average counts */
-    double factor = (average[0] + 1.0) / (double)cores;
-    return factor > 1.0 ? factor : 1.0;
+    double counted = (average[0] + 1.0) / (double)cores;
+    if (counted < 1.0)
+        counted = 1.0;
+    return sqrt(counted * seen);
 }

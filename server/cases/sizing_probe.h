@@ -12,9 +12,9 @@
  *    whose step is slow a handful of steps (at least 5 when there are
  *    that many).
  *  - sizing_load_factor() turns CPU seconds into the run's wall seconds
- *    on this machine now: (one-minute load average + 1) / cores, at least
- *    1 (1 when the load average cannot be read). *load (the windows' own
- *    wall and CPU seconds) is kept for the figures of the dry run.
+ *    on this machine now: the geometric mean of (one-minute load average
+ *    + 1) / cores and the windows' own wall / CPU seconds in *load, each
+ *    at least 1.
  *  - sizing_clock() is the monotonic clock, in seconds.
  */
 #ifndef FDEMD_SIZING_PROBE_H
