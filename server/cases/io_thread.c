@@ -355,51 +355,72 @@ static void io_do_history_read(io_job *j)
 /* Wall seconds a snapshot takes to become durable here (result.h5 row,
  * checkpoint.bin and status.json, fsynced): what a dry run charges per
  * snapshot, as latency + bytes x seconds per byte (the checkpoint's bytes
- * stand for the job's size: the row grows with the same model). Both are
- * moving averages over recent snapshot jobs: the latency over the small
- * ones (where the fsyncs are all of it), the seconds per byte over the
- * large ones, less the latency. One average of every job priced a 2D
- * collision's 3 KB snapshots at the 0.1 s the large 3D jobs before it
- * took, five times its run. */
-#define IO_SNAPSHOT_AVERAGE_WEIGHT 0.2
+ * stand for the job's size: the row grows with the same model), both from
+ * recent snapshot jobs: the latency from the small ones (where the fsyncs
+ * are all of it), the seconds per byte from the
+ * large ones, less the latency: each the median of the last
+ * IO_COST_SAMPLES. One moving average of every job priced a 2D collision's
+ * 3 KB snapshots at the 0.1 s the large 3D jobs before it took, five times
+ * its run, and one write the disk held up for seconds priced a small 3D
+ * case's 76 snapshots at 68 s. */
+#define IO_COST_SAMPLES 9
 #define IO_SMALL_JOB_BYTES 262144.0
+typedef struct io_cost_samples {
+    double value[IO_COST_SAMPLES];
+    int count, next;
+} io_cost_samples;
 static pthread_mutex_t io_cost_lock = PTHREAD_MUTEX_INITIALIZER;
-static double io_latency;          /* seconds */
-static double io_seconds_per_byte;
-static int io_latency_measured, io_rate_measured;
+static io_cost_samples io_latency_samples, io_rate_samples;
+static double io_latency_seed;
 
-static void io_average(double *figure, int *measured, double value)
+static void io_cost_add(io_cost_samples *s, double value)
 {
-    if (*measured)
-        *figure += IO_SNAPSHOT_AVERAGE_WEIGHT * (value - *figure);
-    else
-        *figure = value;
-    *measured = 1;
+    s->value[s->next] = value;
+    s->next = (s->next + 1) % IO_COST_SAMPLES;
+    if (s->count < IO_COST_SAMPLES) s->count++;
+}
+
+static int io_compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The median of the samples (`fallback` when there are none): one write
+ * held up for seconds by a busy disk does not price the next case. */
+static double io_cost_median(const io_cost_samples *s, double fallback)
+{
+    if (s->count == 0) return fallback;
+    double v[IO_COST_SAMPLES];
+    memcpy(v, s->value, sizeof(double) * (size_t)s->count);
+    qsort(v, (size_t)s->count, sizeof *v, io_compare_doubles);
+    return v[s->count / 2];
 }
 
 static void io_note_snapshot_cost(double seconds, double bytes)
 {
     pthread_mutex_lock(&io_cost_lock);
-    if (bytes < IO_SMALL_JOB_BYTES)
-        io_average(&io_latency, &io_latency_measured, seconds);
-    else
-        io_average(&io_seconds_per_byte, &io_rate_measured,
-                   (seconds > io_latency ? seconds - io_latency : 0.0) / bytes);
+    if (bytes < IO_SMALL_JOB_BYTES) {
+        io_cost_add(&io_latency_samples, seconds);
+    } else {
+        double latency = io_cost_median(&io_latency_samples, io_latency_seed);
+        io_cost_add(&io_rate_samples, (seconds > latency ? seconds - latency : 0.0) / bytes);
+    }
     pthread_mutex_unlock(&io_cost_lock);
 }
 
 void io_seed_snapshot_seconds(double seconds)
 {
     pthread_mutex_lock(&io_cost_lock);
-    if (!io_latency_measured)
-        io_latency = seconds;
+    io_latency_seed = seconds;
     pthread_mutex_unlock(&io_cost_lock);
 }
 
 double io_snapshot_seconds(double bytes)
 {
     pthread_mutex_lock(&io_cost_lock);
-    double seconds = io_latency + (bytes > 0 ? bytes : 0) * io_seconds_per_byte;
+    double seconds = io_cost_median(&io_latency_samples, io_latency_seed) +
+                     (bytes > 0 ? bytes : 0) * io_cost_median(&io_rate_samples, 0.0);
     pthread_mutex_unlock(&io_cost_lock);
     return seconds;
 }

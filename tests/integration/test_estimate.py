@@ -42,8 +42,6 @@ SHORT_ENDS = {
     "brazilian-disc": 0.0006,
     # the 3D disc's peak at 0.21 ms, joints broken after it
     "brazilian-disc-3d": 0.0003,
-    # the arc-loaded 3D disc splits at about 0.5 ms (1.5 ms in all)
-    "brazilian-disc-3d-arc": 0.0006,
     # the discs fall from rest and pile up from about 0.25 s (0.8 s in all)
     "disc-pile": 0.4,
     # excavation at 1 ms, the crown and invert break right after (8 ms)
@@ -60,6 +58,13 @@ SHORT_ENDS = {
     "uniaxial-compression": 0.0003,
     # joints soften from 0.15 ms, the load falls by 0.33 ms (0.4 ms)
     "uniaxial-prism-3d": 0.0003,
+}
+
+# Examples not run here, and why (docs/performance.md has their figures).
+NOT_RUN = {
+    # splits at 0.5 ms of 1.5 ms, after which a step costs ~27x: any end
+    # short enough for CI changes that mix, and the whole run is minutes
+    "brazilian-disc-3d-arc": "its split comes at a third of a run of minutes",
 }
 
 # The examples run under the sanitizers: contact between bodies, a 2D and
@@ -95,7 +100,8 @@ class EstimateTest(DaemonTestCase):
         self.client = Client(self.url())
 
     def test_every_example_within_a_factor_of_2(self):
-        names = [n for n in example_names() if SLOW == 1.0 or n in SAN_EXAMPLES]
+        names = [n for n in example_names() if (SLOW == 1.0 or n in SAN_EXAMPLES)
+                 and n not in NOT_RUN]
         rows, bad = [], []
         # A fresh daemon knows its disk from one fsynced write at start-up
         # (docs/api.md, Dry run); a first run lets it time real snapshots,
