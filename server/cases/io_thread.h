@@ -74,8 +74,8 @@ int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_
 void io_release_hold(server_case *c);
 /* Wall seconds a snapshot of a model whose checkpoint is this large takes
  * to write (a result.h5 row with its checkpoint and status, fsynced):
- * latency + bytes x seconds per byte, both from recent snapshot writes;
- * before any, the latency is the seed given at start-up. */
+ * the median of the last small snapshot writes (before any, the seed
+ * given at start-up); the size is not charged (io_thread.c says why). */
 double io_snapshot_seconds(double checkpoint_bytes);
 void io_seed_snapshot_seconds(double seconds);
 
