@@ -17,17 +17,19 @@
  * processes of a busy machine do not change (two dry runs at a load
  * average of 14 on two cores gave 9.4 and 1.0 ms of wall time a step for
  * one model). How much of the machine the run will get is a separate
- * factor, the geometric mean of two figures. The one-minute load average
- * (the run is one task more among those, on this many cores) moves
- * slowly, so that repeated dry runs agree, but it also counts tasks
- * waiting for the disk, which take no CPU (at a load of 18 on two cores it
- * said 9.9 where the windows saw 5 to 8). Wall over CPU time of the
- * windows themselves is what this process got just now, but it swung from
- * 4.8 to 12.4 between two dry runs a minute apart at that load.
+ * factor: the median wall / CPU seconds of the stepping thread over this
+ * daemon's last runs (sizing_note_run), what runs here really got. Before
+ * any, the geometric mean of two guesses: the one-minute load average
+ * (the run is one task more among those, on this many cores), which also
+ * counts tasks waiting for the disk (at a load of 18 on two cores it said
+ * 9.9), and the wall / CPU time of the windows themselves (5 to 8 then,
+ * swinging from 4.8 to 12.4 between two dry runs a minute apart). Both
+ * ran 2-3x above what the runs that followed got (wall / CPU 1.5-3).
  */
 #include "sizing_probe.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -127,8 +129,43 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
     return window[windows / 2];
 }
 
+/* Wall over CPU seconds of the stepping thread in the daemon's recent
+ * runs (sizing_note_run): the share of the machine a run really got. */
+#define RUN_SHARE_SAMPLES 9
+#define RUN_SHARE_MIN_SECONDS 0.2
+static pthread_mutex_t run_share_lock = PTHREAD_MUTEX_INITIALIZER;
+static double run_share[RUN_SHARE_SAMPLES];
+static int run_share_count, run_share_next;
+
+void sizing_note_run(double wall, double cpu)
+{
+    if (!(wall >= RUN_SHARE_MIN_SECONDS) || !(cpu > 0))
+        return;
+    pthread_mutex_lock(&run_share_lock);
+    run_share[run_share_next] = wall / cpu;
+    run_share_next = (run_share_next + 1) % RUN_SHARE_SAMPLES;
+    if (run_share_count < RUN_SHARE_SAMPLES) run_share_count++;
+    pthread_mutex_unlock(&run_share_lock);
+}
+
+/* The median of the recent runs' wall / CPU, or 0 when none ran. */
+static double recent_run_factor(void)
+{
+    double v[RUN_SHARE_SAMPLES];
+    pthread_mutex_lock(&run_share_lock);
+    int n = run_share_count;
+    memcpy(v, run_share, sizeof(double) * (size_t)n);
+    pthread_mutex_unlock(&run_share_lock);
+    if (n == 0) return 0;
+    qsort(v, (size_t)n, sizeof *v, compare_doubles);
+    return v[n / 2];
+}
+
 double sizing_load_factor(const sizing_load *load)
 {
+    double recent = recent_run_factor();
+    if (recent > 0)
+        return recent > 1.0 ? recent : 1.0;
     double average[1];
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     double seen = load->cpu > 0 && load->wall > 0 ? load->wall / load->cpu : 1.0;
@@ -141,4 +178,9 @@ double sizing_load_factor(const sizing_load *load)
     if (counted < 1.0)
         counted = 1.0;
     return sqrt(counted * seen);
+}
+
+double sizing_thread_cpu(void)
+{
+    return probe_cpu();
 }

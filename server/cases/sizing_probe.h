@@ -12,9 +12,12 @@
  *    whose step is slow a handful of steps (at least 5 when there are
  *    that many).
  *  - sizing_load_factor() turns CPU seconds into the run's wall seconds
- *    on this machine now: the geometric mean of (one-minute load average
- *    + 1) / cores and the windows' own wall / CPU seconds in *load, each
- *    at least 1.
+ *    on this machine now: the median wall / CPU of the stepping thread
+ *    over the daemon's last 9 runs of at least 0.2 s (sizing_note_run,
+ *    called by the worker as a run ends), or before any the geometric
+ *    mean of (one-minute load average + 1) / cores and the windows' own
+ *    wall / CPU seconds in *load; at least 1.
+ *  - sizing_thread_cpu() is the calling thread's CPU clock, in seconds.
  *  - sizing_clock() is the monotonic clock, in seconds.
  */
 #ifndef FDEMD_SIZING_PROBE_H
@@ -30,5 +33,7 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
                                  sizing_load *load);
 double sizing_load_factor(const sizing_load *load);
 double sizing_clock(void);
+double sizing_thread_cpu(void);
+void sizing_note_run(double wall, double cpu);
 
 #endif

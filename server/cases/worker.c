@@ -20,6 +20,7 @@
 #include "case_model.h"
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
+#include "sizing_probe.h"
 #include "io_thread.h"
 #include "registry_internal.h"
 #include "worker_history.h"
@@ -55,6 +56,7 @@ typedef struct worker_clock {
      * WORKER_ETA_SAMPLE_EVERY, the oldest overwritten (worker_eta) */
     double eta_wall[WORKER_ETA_SAMPLES], eta_time[WORKER_ETA_SAMPLES];
     int eta_count, eta_next;
+    double io_waited;       /* wall seconds this run waited for its snapshot writes */
 } worker_clock;
 
 static double worker_now(void)
@@ -157,12 +159,20 @@ static void worker_yield_to_requesters(server_case *c)
     pthread_mutex_unlock(&c->yield_lock);
 }
 
-static void worker_wait_io(server_case *c, int max_pending)
+/* Waits until at most max_pending snapshot jobs are left; returns the
+ * wall seconds it waited (0 without a wait). */
+static double worker_wait_io(server_case *c, int max_pending)
 {
+    double waited = 0;
     pthread_mutex_lock(&c->lock);
-    while (c->io_pending > max_pending)
-        pthread_cond_wait(&c->cv, &c->lock);
+    if (c->io_pending > max_pending) {
+        double started = worker_now();
+        while (c->io_pending > max_pending)
+            pthread_cond_wait(&c->cv, &c->lock);
+        waited = worker_now() - started;
+    }
     pthread_mutex_unlock(&c->lock);
+    return waited;
 }
 
 /* The engine's message already names the step, element and dt (fdem.h);
@@ -286,7 +296,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             worker_history_flush(c);
         if (snap || ckpt) {
             io_append(c, events, event_count, snap, ckpt, ckpt_size);
-            worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
+            clk->io_waited += worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
         }
         if (done)
             return EXIT_FINISHED;
@@ -387,7 +397,11 @@ static void *worker_main(void *arg)
                  fdem_get_dt(c->model));
         c->next_output = worker_next_output(c, fdem_get_time(c->model));
         worker_history_start(c);
+        double cpu_started = sizing_thread_cpu();
         why = worker_loop(c, &clk);
+        /* what this run got of the machine, for the next estimates */
+        sizing_note_run(worker_now() - clk.run_started - clk.io_waited,
+                        sizing_thread_cpu() - cpu_started);
         worker_wind_down(c, why, &clk);
         final_state = worker_final_state(why);
     }
