@@ -57,6 +57,7 @@ typedef struct worker_clock {
     double eta_wall[WORKER_ETA_SAMPLES], eta_time[WORKER_ETA_SAMPLES];
     int eta_count, eta_next;
     double io_waited;       /* wall seconds this run waited for its snapshot writes */
+    int snapshots_taken;    /* by this run */
 } worker_clock;
 
 static double worker_now(void)
@@ -275,6 +276,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
+            clk->snapshots_taken++;
         }
         worker_history_after_step(c, cut ? end - t0 : dt, snap != NULL, done);
         /* Every snapshot comes with a checkpoint, so that a restart never
@@ -400,8 +402,9 @@ static void *worker_main(void *arg)
         double cpu_started = sizing_thread_cpu();
         why = worker_loop(c, &clk);
         /* what this run got of the machine, for the next estimates */
-        sizing_note_run(worker_now() - clk.run_started - clk.io_waited,
-                        sizing_thread_cpu() - cpu_started);
+        double wall = worker_now() - clk.run_started;
+        sizing_note_run(wall - clk.io_waited, sizing_thread_cpu() - cpu_started);
+        io_note_paced_run(wall, clk.io_waited, clk.snapshots_taken);
         worker_wind_down(c, why, &clk);
         final_state = worker_final_state(why);
     }
