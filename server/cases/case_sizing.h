@@ -14,7 +14,7 @@
  *    bytes, and a wall time: the slower of stepping and writing the
  *    snapshots (snapshot_seconds each, see io_snapshot_seconds). Stepping
  *    is priced from the model's own steps timed here (sizing_probe.h: a
- *    warm-up, then the median of short windows) at t = 0 and again up to 30 %
+ *    warm-up, then the median of short windows) at t = 0 and at three points up to 30 %
  *    into the run when that is quickly reached; for a fracturing model 2 %
  *    of its joints broken through the whole run, each at the cost a joint
  *    of a crack cut through the model adds to its step
