@@ -442,6 +442,13 @@ fdem_fluid_status fdem_get_fluid(const fdem_model *model);
  * (the opening itself without fluid). */
 const double *fdem_fluid_pressure(const fdem_model *model);
 void fdem_fluid_apertures(const fdem_model *model, double *out);
+/* For run-time estimates only, on a model that is thrown away afterwards
+ * (core/joint/joint_crack.c): breaks every intact joint between two active
+ * elements whose centroids lie on either side of the plane
+ * normal . x = offset (normal: `dimension` numbers), as a crack along it
+ * would, with no fracture event and no energy booked. Returns how many
+ * broke, or -1 out of memory. */
+int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
 
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);

@@ -98,6 +98,18 @@ int ctl_parse_args(int argc, char **argv, const ctl_option_spec *specs, const ch
                    const char **positional, int min_positional, int max_positional);
 static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_OK : CTL_USAGE; }
 
+/* --- ids.c ------------------------------------------------------------- */
+
+/* Room for a resolved case id (ids are 16 characters). */
+#define CTL_ID_SIZE 64
+/* A case id typed by the user, possibly shortened to a unique prefix of
+ * one: a prefix that exactly one case's id starts with is replaced by that
+ * id (*id then points into buf); a whole id, or one that no case starts
+ * with, is left as typed (the server answers 404 for an unknown one).
+ * Returns CTL_OK, or CTL_USAGE after saying why when the prefix is empty
+ * or shared by several cases (they are listed on stderr). */
+int ctl_resolve_id(const ctl_options *o, const char **id, char *buf, size_t size);
+
 /* --- commands.c (shared with wait.c and fetch.c) ----------------------- */
 
 /* GET /cases/ID as a JSON object, or NULL after reporting why (then *code

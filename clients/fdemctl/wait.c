@@ -33,6 +33,7 @@ static const char USAGE_WAIT[] =
 
 typedef struct wait_progress {
     double progress, time, end_time, steps_per_second, dt;
+    double eta;      /* the server's (contract 6.2), < 0 when it sent none */
     long long step;
     const char *state;
     char stage[112]; /* "  stage 1 \"excavate\"" for a case with stages, else "" */
@@ -59,6 +60,8 @@ static wait_progress wait_read(json_t *s)
     p.end_time = json_number_value(json_object_get(s, "end_time"));
     p.steps_per_second = json_number_value(json_object_get(s, "steps_per_second"));
     p.dt = json_number_value(json_object_get(s, "dt"));
+    json_t *eta = json_object_get(s, "eta");
+    p.eta = json_is_number(eta) ? json_number_value(eta) : -1;
     p.step = json_integer_value(json_object_get(s, "step"));
     p.state = json_string_value(json_object_get(s, "state"));
     if (!p.state) p.state = "?";
@@ -73,10 +76,13 @@ static wait_progress wait_read(json_t *s)
     return p;
 }
 
-/* Seconds left from the server's own speed; negative when unknown. */
+/* Seconds left: the server's eta (over its last seconds, steadier than one
+ * speed sample), else from its current speed (an older server); negative
+ * when unknown. */
 static double wait_eta(const wait_progress *p)
 {
     if (strcmp(p->state, "running") != 0) return -1;
+    if (p->eta >= 0) return p->eta;
     if (p->steps_per_second > 0 && p->dt > 0 && p->end_time > p->time)
         return (p->end_time - p->time) / p->dt / p->steps_per_second;
     return -1;
@@ -314,6 +320,9 @@ int cmd_wait(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--interval", "-i", &interval_text, NULL}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_WAIT, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     double interval = 0.5;
     if (interval_text && wait_parse_interval(interval_text, &interval) != 0) return CTL_USAGE;
 

@@ -25,7 +25,8 @@ import warnings
 import urllib.parse
 import urllib.request
 
-__all__ = ["Client", "FdemdError", "FdemdConnectionError", "DEFAULT_URL", "stage_label"]
+__all__ = ["Client", "FdemdError", "FdemdConnectionError", "AmbiguousIdError", "DEFAULT_URL",
+           "stage_label"]
 
 DEFAULT_URL = "http://127.0.0.1:8080"
 TERMINAL_STATES = ("finished", "failed", "stopped")
@@ -66,6 +67,17 @@ class FdemdError(Exception):
 
 class FdemdConnectionError(FdemdError, ConnectionError):
     """The server could not be reached at all (status 0)."""
+
+
+class AmbiguousIdError(ValueError):
+    """A shortened case id that several cases' ids start with
+    (Client.resolve_id); .prefix and .matches (the whole ids)."""
+
+    def __init__(self, prefix, matches):
+        self.prefix = prefix
+        self.matches = list(matches)
+        super().__init__("case id prefix %r is ambiguous: %d cases start with it (%s)"
+                         % (prefix, len(self.matches), ", ".join(self.matches[:10])))
 
 
 class Client:
@@ -170,6 +182,24 @@ class Client:
         if state is not None:
             path += "?state=" + urllib.parse.quote(str(state), safe="")
         return self._json("GET", path)["cases"]
+
+    def resolve_id(self, prefix):
+        """The whole id of the one case whose id starts with `prefix`, as
+        fdemctl resolves a shortened ID (one GET /cases): a whole id, or a
+        prefix no case has, comes back as given (the next request then gets
+        the server's 404). Raises ValueError for an empty prefix and
+        AmbiguousIdError (a ValueError, with .matches: the ids) when several
+        cases start with it."""
+        prefix = str(prefix)
+        if not prefix:
+            raise ValueError("an empty case id names no case")
+        ids = [c.get("id", "") for c in self.list()]
+        if prefix in ids:
+            return prefix
+        matches = [i for i in ids if i.startswith(prefix)]
+        if len(matches) > 1:
+            raise AmbiguousIdError(prefix, matches)
+        return matches[0] if matches else prefix
 
     def status(self, case_id):
         """The status object of one case (state, step, time, progress,

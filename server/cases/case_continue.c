@@ -297,6 +297,10 @@ done:
 static void continue_settle(server_case *c, double end)
 {
     pthread_mutex_lock(&c->lock);
+    /* the run's estimate, for the longer run: at the same pace per
+     * simulated second (the sizing priced the whole run, not a phase) */
+    if (c->info.end_time > 0)
+        c->estimated_seconds *= end / c->info.end_time;
     c->info.end_time = end;
     c->state = CASE_PAUSED;
     c->finished_at[0] = '\0';

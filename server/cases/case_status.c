@@ -58,6 +58,7 @@ void case_publish_from_model(server_case *c)
     fig.fluid = fdem_get_fluid(c->model);
     fig.snapshots = -1;
     fig.elapsed = -1;
+    fig.eta = NAN;
     case_figures_stage(&fig, c->model, &c->info);
     case_publish(c, &fig);
 }
@@ -175,6 +176,7 @@ json_t *case_status_json(server_case *c)
     memcpy(error, c->error, sizeof error);
     memcpy(started, c->started, sizeof started);
     memcpy(finished_at, c->finished_at, sizeof finished_at);
+    double estimated_seconds = c->estimated_seconds;
     pthread_mutex_unlock(&c->lock);
 
     double end = c->info.end_time;
@@ -216,6 +218,8 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "started", json_string_or_null(started));
     json_object_set_new(o, "finished_at", json_string_or_null(finished_at));
     json_object_set_new(o, "elapsed", json_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
+    json_object_set_new(o, "estimated_seconds", json_number_or_null(estimated_seconds));
+    json_object_set_new(o, "eta", json_number_or_null(state == CASE_RUNNING ? f.eta : NAN));
     json_object_set_new(o, "warnings", case_warnings_json(c));
     return o;
 }

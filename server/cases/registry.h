@@ -68,6 +68,7 @@ typedef struct case_figures {
     double steps_per_second;
     int snapshots;
     double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
+    double eta;                /* wall seconds left at the recent speed; NAN: unknown */
     int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
     char stage_name[CASE_STAGE_NAME];
     fdem_fluid_status fluid;   /* contract 6.4; enabled 0 without fluid */
@@ -94,6 +95,8 @@ typedef struct server_case {
     case_state state;
     char error[768];           /* "" = no error */
     case_figures fig;
+    double estimated_seconds;  /* the sizing's wall time for the whole run (case_sizing.h)
+                                  at submission, scaled by an extend; NAN: unknown */
     int worker_active;
     _Atomic int deleted;
     uint64_t queue_seq;

@@ -75,6 +75,7 @@ static void case_load_figures(server_case *c, const json_t *st)
     const char *name = json_string_value(json_object_get(st, "name"));
     snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
     c->info.end_time = status_number(st, "end_time");
+    c->estimated_seconds = status_number(st, "estimated_seconds"); /* NAN before it was kept */
 }
 
 /* The state the case was in when the daemon stopped: a case the shutdown
