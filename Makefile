@@ -57,7 +57,7 @@ UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 LIBCORE    := $(BUILD)/libfdemcore.a
 LIBPROTO   := $(BUILD)/libfdemproto.a
 
-.PHONY: all deps test test-unit test-integration test-san bench demo limits fuzz clean
+.PHONY: all deps test test-unit test-integration test-san bench demo limits estimates fuzz clean
 
 all: deps $(BIN)/fdemd $(BIN)/fdemctl
 
@@ -128,6 +128,12 @@ demo: all
 
 limits: deps $(BUILD)/scripts/limits
 	@LIMITS=$(BUILD)/scripts/limits $(PYTHON) scripts/limits.py
+
+# estimated_seconds against the measured run of every bundled example, and
+# eta against the clock: wall-time figures for a quiet machine (minutes), so
+# not part of make test (tests/integration/test_estimate.py)
+estimates: all
+	@FDEMD_ESTIMATES=1 FDEMD_BIN=$(BIN)/fdemd FDEMCTL_BIN=$(BIN)/fdemctl $(PYTHON) tests/integration/run.py 'test_estimate.py'
 
 fuzz: deps
 	@bash tests/fuzz/run.sh

@@ -26,6 +26,12 @@
  *     element-step split over the stages, the pairs and detections that
  *     drive it, against the same block intact (goal: <= 4x in 3D, <= 3x in
  *     2D).
+ *  9. hydraulic fracturing (issue 36): the 2D fracturing block of 3, fed
+ *     with fluid at its centre (until 20 joints broke, at most 3000
+ *     steps), then timed: ns per element-step with the flow, beside the
+ *     same block stepped from the same state with the flow switched off,
+ *     and the flow's share of the step (its cost follows the open network:
+ *     what remains is the scan of every joint for newly damaged ones).
  * Figures, not pass/fail: nothing here is a test.
  */
 #include <math.h>
@@ -40,6 +46,7 @@
 #include "mesh/mesh_3d.h"
 #include "model/model.h"
 #include "stream.h"
+#include "fluid/fluid.h"
 
 static double now(void)
 {
@@ -585,8 +592,63 @@ static void bench_threads(int rows_2d, int rows_3d)
     thread_row("sphere pile 3D (contact)", one, many, one->elem_plan.color_count, cores, 5e6);
 }
 
+/* The fracturing block of n cells a side (unit square) with water-like
+ * fluid (K_f scaled down to 1e8 Pa, the practice of hydraulic-fracturing
+ * FDEM codes, so the fluid's stiffness leaves the step of the rock), fed
+ * at its centre node. */
+static fdem_model *fed_block(int n, double inject)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err;
+    fdem_material_def rock = {.density = 2500, .young = 1e10, .poisson = 0.2, .damping = 0.1,
+                              .has_fracture = 1};
+    rock.fracture = (fdem_fracture_params){.tensile_strength = 1e6, .cohesion = 3e6,
+                                           .friction_angle = 30, .energy_I = 20,
+                                           .energy_II = 100, .aperture0 = 1e-4};
+    int mat = fdem_add_material(m, &rock, &err);
+    if (mat < 0) build_die("material", &err);
+    build_rectangle_part(m, mat, -0.5, -0.5, 1, 1, n, n, 1);
+    fdem_fluid_def water = {.viscosity = 1e-3, .bulk_modulus = 1e8, .density = 1000};
+    if (fdem_set_fluid(m, &water, &err)) build_die("fluid", &err);
+    const double e = 1e-9;
+    fdem_constraint_def feed = {.select = FDEM_SELECT_BOX, .box = {-e, -e, e, e},
+                                .kind = FDEM_CONSTRAINT_INJECT, .value = {inject}};
+    if (fdem_add_constraint(m, &feed, &err) < 0) build_die("inject", &err);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+static void bench_hydraulic_fracture(void)
+{
+    printf("\n## Hydraulic fracturing (2D fracturing block fed at its centre, issue 36)\n");
+    printf("%10s %8s %8s %8s %10s %14s %14s %9s\n", "elements", "joints", "open", "broken",
+           "subcycles", "ns/elem-step", "no-flow ns", "flow %");
+    const int sizes[] = {100, 224};
+    for (int s = 0; s < 2; s++) {
+        fdem_model *m = fed_block(sizes[s], 2e-2);
+        fdem_error err;
+        /* until some joints broke and the network holds the fluid, or long enough */
+        for (int k = 0; k < 3000 && fdem_get_counts(m).broken_joints < 20; k++)
+            if (fdem_step(m, &err)) build_die("step", &err);
+        int steps = (int)(1e7 / m->elem_count);
+        if (steps < 10) steps = 10;
+        step_time with = best_of_three(m, steps);
+        struct fluid_net *keep = m->fluid;
+        m->fluid = NULL; /* the same state, stepped without the flow */
+        step_time without = best_of_three(m, steps);
+        m->fluid = keep;
+        fdem_counts c = fdem_get_counts(m);
+        fdem_fluid_status f = fdem_get_fluid(m);
+        printf("%10d %8d %8d %8d %10d %14.1f %14.1f %9.1f\n", c.elements, c.joints, f.open_joints,
+               c.broken_joints, f.subcycles, with.cpu, without.cpu,
+               100 * (1 - without.cpu / with.cpu));
+        fdem_model_destroy(m);
+    }
+}
+
 /* With no argument every section runs; otherwise only those named
- * (block, block3d, pile, pile3d, fracture, fracture3d, broken, broken3d, threads, threads3d),
+ * (block, block3d, pile, pile3d, fracture, fracture3d, broken, broken3d, hydraulic, threads,
+ * threads3d),
  * to iterate on one kernel. */
 static int wanted(int argc, char **argv, const char *name)
 {
@@ -612,6 +674,7 @@ int main(int argc, char **argv)
     }
     if (wanted(argc, argv, "broken")) bench_broken_block(&FRACTURE_2D, 3, 5e6);
     if (wanted(argc, argv, "broken3d")) bench_broken_block(&FRACTURE_3D_UNDAMPED, 4, 2e5);
+    if (wanted(argc, argv, "hydraulic")) bench_hydraulic_fracture();
     if (wanted(argc, argv, "threads") || wanted(argc, argv, "threads3d"))
         bench_threads(wanted(argc, argv, "threads"), wanted(argc, argv, "threads3d"));
     return 0;

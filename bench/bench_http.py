@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """HTTP load figure for `make bench`: latency (p50, p99) and requests/s of
-GET /cases/ID against bin/fdemd on loopback while four cases step.
+GET /cases/ID against bin/fdemd on loopback while four cases step, then
+the same with 64 event streams (GET /stream) open and read meanwhile.
 
 Uses wrk when installed (2 threads, 8 connections, 5 s; once with keep-alive and
 once with a connection per request, Connection: close), else a bounded
@@ -11,7 +12,9 @@ Python client (4 threads x 500 requests). Never part of the tests.
 import http.client
 import os
 import re
+import select
 import shutil
+import socket
 import subprocess
 import sys
 import threading
@@ -73,21 +76,70 @@ def python_figures(port, ids):
             len(latencies) / elapsed, bad[0], "python %dx%d" % (PY_THREADS, PY_REQUESTS))
 
 
+STREAMS = 64
+
+
+class OpenStreams:
+    """STREAMS connections on GET /stream, drained by one thread (a stream
+    whose client reads nothing would only measure the socket buffers)."""
+
+    def __init__(self, port):
+        self.socks, self.received, self.stopping = [], 0, False
+        for _ in range(STREAMS):
+            s = socket.create_connection(("127.0.0.1", port), timeout=10)
+            s.sendall(b"GET /stream HTTP/1.1\r\nHost: bench\r\n\r\n")
+            head = s.recv(4096)
+            if not head.startswith(b"HTTP/1.1 200"):
+                raise RuntimeError("GET /stream answered %r" % head[:80])
+            s.setblocking(False)
+            self.socks.append(s)
+        self.thread = threading.Thread(target=self._drain)
+        self.thread.start()
+
+    def _drain(self):
+        while not self.stopping:
+            ready, _, _ = select.select(self.socks, [], [], 0.2)
+            for s in ready:
+                try:
+                    self.received += len(s.recv(65536))
+                except OSError:
+                    pass
+
+    def close(self):
+        self.stopping = True
+        self.thread.join()
+        for s in self.socks:
+            s.close()
+
+
+def report(d, ids, runs, streams):
+    for p50, p99, rate, bad, how in runs:
+        steps = sum(d.status(i)["steps_per_second"] for i in ids)
+        print("http GET /cases/ID (4 cases running, %d streams open, %s): p50 %.3f ms, p99 "
+              "%.3f ms, %.0f requests/s, %d non-200; cases stepped %.3g steps/s in total "
+              "meanwhile" % (streams, how, p50, p99, rate, bad, steps))
+
+
 def main():
     d = Daemon(args=["--max-running", "4"]).start()
     try:
         ids = [d.create(tiny_case("bench%d" % i, end=100.0, interval=1e-3), start=True)["id"]
                for i in range(4)]
         url = "http://127.0.0.1:%d/cases/%s" % (d.port, ids[0])
-        # keep-alive (what clients that reuse a connection get), then a
-        # connection per request (what each passes through the gate)
-        runs = [wrk_figures(url), wrk_figures(url, close=True)] if shutil.which("wrk") \
-            else [python_figures(d.port, ids)]
-        for p50, p99, rate, bad, how in runs:
-            steps = sum(d.status(i)["steps_per_second"] for i in ids)
-            print("http GET /cases/ID (4 cases running, %s): p50 %.3f ms, p99 %.3f ms, %.0f "
-                  "requests/s, %d non-200; cases stepped %.3g steps/s in total meanwhile" %
-                  (how, p50, p99, rate, bad, steps))
+
+        def measure():
+            # keep-alive (what clients that reuse a connection get), then a
+            # connection per request (what each passes through the gate)
+            return [wrk_figures(url), wrk_figures(url, close=True)] if shutil.which("wrk") \
+                else [python_figures(d.port, ids)]
+        report(d, ids, measure(), 0)
+        streams = OpenStreams(d.port)
+        try:
+            report(d, ids, measure(), STREAMS)
+        finally:
+            streams.close()
+        print("http: the %d streams read %.0f kB of events meanwhile" %
+              (STREAMS, streams.received / 1e3))
         d.stop()
     finally:
         d.close()

@@ -74,6 +74,14 @@ typedef struct fdem_fracture_params {
     double friction_angle;   /* degrees */
     double energy_I;         /* J/m^2 */
     double energy_II;        /* J/m^2 */
+    /* Fluid in the fractures (contract 6.4; only with fdem_set_fluid):
+     * the hydraulic aperture of a shut joint (m; <= 0: 1e-6), and a static
+     * pore pressure that wets the joint from t = 0: value (Pa) + gradient
+     * (Pa per metre of height: y in 2D, z in 3D) * (height of the joint's
+     * centre at t = 0 - reference), when has_pore_pressure. */
+    double aperture0;
+    int has_pore_pressure;
+    double pore_pressure[3]; /* value, gradient, reference */
 } fdem_fracture_params;
 
 typedef struct fdem_material_def {
@@ -239,6 +247,9 @@ typedef enum fdem_constraint_kind {
                                         consistently (linear along the facet), see boundary_load.c */
     FDEM_CONSTRAINT_TRACTION, /* value[0..dim) Pa: a fixed vector traction per unit current
                                  area of the same boundary edges (faces), |S|/dim per vertex */
+    FDEM_CONSTRAINT_INJECT,   /* value[0]: fluid injected (m^3/s in 3D, m^2/s per unit thickness
+                                 in 2D), shared equally by the joints touching a selected node
+                                 (contract 6.4; needs fdem_set_fluid) */
 } fdem_constraint_kind;
 
 typedef struct fdem_constraint_def {
@@ -300,6 +311,15 @@ typedef struct fdem_stage_def {
     int excavate_count;
 } fdem_stage_def;
 int fdem_add_stage(fdem_model *model, const fdem_stage_def *def, fdem_error *err);
+
+/* Fluid in the fractures (contract 6.4, core/fluid/fluid.h): viscosity
+ * (Pa s, > 0), bulk modulus (Pa, > 0), density (kg/m^3, >= 0: the fluid's
+ * weight under gravity, which makes a hydrostatic pore pressure rest).
+ * Before finalize. Without it nothing of the fluid runs. */
+typedef struct fdem_fluid_def {
+    double viscosity, bulk_modulus, density;
+} fdem_fluid_def;
+int fdem_set_fluid(fdem_model *model, const fdem_fluid_def *def, fdem_error *err);
 
 /* Lumps masses, builds element and contact data, selects constraint nodes,
  * computes the stable step. Returns 0 or -1. */
@@ -365,6 +385,11 @@ typedef struct fdem_energy {
                              they were on; added to the balance like a dissipation, and
                              the work gravity did on the removed mass stays in
                              gravity_work */
+    double fluid_work;    /* work of the fluid's pressure on the solid (in the balance, as
+                             a work done on it) */
+    double fluid_dissipation; /* dissipated by the fluid's viscous flow (the fluid's own
+                             budget: what injection delivers goes to fluid_work, this, and
+                             the fluid's compression; not a term of residual) */
 } fdem_energy;
 
 typedef struct fdem_counts {
@@ -399,6 +424,32 @@ typedef struct fdem_penetration {
 } fdem_penetration;
 int fdem_take_penetrations(fdem_model *model, fdem_penetration *out, int max, long *more);
 
+/* The fluid (contract 6.4): volumes since t = 0 (2D: per unit
+ * thickness), the mean pressure of the joints an injection feeds (0
+ * without one), the flow's stable step and how many flow steps the last
+ * mechanical step took (fluid_flow.c), the joints in the flow network.
+ * enabled 0 (and the rest 0) without fluid. */
+typedef struct fdem_fluid_status {
+    int enabled;
+    double injected_volume, stored_volume, source_pressure;
+    double flow_step; /* INFINITY while no two open cavities are linked */
+    int subcycles, open_joints;
+} fdem_fluid_status;
+fdem_fluid_status fdem_get_fluid(const fdem_model *model);
+/* Per joint: the fluid pressure of the last evaluation (0 in a sealed
+ * joint; NULL without fluid or joints), and the hydraulic aperture
+ * max(opening, aperture0) on the current positions into out[joints]
+ * (the opening itself without fluid). */
+const double *fdem_fluid_pressure(const fdem_model *model);
+void fdem_fluid_apertures(const fdem_model *model, double *out);
+/* For run-time estimates only, on a model that is thrown away afterwards
+ * (core/joint/joint_crack.c): breaks every intact joint between two active
+ * elements whose centroids lie on either side of the plane
+ * normal . x = offset (normal: `dimension` numbers), as a crack along it
+ * would, with no fracture event and no energy booked. Returns how many
+ * broke, or -1 out of memory. */
+int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
+
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);
 fdem_counts fdem_get_counts(const fdem_model *model);
@@ -430,9 +481,13 @@ const int32_t *fdem_tetrahedra(const fdem_model *model);
 const int32_t *fdem_element_parts(const fdem_model *model);
 /* Joint arrays (2 dim node indices per joint: a0, a1 (, a2) on one face,
  * b0, b1 (, b2) the matching nodes of the other, a_i opposite b_i), and
- * damage 0..1 per joint. NULL when no joints. */
+ * the engine's damage per joint: 0..1, but above 1 for a joint a stage
+ * excavated (it holds nothing). NULL when no joints. fdem_copy_joint_damage
+ * writes the damage to show, 0..1, into out[joints]: an excavated joint's
+ * as it was when excavated (fdem_element_active says which are gone). */
 const int32_t *fdem_joints(const fdem_model *model);
 const double *fdem_joint_damage(const fdem_model *model);
+void fdem_copy_joint_damage(const fdem_model *model, double *out);
 
 /* Fragments (contract 5.4): pieces connected through shared nodes or
  * intact joints. fdem_fragment_labels writes each element's fragment id
@@ -541,7 +596,7 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
 /* The format version a checkpoint buffer says it is in (1 to the current
  * one, FDEM_CHECKPOINT_VERSION), or -1 when it does not start like one. */
-#define FDEM_CHECKPOINT_VERSION 8
+#define FDEM_CHECKPOINT_VERSION 9
 int fdem_checkpoint_version(const void *buf, size_t size);
 
 /* Seconds spent in each stage of fdem_step() since the model was built
@@ -575,6 +630,10 @@ size_t fdem_memory_estimate_of(const fdem_counts *counts);
 /* What each thread of a case run on more than one may add (its contact
  * touch lists, one per thread, the first's included). */
 size_t fdem_memory_per_thread(int dimension);
+/* What fluid in the fractures adds to a model with this many joints (an
+ * upper bound: every joint's cavity, links of the densest meshes, one
+ * injection's sources, finalize's scratch; core/fluid/fluid_network.c). */
+size_t fdem_fluid_memory_estimate(int dimension, long joints);
 
 #ifdef __cplusplus
 }

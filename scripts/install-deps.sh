@@ -10,6 +10,7 @@ packages=(
   hdf5-tools python3-h5py python3-numpy python3-matplotlib
   gmsh clang libclang-rt-14-dev wrk
   python3-paraview xvfb xauth octave
+  chromium chromium-driver python3-selenium
 )
 
 missing=()

@@ -30,7 +30,7 @@ static void usage(FILE *out)
             "             [--max-upload BYTES] [--max-running N] [--threads T]\n"
             "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
             "             [--checkpoint-every SECONDS] [--max-connections-per-ip N]\n"
-            "             [--request-timeout SECONDS]\n"
+            "             [--request-timeout SECONDS] [--max-streams N] [--web DIR]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -44,6 +44,8 @@ static void usage(FILE *out)
             "  --max-connections-per-ip N  open connections per client address (default 16)\n"
             "  --request-timeout SECONDS   a request must arrive whole (headers and body)\n"
             "                          within this time, or is cut (default 30)\n"
+            "  --max-streams N         GET /stream event streams open at once (default 64)\n"
+            "  --web DIR               the web page's files (default: web/ beside bin/)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -117,7 +119,8 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
     enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY,
-           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT };
+           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_MAX_STREAMS };
+           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_WEB };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
@@ -127,6 +130,8 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         {"checkpoint-every", required_argument, 0, OPT_CHECKPOINT_EVERY},
         {"max-connections-per-ip", required_argument, 0, OPT_MAX_CONNECTIONS_PER_IP},
         {"request-timeout", required_argument, 0, OPT_REQUEST_TIMEOUT},
+        {"max-streams", required_argument, 0, OPT_MAX_STREAMS},
+        {"web", required_argument, 0, OPT_WEB},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -141,6 +146,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->checkpoint_every = 60.0;
     cfg->max_connections_per_ip = 16;
     cfg->request_timeout = 30;
+    cfg->max_streams = 64;
     int request_timeout = 30;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
@@ -188,6 +194,13 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case OPT_REQUEST_TIMEOUT:
             if (parse_int(optarg, 1, &request_timeout)) bad = "--request-timeout takes a positive number of seconds";
             cfg->request_timeout = request_timeout;
+            break;
+        case OPT_MAX_STREAMS:
+            if (parse_int(optarg, 0, &cfg->max_streams)) bad = "--max-streams takes a number of streams, 0 or more";
+            break;
+        case OPT_WEB:
+            if (!*optarg || strlen(optarg) >= sizeof cfg->web_dir) bad = "--web takes a directory path";
+            else strcpy(cfg->web_dir, optarg);
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

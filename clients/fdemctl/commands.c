@@ -223,16 +223,37 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
 
 static const char USAGE_LIST[] =
     "usage: fdemctl list [--state STATE]\n"
-    "  One line per case, oldest first: id, name, state, progress, step, time.\n"
+    "  One line per case, oldest first: id, name, state, progress, step, time,\n"
+    "  speed (steps per second: now while running, else the mean of the run)\n"
+    "  and ETA (wall time left from the recent speed; '-' unless running).\n"
     "  --state S   only the cases in state S (created, queued, running, paused,\n"
     "              finished, stopped or failed)\n";
 
+/* A duration as a person reads it: "42s", "3m05s", "2h07m", "3.1d";
+ * "-" when unknown (a status whose eta is null). */
+static void list_duration_text(json_t *value, char *out, size_t size)
+{
+    if (!json_is_number(value)) {
+        snprintf(out, size, "-");
+        return;
+    }
+    double s = json_number_value(value);
+    if (!(s >= 0)) snprintf(out, size, "-");
+    else if (s < 59.5) snprintf(out, size, "%.0fs", s);
+    else if (s < 3600 - 0.5) snprintf(out, size, "%dm%02ds", (int)(s + 0.5) / 60, (int)(s + 0.5) % 60);
+    else if (s < 86400 * 2) snprintf(out, size, "%dh%02dm", (int)(s / 3600), (int)(s / 60) % 60);
+    else snprintf(out, size, "%.1fd", s / 86400);
+}
+
 static void list_print_row(json_t *c, int id_width, int name_width)
 {
-    printf("%-*s  %-*s  %-9s %6.1f%%  %10lld  %.4g\n", id_width, status_text(c, "id", "?"),
-           name_width, status_text(c, "name", ""), status_text(c, "state", "?"),
-           100.0 * status_number(c, "progress"), json_integer_value(json_object_get(c, "step")),
-           status_number(c, "time"));
+    char eta[32];
+    list_duration_text(json_object_get(c, "eta"), eta, sizeof eta);
+    printf("%-*s  %-*s  %-9s %6.1f%%  %10lld  %-10.4g  %10.4g  %s\n", id_width,
+           status_text(c, "id", "?"), name_width, status_text(c, "name", ""),
+           status_text(c, "state", "?"), 100.0 * status_number(c, "progress"),
+           json_integer_value(json_object_get(c, "step")), status_number(c, "time"),
+           status_number(c, "steps_per_second"), eta);
 }
 
 int cmd_list(const ctl_options *o, int argc, char **argv)
@@ -274,8 +295,8 @@ int cmd_list(const ctl_options *o, int argc, char **argv)
         if (w > name_width) name_width = w;
     }
     if (name_width > 40) name_width = 40;
-    printf("%-*s  %-*s  %-9s %7s  %10s  %s\n", id_width, "ID", name_width, "NAME", "STATE",
-           "PROGRESS", "STEP", "TIME [s]");
+    printf("%-*s  %-*s  %-9s %7s  %10s  %-10s  %10s  %s\n", id_width, "ID", name_width, "NAME",
+           "STATE", "PROGRESS", "STEP", "TIME [s]", "STEPS/S", "ETA");
     json_array_foreach(cases, i, c) list_print_row(c, id_width, name_width);
     json_decref(doc);
     return CTL_OK;
@@ -363,6 +384,13 @@ static void status_print_table(json_t *s)
            json_integer_value(json_object_get(s, "joints")),
            json_integer_value(json_object_get(s, "broken_joints")));
     printf("%-14s%lld\n", "contacts", json_integer_value(json_object_get(s, "contacts")));
+    json_t *fluid = json_object_get(s, "fluid"); /* contract 6.4, null without fluid */
+    if (json_is_object(fluid))
+        printf("%-14sinjected %.4g, stored %.4g, source pressure %.4g Pa, flow step %.3g s x %lld\n",
+               "fluid", status_number(fluid, "injected_volume"),
+               status_number(fluid, "stored_volume"), status_number(fluid, "source_pressure"),
+               status_number(fluid, "fluid_step"),
+               json_integer_value(json_object_get(fluid, "fluid_subcycles")));
     printf("%-14s%lld\n", "snapshots", json_integer_value(json_object_get(s, "snapshots")));
     status_print_energy(s);
     printf("%-14s%.4g steps/s\n", "speed", status_number(s, "steps_per_second"));
@@ -379,6 +407,9 @@ int cmd_status(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--json", NULL, NULL, &raw}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_STATUS, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     if (raw) return print_case_json(o, id[0], NULL);
     int code;
     json_t *s = ctl_get_status(o, id[0], &code);
@@ -403,6 +434,9 @@ int cmd_control(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_CONTROL, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char suffix[16], path[512];
     snprintf(suffix, sizeof suffix, "/%s", argv[0]);
     if (http_case_path(path, sizeof path, id[0], suffix) != 0) {
@@ -431,6 +465,9 @@ int cmd_delete(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_DELETE, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char path[512];
     if (http_case_path(path, sizeof path, id[0], NULL) != 0) {
         fprintf(stderr, "fdemctl: case id '%s' is too long\n", id[0]);
@@ -456,6 +493,9 @@ int cmd_case(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_CASE, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     return print_case_json(o, id[0], "/case");
 }
 
@@ -477,6 +517,9 @@ int cmd_state(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--fields", "-f", &fields, NULL}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_STATE, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char suffix[512] = "/state";
     if (fields) {
         for (const char *c = fields; *c; c++) {

@@ -64,6 +64,9 @@ int cmd_events(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--since", NULL, &since, NULL}, {"--json", NULL, NULL, &raw}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_EVENTS, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char path[1024];
     if (http_case_path(path, sizeof path, id[0], "/events") != 0) {
         fprintf(stderr, "fdemctl events: case id too long\n");

@@ -48,6 +48,15 @@ int http_request_as(const ctl_options *o, const char *method, const char *path,
 /* GET base+path streaming the body into `sink`; status and transport error
  * are reported as for http_request (the body is not kept). */
 int http_download(const ctl_options *o, const char *path, FILE *sink, http_response *out);
+/* GET base+path, handing its body to `take` piece by piece as it arrives
+ * (never from inside libcurl, so `take` may make requests itself) until
+ * `take` returns non-zero: then 0. -1 when the answer is not 200 (status
+ * and body in `out`), or the transfer failed, ended, or was silent for
+ * `quiet_limit` seconds (`error` says which). Free `out` with
+ * http_response_free(). */
+typedef int (*http_piece_fn)(void *arg, const char *data, size_t length);
+int http_follow(const ctl_options *o, const char *path, double quiet_limit, http_piece_fn take,
+                void *arg, http_response *out);
 void http_response_free(http_response *r);
 /* "/cases/<escaped id><suffix>" into out; returns 0, or -1 if it doesn't fit. */
 int http_case_path(char *out, size_t size, const char *id, const char *suffix);
@@ -88,6 +97,18 @@ enum { ARGS_ERROR = -1, ARGS_HELP = -2 };
 int ctl_parse_args(int argc, char **argv, const ctl_option_spec *specs, const char *usage,
                    const char **positional, int min_positional, int max_positional);
 static inline int ctl_args_exit(int parsed) { return parsed == ARGS_HELP ? CTL_OK : CTL_USAGE; }
+
+/* --- ids.c ------------------------------------------------------------- */
+
+/* Room for a resolved case id (ids are 16 characters). */
+#define CTL_ID_SIZE 64
+/* A case id typed by the user, possibly shortened to a unique prefix of
+ * one: a prefix that exactly one case's id starts with is replaced by that
+ * id (*id then points into buf); a whole id, or one that no case starts
+ * with, is left as typed (the server answers 404 for an unknown one).
+ * Returns CTL_OK, or CTL_USAGE after saying why when the prefix is empty
+ * or shared by several cases (they are listed on stderr). */
+int ctl_resolve_id(const ctl_options *o, const char **id, char *buf, size_t size);
 
 /* --- commands.c (shared with wait.c and fetch.c) ----------------------- */
 

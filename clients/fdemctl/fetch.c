@@ -193,6 +193,9 @@ int cmd_fetch(const ctl_options *o, int argc, char **argv)
                                {"--force", "-f", NULL, &force}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_FETCH, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
 
     char h5_file[2048], xdmf_file[2048], path[512];
     if (http_case_path(path, sizeof path, id[0], "/result.h5") != 0 ||

@@ -116,6 +116,9 @@ int cmd_fragments(const ctl_options *o, int argc, char **argv)
                                {"--exclude-host", NULL, NULL, &exclude_host}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_FRAGMENTS, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char query[700], path[1800];
     if (fragments_query(parts, exclude_host, query, sizeof query) != 0) {
         fprintf(stderr, "fdemctl fragments: --parts is too long\n");

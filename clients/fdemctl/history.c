@@ -94,6 +94,9 @@ int cmd_history(const ctl_options *o, int argc, char **argv)
                                {"--json", NULL, NULL, &raw}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_HISTORY, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char path[1024];
     if (http_case_path(path, sizeof path, id[0], "/history") != 0) {
         fprintf(stderr, "fdemctl history: case id too long\n");

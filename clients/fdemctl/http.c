@@ -1,12 +1,14 @@
 /*
  * http.c - the one place fdemctl touches libcurl: a request returning
- * status + body, and a download streaming into a FILE.
+ * status + body, a download streaming into a FILE, and a body followed as
+ * it arrives (an event stream, GET /stream).
  *
  * Each call builds and frees its own easy handle: fdemctl makes a handful of
  * requests per run, so connection reuse is not worth shared mutable state.
  */
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <curl/curl.h>
 #include "fdemctl.h"
 
@@ -148,6 +150,106 @@ int http_download(const ctl_options *o, const char *path, FILE *sink, http_respo
     curl_slist_free_all(h);
     curl_easy_cleanup(c);
     return rc;
+}
+
+/* ------------------------------------------------------------ following */
+
+/* What a followed body's write callback keeps until the loop hands it on:
+ * `take` may make requests of its own, which must not run inside a
+ * libcurl callback. */
+typedef struct follow_state {
+    CURL *c;
+    body_buffer pending;
+    long status;       /* known once the first piece arrives */
+} follow_state;
+
+static size_t http_follow_collect(char *chunk, size_t size, size_t count, void *user)
+{
+    follow_state *f = user;
+    if (!f->status)
+        curl_easy_getinfo(f->c, CURLINFO_RESPONSE_CODE, &f->status);
+    return http_collect(chunk, size, count, &f->pending);
+}
+
+static double http_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Runs the transfer in `m` until `take` asks to stop (returns 1), the
+ * answer is not 200, the transfer ends or fails, or nothing arrives for
+ * `quiet_limit` seconds (returns -1, out says which). */
+static int http_follow_loop(CURLM *m, follow_state *f, double quiet_limit,
+                            http_piece_fn take, void *arg, http_response *out)
+{
+    double heard = http_now();
+    for (;;) {
+        int running = 0;
+        curl_multi_perform(m, &running);
+        int refused = f->status && f->status != 200; /* its body is a problem: kept whole */
+        if (refused && !running) {
+            out->status = f->status;
+            out->body = f->pending.data ? f->pending.data : calloc(1, 1);
+            out->length = f->pending.length;
+            f->pending = (body_buffer){0};
+            return -1;
+        }
+        if (!refused && f->pending.length > 0) {
+            heard = http_now();
+            body_buffer piece = f->pending;
+            f->pending = (body_buffer){0};
+            int stop = take(arg, piece.data, piece.length);
+            free(piece.data);
+            if (stop)
+                return 1;
+        }
+        if (!running) {
+            CURLMsg *msg;
+            int left;
+            CURLcode rc = CURLE_OK;
+            while ((msg = curl_multi_info_read(m, &left)) != NULL)
+                if (msg->msg == CURLMSG_DONE) rc = msg->data.result;
+            out->status = f->status;
+            snprintf(out->error, sizeof out->error, "%s",
+                     rc != CURLE_OK ? curl_easy_strerror(rc) : "the server ended the stream");
+            return -1;
+        }
+        if (http_now() - heard > quiet_limit) {
+            out->status = f->status;
+            snprintf(out->error, sizeof out->error, "nothing arrived for %.0f s", quiet_limit);
+            return -1;
+        }
+        curl_multi_poll(m, NULL, 0, 1000, NULL);
+    }
+}
+
+int http_follow(const ctl_options *o, const char *path, double quiet_limit, http_piece_fn take,
+                void *arg, http_response *out)
+{
+    char errbuf[CURL_ERROR_SIZE];
+    memset(out, 0, sizeof *out);
+    follow_state f = {0};
+    f.c = http_open(o, path, errbuf);
+    CURLM *m = f.c ? curl_multi_init() : NULL;
+    if (!m) {
+        if (f.c) curl_easy_cleanup(f.c);
+        snprintf(out->error, sizeof out->error, "out of memory");
+        return -1;
+    }
+    struct curl_slist *h = http_headers(o, NULL);
+    curl_easy_setopt(f.c, CURLOPT_HTTPHEADER, h);
+    curl_easy_setopt(f.c, CURLOPT_WRITEFUNCTION, http_follow_collect);
+    curl_easy_setopt(f.c, CURLOPT_WRITEDATA, &f);
+    curl_multi_add_handle(m, f.c);
+    int rc = http_follow_loop(m, &f, quiet_limit, take, arg, out);
+    curl_multi_remove_handle(m, f.c);
+    curl_multi_cleanup(m);
+    curl_easy_cleanup(f.c);
+    curl_slist_free_all(h);
+    free(f.pending.data);
+    return rc > 0 ? 0 : -1;
 }
 
 void http_response_free(http_response *r)

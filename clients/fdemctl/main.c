@@ -61,8 +61,13 @@ static void ctl_print_help(FILE *out)
             "  FDEMD_URL      server base URL\n"
             "  FDEMD_TOKEN    bearer token, when the server was started with --token\n"
             "\n"
+            "case ids: every ID may be shortened to a prefix that only one case's id\n"
+            "starts with (fdemctl status 3f2a); a prefix several ids share is refused,\n"
+            "listing them.\n"
+            "\n"
             "exit status: 0 success, 1 refused by the server (or the case failed/was\n"
-            "stopped, for wait), 2 usage or connection error.\n");
+            "stopped, for wait; or no case has that id: 404), 2 usage or connection\n"
+            "error (an id prefix shared by several cases is a usage error).\n");
 }
 
 static const ctl_command *ctl_find_command(const char *name)

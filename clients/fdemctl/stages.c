@@ -59,6 +59,9 @@ int cmd_extend(const ctl_options *o, int argc, char **argv)
     ctl_option_spec specs[] = {{"--start", NULL, NULL, &start}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_EXTEND, args, 2, 2);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &args[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     char *rest = NULL;
     double end = strtod(args[1], &rest);
     if (rest == args[1] || *rest != '\0' || !isfinite(end)) {
@@ -114,6 +117,9 @@ int cmd_clone(const ctl_options *o, int argc, char **argv)
                                {"--dry-run", NULL, NULL, &dry_run}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_CLONE, args, 2, 2);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &args[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     if (start && dry_run) {
         fprintf(stderr, "fdemctl clone: --dry-run creates nothing, so it cannot --start\n%s",
                 USAGE_CLONE);

@@ -1,5 +1,11 @@
 /*
- * wait.c - `fdemctl wait ID`: polls a case until it ends, showing progress.
+ * wait.c - `fdemctl wait ID`: follows a case until it ends, showing progress.
+ *
+ * It follows the daemon's event stream (GET /stream?case=ID): each status
+ * event is shown as it comes, so an end is seen at once and nothing is
+ * polled. When the daemon has no stream (an older one: 404), refuses one
+ * (503: --max-streams are open) or the stream is cut, it polls GET
+ * /cases/ID every --interval instead, as it always did.
  *
  * On a terminal the progress is one line redrawn in place (bar, percent,
  * step, simulated time, steps/s, ETA); piped, it is one plain line per
@@ -17,8 +23,9 @@
 static const char USAGE_WAIT[] =
     "usage: fdemctl wait ID [--interval SECONDS]\n"
     "  Waits until the case is finished, failed or stopped, showing its progress\n"
-    "  (a redrawn bar on a terminal, one line per update otherwise).\n"
-    "  --interval S   seconds between polls (default 0.5)\n"
+    "  (a redrawn bar on a terminal, one line per update otherwise). It follows\n"
+    "  the daemon's event stream (GET /stream), else polls.\n"
+    "  --interval S   seconds between polls, when polling (default 0.5)\n"
     "  Exit 0 when the case finished; 1 when it failed (its error is printed) or\n"
     "  was stopped, or the server refused; 2 for usage or connection errors.\n";
 
@@ -26,6 +33,7 @@ static const char USAGE_WAIT[] =
 
 typedef struct wait_progress {
     double progress, time, end_time, steps_per_second, dt;
+    double eta;      /* the server's (contract 6.2), < 0 when it sent none */
     long long step;
     const char *state;
     char stage[112]; /* "  stage 1 \"excavate\"" for a case with stages, else "" */
@@ -52,6 +60,8 @@ static wait_progress wait_read(json_t *s)
     p.end_time = json_number_value(json_object_get(s, "end_time"));
     p.steps_per_second = json_number_value(json_object_get(s, "steps_per_second"));
     p.dt = json_number_value(json_object_get(s, "dt"));
+    json_t *eta = json_object_get(s, "eta");
+    p.eta = json_is_number(eta) ? json_number_value(eta) : -1;
     p.step = json_integer_value(json_object_get(s, "step"));
     p.state = json_string_value(json_object_get(s, "state"));
     if (!p.state) p.state = "?";
@@ -66,10 +76,13 @@ static wait_progress wait_read(json_t *s)
     return p;
 }
 
-/* Seconds left from the server's own speed; negative when unknown. */
+/* Seconds left: the server's eta (over its last seconds, steadier than one
+ * speed sample), else from its current speed (an older server); negative
+ * when unknown. */
 static double wait_eta(const wait_progress *p)
 {
     if (strcmp(p->state, "running") != 0) return -1;
+    if (p->eta >= 0) return p->eta;
     if (p->steps_per_second > 0 && p->dt > 0 && p->end_time > p->time)
         return (p->end_time - p->time) / p->dt / p->steps_per_second;
     return -1;
@@ -154,43 +167,171 @@ static int wait_parse_interval(const char *text, double *interval)
     return 0;
 }
 
+/* ------------------------------------------------------------- showing */
+
+typedef struct wait_view {
+    const ctl_options *o;
+    const char *id;
+    FILE *tty;
+    long long last_step;
+    char last_state[32];
+    int code;          /* the exit code, once the wait is over */
+} wait_view;
+
+/* Shows one status; 1 when the case has ended (v->code is its verdict). */
+static int wait_show(wait_view *v, json_t *s)
+{
+    wait_progress p = wait_read(s);
+    if (strcmp(p.state, v->last_state) != 0)
+        wait_hint_idle(v->tty, v->id, p.state, v->last_step >= 0);
+    if (v->tty) {
+        wait_draw_bar(v->tty, &p);
+    } else if (p.step != v->last_step || strcmp(p.state, v->last_state) != 0) {
+        wait_print_line(&p);
+    }
+    v->last_step = p.step;
+    snprintf(v->last_state, sizeof v->last_state, "%s", p.state);
+    if (!wait_is_terminal(p.state)) return 0;
+    if (v->tty) fputc('\n', v->tty);
+    v->code = wait_verdict(v->id, s, &p);
+    return 1;
+}
+
+/* GET /cases/ID, shown; 1 when the wait is over (ended, or the request
+ * failed: v->code says how). */
+static int wait_poll_once(wait_view *v)
+{
+    int code;
+    json_t *s = ctl_get_status(v->o, v->id, &code);
+    if (!s) {
+        if (v->tty && v->last_step >= 0) fputc('\n', v->tty);
+        v->code = code;
+        return 1;
+    }
+    int over = wait_show(v, s);
+    json_decref(s);
+    return over;
+}
+
+/* ----------------------------------------------------------- following */
+
+#define WAIT_STREAM_QUIET 45.0 /* s without a byte: the stream is cut (keep-alives come every 15 s) */
+
+/* The text/event-stream parser: lines are gathered until a blank one
+ * ends an event; "event:" and "data:" are kept, comments skipped. */
+typedef struct wait_stream {
+    wait_view *v;
+    int opened;
+    char *buf;                     /* bytes not yet split into lines */
+    size_t length, capacity;
+    char event[32];
+    char *data;
+} wait_stream;
+
+/* One whole event: a status is shown; a deletion ends the wait as GET
+ * /cases/ID tells it (404). Returns 1 when the wait is over. */
+static int wait_dispatch(wait_stream *w)
+{
+    int over = 0;
+    if (strcmp(w->event, "status") == 0 && w->data) {
+        json_t *s = json_loads(w->data, 0, NULL);
+        if (json_is_object(s)) over = wait_show(w->v, s);
+        json_decref(s);
+    } else if (strcmp(w->event, "deleted") == 0) {
+        over = wait_poll_once(w->v);
+    }
+    w->event[0] = '\0';
+    free(w->data);
+    w->data = NULL;
+    return over;
+}
+
+static int wait_line(wait_stream *w, char *line, size_t length)
+{
+    if (length && line[length - 1] == '\r') line[--length] = '\0';
+    if (length == 0) return wait_dispatch(w);
+    if (line[0] == ':') return 0; /* a comment: the opening line, keep-alives, a gap note */
+    char *colon = memchr(line, ':', length);
+    const char *value = colon ? colon + 1 + (colon[1] == ' ') : "";
+    if (colon) *colon = '\0';
+    if (strcmp(line, "event") == 0) {
+        snprintf(w->event, sizeof w->event, "%s", value);
+    } else if (strcmp(line, "data") == 0) {
+        size_t had = w->data ? strlen(w->data) : 0;
+        char *grown = realloc(w->data, had + strlen(value) + 2);
+        if (!grown) return 0;
+        if (had) grown[had++] = '\n';
+        strcpy(grown + had, value);
+        w->data = grown;
+    }
+    return 0;
+}
+
+static int wait_take(void *arg, const char *data, size_t n)
+{
+    wait_stream *w = arg;
+    if (!w->opened) {
+        /* the stream is open: the state it may have changed from since
+         * the first look is read now, so no change falls between them */
+        w->opened = 1;
+        if (wait_poll_once(w->v)) return 1;
+    }
+    if (w->length + n + 1 > w->capacity) {
+        size_t capacity = w->capacity ? w->capacity : 4096;
+        while (capacity < w->length + n + 1) capacity *= 2;
+        char *grown = realloc(w->buf, capacity);
+        if (!grown) return 0;
+        w->buf = grown;
+        w->capacity = capacity;
+    }
+    memcpy(w->buf + w->length, data, n);
+    w->length += n;
+    size_t at = 0;
+    char *nl;
+    while ((nl = memchr(w->buf + at, '\n', w->length - at)) != NULL) {
+        *nl = '\0';
+        if (wait_line(w, w->buf + at, (size_t)(nl - (w->buf + at)))) return 1;
+        at = (size_t)(nl - w->buf) + 1;
+    }
+    memmove(w->buf, w->buf + at, w->length - at);
+    w->length -= at;
+    return 0;
+}
+
+/* Follows GET /stream?case=ID; 1 when the wait is over, 0 when there is
+ * no stream to follow (the caller polls). */
+static int wait_follow(wait_view *v)
+{
+    if (strspn(v->id, "0123456789abcdef") != strlen(v->id)) return 0;
+    char path[128];
+    snprintf(path, sizeof path, "/stream?case=%.64s", v->id);
+    wait_stream w = {.v = v};
+    http_response r;
+    int rc = http_follow(v->o, path, WAIT_STREAM_QUIET, wait_take, &w, &r);
+    http_response_free(&r);
+    free(w.buf);
+    free(w.data);
+    return rc == 0;
+}
+
 int cmd_wait(const ctl_options *o, int argc, char **argv)
 {
     const char *id[1], *interval_text = NULL;
     ctl_option_spec specs[] = {{"--interval", "-i", &interval_text, NULL}, {0}};
     int n = ctl_parse_args(argc, argv, specs, USAGE_WAIT, id, 1, 1);
     if (n < 0) return ctl_args_exit(n);
+    char id_buf[CTL_ID_SIZE];
+    int resolved = ctl_resolve_id(o, &id[0], id_buf, sizeof id_buf);
+    if (resolved) return resolved;
     double interval = 0.5;
     if (interval_text && wait_parse_interval(interval_text, &interval) != 0) return CTL_USAGE;
 
-    FILE *tty = isatty(fileno(stderr)) ? stderr : isatty(fileno(stdout)) ? stdout : NULL;
-    long long last_step = -1;
-    char last_state[32] = "";
-    for (;;) {
+    wait_view v = {o, id[0], NULL, -1, "", CTL_OK};
+    v.tty = isatty(fileno(stderr)) ? stderr : isatty(fileno(stdout)) ? stdout : NULL;
+    if (wait_poll_once(&v) || wait_follow(&v)) return v.code;
+    for (;;) { /* no stream: poll */
         double polled_at = wait_now();
-        int code;
-        json_t *s = ctl_get_status(o, id[0], &code);
-        if (!s) {
-            if (tty) fputc('\n', tty);
-            return code;
-        }
-        wait_progress p = wait_read(s);
-        if (strcmp(p.state, last_state) != 0)
-            wait_hint_idle(tty, id[0], p.state, last_step >= 0);
-        if (tty) {
-            wait_draw_bar(tty, &p);
-        } else if (p.step != last_step || strcmp(p.state, last_state) != 0) {
-            wait_print_line(&p);
-        }
-        last_step = p.step;
-        snprintf(last_state, sizeof last_state, "%s", p.state);
-        if (wait_is_terminal(p.state)) {
-            if (tty) fputc('\n', tty);
-            code = wait_verdict(id[0], s, &p);
-            json_decref(s);
-            return code;
-        }
-        json_decref(s);
+        if (wait_poll_once(&v)) return v.code;
         double left = interval - (wait_now() - polled_at);
         if (left > 0) wait_sleep(left);
     }

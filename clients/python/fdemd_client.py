@@ -25,7 +25,8 @@ import warnings
 import urllib.parse
 import urllib.request
 
-__all__ = ["Client", "FdemdError", "FdemdConnectionError", "DEFAULT_URL", "stage_label"]
+__all__ = ["Client", "FdemdError", "FdemdConnectionError", "AmbiguousIdError", "DEFAULT_URL",
+           "stage_label"]
 
 DEFAULT_URL = "http://127.0.0.1:8080"
 TERMINAL_STATES = ("finished", "failed", "stopped")
@@ -66,6 +67,17 @@ class FdemdError(Exception):
 
 class FdemdConnectionError(FdemdError, ConnectionError):
     """The server could not be reached at all (status 0)."""
+
+
+class AmbiguousIdError(ValueError):
+    """A shortened case id that several cases' ids start with
+    (Client.resolve_id); .prefix and .matches (the whole ids)."""
+
+    def __init__(self, prefix, matches):
+        self.prefix = prefix
+        self.matches = list(matches)
+        super().__init__("case id prefix %r is ambiguous: %d cases start with it (%s)"
+                         % (prefix, len(self.matches), ", ".join(self.matches[:10])))
 
 
 class Client:
@@ -170,6 +182,24 @@ class Client:
         if state is not None:
             path += "?state=" + urllib.parse.quote(str(state), safe="")
         return self._json("GET", path)["cases"]
+
+    def resolve_id(self, prefix):
+        """The whole id of the one case whose id starts with `prefix`, as
+        fdemctl resolves a shortened ID (one GET /cases): a whole id, or a
+        prefix no case has, comes back as given (the next request then gets
+        the server's 404). Raises ValueError for an empty prefix and
+        AmbiguousIdError (a ValueError, with .matches: the ids) when several
+        cases start with it."""
+        prefix = str(prefix)
+        if not prefix:
+            raise ValueError("an empty case id names no case")
+        ids = [c.get("id", "") for c in self.list()]
+        if prefix in ids:
+            return prefix
+        matches = [i for i in ids if i.startswith(prefix)]
+        if len(matches) > 1:
+            raise AmbiguousIdError(prefix, matches)
+        return matches[0] if matches else prefix
 
     def status(self, case_id):
         """The status object of one case (state, step, time, progress,
@@ -399,13 +429,55 @@ class Client:
         columns["energy"] = {k: np.asarray(v, dtype=float) for k, v in columns["energy"].items()}
         return columns
 
+    def stream(self, case_id=None, last_event_id=None, read_timeout=45.0):
+        """Follows the daemon's event stream (GET /stream, Server-Sent Events).
+
+        The stream is open when this returns (raising FdemdError when the
+        daemon refuses one: 404 from a daemon without streams, 503 when
+        --max-streams are open): an iterator of (kind, data, event_id), one
+        per event as it arrives. kind is "status" (data: a status object,
+        as status() gives), "snapshot" ({"id", "index", "time"}: snapshot
+        `index` of the case is written) or "deleted" ({"id"}); event_id is
+        the event's id (a string). Given back as last_event_id, it resumes
+        the stream right after that event, with nothing lost if it is among
+        the daemon's last 1000. case_id narrows the stream to one case. The
+        iterator ends when the daemon ends the stream (it stops), and
+        raises TimeoutError when nothing arrives for read_timeout seconds
+        (the daemon sends a keep-alive every 15 s).
+        """
+        response = self._open_stream(case_id, last_event_id, read_timeout)
+        return _closing_events(response)
+
+    def _open_stream(self, case_id, last_event_id, read_timeout):
+        headers = {"Accept": "text/event-stream"}
+        if self.token:
+            headers["Authorization"] = "Bearer " + self.token
+        if last_event_id is not None:
+            headers["Last-Event-ID"] = str(last_event_id)
+        path = "/stream" + ("?case=" + urllib.parse.quote(str(case_id), safe="")
+                            if case_id is not None else "")
+        request = urllib.request.Request(self.url + path, headers=headers)
+        try:
+            return urllib.request.urlopen(request, timeout=read_timeout)
+        except urllib.error.HTTPError as e:
+            raise _problem_from(e.code, e.read()) from None
+        except (urllib.error.URLError, OSError) as e:
+            raise FdemdConnectionError(
+                0, "Cannot reach fdemd", "could not reach the fdemd server at %s%s (%s)"
+                % (self.url, path, getattr(e, "reason", e))) from None
+
     def wait(self, case_id, callback=None, interval=0.5, raise_on_failure=False, timeout=None):
-        """Polls until the case is finished, failed or stopped.
+        """Waits until the case is finished, failed or stopped.
+
+        It follows the daemon's event stream (stream()), so each status is
+        seen as the daemon sends it and an end at once; when the daemon has
+        no stream (an older one), refuses one, or the stream is cut, it
+        polls GET /cases/ID instead.
 
         Args:
-            callback: called with every status object polled (the last one
+            callback: called with every status object seen (the last one
                 included), e.g. to draw progress.
-            interval: seconds between polls.
+            interval: seconds between polls, when polling.
             raise_on_failure: raise FdemdError (status None, the case's
                 error as detail, case_status set) when the case ends failed
                 or stopped instead of returning its status.
@@ -414,27 +486,65 @@ class Client:
             the final status object.
         """
         deadline = None if timeout is None else time.monotonic() + timeout
-        last_state = None
-        while True:
-            s = self.status(case_id)
+        last_state = [None]
+
+        def seen(s):
+            """Shows one status; True when the case has ended."""
             if callback is not None:
                 callback(s)
-            if s.get("state") in TERMINAL_STATES:
-                break
-            if s.get("state") in ("created", "paused") and s.get("state") != last_state:
+            state = s.get("state")
+            if state in ("created", "paused") and state != last_state[0]:
                 # It will not move until someone starts it: keep waiting
                 # (another client may), but say why, once per such state.
                 warnings.warn("case %s is %s: it does not run until it is started "
-                              "(Client.start(%r)); waiting" % (case_id, s["state"], case_id),
-                              stacklevel=2)
-            last_state = s.get("state")
-            if deadline is not None and time.monotonic() > deadline:
-                raise TimeoutError("case %s still %s after %g s" % (case_id, s.get("state"), timeout))
-            time.sleep(interval)
+                              "(Client.start(%r)); waiting" % (case_id, state, case_id),
+                              stacklevel=3)
+            last_state[0] = state
+            return state in TERMINAL_STATES
+
+        s = self.status(case_id)
+        if not seen(s):
+            s = self._follow(case_id, seen, deadline) or self._poll(case_id, seen, interval,
+                                                                      deadline, timeout)
         if raise_on_failure and s["state"] != "finished":
             detail = s.get("error") or "stopped at step %s, t = %s s" % (s.get("step"), s.get("time"))
             raise FdemdError(None, "Case %s %s" % (case_id, s["state"]), detail, case_status=s)
         return s
+
+    def _follow(self, case_id, seen, deadline):
+        """The final status, followed on the event stream; None when there
+        is no stream to follow (the caller polls)."""
+        left = None if deadline is None else deadline - time.monotonic()
+        read_timeout = 45.0 if left is None else max(0.1, min(45.0, left))
+        try:
+            response = self._open_stream(case_id, None, read_timeout)
+        except FdemdError:
+            return None
+        with response:
+            # the stream is open: what changed since the first look is read now
+            s = self.status(case_id)
+            if seen(s):
+                return s
+            try:
+                for kind, data, _ in _read_events(response):
+                    if kind == "status" and seen(data):
+                        return data
+                    if kind == "deleted":
+                        self.status(case_id)  # raises its 404
+                    if deadline is not None and time.monotonic() > deadline:
+                        break  # the poll says it has timed out
+            except (TimeoutError, OSError, ValueError):
+                pass
+        return None
+
+    def _poll(self, case_id, seen, interval, deadline, timeout):
+        while True:
+            s = self.status(case_id)
+            if seen(s):
+                return s
+            if deadline is not None and time.monotonic() > deadline:
+                raise TimeoutError("case %s still %s after %g s" % (case_id, s.get("state"), timeout))
+            time.sleep(interval)
 
     def fetch(self, case_id, path=None, force=False):
         """Downloads result.h5 to `path` and the XDMF sidecar beside it.
@@ -508,6 +618,35 @@ def _problem_from(status, body):
                           doc.get("detail") or "", doc.get("errors") or [])
     text = body.decode("utf-8", "replace")[:300] if body else ""
     return FdemdError(status, "Request refused", text)
+
+
+def _closing_events(response):
+    with response:
+        yield from _read_events(response)
+
+
+def _read_events(response):
+    """(kind, data, event_id) of each event of a text/event-stream body;
+    comment lines (the opening line, keep-alives, a note that events were
+    dropped) are skipped."""
+    kind, data, event_id = None, [], None
+    for raw in response:
+        line = raw.decode("utf-8").rstrip("\r\n")
+        if not line:
+            if data:
+                yield kind or "message", json.loads("\n".join(data)), event_id
+            kind, data = None, []
+            continue
+        if line.startswith(":"):
+            continue
+        field, _, value = line.partition(":")
+        value = value[1:] if value.startswith(" ") else value
+        if field == "event":
+            kind = value
+        elif field == "data":
+            data.append(value)
+        elif field == "id":
+            event_id = value
 
 
 def _save_stream(response, path):

@@ -19,6 +19,7 @@
 #include "model/model.h"
 #include "contact/contact.h"
 #include "joint/joint.h"
+#include "fluid/fluid.h"
 #include "parallel/scatter_plan.h"
 #include "step/step.h"
 #include "build.h"
@@ -66,6 +67,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     stages_free(m);
+    fluid_free(m);
     contact_free(&m->contact);
     scatter_plan_free(&m->elem_plan);
     joint_sweep_free(&m->joint_sweep);
@@ -605,7 +607,7 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     if (has_amplitude && (def->kind == FDEM_CONSTRAINT_FIX || def->kind == FDEM_CONSTRAINT_ABSORB)) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k,
                     "constraint %d: an amplitude scales a velocity, force, pressure, boundary "
-                    "stress or traction only", k);
+                    "stress, traction or injection only", k);
         return -1;
     }
     double *amplitude = NULL;
@@ -625,7 +627,8 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
     m->constraints[k].amplitude = amplitude;
     m->constraints[k].def.amplitude = amplitude;
     m->constraints[k].def.amplitude_count = amplitude ? def->amplitude_count : 0;
-    if (def->kind == FDEM_CONSTRAINT_PRESSURE || def->kind == FDEM_CONSTRAINT_ABSORB)
+    if (def->kind == FDEM_CONSTRAINT_PRESSURE || def->kind == FDEM_CONSTRAINT_ABSORB ||
+        def->kind == FDEM_CONSTRAINT_INJECT)
         m->constraints[k].def.value[1] = m->constraints[k].def.value[2] = 0;
     if (constraint_keep_vertices(&m->constraints[k])) {
         free(amplitude);

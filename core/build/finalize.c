@@ -15,6 +15,7 @@
 
 #include "contact/contact.h"
 #include "element/element.h"
+#include "fluid/fluid.h"
 #include "joint/joint.h"
 #include "model/model.h"
 #include "parallel/scatter_plan.h"
@@ -155,6 +156,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     if (constraint_select(m, err)) return -1;
     if (boundary_load_select(m, err)) return -1;
     if (fixed_parts_prepare(m, err)) return -1;
+    if (fluid_prepare(m, err)) return -1; /* tightens stable_dt by the fluid's stiffness */
     m->dt = m->stable_dt * 0.5;
     m->dt_prev = 0;
     m->finalized = 1;

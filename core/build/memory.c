@@ -17,6 +17,7 @@
 
 #include "contact/contact.h"
 #include "joint/joint.h"
+#include "fluid/fluid.h"
 #include "model/model.h"
 #include "nbs/nbs.h"
 #include "build.h"
@@ -203,8 +204,10 @@ size_t fdem_memory_bytes(const fdem_model *m)
          (size_t)m->constraint_count * D * sizeof(double);
     b += (size_t)m->part_capacity * (sizeof(part) + 3 * sizeof(double)) +
          (size_t)m->material_capacity * sizeof(material);
-    /* boundary facets of pressures and dashpots: nodes, element, forces */
-    b += (size_t)m->bfacet_count * ((D + 1) * sizeof(int32_t) + D * D * sizeof(double));
+    /* boundary facets of pressures and dashpots: nodes, element, forces (and
+     * with excavations when each opens) */
+    b += (size_t)m->bfacet_count * ((D + 1 + (m->bfacet_open != NULL)) * sizeof(int32_t) +
+                                    D * D * sizeof(double));
     b += scatter_plan_bytes(&m->elem_plan) + joint_sweep_bytes(&m->joint_sweep) +
          scatter_plan_bytes(&m->node_plan);
     b += contact_memory_bytes(&m->contact);
@@ -214,5 +217,6 @@ size_t fdem_memory_bytes(const fdem_model *m)
         b += (size_t)m->stages[k].excavate_count * sizeof(int32_t) +
              (size_t)m->stages[k].ramp_count * (sizeof(int32_t) + D * sizeof(double));
     if (m->elem_active) b += (size_t)m->elem_count + (size_t)m->node_count;
+    b += fluid_memory_bytes(m);
     return b;
 }

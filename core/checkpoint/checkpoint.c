@@ -18,6 +18,7 @@
 #include "checkpoint.h"
 #include "contact/contact.h"
 #include "element/element.h"
+#include "fluid/fluid.h"
 #include "joint/joint.h"
 #include "step/step.h"
 
@@ -53,8 +54,19 @@ static checkpoint_energy checkpoint_energy_of(const fdem_energy *e)
 
 static fdem_energy energy_of_checkpoint(const checkpoint_energy *c, double excavated)
 {
-    return (fdem_energy){c->kinetic, c->elastic, c->joint, c->contact, c->friction, c->fracture,
-                         c->damping, c->gravity_work, c->external_work, c->residual, excavated};
+    fdem_energy e = {0};
+    e.kinetic = c->kinetic;
+    e.elastic = c->elastic;
+    e.joint = c->joint;
+    e.contact = c->contact;
+    e.friction = c->friction;
+    e.fracture = c->fracture;
+    e.damping = c->damping;
+    e.gravity_work = c->gravity_work;
+    e.external_work = c->external_work;
+    e.residual = c->residual;
+    e.excavated = excavated;
+    return e;
 }
 
 /* Version 2 adds what makes a restored run continue bit for bit: the last
@@ -83,7 +95,9 @@ typedef struct checkpoint_header {
      * files, whose time was summed plainly). Version 7: the same header;
      * the slip each joint point keeps (joint_law.h) follows the events.
      * Version 8: the same header; a model with stages has its stage
-     * section (step/stages.c) after the slip. */
+     * section (step/stages.c) after the slip. Version 9: the same header;
+     * a model with fluid has its fluid section (fluid/fluid_checkpoint.c)
+     * between the slip and the stages. */
     double time_carry;
 } checkpoint_header;
 
@@ -118,7 +132,8 @@ size_t fdem_checkpoint_size(const fdem_model *m)
     return sizeof(checkpoint_header) +
            checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
                                 contact_history_checkpoint_size(&m->contact)) +
-           events_checkpoint_size(m) + checkpoint_slip_size(m) + stages_checkpoint_size(m);
+           events_checkpoint_size(m) + checkpoint_slip_size(m) + fluid_checkpoint_size(m) +
+           stages_checkpoint_size(m);
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
@@ -171,6 +186,8 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     p += events_checkpoint_size(m);
     if (m->joint_count) memcpy(p, m->joint_slip, checkpoint_slip_size(m));
     p += m->joint_count ? checkpoint_slip_size(m) : 0;
+    fluid_checkpoint_write(m, p);
+    p += fluid_checkpoint_size(m);
     stages_checkpoint_write(m, p);
     return 0;
 }
@@ -269,6 +286,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
             expected += sizeof(double) * (size_t)m->joint_count +
                         sizeof(fdem_event) * (size_t)h.pending_events;
         if (h1.version >= 7) expected += checkpoint_slip_size(m);
+        if (h1.version >= 9) expected += fluid_checkpoint_size(m);
     }
     /* the stage section's size depends on its ramps: it is checked as it
      * is read, and takes what follows the fixed part */
@@ -304,12 +322,13 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         else
             memset(m->joint_slip, 0, checkpoint_slip_size(m));
     }
+    const unsigned char *fluid = events + events_checkpoint_size(m) +
+                                 (m->joint_count ? checkpoint_slip_size(m) : 0);
+    size_t fluid_bytes = h1.version >= 9 ? fluid_checkpoint_size(m) : 0;
     /* the stages before the counts below: they leave excavated joints out */
     size_t stage_used = 0;
     if (stage_bytes &&
-        (stages_checkpoint_read(m, events + events_checkpoint_size(m) +
-                                       (m->joint_count ? checkpoint_slip_size(m) : 0),
-                                stage_bytes, &stage_used, err) ||
+        (stages_checkpoint_read(m, fluid + fluid_bytes, stage_bytes, &stage_used, err) ||
          stage_used != stage_bytes)) {
         if (stage_used != stage_bytes)
             model_error(err, FDEM_ITEM_NONE, -1, "checkpoint's stage section does not fit");
@@ -358,6 +377,8 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         return -1;
     }
     m->contact.max_disp2 = h.max_disp2;
+    /* after the positions: pressures and apertures follow from them */
+    if (fluid_bytes) fluid_checkpoint_read(m, fluid);
     if (h1.version == 1) { /* no accounts stored: those of the restored positions */
         element_forces(m);
         memset(m->force, 0, nb);
@@ -368,6 +389,10 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
         m->elastic_energy = h.energy.elastic;
         m->joint_energy = h.energy.joint;
         m->restored_energy = energy_of_checkpoint(&h.energy, m->excavated_energy);
+        if (fluid_bytes) {
+            m->restored_energy.fluid_work = m->fluid->restored_work;
+            m->restored_energy.fluid_dissipation = m->fluid->dissipation;
+        }
         m->restored_energy_valid = 1;
         energy_gravity_restored(m, h.energy.gravity_work);
     }

@@ -38,9 +38,12 @@ int contact_pair_force_now(const fdem_model *m, size_t k, double *out);
 
 /* contact_excavation.c: the forces of the candidate pairs between removed
  * and remaining elements on the remaining ones, added to f (dim per node;
- * returns 0); the candidate pairs of excavated elements dropped */
+ * returns 0); the candidate pairs of excavated elements dropped; */
 int contact_excavation_forces(fdem_model *m, const uint8_t *removed, double *f);
 void contact_drop_excavated(fdem_model *m);
+/* The penalty energy of the touching pairs with an element removed now
+ * (removed[e]), before any is dropped. */
+double contact_excavation_energy(const fdem_model *m, const uint8_t *removed);
 
 /* contact_history.c */
 int contact_history_reserve(contact_state *cs, size_t pairs);

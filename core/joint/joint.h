@@ -104,6 +104,8 @@ void events_checkpoint_write(const fdem_model *m, unsigned char *p);
 int events_checkpoint_read(fdem_model *m, const unsigned char *p, int64_t count);
 /* joint_strength.c: every joint's strength (material, joint set, variation) */
 int joint_strengths_assign(fdem_model *m, fdem_error *err);
+/* the joint set joint j lies on (the last that names its face), or -1 */
+int joint_set_index(const fdem_model *m, int j);
 void joint_sets_free(fdem_model *m);
 double weibull_factor(uint64_t seed, uint64_t index, double modulus);
 /* joint_region.c: fracture in a region. The node (0-based within the part)

@@ -69,15 +69,38 @@ static const initial_stress_def *stress_def_of_part(const fdem_model *m, int p)
     return NULL;
 }
 
+/* The pore pressure joint j holds at t = 0 (contract 6.4: its set's or its
+ * material's fracture parameters, at the height of face A's centre, as
+ * core/fluid evaluates it), 0 without fluid or without one. The fluid
+ * pushes the faces apart with it, so the joint itself carries the
+ * effective traction sigma . n + p n (Terzaghi): the two together are the
+ * rock's sigma . n, and a stressed part with pore pressure is at rest at
+ * t = 0 as one without. */
+static double joint_pore_pressure0(const fdem_model *m, int j)
+{
+    if (!m->fluid) return 0;
+    int set = m->joint_set_count ? joint_set_index(m, j) : -1;
+    const fdem_fracture_params *p =
+        set >= 0 ? &m->joint_sets[set].params
+                 : &m->materials[element_material(m, m->joint_elem[2 * j])].def.fracture;
+    if (!p->has_pore_pressure) return 0;
+    const int D = m->dim;
+    const int32_t *n = m->joint_node + 2 * (size_t)D * (size_t)j;
+    double h = 0;
+    for (int i = 0; i < D; i++) h += m->pos0[(size_t)D * (size_t)n[i] + (size_t)(D - 1)];
+    h /= D;
+    return p->pore_pressure[0] + p->pore_pressure[1] * (h - p->pore_pressure[2]);
+}
+
 /* Joint j's in-situ gaps, dim x dim values: corner by corner, the opening
- * and the slide(s) of k o = sigma . n. */
+ * and the slide(s) of k o = sigma . n (+ p n with a pore pressure). */
 static void joint_offsets(const fdem_model *m, int j, const initial_stress_def *def, double *o)
 {
     const int D = m->dim, S = model_stress_comps(m);
     double frame[3][3];
     if (!initial_frame(m, j, frame)) return; /* a face of no area carries nothing */
     const int32_t *n = m->joint_node + 2 * (size_t)D * (size_t)j;
-    double k = m->joint_k[j];
+    double k = m->joint_k[j], pore = joint_pore_pressure0(m, j);
     for (int i = 0; i < D; i++) {
         double s[6], t[3];
         initial_stress_at(def, S, m->pos0[(size_t)D * (size_t)n[i] + (size_t)(D - 1)], s);
@@ -85,6 +108,7 @@ static void joint_offsets(const fdem_model *m, int j, const initial_stress_def *
         for (int a = 0; a < D; a++) {
             double along = 0;
             for (int c = 0; c < D; c++) along += t[c] * frame[a][c];
+            if (a == 0 && pore != 0) along += pore; /* without: the same bits as before */
             o[D * i + a] = along / k;
         }
     }

@@ -157,6 +157,8 @@ static int joint_set_of(const fdem_model *m, int j)
     return -1;
 }
 
+int joint_set_index(const fdem_model *m, int j) { return joint_set_of(m, j); }
+
 /* ------------------------------------------------------------ the table */
 
 /* The variation joint j's strengths take: its set's, else its material's. */

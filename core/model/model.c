@@ -80,6 +80,11 @@ const int32_t *fdem_element_parts(const fdem_model *m) { return m->elem_part; }
 const int32_t *fdem_joints(const fdem_model *m) { return m->joint_count ? m->joint_node : NULL; }
 const double *fdem_joint_damage(const fdem_model *m) { return m->joint_count ? m->joint_damage : NULL; }
 
+void fdem_copy_joint_damage(const fdem_model *m, double *out)
+{
+    for (int j = 0; j < m->joint_count; j++) out[j] = joint_damage_shown(m, j);
+}
+
 int fdem_nodes_per_element(const fdem_model *m) { return m->elem_nodes; }
 const int32_t *fdem_element_nodes(const fdem_model *m) { return m->elem_node; }
 const int32_t *fdem_triangles(const fdem_model *m) { return m->dim == 2 ? m->elem_node : NULL; }

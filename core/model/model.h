@@ -298,7 +298,8 @@ struct fdem_model {
                                 the in-situ gap at each corner, its opening and then its
                                 slide, in the face's own frame, so that the joint carries
                                 sigma.n from t = 0 (joint_prestress.c) */
-    double *joint_damage;    /* 0 intact .. 1 broken, never decreases */
+    double *joint_damage;    /* 0 intact .. 1 broken, never decreases; an excavated joint
+                                holds JOINT_DAMAGE_EXCAVATED + its damage then (see there) */
     joint_slip *joint_slip;  /* dim per joint, one per integration point: the plastic slide
                                 and slip path each keeps (joint_law.h); zero while undamaged */
     int32_t *elem_joint;     /* dim + 1 per element: its joints, -1 where none */
@@ -331,6 +332,8 @@ struct fdem_model {
     int32_t *bfacet_node;
     int32_t *bfacet_elem;
     double *bfacet_force;
+    int32_t *bfacet_open;    /* with excavations: stages started before each entry is boundary
+                                (0: from the start), NULL without */
     double boundary_power_old[2]; /* this step's sum f . v_old: applied loads, dashpots */
     double dt, dt_prev;      /* h_next and h_current of seed eq. 5.9 */
     int64_t step;
@@ -377,6 +380,7 @@ struct fdem_model {
 
     contact_state contact;
     fdem_stage_times times;
+    struct fluid_net *fluid; /* fluid in the fractures (fluid/fluid.h); NULL without */
 
     /* threads for the per-step loops; the plans fix the summation order so
      * that the result does not depend on the thread count */
@@ -443,6 +447,21 @@ static inline double element_size0(const fdem_model *m, int e)
 static inline int element_is_active(const fdem_model *m, int e)
 {
     return !m->elem_active || m->elem_active[e];
+}
+
+/* A joint on an excavated element holds nothing from then on, yet its
+ * damage is not 1: it did not break (contract 5.4: 1 is broken). It keeps
+ * the damage it had as JOINT_DAMAGE_EXCAVATED + d: at least 1, so every
+ * joint loop leaves it alone as it does a broken joint, and d kept (to
+ * 2 ulp) for the output (fdem_copy_joint_damage) and in checkpoints. A
+ * joint broken before the excavation stays at 1. */
+#define JOINT_DAMAGE_EXCAVATED 2.0
+
+/* The damage joint j shows: what it had when excavated, if it was. */
+static inline double joint_damage_shown(const fdem_model *m, int j)
+{
+    double d = m->joint_damage[j];
+    return d >= JOINT_DAMAGE_EXCAVATED ? d - JOINT_DAMAGE_EXCAVATED : d;
 }
 
 static inline double element_eta(const fdem_model *m, int e)

@@ -16,6 +16,17 @@
  * at finalize, their forces are recomputed on the deformed geometry at
  * every step. Nothing here runs for a model without such constraints.
  *
+ * Excavation (stages.c) changes the boundary: a facet between an element
+ * that stays and one a stage removes becomes boundary when that stage
+ * starts (the opening), and the facets of a removed element stop being
+ * boundary. So in a model whose stages excavate, finalize also keeps the
+ * facets that open later, each with the number of stages that must have
+ * started before it is loaded (bfacet_open), and a facet loads only while
+ * its element is active: a pressure, boundary stress, traction or dashpot
+ * on nodes of the opening acts on its wall (a support pressure in a
+ * staged tunnel). Which facets are live follows from the stages started
+ * and the active elements alone, so a checkpoint needs nothing more.
+ *
  * Lumping: a load uniform over a facet puts |S|/dim of it on each vertex.
  * A boundary stress varies linearly with the height, so its traction is
  * linear along the facet and is lumped consistently (int N_a t dA): 2D
@@ -136,11 +147,52 @@ static facet_key *facets_sorted(const fdem_model *m, int *out_count)
     return keys;
 }
 
-static int facet_is_boundary(const facet_key *keys, int count, int i)
+static int same_facet(const facet_key *a, const facet_key *b)
 {
-    const size_t bytes = sizeof keys[i].vertex;
-    return !(i > 0 && memcmp(keys[i].vertex, keys[i - 1].vertex, bytes) == 0) &&
-           !(i + 1 < count && memcmp(keys[i].vertex, keys[i + 1].vertex, bytes) == 0);
+    return memcmp(a->vertex, b->vertex, sizeof a->vertex) == 0;
+}
+
+/* When facet i of keys is on the boundary of its element's body: 0 from
+ * the start, k once k stages have started (the stage k - 1 that removes
+ * the last element on its other side), -1 never (an element that stays is
+ * on its other side, or its own element goes no later than that). removed_by
+ * (NULL without excavations) holds per element the number of stages started
+ * once it is gone, 0 if it stays. */
+static int facet_opens_at(const facet_key *keys, int count, int i, const int32_t *removed_by)
+{
+    int lo = i, hi = i + 1;
+    while (lo > 0 && same_facet(&keys[lo - 1], &keys[i])) lo--;
+    while (hi < count && same_facet(&keys[hi], &keys[i])) hi++;
+    if (hi - lo == 1) return 0;
+    if (!removed_by) return -1;
+    int opens = 0;
+    for (int o = lo; o < hi; o++) {
+        if (o == i) continue;
+        int gone = removed_by[keys[o].elem];
+        if (!gone) return -1;
+        if (gone > opens) opens = gone;
+    }
+    int own = removed_by[keys[i].elem];
+    return own && own <= opens ? -1 : opens;
+}
+
+/* Per element, 1 + the first stage that excavates it (the number of stages
+ * started once it is gone), 0 for one that stays; NULL when no stage
+ * excavates (*failed set when out of memory). */
+static int32_t *elements_removed_by(const fdem_model *m, int *failed)
+{
+    int any = 0;
+    for (int k = 0; k < m->stage_count; k++) any |= m->stages[k].excavate_count > 0;
+    *failed = 0;
+    if (!any) return NULL;
+    int32_t *by = calloc((size_t)(m->elem_count ? m->elem_count : 1), sizeof *by);
+    if (!by) {
+        *failed = 1;
+        return NULL;
+    }
+    for (int k = m->stage_count - 1; k >= 0; k--)
+        for (int i = 0; i < m->stages[k].excavate_count; i++) by[m->stages[k].excavate[i]] = k + 1;
+    return by;
 }
 
 /* Boundary facet i of keys, when constraint c selects all its nodes: its
@@ -159,7 +211,8 @@ static int facet_selected(const fdem_model *m, const constraint *c, const facet_
 
 /* Pass 0 counts the entries of every boundary-load constraint, pass 1 fills
  * them in. */
-static void facets_assign(fdem_model *m, const facet_key *keys, int count, int pass)
+static void facets_assign(fdem_model *m, const facet_key *keys, int count,
+                          const int32_t *removed_by, int pass)
 {
     const int D = m->dim;
     int at = 0;
@@ -169,10 +222,12 @@ static void facets_assign(fdem_model *m, const facet_key *keys, int count, int p
         c->facet_begin = at;
         for (int i = 0; i < count; i++) {
             int32_t n[3];
-            if (!facet_is_boundary(keys, count, i) || !facet_selected(m, c, &keys[i], n)) continue;
+            int opens = facet_opens_at(keys, count, i, removed_by);
+            if (opens < 0 || !facet_selected(m, c, &keys[i], n)) continue;
             if (pass) {
                 memcpy(m->bfacet_node + (size_t)D * (size_t)at, n, sizeof(int32_t) * (size_t)D);
                 m->bfacet_elem[at] = keys[i].elem;
+                if (m->bfacet_open) m->bfacet_open[at] = opens;
             }
             at++;
         }
@@ -207,24 +262,29 @@ int boundary_load_select(fdem_model *m, fdem_error *err)
     for (int k = 0; k < m->constraint_count; k++) wanted |= is_boundary_load(&m->constraints[k]);
     if (!wanted) return 0;
     if (!stress_fields_finite(m, err)) return -1;
-    int count = 0;
-    facet_key *keys = facets_sorted(m, &count);
+    int count = 0, failed = 0;
+    int32_t *removed_by = elements_removed_by(m, &failed);
+    facet_key *keys = failed ? NULL : facets_sorted(m, &count);
     if (!keys) {
+        free(removed_by);
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the boundary facets");
         return -1;
     }
-    facets_assign(m, keys, count, 0);
+    facets_assign(m, keys, count, removed_by, 0);
     const size_t D = (size_t)m->dim, n = (size_t)(m->bfacet_count ? m->bfacet_count : 1);
     m->bfacet_node = malloc(sizeof(int32_t) * D * n);
     m->bfacet_elem = malloc(sizeof(int32_t) * n);
     m->bfacet_force = calloc(D * D * n, sizeof(double));
-    if (!m->bfacet_node || !m->bfacet_elem || !m->bfacet_force) {
+    if (removed_by) m->bfacet_open = malloc(sizeof(int32_t) * n);
+    if (!m->bfacet_node || !m->bfacet_elem || !m->bfacet_force || (removed_by && !m->bfacet_open)) {
         free(keys);
+        free(removed_by);
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the boundary facets");
         return -1;
     }
-    facets_assign(m, keys, count, 1);
+    facets_assign(m, keys, count, removed_by, 1);
     free(keys);
+    free(removed_by);
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
         if (is_boundary_load(c) && c->facet_count == 0) {
@@ -305,9 +365,18 @@ static void vertex_force(const fdem_model *m, const constraint *c, int j, const 
     }
 }
 
+/* Facet j is boundary now: opened by the stages started, its element not
+ * excavated (always, in a model whose stages excavate nothing). */
+static int facet_live(const fdem_model *m, int j)
+{
+    return !m->bfacet_open || (m->stages_started >= m->bfacet_open[j] &&
+                               element_is_active(m, m->bfacet_elem[j]));
+}
+
 /* The facet forces of this step, at the positions of t_n and (dashpots) the
  * velocities v(t_n - h/2): added to the node forces, totalled per
  * constraint, and their power with those velocities kept for the work. */
+
 void boundary_load_apply(fdem_model *m)
 {
     if (!m->bfacet_count) return;
@@ -319,6 +388,11 @@ void boundary_load_apply(fdem_model *m)
         int absorb = c->def.kind == FDEM_CONSTRAINT_ABSORB;
         c->force[0] = c->force[1] = c->force[2] = 0;
         for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++) {
+            if (!facet_live(m, j)) { /* no force, so no work (boundary_power) */
+                memset(m->bfacet_force + (size_t)D * (size_t)D * (size_t)j, 0,
+                       sizeof(double) * (size_t)D * (size_t)D);
+                continue;
+            }
             const int32_t *n = m->bfacet_node + (size_t)D * (size_t)j;
             double s[3];
             facet_area_vector(m, n, s);
@@ -379,4 +453,5 @@ void boundary_load_free(fdem_model *m)
     free(m->bfacet_node);
     free(m->bfacet_elem);
     free(m->bfacet_force);
+    free(m->bfacet_open);
 }

@@ -30,6 +30,7 @@
 #include "model/model.h"
 #include "step.h"
 #include "element/element.h"
+#include "fluid/fluid.h"
 #include "joint/joint.h"
 
 static void total_momentum(const fdem_model *m, double p[3]);
@@ -76,6 +77,7 @@ void energy_initial(fdem_model *m)
     m->joint_energy = joint_prestress_rest_forces(m);
     constraint_apply_forces(m);
     boundary_load_apply(m);
+    if (m->fluid) fluid_forces_at_rest(m);
     m->initial_acceleration2 = initial_acceleration2(m);
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     if (m->elem_viscous)
@@ -215,7 +217,12 @@ fdem_energy fdem_get_energy(const fdem_model *m)
                                            : gravity_work + m->gravity_work_removed;
     en.external_work = m->external_work - constraints_last_half_step(m);
     en.excavated = m->excavated_energy;
+    if (m->fluid) {
+        en.fluid_work = fluid_work_reported(m);
+        en.fluid_dissipation = m->fluid->dissipation;
+    }
     en.residual = en.kinetic + en.elastic + en.joint + en.contact + en.friction + en.fracture +
                   en.damping + en.excavated - en.gravity_work - en.external_work - initial;
+    if (m->fluid) en.residual -= en.fluid_work;
     return en;
 }

@@ -18,8 +18,9 @@
  *
  * What the removed elements take with them, booked in excavated_energy so
  * the balance closes (energy.c): their strain energy at that moment (the
- * in-situ stress's share included), the energy of the joints on them, and
- * the kinetic energy of the mass that leaves. That mass leaves the shared
+ * in-situ stress's share included), the energy of the joints on them, the
+ * penalty energy of their contact pairs (out of the contact account:
+ * contact_excavation.c), and the kinetic energy of the mass that leaves. That mass leaves the shared
  * nodes (the lumped masses are summed again over the active elements,
  * finalize's sum less the removed elements' terms), so gravity no longer
  * pulls it; a node that only removed elements held keeps no mass, is held
@@ -119,8 +120,9 @@ static const int32_t *joint_face(const fdem_model *m, int j, int face)
  * intact joint on a removed element. Each is evaluated on the positions
  * now as the step would, and its history (damage, slip, fracture account)
  * is put back as it was: it is not going to be stepped. Then every joint
- * on an inactive element holds nothing from now on (damage 1: the joint
- * loop skips it), without being a fracture event or a broken joint. */
+ * on an inactive element holds nothing from now on (damage at least 1:
+ * the joint loop skips it), without being a fracture event or a broken
+ * joint (joints_on_removed_let_go). */
 static double removed_joint_forces(fdem_model *m, const uint8_t *removed, double *f)
 {
     const int D = m->dim;
@@ -152,13 +154,14 @@ static double removed_joint_forces(fdem_model *m, const uint8_t *removed, double
     return energy;
 }
 
-/* Joints with an inactive element hold nothing. */
+/* Joints with an inactive element hold nothing: JOINT_DAMAGE_EXCAVATED
+ * above the damage they had (model.h), which the joint loops skip as they
+ * skip a broken joint, and which output shows as that damage. */
 static void joints_on_removed_let_go(fdem_model *m)
 {
     for (int j = 0; j < m->joint_count; j++)
-        if (!element_is_active(m, m->joint_elem[2 * j]) ||
-            !element_is_active(m, m->joint_elem[2 * j + 1]))
-            m->joint_damage[j] = 1.0;
+        if (m->joint_damage[j] < 1.0 && joint_is_excavated(m, j))
+            m->joint_damage[j] += JOINT_DAMAGE_EXCAVATED;
 }
 
 /* rho V / K of every active element to each of its nodes, in element
@@ -306,6 +309,11 @@ int excavation_start(fdem_model *m, int k, fdem_error *err)
     if (!failed && count) {
         energy += removed_joint_forces(m, removed, f);
         if (m->contact.enabled && contact_excavation_forces(m, removed, f)) failed = 1;
+        if (m->contact.enabled) { /* the pairs' penalty energy leaves the contact account */
+            double held = contact_excavation_energy(m, removed);
+            energy += held;
+            m->contact_work += held;
+        }
         memcpy(old_mass, m->mass, sizeof(double) * N);
         double locked = m->elem_stress0 ? m->stress0_energy : 0;
         /* stages_started counts stage k from here: refresh sees its list */

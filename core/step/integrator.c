@@ -20,6 +20,7 @@
 #include "step.h"
 #include "contact/contact.h"
 #include "element/element.h"
+#include "fluid/fluid.h"
 #include "joint/joint.h"
 #include "parallel/scatter_plan.h"
 
@@ -430,6 +431,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
             m->contact.need_detect = 1; /* the freed faces must meet through contact */
         }
     }
+    if (m->fluid) fluid_step(m, h);
     double t1 = stage_clock();
     m->times.elements += t1 - t0;
     if (contact_forces(m)) {

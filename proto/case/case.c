@@ -4,7 +4,8 @@
  *
  * This file owns the order of things: parse, read every section (pass 1,
  * case_materials.c, case_parts.c, case_constraints.c and the small sections
- * here), estimate memory (pass 2, case_memory.c), build and finalize the
+ * here), estimate memory (pass 2, case_memory.c), check the boxes that
+ * need generated meshes with the other problems (case_boxes.c), build and finalize the
  * model (pass 3), then choose the time step. Engine errors are mapped to
  * JSON Pointers (only the case knows which document item became which
  * engine index) in case_doc.c, which the sections share; no case file calls
@@ -21,7 +22,7 @@
 
 static const char *const top_keys[] = {
     "name", "dimension", "materials", "parts", "constraints", "stages", "gravity",
-    "gravity_amplitude", "time", "output", "history", NULL,
+    "gravity_amplitude", "time", "output", "history", "fluid", NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
@@ -180,12 +181,14 @@ static void case_read(case_doc *doc, const json_t *root)
     case_check_keys(doc, root, "", top_keys, "the case");
     case_read_dimension(doc, json_object_get(root, "dimension"));
     case_read_name(doc, root);
+    case_read_fluid(doc, json_object_get(root, "fluid"));
     json_t *materials = json_object_get(root, "materials");
     if (materials) case_read_materials(doc, materials);
     else case_problem(doc, "", "missing required \"materials\" {name: {...}}");
     json_t *parts = json_object_get(root, "parts");
     if (parts) case_read_parts(doc, parts);
     else case_problem(doc, "", "missing required \"parts\" [...]");
+    case_check_fluid(doc);
     json_t *constraints = json_object_get(root, "constraints");
     if (constraints) case_read_constraints(doc, constraints);
     json_t *stages = json_object_get(root, "stages");
@@ -305,6 +308,10 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
         ok = fdem_set_gravity_amplitude(model, doc->gravity_amplitude,
                                         doc->gravity_amplitude_count, &err) == 0;
         if (!ok) case_engine_problem(doc, &err, "/gravity_amplitude");
+        if (ok && doc->has_fluid && fdem_set_fluid(model, &doc->fluid, &err)) {
+            case_engine_problem(doc, &err, "/fluid");
+            ok = 0;
+        }
         ok = ok && fdem_model_finalize(model, &err) == 0;
         /* a constraint that selects nothing: name every such one */
         if (!ok && err.kind == FDEM_ITEM_CONSTRAINT &&
@@ -430,12 +437,15 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
     char **names = case_copy_names(&doc);
     json_decref(root);
     if (!names) case_problem(&doc, "", "out of memory");
-    if (out->count + out->dropped != before)
+    if (out->count + out->dropped != before) {
+        case_check_boxes(&doc, before, memory_limit);
         case_probe_dt(&doc, before, memory_limit, gate, gate_ctx);
-    else if (gate && gate(gate_ctx, bytes) != 0) {
+    } else if (gate && gate(gate_ctx, bytes) != 0) {
         snprintf(out->title, sizeof out->title, "Service unavailable");
         problems_add(out, 503, "", "the daemon has no memory to spare for this model now "
                                    "(--max-memory); try again later");
+    } else {
+        case_check_boxes(&doc, before, memory_limit); /* the boxes of the shapes meshed now */
     }
     fdem_model *model = NULL;
     if (out->count + out->dropped == before) model = case_build_model(&doc, info);

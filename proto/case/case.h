@@ -11,7 +11,7 @@
  *  - time.dt "auto" = safety x fdem_stable_dt(); a number above the stable
  *    step is rejected with 422 naming the stable value.
  *  - On success the model is finalized, its dt set, and `info` filled.
- *  - "stages" (contract 6.1, case_stage.c): the engine gets each stage's
+ *  - "stages" (contract 6.1, case_stages.c): the engine gets each stage's
  *    end, relax and excavated element indices (fdem_add_stage) and every
  *    stage constraint with def.only_stage = k + 1, after the top-level
  *    ones; info gets the stage names (the engine has none) and, when

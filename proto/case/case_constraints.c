@@ -29,7 +29,7 @@
 static const char *const constraint_keys[] = {"part",     "group",    "box",
                                               "fix",      "velocity", "force",
                                               "pressure", "absorb",   "boundary_stress",
-                                              "traction", "amplitude", NULL};
+                                              "traction", "inject",   "amplitude", NULL};
 
 int case_part_by_name(case_doc *doc, const json_t *name, const char *ptr)
 {
@@ -221,6 +221,22 @@ static void constraint_read_boundary_stress(case_doc *doc, fdem_constraint_def *
     def->stress_reference = f.reference;
 }
 
+/* "inject": Q (contract 6.4), a rate of fluid volume; needs the top-level
+ * "fluid" (read before the constraints). A negative Q would draw fluid
+ * out of a cavity that may hold none: refused. */
+static void constraint_read_inject(case_doc *doc, fdem_constraint_def *def, const json_t *q,
+                                   const char *ptr)
+{
+    def->kind = FDEM_CONSTRAINT_INJECT;
+    if (!case_read_number(doc, q, ptr, &def->value[0])) return;
+    if (def->value[0] < 0)
+        case_problem(doc, ptr, "must be >= 0 (a rate of injected volume, %s), got %g",
+                     doc->dimension == 3 ? "m^3/s" : "m^2/s per unit thickness", def->value[0]);
+    if (!doc->has_fluid)
+        case_problem(doc, ptr, "injects fluid, but the case has no top-level \"fluid\": give "
+                               "{\"viscosity\", \"bulk_modulus\", \"density\"}");
+}
+
 /* "amplitude" only scales a value: not a fix or an absorbing boundary. */
 static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const json_t *value,
                                       const char *ptr)
@@ -230,7 +246,7 @@ static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const j
     if (!table) return;
     if (c->def.kind == FDEM_CONSTRAINT_FIX || c->def.kind == FDEM_CONSTRAINT_ABSORB) {
         case_problem(doc, at, "an amplitude scales a \"velocity\", \"force\", \"pressure\", "
-                              "\"boundary_stress\" or \"traction\", not %s",
+                              "\"boundary_stress\", \"traction\" or \"inject\", not %s",
                      c->def.kind == FDEM_CONSTRAINT_FIX ? "\"fix\"" : "\"absorb\"");
         return;
     }
@@ -242,8 +258,8 @@ static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const j
 static void constraint_read(case_doc *doc, case_constraint *c, int index, const json_t *value)
 {
     static const char *const selectors[] = {"part", "box"};
-    static const char *const actions[] = {"fix",    "velocity",        "force",   "pressure",
-                                          "absorb", "boundary_stress", "traction"};
+    static const char *const actions[] = {"fix",    "velocity",        "force",    "pressure",
+                                          "absorb", "boundary_stress", "traction", "inject"};
     const char *ptr = c->ptr;
     char at[CASE_POINTER], what[32];
     if (!case_expect_object(doc, value, ptr)) return;
@@ -266,9 +282,9 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
     else if (group && json_is_string(part) &&
              case_names_find(doc->part_names, json_string_value(part)) >= 0)
         constraint_read_group(doc, c, group, at); /* an unknown part is reported at "part" */
-    int action = constraint_pick(doc, value, ptr, actions, 7,
+    int action = constraint_pick(doc, value, ptr, actions, 8,
                                  "an action: \"fix\", \"velocity\", \"force\", \"pressure\", "
-                                 "\"absorb\", \"boundary_stress\" or \"traction\"");
+                                 "\"absorb\", \"boundary_stress\", \"traction\" or \"inject\"");
     if (action < 0) return;
     json_t *a = case_member(value, ptr, actions[action], at);
     if (action == 0) {
@@ -288,6 +304,8 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
                                   "the top-level \"constraints\", not in a stage's");
     } else if (action == 5) {
         constraint_read_boundary_stress(doc, &c->def, a, at);
+    } else if (action == 7) {
+        constraint_read_inject(doc, &c->def, a, at);
     } else {
         c->def.kind = FDEM_CONSTRAINT_TRACTION;
         case_read_axes(doc, a, at, c->def.value);

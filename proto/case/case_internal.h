@@ -108,7 +108,7 @@ typedef struct case_constraint {
     char ptr[CASE_POINTER];  /* "/constraints/3" or "/stages/1/constraints/0" */
 } case_constraint;
 
-/* An element selector of a stage's "excavate" (case_stage.c): read in
+/* An element selector of a stage's "excavate" (case_stages.c): read in
  * pass 1, turned into model element indices in pass 3. */
 typedef enum case_pick { CASE_PICK_NONE, CASE_PICK_PART, CASE_PICK_GROUP, CASE_PICK_BOX } case_pick;
 
@@ -154,7 +154,7 @@ typedef struct case_doc {
     unsigned fields;
     json_t *material_names;  /* name -> index into materials (case_names_add) */
     json_t *part_names;      /* name -> index into parts */
-    case_stage *stages;      /* "stages", in order (case_stage.c) */
+    case_stage *stages;      /* "stages", in order (case_stages.c) */
     int stage_count;
     int stages_given;        /* "stages" was in the document */
     int end_given;           /* time.end was in the document (stages may leave it out) */
@@ -163,7 +163,17 @@ typedef struct case_doc {
     double history_interval;
     case_history_point history_points[CASE_MAX_HISTORY_POINTS];
     int history_point_count;
+    int has_fluid;           /* "fluid" was in the document (case_fluid.c) */
+    fdem_fluid_def fluid;
 } case_doc;
+
+/* case_fluid.c: the top-level "fluid" (read before the materials and
+ * constraints, which ask whether there is one), the hydraulic members of
+ * fracture parameters, and the cross-section checks after the parts. */
+void case_read_fluid(case_doc *doc, const json_t *fluid);
+void case_read_fracture_fluid(case_doc *doc, const json_t *value, const char *ptr,
+                              fdem_fracture_params *f);
+void case_check_fluid(case_doc *doc);
 
 /* case_amplitude.c: an amplitude table [[t, a], ...] at ptr, finite with
  * strictly increasing times: the pairs (free() them) and their count, or
@@ -288,7 +298,7 @@ int case_read_box(case_doc *doc, const json_t *box, const char *ptr, double *out
  * def.only_stage = only_stage (0: top level; k + 1: stage k's own). */
 void case_read_constraint_list(case_doc *doc, const json_t *list, const char *ptr,
                                int only_stage);
-/* case_stage.c: "stages" (pass 1, after parts and constraints, before
+/* case_stages.c: "stages" (pass 1, after parts and constraints, before
  * time); reconciling time.end with the last stage's end (after time);
  * the stages handed to the engine (pass 3, after the parts; 0 or -1 after
  * a problem); freeing them. */
@@ -359,9 +369,23 @@ int case_add_parts(case_doc *doc, fdem_model *model);
 int case_add_constraints(case_doc *doc, fdem_model *model, int stages_added);
 
 /* case_probe.c: after pass 1 found problems, adds the /time/dt one a build
- * would find too, from a scratch model of the parts without problems. */
+ * would find too, from a scratch model of the parts without problems;
+ * whether a problem from index `from` on is at `base` or below it; whether
+ * part i (its shape, material and all) read without one. */
 void case_probe_dt(case_doc *doc, int from, size_t memory_limit, case_memory_gate gate,
                    void *gate_ctx);
+int case_problem_under(const problems *p, int from, const char *base);
+int case_part_sound(const case_doc *doc, int i, int from);
+
+/* case_boxes.c: after pass 1, whatever it found (and before case_probe_dt,
+ * which takes the meshes), the region and excavation boxes that hold no
+ * element centroid, each a problem at its selector; meshes the generated
+ * shapes a box needs within memory_limit. */
+void case_check_boxes(case_doc *doc, int from, size_t memory_limit);
+/* case_memory.c: the estimated bytes of one part as a model of its own. */
+double case_part_bytes(const case_doc *doc, case_part *part);
+/* case_region.c: the centroid of element t of the part's mesh (dim numbers). */
+void case_element_centroid(const case_doc *doc, const case_part *part, int t, double *c);
 
 /* case_history.c: "history" (pass 1), its row count against time.end
  * (after time), its points located in the built model (pass 3: 1, or 0

@@ -19,7 +19,8 @@ static const char *const material_keys[] = {
     "density", "young", "poisson", "damping", "penalty", "friction", "fracture", NULL,
 };
 static const char *const fracture_keys[] = {
-    "tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", "variation", NULL,
+    "tensile_strength", "cohesion", "friction_angle", "energy_I", "energy_II", "variation",
+    "aperture0", "pore_pressure", NULL,
 };
 static const char *const variation_keys[] = {"distribution", "modulus", "seed", NULL};
 
@@ -88,13 +89,14 @@ void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, con
     if (variation) read_variation(doc, variation, at, v);
     if (!required) { /* a joint set: what it leaves out is its material's */
         static const char *const keys[] = {"tensile_strength", "cohesion", "friction_angle",
-                                           "energy_I", "energy_II"};
+                                           "energy_I", "energy_II", "aperture0",
+                                           "pore_pressure"};
         int given = 0;
-        for (int k = 0; k < 5; k++) given += json_object_get(value, keys[k]) != NULL;
+        for (int k = 0; k < 7; k++) given += json_object_get(value, keys[k]) != NULL;
         if (!given && !variation)
             case_problem(doc, ptr, "a joint set needs at least one fracture parameter "
                                    "(tensile_strength, cohesion, friction_angle, energy_I, "
-                                   "energy_II or variation)");
+                                   "energy_II, aperture0, pore_pressure or variation)");
     }
     if (case_number_member(doc, value, ptr, "tensile_strength", required, &f->tensile_strength))
         material_require(doc, f->tensile_strength > 0, ptr, "tensile_strength", "must be > 0",
@@ -108,6 +110,7 @@ void case_read_fracture(case_doc *doc, const json_t *value, const char *ptr, con
         material_require(doc, f->energy_I > 0, ptr, "energy_I", "must be > 0", f->energy_I);
     if (case_number_member(doc, value, ptr, "energy_II", required, &f->energy_II))
         material_require(doc, f->energy_II > 0, ptr, "energy_II", "must be > 0", f->energy_II);
+    case_read_fracture_fluid(doc, value, ptr, f);
 }
 
 static void material_read(case_doc *doc, const char *name, const json_t *value,

@@ -121,6 +121,12 @@ static void memory_describe(double nodes, double elements, double joints, char *
         snprintf(out + n, size - (size_t)n, ", %.3g joints", joints);
 }
 
+double case_part_bytes(const case_doc *doc, case_part *part)
+{
+    memory_part_counts(part, doc->dimension);
+    return memory_bytes(doc->dimension, part->nodes, part->elements, part->joints, 1);
+}
+
 double case_check_memory(case_doc *doc, size_t memory_limit)
 {
     double nodes = 0, elements = 0, joints = 0;
@@ -131,6 +137,8 @@ double case_check_memory(case_doc *doc, size_t memory_limit)
         joints += doc->parts[i].joints;
     }
     double bytes = memory_bytes(doc->dimension, nodes, elements, joints, doc->part_count);
+    if (doc->has_fluid) /* contract 6.4: the fluid network over the joints */
+        bytes += (double)fdem_fluid_memory_estimate(doc->dimension, 1000) * (joints / 1000);
     char need[32], limit[32], counts[96];
     memory_format(bytes, need, sizeof need);
     memory_describe(nodes, elements, joints, counts, sizeof counts);

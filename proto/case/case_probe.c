@@ -17,8 +17,7 @@
 
 #include "case_internal.h"
 
-/* Whether a problem from index `from` on is at `base` or below it. */
-static int problem_under(const problems *p, int from, const char *base)
+int case_problem_under(const problems *p, int from, const char *base)
 {
     size_t n = strlen(base);
     for (int i = from; i < p->count; i++) {
@@ -32,16 +31,16 @@ static int material_sound(const case_doc *doc, int k, int from)
 {
     char ptr[CASE_POINTER];
     pointer_join(ptr, sizeof ptr, "/materials", doc->materials[k].name);
-    return !problem_under(doc->out, from, ptr);
+    return !case_problem_under(doc->out, from, ptr);
 }
 
-static int part_sound(const case_doc *doc, int i, int from)
+int case_part_sound(const case_doc *doc, int i, int from)
 {
     const case_part *part = &doc->parts[i];
     char ptr[CASE_POINTER];
     pointer_join_index(ptr, sizeof ptr, "/parts", i);
     return part->shape != CASE_SHAPE_NONE && part->material >= 0 &&
-           part->material < doc->material_count && !problem_under(doc->out, from, ptr) &&
+           part->material < doc->material_count && !case_problem_under(doc->out, from, ptr) &&
            material_sound(doc, part->material, from);
 }
 
@@ -65,7 +64,7 @@ static int probe_doc_make(case_doc *doc, int from, case_doc *probe, problems *sc
     for (int k = 0; k < doc->material_count; k++)
         probe->materials[k] = doc->materials[material_sound(doc, k, from) ? k : stand_in];
     for (int i = 0; i < doc->part_count; i++) {
-        if (!part_sound(doc, i, from)) continue;
+        if (!case_part_sound(doc, i, from)) continue;
         probe->parts[probe->part_count++] = doc->parts[i];
         /* what the part owns moves over: both documents are freed */
         memset(&doc->parts[i].mesh, 0, sizeof doc->parts[i].mesh);
@@ -100,8 +99,8 @@ void case_probe_dt(case_doc *doc, int from, size_t memory_limit, case_memory_gat
                    void *gate_ctx)
 {
     problems *out = doc->out;
-    if (doc->dt_auto || !(doc->dt > 0) || out->dropped || problem_under(out, from, "/time/dt") ||
-        problem_under(out, from, "/dimension"))
+    if (doc->dt_auto || !(doc->dt > 0) || out->dropped || case_problem_under(out, from, "/time/dt") ||
+        case_problem_under(out, from, "/dimension"))
         return;
     problems scratch;
     problems_init(&scratch);

@@ -6,9 +6,10 @@
  *
  * Pass 1 reads the selectors (after the part's shape and groups, which a
  * group needs) and, for a mesh that is already read (mesh, gmsh), checks
- * that every selector selects some element; a generated shape is meshed
- * in pass 3, where the same check runs before its part goes to the engine
- * with a flag per element (fdem_add_part_region). A problem is at the
+ * that every selector selects some element; a generated shape's boxes are
+ * checked right after pass 1, with its other problems (case_boxes.c), and
+ * in pass 3 its part goes to the engine with a flag per element
+ * (fdem_add_part_region). A problem is at the
  * selector's pointer: /parts/i/fracture, or /parts/i/fracture/k in a list.
  * That the part's material has a "fracture" block is checked with the
  * flag itself (case_parts.c), at /parts/i/fracture.
@@ -90,8 +91,7 @@ void case_read_region(case_doc *doc, case_part *part, const json_t *value, const
     }
 }
 
-/* The centroid of element t of the part's mesh (dim numbers). */
-static void element_centroid(const case_doc *doc, const case_part *part, int t, double *c)
+void case_element_centroid(const case_doc *doc, const case_part *part, int t, double *c)
 {
     const int dim = doc->dimension, K = dim + 1;
     const double *xyz = dim == 3 ? part->tet_mesh.xyz : part->mesh.xy;
@@ -112,7 +112,7 @@ static int mark_box(const case_doc *doc, const case_part *part, const double *bo
     int marked = 0;
     for (int t = 0; t < count; t++) {
         double c[3];
-        element_centroid(doc, part, t, c);
+        case_element_centroid(doc, part, t, c);
         int inside = 1;
         for (int d = 0; d < dim; d++) {
             inside &= c[d] >= box[d] && c[d] <= box[dim + d];

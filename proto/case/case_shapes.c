@@ -171,9 +171,11 @@ void case_read_cylinder(case_doc *doc, case_part *part, const json_t *cylinder,
 /* -------------------------------------------------------------- pass 3 */
 
 /* The memory check has bounded every count by INT_MAX, so the divisions
- * fit an int here. */
+ * fit an int here. A shape meshed already (for its boxes: case_boxes.c)
+ * is left as it is. */
 int case_generate_shape(case_part *part, fdem_error *err)
 {
+    if (part->mesh.tri || part->tet_mesh.tet) return 0;
     int d[3] = {(int)part->divisions[0], (int)part->divisions[1], (int)part->divisions[2]};
     switch (part->shape) {
     case CASE_SHAPE_RECTANGLE:

@@ -89,6 +89,26 @@ int result_append_history(result_file *f, history_row *const *rows, int count, c
 int result_read_history(result_file *f, const char *path, double since, history_row ***out,
                         int *count, history_names *names, char *err, size_t errlen);
 void result_free_history(history_row **rows, int count);
+/* One snapshot as the web page's binary frame (result_frame.c; the layout
+ * is in docs/api.md, "Binary mesh frames"): the mesh, the deformed
+ * positions and the fields asked for, float32. */
+#define RESULT_FRAME_FIELDS 8
+/* velocity, displacement, stress, strain, principal_stress, damage,
+ * fragment, active: bit k of result_frame_request.fields */
+extern const char *const result_frame_field_names[RESULT_FRAME_FIELDS];
+typedef struct result_frame_request {
+    int snapshot;      /* index, or -1 for the last complete one */
+    unsigned fields;   /* bit k: result_frame_field_names[k]; those the file lacks are left out */
+    /* called with the frame's size before it is allocated; non-zero refuses (503) */
+    int (*reserve)(void *ctx, size_t bytes);
+    void *reserve_ctx;
+} result_frame_request;
+/* Reads the frame from the open file f, or the closed file at path (f
+ * NULL): *out (free() it) gets *size bytes. Returns 0; 404 (no such
+ * snapshot) or 503 (refused by reserve, out of memory) with err; -1 with
+ * err when the file cannot be read. */
+int result_read_frame(result_file *f, const char *path, const result_frame_request *q,
+                      unsigned char **out, size_t *size, char *err, size_t errlen);
 int result_flush(result_file *f, char *err, size_t errlen);
 int result_check_file(const char *path, char *err, size_t errlen);
 /* Copies the next piece of bytes [done, size) of src to the same place in

@@ -62,7 +62,7 @@ const char *const series_names[SERIES_COUNT] = {
     "step", "position", "velocity", "stress", "damage", "fragment", "strain", "principal_stress",
     "displacement", "stage", "active", "excavated_energy", "constraint_force", "kinetic_energy", "elastic_energy", "contact_energy",
     "friction_energy", "joint_energy", "fracture_energy", "damping_energy", "gravity_work",
-    "external_work", "time",
+    "external_work", "fluid_pressure", "aperture", "time",
 };
 
 /* ------------------------------------------------------------------ errors */
@@ -267,6 +267,7 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
     fdem_counts c = fdem_get_counts(model);
     int dim = fdem_get_dimension(model);
     int staged = fdem_stage_index(model) >= 0;
+    int fluid = fdem_get_fluid(model).enabled && c.joints > 0;
     for (int k = 0; k < SERIES_COUNT; k++) {
         ds[k].id = H5I_INVALID_HID;
         ds[k].rank = 1;
@@ -285,6 +286,8 @@ void series_layout(series ds[SERIES_COUNT], const fdem_model *model, unsigned fi
         {SERIES_DISPLACEMENT, (fields & CASE_FIELD_DISPLACEMENT) != 0, c.nodes, dim},
         {SERIES_ACTIVE, staged, c.elements, 0},
         {SERIES_CONSTRAINT_FORCE, 1, c.constraints, dim},
+        {SERIES_FLUID_PRESSURE, fluid, c.joints, 0},
+        {SERIES_APERTURE, fluid, c.joints, 0},
     };
     for (size_t i = 0; i < sizeof shapes / sizeof shapes[0]; i++) {
         series *s = &ds[shapes[i].kind];
@@ -365,6 +368,8 @@ static const void *series_row_data(int kind, const snapshot *s)
     case SERIES_DAMPING: return &s->energy.damping;
     case SERIES_GRAVITY_WORK: return &s->energy.gravity_work;
     case SERIES_EXTERNAL_WORK: return &s->energy.external_work;
+    case SERIES_FLUID_PRESSURE: return s->fluid_pressure;
+    case SERIES_APERTURE: return s->aperture;
     case SERIES_TIME: return &s->time;
     }
     return NULL;

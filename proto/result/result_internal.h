@@ -38,6 +38,8 @@ enum series_kind {
     SERIES_DAMPING,
     SERIES_GRAVITY_WORK,
     SERIES_EXTERNAL_WORK,
+    SERIES_FLUID_PRESSURE, /* contract 6.4: (S, J), only with fluid */
+    SERIES_APERTURE,
     SERIES_TIME,
     SERIES_COUNT
 };

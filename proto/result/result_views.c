@@ -59,6 +59,8 @@ static int view_shape_of(int kind, int width, int dimension, view_shape *v)
     case SERIES_POSITION:
     case SERIES_PRINCIPAL_STRESS:
     case SERIES_DAMAGE:
+    case SERIES_FLUID_PRESSURE:
+    case SERIES_APERTURE:
     case SERIES_FRAGMENT:
     case SERIES_ACTIVE:
         v->columns = width; /* a copy; 0 for the 1-D series */

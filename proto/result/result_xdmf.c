@@ -71,6 +71,7 @@ typedef struct xdmf_ctx {
     long constraints;
     unsigned fields;
     int staged;            /* the case has stages: /snapshots/active is written */
+    int fluid;             /* the case has fluid: fluid_pressure and aperture per joint */
 } xdmf_ctx;
 
 static void xml_escape(char *out, size_t size, const char *in)
@@ -224,6 +225,14 @@ static void xdmf_joint_grid(const xdmf_ctx *x, int s, double time)
     if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, "damage");
     else xdmf_scalar_row_item(x, s, J, "Float", 8, "damage");
     fprintf(x->out, "      </Attribute>\n");
+    static const char *const fluid_fields[] = {"fluid_pressure", "aperture"};
+    for (int k = 0; x->fluid && k < 2; k++) { /* contract 6.4, per joint like damage */
+        fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
+                "Center=\"Cell\">\n", fluid_fields[k]);
+        if (xdmf_has_view(x, s)) xdmf_view_item(x, s, dims, "Float", 8, fluid_fields[k]);
+        else xdmf_scalar_row_item(x, s, J, "Float", 8, fluid_fields[k]);
+        fprintf(x->out, "      </Attribute>\n");
+    }
     /* on the same nodes as the elements: Warp By Vector moves both blocks */
     if (x->fields & CASE_FIELD_DISPLACEMENT)
         xdmf_node_vector(x, s, "displacement");
@@ -270,6 +279,7 @@ static void xdmf_cell_field(const xdmf_ctx *x, int s, const char *dataset, int w
 static void xdmf_series_attributes(const xdmf_ctx *x)
 {
     for (int kind = SERIES_KINETIC; kind <= SERIES_TIME; kind++) {
+        if (kind == SERIES_FLUID_PRESSURE || kind == SERIES_APERTURE) continue; /* per joint */
         fprintf(x->out, "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" "
                 "Center=\"Grid\">\n", series_names[kind]);
         fprintf(x->out, "        <DataItem Dimensions=\"%d 1\" NumberType=\"Float\" "
@@ -395,7 +405,8 @@ int xdmf_write(const char *xdmf_path, const char *h5_name, const fdem_model *mod
                   .stress_components = fdem_stress_components(model),
                   .snapshots = result_snapshot_count(f), .views = result_view_count(f),
                   .constraints = counts.constraints, .fields = info->fields,
-                  .staged = fdem_stage_index(model) >= 0};
+                  .staged = fdem_stage_index(model) >= 0,
+                  .fluid = fdem_get_fluid(model).enabled && counts.joints > 0};
     xml_escape(x.h5, sizeof x.h5, h5_name);
 
     char tmp[4096];

@@ -145,8 +145,19 @@ snapshot *snapshot_take(const fdem_model *model, unsigned fields)
         else s->fields |= SNAPSHOT_FRAGMENTS;
     }
     if (counts.joints > 0) {
-        s->damage = copy_doubles(fdem_joint_damage(model), (size_t)counts.joints, &failed);
+        /* an excavated joint shows the damage it had then (not 1: it did
+         * not break); /snapshots/active says it is gone */
+        s->damage = malloc((size_t)counts.joints * sizeof *s->damage);
+        if (s->damage) fdem_copy_joint_damage(model, s->damage);
+        else failed = 1;
         if (s->damage && (fields & CASE_FIELD_DAMAGE)) s->fields |= CASE_FIELD_DAMAGE;
+    }
+    if (counts.joints > 0 && fdem_get_fluid(model).enabled) {
+        s->fluid_pressure = copy_doubles(fdem_fluid_pressure(model), (size_t)counts.joints,
+                                         &failed);
+        s->aperture = malloc(sizeof(double) * (size_t)counts.joints);
+        if (s->aperture) fdem_fluid_apertures(model, s->aperture);
+        else failed = 1;
     }
     s->constraint_force = copy_doubles(fdem_constraint_forces(model),
                                        dim * (size_t)counts.constraints, &failed);
@@ -166,6 +177,8 @@ void snapshot_free(snapshot *s)
     free(s->velocity);
     free(s->stress);
     free(s->damage);
+    free(s->fluid_pressure);
+    free(s->aperture);
     free(s->strain);
     free(s->principal_stress);
     free(s->displacement);

@@ -54,6 +54,8 @@ typedef struct snapshot {
     fdem_energy energy;
     int stage;                  /* the stage the model is in, -1: the case has no stages */
     uint8_t *active;            /* with stages: elements flags, 1 active, 0 excavated; else NULL */
+    double *fluid_pressure;     /* with fluid (contract 6.4): per joint; else NULL */
+    double *aperture;           /* with fluid: hydraulic aperture per joint; else NULL */
 } snapshot;
 
 snapshot *snapshot_take(const fdem_model *model, unsigned fields);

@@ -14,7 +14,7 @@
  *    reopened is an error and is left as found (only a missing one is made
  *    anew from the checkpoint); case_model_drop() closes the result file,
  *    frees the model and releases c->reserve.
- *  - Extend (case_stages.c): the worker keeps, besides checkpoint.bin,
+ *  - Extend (case_continue.c): the worker keeps, besides checkpoint.bin,
  *    the state one step before the step it cut to land on time.end
  *    (CASE_END_CHECKPOINT). Extending a finished case renames it to
  *    CASE_RESUME_CHECKPOINT, and case_model_build() then resumes from it

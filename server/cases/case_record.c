@@ -5,6 +5,7 @@
  * so every file of cases/ may lean on it without a circle through it (the
  * registry table and state machine: registry.c).
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -80,6 +81,8 @@ server_case *case_new(void)
     c->last_checkpoint_step = -1;
     c->resume_rows_until = -1;
     c->fig.stage = -1; /* no stages until a model or status.json says */
+    c->fig.eta = NAN;
+    c->estimated_seconds = NAN;
     return c;
 }
 

@@ -12,14 +12,14 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "case_model.h"
+#include "sizing_probe.h"
+#include "state/snapshot.h"
+#include "store/checkpoint_file.h"
 
-/* Stepping the model to time it stops after whichever comes first. */
-#define SIZING_PROBE_SECONDS 0.05
-#define SIZING_PROBE_STEPS 200
 
 int sizing_is_last_step(double t0, double dt, double end)
 {
@@ -90,32 +90,126 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
         row += nodes * dim * 8;
     if (info->stage_count > 0) /* /snapshots/stage, active and excavated_energy */
         row += 4 + elements + 8;
+    if (fdem_get_fluid(model).enabled) /* /snapshots/fluid_pressure and aperture */
+        row += joints * 2 * 8;
     return mesh + snapshots * row;
 }
 
-static double sizing_now(void)
+/* Broken joints cost a run through the contact their faces make (the
+ * faces of a crack, and in 3D every pair of tetrahedra around its
+ * vertices): a step costs about intact + (broken joints) x (the cost of one),
+ * measured on the model with a crack cut through it
+ * (sizing_cracked_step_seconds). How many break, and when, is not known
+ * before the run; the bundled examples break 0 to 16 % of their joints by
+ * the end, late in some runs and early in others, and 0 to 5 % on average
+ * over their steps: tunnel-region 1.6 % (none until 80 % of the run, then
+ * 1000; each step then 55x an intact one), staged-tunnel 5 %, drift-3d
+ * 2 %, the arc-loaded 3D disc 2 % (27x a step after its split), the 3D
+ * disc 2 %, the 3D prism none (it only softens). The estimate takes this
+ * share of the joints as broken through the whole run. */
+#define SIZING_BROKEN_SHARE 0.02
+
+/* Later looks: the model is stepped on, untimed, to SIZING_LOOKS evenly
+ * spaced points up to this share of the run's steps and timed at each, so
+ * that contact that starts soon after t = 0 (a pile whose lowest bodies
+ * fall a few millimetres: a sphere pile's step costs 20 us at rest and
+ * 1-3 ms once they touch, from about step 700) is priced from then on.
+ * How far they go is set in steps from the first pace (as far as
+ * SIZING_ADVANCE_CPU seconds of it reach), not by a clock, so that two dry
+ * runs look at the same steps; and the looks are averaged, so that one
+ * that lands in a short impact (a 3D collision's contact: 30x a step for
+ * a few hundred steps) does not price the whole run at it. */
+#define SIZING_ADVANCE_SHARE 0.3
+#define SIZING_ADVANCE_CPU 0.1
+#define SIZING_LOOKS 3
+
+/* The centre of the jointed rock: the mean of every joint's first face
+ * node (joints lie where fracture can happen, so the crack of the probe
+ * runs through the fracturing part or region, not through a platen). */
+static void sizing_joint_centre(const fdem_model *model, double centre[3])
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    int dim = fdem_get_dimension(model), J = fdem_get_counts(model).joints;
+    const int32_t *joint = fdem_joints(model);
+    const double *x = fdem_positions(model);
+    centre[0] = centre[1] = centre[2] = 0;
+    if (!joint || J <= 0) return;
+    for (int j = 0; j < J; j++)
+        for (int d = 0; d < dim; d++) centre[d] += x[dim * (size_t)joint[2 * dim * (size_t)j] + d];
+    for (int d = 0; d < dim; d++) centre[d] /= J;
 }
 
-/* Steps per second of this model here; 0 when a step fails (the run's
- * first steps will say why). */
-static double sizing_probe(fdem_model *model, double steps)
+/* Wall seconds per step once the rock has broken: the model is cut by
+ * a crack through the middle of its joints, along the plane x = centre
+ * (a vertical crack: through a disc or a specimen loaded along y or z,
+ * through the crown and invert of a tunnel), and timed again. NAN when
+ * no joint crosses it or a step fails. */
+static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
+                                          sizing_load *load)
 {
-    double started = sizing_now(), now = started;
+    double centre[3], normal[3] = {1, 0, 0};
+    sizing_joint_centre(model, centre);
+    *broke = fdem_break_joints_across(model, normal, centre[0]);
+    if (*broke <= 0) return NAN;
     int taken = 0;
-    while (taken < SIZING_PROBE_STEPS && taken < steps &&
-           (taken < 2 || now - started < SIZING_PROBE_SECONDS)) {
-        fdem_error err;
-        memset(&err, 0, sizeof err);
-        if (fdem_step(model, &err) != 0)
-            break;
-        taken++;
-        now = sizing_now();
+    return sizing_probe_step_seconds(model, steps_left, &taken, load);
+}
+
+/* The pace of the run after the first probe (later_step_seconds, the
+ * mean of the later looks): the steps up to the last look go at the first
+ * pace, the rest at the later one. */
+static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int *taken,
+                                        sizing_load *load)
+{
+    out->later_step_seconds = NAN;
+    double first = out->step_seconds;
+    if (!isfinite(first) || !(first > 0))
+        return first;
+    double reach = SIZING_ADVANCE_SHARE * out->steps;
+    if (reach > SIZING_ADVANCE_CPU / first)
+        reach = SIZING_ADVANCE_CPU / first;
+    if (reach <= *taken || out->steps - reach < 16)
+        return first;
+    double sum = 0;
+    int looks = 0;
+    for (int k = 1; k <= SIZING_LOOKS; k++) {
+        double target = reach * k / SIZING_LOOKS;
+        while (*taken < target) {
+            fdem_error err;
+            memset(&err, 0, sizeof err);
+            if (fdem_step(model, &err) != 0)
+                return first; /* the run will say why */
+            (*taken)++;
+        }
+        int more = 0;
+        double pace = sizing_probe_step_seconds(model, out->steps - *taken, &more, load);
+        *taken += more;
+        if (!isfinite(pace))
+            return first;
+        sum += pace;
+        looks++;
     }
-    return taken > 0 && now > started ? taken / (now - started) : 0.0;
+    double later = out->later_step_seconds = sum / looks;
+    double done = *taken / out->steps;
+    return done * first + (1 - done) * later;
+}
+
+/* Wall seconds the worker spends on one snapshot besides writing it (the
+ * I/O thread writes): copying the fields and the checkpoint that comes
+ * with every snapshot (worker.c). */
+static double sizing_snapshot_copy_seconds(const fdem_model *model, const case_info *info)
+{
+    double best = INFINITY;
+    for (int k = 0; k < 2; k++) { /* the faster of two: one copy met a 12 ms stall */
+        double started = sizing_clock();
+        snapshot *snap = snapshot_take(model, info->fields);
+        size_t size = 0;
+        void *ckpt = checkpoint_file_take(model, &size);
+        double seconds = sizing_clock() - started;
+        snapshot_free(snap);
+        free(ckpt);
+        if (seconds < best) best = seconds;
+    }
+    return best;
 }
 
 void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
@@ -131,11 +225,36 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->snapshots = sizing_snapshots(info, fdem_get_time(model), out->dt, out->steps);
     out->memory_bytes = (double)case_model_cost(model_bytes);
     out->result_bytes = sizing_result_bytes(model, info, out->snapshots);
+    fdem_fluid_status fluid = fdem_get_fluid(model);
+    out->fluid = fluid.enabled;
+    out->fluid_step = fluid.flow_step;
+    out->fluid_subcycles = fluid.subcycles;
     fdem_set_threads(model, threads);
-    out->steps_per_second = sizing_probe(model, out->steps);
+    double copy = out->snapshot_copy_seconds = sizing_snapshot_copy_seconds(model, info);
+    int taken = 0;
+    sizing_load load = {0, 0};
+    out->step_seconds = sizing_probe_step_seconds(model, out->steps, &taken, &load);
+    double per_step = sizing_later_step_seconds(model, out, &taken, &load);
+    out->cracked_step_seconds = NAN;
+    if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
+        out->cracked_step_seconds = sizing_cracked_step_seconds(
+            model, out->steps - taken, &out->cracked_joints, &load);
+        if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {
+            double each = (out->cracked_step_seconds - per_step) / out->cracked_joints;
+            out->broken_joints = SIZING_BROKEN_SHARE * c.joints;
+            if (each > 0)
+                per_step += out->broken_joints * each;
+        }
+    }
+    /* CPU seconds so far; the machine's present load turns them into wall
+     * seconds (sizing_probe.h) */
+    out->load_factor = sizing_load_factor(&load);
+    out->probe_wall_over_cpu = load.cpu > 0 ? load.wall / load.cpu : NAN;
+    per_step *= out->load_factor;
+    out->steps_per_second = per_step > 0 ? 1.0 / per_step : 0.0;
     /* Snapshots are written on the I/O thread while the worker steps on:
-     * the slower of the two sets the pace. */
-    double stepping = out->steps_per_second > 0 ? out->steps / out->steps_per_second : NAN;
+     * the slower of the two sets the pace; the worker's copies add. */
+    double stepping = per_step > 0 ? out->steps * per_step + out->snapshots * copy : NAN;
     double writing = out->snapshots * snapshot_seconds;
     out->estimated_seconds = writing > stepping ? writing : stepping;
 }
@@ -187,6 +306,21 @@ json_t *case_sizing_json(const case_sizing *s)
     json_object_set_new(o, "memory_bytes", sizing_count_json(s->memory_bytes));
     json_object_set_new(o, "result_bytes", sizing_count_json(ceil(s->result_bytes)));
     json_object_set_new(o, "estimated_seconds", sizing_number_json(s->estimated_seconds));
+    if (s->fluid) { /* the flow's step: null while no fluid can flow yet */
+        json_object_set_new(o, "fluid_step", sizing_number_json(s->fluid_step));
+        json_object_set_new(o, "fluid_subcycles", json_integer(s->fluid_subcycles));
+    }
+    /* what the estimate was made of (docs/api.md), to judge it by */
+    json_t *parts = json_object();
+    json_object_set_new(parts, "step_seconds", sizing_number_json(s->step_seconds));
+    json_object_set_new(parts, "load_factor", sizing_number_json(s->load_factor));
+    json_object_set_new(parts, "probe_wall_over_cpu", sizing_number_json(s->probe_wall_over_cpu));
+    json_object_set_new(parts, "later_step_seconds", sizing_number_json(s->later_step_seconds));
+    json_object_set_new(parts, "cracked_step_seconds", sizing_number_json(s->cracked_step_seconds));
+    json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
+    json_object_set_new(parts, "broken_joints", sizing_number_json(s->broken_joints));
+    json_object_set_new(parts, "snapshot_seconds", sizing_number_json(s->snapshot_copy_seconds));
+    json_object_set_new(o, "estimate", parts);
     char warning[400];
     if (case_sizing_warning(s, warning, sizeof warning))
         json_object_set_new(o, "warning", json_string(warning));

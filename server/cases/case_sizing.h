@@ -11,10 +11,17 @@
  *  - case_sizing_measure() sizes a model just built from a case document
  *    (model_bytes: the builder's own estimate, see case_model_build_upload):
  *    counts, dt, steps, snapshots, memory charged while it runs, result.h5
- *    bytes, and a wall time: the slower of stepping (timed on the model for
- *    a moment) and writing the snapshots (snapshot_seconds each, see
- *    io_snapshot_seconds). It ADVANCES the model: call it only on a model
- *    that is thrown away.
+ *    bytes, and a wall time: the slower of stepping and writing the
+ *    snapshots (snapshot_seconds each, see io_snapshot_seconds). Stepping
+ *    is priced from the model's own steps timed here (sizing_probe.h: a
+ *    warm-up, then the median of short windows) at t = 0 and at three points up to 30 %
+ *    into the run when that is quickly reached; for a fracturing model 2 %
+ *    of its joints broken through the whole run, each at the cost a joint
+ *    of a crack cut through the model adds to its step
+ *    (fdem_break_joints_across); plus the worker's copy of each snapshot
+ *    and its checkpoint. Steps are timed in CPU seconds and turned into
+ *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
+ *    call it only on a model that is thrown away.
  */
 #ifndef FDEMD_CASE_SIZING_H
 #define FDEMD_CASE_SIZING_H
@@ -34,8 +41,19 @@ typedef struct case_sizing {
     double steps;             /* a double: absurd end times do not overflow */
     double snapshots;
     double memory_bytes, result_bytes;
-    double steps_per_second;  /* measured on the model */
+    double steps_per_second;  /* the mean pace the estimate assumes */
+    double step_seconds;      /* CPU seconds a step, measured on the model as built */
+    double later_step_seconds; /* the same up to 30 % into the run (NAN: not timed) */
+    double load_factor;       /* wall / CPU seconds the run will see (sizing_load_factor) */
+    double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
+    double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
+    int cracked_joints;       /* joints the crack broke */
+    double broken_joints;     /* joints priced as broken through the run */
+    double snapshot_copy_seconds; /* the worker's share of one snapshot */
     double estimated_seconds;
+    int fluid;                /* the case has fluid (contract 6.4): then fluid_step and */
+    double fluid_step;        /* fluid_subcycles, the flow's stable step and how many */
+    int fluid_subcycles;      /* flow steps a mechanical step takes, at t = 0 */
 } case_sizing;
 
 int sizing_is_last_step(double t0, double dt, double end);
@@ -46,7 +64,8 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
                          int threads, double snapshot_seconds, case_sizing *out);
 /* The dry run's answer: {"nodes", "elements", "joints", "dt", "steps",
  * "snapshots", "memory_bytes", "result_bytes", "estimated_seconds"} (and
- * "warning" for a long run). */
+ * "warning" for a long run; "fluid_step" and "fluid_subcycles" for a case
+ * with fluid). */
 json_t *case_sizing_json(const case_sizing *s);
 /* "this case will run for about 5.2 hours (...)" into out, or "" when it
  * is not long; returns whether there is a warning. */

@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "case_feed.h"
 #include "store/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
@@ -54,8 +55,10 @@ void case_publish_from_model(server_case *c)
     fig.dt = fdem_get_dt(c->model);
     fig.counts = fdem_get_counts(c->model);
     fig.energy = fdem_get_energy(c->model);
+    fig.fluid = fdem_get_fluid(c->model);
     fig.snapshots = -1;
     fig.elapsed = -1;
+    fig.eta = NAN;
     case_figures_stage(&fig, c->model, &c->info);
     case_publish(c, &fig);
 }
@@ -148,6 +151,22 @@ void case_stage_from_json(case_figures *f, const json_t *stage)
     snprintf(f->stage_name, sizeof f->stage_name, "%s", f->stage >= 0 && name ? name : "");
 }
 
+/* "fluid" (contract 6.4): null without fluid; the flow's step and subcycle
+ * count beside the contract's three (docs/api.md). */
+static json_t *case_fluid_json(const fdem_fluid_status *f)
+{
+    if (!f->enabled) return json_null();
+    json_t *o = json_object();
+    if (!o) return NULL;
+    json_object_set_new(o, "injected_volume", json_number_or_null(f->injected_volume));
+    json_object_set_new(o, "stored_volume", json_number_or_null(f->stored_volume));
+    json_object_set_new(o, "source_pressure", json_number_or_null(f->source_pressure));
+    json_object_set_new(o, "fluid_step", json_number_or_null(f->flow_step));
+    json_object_set_new(o, "fluid_subcycles", json_integer(f->subcycles));
+    json_object_set_new(o, "open_joints", json_integer(f->open_joints));
+    return o;
+}
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);
@@ -157,6 +176,7 @@ json_t *case_status_json(server_case *c)
     memcpy(error, c->error, sizeof error);
     memcpy(started, c->started, sizeof started);
     memcpy(finished_at, c->finished_at, sizeof finished_at);
+    double estimated_seconds = c->estimated_seconds;
     pthread_mutex_unlock(&c->lock);
 
     double end = c->info.end_time;
@@ -166,6 +186,11 @@ json_t *case_status_json(server_case *c)
         json_object_set_new(energy, energy_accounts[i].key,
                             json_number_or_null(*(const double *)((const char *)&f.energy +
                                                                   energy_accounts[i].offset)));
+    if (energy && f.fluid.enabled) {
+        json_object_set_new(energy, "fluid_work", json_number_or_null(f.energy.fluid_work));
+        json_object_set_new(energy, "fluid_dissipation",
+                            json_number_or_null(f.energy.fluid_dissipation));
+    }
     json_t *o = json_object();
     json_object_set_new(o, "id", json_string(c->id));
     json_object_set_new(o, "name", json_string(c->info.name));
@@ -183,6 +208,7 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
     json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
     json_object_set_new(o, "stage", case_stage_json(&f));
+    json_object_set_new(o, "fluid", case_fluid_json(&f.fluid));
     json_object_set_new(o, "snapshots", json_integer(f.snapshots));
     json_object_set_new(o, "energy", energy ? energy : json_null());
     json_object_set_new(o, "steps_per_second",
@@ -192,6 +218,8 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "started", json_string_or_null(started));
     json_object_set_new(o, "finished_at", json_string_or_null(finished_at));
     json_object_set_new(o, "elapsed", json_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
+    json_object_set_new(o, "estimated_seconds", json_number_or_null(estimated_seconds));
+    json_object_set_new(o, "eta", json_number_or_null(state == CASE_RUNNING ? f.eta : NAN));
     json_object_set_new(o, "warnings", case_warnings_json(c));
     return o;
 }
@@ -265,8 +293,10 @@ static void case_status_write_failed(server_case *c, const char *reason)
     }
     pthread_mutex_unlock(&c->lock);
     char again[128];
-    if (idle)
+    if (idle) {
         case_write_status_json(c, case_status_json(c), again, sizeof again);
+        case_feed_status(c);
+    }
 }
 
 int case_persist_status(server_case *c)

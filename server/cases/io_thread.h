@@ -54,6 +54,11 @@ void io_append_history(server_case *c, history_row **rows, int count);
  * point names the file holds. */
 int io_read_history(server_case *c, double since, history_row ***out, int *count,
                     history_names *names, char *err, size_t errlen);
+/* Snapshot q->snapshot of the case's result.h5 as the web page's binary
+ * frame (result_read_frame): *out (free() it), *size. 0; 404 (no file, no
+ * such snapshot), 503 (memory) or -1 (unreadable file) with err. */
+int io_read_frame(server_case *c, const result_frame_request *q, unsigned char **out,
+                  size_t *size, char *err, size_t errlen);
 /* Writes the events (as io_append), then `ckpt` as DIR/ID/<name> (a string
  * literal), after the jobs queued before it; takes ownership, returns at once. */
 void io_write_named_checkpoint(server_case *c, const char *name, fdem_event *events,
@@ -72,9 +77,14 @@ void io_close(server_case *c);
 int io_fetch_result(server_case *c, int *fd, size_t *size, int *held, int *http_status,
                     char *err, size_t errlen);
 void io_release_hold(server_case *c);
-/* Mean wall seconds of the recent snapshot writes (a result.h5 row with its
- * checkpoint and status, fsynced); before any, the seed given at start-up. */
-double io_snapshot_seconds(void);
+/* Wall seconds a snapshot of a model whose checkpoint is this large takes
+ * to write (a result.h5 row with its checkpoint and status, fsynced):
+ * the median wall seconds per snapshot of the last runs whose pace their
+ * writes set (io_note_paced_run, from the worker as a run ends), else of
+ * the last small snapshot jobs, else the seed given at start-up; the
+ * size is not charged (io_thread.c says why). */
+void io_note_paced_run(double wall, double waited, int snapshots);
+double io_snapshot_seconds(double checkpoint_bytes);
 void io_seed_snapshot_seconds(double seconds);
 
 #endif

@@ -21,6 +21,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "case_sizing.h"
 #include "io_thread.h"
@@ -163,6 +164,7 @@ static void registry_dispatch(void)
         if (!started)
             return;
         case_persist_status(started);
+        case_feed_status(started);
         case_release(started);
     }
 }
@@ -217,6 +219,7 @@ void registry_worker_exited(server_case *c, case_state final_state)
     pthread_mutex_unlock(&reg_lock);
     if (!atomic_load(&c->deleted))
         case_log_state(c, final_state);
+    case_feed_status(c);
     registry_dispatch();
 }
 
@@ -270,6 +273,7 @@ static void case_mark_broken(server_case *c, const char *why)
     pthread_mutex_unlock(&c->lock);
     case_log_state(c, CASE_FAILED);
     case_persist_status(c);
+    case_feed_status(c);
 }
 
 /* Reserves the model's memory and, when it will run at once (not queued),
@@ -376,8 +380,10 @@ int registry_start(server_case *c, char *msg, size_t msglen)
         if (status != 0)
             membudget_release(&c->reserve);
     }
-    if (status == 0)
+    if (status == 0) {
         case_persist_status(c);
+        case_feed_status(c);
+    }
     if (status == 0 && retry)
         case_log(c, "started again from its last checkpoint after failing for a full disk");
     if (queued)
@@ -430,8 +436,10 @@ int registry_pause(server_case *c, char *msg, size_t msglen)
     membudget_release(&unreserve);
     if (status == 0)
         case_persist_status(c);
-    if (status == 0 && !logged)
+    if (status == 0 && !logged) {
         case_log(c, "paused while queued");
+        case_feed_status(c); /* a running case's worker said it as it left */
+    }
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
 }
@@ -461,6 +469,7 @@ static int case_stop_idle(server_case *c, char *msg, size_t msglen)
     pthread_mutex_unlock(&c->lock);
     membudget_release(&unreserve);
     case_log_state(c, now);
+    case_feed_status(c);
     if (!written)
         registry_dispatch(); /* a queued case that failed leaves its turn */
     return written ? 0 : 500;
@@ -564,10 +573,12 @@ int registry_delete(server_case *c, char *msg, size_t msglen)
         pthread_mutex_unlock(&c->lock);
         atomic_store(&c->deleted, 0);
         case_persist_status(c);
+        case_feed_status(c);
         status = 500;
     } else {
         case_log(c, "deleted (was %s)", case_state_name(before));
         registry_unlist(c);
+        case_feed_deleted(c->id);
     }
     pthread_mutex_unlock(&c->ctl_lock);
     return status;
@@ -650,6 +661,7 @@ static int case_order(const void *a, const void *b)
 int registry_init(const fdemd_config *cfg)
 {
     reg_cfg = cfg;
+    case_feed_init();
     if (persist_mkdir(cfg->data_dir) != 0) {
         fprintf(stderr, "fdemd: cannot create the data directory %s: %s\n", cfg->data_dir,
                 strerror(errno));

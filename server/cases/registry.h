@@ -5,9 +5,10 @@
  *    upload (registry_create.c) and loading a stored case
  *    (registry_load.c, registry_internal.h between them); status objects
  *    and status.json (case_status.c); building, sizing and dropping models
- *    (case_model.c, case_sizing.c); extend and clone (case_stages.c); one
+ *    (case_model.c, case_sizing.c); extend and clone (case_continue.c); one
  *    worker thread per running case (worker.c); the one HDF5 I/O thread
- *    (io_thread.c). The state machine, the workers and the I/O thread call
+ *    (io_thread.c); the feed of case events GET /stream serves
+ *    (case_feed.c). The state machine, the workers and the I/O thread call
  *    each other: that circle stays inside this folder.
  *  - May call: store/ (persist.h, checkpoint_file.h, fault_point.h),
  *    common/ (config.h, memory_budget.h), proto/ and core/.
@@ -67,8 +68,10 @@ typedef struct case_figures {
     double steps_per_second;
     int snapshots;
     double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
+    double eta;                /* wall seconds left at the recent speed; NAN: unknown */
     int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
     char stage_name[CASE_STAGE_NAME];
+    fdem_fluid_status fluid;   /* contract 6.4; enabled 0 without fluid */
 } case_figures;
 
 #define CASE_ID_LEN 16
@@ -92,6 +95,8 @@ typedef struct server_case {
     case_state state;
     char error[768];           /* "" = no error */
     case_figures fig;
+    double estimated_seconds;  /* the sizing's wall time for the whole run (case_sizing.h)
+                                  at submission, scaled by an extend; NAN: unknown */
     int worker_active;
     _Atomic int deleted;
     uint64_t queue_seq;
@@ -128,6 +133,7 @@ typedef struct server_case {
     _Atomic int unchecked;     /* loaded at start-up, its stored files not checked yet: the
                                   daemon listens first (registry_ensure_checked) */
     case_state stored_state;   /* the state status.json had at start-up (for the log) */
+    double feed_status_at;     /* its last status event (monotonic s; case_feed.c's lock) */
 
     /* worker-private */
     int64_t resume_rows_until; /* >= 0: resumed from the step before an extended case's

@@ -15,6 +15,7 @@
 #include <sys/random.h>
 #include <sys/stat.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
@@ -107,8 +108,10 @@ static fdem_model *registry_build_upload(const char *body, size_t size, membudge
 static void registry_log_submitted(server_case *c, const case_sizing *z)
 {
     case_log(c, "submitted: %d nodes, %d elements, %d joints, dt = %.3g s, end = %.6g s, "
-             "%.4g steps, %.4g snapshots, about %.3g s to run", z->nodes, z->elements, z->joints,
-             z->dt, c->info.end_time, z->steps, z->snapshots, z->estimated_seconds);
+             "%.4g steps, %.4g snapshots, about %.3g s to run (%.3g ms of CPU a step as built, "
+             "%.3g ms with %d joints cracked)", z->nodes, z->elements, z->joints,
+             z->dt, c->info.end_time, z->steps, z->snapshots, z->estimated_seconds,
+             1e3 * z->step_seconds, 1e3 * z->cracked_step_seconds, z->cracked_joints);
 }
 
 /* registry_create() with the lease that pays for the upload. */
@@ -162,6 +165,18 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         goto fail;
     io_close(c); /* a case that is not running keeps no file open */
     case_publish_from_model(c);
+    /* Its t = 0 is stored and published: the model is stepped for a
+     * moment to time the run (the estimate goes into the first
+     * status.json), then freed; a start builds it again from the stored
+     * files, as every later start does. */
+    case_sizing sizing;
+    case_sizing_measure(model, &info, model_bytes, registry_config()->threads,
+                        io_snapshot_seconds((double)fdem_checkpoint_size(model)),
+                        &sizing);
+    case_sizing_warning(&sizing, warning, warning_size);
+    pthread_mutex_lock(&c->lock);
+    c->estimated_seconds = sizing.estimated_seconds;
+    pthread_mutex_unlock(&c->lock);
     if (case_persist_status(c) != 0) {
         snprintf(err, errlen, "cannot store status.json: %s", c->io_error);
         goto fail;
@@ -170,13 +185,6 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
         goto fail;
     fdem_counts n = fdem_get_counts(model);
     size_t cost = case_model_cost((double)fdem_memory_estimate_of(&n));
-    /* Its t = 0 is stored: the model is stepped for a moment to time the
-     * run, then freed; a start builds it again from the stored files, as
-     * every later start does. */
-    case_sizing sizing;
-    case_sizing_measure(model, &info, model_bytes, registry_config()->threads, io_snapshot_seconds(),
-                        &sizing);
-    case_sizing_warning(&sizing, warning, warning_size);
     c->model = NULL;
     fdem_model_destroy(model);
     registry_log_submitted(c, &sizing); /* before a worker can log its start */
@@ -188,6 +196,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
      * is acknowledged comes back after a crash). */
     if (start)
         case_persist_status(c);
+    case_feed_status(c);
     *http_status = 201;
     case_retain(c);
     return c;
@@ -228,7 +237,8 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
     json_t *answer = NULL;
     if (model) {
         case_sizing sizing;
-        case_sizing_measure(model, &info, model_bytes, registry_config()->threads, io_snapshot_seconds(),
+        case_sizing_measure(model, &info, model_bytes, registry_config()->threads,
+                        io_snapshot_seconds((double)fdem_checkpoint_size(model)),
                         &sizing);
         fdem_model_destroy(model);
         answer = case_sizing_json(&sizing);

@@ -1,6 +1,6 @@
 /*
  * registry_internal.h - what registry.c, case_record.c, registry_create.c,
- * case_status.c, registry_load.c and case_stages.c share, and nothing else
+ * case_status.c, registry_load.c and case_continue.c share, and nothing else
  * includes:
  * building a case record, its state names, the status object's durable
  * write, admitting a stored case, and loading one.

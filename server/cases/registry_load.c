@@ -18,8 +18,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "case_feed.h"
 #include "case_model.h"
-#include "case_stages.h"
+#include "case_continue.h"
 #include "common/memory_budget.h"
 #include "store/persist.h"
 #include "registry.h"
@@ -74,6 +75,7 @@ static void case_load_figures(server_case *c, const json_t *st)
     const char *name = json_string_value(json_object_get(st, "name"));
     snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
     c->info.end_time = status_number(st, "end_time");
+    c->estimated_seconds = status_number(st, "estimated_seconds"); /* NAN before it was kept */
 }
 
 /* The state the case was in when the daemon stopped: a case the shutdown
@@ -228,14 +230,23 @@ void registry_ensure_checked(server_case *c)
     if (!atomic_load(&c->unchecked))
         return;
     pthread_mutex_lock(&c->ctl_lock);
+    int changed = 0;
     if (atomic_load(&c->unchecked)) {
+        pthread_mutex_lock(&c->lock);
+        case_state before = c->state;
+        pthread_mutex_unlock(&c->lock);
         c->load_broken = case_check_stored(c) != 0;
         if (!c->load_broken)
             case_persist_status(c);
         case_log_restored(c, c->stored_state);
         atomic_store(&c->unchecked, 0);
+        pthread_mutex_lock(&c->lock);
+        changed = c->state != before;
+        pthread_mutex_unlock(&c->lock);
     }
     pthread_mutex_unlock(&c->ctl_lock);
+    if (changed) /* the check found its files broken */
+        case_feed_status(c);
 }
 
 /* Start-up's rebuilds run here, after the daemon listens: three stored

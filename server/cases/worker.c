@@ -17,15 +17,26 @@
 #include <string.h>
 #include <time.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/checkpoint_file.h"
 #include "case_sizing.h"
+#include "sizing_probe.h"
 #include "io_thread.h"
 #include "registry_internal.h"
 #include "worker_history.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
+/* The eta (contract 6.2) divides the simulated time left by the simulated
+ * seconds per wall second over the last WORKER_ETA_SAMPLES x
+ * WORKER_ETA_SAMPLE_EVERY (8 s) of this run: long enough that one slow
+ * step or a snapshot write does not swing it, short enough to follow a
+ * case that slows once it breaks. Unknown (null) before
+ * WORKER_ETA_MIN_WINDOW of the run. */
+#define WORKER_ETA_SAMPLES 32
+#define WORKER_ETA_SAMPLE_EVERY 0.25
+#define WORKER_ETA_MIN_WINDOW 0.2
 
 typedef enum worker_exit {
     EXIT_PAUSE, EXIT_STOP, EXIT_ABANDON, EXIT_FINISHED, EXIT_FAILED,
@@ -42,6 +53,12 @@ typedef struct worker_clock {
     double steps_per_second;
     double run_started;     /* when this run began stepping */
     double elapsed_before;  /* wall seconds spent stepping in earlier runs */
+    /* the eta's window: (wall, simulated time) once every
+     * WORKER_ETA_SAMPLE_EVERY, the oldest overwritten (worker_eta) */
+    double eta_wall[WORKER_ETA_SAMPLES], eta_time[WORKER_ETA_SAMPLES];
+    int eta_count, eta_next;
+    double io_waited;       /* wall seconds this run waited for its snapshot writes */
+    int snapshots_taken;    /* by this run */
 } worker_clock;
 
 static double worker_now(void)
@@ -85,6 +102,26 @@ static void worker_take_warnings(server_case *c)
         case_add_warning(c, "", "more element pairs passed into one another than are listed");
 }
 
+/* Wall seconds left at the speed of the recent window (see
+ * WORKER_ETA_SAMPLES), NAN while the window is too short or the case is not
+ * advancing; takes the sample of `now` when one is due. */
+static double worker_eta(worker_clock *clk, double now, double time, double end)
+{
+    int newest = (clk->eta_next + WORKER_ETA_SAMPLES - 1) % WORKER_ETA_SAMPLES;
+    if (clk->eta_count == 0 || now - clk->eta_wall[newest] >= WORKER_ETA_SAMPLE_EVERY) {
+        clk->eta_wall[clk->eta_next] = now;
+        clk->eta_time[clk->eta_next] = time;
+        clk->eta_next = (clk->eta_next + 1) % WORKER_ETA_SAMPLES;
+        if (clk->eta_count < WORKER_ETA_SAMPLES) clk->eta_count++;
+    }
+    int oldest = clk->eta_count < WORKER_ETA_SAMPLES ? 0 : clk->eta_next;
+    double wall = now - clk->eta_wall[oldest], advanced = time - clk->eta_time[oldest];
+    if (!(wall >= WORKER_ETA_MIN_WINDOW) || !(advanced > 0))
+        return NAN;
+    double left = end - time;
+    return left > 0 ? left * wall / advanced : 0.0;
+}
+
 /* Called with model_lock held (the figures must belong to one step). */
 static void worker_publish(server_case *c, worker_clock *clk, double now, int running)
 {
@@ -96,6 +133,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.dt = fdem_get_dt(m);
     fig.counts = fdem_get_counts(m);
     fig.energy = fdem_get_energy(m);
+    fig.fluid = fdem_get_fluid(m);
     clk->last_publish = now;
     double wall = now - clk->speed_since;
     if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_speed > 100))
@@ -105,6 +143,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
         clk->steps_at_speed = fig.step;
     }
     fig.steps_per_second = running ? clk->steps_per_second : 0.0;
+    fig.eta = running ? worker_eta(clk, now, fig.time, c->info.end_time) : NAN;
     fig.snapshots = -1; /* owned by the I/O thread */
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
     case_figures_stage(&fig, m, &c->info);
@@ -123,12 +162,20 @@ static void worker_yield_to_requesters(server_case *c)
     pthread_mutex_unlock(&c->yield_lock);
 }
 
-static void worker_wait_io(server_case *c, int max_pending)
+/* Waits until at most max_pending snapshot jobs are left; returns the
+ * wall seconds it waited (0 without a wait). */
+static double worker_wait_io(server_case *c, int max_pending)
 {
+    double waited = 0;
     pthread_mutex_lock(&c->lock);
-    while (c->io_pending > max_pending)
-        pthread_cond_wait(&c->cv, &c->lock);
+    if (c->io_pending > max_pending) {
+        double started = worker_now();
+        while (c->io_pending > max_pending)
+            pthread_cond_wait(&c->cv, &c->lock);
+        waited = worker_now() - started;
+    }
     pthread_mutex_unlock(&c->lock);
+    return waited;
 }
 
 /* The engine's message already names the step, element and dt (fdem.h);
@@ -231,6 +278,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
+            clk->snapshots_taken++;
         }
         worker_history_after_step(c, cut ? end - t0 : dt, snap != NULL, done);
         /* Every snapshot comes with a checkpoint, so that a restart never
@@ -243,16 +291,19 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             c->last_checkpoint_step = fdem_get_step(m);
             clk->last_checkpoint = now;
         }
-        if (snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL)
+        int published = snap || done || now - clk->last_publish >= WORKER_PUBLISH_INTERVAL;
+        if (published)
             worker_publish(c, clk, now, 1);
         pthread_mutex_unlock(&c->model_lock);
+        if (published)
+            case_feed_progress(c); /* at most CASE_FEED_STATUS_RATE a second */
 
         /* a checkpoint's rows go before it (worker_history.h) */
         if (ckpt || worker_history_batch_full(c))
             worker_history_flush(c);
         if (snap || ckpt) {
             io_append(c, events, event_count, snap, ckpt, ckpt_size);
-            worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
+            clk->io_waited += worker_wait_io(c, WORKER_MAX_IO_BACKLOG);
         }
         if (done)
             return EXIT_FINISHED;
@@ -345,13 +396,20 @@ static void *worker_main(void *arg)
         pthread_mutex_lock(&c->lock);
         double elapsed_before = c->fig.elapsed > 0 ? c->fig.elapsed : 0.0;
         pthread_mutex_unlock(&c->lock);
-        worker_clock clk = {now, now, now, fdem_get_step(c->model), 0.0, now, elapsed_before};
+        worker_clock clk = {.last_publish = now, .last_checkpoint = now, .speed_since = now,
+                            .steps_at_speed = fdem_get_step(c->model), .run_started = now,
+                            .elapsed_before = elapsed_before};
         case_log(c, "started at step %lld (t = %.6g of %.6g s, dt = %.3g s)",
                  (long long)fdem_get_step(c->model), fdem_get_time(c->model), c->info.end_time,
                  fdem_get_dt(c->model));
         c->next_output = worker_next_output(c, fdem_get_time(c->model));
         worker_history_start(c);
+        double cpu_started = sizing_thread_cpu();
         why = worker_loop(c, &clk);
+        /* what this run got of the machine, for the next estimates */
+        double wall = worker_now() - clk.run_started;
+        sizing_note_run(wall - clk.io_waited, sizing_thread_cpu() - cpu_started);
+        io_note_paced_run(wall, clk.io_waited, clk.snapshots_taken);
         worker_wind_down(c, why, &clk);
         final_state = worker_final_state(why);
     }

@@ -30,6 +30,8 @@ typedef struct fdemd_config {
     double checkpoint_every;  /* s of wall time between checkpoints of a running case */
     int max_connections_per_ip; /* open connections per client address */
     double request_timeout;   /* s for a whole request, headers and body */
+    int max_streams;          /* GET /stream streams open at once */
+    char web_dir[1024];       /* --web: the page's files; "" = web/ beside bin/ */
 } fdemd_config;
 
 #endif

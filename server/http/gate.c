@@ -74,6 +74,7 @@ typedef struct gate_slot {
     int live;          /* counted in gate_ips */
     int idle;          /* handed over and between requests: the watchdog's */
     int requests;      /* answered on it so far */
+    int stream;        /* an event stream now: no longer counted for its address */
 } gate_slot;
 
 typedef struct gate_ip {
@@ -148,12 +149,21 @@ static int gate_admit(int fd, uint32_t ip, double now, const char **why)
         }
         entry->count++;
         gate.total++;
-        gate.slots[fd] = (gate_slot){ip, now, 1, 0, 0};
+        gate.slots[fd] = (gate_slot){ip, now, 1, 0, 0, 0};
         if (fd >= gate.slot_high) gate.slot_high = fd + 1;
         ok = 1;
     }
     pthread_mutex_unlock(&gate.lock);
     return ok;
+}
+
+/* One connection of address `ip` less; a connection waiting for a slot
+ * of its address may take it. With the lock held. */
+static void gate_uncount_ip_locked(uint32_t ip)
+{
+    gate_ip *entry = gate_find_ip(ip);
+    if (entry && --entry->count == 0) *entry = gate.ips[--gate.ip_count];
+    if (gate.waiting > 0) (void)!write(gate.wake[1], "", 1);
 }
 
 void gate_closed(int fd)
@@ -162,9 +172,18 @@ void gate_closed(int fd)
     if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live) {
         gate.slots[fd].live = 0;
         gate.total--;
-        gate_ip *entry = gate_find_ip(gate.slots[fd].ip);
-        if (entry && --entry->count == 0) *entry = gate.ips[--gate.ip_count];
-        if (gate.waiting > 0) (void)!write(gate.wake[1], "", 1);
+        if (!gate.slots[fd].stream) gate_uncount_ip_locked(gate.slots[fd].ip);
+        gate.slots[fd].stream = 0;
+    }
+    pthread_mutex_unlock(&gate.lock);
+}
+
+void gate_stream_began(int fd)
+{
+    pthread_mutex_lock(&gate.lock);
+    if (fd >= 0 && fd < gate.slot_count && gate.slots[fd].live && !gate.slots[fd].stream) {
+        gate.slots[fd].stream = 1;
+        gate_uncount_ip_locked(gate.slots[fd].ip);
     }
     pthread_mutex_unlock(&gate.lock);
 }

@@ -25,6 +25,11 @@
  *    from gate_request_done() on, the next request's headers must reach the
  *    daemon within `timeout`, or the gate shuts the socket down (the
  *    owner then closes it and calls gate_closed() as for any close).
+ *  - gate_stream_began(fd): the connection now carries an event stream
+ *    (GET /stream, stream.h), which lives as long as its client wants:
+ *    it stops counting against its address's limit (it still counts in
+ *    `total` until gate_closed). Its request is the daemon's, so the
+ *    watchdog leaves it alone as it does every request being answered.
  *  - gate_stop() stops accepting, closes held connections and joins.
  */
 #ifndef FDEMD_GATE_H
@@ -47,6 +52,7 @@ void gate_stop(void);
 void gate_closed(int fd);
 double gate_request_began(int fd, int *later);
 void gate_request_done(int fd);
+void gate_stream_began(int fd);
 
 /* Monotonic clock in seconds. */
 double gate_now(void);

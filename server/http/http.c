@@ -27,6 +27,8 @@
 #include "http_frame.h"
 #include "json/json_depth.h"
 #include "routes.h"
+#include "stream.h"
+#include "web.h"
 
 #define HTTP_THREADS 4
 #define HTTP_CONNECTION_TIMEOUT 30 /* s of inactivity while a response is sent */
@@ -108,6 +110,12 @@ static struct MHD_Response *http_text_response(char *text, const char *content_t
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, content_type);
     MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
     return resp;
+}
+
+enum MHD_Result http_reply_response(struct MHD_Connection *conn, unsigned status,
+                                    struct MHD_Response *resp)
+{
+    return http_queue(conn, status, resp);
 }
 
 enum MHD_Result http_reply_json(struct MHD_Connection *conn, unsigned status, json_t *body,
@@ -194,6 +202,22 @@ enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
         snprintf(disposition, sizeof disposition, "attachment; filename=\"%s\"", filename);
         MHD_add_response_header(resp, "Content-Disposition", disposition);
     }
+    return http_queue(conn, 200, resp);
+}
+
+enum MHD_Result http_reply_stream(struct MHD_Connection *conn, struct MHD_Response *resp,
+                                  unsigned idle_timeout)
+{
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONTENT_TYPE, "text/event-stream");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+    MHD_add_response_header(resp, MHD_HTTP_HEADER_CONNECTION, "close");
+    if (tl_request)
+        tl_request->closing = 1;
+    const union MHD_ConnectionInfo *info =
+        MHD_get_connection_info(conn, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (info)
+        gate_stream_began(info->connect_fd);
+    MHD_set_connection_option(conn, MHD_CONNECTION_OPTION_TIMEOUT, idle_timeout);
     return http_queue(conn, 200, resp);
 }
 
@@ -287,7 +311,10 @@ static enum MHD_Result http_reply_owed(struct MHD_Connection *conn, const http_r
 static int http_check_headers(struct MHD_Connection *conn, const char *url, const char *method,
                               http_request *r, enum MHD_Result *rc)
 {
-    const char *unauthorized = r->route.kind != ROUTE_HEALTH ? http_unauthorized_reason(conn) : NULL;
+    /* /health and the page's own files need no token: the page must load
+     * to ask for it, and its files hold no data (web.h). */
+    int open_route = r->route.kind == ROUTE_HEALTH || r->route.kind == ROUTE_WEB;
+    const char *unauthorized = !open_route ? http_unauthorized_reason(conn) : NULL;
     if (unauthorized) {
         *rc = http_reply_unauthorized(conn, unauthorized);
         return 1;
@@ -725,10 +752,18 @@ int http_start(const fdemd_config *cfg)
 {
     http_cfg = cfg;
     int port = 0;
+    if (web_init(cfg->web_dir) != 0)
+        fprintf(stderr, "fdemd: no web page: %s is not a folder (--web DIR); GET / answers 404\n",
+                cfg->web_dir[0] ? cfg->web_dir : "web/ beside bin/");
     if (heavy_work_start() != 0)
         return -1;
+    if (stream_start(cfg->max_streams) != 0) {
+        heavy_work_stop();
+        return -1;
+    }
     int listen_fd = http_listen(cfg, &port);
     if (listen_fd < 0) {
+        stream_stop();
         heavy_work_stop();
         return -1;
     }
@@ -757,6 +792,7 @@ int http_start(const fdemd_config *cfg)
         else
             close(listen_fd);
         http_daemon = NULL;
+        stream_stop();
         heavy_work_stop();
         return -1;
     }
@@ -766,6 +802,7 @@ int http_start(const fdemd_config *cfg)
 void http_stop(void)
 {
     gate_stop(); /* no new connections while the open ones are closed */
+    stream_stop(); /* ends every stream: none may be left suspended */
     heavy_work_stop(); /* answers and resumes every suspended request first */
     if (http_daemon) {
         MHD_stop_daemon(http_daemon);

@@ -5,9 +5,10 @@
  *    checks on a raw header block (http_frame.c); libmicrohttpd, request
  *    bodies, authentication and the reply helpers (this header, http.c);
  *    one function per API route (routes.c); result.h5 downloads
- *    (download.c); the threads for requests that build a model
- *    (heavy_work.c).
- *  - May call: cases/ (registry.h, case_stages.h, io_thread.h), common/
+ *    (download.c); the web page's files (web.c) and its binary snapshot
+ *    frames (mesh_frame.c); the threads for requests that build a model
+ *    (heavy_work.c); GET /stream's event streams (stream.c).
+ *  - May call: cases/ (registry.h, case_continue.h, io_thread.h), common/
  *    (config.h, memory_budget.h), proto/ and core/.
  *  - Called by: main.c only (http_start, http_stop). Nothing in cases/,
  *    store/ or common/ calls back into this folder.
@@ -59,6 +60,15 @@ enum MHD_Result http_reply_empty(struct MHD_Connection *conn, unsigned status);
  * waits suspended, so the threads that answer HTTP never build models. */
 enum MHD_Result http_defer_heavy(struct MHD_Connection *conn);
 int http_on_heavy_thread(void);
+/* Queues an event stream (stream.c), text/event-stream: its connection
+ * leaves the per-address count and the request deadline (gate.h), is cut
+ * after `idle_timeout` s in which its client reads nothing, and closes
+ * when the stream ends. */
+enum MHD_Result http_reply_stream(struct MHD_Connection *conn, struct MHD_Response *resp,
+                                  unsigned idle_timeout);
+/* Queues a response a route built itself (consumed; NULL answers nothing). */
+enum MHD_Result http_reply_response(struct MHD_Connection *conn, unsigned status,
+                                    struct MHD_Response *resp);
 /* Serves `size` bytes of an open descriptor (closed by libmicrohttpd). */
 enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
                               const char *content_type, const char *filename);

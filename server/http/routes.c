@@ -17,14 +17,17 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "cases/case_stages.h"
+#include "cases/case_continue.h"
 #include "download.h"
 #include "fragment_query.h"
+#include "mesh_frame.h"
 #include "state/events_json.h"
 #include "http.h"
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
 #include "state/state_json.h"
+#include "stream.h"
+#include "web.h"
 
 /* ------------------------------------------------------------- matching */
 
@@ -61,13 +64,20 @@ void routes_match(const char *url, route_match *out)
         {"result.h5", ROUTE_CASE_RESULT_H5}, {"result.xdmf", ROUTE_CASE_RESULT_XDMF},
         {"fragments", ROUTE_CASE_FRAGMENTS}, {"extend", ROUTE_CASE_EXTEND},
         {"clone", ROUTE_CASE_CLONE}, {"events", ROUTE_CASE_EVENTS},
-        {"history", ROUTE_CASE_HISTORY},
+        {"history", ROUTE_CASE_HISTORY}, {"mesh.bin", ROUTE_CASE_MESH},
     };
     char seg[ROUTE_MAX_SEGMENTS][32];
     memset(out, 0, sizeof *out);
+    if (web_path(url)) { /* the page's files: web.c checks the rest of the path */
+        out->kind = ROUTE_WEB;
+        out->url = url;
+        return;
+    }
     int n = routes_split(url, seg);
     if (n == 1 && strcmp(seg[0], "health") == 0)
         out->kind = ROUTE_HEALTH;
+    if (n == 1 && strcmp(seg[0], "stream") == 0)
+        out->kind = ROUTE_STREAM;
     if (n < 1 || strcmp(seg[0], "cases") != 0)
         return;
     if (n == 1) {
@@ -99,6 +109,7 @@ const char *routes_allowed(route_kind kind)
     case ROUTE_CASE: return "GET, HEAD, DELETE";
     case ROUTE_CASE_START: case ROUTE_CASE_PAUSE: case ROUTE_CASE_STOP:
     case ROUTE_CASE_EXTEND: case ROUTE_CASE_CLONE: return "POST";
+    case ROUTE_STREAM: return "GET";
     default: return "GET, HEAD";
     }
 }
@@ -169,14 +180,19 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const state[] = {"fields", NULL};
     static const char *const events[] = {"since", NULL};
     static const char *const fragments[] = {"parts", "exclude_host", NULL};
+    static const char *const stream[] = {"case", NULL};
+    static const char *const mesh[] = {"snapshot", "fields", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;
     if (kind == ROUTE_CASE_CLONE)
         return create; /* a clone is made exactly as POST /cases makes a case */
+    if (kind == ROUTE_STREAM)
+        return stream;
     return kind == ROUTE_CASE_STATE ? state
          : kind == ROUTE_CASE_EVENTS || kind == ROUTE_CASE_HISTORY ? events
-         : kind == ROUTE_CASE_FRAGMENTS ? fragments : none;
+         : kind == ROUTE_CASE_FRAGMENTS ? fragments
+         : kind == ROUTE_CASE_MESH ? mesh : none;
 }
 
 typedef struct routes_query_check {
@@ -533,6 +549,28 @@ static int routes_since(struct MHD_Connection *conn, double *since, const char *
     return -1;
 }
 
+/* The tail of a JSON answer built under the memory meter (the tree o
+ * charged to the budget through lease): 200 with it, else 503 when the
+ * budget refused it (`what` names the items, "these events"), else 500;
+ * the lease is released either way. */
+static enum MHD_Result routes_reply_metered(struct MHD_Connection *conn, json_t *o,
+                                            membudget_lease *lease, const char *what)
+{
+    enum MHD_Result rc;
+    if (!o && membudget_meter_refused()) {
+        char detail[200];
+        snprintf(detail, sizeof detail, "the JSON form of %s would take the daemon past its "
+                 "memory budget (--max-memory) now; ask for fewer with ?since=", what);
+        rc = http_reply_unavailable(conn, detail, NULL);
+    } else if (!o) {
+        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
+    } else {
+        rc = http_reply_json(conn, 200, o, NULL);
+    }
+    membudget_release(lease);
+    return rc;
+}
+
 static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
 {
     const char *text = NULL;
@@ -555,17 +593,7 @@ static enum MHD_Result route_events(struct MHD_Connection *conn, server_case *c)
     json_t *o = events_to_json(events, count, dimension, text ? &since : NULL);
     membudget_meter_end();
     free(events);
-    enum MHD_Result rc;
-    if (!o && membudget_meter_refused())
-        rc = http_reply_unavailable(conn, "the JSON form of these events would take the daemon "
-                                    "past its memory budget (--max-memory) now; ask for fewer "
-                                    "with ?since=", NULL);
-    else if (!o)
-        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
-    else
-        rc = http_reply_json(conn, 200, o, NULL);
-    membudget_release(&lease);
-    return rc;
+    return routes_reply_metered(conn, o, &lease, "these events");
 }
 
 /* GET /cases/ID/history?since=T (contract 6.2): the history rows in
@@ -588,16 +616,7 @@ static enum MHD_Result route_history(struct MHD_Connection *conn, server_case *c
     json_t *o = history_rows_json(rows, count, &names);
     membudget_meter_end();
     result_free_history(rows, count);
-    if (!o && membudget_meter_refused())
-        rc = http_reply_unavailable(conn, "the JSON form of these history rows would take the "
-                                    "daemon past its memory budget (--max-memory) now; ask for "
-                                    "fewer with ?since=", NULL);
-    else if (!o)
-        rc = http_reply_problem(conn, 500, "Internal error", "out of memory", NULL);
-    else
-        rc = http_reply_json(conn, 200, o, NULL);
-    membudget_release(&lease);
-    return rc;
+    return routes_reply_metered(conn, o, &lease, "these history rows");
 }
 
 static enum MHD_Result route_delete(struct MHD_Connection *conn, server_case *c)
@@ -702,6 +721,8 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
         return route_events(conn, c);
     case ROUTE_CASE_HISTORY:
         return route_history(conn, c);
+    case ROUTE_CASE_MESH:
+        return mesh_frame_reply(conn, c);
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c, strcmp(method, "HEAD") == 0);
     case ROUTE_CASE_RESULT_XDMF:
@@ -720,6 +741,10 @@ enum MHD_Result routes_handle(struct MHD_Connection *conn, const route_match *m,
 {
     if (m->kind == ROUTE_HEALTH)
         return route_health(conn);
+    if (m->kind == ROUTE_STREAM)
+        return stream_open(conn);
+    if (m->kind == ROUTE_WEB)
+        return web_reply(conn, m->url);
     if (m->kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? route_create_case(conn, body, body_size)
                                            : route_list_cases(conn);

@@ -18,13 +18,15 @@ typedef enum route_kind {
     ROUTE_NONE, ROUTE_HEALTH, ROUTE_CASES, ROUTE_CASE, ROUTE_CASE_START, ROUTE_CASE_PAUSE,
     ROUTE_CASE_STOP, ROUTE_CASE_DOCUMENT, ROUTE_CASE_STATE, ROUTE_CASE_RESULT_H5,
     ROUTE_CASE_RESULT_XDMF, ROUTE_CASE_FRAGMENTS, ROUTE_CASE_EXTEND, ROUTE_CASE_CLONE,
-    ROUTE_CASE_EVENTS, ROUTE_CASE_HISTORY,
+    ROUTE_CASE_EVENTS, ROUTE_CASE_HISTORY, ROUTE_STREAM,
+    ROUTE_CASE_EVENTS, ROUTE_CASE_HISTORY, ROUTE_CASE_MESH, ROUTE_WEB,
 } route_kind;
 
 typedef struct route_match {
     route_kind kind;
     char id[CASE_ID_LEN + 1]; /* "" unless the path names a valid id */
     int bad_id;               /* /cases/X... with an X that is not an id (its 404 says so) */
+    const char *url;          /* ROUTE_WEB: the path (libmicrohttpd's, alive for the request) */
 } route_match;
 
 void routes_match(const char *url, route_match *out);

@@ -278,3 +278,39 @@ class DaemonTestCase(unittest.TestCase):
         with open(path, "wb") as f:
             f.write(data)
         return st, path
+
+
+class DimensionRunsTestCase(DaemonTestCase):
+    """A class whose tests read one finished run per dimension: setUpClass
+    runs case_of(2) and case_of(3) (CASE_OF, a function of the dimension)
+    to their end, reads GET /cases/ID/<ROUTE> and downloads result.h5;
+    each() yields (dimension, id, final status, JSON of ROUTE, path of the
+    file), one subTest per dimension."""
+    ROUTE = "status"
+    RUN_TIMEOUT = 120
+
+    @classmethod
+    def case_of(cls, dimension):
+        raise NotImplementedError
+
+    @classmethod
+    def setUpClass(cls):
+        super().setUpClass()
+        cls.runs = {}
+        for dimension in (2, 3):
+            st = cls.d.create(cls.case_of(dimension), start=True)
+            final = cls.d.wait_state(st["id"], ("finished", "failed", "stopped"),
+                                     timeout=cls.RUN_TIMEOUT)
+            status, body = cls.d.json("GET", "/cases/%s/%s" % (st["id"], cls.ROUTE))
+            assert status == 200, (status, body)
+            status, _, data = cls.d.request("GET", "/cases/%s/result.h5" % st["id"])
+            assert status == 200, status
+            path = os.path.join(cls.tmp, "%s-%dd.h5" % (cls.ROUTE, dimension))
+            with open(path, "wb") as f:
+                f.write(data)
+            cls.runs[dimension] = (st["id"], final, body, path)
+
+    def each(self):
+        for dimension in (2, 3):
+            with self.subTest(dimension=dimension):
+                yield (dimension,) + self.runs[dimension]

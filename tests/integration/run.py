@@ -68,7 +68,7 @@ MODULE_SECONDS = {"test_paraview": 70, "test_observation_3d": 47, "test_hostile_
                   "test_excavation": 27, "test_plot_3d": 22, "test_heavy_work": 21,
                   "test_hostile_requests": 16, "test_crash_consistency": 13,
                   "test_hostile_resources": 12, "test_results_displacement": 11,
-                  "test_history": 10, "test_memory": 8, "test_3d": 8}
+                  "test_history": 10, "test_memory": 8, "test_3d": 8, "test_stream": 32}
 
 
 def module_of(test):

@@ -22,7 +22,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, DimensionRunsTestCase, tiny_case
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 from fdemd_client import Client  # noqa: E402
@@ -74,29 +74,13 @@ def face_size(x0, nodes, dimension):
     return 0.5 * float(np.linalg.norm(np.cross(a[1] - a[0], a[2] - a[0])))
 
 
-class EventsThroughDaemon(DaemonTestCase):
+class EventsThroughDaemon(DimensionRunsTestCase):
     PREFIX = "fdemd-events-"
+    ROUTE = "events"
 
     @classmethod
-    def setUpClass(cls):
-        super().setUpClass()
-        cls.runs = {}
-        for dimension in (2, 3):
-            st = cls.d.create(pulled_bar(dimension), start=True)
-            final = cls.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=120)
-            status, body = cls.d.json("GET", "/cases/%s/events" % st["id"])
-            assert status == 200, (status, body)
-            status, _, data = cls.d.request("GET", "/cases/%s/result.h5" % st["id"])
-            assert status == 200, status
-            path = os.path.join(cls.tmp, "result-%dd.h5" % dimension)
-            with open(path, "wb") as f:
-                f.write(data)
-            cls.runs[dimension] = (st["id"], final, body, path)
-
-    def each(self):
-        for dimension in (2, 3):
-            with self.subTest(dimension=dimension):
-                yield (dimension,) + self.runs[dimension]
+    def case_of(cls, dimension):
+        return pulled_bar(dimension)
 
     def test_one_event_per_broken_joint(self):
         for dimension, _, final, body, _ in self.each():

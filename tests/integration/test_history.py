@@ -22,7 +22,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import ROOT, Daemon, DaemonTestCase
+from fdemd_harness import ROOT, Daemon, DimensionRunsTestCase
 
 sys.path.insert(0, os.path.join(ROOT, "clients", "python"))
 
@@ -61,29 +61,13 @@ def bar(dimension, history=True):
     return case
 
 
-class HistoryThroughDaemon(DaemonTestCase):
+class HistoryThroughDaemon(DimensionRunsTestCase):
     PREFIX = "fdemd-history-"
+    ROUTE = "history"
 
     @classmethod
-    def setUpClass(cls):
-        super().setUpClass()
-        cls.runs = {}
-        for dimension in (2, 3):
-            st = cls.d.create(bar(dimension), start=True)
-            final = cls.d.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=120)
-            status, body = cls.d.json("GET", "/cases/%s/history" % st["id"])
-            assert status == 200, (status, body)
-            status, _, data = cls.d.request("GET", "/cases/%s/result.h5" % st["id"])
-            assert status == 200, status
-            path = os.path.join(cls.tmp, "history-%dd.h5" % dimension)
-            with open(path, "wb") as f:
-                f.write(data)
-            cls.runs[dimension] = (st["id"], final, body, path)
-
-    def each(self):
-        for dimension in (2, 3):
-            with self.subTest(dimension=dimension):
-                yield (dimension,) + self.runs[dimension]
+    def case_of(cls, dimension):
+        return bar(dimension)
 
     def test_force_against_displacement_has_slope_EA_over_L(self):
         for dimension, _, final, _, path in self.each():

@@ -15,7 +15,7 @@
 #include "fdem.h"
 #include "mesh/mesh_3d.h"
 
-static int fixture_add_block(fdem_model *m, double ox, double oy, double w, double h, int nx,
+static inline int fixture_add_block(fdem_model *m, double ox, double oy, double w, double h, int nx,
                              int ny, int material, int fracture, fdem_error *err)
 {
     fdem_mesh mesh = {0};
@@ -28,7 +28,7 @@ static int fixture_add_block(fdem_model *m, double ox, double oy, double w, doub
 /* Sets dt = 0.5 x stable and fills `info` (when not NULL) as case_build
  * would: 1000 steps, a snapshot every 5, position, velocity, stress, strain,
  * principal_stress and displacement. */
-static void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
+static inline void fixture_info(fdem_model *m, case_info *info, const char *name, int parts,
                          int constraints, int fracture)
 {
     fdem_set_dt(m, 0.5 * fdem_stable_dt(m));
@@ -49,7 +49,7 @@ static void fixture_info(fdem_model *m, case_info *info, const char *name, int p
 
 /* Returns a finalized model with dt = 0.5 x stable, or NULL (printing why).
  * `fracturing` adds the breakable slab, `constraints` the two constraints. */
-static fdem_model *fixture_model(int fracturing, int constraints, case_info *info)
+static inline fdem_model *fixture_model(int fracturing, int constraints, case_info *info)
 {
     fdem_error err = {0};
     fdem_model *m = fdem_model_create();
@@ -87,7 +87,7 @@ static fdem_model *fixture_model(int fracturing, int constraints, case_info *inf
 /* The 3D counterpart: one 0.4 x 0.2 x 0.2 m box of 4 x 2 x 2 cells (six
  * tetrahedra each) under gravity along -z, fixed at z = 0 and, with
  * `constraints`, pushed by a force; one part, so no contact is needed. */
-static fdem_model *fixture_model_3d(int constraints, case_info *info)
+static inline fdem_model *fixture_model_3d(int constraints, case_info *info)
 {
     fdem_error err = {0};
     fdem_model *m = fdem_model_create();
@@ -154,7 +154,7 @@ static inline fdem_model *fixture_model_staged(case_info *info)
 }
 
 /* Steps n times; returns 0 or -1 (printing the engine's error). */
-static int fixture_step(fdem_model *m, int n)
+static inline int fixture_step(fdem_model *m, int n)
 {
     fdem_error err = {0};
     for (int i = 0; i < n; i++)

@@ -31,7 +31,7 @@ static fdem_material_def rock(int strong, double damping)
     fdem_material_def d = {.density = 2700, .young = 3e10, .poisson = 0.25, .damping = damping,
                            .friction = 0.3, .has_fracture = 1,
                            .fracture = {1e6, 3e6, 30, 10, 50}};
-    if (strong) d.fracture = (fdem_fracture_params){1e9, 3e9, 30, 1e6, 5e6};
+    if (strong) d.fracture = (fdem_fracture_params){.tensile_strength = 1e9, .cohesion = 3e9, .friction_angle = 30, .energy_I = 1e6, .energy_II = 5e6};
     return d;
 }
 

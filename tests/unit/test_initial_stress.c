@@ -25,6 +25,7 @@
 #include "mesh/mesh_3d.h"
 #include "model/model.h"
 #include "element/element.h"
+#include "stress_watch.h"
 
 #define RHO 2700.0
 #define YOUNG 3e10
@@ -58,31 +59,7 @@ static void set_stress(fdem_model *m, int p, const double *value, const double *
         build_die("initial stress", &err);
 }
 
-/* Height (y in 2D, z in 3D) of element e's centroid at the current positions. */
-static double centroid_height(const fdem_model *m, int e)
-{
-    const int K = fdem_nodes_per_element(m), D = fdem_get_dimension(m);
-    const int32_t *node = fdem_element_nodes(m) + (size_t)K * (size_t)e;
-    double h = 0;
-    for (int c = 0; c < K; c++) h += fdem_initial_positions(m)[D * node[c] + D - 1];
-    return h / K;
-}
 
-static double *element_stresses(const fdem_model *m)
-{
-    int S = fdem_stress_components(m);
-    double *s = malloc(sizeof(double) * (size_t)S * (size_t)fdem_get_counts(m).elements);
-    fdem_element_stress(m, s);
-    return s;
-}
-
-/* The largest |component| of a stress in Voigt layout. */
-static double stress_scale(int S, const double *s)
-{
-    double big = 0;
-    for (int k = 0; k < S; k++) big = fmax(big, fabs(s[k]));
-    return big;
-}
 
 /* ------------------------------------------------------------------ t = 0 */
 
@@ -236,21 +213,6 @@ static void run_periods(fdem_model *m, double height, double periods)
         if (fdem_step(m, &err)) build_die("step", &err);
 }
 
-/* Steps to t_end; returns the worst |energy residual| / scale and sets
- * *kinetic_max (when not NULL) to the largest kinetic energy seen. */
-static double run_watched(fdem_model *m, double t_end, double scale, double *kinetic_max)
-{
-    double worst = 0, kinetic = 0;
-    fdem_error err;
-    while (fdem_get_time(m) < t_end) {
-        if (fdem_step(m, &err)) build_die("step", &err);
-        fdem_energy en = fdem_get_energy(m);
-        worst = fmax(worst, fabs(en.residual) / scale);
-        kinetic = fmax(kinetic, en.kinetic);
-    }
-    if (kinetic_max) *kinetic_max = kinetic;
-    return worst;
-}
 
 /* The 2 x 1.5 (x 1) m block of the equilibrium tests under the uniform
  * in-situ stress *value (principal along the axes). */
@@ -265,18 +227,6 @@ static fdem_model *uniform_block(int dim, const double size[3], const double **v
     return m;
 }
 
-/* Largest relative change of any element's stress against `want` (per element). */
-static double stress_change(const fdem_model *m, const double *want)
-{
-    const int S = fdem_stress_components(m), E = fdem_get_counts(m).elements;
-    double *s = element_stresses(m), worst = 0;
-    for (int e = 0; e < E; e++) {
-        double scale = stress_scale(S, want + S * e);
-        for (int k = 0; k < S; k++) worst = fmax(worst, fabs(s[S * e + k] - want[S * e + k]) / scale);
-    }
-    free(s);
-    return worst;
-}
 
 static void rollers_hold_a_stressed_block(void)
 {

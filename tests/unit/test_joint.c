@@ -19,7 +19,7 @@ static int fracture_material(fdem_model *m, double penalty_factor)
     d.poisson = 0.0;
     d.penalty = penalty_factor * d.young;
     d.has_fracture = 1;
-    d.fracture = (fdem_fracture_params){1e6, 3e6, 30, 10, 50};
+    d.fracture = (fdem_fracture_params){.tensile_strength = 1e6, .cohesion = 3e6, .friction_angle = 30, .energy_I = 10, .energy_II = 50};
     fdem_error err;
     int k = fdem_add_material(m, &d, &err);
     if (k < 0) build_die("material", &err);
@@ -315,6 +315,42 @@ static void broken_joints_make_fragments(void)
     fdem_model_destroy(m);
 }
 
+/* fdem_break_joints_across (the daemon's cracked estimate): a plane
+ * between two columns of cells breaks exactly the joints on it, ny in 2D
+ * (one vertical edge a row) and 2 ny nz in 3D (two triangles a cube face),
+ * no joint inside a column, and leaves two fragments; a second cut along
+ * the same plane finds nothing left, and the cracked block steps. */
+static void crack_across_a_plane_breaks_the_joints_on_it(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = fdem_model_create();
+        fdem_error err;
+        if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
+        int mat = fracture_material(m, 10);
+        const double size[3] = {0.04, 0.03, 0.02};
+        const int div[3] = {4, 3, 2};
+        build_box_part(m, mat, dim, size, div, 1);
+        build_finalize(m, 0.5);
+        const double normal[3] = {1, 0, 0};
+        int want = dim == 2 ? div[1] : 2 * div[1] * div[2];
+        int broke = fdem_break_joints_across(m, normal, 0.02);
+        CHECK(broke == want, "%dD: %d joints broke, want %d", dim, broke, want);
+        fdem_counts c = fdem_get_counts(m);
+        CHECK(c.broken_joints == want, "%dD: %d broken", dim, c.broken_joints);
+        CHECK(c.fragments == 2, "%dD: fragments %d", dim, c.fragments);
+        CHECK(fdem_break_joints_across(m, normal, 0.02) == 0, "%dD: broke twice", dim);
+        const double *damage = fdem_joint_damage(m);
+        int whole = 0;
+        for (int j = 0; j < c.joints; j++) whole += damage[j] == 0;
+        CHECK(whole == c.joints - want, "%dD: %d joints intact of %d", dim, whole, c.joints);
+        for (int k = 0; k < 20; k++) {
+            memset(&err, 0, sizeof err);
+            CHECK(fdem_step(m, &err) == 0, "%dD: step after the cut: %s", dim, err.message);
+        }
+        fdem_model_destroy(m);
+    }
+}
+
 /* Tip period of a fixed-free bar with nu = 0: fracturing (every triangle on
  * its own nodes, joints everywhere) against the same bar without fracture. */
 static double bar_period(int fracture, double penalty_factor)
@@ -363,4 +399,5 @@ CHECK_MAIN(T(softening_curve_ends), T(mode_I_energy_matches_softening_curve),
            T(elastic_joint_is_a_penalty_spring_in_any_orientation),
            T(damaged_joint_shut_at_one_end_resists_along_the_shut_part),
            T(block_of_fracturing_triangles_is_built_right),
-           T(broken_joints_make_fragments), T(intact_fracturing_bar_vibrates_like_continuum))
+           T(broken_joints_make_fragments), T(crack_across_a_plane_breaks_the_joints_on_it),
+           T(intact_fracturing_bar_vibrates_like_continuum))

@@ -58,6 +58,7 @@ typedef struct tunnel_spec {
     double relax;     /* of the excavation */
     double damping;
     int threads;
+    double support;   /* a pressure on the wall during stage 1 (Pa; 0: none) */
 } tunnel_spec;
 
 typedef struct tunnel {
@@ -175,6 +176,19 @@ static void roller(fdem_model *m, int axis, double at)
     add_constraint(m, &c);
 }
 
+/* A constraint of `kind` on `count` mesh vertices of the tunnel's part. */
+static fdem_constraint_def on_vertices(const tunnel *t, const int32_t *vertices, int count,
+                                       fdem_constraint_kind kind)
+{
+    fdem_constraint_def c = {0};
+    c.select = FDEM_SELECT_VERTICES;
+    c.part = t->part;
+    c.vertices = vertices;
+    c.vertex_count = count;
+    c.kind = kind;
+    return c;
+}
+
 /* sigma (Voigt, tension positive) times the area vector N. */
 static void traction(int dim, const double *s, const double *N, double *f)
 {
@@ -237,25 +251,31 @@ static void outer_boundary(fdem_model *m, tunnel *t, const double *x, int vertex
     for (int v = 0; v < vertex_count; v++) {
         if (!on[v]) continue;
         outer[count++] = v;
-        fdem_constraint_def c = {0};
-        c.select = FDEM_SELECT_VERTICES;
-        c.part = t->part;
-        c.vertices = &outer[count - 1];
-        c.vertex_count = 1;
-        c.kind = FDEM_CONSTRAINT_FORCE;
+        fdem_constraint_def c = on_vertices(t, &outer[count - 1], 1, FDEM_CONSTRAINT_FORCE);
         for (int d = 0; d < D; d++) c.value[d] = f[D * v + d];
         add_constraint(m, &c);
     }
-    fdem_constraint_def c = {0};
-    c.select = FDEM_SELECT_VERTICES;
-    c.part = t->part;
-    c.vertices = outer;
-    c.vertex_count = count;
-    c.kind = FDEM_CONSTRAINT_ABSORB;
+    fdem_constraint_def c = on_vertices(t, outer, count, FDEM_CONSTRAINT_ABSORB);
     add_constraint(m, &c);
     free(outer);
     free(on);
     free(f);
+}
+
+/* The support pressure on the wall (ring 0) during stage 1: the facets it
+ * loads are interior until the stage excavates the fan (boundary_load.c). */
+static void wall_pressure(fdem_model *m, const tunnel *t, int vertex_count, double p)
+{
+    const int per_layer = m->dim == 3 ? vertex_count / 2 : vertex_count, n = t->crown;
+    int32_t *wall = malloc(sizeof(int32_t) * 2 * (size_t)n);
+    int count = 0;
+    for (int layer = 0; layer < (m->dim == 3 ? 2 : 1); layer++)
+        for (int v = 1; v <= n; v++) wall[count++] = layer * per_layer + v;
+    fdem_constraint_def c = on_vertices(t, wall, count, FDEM_CONSTRAINT_PRESSURE);
+    c.value[0] = p;
+    c.only_stage = 2;
+    add_constraint(m, &c);
+    free(wall);
 }
 
 /* The in-situ stress: p_h along x, p_v along y (compressions), plane
@@ -290,6 +310,7 @@ static tunnel tunnel_build(const tunnel_spec *s, double end)
         t.part = fdem_add_part(m, &m2, mat, 0, &err);
         if (t.part < 0) build_die("part", &err);
         outer_boundary(m, &t, m2.xy, m2.node_count, m2.tri, m2.triangle_count, stress);
+        if (s->support != 0) wall_pressure(m, &t, m2.node_count, s->support);
     } else {
         fdem_tet_mesh m3 = {0};
         const double thickness = A_HOLE * 0.5 * M_PI / s->cells;
@@ -297,6 +318,7 @@ static tunnel tunnel_build(const tunnel_spec *s, double end)
         t.part = fdem_add_part_3d(m, &m3, mat, 0, &err);
         if (t.part < 0) build_die("part", &err);
         outer_boundary(m, &t, m3.xyz, m3.node_count, m3.tet, m3.tet_count, stress);
+        if (s->support != 0) wall_pressure(m, &t, m3.node_count, s->support);
         fdem_tet_mesh_free(&m3);
         roller(m, 2, 0);
         roller(m, 2, thickness);
@@ -389,12 +411,16 @@ typedef struct kirsch {
     double hoop_crown, hoop_sidewall, u_crown, u_sidewall;
 } kirsch;
 
-static kirsch kirsch_of(double k0)
+/* Kirsch, with a support pressure p on the wall: Lame's term for a hole
+ * in an infinite plate under internal pressure, sigma_theta = +p a^2 / r^2
+ * and u_r = p a^2 / (2 G r), added to both (superposition). */
+static kirsch kirsch_of(double k0, double p)
 {
     const double G = YOUNG / (2 * (1 + NU)), ph = k0 * P_V, pv = P_V;
     const double P = 0.5 * (ph + pv), S = 0.5 * (pv - ph);
-    return (kirsch){-(3 * ph - pv), -(3 * pv - ph), A_HOLE / (2 * G) * (-P - (3 - 4 * NU) * S),
-                    A_HOLE / (2 * G) * (-P + (3 - 4 * NU) * S)};
+    return (kirsch){-(3 * ph - pv) + p, -(3 * pv - ph) + p,
+                    A_HOLE / (2 * G) * (-P + p - (3 - 4 * NU) * S),
+                    A_HOLE / (2 * G) * (-P + p + (3 - 4 * NU) * S)};
 }
 
 static kirsch measured(const tunnel *t, const tunnel_spec *s)

@@ -1,5 +1,5 @@
 /*
- * case_stage.c - the "stages" of a case (contract 6.1 "Stages"): named
+ * case_stages.c - the "stages" of a case (contract 6.1 "Stages"): named
  * periods, in order, stage k running from the end of stage k - 1 (or 0) to
  * its "end". At a stage's start the elements its "excavate" selectors pick
  * are removed (the engine applies the forces they exerted on the rest and
@@ -18,8 +18,9 @@
  * excavated by an earlier stage is not handed over again. The engine never
  * sees a name: the names go to case_info, for the status.
  *
- * Not to be confused with server/cases/case_stages.c (extend and clone,
- * contract 5.3), whose "stages" are successive runs of one case.
+ * Named, like the other sections' files, after its key in the document;
+ * extending and cloning a stored case (contract 5.3) is
+ * server/cases/case_continue.c.
  */
 #include <math.h>
 #include <stdint.h>

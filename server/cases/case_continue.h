@@ -1,5 +1,5 @@
 /*
- * case_stages.h - a case in stages (contract 5.3 "Continue and clone"):
+ * case_continue.h - a case continued (contract 5.3 "Continue and clone"):
  * POST /cases/ID/extend runs a finished or paused case on to a later end
  * in the same files; POST /cases/ID/clone makes a new case from a stored
  * one and a JSON Merge Patch (RFC 7396) or a JSON Patch (RFC 6902).
@@ -32,8 +32,8 @@
  *    (the work would pass --max-memory; it is metered against the
  *    request's lease) or 500 (err).
  */
-#ifndef FDEMD_CASE_STAGES_H
-#define FDEMD_CASE_STAGES_H
+#ifndef FDEMD_CASE_CONTINUE_H
+#define FDEMD_CASE_CONTINUE_H
 
 #include <stddef.h>
 

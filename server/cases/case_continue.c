@@ -1,5 +1,5 @@
 /*
- * case_stages.c - extend and clone (case_stages.h): the two ways a case
+ * case_continue.c - extend and clone (case_continue.h): the two ways a case
  * goes on past what its document first said.
  *
  * An extended case keeps its files: its document is rewritten with the
@@ -13,7 +13,7 @@
  * run that was asked for the new end from the start, and the row of the
  * old end stays in the file as it was.
  */
-#include "case_stages.h"
+#include "case_continue.h"
 
 #include <errno.h>
 #include <math.h>
@@ -22,6 +22,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "case_feed.h"
 #include "case_model.h"
 #include "store/fault_point.h"
 #include "io_thread.h"
@@ -32,7 +33,7 @@
 
 /* ---------------------------------------------------------------- reading */
 
-static json_t *stages_parse(const char *body, size_t size, size_t flags, problems *p)
+static json_t *continue_parse(const char *body, size_t size, size_t flags, problems *p)
 {
     json_error_t e;
     json_t *root = json_loadb(body, size, JSON_REJECT_DUPLICATES | flags, &e);
@@ -44,9 +45,9 @@ static json_t *stages_parse(const char *body, size_t size, size_t flags, problem
 }
 
 /* The new end of {"end": t}: 0, or 400/422 with the problems in p. */
-static int stages_read_end(const char *body, size_t size, double *end, problems *p)
+static int continue_read_end(const char *body, size_t size, double *end, problems *p)
 {
-    json_t *root = stages_parse(body, size, 0, p);
+    json_t *root = continue_parse(body, size, 0, p);
     if (!root)
         return 400;
     snprintf(p->title, sizeof p->title, "Invalid extend request");
@@ -77,7 +78,7 @@ static int stages_read_end(const char *body, size_t size, double *end, problems 
 }
 
 /* The stored document of `c` as a tree, or NULL with err. */
-static json_t *stages_load_document(server_case *c, char *err, size_t errlen)
+static json_t *continue_load_document(server_case *c, char *err, size_t errlen)
 {
     char path[1200], *text = NULL;
     size_t size = 0;
@@ -96,7 +97,7 @@ static json_t *stages_load_document(server_case *c, char *err, size_t errlen)
 /* ---------------------------------------------------------------- extend */
 
 /* 0 when `c` may be extended now; 404, or 409 with a sentence. */
-static int stages_extendable(server_case *c, case_state *was, char *msg, size_t msglen)
+static int continue_extendable(server_case *c, case_state *was, char *msg, size_t msglen)
 {
     pthread_mutex_lock(&c->lock);
     int status = 0;
@@ -117,7 +118,7 @@ static int stages_extendable(server_case *c, case_state *was, char *msg, size_t 
 }
 
 /* The last entry of a case's "stages" (contract 6.1), or NULL. */
-static json_t *stages_last_stage(json_t *doc)
+static json_t *continue_last_stage(json_t *doc)
 {
     json_t *stages = json_object_get(doc, "stages");
     size_t n = json_array_size(stages);
@@ -127,10 +128,10 @@ static json_t *stages_last_stage(json_t *doc)
 
 /* The end a stored document says: time.end, or its last stage's end when
  * it leaves time.end out; 0 when it says none. */
-static double stages_document_end(json_t *doc)
+static double continue_document_end(json_t *doc)
 {
     json_t *time_end = json_object_get(json_object_get(doc, "time"), "end");
-    return json_number_value(time_end ? time_end : json_object_get(stages_last_stage(doc), "end"));
+    return json_number_value(time_end ? time_end : json_object_get(continue_last_stage(doc), "end"));
 }
 
 /* `doc` with time.end = end, and output.interval pinned when it was left
@@ -139,12 +140,12 @@ static double stages_document_end(json_t *doc)
  * the new end too (its last stage runs on; the engine puts the steps
  * after a last stage's end in it). 0, or 409/422/500 with msg (422 also
  * in p). */
-static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_t msglen)
+static int continue_set_end(json_t *doc, double end, problems *p, char *msg, size_t msglen)
 {
     json_t *time = json_object_get(doc, "time");
-    json_t *last = stages_last_stage(doc);
+    json_t *last = continue_last_stage(doc);
     json_t *time_end = json_object_get(time, "end");
-    double old_end = stages_document_end(doc);
+    double old_end = continue_document_end(doc);
     if (!(old_end > 0)) {
         snprintf(msg, msglen, "the stored case.json has no time.end");
         return 500;
@@ -186,7 +187,7 @@ static int stages_set_end(json_t *doc, double end, problems *p, char *msg, size_
 }
 
 /* An extended finished case goes on from the step before its old end. */
-static int stages_keep_resume_point(server_case *c, char *msg, size_t msglen)
+static int continue_keep_resume_point(server_case *c, char *msg, size_t msglen)
 {
     char from[1200], to[1200];
     snprintf(from, sizeof from, "%s/%s", c->dir, CASE_END_CHECKPOINT);
@@ -199,12 +200,12 @@ static int stages_keep_resume_point(server_case *c, char *msg, size_t msglen)
     return 0;
 }
 
-/* The extend's one durable record (case_stages.h), written before any of
+/* The extend's one durable record (case_continue.h), written before any of
  * its files changes: from then on the extend is carried out, now or, after
  * a crash between its writes, at the next start-up. */
 #define STAGES_INTENT "extend.json"
 
-static int stages_write_intent(server_case *c, double end, char *msg, size_t msglen)
+static int continue_write_intent(server_case *c, double end, char *msg, size_t msglen)
 {
     json_t *o = json_pack("{s:f}", "end", end);
     char *text = o ? json_dumps(o, JSON_COMPACT) : NULL;
@@ -218,7 +219,7 @@ static int stages_write_intent(server_case *c, double end, char *msg, size_t msg
 }
 
 /* 1 with the end of an extend begun and not completed, else 0. */
-static int stages_read_intent(server_case *c, double *end)
+static int continue_read_intent(server_case *c, double *end)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/%s", c->dir, STAGES_INTENT);
@@ -231,7 +232,7 @@ static int stages_read_intent(server_case *c, double *end)
     return found;
 }
 
-static void stages_drop_intent(server_case *c)
+static void continue_drop_intent(server_case *c)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/%s", c->dir, STAGES_INTENT);
@@ -243,15 +244,15 @@ static void stages_drop_intent(server_case *c)
  * completing an extend whose record is already stored, so a case.json that
  * already says `end` is left as it is and every step may be one a crash
  * had already done. */
-static int stages_store_extension(server_case *c, double end, case_state was, int redo,
+static int continue_store_extension(server_case *c, double end, case_state was, int redo,
                                   problems *p, char *msg, size_t msglen)
 {
-    json_t *doc = stages_load_document(c, msg, msglen);
+    json_t *doc = continue_load_document(c, msg, msglen);
     if (!doc)
         return 500;
-    double stored_end = stages_document_end(doc);
+    double stored_end = continue_document_end(doc);
     int stored = redo && stored_end >= end;
-    int status = stored ? 0 : stages_set_end(doc, end, p, msg, msglen);
+    int status = stored ? 0 : continue_set_end(doc, end, p, msg, msglen);
     size_t length = 0;
     char *text = status == 0 ? json_dump_document(doc, &length) : NULL;
     json_decref(doc);
@@ -263,7 +264,7 @@ static int stages_store_extension(server_case *c, double end, case_state was, in
         return 500;
     }
     status = 500;
-    if (!redo && stages_write_intent(c, end, msg, msglen) != 0)
+    if (!redo && continue_write_intent(c, end, msg, msglen) != 0)
         goto done;
     fault_point("extend:intent");
     if (!stored && persist_write_atomic(c->dir, "case.json", text, length) != 0) {
@@ -282,7 +283,7 @@ static int stages_store_extension(server_case *c, double end, case_state was, in
         goto done;
     }
     fault_point("extend:result.h5");
-    if (was == CASE_FINISHED && stages_keep_resume_point(c, msg, msglen) != 0)
+    if (was == CASE_FINISHED && continue_keep_resume_point(c, msg, msglen) != 0)
         goto done;
     fault_point("extend:resume-point");
     status = 0;
@@ -293,34 +294,40 @@ done:
 
 /* The case shows paused with the new end; once status.json says so the
  * record goes. A failed status write leaves the record for a restart. */
-static void stages_settle(server_case *c, double end)
+static void continue_settle(server_case *c, double end)
 {
     pthread_mutex_lock(&c->lock);
+    /* the run's estimate, for the longer run: at the same pace per
+     * simulated second (the sizing priced the whole run, not a phase) */
+    if (c->info.end_time > 0)
+        c->estimated_seconds *= end / c->info.end_time;
     c->info.end_time = end;
     c->state = CASE_PAUSED;
     c->finished_at[0] = '\0';
     pthread_mutex_unlock(&c->lock);
-    if (case_persist_status(c) != 0)
+    int stored = case_persist_status(c) == 0;
+    case_feed_status(c);
+    if (!stored)
         return;
     fault_point("extend:status.json");
-    stages_drop_intent(c);
+    continue_drop_intent(c);
 }
 
 /* Completes an extend whose record is stored (cut short by a crash, or by
  * a failed write of an earlier request); 0, 1 when there is none, or an
  * HTTP status with msg. */
-static int stages_complete_stored(server_case *c, double *end, char *msg, size_t msglen)
+static int continue_complete_stored(server_case *c, double *end, char *msg, size_t msglen)
 {
-    if (!stages_read_intent(c, end))
+    if (!continue_read_intent(c, end))
         return 1;
     problems p;
     problems_init(&p);
     pthread_mutex_lock(&c->lock);
     case_state was = c->state;
     pthread_mutex_unlock(&c->lock);
-    int status = stages_store_extension(c, *end, was, 1, &p, msg, msglen);
+    int status = continue_store_extension(c, *end, was, 1, &p, msg, msglen);
     if (status == 0) {
-        stages_settle(c, *end);
+        continue_settle(c, *end);
         case_log(c, "completed an extend to end = %.6g s that was cut short (was %s); now "
                  "paused", *end, case_state_name(was));
     } else if (p.count) {
@@ -337,7 +344,7 @@ void registry_extend_recover(server_case *c)
     char msg[640] = "";
     if (c->state != CASE_FINISHED && c->state != CASE_PAUSED)
         return; /* a case failed at loading keeps its files as found */
-    int status = stages_complete_stored(c, &end, msg, sizeof msg);
+    int status = continue_complete_stored(c, &end, msg, sizeof msg);
     if (status > 1)
         fprintf(stderr, "fdemd: case %s: an extend to end = %.6g s cut short by a crash could "
                 "not be completed: %s; %s is kept for the next start-up\n", c->id, end, msg,
@@ -348,29 +355,29 @@ int registry_extend(server_case *c, const char *body, size_t size, problems *p, 
                     size_t msglen)
 {
     double end = 0, stored_end = 0;
-    int status = stages_read_end(body, size, &end, p);
+    int status = continue_read_end(body, size, &end, p);
     if (status != 0)
         return status;
     pthread_mutex_lock(&c->ctl_lock);
     case_state was;
     double old_end = c->info.end_time;
-    status = stages_extendable(c, &was, msg, msglen);
+    status = continue_extendable(c, &was, msg, msglen);
     if (status == 0) {
         /* An earlier request that failed half way is completed first: a
          * repeat of it is then answered as it would have been. */
-        int left = stages_complete_stored(c, &stored_end, msg, msglen);
+        int left = continue_complete_stored(c, &stored_end, msg, msglen);
         if (left == 0 && stored_end == end) {
             pthread_mutex_unlock(&c->ctl_lock);
             return 0;
         }
         status = left == 1 ? 0 : left;
         if (left == 0)
-            status = stages_extendable(c, &was, msg, msglen);
+            status = continue_extendable(c, &was, msg, msglen);
     }
     if (status == 0)
-        status = stages_store_extension(c, end, was, 0, p, msg, msglen);
+        status = continue_store_extension(c, end, was, 0, p, msg, msglen);
     if (status == 0) {
-        stages_settle(c, end);
+        continue_settle(c, end);
         case_log(c, "extended from end = %.6g s to %.6g s (was %s); now paused, start it to go on",
                  old_end, end, case_state_name(was));
     }
@@ -381,7 +388,7 @@ int registry_extend(server_case *c, const char *body, size_t size, problems *p, 
 /* ----------------------------------------------------------------- clone */
 
 /* 0 when `patch` has the form its content type asks for; else 422 in p. */
-static int stages_check_patch_form(const json_t *patch, int json_patch, problems *p)
+static int continue_check_patch_form(const json_t *patch, int json_patch, problems *p)
 {
     if (json_patch ? json_is_array(patch) : json_is_object(patch))
         return 0;
@@ -404,16 +411,16 @@ static int stages_check_patch_form(const json_t *patch, int json_patch, problems
     return 422;
 }
 
-static char *stages_clone_document(server_case *c, const char *body, size_t size, int json_patch,
+static char *continue_clone_document(server_case *c, const char *body, size_t size, int json_patch,
                                    size_t *length, problems *p, int *status, char *err,
                                    size_t errlen)
 {
-    json_t *patch = stages_parse(body, size, JSON_DECODE_ANY, p);
+    json_t *patch = continue_parse(body, size, JSON_DECODE_ANY, p);
     if (!patch) {
         *status = 400;
         return NULL;
     }
-    if ((*status = stages_check_patch_form(patch, json_patch, p)) != 0) {
+    if ((*status = continue_check_patch_form(patch, json_patch, p)) != 0) {
         json_decref(patch);
         return NULL;
     }
@@ -422,7 +429,7 @@ static char *stages_clone_document(server_case *c, const char *body, size_t size
     if (atomic_load(&c->deleted))
         *status = 404;
     else
-        doc = stages_load_document(c, err, errlen);
+        doc = continue_load_document(c, err, errlen);
     if (json_patch)
         snprintf(p->title, sizeof p->title, "Invalid patch");
     json_t *patched = !doc ? NULL : json_patch ? json_patch_apply(doc, patch, p)
@@ -447,7 +454,7 @@ char *registry_clone_document(server_case *c, const char *body, size_t size, int
     membudget_lease own = {0};
     membudget_lease *lease = membudget_request_lease() ? membudget_request_lease() : &own;
     membudget_meter_begin(lease, lease->bytes);
-    char *text = stages_clone_document(c, body, size, json_patch, length, p, status, err,
+    char *text = continue_clone_document(c, body, size, json_patch, length, p, status, err,
                                        errlen);
     membudget_meter_end();
     if (!text && *status != 422 && membudget_meter_refused()) {

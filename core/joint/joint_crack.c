@@ -1,0 +1,55 @@
+/*
+ * joint_crack.c - a crack cut through a model on purpose, for estimates.
+ *
+ * A short timing of a model before it runs sees its intact rock only: once
+ * a crack opens, the elements along it meet through contact, and in 3D a
+ * step after a split cost 27x one before it (issue 34). The daemon's
+ * sizing prices that phase by timing a throwaway copy with a crack already
+ * in it (server/cases/case_sizing.c): every intact joint between two
+ * elements whose centroids lie on either side of a plane breaks, as a crack
+ * running through the whole body along that plane would. No event is
+ * recorded and no energy booked: the model is not meant to run on.
+ */
+#include <math.h>
+
+#include "fdem.h"
+#include "joint.h"
+
+static void element_centroid(const fdem_model *m, int e, double c[3])
+{
+    const int32_t *n = element_nodes(m, e);
+    c[0] = c[1] = c[2] = 0;
+    for (int k = 0; k < m->elem_nodes; k++)
+        for (int d = 0; d < m->dim; d++) c[d] += m->pos[m->dim * (size_t)n[k] + d];
+    for (int d = 0; d < m->dim; d++) c[d] /= m->elem_nodes;
+}
+
+static double plane_side(const fdem_model *m, const double *normal, double offset, int e)
+{
+    double c[3];
+    element_centroid(m, e, c);
+    double s = -offset;
+    for (int d = 0; d < m->dim; d++) s += normal[d] * c[d];
+    return s;
+}
+
+int fdem_break_joints_across(fdem_model *m, const double *normal, double offset)
+{
+    int broke = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        if (m->joint_damage[j] >= 1.0) continue;
+        int a = m->joint_elem[2 * j], b = m->joint_elem[2 * j + 1];
+        if (!element_is_active(m, a) || !element_is_active(m, b)) continue;
+        double sa = plane_side(m, normal, offset, a), sb = plane_side(m, normal, offset, b);
+        if (!((sa < 0 && sb >= 0) || (sa >= 0 && sb < 0))) continue;
+        m->joint_damage[j] = 1.0;
+        broke++;
+    }
+    if (!broke) return 0;
+    m->broken_joints += broke;
+    int fragments = joint_fragment_count(m);
+    if (fragments < 0) return -1;
+    m->fragments = fragments;
+    m->contact.need_detect = 1; /* the crack's faces meet through contact */
+    return broke;
+}

@@ -1,0 +1,186 @@
+/*
+ * sizing_probe.c - the wall time of one step of a model on this machine
+ * (sizing_probe.h), measured so that it means the run's steps and not the
+ * first ones.
+ *
+ * The first steps of a fresh model are not like the rest: its arrays are
+ * touched for the first time (page faults), the caches are cold, the first
+ * contact detection runs, OpenMP starts its threads. One 50 ms sample of
+ * them gave 115 s and 3,300 s for two dry runs of one document, and 12x
+ * the measured run on a fracturing tunnel. So: a warm-up that is not timed,
+ * then several short windows, each its own figure, and their median: a
+ * window that a neighbour's process or a page fault slowed does not move
+ * it, and neither does the one window with a detection in it (detection
+ * reruns seldom, docs/physics.md).
+ *
+ * A window is timed in CPU seconds of the stepping thread, which the other
+ * processes of a busy machine do not change (two dry runs at a load
+ * average of 14 on two cores gave 9.4 and 1.0 ms of wall time a step for
+ * one model). How much of the machine the run will get is a separate
+ * factor: the median wall / CPU seconds of the stepping thread over this
+ * daemon's last runs (sizing_note_run), what runs here really got. Before
+ * any, the geometric mean of two guesses: the one-minute load average
+ * (the run is one task more among those, on this many cores), which also
+ * counts tasks waiting for the disk (at a load of 18 on two cores it said
+ * 9.9), and the wall / CPU time of the windows themselves (5 to 8 then,
+ * swinging from 4.8 to 12.4 between two dry runs a minute apart). Both
+ * ran 2-3x above what the runs that followed got (wall / CPU 1.5-3).
+ */
+#include "sizing_probe.h"
+
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+/* Untimed warm-up: at least this many steps and this long. */
+#define PROBE_WARM_STEPS 2
+#define PROBE_WARM_SECONDS 0.01
+/* Timed windows: each at least PROBE_WINDOW_SECONDS and one step, at most
+ * PROBE_WINDOW_STEPS steps. */
+#define PROBE_WINDOWS 7
+#define PROBE_WINDOW_SECONDS 0.008
+#define PROBE_WINDOW_STEPS 64
+/* Past PROBE_MIN_WINDOWS windows, no new one starts after this much of
+ * the probe: a model whose step takes 0.1 s is timed in under a second. */
+#define PROBE_MIN_WINDOWS 3
+#define PROBE_BUDGET_SECONDS 0.3
+
+double sizing_clock(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* CPU seconds of the calling thread: what a step costs whatever else the
+ * machine is doing. */
+static double probe_cpu(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int probe_step(fdem_model *model)
+{
+    fdem_error err;
+    memset(&err, 0, sizeof err);
+    return fdem_step(model, &err);
+}
+
+static int compare_doubles(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Steps for at least `seconds` and `min_steps`, at most `max_steps`;
+ * the steps taken, -1 when one failed; its wall and CPU time into `load`. */
+static int probe_run(fdem_model *model, double seconds, int min_steps, int max_steps,
+                     sizing_load *load, double *cpu)
+{
+    double started = sizing_clock(), now = started, cpu0 = probe_cpu();
+    int taken = 0;
+    while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
+        if (probe_step(model) != 0)
+            return -1;
+        taken++;
+        now = sizing_clock();
+    }
+    *cpu = probe_cpu() - cpu0;
+    load->wall += now - started;
+    load->cpu += *cpu;
+    return taken;
+}
+
+double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken,
+                                 sizing_load *load)
+{
+    *taken = 0;
+    double cpu, window[PROBE_WINDOWS], started = sizing_clock();
+    sizing_load warm_load = {0, 0};
+    int room = steps_left < 1e9 ? (int)steps_left : 1000000000;
+    int warm = probe_run(model, PROBE_WARM_SECONDS, PROBE_WARM_STEPS,
+                         room < PROBE_WARM_STEPS ? room : 1000, &warm_load, &cpu);
+    if (warm < 0)
+        return NAN;
+    *taken += warm;
+    room -= warm;
+    if (room <= 0) { /* a run this short: its own steps are the figure */
+        load->wall += warm_load.wall;
+        load->cpu += warm_load.cpu;
+        return warm > 0 ? cpu / warm : NAN;
+    }
+    int windows = 0;
+    while (windows < PROBE_WINDOWS && room > 0 &&
+           (windows < PROBE_MIN_WINDOWS || sizing_clock() - started < PROBE_BUDGET_SECONDS)) {
+        int n = probe_run(model, PROBE_WINDOW_SECONDS, 1,
+                          room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, load, &cpu);
+        if (n < 0)
+            return NAN;
+        *taken += n;
+        room -= n;
+        window[windows++] = cpu / n;
+    }
+    qsort(window, (size_t)windows, sizeof *window, compare_doubles);
+    return window[windows / 2];
+}
+
+/* Wall over CPU seconds of the stepping thread in the daemon's recent
+ * runs (sizing_note_run): the share of the machine a run really got. */
+#define RUN_SHARE_SAMPLES 9
+#define RUN_SHARE_MIN_SECONDS 0.2
+static pthread_mutex_t run_share_lock = PTHREAD_MUTEX_INITIALIZER;
+static double run_share[RUN_SHARE_SAMPLES];
+static int run_share_count, run_share_next;
+
+void sizing_note_run(double wall, double cpu)
+{
+    if (!(wall >= RUN_SHARE_MIN_SECONDS) || !(cpu > 0))
+        return;
+    pthread_mutex_lock(&run_share_lock);
+    run_share[run_share_next] = wall / cpu;
+    run_share_next = (run_share_next + 1) % RUN_SHARE_SAMPLES;
+    if (run_share_count < RUN_SHARE_SAMPLES) run_share_count++;
+    pthread_mutex_unlock(&run_share_lock);
+}
+
+/* The median of the recent runs' wall / CPU, or 0 when none ran. */
+static double recent_run_factor(void)
+{
+    double v[RUN_SHARE_SAMPLES];
+    pthread_mutex_lock(&run_share_lock);
+    int n = run_share_count;
+    memcpy(v, run_share, sizeof(double) * (size_t)n);
+    pthread_mutex_unlock(&run_share_lock);
+    if (n == 0) return 0;
+    qsort(v, (size_t)n, sizeof *v, compare_doubles);
+    return v[n / 2];
+}
+
+double sizing_load_factor(const sizing_load *load)
+{
+    double recent = recent_run_factor();
+    if (recent > 0)
+        return recent > 1.0 ? recent : 1.0;
+    double average[1];
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    double seen = load->cpu > 0 && load->wall > 0 ? load->wall / load->cpu : 1.0;
+    if (seen < 1.0)
+        seen = 1.0;
+    if (getloadavg(average, 1) != 1 || !(average[0] >= 0) || cores < 1)
+        return seen;
+    /* the run is one more task among those the load average counts */
+    double counted = (average[0] + 1.0) / (double)cores;
+    if (counted < 1.0)
+        counted = 1.0;
+    return sqrt(counted * seen);
+}
+
+double sizing_thread_cpu(void)
+{
+    return probe_cpu();
+}

@@ -1,0 +1,328 @@
+/*
+ * test_fluid.c - fluid in the fractures (contract 6.4, core/fluid/):
+ *  - the network keeps its fluid: what is stored is what was injected, to
+ *    round-off, in 2D and 3D, while the fluid breaks the rock;
+ *  - the pressure's forces are equal and opposite: the momentum of a free
+ *    body stays zero;
+ *  - the fluid's work closes the energy balance (residual < 1 % of it);
+ *  - 1 and 2 threads, and a restart from a checkpoint, give the same bits;
+ *  - a wet joint sheared under a normal stress sigma_n slides at
+ *    c + (sigma_n - p) tan(phi) (Terzaghi's effective stress), within 3 %;
+ *  - bad input: one 422 with a problem at each pointer.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "case_doc.h"
+#include "check.h"
+#include "fdem.h"
+
+/* A fracturing square (cube) fed at its centre node. */
+static const char *const network_2d =
+    "{'dimension': 2,"
+    " 'materials': {'rock': {'density': 2500, 'young': 1e10, 'poisson': 0.2, 'damping': 0.2,"
+    "   'fracture': {'tensile_strength': 1e6, 'cohesion': 3e6, 'friction_angle': 30,"
+    "                'energy_I': 20, 'energy_II': 100, 'aperture0': 1e-4}}},"
+    " 'fluid': {'viscosity': 1e-3, 'bulk_modulus': 1e8, 'density': 1000},"
+    " 'parts': [{'name': 'rock', 'material': 'rock', 'fracture': true,"
+    "            'rectangle': {'origin': [-0.5, -0.5], 'size': [1, 1], 'divisions': [8, 8]}}],"
+    " 'constraints': [{'box': [-0.01, -0.01, 0.01, 0.01], 'inject': 2e-3}],"
+    " 'time': {'end': 1}}";
+
+static const char *const network_3d =
+    "{'dimension': 3,"
+    " 'materials': {'rock': {'density': 2500, 'young': 1e10, 'poisson': 0.2, 'damping': 0.2,"
+    "   'fracture': {'tensile_strength': 1e6, 'cohesion': 3e6, 'friction_angle': 30,"
+    "                'energy_I': 20, 'energy_II': 100, 'aperture0': 1e-4}}},"
+    " 'fluid': {'viscosity': 1e-3, 'bulk_modulus': 1e8, 'density': 1000},"
+    " 'parts': [{'name': 'rock', 'material': 'rock', 'fracture': true,"
+    "            'box': {'origin': [-0.5, -0.5, -0.5], 'size': [1, 1, 1], 'divisions': [4, 4, 4]}}],"
+    " 'constraints': [{'box': [-0.01, -0.01, -0.01, 0.01, 0.01, 0.01], 'inject': 1e-2}],"
+    " 'time': {'end': 1}}";
+
+static fdem_model *network(const char *doc)
+{
+    return expect_built(load(doc), NULL);
+}
+
+static int run(fdem_model *m, int steps)
+{
+    fdem_error err;
+    for (int s = 0; s < steps; s++)
+        if (fdem_step(m, &err)) {
+            fprintf(stderr, "  step failed: %s\n", err.message);
+            return -1;
+        }
+    return 0;
+}
+
+static void momentum(const fdem_model *m, double p[3], double *scale)
+{
+    const int D = fdem_get_dimension(m), N = fdem_get_counts(m).nodes;
+    const double *v = fdem_velocities(m), *mass = fdem_node_masses(m);
+    p[0] = p[1] = p[2] = 0;
+    *scale = 0;
+    for (int i = 0; i < N; i++)
+        for (int d = 0; d < D; d++) {
+            p[d] += mass[i] * v[D * i + d];
+            *scale += mass[i] * fabs(v[D * i + d]);
+        }
+}
+
+static void check_network(const char *doc, int steps)
+{
+    fdem_model *m = network(doc);
+    if (!m) return;
+    fdem_fluid_status f0 = fdem_get_fluid(m);
+    CHECK(f0.enabled && f0.injected_volume == 0 && f0.stored_volume > 0, "at t = 0");
+    if (run(m, steps)) {
+        fdem_model_destroy(m);
+        return;
+    }
+    fdem_fluid_status f = fdem_get_fluid(m);
+    fdem_energy e = fdem_get_energy(m);
+    fdem_counts c = fdem_get_counts(m);
+    double p[3], scale;
+    momentum(m, p, &scale);
+    fprintf(stderr, "  %dD: injected %.6g, stored %.6g (%.6g at t = 0), source %.4g Pa, flow "
+                    "step %.3g s x %d, %d open, %d broken of %d; fluid work %.6g J, "
+                    "dissipation %.4g J, residual %.3g J; momentum %.3g of %.3g\n",
+            fdem_get_dimension(m), f.injected_volume, f.stored_volume, f0.stored_volume,
+            f.source_pressure, f.flow_step, f.subcycles, f.open_joints, c.broken_joints,
+            c.joints, e.fluid_work, e.fluid_dissipation, e.residual, fabs(p[0]) + fabs(p[1]) +
+            fabs(p[2]), scale);
+    CHECK_REL(f.stored_volume - f0.stored_volume, f.injected_volume, 1e-9);
+    CHECK(f.source_pressure > 0, "the source is under pressure");
+    CHECK(c.broken_joints > 0, "the fluid broke the rock");
+    CHECK(f.open_joints > f0.open_joints, "the network grew");
+    CHECK(e.fluid_work > 0 && e.fluid_dissipation >= 0, "the fluid worked on the rock");
+    CHECK(fabs(e.residual) < 0.01 * e.fluid_work, "residual %.3g of fluid work %.3g", e.residual,
+          e.fluid_work);
+    CHECK(fabs(p[0]) + fabs(p[1]) + fabs(p[2]) <= 1e-9 * scale, "momentum");
+    /* the case builder admits a case on the estimate: the fluid's is in it */
+    size_t held = fdem_memory_bytes(m);
+    size_t priced = fdem_memory_estimate_of(&c) + fdem_fluid_memory_estimate(c.dimension, c.joints);
+    CHECK(held <= priced, "memory %zu bytes, estimated %zu", held, priced);
+    fdem_model_destroy(m);
+}
+
+static void fluid_network_2d(void) { check_network(network_2d, 600); }
+static void fluid_network_3d(void) { check_network(network_3d, 300); }
+
+/* 1 vs 2 threads and a restart halfway give the same positions and fluid. */
+static void check_same_bits(const char *doc, int steps)
+{
+    fdem_model *a = network(doc), *b = network(doc), *c = network(doc);
+    if (!a || !b || !c) return;
+    fdem_set_threads(b, 2);
+    run(a, steps / 2);
+    run(b, steps / 2);
+    size_t size = fdem_checkpoint_size(a);
+    void *buf = malloc(size);
+    CHECK(fdem_checkpoint_write(a, buf, size) == 0, "checkpoint written");
+    fdem_error err;
+    CHECK(fdem_checkpoint_read(c, buf, size, &err) == 0, "checkpoint read: %s", err.message);
+    free(buf);
+    fdem_energy ea = fdem_get_energy(a), ec = fdem_get_energy(c);
+    CHECK(ea.fluid_work == ec.fluid_work && ea.residual == ec.residual, "restored accounts");
+    run(a, steps - steps / 2);
+    run(b, steps - steps / 2);
+    run(c, steps - steps / 2);
+    size_t n = (size_t)fdem_get_dimension(a) * (size_t)fdem_get_counts(a).nodes;
+    CHECK(memcmp(fdem_positions(a), fdem_positions(b), n * sizeof(double)) == 0, "2 threads");
+    CHECK(memcmp(fdem_positions(a), fdem_positions(c), n * sizeof(double)) == 0, "restart");
+    fdem_fluid_status fa = fdem_get_fluid(a), fb = fdem_get_fluid(b), fc = fdem_get_fluid(c);
+    CHECK(fa.stored_volume == fb.stored_volume && fa.stored_volume == fc.stored_volume &&
+              fa.source_pressure == fc.source_pressure && fa.injected_volume == fc.injected_volume,
+          "fluid");
+    ea = fdem_get_energy(a);
+    ec = fdem_get_energy(c);
+    CHECK(ea.fluid_work == ec.fluid_work && ea.fluid_dissipation == ec.fluid_dissipation,
+          "fluid accounts %.17g %.17g", ea.fluid_work, ec.fluid_work);
+    fdem_model_destroy(a);
+    fdem_model_destroy(b);
+    fdem_model_destroy(c);
+}
+
+static void fluid_same_bits_2d(void) { check_same_bits(network_2d, 400); }
+static void fluid_same_bits_3d(void) { check_same_bits(network_3d, 200); }
+
+/* ------------------------------------------------------- a wet joint */
+
+/* A 1 x 0.2 m block in two rows of elements, joined along y = 0.1 by a
+ * joint set of cohesion c and friction angle phi holding a pore pressure
+ * p (or none); the rest of the block is far stronger. The bottom is fixed,
+ * the top pressed by sigma_n and dragged along x; the drag's reaction
+ * per unit thickness, once the joint slides, is c + (sigma_n - p) tan phi
+ * over the width. Returns that reaction (mean over the last quarter). */
+#define SHEAR_WIDTH 1.0
+#define SHEAR_SIGMA 1e7
+#define SHEAR_C 1e4
+#define SHEAR_PHI 30.0
+
+static double wet_joint_shear(double pore, double *expected)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err;
+    fdem_material_def rock = {.density = 2500, .young = 1e10, .poisson = 0.2, .damping = 0.3,
+                              .has_fracture = 1};
+    rock.fracture = (fdem_fracture_params){.tensile_strength = 1e9, .cohesion = 1e9,
+                                           .friction_angle = 30, .energy_I = 1e6,
+                                           .energy_II = 1e6};
+    int mat = fdem_add_material(m, &rock, &err);
+    fdem_mesh mesh;
+    const int nx = 10, ny = 2;
+    fdem_mesh_rectangle(0, 0, SHEAR_WIDTH, 0.2, nx, ny, &mesh, &err);
+    int part = fdem_add_part(m, &mesh, mat, 1, &err);
+    int32_t faces[2 * 16];
+    int count = 0;
+    for (int i = 0; i < mesh.node_count; i++)
+        for (int k = 0; k < mesh.node_count; k++) {
+            const double *a = mesh.xy + 2 * i, *b = mesh.xy + 2 * k;
+            if (fabs(a[1] - 0.1) < 1e-9 && fabs(b[1] - 0.1) < 1e-9 && b[0] > a[0] &&
+                fabs(b[0] - a[0] - SHEAR_WIDTH / nx) < 1e-9) {
+                faces[2 * count] = i;
+                faces[2 * count + 1] = k;
+                count++;
+            }
+        }
+    CHECK(count == nx, "%d faces on the interface", count);
+    fdem_fracture_params weak = {.tensile_strength = 1e6, .cohesion = SHEAR_C,
+                                 .friction_angle = SHEAR_PHI, .energy_I = 1e3,
+                                 .energy_II = 1e9, .aperture0 = 1e-4};
+    if (pore > 0) {
+        weak.has_pore_pressure = 1;
+        weak.pore_pressure[0] = pore;
+    }
+    fdem_add_joint_set(m, part, &weak, NULL, faces, count, &err);
+    fdem_fluid_def water = {.viscosity = 1e-3, .bulk_modulus = 1e8, .density = 1000};
+    fdem_set_fluid(m, &water, &err);
+    fdem_constraint_def bottom = {.select = FDEM_SELECT_BOX, .box = {-1, -1e-6, 2, 1e-6},
+                                  .kind = FDEM_CONSTRAINT_FIX, .fix_x = 1, .fix_y = 1};
+    fdem_add_constraint(m, &bottom, &err);
+    fdem_constraint_def top = {.select = FDEM_SELECT_BOX, .box = {-1, 0.2 - 1e-6, 2, 0.2 + 1e-6}};
+    top.kind = FDEM_CONSTRAINT_PRESSURE;
+    top.value[0] = SHEAR_SIGMA;
+    fdem_add_constraint(m, &top, &err);
+    /* the drag ramps up, so the block is pressed before it is dragged */
+    const double ramp[] = {0, 0, 0.004, 0, 0.008, 1};
+    fdem_constraint_def drag = top;
+    drag.kind = FDEM_CONSTRAINT_VELOCITY;
+    drag.value[0] = 0.02;
+    drag.value[1] = 0;
+    drag.free_y = 1;
+    drag.amplitude = ramp;
+    drag.amplitude_count = 3;
+    int drag_index = fdem_add_constraint(m, &drag, &err);
+    fdem_mesh_free(&mesh);
+    if (fdem_model_finalize(m, &err)) {
+        CHECK(0, "finalize: %s", err.message);
+        fdem_model_destroy(m);
+        return NAN;
+    }
+    const double end = 0.06, dt = fdem_get_dt(m);
+    int steps = (int)(end / dt), tail = steps / 4;
+    double sum = 0;
+    for (int s = 0; s < steps; s++) {
+        if (fdem_step(m, &err)) {
+            CHECK(0, "step: %s", err.message);
+            break;
+        }
+        if (s >= steps - tail) sum += fdem_constraint_forces(m)[2 * drag_index];
+    }
+    *expected = (SHEAR_C + (SHEAR_SIGMA - pore) * tan(SHEAR_PHI * M_PI / 180)) * SHEAR_WIDTH;
+    fdem_fluid_status f = fdem_get_fluid(m);
+    fprintf(stderr, "  pore %.3g Pa: drag %.6g N/m (want %.6g), %d steps, pore now %.6g Pa\n",
+            pore, sum / tail, *expected, steps, f.open_joints ? fdem_fluid_pressure(m)[0] : 0.0);
+    fdem_model_destroy(m);
+    return sum / tail;
+}
+
+static void wet_joint_slides_at_effective_stress(void)
+{
+    double want_dry, want_wet;
+    double dry = wet_joint_shear(0, &want_dry), wet = wet_joint_shear(4e6, &want_wet);
+    CHECK_REL(dry, want_dry, 0.03);
+    CHECK_REL(wet, want_wet, 0.03);
+}
+
+/* ------------------------------------------------------- at rest */
+
+/* A fracturing block under an in-situ stress held by the matching
+ * boundary stress, its joints holding a pore pressure: the joints carry
+ * the effective traction sigma.n + p n from t = 0 and the fluid the rest,
+ * so the block is at rest (contract 6.1 with 6.4). */
+static void pore_pressure_starts_at_rest(void)
+{
+    json_t *doc = load(network_2d);
+    edit(doc, "/constraints/0",
+         load("{'box': [-1, -1, 1, 1], 'boundary_stress': {'value': [-2e6, -3e6, 0]}}"));
+    edit(doc, "/parts/0/initial_stress", load("{'value': [-2e6, -3e6, 0]}"));
+    edit(doc, "/materials/rock/fracture/pore_pressure", load("{'value': 5e5}"));
+    edit(doc, "/materials/rock/damping", json_real(0));
+    fdem_model *m = expect_built(doc, NULL);
+    if (!m) return;
+    fdem_fluid_status f0 = fdem_get_fluid(m);
+    run(m, 400);
+    fdem_energy e = fdem_get_energy(m);
+    fdem_fluid_status f = fdem_get_fluid(m);
+    const double *p = fdem_fluid_pressure(m), *damage = fdem_joint_damage(m);
+    double most = 0, worst = 0;
+    for (int j = 0; j < fdem_get_counts(m).joints; j++) {
+        most = fmax(most, fabs(p[j] - 5e5));
+        worst = fmax(worst, damage[j]);
+    }
+    fprintf(stderr, "  kinetic %.3g J of elastic %.3g J, joint %.3g J; pressure off by %.3g Pa at "
+                    "most; %d open joints; largest damage %.3g\n",
+            e.kinetic, e.elastic, e.joint, most, f.open_joints, worst);
+    CHECK(f0.open_joints == fdem_get_counts(m).joints, "every joint wet");
+    CHECK(e.kinetic < 1e-12 * e.elastic, "at rest: kinetic %.3g", e.kinetic);
+    CHECK(most < 1e-6 * 5e5, "pressure held");
+    CHECK(worst == 0, "no joint damaged");
+    fdem_model_destroy(m);
+}
+
+/* ------------------------------------------------------- bad input */
+
+static void fluid_bad_input(void)
+{
+    problems p;
+    json_t *doc = load(network_2d);
+    edit(doc, "/fluid/viscosity", json_real(-1));
+    edit(doc, "/fluid/bulk_modulus", json_real(-1));
+    edit(doc, "/fluid/density", json_real(-1));
+    edit(doc, "/materials/rock/fracture/aperture0", json_real(0));
+    build_refused(doc, GiB, &p);
+    CHECK(p.status == 422, "status %d", p.status);
+    CHECK(has_problem(&p, "/fluid/viscosity", "must be > 0"), "viscosity");
+    CHECK(has_problem(&p, "/fluid/bulk_modulus", "must be > 0"), "bulk_modulus");
+    CHECK(has_problem(&p, "/fluid/density", "must be >= 0"), "density");
+    CHECK(has_problem(&p, "/materials/rock/fracture/aperture0", "must be > 0"), "aperture0");
+    if (p.count != 4) dump_problems(&p);
+    problems_free(&p);
+
+    /* inject and pore pressure without fluid; pore pressure on a part
+     * that does not fracture */
+    doc = load(network_2d);
+    edit(doc, "/fluid", NULL);
+    edit(doc, "/parts/0/fracture", json_false());
+    edit(doc, "/materials/rock/fracture/pore_pressure", load("{'value': 1e6}"));
+    build_refused(doc, GiB, &p);
+    CHECK(p.status == 422, "status %d", p.status);
+    CHECK(has_problem(&p, "/constraints/0/inject", "no top-level \"fluid\""), "inject");
+    CHECK(has_problem(&p, "/materials/rock/fracture/pore_pressure", "needs the top-level"),
+          "pore pressure without fluid");
+    CHECK(has_problem(&p, "/materials/rock/fracture/pore_pressure", "does not fracture"),
+          "pore pressure on a part that does not fracture");
+    problems_free(&p);
+
+    /* an injection that touches no joint */
+    doc = load(network_2d);
+    edit(doc, "/parts/0/fracture", json_false());
+    expect_doc(doc, GiB, 422, "/constraints/0", "none of the nodes");
+}
+
+CHECK_MAIN(T(fluid_network_2d), T(fluid_network_3d), T(fluid_same_bits_2d), T(fluid_same_bits_3d),
+           T(wet_joint_slides_at_effective_stress), T(pore_pressure_starts_at_rest),
+           T(fluid_bad_input))
