@@ -119,8 +119,8 @@ static int parse_listen(const char *s, fdemd_config *cfg)
 static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
     enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY,
-           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_MAX_STREAMS };
-           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_WEB };
+           OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_MAX_STREAMS,
+           OPT_WEB };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
