@@ -44,6 +44,11 @@ static_assert(sizeof(element_hot) == 64, "the hot element record is one cache li
 
 #define J_MIN 0.05
 
+/* The loop's helpers are forced inline: the loop is instantiated once per
+ * variant (tri_forces), and gcc left neo_hookean_half out of line once
+ * there were three, a call per element. */
+#define TRI_KERNEL static inline __attribute__((always_inline))
+
 /* How far ahead element_forces asks for element records: 16 records = 1 KB,
  * measured best of 4/8/16/24 on a 1e6-element mesh. */
 #define ELEM_PREFETCH 16
@@ -155,8 +160,8 @@ double element_log_near1(double J) { return log_near1(J); }
  * power of two is exact, so this is bit for bit half of sigma and the 0.5
  * costs no multiplications per component. lambda ln J is shared by the
  * stress and the energy. */
-static inline double neo_hookean_half(double a, double b, double c, double d, double hlambda,
-                                      double hmu, double hs[3], double *w, double *invJ_out)
+TRI_KERNEL double neo_hookean_half(double a, double b, double c, double d, double hlambda,
+                                   double hmu, double hs[3], double *w, double *invJ_out)
 {
     double J = a * d - b * c;
     double lnJ, invJ;
@@ -175,8 +180,8 @@ static inline double neo_hookean_half(double a, double b, double c, double d, do
  * c d), F S0 F^T / J, times `scale` (1/2 for the half stress, with 1/J as
  * the law takes it below J_MIN), added to hs; returns its strain energy
  * density S0 : E = (tr(F S0 F^T) - tr S0) / 2 (initial_stress.c). */
-static inline double prestress_add(double a, double b, double c, double d, double scale,
-                                   const double s0[3], double hs[3])
+TRI_KERNEL double prestress_add(double a, double b, double c, double d, double scale,
+                                const double s0[3], double hs[3])
 {
     double r0 = a * s0[0] + b * s0[2], r1 = a * s0[2] + b * s0[1]; /* first row of F S0 */
     double q0 = c * s0[0] + d * s0[2], q1 = c * s0[2] + d * s0[1]; /* second row */
@@ -197,8 +202,8 @@ static inline double prestress_add(double a, double b, double c, double d, doubl
  * round-off; on the current geometry it was of order h omega^2 (the spin
  * was damped). The division is paid only by damped elements. */
 static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, double hh,
-                                      double x1, double y1, double x2, double y2, double mid[4],
-                                      double *inv_out, double a[3])
+                                   double x1, double y1, double x2, double y2, double mid[4],
+                                   double *inv_out, double a[3])
 {
     double u1 = v[2 * n1] - v[2 * n0], w1 = v[2 * n1 + 1] - v[2 * n0 + 1];
     double u2 = v[2 * n2] - v[2 * n0], w2 = v[2 * n2 + 1] - v[2 * n0 + 1];
@@ -231,8 +236,8 @@ static inline int rate_of_deformation(const double *v, int n0, int n1, int n2, d
  * lane rounds exactly as the scalar would, so the damping account keeps its
  * bits; 18.9 -> 17.2 ns per damped element, CPU time). */
 static inline void viscous_half(const double *v, int n0, int n1, int n2, double hh, double x1,
-                                double y1, double x2, double y2, double eta, const double prev[3],
-                                double hv[3], double mid[4], double power[2])
+                             double y1, double x2, double y2, double eta, const double prev[3],
+                             double hv[3], double mid[4], double power[2])
 {
     double inv, a[3];
     if (!rate_of_deformation(v, n0, n1, n2, hh, x1, y1, x2, y2, mid, &inv, a)) {
@@ -249,8 +254,8 @@ static inline void viscous_half(const double *v, int n0, int n1, int n2, double 
 
 /* Nodal forces 1/2 sigma m_a of a half stress hs on the element with edge
  * vectors (x1, y1), (x2, y2), added to f (node 0 takes minus the sum). */
-static inline void edge_traction_forces(double *f, int n0, int n1, int n2, double x1, double y1,
-                                        double x2, double y2, const double hs[3])
+TRI_KERNEL void edge_traction_forces(double *f, int n0, int n1, int n2, double x1, double y1,
+                                     double x2, double y2, const double hs[3])
 {
     double f1x = hs[2] * x2 - hs[0] * y2, f1y = hs[1] * x2 - hs[2] * y2;
     double f2x = hs[0] * y1 - hs[2] * x1, f2y = hs[2] * y1 - hs[1] * x1;
@@ -271,8 +276,8 @@ static inline void edge_traction_forces(double *f, int n0, int n1, int n2, doubl
  * hv0 my2) and so on, in half the instructions. */
 typedef double tri_xy __attribute__((vector_size(16)));
 static inline void edge_traction_forces_damped(double *f, int n0, int n1, int n2, double x1,
-                                               double y1, double x2, double y2, const double hs[3],
-                                               const double mid[4], const double hv[3])
+                                            double y1, double x2, double y2, const double hs[3],
+                                            const double mid[4], const double hv[3])
 {
     const tri_xy A = {hs[2], hs[1]}, B = {hs[0], hs[2]}, Av = {hv[2], hv[1]}, Bv = {hv[0], hv[2]};
     tri_xy f1 = (x2 * A - y2 * B) + (mid[2] * Av - mid[3] * Bv);
@@ -305,8 +310,9 @@ static inline void edge_traction_forces_damped(double *f, int n0, int n1, int n2
  *    the loop is too long per element for the hardware prefetcher's window
  *    to keep the record stream ahead of it (1e6 elements: ~17.5 -> ~15 ns
  *    per element-step). */
-static inline __attribute__((always_inline)) void
-tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double sums[SCATTER_SUMS])
+TRI_KERNEL void
+tri_forces(fdem_model *m, int begin, int end_index, const int stressed, const int damped,
+           double sums[SCATTER_SUMS])
 {
     const double *pos = m->pos, *vel = m->vel;
     /* stressed: this block's pre-stresses, walked alongside the records */
@@ -314,7 +320,7 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
     double *f = m->force;
     /* this block's stored viscous stresses, walked alongside the records
      * (restrict: no other array of the loop lives there) */
-    double *restrict prev = m->elem_viscous ? m->elem_viscous + 3 * (size_t)begin : NULL;
+    double *restrict prev = damped ? m->elem_viscous + 3 * (size_t)begin : NULL;
     const material *mats = m->materials;
     double energy = 0, power[2] = {0, 0}; /* of this step's and the last step's viscous stress */
     int32_t cur_mat = -1;
@@ -343,7 +349,7 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
             stress0 += 3;
         }
         energy += w * el->area0;
-        if (el->eta > 0) {
+        if (damped && el->eta > 0) {
             /* Damping is booked with the step-averaged velocity, like every
              * work: its forces' power with the velocities before this step
              * now, and with those after it at the next step, from the stored
@@ -360,23 +366,39 @@ tri_forces(fdem_model *m, int begin, int end_index, const int stressed, double s
         } else {
             edge_traction_forces(f, n0, n1, n2, x1, y1, x2, y2, hs);
         }
-        if (prev) prev += 3; /* NULL + 0 would be undefined: undamped models have no array */
+        if (damped) prev += 3; /* NULL + 0 would be undefined: undamped models have no array */
     }
     sums[0] += energy;
     sums[1] += power[0];
     sums[2] += power[1];
 }
 
-void tri_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+/* A model without a damped element (no elem_viscous: finalize.c) runs a
+ * loop with no damping code in it at all: the damped branch, inlined into
+ * the one loop, had cost the undamped elements their registers and the
+ * stored-stress pointer's walk (issue 38: 1.36x the samples of 7f53400's
+ * loop on the same undamped block). Same arithmetic, same bits. */
+/* Its own function, so that gcc inlines the damping helpers into it as
+ * into the one loop before (beside a second loop in one body it left
+ * viscous_half out of line: +10 % instructions a damped element). */
+static __attribute__((noinline)) void tri_forces_damped(fdem_model *m, int begin, int end,
+                                                        double sums[SCATTER_SUMS])
 {
-    tri_forces(m, begin, end, 0, sums);
+    tri_forces(m, begin, end, 0, 1, sums);
 }
 
-/* The same loop for the elements of a part with an in-situ stress. */
+void tri_element_forces_range(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    if (m->elem_viscous) tri_forces_damped(m, begin, end, sums);
+    else tri_forces(m, begin, end, 0, 0, sums);
+}
+
+/* The same loop for the elements of a part with an in-situ stress (rare:
+ * one loop for damped and undamped models). */
 void tri_element_forces_range_stressed(fdem_model *m, int begin, int end,
                                        double sums[SCATTER_SUMS])
 {
-    tri_forces(m, begin, end, 1, sums);
+    tri_forces(m, begin, end, 1, m->elem_viscous != NULL, sums);
 }
 
 void tri_element_stress(const fdem_model *m, int e, double out[3])

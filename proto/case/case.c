@@ -333,6 +333,31 @@ static fdem_model *case_build_model(case_doc *doc, case_info *info)
     return model;
 }
 
+/* Appends a name and its NUL to info->names; 0, or -1 when it does not fit. */
+static int case_pack_name(case_info *info, const char *name)
+{
+    size_t n = strlen(name) + 1;
+    if (n > sizeof info->names - (size_t)info->names_bytes) return -1;
+    memcpy(info->names + info->names_bytes, name, n);
+    info->names_bytes += (int)n;
+    return 0;
+}
+
+/* The part names (part_read_name made "part<i>" of an unnamed one) and the
+ * material names, in the orders result_describe() reads them from the
+ * document; none when they do not all fit. */
+static void case_fill_names(const case_doc *doc, case_info *info)
+{
+    info->material_count = doc->material_count;
+    info->names_bytes = 0;
+    int fits = 1;
+    for (int i = 0; fits && i < doc->part_count; i++)
+        fits = case_pack_name(info, doc->parts[i].name) == 0;
+    for (int i = 0; fits && i < doc->material_count; i++)
+        fits = case_pack_name(info, doc->materials[i].name) == 0;
+    if (!fits) info->names_bytes = 0;
+}
+
 static void case_fill_info(const case_doc *doc, case_info *info)
 {
     snprintf(info->name, sizeof info->name, "%s", doc->name);
@@ -348,6 +373,7 @@ static void case_fill_info(const case_doc *doc, case_info *info)
     for (int k = 0; k < doc->stage_count; k++)
         snprintf(info->stage_names[k], sizeof info->stage_names[k], "%s", doc->stages[k].name);
     case_fill_history_info(doc, info);
+    case_fill_names(doc, info);
 }
 
 const char *case_stage_name(const case_info *info, int index)
@@ -392,7 +418,7 @@ static void case_free_names(char **names)
 
 fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limit,
                              case_memory_gate gate, void *gate_ctx,
-                             case_info *info, problems *out)
+                             case_info *info, problems *out, problems *warnings)
 {
     case_info scratch;
     if (!info) info = &scratch;
@@ -405,6 +431,7 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
     case_read(&doc, root);
     double bytes = 0;
     if (out->count + out->dropped == before) bytes = case_check_memory(&doc, memory_limit);
+    if (warnings && out->count + out->dropped == before) case_warnings_of(root, warnings);
     /* The tree of an explicit mesh is ten or more times its text; the model
      * must not come on top of it. */
     char **names = case_copy_names(&doc);
@@ -431,7 +458,7 @@ fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limi
 fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
                        case_info *info, problems *out)
 {
-    return case_build_gated(text, length, memory_limit, NULL, NULL, info, out);
+    return case_build_gated(text, length, memory_limit, NULL, NULL, info, out, NULL);
 }
 
 unsigned case_parse_fields(const char *csv, problems *out)

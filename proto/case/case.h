@@ -70,6 +70,9 @@ enum case_field {
  * per point and constraint). */
 #define CASE_MAX_HISTORY_POINTS 64
 #define CASE_HISTORY_NAME 64
+/* Room in case_info for the part and material names: 64 names of 127
+ * bytes, or many more short ones. */
+#define CASE_NAMES_BYTES 8192
 #define CASE_MAX_HISTORY_ROWS 1e6
 
 typedef struct case_info {
@@ -92,6 +95,16 @@ typedef struct case_info {
     int history_point_count;
     char history_names[CASE_MAX_HISTORY_POINTS][CASE_HISTORY_NAME];
     int32_t history_nodes[CASE_MAX_HISTORY_POINTS];
+    /* The names behind result.h5's part and material indices (its
+     * /mesh/part_names and /mesh/material_names, result_describe.c), read
+     * by the builder so that nobody parses the document again for them:
+     * part_count part names in "parts" order (an unnamed part is
+     * "part<i>"), then material_count material names in the order of
+     * "materials", each ending in a NUL. names_bytes is 0 when they do not
+     * fit (result_describe() then reads them from the document). */
+    int material_count;
+    int names_bytes;
+    char names[CASE_NAMES_BYTES];
 } case_info;
 
 /* The name of stage `index` of the case, or NULL when it has no such stage
@@ -109,14 +122,18 @@ fdem_model *case_build(const char *text, size_t length, size_t memory_limit,
 typedef int (*case_memory_gate)(void *ctx, double bytes);
 
 /* case_build() with a gate; the JSON tree is freed before the model is built
- * (never both at once). */
+ * (never both at once). `warnings` (may be NULL) gets the document's
+ * warnings (case_warnings) from the same tree, when the document reads
+ * without a problem: one parse for both. */
 fdem_model *case_build_gated(const char *text, size_t length, size_t memory_limit,
                              case_memory_gate gate, void *gate_ctx,
-                             case_info *info, problems *out);
+                             case_info *info, problems *out, problems *warnings);
 
 /* Adds to `out` (status left 0) the values of an accepted case document
  * far outside rock and steel, each once at its JSON Pointer (contract 6.2
- * "Warnings", case_warnings.c); returns how many. Never a refusal. */
+ * "Warnings", case_warnings.c); returns how many. Never a refusal. It
+ * parses the text; case_build_gated() gives the same list without a second
+ * parse. */
 int case_warnings(const char *text, size_t length, problems *out);
 
 /* Parses "position,velocity,..." (the ?fields= of GET /state) into

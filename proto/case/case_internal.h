@@ -394,6 +394,8 @@ void case_read_history(case_doc *doc, const json_t *history);
 void case_check_history_rows(case_doc *doc);
 int case_locate_history(case_doc *doc, const fdem_model *model);
 void case_fill_history_info(const case_doc *doc, case_info *info);
+/* case_warnings.c: case_warnings() on a tree already parsed. */
+int case_warnings_of(const json_t *root, problems *out);
 
 /* The pointer of part i's mesh source ("/parts/3/mesh" or "/parts/3/gmsh"). */
 void case_part_mesh_pointer(const case_doc *doc, int part, char *ptr);

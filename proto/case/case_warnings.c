@@ -4,9 +4,11 @@
  * `young` 40 (MPa meant as Pa) or a friction angle 0.61 (radians meant as
  * degrees). They never refuse a case: case_warnings() is asked only about
  * a document case_build() accepted and lists each finding once at its JSON
- * Pointer. It reads the JSON again (not the case_doc) so that the readers
+ * Pointer. It reads the JSON tree (not the case_doc) so that the readers
  * of case_build stay about what is valid, and this file alone about what
- * is plausible; the cost is one more parse of a document already in memory.
+ * is plausible; case_build_gated() hands it the tree it parsed, so an
+ * upload is parsed once (issue 38: a second parse had cost a document's
+ * set-up as much again, and had been skipped above 2 MiB for its memory).
  *
  * The ranges (docs/case-format.md "Warnings") are wide on purpose: soft
  * soils to tungsten, foams excepted, so that a warning is worth reading.
@@ -126,10 +128,8 @@ static void warn_gravity(problems *out, const json_t *gravity)
                      "the Earth's: check the unit", sqrt(sum));
 }
 
-int case_warnings(const char *text, size_t length, problems *out)
+int case_warnings_of(const json_t *root, problems *out)
 {
-    json_t *root = json_loadb(text, length, JSON_REJECT_DUPLICATES, NULL);
-    if (!root) return 0;
     int before = out->count;
     const char *name;
     json_t *m_;
@@ -140,7 +140,15 @@ int case_warnings(const char *text, size_t length, problems *out)
     }
     warn_parts(out, json_object_get(root, "parts"));
     warn_gravity(out, json_object_get(root, "gravity"));
-    json_decref(root);
     out->status = 0; /* warnings, not problems: nothing is refused */
     return out->count - before;
+}
+
+int case_warnings(const char *text, size_t length, problems *out)
+{
+    json_t *root = json_loadb(text, length, JSON_REJECT_DUPLICATES, NULL);
+    if (!root) return 0;
+    int n = case_warnings_of(root, out);
+    json_decref(root);
+    return n;
 }

@@ -6,11 +6,13 @@
  * /snapshots/principal_stress, named for a rock mechanic (attributes
  * `order` and `rock_mechanics_names`: sigma1 is the most compressive).
  *
- * Why the names are read from the document here rather than kept by the
- * builder: the document is what the file stores anyway, and the builder
- * numbers parts by their place in "parts" (unnamed ones are "part<i>") and
- * materials in the order of the "materials" object, which is the order
- * jansson iterates; reading it the same way gives the same indices. The
+ * The names come from the builder (case_info's names: parts by their
+ * place in "parts", unnamed ones "part<i>", materials in the order of the
+ * "materials" object, which is the order jansson iterates and the engine
+ * numbers them in). Only when they did not fit there is the document
+ * parsed again here, the same way, for the same indices: a second parse
+ * of a 4 MB explicit mesh cost as much CPU as building its model (issue
+ * 38). The
  * name lists are fixed-length strings (see write_string_list); the
  * `case` attribute is variable length, as the other root attributes.
  * Runs before SWMR writing starts: a SWMR writer cannot add objects.
@@ -119,13 +121,43 @@ static int write_case_attribute(hid_t file, const char *text, size_t length)
     return rc;
 }
 
-int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen)
+/* The names the builder kept (case_info's names: part_count parts, then
+ * material_count materials, each ending in a NUL). */
+static int write_kept_names(hid_t file, const case_info *info, char *err, size_t errlen)
+{
+    size_t parts = (size_t)info->part_count, count = parts + (size_t)info->material_count;
+    const char **names = calloc(count ? count : 1, sizeof *names);
+    const char *at = info->names, *end = info->names + info->names_bytes;
+    for (size_t i = 0; names && i < count; i++) {
+        names[i] = at < end ? at : "";
+        at += at < end ? strlen(at) + 1 : 0;
+    }
+    hid_t mesh = H5Gopen2(file, "mesh", H5P_DEFAULT);
+    int rc = -1;
+    if (!names)
+        snprintf(err, errlen, "out of memory listing the part and material names");
+    else if (mesh < 0)
+        result_fail(err, errlen, "cannot open /mesh to write the part names");
+    else if (write_string_list(mesh, "part_names", names, parts) < 0 ||
+             write_string_list(mesh, "material_names", names + parts,
+                               (size_t)info->material_count) < 0)
+        result_fail(err, errlen, "cannot write /mesh/part_names and /mesh/material_names");
+    else
+        rc = 0;
+    if (mesh >= 0) H5Gclose(mesh);
+    free(names);
+    return rc;
+}
+
+int result_describe(hid_t file, const char *text, size_t length, const case_info *info,
+                    char *err, size_t errlen)
 {
     if (!text) return 0;
     if (write_case_attribute(file, text, length) < 0) {
         result_fail(err, errlen, "cannot write the case document as the root attribute \"case\"");
         return -1;
     }
+    if (info && info->names_bytes > 0) return write_kept_names(file, info, err, errlen);
     json_t *root = json_loadb(text, length, 0, NULL);
     if (!root) {
         snprintf(err, errlen, "the case document stored with the result is not JSON");

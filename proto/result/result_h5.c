@@ -561,7 +561,7 @@ result_file *result_create_described(const char *path, const fdem_model *model,
         goto fail;
     }
     if (write_mesh(f->file, model, err, errlen) < 0) goto fail;
-    if (result_describe(f->file, document, document_length, err, errlen) < 0) goto fail;
+    if (result_describe(f->file, document, document_length, info, err, errlen) < 0) goto fail;
     series_layout(f->ds, model, info->fields);
     if (create_snapshot_series(f, err, errlen) < 0) goto fail;
     if (events_create(f, fdem_get_dimension(model), err, errlen) < 0) goto fail;

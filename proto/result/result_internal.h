@@ -107,8 +107,11 @@ result_file *result_alloc(void);
 int result_close_handles(result_file *f);
 int result_release(result_file *f);
 /* The root attribute `case` (the document) and /mesh/part_names,
- * /mesh/material_names; nothing when text is NULL (result_describe.c). */
-int result_describe(hid_t file, const char *text, size_t length, char *err, size_t errlen);
+ * /mesh/material_names, the names from info when the builder kept them
+ * there (else read from the document); nothing when text is NULL
+ * (result_describe.c). */
+int result_describe(hid_t file, const char *text, size_t length, const case_info *info,
+                    char *err, size_t errlen);
 /* The attributes `order` and `rock_mechanics_names` of the principal
  * stress dataset (result_describe.c); 0 or -1. */
 int result_describe_principal_stress(hid_t dataset, int dimension);

@@ -92,7 +92,7 @@ static case_model_rc case_model_parse(server_case *c, membudget_lease *lease, fd
     /* No --max-case-memory here: the case was admitted when it was stored,
      * and a lower limit since must not turn it into a broken case. */
     membudget_meter_begin(lease, 0);
-    *model = case_build_gated(doc, size, (size_t)-1, case_model_gate, &gate, info, &p);
+    *model = case_build_gated(doc, size, (size_t)-1, case_model_gate, &gate, info, &p, NULL);
     membudget_meter_end();
     free(doc);
     case_model_rc rc = CASE_MODEL_OK;
@@ -176,11 +176,6 @@ void case_model_forget_resume(server_case *c)
         persist_fsync_dir(c->dir);
 }
 
-/* Documents up to this size get their warnings (a second parse of the
- * document; above it, one upload would hold two trees' worth of memory
- * in its allocator: test_memory's concurrent uploads). */
-#define CASE_MODEL_WARNED_BYTES ((size_t)2 << 20)
-
 fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lease *lease,
                                     case_info *info, problems *p, double *model_bytes,
                                     problems *warnings)
@@ -188,12 +183,14 @@ fdem_model *case_model_build_upload(const char *body, size_t size, membudget_lea
     size_t kept = case_model_document_cost(size);
     case_model_gate_ctx gate = {lease, kept, 0};
     membudget_meter_begin(lease, lease->bytes > kept ? lease->bytes - kept : 0);
-    /* the warnings' own parse, metered like the build's and freed before
-     * it, so the two JSON trees of one upload are never held at once */
-    if (warnings && size <= CASE_MODEL_WARNED_BYTES) case_warnings(body, size, warnings);
+    /* the warnings come from the build's own tree: one parse of any size */
     fdem_model *model = case_build_gated(body, size, registry_config()->max_case_memory,
-                                         case_model_gate, &gate, info, p);
+                                         case_model_gate, &gate, info, p, warnings);
     membudget_meter_end();
+    /* The tree is freed by now. Its pages go back at once: with the one
+     * parse (no second tree before this one) glibc otherwise kept up to
+     * 0.7 MiB of them per upload (test_memory's stored cases). */
+    membudget_give_back();
     if (!model && membudget_meter_refused()) {
         /* jansson saw its allocation refused and called the body malformed */
         problems_free(p);

@@ -39,6 +39,9 @@ int membudget_grow(membudget_lease *lease, size_t bytes);
 /* Gives back part (shrink) or all (release) of a lease. */
 void membudget_shrink(membudget_lease *lease, size_t bytes);
 void membudget_release(membudget_lease *lease);
+/* Hands the heap's free pages back to the OS (malloc_trim), e.g. after a
+ * parse tree was freed. */
+void membudget_give_back(void);
 /* Moves up to `bytes` from one lease to another (the total is unchanged). */
 void membudget_move(membudget_lease *from, membudget_lease *to, size_t bytes);
 

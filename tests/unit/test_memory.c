@@ -63,7 +63,7 @@ static fdem_model *memory_build(const char *path)
     problems_init(&p);
     case_info info;
     gated_estimate = -1;
-    fdem_model *m = case_build_gated(text, length, (size_t)1 << 32, memory_gate, NULL, &info, &p);
+    fdem_model *m = case_build_gated(text, length, (size_t)1 << 32, memory_gate, NULL, &info, &p, NULL);
     CHECK(m != NULL, "%s was rejected", path);
     problems_free(&p);
     free(text);

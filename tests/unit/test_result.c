@@ -388,6 +388,78 @@ static void test_result_bad_input_is_an_error(void)
     run_end(&r);
 }
 
+/* The fixed-length strings of /mesh/<name> joined by '|' into out. */
+static void read_mesh_names(const char *path, const char *name, char *out, size_t size)
+{
+    out[0] = '\0';
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    char where[64];
+    snprintf(where, sizeof where, "/mesh/%s", name);
+    hid_t ds = file >= 0 ? H5Dopen2(file, where, H5P_DEFAULT) : H5I_INVALID_HID;
+    hid_t type = ds >= 0 ? H5Dget_type(ds) : H5I_INVALID_HID;
+    hid_t space = ds >= 0 ? H5Dget_space(ds) : H5I_INVALID_HID;
+    if (type >= 0 && space >= 0) {
+        size_t width = H5Tget_size(type);
+        hssize_t count = H5Sget_simple_extent_npoints(space);
+        char *all = calloc((size_t)(count > 0 ? count : 1), width);
+        if (all && (count == 0 || H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, all) >= 0))
+            for (hssize_t i = 0; i < count; i++) {
+                size_t used = strlen(out);
+                snprintf(out + used, size - used, "%s%.*s", i ? "|" : "", (int)width,
+                         all + (size_t)i * width);
+            }
+        free(all);
+    }
+    if (space >= 0) H5Sclose(space);
+    if (type >= 0) H5Tclose(type);
+    if (ds >= 0) H5Dclose(ds);
+    if (file >= 0) H5Fclose(file);
+}
+
+/* /mesh/part_names and material_names come from the builder's case_info
+ * (issue 38: the I/O thread parsed a 4 MB document a second time only for
+ * them, as much CPU as building its model): with the names kept, the
+ * stored text is not read for them (a text that is not JSON still
+ * describes the file); parts in "parts" order, an unnamed one "part<i>",
+ * materials in the document's order. Without kept names (too many to keep)
+ * the document is read as before. */
+static void test_result_names_come_from_the_builder(void)
+{
+    const char *doc =
+        "{\"materials\": {\"soft\": {\"density\": 2000, \"young\": 1e8, \"poisson\": 0.25},"
+        " \"hard\": {\"density\": 2700, \"young\": 3e10, \"poisson\": 0.25}},"
+        " \"parts\": [{\"material\": \"hard\", \"rectangle\": {\"origin\": [0, 0],"
+        " \"size\": [1, 1], \"divisions\": [2, 2]}}, {\"name\": \"top\", \"material\": \"soft\","
+        " \"rectangle\": {\"origin\": [0, 1.5], \"size\": [1, 1], \"divisions\": [2, 2]}}],"
+        " \"time\": {\"end\": 1e-4}}";
+    problems p;
+    problems_init(&p);
+    case_info info;
+    fdem_model *m = case_build(doc, strlen(doc), (size_t)1 << 30, &info, &p);
+    CHECK(m && info.names_bytes > 0 && info.part_count == 2 && info.material_count == 2,
+          "built %d, names %d bytes", m != NULL, m ? info.names_bytes : 0);
+    if (!m) return;
+    char path[512], err[512] = "", names[256];
+    tmp_path(path, sizeof path, "names.h5");
+    const char text[] = "not JSON: the names are the builder's";
+    result_file *f = result_create_described(path, m, &info, text, sizeof text - 1, err,
+                                             sizeof err);
+    CHECK(f && result_close(f) == 0, "described with kept names: %s", err);
+    read_mesh_names(path, "part_names", names, sizeof names);
+    CHECK(strcmp(names, "part0|top") == 0, "part names %s", names);
+    read_mesh_names(path, "material_names", names, sizeof names);
+    CHECK(strcmp(names, "soft|hard") == 0, "material names %s", names);
+    info.names_bytes = 0; /* as when they did not fit: the document is read */
+    f = result_create_described(path, m, &info, doc, strlen(doc), err, sizeof err);
+    CHECK(f && result_close(f) == 0, "described from the document: %s", err);
+    read_mesh_names(path, "part_names", names, sizeof names);
+    CHECK(strcmp(names, "part0|top") == 0, "part names read from the document %s", names);
+    read_mesh_names(path, "material_names", names, sizeof names);
+    CHECK(strcmp(names, "soft|hard") == 0, "material names read from the document %s", names);
+    fdem_model_destroy(m);
+    problems_free(&p);
+}
+
 int main(int argc, char **argv)
 {
     static const check_test tests[] = {
@@ -395,7 +467,7 @@ int main(int argc, char **argv)
         T(test_result_writer_stopped_mid_append), T(test_result_minimal_fields_without_constraints),
         T(test_xdmf_matches_file), T(test_result_3d_layout_and_xdmf),
         T(test_result_displacement_without_position), T(test_result_stages_layout_and_xdmf),
-        T(test_result_bad_input_is_an_error),
+        T(test_result_bad_input_is_an_error), T(test_result_names_come_from_the_builder),
     };
     return result_tests_main(tests, (int)(sizeof tests / sizeof tests[0]), argc, argv);
 }

@@ -1,7 +1,8 @@
 /*
  * test_warnings.c - contract 6.2 "Warnings": case_warnings() on a document
  * with units typed wrong (each value warned once, at its JSON Pointer; a
- * plausible document has none; neither is refused by case_build), and the
+ * plausible document has none; neither is refused by case_build; the
+ * build hands back the same list from its own parse), and the
  * engine's penetration depth (core/contact/penetration.c) against a depth
  * worked out by hand, then the issue's case: a 3000 m/s block through a
  * 10 mm steel slab is found by fdem_take_penetrations, a 1 m/s touch is not.
@@ -70,6 +71,39 @@ static void test_typos_are_warned_at_their_pointers(void)
     fdem_model_destroy(m);
     problems_free(&p);
     problems_free(&w);
+    free(text);
+}
+
+/* case_build_gated() hands back the warnings of the tree it parsed (one
+ * parse per upload, issue 38): the same list as case_warnings(), in the
+ * same order; a refused document gets none. */
+static void test_build_gives_the_warnings_of_its_own_parse(void)
+{
+    char *text = quotes(typos);
+    problems alone, built, p;
+    problems_init(&alone);
+    problems_init(&built);
+    problems_init(&p);
+    case_warnings(text, strlen(text), &alone);
+    case_info info;
+    fdem_model *m = case_build_gated(text, strlen(text), GiB, NULL, NULL, &info, &p, &built);
+    CHECK(m != NULL && built.count == alone.count && built.status == 0,
+          "built %d, %d warnings against %d", m != NULL, built.count, alone.count);
+    for (int i = 0; i < built.count && i < alone.count; i++)
+        CHECK(strcmp(built.items[i].pointer, alone.items[i].pointer) == 0 &&
+                  strcmp(built.items[i].message, alone.items[i].message) == 0,
+              "warning %d: %s against %s", i, built.items[i].pointer, alone.items[i].pointer);
+    fdem_model_destroy(m);
+    problems_free(&built);
+    problems_free(&p);
+    problems_init(&built);
+    problems_init(&p);
+    text[strlen(text) - 1] = ','; /* no longer JSON */
+    m = case_build_gated(text, strlen(text), GiB, NULL, NULL, &info, &p, &built);
+    CHECK(m == NULL && built.count == 0, "a refused document got %d warnings", built.count);
+    problems_free(&alone);
+    problems_free(&built);
+    problems_free(&p);
     free(text);
 }
 
@@ -255,5 +289,6 @@ static void test_fast_body_through_a_slab(void)
     }
 }
 
-CHECK_MAIN(T(test_typos_are_warned_at_their_pointers), T(test_plausible_case_has_none),
+CHECK_MAIN(T(test_typos_are_warned_at_their_pointers),
+           T(test_build_gives_the_warnings_of_its_own_parse), T(test_plausible_case_has_none),
            T(test_depth_by_hand), T(test_fast_body_through_a_slab))
