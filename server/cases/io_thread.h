@@ -86,5 +86,8 @@ void io_release_hold(server_case *c);
 void io_note_paced_run(double wall, double waited, int snapshots);
 double io_snapshot_seconds(double checkpoint_bytes);
 void io_seed_snapshot_seconds(double seconds);
+/* The I/O thread's own timing of one snapshot job of `bytes` (the
+ * checkpoint's size), io_snapshot_cost.c. */
+void io_note_snapshot_cost(double seconds, double bytes);
 
 #endif

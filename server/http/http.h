@@ -3,7 +3,8 @@
  * socket and the case lifecycle.
  *  - Owns: accepting and holding connections (gate.c) and the framing
  *    checks on a raw header block (http_frame.c); libmicrohttpd, request
- *    bodies, authentication and the reply helpers (this header, http.c);
+ *    bodies, authentication and the reply helpers (this header, http.c),
+ *    a kept-alive connection's later requests (http_keepalive.c);
  *    one function per API route (routes.c); result.h5 downloads
  *    (download.c); the web page's files (web.c) and its binary snapshot
  *    frames (mesh_frame.c); the threads for requests that build a model
@@ -72,5 +73,13 @@ enum MHD_Result http_reply_response(struct MHD_Connection *conn, unsigned status
 /* Serves `size` bytes of an open descriptor (closed by libmicrohttpd). */
 enum MHD_Result http_reply_fd(struct MHD_Connection *conn, int fd, size_t size,
                               const char *content_type, const char *filename);
+
+/* http_keepalive.c, for http.c's request phases: does the client want its
+ * connection closed after this request ("Connection: close", or HTTP/1.0
+ * without keep-alive); and the gate's framing checks on a later request of
+ * a kept-alive connection (1 with its answer queued in *rc). */
+int http_client_closes(struct MHD_Connection *conn, const char *version);
+int http_refuse_bad_framing(struct MHD_Connection *conn, const char *method,
+                            const char *version, enum MHD_Result *rc);
 
 #endif
