@@ -289,8 +289,11 @@ static const int32_t *contact_detect_bodies(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (!m->joint_count) return cs->body;
-    joint_mark_broken_vertices(m);
-    joint_fragment_labels(m, cs->piece);
+    /* the contact force array (D doubles a node) is free until this step's
+     * pairs fill it: the crack marks take 4 int32 a node of it as scratch */
+    joint_mark_cracks(m, cs->piece, (int32_t *)cs->force);
+    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->force_is_zero = 1;
     joint_contact_bodies(m, cs->piece, cs->body, cs->detect_body);
     return cs->detect_body;
 }

@@ -84,6 +84,11 @@ int joint_prepare(fdem_model *m, fdem_error *err);
 double joint_stable_dt(const fdem_model *m);
 int joint_holds(const fdem_model *m, int a, int b);
 void joint_mark_broken_vertices(fdem_model *m);
+/* What contact needs to know of the cracks, at each detection: the broken
+ * vertices, the copies intact joints join around each, the pieces (piece,
+ * joint_fragment_labels) and the vertices of cracks inside one piece;
+ * scratch holds 4 node_count int32 (its contents are left undefined). */
+void joint_mark_cracks(fdem_model *m, int32_t *piece, int32_t *scratch);
 int joint_fan_holds(const fdem_model *m, int a, int b);
 int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int b);
 /* Body ids for detection (nbs.h: pairs of one body are never listed):
