@@ -309,28 +309,6 @@ void joint_mark_cracks(fdem_model *m, int32_t *piece, int32_t *scratch)
     if (m->joint_count) joint_mark_inner_cracks(m, piece, scratch);
 }
 
-/* a and b hold copies of some mesh vertex but not of a whole face (dim
- * vertices), and at each vertex they share their copies are joined around
- * it (joint_vertex_groups): they meet only where intact joints hold them
- * together, like elements of a fan whose joints are all intact. The two
- * sides of a broken joint always keep their contact: pressed together,
- * nothing else stops them (the joints around may be damaged and slide; the
- * Brazilian disc 2D made 6.7 times the work put in without it). Only asked
- * once some vertex is broken. */
-static int joint_groups_hold(const fdem_model *m, int a, int b)
-{
-    int K = m->elem_nodes, shared = 0;
-    const int32_t *na = m->elem_node + (size_t)K * (size_t)a;
-    const int32_t *nb = m->elem_node + (size_t)K * (size_t)b;
-    for (int i = 0; i < K; i++)
-        for (int k = 0; k < K; k++) {
-            if (m->node_origin[na[i]] != m->node_origin[nb[k]]) continue;
-            if (m->vertex_root[na[i]] != m->vertex_root[nb[k]]) return 0;
-            shared++;
-        }
-    return shared > 0 && shared < m->dim;
-}
-
 /* True when a and b (of one fracturing part) are glued together: an intact
  * joint joins them, they share a mesh vertex around which every joint is
  * intact, or they share a node (a fracture region's elements outside its
@@ -358,7 +336,7 @@ static int element_on_crack(const fdem_model *m, int e)
 }
 
 /* True when contact between a and b (of one fracturing part) can be left
- * out: they are glued (joint_fan_holds, joint_groups_hold), or they belong
+ * out: they are glued (joint_fan_holds), or they belong
  * to one piece (piece[], from joint_fragment_labels) and neither has a
  * vertex on a crack inside a piece (joint_mark_inner_cracks). The faces a
  * crack exposes all have a vertex on it, so every pair that can meet
@@ -418,7 +396,6 @@ int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int
     if (m->elem_piece0 && elements_share_a_node(m, a, b)) return 1; /* a region's */
     if (joint_broken_between(m, a, b)) return 0;
     if (joint_fan_holds(m, a, b)) return 1;
-    if (joint_groups_hold(m, a, b)) return 1;
     return piece[a] == piece[b] && !element_on_crack(m, a) && !element_on_crack(m, b);
 }
 

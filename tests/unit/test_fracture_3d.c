@@ -534,13 +534,13 @@ static double centroid_x(const fdem_model *m, int e)
 }
 
 /* A fracturing block split by a crack across it (every joint on the plane
- * x = 1/2 broken), in either dimension: contact keeps every pair of
- * elements across the crack that share a face (the crack's two faces), and
- * no pair of elements on one side that share a vertex of it, which intact
- * joints hold together around that vertex as they did before the crack
- * (issue 34: before, every element with a vertex on the crack was paired
- * with each neighbour sharing that vertex, about 60 pairs an element in
- * 3D, each through the pair kernel every step). */
+ * x = 1/2 broken) into two pieces, in either dimension: contact keeps
+ * every pair of elements across the crack that share a face (the crack's
+ * two faces), and no pair of elements on one side, which belong to one
+ * piece and can meet only the other (issue 34: before, every element with
+ * a vertex on the crack was paired with its neighbours on its own side,
+ * about 6,600 of 14,008 pairs in this 3D block and 18 of 62 in 2D, each
+ * through the pair kernel every step). */
 static void crack_keeps_only_the_pairs_across_it(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
@@ -567,17 +567,17 @@ static void crack_keeps_only_the_pairs_across_it(void)
             int left_a = centroid_x(m, a) < 0.5, left_b = centroid_x(m, b) < 0.5;
             int shared = vertices_shared(m, a, b);
             across += left_a != left_b && shared == dim;
-            same_side += left_a == left_b && shared > 0;
+            same_side += left_a == left_b;
         }
         /* the plane crosses 4 (2D: 4 edges, 1 a side) or 4 x 4 x 2 faces */
         int faces = dim == 2 ? 4 : 32;
         printf("  %dD: %d joints cut, %zu candidate pairs, %d across the crack face to face, "
-               "%d on one side sharing a vertex\n", dim, cut, m->contact.pairs.count, across,
+               "%d on one side\n", dim, cut, m->contact.pairs.count, across,
                same_side);
         CHECK(cut == faces, "%dD: %d joints on the plane, want %d", dim, cut, faces);
         CHECK(across == faces, "%dD: %d face pairs across the crack kept, want %d", dim, across,
               faces);
-        CHECK(same_side == 0, "%dD: %d pairs on one side sharing a vertex kept", dim, same_side);
+        CHECK(same_side == 0, "%dD: %d pairs on one side kept", dim, same_side);
         fdem_model_destroy(m);
     }
 }
