@@ -17,10 +17,7 @@
  * FDEM_PENETRATIONS_MAX of them; later ones only counted) for the owner to
  * take with fdem_take_penetrations(). Nothing here changes the state: it
  * is an observation, not carried by checkpoints (the daemon keeps the
- * warnings it took in the case's status). A pair with no node strictly
- * inside the other (node_strictly_inside: no division, no square root) is
- * at depth 0 and ends there: two faces pressed together, the usual touch,
- * cost the check a few dot products.
+ * warnings it took in the case's status).
  */
 #include <math.h>
 #include <string.h>
@@ -90,54 +87,8 @@ static double nodes_depth(const fdem_model *m, int a, const double g[4][3], cons
     return deepest / inradius;
 }
 
-/* Some node of element a lies strictly inside element b: every
- * barycentric coordinate of it in b has the sign of b's volume (2D: area),
- * from b's edge vectors' cofactors, without the divisions and square roots
- * the depth needs. A node with any depth has it; most touching pairs (faces
- * pressed flat, corners on or outside the other's faces) have none, and
- * then pay only this. */
-static int node_strictly_inside(const fdem_model *m, int a, int b)
-{
-    const int D = m->dim;
-    const int32_t *nb = element_nodes(m, b), *na = element_nodes(m, a);
-    const double *p = m->pos, *p0 = p + D * nb[0];
-    double ed[3][3] = {{0}}, c[3][3] = {{0}}, det;
-    for (int k = 0; k < D; k++)
-        for (int d = 0; d < D; d++) ed[k][d] = p[D * nb[k + 1] + d] - p0[d];
-    if (D == 2) {
-        det = ed[0][0] * ed[1][1] - ed[1][0] * ed[0][1];
-        c[0][0] = ed[1][1], c[0][1] = -ed[1][0];
-        c[1][0] = -ed[0][1], c[1][1] = ed[0][0];
-    } else {
-        for (int k = 0; k < 3; k++) { /* c[k] = e_{k+1} x e_{k+2}: det times gradient k+1 */
-            const double *u = ed[(k + 1) % 3], *v = ed[(k + 2) % 3];
-            c[k][0] = u[1] * v[2] - u[2] * v[1];
-            c[k][1] = u[2] * v[0] - u[0] * v[2];
-            c[k][2] = u[0] * v[1] - u[1] * v[0];
-        }
-        det = ed[0][0] * c[0][0] + ed[0][1] * c[0][1] + ed[0][2] * c[0][2];
-    }
-    if (!(fabs(det) > 0)) return 0;
-    double sign = det > 0 ? 1 : -1;
-    for (int v = 0; v <= D; v++) {
-        const double *x = p + D * na[v];
-        double sum = 0;
-        int inside = 1;
-        for (int k = 0; k < D; k++) {
-            double l = 0; /* lambda_{k+1} times |det| */
-            for (int d = 0; d < D; d++) l += c[k][d] * (x[d] - p0[d]);
-            l *= sign;
-            inside &= l > 0;
-            sum += l;
-        }
-        if (inside && fabs(det) - sum > 0) return 1; /* lambda_0 > 0 too */
-    }
-    return 0;
-}
-
 double contact_penetration(const fdem_model *m, int a, int b)
 {
-    if (!node_strictly_inside(m, a, b) && !node_strictly_inside(m, b, a)) return 0;
     double ga[4][3], gb[4][3];
     const double *pa, *pb;
     if (!element_gradients(m, a, ga, &pa) || !element_gradients(m, b, gb, &pb)) return 0;
