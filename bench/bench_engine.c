@@ -45,6 +45,7 @@
 #include "../tests/unit/build_model.h"
 #include "mesh/mesh_3d.h"
 #include "model/model.h"
+#include "pair_kinds.h"
 #include "stream.h"
 #include "fluid/fluid.h"
 
@@ -218,7 +219,8 @@ static void bench_disc_pile(void)
         for (int s = 0; s < steps; s++) fdem_step(m, &err);
         double total = now() - t0;
         fdem_stage_times after = fdem_get_stage_times(m);
-        double fe = after.elements - before.elements, de = after.detection - before.detection;
+        double fe = after.elements + after.joints - before.elements - before.joints;
+        double de = after.detection - before.detection;
         double co = after.contact - before.contact, in = after.integration - before.integration;
         double sum = fe + de + co + in;
         fdem_counts c = fdem_get_counts(m);
@@ -323,7 +325,8 @@ static void bench_sphere_pile(void)
         fdem_stage_times before = fdem_get_stage_times(m);
         step_time t = best_of_three(m, steps);
         fdem_stage_times after = fdem_get_stage_times(m);
-        double fe = after.elements - before.elements, de = after.detection - before.detection;
+        double fe = after.elements + after.joints - before.elements - before.joints;
+        double de = after.detection - before.detection;
         double co = after.contact - before.contact, in = after.integration - before.integration;
         double sum = fe + de + co + in, ns = t.wall, cpu = t.cpu;
         fdem_counts c = fdem_get_counts(m);
@@ -424,7 +427,7 @@ static void bench_fracturing_block(const fracture_kind *k, double bandwidth_gbs)
         }
         fdem_model *m = keep;
         fdem_stage_times t = fdem_get_stage_times(m);
-        t.elements -= before.elements;
+        t.elements += t.joints - before.elements - before.joints;
         t.detection -= before.detection;
         t.contact -= before.contact;
         t.integration -= before.integration;
@@ -469,15 +472,19 @@ static void break_every_joint(fdem_model *m)
 
 /* The fracturing block after fracture against the same block intact, CPU
  * ns per element-step (best of three replays of the same window), with the
- * split over the stages (elements includes the joint loop) and what drives
- * the cost: candidate pairs kept and pairs touching per element, detections
- * per 1000 steps. */
+ * split over the stages (elements, joints, detection, contact) and what
+ * drives the cost: candidate pairs kept, near pairs walked and pairs
+ * touching per element, detections per 1000 steps; then the candidate
+ * pairs by what their elements share (pair_kinds.h: the two sides of a
+ * broken joint, an edge, a corner, nothing) with the pair kernel's time on
+ * each kind (every pair of it once, ns per element) and the share of it
+ * touching. */
 static void bench_broken_block(const fracture_kind *k, double goal, double work)
 {
     printf("\n## %s, every joint broken in place (after fracture)\n", k->title);
-    printf("%10s %7s %10s %10s %7s %9s %9s %9s %9s %9s %9s %10s\n", "elements", "steps",
-           "broken ns", "intact ns", "x", "forces%", "detect%", "contact%", "integr%",
-           "pairs/el", "touch/el", "det/1000");
+    printf("%10s %7s %10s %10s %7s %7s %7s %8s %9s %8s %8s %8s %9s %9s\n", "elements", "steps",
+           "broken ns", "intact ns", "x", "elem%", "joint%", "detect%", "contact%", "integr%",
+           "pairs/el", "near/el", "touch/el", "det/1000");
     char line[256] = "";
     for (int s = 0; s < 2 && k->sizes[s]; s++) {
         fdem_error err;
@@ -498,15 +505,26 @@ static void bench_broken_block(const fracture_kind *k, double goal, double work)
         step_time t = best_of_three(m, steps);
         fdem_stage_times after = fdem_get_stage_times(m);
         fdem_counts c = fdem_get_counts(m);
-        double fe = after.elements - before.elements, de = after.detection - before.detection;
+        double fe = after.elements - before.elements, jo = after.joints - before.joints;
+        double de = after.detection - before.detection;
         double co = after.contact - before.contact, in = after.integration - before.integration;
-        double sum = fe + de + co + in;
+        double sum = fe + jo + de + co + in;
         /* three replays of the window ran: a third of the detections each */
         double det = (double)(c.detections - det0) / 3 * 1000 / steps;
-        printf("%10d %7d %10.1f %10.1f %7.2f %9.1f %9.1f %9.1f %9.1f %9.2f %9.3f %10.1f\n", E,
-               steps, t.cpu, intact_cpu, t.cpu / intact_cpu, 100 * fe / sum, 100 * de / sum,
-               100 * co / sum, 100 * in / sum, (double)c.contact_pairs / E,
+        printf("%10d %7d %10.1f %10.1f %7.2f %7.1f %7.1f %8.1f %9.1f %8.1f %8.2f %8.2f %9.3f "
+               "%9.1f\n", E, steps, t.cpu, intact_cpu, t.cpu / intact_cpu, 100 * fe / sum,
+               100 * jo / sum, 100 * de / sum, 100 * co / sum, 100 * in / sum,
+               (double)c.contact_pairs / E, (double)m->contact.near_count / E,
                (double)c.contacts / E, det);
+        double count[PAIR_KINDS], seconds[PAIR_KINDS], touching[PAIR_KINDS];
+        pair_kind_counts(m, count);
+        pair_kind_kernel(m, seconds, touching);
+        printf("%10s pairs by kind (per element; kernel ns per element over them once; "
+               "touching %%):", "");
+        for (int kind = PAIR_KINDS - 1; kind >= 0; kind--)
+            printf(" %s %.2f / %.0f ns / %.0f%%", pair_kind_name[kind], count[kind] / E,
+                   seconds[kind] * 1e9 / E, count[kind] ? 100 * touching[kind] / count[kind] : 0);
+        printf("\n");
         snprintf(line + strlen(line), sizeof line - strlen(line), "%s %d: %.2fx", s ? ";" : "", E,
                  t.cpu / intact_cpu);
         fdem_model_destroy(m);

@@ -603,6 +603,7 @@ int fdem_checkpoint_version(const void *buf, size_t size);
  * (wall clock, for benchmarks and the status' figures). */
 typedef struct fdem_stage_times {
     double elements;    /* internal forces, stress, damping */
+    double joints;      /* the joint loop (fracture) and what a break sets off */
     double detection;   /* NBS runs */
     double contact;     /* pair forces */
     double integration; /* central difference update and constraints */

@@ -63,7 +63,7 @@ void fdem_model_destroy(fdem_model *m)
     free(m->joint_node); free(m->joint_damage); free(m->joint_offset); free(m->joint_elem); free(m->joint_h);
     free(m->joint_slip); free(m->joint_k); free(m->joint_strength_of); free(m->joint_strengths);
     joint_sets_free(m);
-    free(m->elem_joint); free(m->elem_piece0); free(m->vertex_broken); free(m->elem_viscous); free(m->fixed_force);
+    free(m->elem_joint); free(m->elem_piece0); free(m->vertex_broken); free(m->vertex_root); free(m->elem_viscous); free(m->fixed_force);
     free(m->stress0_defs); free(m->elem_stress0);
     free(m->joint_fracture); free(m->joint_broke); free(m->events);
     stages_free(m);

@@ -50,12 +50,13 @@ static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_S
  * entry (node, dofs); a quarter of a loaded
  * boundary facet (nodes, element, dim x dim forces; tunnel measures 0.15 a
  * node); with contact pos_detect, pos_near and the contact force (dim
- * each); with joints vertex_broken */
+ * each); with joints vertex_broken and vertex_root */
 static size_t memory_node(const memory_figures *f, int contact, int joints)
 {
     size_t facet = (f->D + 1) * sizeof(int32_t) + f->D * f->D * sizeof(double);
     return sizeof(double) * (5 * f->D + 2) + 2 * sizeof(int32_t) + 1 + sizeof(int32_t) + 1 +
-           facet / 4 + (contact ? 3 * f->D * sizeof(double) : 0) + (joints ? 1 : 0);
+           facet / 4 + (contact ? 3 * f->D * sizeof(double) : 0) +
+           (joints ? 1 + sizeof(int32_t) : 0);
 }
 
 /* hot record, elem_node, elem_part, elem_h, elem_viscous and elem_stress0
@@ -67,8 +68,8 @@ static size_t memory_element(const memory_figures *f, int joints)
            2 * f->stress_comps * sizeof(double) + (joints ? (f->D + 1) * sizeof(int32_t) + 1 : 0);
 }
 
-/* Detection arrays (centre and radius, box, elem_gap; body, piece, active,
- * near_active; in_pair; the NBS grid's heads, 12 bytes measured in 3D, 40
+/* Detection arrays (centre and radius, box, elem_gap; body, piece,
+ * detect_body, active, near_active; in_pair; the NBS grid's heads, 12 bytes measured in 3D, 40
  * in 2D, and in 3D its packed copy of the spheres, nbs_packed doubles) and
  * the pair lists at their capacities: a kept pair is two element
  * ids and its spring_of, a near_pair 24 bytes, a set slots doubles and a
@@ -79,7 +80,7 @@ static size_t memory_contact_element(const memory_figures *f)
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 2 + f->nbs_packed) * sizeof(double) + 4 * sizeof(int32_t) + 1 +
+    return (3 * f->D + 2 + f->nbs_packed) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
            10 * sizeof(int32_t) + (size_t)lists;
 }
 
@@ -172,8 +173,9 @@ size_t fdem_memory_bytes(const fdem_model *m)
     size_t b = sizeof *m, D = (size_t)m->dim;
     /* pos, vel, force, pos0, mass, inv_mass; node_part, node_origin */
     b += (size_t)m->node_capacity * (sizeof(double) * (D * 4 + 2) + 2 * sizeof(int32_t));
-    /* dof_owned; vertex_broken with joints; the contact's pos_detect, pos_near, force */
-    b += (size_t)m->node_count * (1 + (m->joint_count ? 1 : 0) +
+    /* dof_owned; vertex_broken and vertex_root with joints; the contact's
+     * pos_detect, pos_near, force */
+    b += (size_t)m->node_count * (1 + (m->joint_count ? 1 + sizeof(int32_t) : 0) +
                                   (m->contact.enabled ? 3 * D * sizeof(double) : 0));
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
@@ -184,9 +186,9 @@ size_t fdem_memory_bytes(const fdem_model *m)
     if (m->elem_stress0) b += stress;
     if (m->elem_viscous) b += stress;
     /* spheres (centre, radius), boxes (2 dim), elem_gap; body, piece,
-     * active, near_active; in_pair */
+     * detect_body, active, near_active; in_pair */
     if (m->contact.enabled)
-        b += (size_t)m->elem_count * ((3 * D + 2) * sizeof(double) + 4 * sizeof(int32_t) + 1) +
+        b += (size_t)m->elem_count * ((3 * D + 2) * sizeof(double) + 5 * sizeof(int32_t) + 1) +
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
                           : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
     /* joints: 2 dim nodes and 2 elements; damage, fracture, h, k; broke;

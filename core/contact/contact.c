@@ -245,13 +245,12 @@ static void contact_pairs_fit(nbs_pairs *pairs)
     if (b) pairs->b = b;
 }
 
-/* Pairs of triangles glued by intact joints never contact: they leave the
- * candidate list. */
+/* Pairs of elements glued by intact joints never contact: they leave the
+ * candidate list (cs->piece and the broken vertices are this detection's:
+ * contact_detect_bodies). */
 static void contact_drop_joined(fdem_model *m)
 {
     contact_state *cs = &m->contact;
-    joint_mark_broken_vertices(m);
-    joint_fragment_labels(m, cs->piece);
     size_t kept = 0;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
@@ -281,6 +280,24 @@ int contact_pair_force_now(const fdem_model *m, size_t k, double *out)
     return contact_pair_force(m, a, b, m->dt_prev, springs, out, NULL);
 }
 
+/* The body ids this detection runs on: with joints, the pieces of this
+ * moment (joint_contact_bodies), so that detection never lists the pairs
+ * inside a piece away from its cracks, which contact_drop_joined would
+ * drop: an intact fracturing block's detection was almost all listing and
+ * dropping those (3D: ~100 pairs an element, each looked up in the joints). */
+static const int32_t *contact_detect_bodies(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (!m->joint_count) return cs->body;
+    /* the contact force array (D doubles a node) is free until this step's
+     * pairs fill it: the crack marks take 4 int32 a node of it as scratch */
+    joint_mark_cracks(m, cs->piece, (int32_t *)cs->force);
+    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->force_is_zero = 1;
+    joint_contact_bodies(m, cs->piece, cs->body, cs->detect_body);
+    return cs->detect_body;
+}
+
 /* Candidate pairs from the bounding circles or spheres of the elements at
  * `pos` (the current positions, or a checkpoint's positions at its last
  * detection), with the stick springs of the pairs that stay. */
@@ -296,10 +313,11 @@ static int contact_detect_at(fdem_model *m, const double *pos)
         if (cs->cz) cs->cz[e] = c[2];
         cs->r[e] += 0.5 * cs->buffer;
     }
+    const int32_t *body = contact_detect_bodies(m);
     int failed = m->dim == 3 ? nbs_detect_3d(&cs->grid3, (size_t)m->elem_count, cs->cx, cs->cy,
-                                             cs->cz, cs->r, cs->body, &cs->pairs)
+                                             cs->cz, cs->r, body, &cs->pairs)
                              : nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r,
-                                          cs->body, &cs->pairs);
+                                          body, &cs->pairs);
     if (failed) return -1;
     if (m->elem_active) contact_drop_excavated(m);
     if (m->joint_count) contact_drop_joined(m);
@@ -356,6 +374,7 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->r = malloc(sizeof(double) * E);
     cs->body = malloc(sizeof(int32_t) * E);
     cs->piece = malloc(sizeof(int32_t) * E);
+    cs->detect_body = malloc(sizeof(int32_t) * E);
     cs->pos_detect = malloc(sizeof(double) * D * N);
     cs->pos_near = malloc(sizeof(double) * D * N);
     cs->force = calloc(D * N, sizeof(double));
@@ -366,6 +385,7 @@ int contact_init(fdem_model *m, fdem_error *err)
     cs->elem_gap = malloc(sizeof(double) * E);
     cs->in_pair = malloc(E);
     if (!cs->cx || !cs->cy || (D == 3 && !cs->cz) || !cs->r || !cs->body || !cs->piece ||
+        !cs->detect_body ||
         !cs->pos_detect || !cs->pos_near || !cs->force || !cs->box || !cs->active || !cs->near_active || !cs->elem_gap ||
         !cs->in_pair) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
@@ -397,7 +417,7 @@ int contact_init(fdem_model *m, fdem_error *err)
 
 void contact_free(contact_state *cs)
 {
-    free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece);
+    free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece); free(cs->detect_body);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
     free(cs->near);

@@ -84,8 +84,20 @@ int joint_prepare(fdem_model *m, fdem_error *err);
 double joint_stable_dt(const fdem_model *m);
 int joint_holds(const fdem_model *m, int a, int b);
 void joint_mark_broken_vertices(fdem_model *m);
+/* What contact needs to know of the cracks, at each detection: the broken
+ * vertices, the copies intact joints join around each, the pieces (piece,
+ * joint_fragment_labels) and the vertices of cracks inside one piece;
+ * scratch holds 4 node_count int32 (its contents are left undefined). */
+void joint_mark_cracks(fdem_model *m, int32_t *piece, int32_t *scratch);
 int joint_fan_holds(const fdem_model *m, int a, int b);
 int joint_contact_excluded(const fdem_model *m, const int32_t *piece, int a, int b);
+/* Body ids for detection (nbs.h: pairs of one body are never listed):
+ * body's, but an element of a fracturing part that is not on a crack takes
+ * its piece's id, so the pairs joint_contact_excluded would drop for being
+ * of one piece off the cracks are never listed. Valid after
+ * joint_mark_broken_vertices and joint_fragment_labels (piece). */
+void joint_contact_bodies(const fdem_model *m, const int32_t *piece, const int32_t *body,
+                          int32_t *out);
 int joint_fragment_labels(const fdem_model *m, int32_t *label);
 int joint_forces(fdem_model *m);
 void joint_forces_range_2d(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS]);

@@ -199,6 +199,7 @@ typedef struct contact_state {
     int force_is_zero;       /* force holds only zeros: no pair was evaluated */
     int32_t *body;           /* body id per element: pairs of one body never touch */
     int32_t *piece;          /* scratch: piece label per element (fracturing models) */
+    int32_t *detect_body;    /* scratch: the body ids a detection runs on (contact.c) */
     double *box;             /* 2 dim per element: lo, hi of each axis, each step, of the
                                 elements in some candidate pair */
     int32_t *active;         /* the elements in some candidate pair, once each */
@@ -308,6 +309,8 @@ struct fdem_model {
                                 any joint counts; joint_region.c); NULL without one */
     uint8_t *vertex_broken;  /* per mesh vertex (node_origin): some joint on it is broken;
                                 refreshed at each contact detection */
+    int32_t *vertex_root;    /* per node: the first copy of its vertex joined to it around the
+                                vertex by intact joints; refreshed with vertex_broken */
     double *joint_fracture;  /* per joint: what its damage growth dissipated so far (the
                                 fracture account joint by joint; its event's energy) */
     uint8_t *joint_broke;    /* per joint: the mode of a break in this step's joint loop,

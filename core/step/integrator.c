@@ -418,6 +418,8 @@ int fdem_step(fdem_model *m, fdem_error *err)
     constraint_set_time(m, m->time + 0.5 * h);
     forces_clear(m);
     element_forces(m);
+    double tj = stage_clock();
+    m->times.elements += tj - t0;
     if (m->joint_count) {
         int broke = joint_forces(m);
         if (broke < 0) {
@@ -433,7 +435,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     }
     if (m->fluid) fluid_step(m, h);
     double t1 = stage_clock();
-    m->times.elements += t1 - t0;
+    m->times.joints += t1 - tj;
     if (contact_forces(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory in contact detection at step %lld",
                     (long long)m->step + 1);

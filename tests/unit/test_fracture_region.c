@@ -543,11 +543,12 @@ static void region_pieces_and_contact(void)
     build_finalize(m, 0.5);
     CHECK(joint_fragment_count(m) == 1, "intact: one piece, got %d", joint_fragment_count(m));
     for (int j = 0; j < m->joint_count; j++) m->joint_damage[j] = 1;
-    joint_mark_broken_vertices(m);
     int pieces = joint_fragment_count(m);
     CHECK(pieces == 1 + isolated, "broken through: %d pieces, want 1 + %d", pieces, isolated);
     int32_t *piece = malloc(sizeof(int32_t) * (size_t)m->elem_count);
-    joint_fragment_labels(m, piece);
+    int32_t *scratch = malloc(4 * sizeof(int32_t) * (size_t)m->node_count);
+    joint_mark_cracks(m, piece, scratch);
+    free(scratch);
     int share_kept = 0, crack_dropped = 0, sharing = 0, across = 0;
     for (int a = 0; a < m->elem_count; a++)
         for (int b = a + 1; b < m->elem_count; b++) {
