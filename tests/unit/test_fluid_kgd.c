@@ -159,6 +159,14 @@ static fdem_model *kgd_model(const kgd_setup *k)
     return m;
 }
 
+/* Steps m until its time reaches t; non-zero (err says why) if a step fails. */
+static int kgd_step_to(fdem_model *m, double t, fdem_error *err)
+{
+    while (fdem_get_time(m) < t)
+        if (fdem_step(m, err)) return -1;
+    return 0;
+}
+
 static void kgd_toughness_dominated(void)
 {
     fdem_model *m = kgd_model(&TOUGH);
@@ -177,13 +185,12 @@ static void kgd_toughness_dominated(void)
     fdem_error err;
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (int s = 0; s < SAMPLES; s++) {
-        while (fdem_get_time(m) < times[s])
-            if (fdem_step(m, &err)) {
-                CHECK(0, "step: %s", err.message);
-                free(aperture);
-                fdem_model_destroy(m);
-                return;
-            }
+        if (kgd_step_to(m, times[s], &err)) {
+            CHECK(0, "step: %s", err.message);
+            free(aperture);
+            fdem_model_destroy(m);
+            return;
+        }
         k[s] = kgd_measure(m, aperture);
         double l = pow(Ep * k[s].volume / (2 * sqrt(M_PI) * Kic), 2.0 / 3);
         double p = Kic / sqrt(M_PI * l), w = 4 * p * l / Ep;
@@ -240,13 +247,12 @@ static void kgd_viscosity_dominated(void)
     fdem_error err;
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
     for (int s = 0; s < SAMPLES; s++) {
-        while (fdem_get_time(m) < times[s])
-            if (fdem_step(m, &err)) {
-                CHECK(0, "step: %s", err.message);
-                free(aperture);
-                fdem_model_destroy(m);
-                return;
-            }
+        if (kgd_step_to(m, times[s], &err)) {
+            CHECK(0, "step: %s", err.message);
+            free(aperture);
+            fdem_model_destroy(m);
+            return;
+        }
         kgd_figures k = kgd_measure(m, aperture);
         double t = k.time, l = 0.6152 * pow(Ep * Q * Q * Q / mup, 1.0 / 6) * pow(t, 2.0 / 3);
         double w = sqrt(2.1 * sqrt(mup * Q / Ep) * l), p = 0.62 * sqrt(mup * Q * Ep) / w;
