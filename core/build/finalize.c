@@ -45,24 +45,10 @@ static void fit_array(void **array, size_t bytes)
     if (p) *array = p;
 }
 
-/* Positions and velocities get one number more than the nodes hold (0,
- * never read as a value): the 3D element loop loads a node's x, y, z as a
- * row of four (tet_gather_shared_quad), the last node's too. A failure is
- * out of memory, since the loop would read past the block. */
-static int fit_padded(double **array, size_t count)
-{
-    double *p = realloc(*array, sizeof(double) * (count + 1));
-    if (!p) return -1;
-    p[count] = 0;
-    *array = p;
-    return 0;
-}
-
-static int fit_model_arrays(fdem_model *m)
+static void fit_model_arrays(fdem_model *m)
 {
     const size_t D = (size_t)m->dim, N = (size_t)m->node_count, E = (size_t)m->elem_count;
-    if (fit_padded(&m->pos, D * N) || fit_padded(&m->vel, D * N)) return -1;
-    void **by_dim[] = {(void **)&m->force, (void **)&m->pos0};
+    void **by_dim[] = {(void **)&m->pos, (void **)&m->vel, (void **)&m->force, (void **)&m->pos0};
     for (size_t i = 0; i < sizeof by_dim / sizeof by_dim[0]; i++)
         fit_array(by_dim[i], sizeof(double) * D * N);
     fit_array((void **)&m->inv_mass, sizeof(double) * N);
@@ -75,7 +61,6 @@ static int fit_model_arrays(fdem_model *m)
     fit_array((void **)&m->elem_part, sizeof(int32_t) * E);
     fit_array((void **)&m->elem_node, sizeof(int32_t) * (size_t)m->elem_nodes * E);
     m->elem_capacity = m->elem_count;
-    return 0;
 }
 
 /* Element nodes sit at the start of each hot record (16 int32 apart for a
@@ -105,10 +90,7 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         return -1;
     }
     const size_t D = (size_t)m->dim;
-    if (fit_model_arrays(m)) {
-        model_error(err, FDEM_ITEM_NONE, -1, "out of memory");
-        return -1;
-    }
+    fit_model_arrays(m);
     memcpy(m->pos, m->pos0, sizeof(double) * D * (size_t)m->node_count);
     memset(m->force, 0, sizeof(double) * D * (size_t)m->node_count);
     for (int k = 0; k < m->part_count; k++) {

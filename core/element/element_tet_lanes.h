@@ -14,16 +14,13 @@
  *                       whose elements' nodes are their own and consecutive
  *                       (model_part_stores_forces): whole rows moved and
  *                       transposed, or the lane by lane way
- *   TET_GATHER_SHARED(xyz, t, x)
- *                       tet_gather_nodes for any nodes: the lane by lane
- *                       way, or whole rows transposed
  *   TET_LOAD_SIX(rows, v), TET_STORE_SIX(rows, v)
  *                       v[q] = the vector of rows[6 lane + q], q < 6, and
  *                       back (the group's stored viscous stresses)
  */
 #if !defined(TET_V) || !defined(TET_N) || !defined(TET_VFN) || !defined(TET_GATHER) ||           \
     !defined(TET_GATHER_OWN) || !defined(TET_STORE_OWN) || !defined(TET_LOAD_SIX) ||        \
-    !defined(TET_STORE_SIX) || !defined(TET_GATHER_SHARED)
+    !defined(TET_STORE_SIX)
 #error "element_tet_lanes.h is included by element_tet_model.c only"
 #endif
 
@@ -77,7 +74,7 @@ TET_KERNEL void TET_VFN(tet_damp_group)(const fdem_model *m, const tet_hot *t,
     if (store)
         TET_GATHER_OWN(m->vel, t, v);
     else
-        TET_GATHER_SHARED(m->vel, t, v);
+        TET_VFN(tet_gather_nodes)(m->vel, t, v);
     TET_VFN(tet_kernel_edges)(v[0], v[1], v[2], v[3], dv);
     TET_V det = TET_VFN(tet_kernel_mid_faces)(e, dv, 0.5 * m->dt_prev, cm);
     int all = 1;
@@ -119,7 +116,7 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
     if (store)
         TET_GATHER_OWN(m->pos, t, x);
     else
-        TET_GATHER_SHARED(m->pos, t, x);
+        TET_VFN(tet_gather_nodes)(m->pos, t, x);
     TET_UNROLL
     for (int l = 0; l < TET_N; l++) p[l] = t[l].xinv;
     TET_UNROLL
@@ -163,4 +160,3 @@ TET_KERNEL void TET_VFN(tet_forces_group)(fdem_model *m, const tet_hot *t, tet_c
 #undef TET_STORE_OWN
 #undef TET_LOAD_SIX
 #undef TET_STORE_SIX
-#undef TET_GATHER_SHARED

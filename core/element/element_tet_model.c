@@ -192,7 +192,6 @@ TET_KERNEL void tet_forces_one(fdem_model *m, const tet_hot *t, tet_constants *k
 #define TET_VFN(name) name##_pair
 #define TET_GATHER(p, i) ((tet_pair){(p)[0][i], (p)[1][i]})
 #define TET_GATHER_OWN(xyz, t, x) tet_gather_nodes_pair(xyz, t, x)
-#define TET_GATHER_SHARED(xyz, t, x) tet_gather_nodes_pair(xyz, t, x)
 #define TET_LOAD_SIX(rows, v)                                                                    \
     do {                                                                                         \
         for (int q_ = 0; q_ < 6; q_++) v[q_] = (tet_pair){(rows)[q_], (rows)[6 + q_]};          \
@@ -251,26 +250,6 @@ TET_KERNEL void tet_gather_own_quad(const double *xyz, const tet_hot *t, fdem_qu
     for (int q = 0; q < 12; q++) x[q / 3][q % 3] = col[q];
 }
 
-/* tet_gather_nodes for four elements on any nodes: each node's x, y, z and
- * the number after it as one row of four (the arrays have a number to
- * spare after the last node: finalize.c; the fourth is never used), the
- * four rows of a corner transposed: 16 loads and 4 transposes for the 48
- * numbers instead of 48 single loads and the inserts that put them in
- * lanes. The same numbers, so the same bits. */
-TET_KERNEL void tet_gather_shared_quad(const double *xyz, const tet_hot *t, fdem_quad x[4][3])
-{
-    TET_UNROLL
-    for (int a = 0; a < 4; a++) {
-        fdem_quad r[4];
-        TET_UNROLL
-        for (int l = 0; l < 4; l++) memcpy(&r[l], xyz + 3 * (size_t)t[l].node[a], sizeof r[l]);
-        tet_transpose_quad(r);
-        x[a][0] = r[0];
-        x[a][1] = r[1];
-        x[a][2] = r[2];
-    }
-}
-
 /* The storing scatter (vec3_scatter with store) of four such elements:
  * 0 + g_0 and 0 - g_a as vectors, lane by lane what the scalar store
  * gives, transposed back to rows and stored whole. */
@@ -321,7 +300,6 @@ TET_KERNEL void tet_store_six_quad(double *rows, const fdem_quad v[6])
 }
 
 #define TET_GATHER_OWN(xyz, t, x) tet_gather_own_quad(xyz, t, x)
-#define TET_GATHER_SHARED(xyz, t, x) tet_gather_shared_quad(xyz, t, x)
 #define TET_STORE_OWN(f, t, g) tet_store_own_quad(f, t, g)
 #define TET_LOAD_SIX(rows, v) tet_load_six_quad(rows, v)
 #define TET_STORE_SIX(rows, v) tet_store_six_quad(rows, v)
