@@ -27,10 +27,22 @@ class LineResult(unittest.TestResult):
     def __init__(self):
         super().__init__()
         self._started = {}
+        # wall seconds per module, class set-ups included: the time since
+        # the last test ended goes to the module of the one ending now
+        # (what MODULE_SECONDS below should say)
+        self.module_seconds = {}
+        self._last_end = time.monotonic()
 
     def startTest(self, test):
         super().startTest(test)
         self._started[test.id()] = time.monotonic()
+
+    def stopTest(self, test):
+        super().stopTest(test)
+        now = time.monotonic()
+        name = test.id().split(".", 1)[0]
+        self.module_seconds[name] = self.module_seconds.get(name, 0.0) + now - self._last_end
+        self._last_end = now
 
     def _elapsed(self, test):
         return time.monotonic() - self._started.get(test.id(), time.monotonic())
@@ -68,7 +80,8 @@ MODULE_SECONDS = {"test_paraview": 70, "test_observation_3d": 47, "test_hostile_
                   "test_excavation": 27, "test_plot_3d": 22, "test_heavy_work": 21,
                   "test_hostile_requests": 16, "test_crash_consistency": 13,
                   "test_hostile_resources": 12, "test_results_displacement": 11,
-                  "test_history": 10, "test_memory": 8, "test_3d": 8, "test_stream": 32}
+                  "test_history": 10, "test_memory": 8, "test_3d": 8, "test_stream": 32,
+                  "test_web": 60, "test_fluid": 20, "test_estimate": 15}
 
 
 def module_of(test):
@@ -120,6 +133,9 @@ def main():
     started = time.monotonic()
     suite.run(result)
     failed = len(result.failures) + len(result.errors) + len(result.unexpectedSuccesses)
+    longest = sorted(result.module_seconds.items(), key=lambda kv: -kv[1])[:12]
+    print("integration modules, longest: " + ", ".join("%s %.0f s" % kv for kv in longest),
+          file=sys.stderr)
     print("integration: %d run, %d failed, %.1f s" % (result.testsRun, failed, time.monotonic() - started),
           file=sys.stderr)
     return 1 if failed or result.testsRun == 0 else 0

