@@ -28,20 +28,7 @@
 #include "case/case.h"
 #include "model/model.h"
 #include "pair_kinds.h"
-
-static double thread_cpu(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "clock.h"
 
 static char *read_file(const char *path, size_t *length)
 {
@@ -119,7 +106,7 @@ static int run_case(const char *path, int window, int threads, long max_steps)
     while (fdem_get_time(m) < info.end_time && total_steps < max_steps) {
         fdem_stage_times before = fdem_get_stage_times(m);
         long det0 = m->contact.detections;
-        double c0 = thread_cpu(), w0 = now();
+        double c0 = bench_cpu_seconds(), w0 = bench_wall_seconds();
         int steps = 0;
         fdem_error err;
         for (; steps < window && fdem_get_time(m) < info.end_time &&
@@ -130,9 +117,9 @@ static int run_case(const char *path, int window, int threads, long max_steps)
                 fdem_model_destroy(m);
                 return -1;
             }
-        double cpu = thread_cpu() - c0;
+        double cpu = bench_cpu_seconds() - c0;
         total_cpu += cpu;
-        total_wall += now() - w0;
+        total_wall += bench_wall_seconds() - w0;
         total_steps += steps;
         fdem_stage_times t = fdem_get_stage_times(m);
         double fe = t.elements - before.elements, jo = t.joints - before.joints;

@@ -48,23 +48,7 @@
 #include "pair_kinds.h"
 #include "stream.h"
 #include "fluid/fluid.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU time of the calling thread: on one thread (the element loop runs on
- * the caller then) it leaves out the time a busy machine's other jobs held
- * the core, which wall time cannot. */
-static double thread_cpu(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "clock.h"
 
 /* The elastic block in either dimension: one builder and one bytes count,
  * so the 2D and 3D figures are measured the same way and printed alike. */
@@ -157,9 +141,9 @@ static void window_rewind(fdem_model *m, const window_start *w)
 static step_time timed_steps(fdem_model *m, int steps)
 {
     fdem_error err;
-    double t0 = now(), c0 = thread_cpu();
+    double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
     for (int s = 0; s < steps; s++) fdem_step(m, &err);
-    return (step_time){now() - t0, thread_cpu() - c0};
+    return (step_time){bench_wall_seconds() - t0, bench_cpu_seconds() - c0};
 }
 
 /* The best of three runs of the same `steps` steps from m's state; m is
@@ -215,9 +199,9 @@ static void bench_disc_pile(void)
         fdem_stage_times before = fdem_get_stage_times(m);
         int steps = (int)(2e7 / m->elem_count);
         if (steps < 100) steps = 100;
-        double t0 = now();
+        double t0 = bench_wall_seconds();
         for (int s = 0; s < steps; s++) fdem_step(m, &err);
-        double total = now() - t0;
+        double total = bench_wall_seconds() - t0;
         fdem_stage_times after = fdem_get_stage_times(m);
         double fe = after.elements + after.joints - before.elements - before.joints;
         double de = after.detection - before.detection;
@@ -234,13 +218,13 @@ static void bench_disc_pile(void)
         nbs_pairs brute;
         nbs_pairs_init(&brute);
         int reps = 20;
-        double tn = now();
+        double tn = bench_wall_seconds();
         for (int s = 0; s < reps; s++)
             nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs);
-        tn = (now() - tn) / reps;
-        double tb = now();
+        tn = (bench_wall_seconds() - tn) / reps;
+        double tb = bench_wall_seconds();
         nbs_detect_brute((size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &brute);
-        tb = now() - tb;
+        tb = bench_wall_seconds() - tb;
         printf("         detection on these circles: NBS %.1f ns/element, all-pairs %.1f ns/element "
                "(%.0fx), same pairs: %s\n",
                tn * 1e9 / m->elem_count, tb * 1e9 / m->elem_count, tb / tn,
