@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "common/clock.h"
 
 typedef struct feed_event {
     uint64_t id;
@@ -40,13 +41,6 @@ static struct {
     unsigned wakes;         /* case_feed_wake() calls */
 } feed = {.publish_lock = PTHREAD_MUTEX_INITIALIZER, .lock = PTHREAD_MUTEX_INITIALIZER,
           .grew = PTHREAD_COND_INITIALIZER, .first_id = 1};
-
-static double feed_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 void case_feed_init(void)
 {
@@ -111,13 +105,13 @@ void case_feed_status(server_case *c)
     if (atomic_load(&c->deleted))
         return;
     pthread_mutex_lock(&feed.publish_lock);
-    feed_status_locked(c, feed_now());
+    feed_status_locked(c, clock_wall_seconds());
     pthread_mutex_unlock(&feed.publish_lock);
 }
 
 void case_feed_progress(server_case *c)
 {
-    double now = feed_now();
+    double now = clock_wall_seconds();
     pthread_mutex_lock(&feed.publish_lock);
     if (now - c->feed_status_at >= 1.0 / CASE_FEED_STATUS_RATE && !atomic_load(&c->deleted))
         feed_status_locked(c, now);

@@ -23,6 +23,7 @@
 #include "case_feed.h"
 #include "case_model.h"
 #include "store/persist.h"
+#include "common/clock.h"
 
 typedef enum io_job_kind {
     IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_HISTORY,
@@ -69,19 +70,12 @@ static int io_running;
 #define IO_XDMF_EAGER_SNAPSHOTS 200
 #define IO_XDMF_MIN_INTERVAL 0.5
 
-static double io_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 static void io_write_xdmf(server_case *c, int force)
 {
     if (!c->result || !c->model)
         return;
     int count = result_snapshot_count(c->result);
-    double now = io_now();
+    double now = clock_wall_seconds();
     if (!force && count > IO_XDMF_EAGER_SNAPSHOTS &&
         now - c->xdmf_written_at < IO_XDMF_MIN_INTERVAL) {
         c->xdmf_dirty = 1;
@@ -378,7 +372,7 @@ static void io_do_frame(io_job *j)
 
 static void io_run_job(io_job *j)
 {
-    double started = io_now();
+    double started = clock_wall_seconds();
     int writes_snapshot = j->kind == IO_APPEND && j->snap && j->ckpt;
     switch (j->kind) {
     case IO_CREATE: io_do_create(j); break;
@@ -394,7 +388,7 @@ static void io_run_job(io_job *j)
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
-        io_note_snapshot_cost(io_now() - started, (double)j->ckpt_size);
+        io_note_snapshot_cost(clock_wall_seconds() - started, (double)j->ckpt_size);
 }
 
 static void io_job_free(io_job *j)

@@ -34,6 +34,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#include "common/clock.h"
 
 /* Untimed warm-up: at least this many steps and this long. */
 #define PROBE_WARM_STEPS 2
@@ -47,22 +48,6 @@
  * the probe: a model whose step takes 0.1 s is timed in under a second. */
 #define PROBE_MIN_WINDOWS 3
 #define PROBE_BUDGET_SECONDS 0.3
-
-double sizing_clock(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-/* CPU seconds of the calling thread: what a step costs whatever else the
- * machine is doing. */
-static double probe_cpu(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static int probe_step(fdem_model *model)
 {
@@ -82,15 +67,15 @@ static int compare_doubles(const void *a, const void *b)
 static int probe_run(fdem_model *model, double seconds, int min_steps, int max_steps,
                      sizing_load *load, double *cpu)
 {
-    double started = sizing_clock(), now = started, cpu0 = probe_cpu();
+    double started = clock_wall_seconds(), now = started, cpu0 = clock_cpu_seconds();
     int taken = 0;
     while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
         if (probe_step(model) != 0)
             return -1;
         taken++;
-        now = sizing_clock();
+        now = clock_wall_seconds();
     }
-    *cpu = probe_cpu() - cpu0;
+    *cpu = clock_cpu_seconds() - cpu0;
     load->wall += now - started;
     load->cpu += *cpu;
     return taken;
@@ -100,7 +85,7 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
                                  sizing_load *load)
 {
     *taken = 0;
-    double cpu, window[PROBE_WINDOWS], started = sizing_clock();
+    double cpu, window[PROBE_WINDOWS], started = clock_wall_seconds();
     sizing_load warm_load = {0, 0};
     int room = steps_left < 1e9 ? (int)steps_left : 1000000000;
     int warm = probe_run(model, PROBE_WARM_SECONDS, PROBE_WARM_STEPS,
@@ -116,7 +101,7 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
     }
     int windows = 0;
     while (windows < PROBE_WINDOWS && room > 0 &&
-           (windows < PROBE_MIN_WINDOWS || sizing_clock() - started < PROBE_BUDGET_SECONDS)) {
+           (windows < PROBE_MIN_WINDOWS || clock_wall_seconds() - started < PROBE_BUDGET_SECONDS)) {
         int n = probe_run(model, PROBE_WINDOW_SECONDS, 1,
                           room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, load, &cpu);
         if (n < 0)
@@ -180,7 +165,3 @@ double sizing_load_factor(const sizing_load *load)
     return sqrt(counted * seen);
 }
 
-double sizing_thread_cpu(void)
-{
-    return probe_cpu();
-}

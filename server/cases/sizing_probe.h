@@ -17,8 +17,7 @@
  *    called by the worker as a run ends), or before any the geometric
  *    mean of (one-minute load average + 1) / cores and the windows' own
  *    wall / CPU seconds in *load; at least 1.
- *  - sizing_thread_cpu() is the calling thread's CPU clock, in seconds.
- *  - sizing_clock() is the monotonic clock, in seconds.
+ *  The clocks are common/clock.h's.
  */
 #ifndef FDEMD_SIZING_PROBE_H
 #define FDEMD_SIZING_PROBE_H
@@ -32,8 +31,6 @@ typedef struct sizing_load {
 double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken,
                                  sizing_load *load);
 double sizing_load_factor(const sizing_load *load);
-double sizing_clock(void);
-double sizing_thread_cpu(void);
 void sizing_note_run(double wall, double cpu);
 
 #endif

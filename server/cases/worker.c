@@ -25,6 +25,7 @@
 #include "io_thread.h"
 #include "registry_internal.h"
 #include "worker_history.h"
+#include "common/clock.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
@@ -60,13 +61,6 @@ typedef struct worker_clock {
     double io_waited;       /* wall seconds this run waited for its snapshot writes */
     int snapshots_taken;    /* by this run */
 } worker_clock;
-
-static double worker_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* The first output time strictly after `t` on the grid k * interval. */
 static double worker_next_output(const server_case *c, double t)
@@ -169,10 +163,10 @@ static double worker_wait_io(server_case *c, int max_pending)
     double waited = 0;
     pthread_mutex_lock(&c->lock);
     if (c->io_pending > max_pending) {
-        double started = worker_now();
+        double started = clock_wall_seconds();
         while (c->io_pending > max_pending)
             pthread_cond_wait(&c->cv, &c->lock);
-        waited = worker_now() - started;
+        waited = clock_wall_seconds() - started;
     }
     pthread_mutex_unlock(&c->lock);
     return waited;
@@ -267,7 +261,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
             pthread_mutex_unlock(&c->model_lock);
             return EXIT_FAILED;
         }
-        double t = fdem_get_time(m), now = worker_now();
+        double t = fdem_get_time(m), now = clock_wall_seconds();
         int done = cut || t >= end;
         snapshot *snap = NULL;
         void *ckpt = NULL;
@@ -335,7 +329,7 @@ static void worker_wind_down(server_case *c, worker_exit why, worker_clock *clk)
         ckpt = checkpoint_file_take(c->model, &ckpt_size);
         c->last_checkpoint_step = step;
     }
-    worker_publish(c, clk, worker_now(), 0);
+    worker_publish(c, clk, clock_wall_seconds(), 0);
     pthread_mutex_unlock(&c->model_lock);
     worker_history_flush(c);
     if (snap || ckpt || events)
@@ -392,7 +386,7 @@ static void *worker_main(void *arg)
     case_state final_state = CASE_FAILED;
     if (worker_take_model(c, &final_state) == 0) {
         fdem_set_threads(c->model, cfg->threads);
-        double now = worker_now();
+        double now = clock_wall_seconds();
         pthread_mutex_lock(&c->lock);
         double elapsed_before = c->fig.elapsed > 0 ? c->fig.elapsed : 0.0;
         pthread_mutex_unlock(&c->lock);
@@ -404,11 +398,11 @@ static void *worker_main(void *arg)
                  fdem_get_dt(c->model));
         c->next_output = worker_next_output(c, fdem_get_time(c->model));
         worker_history_start(c);
-        double cpu_started = sizing_thread_cpu();
+        double cpu_started = clock_cpu_seconds();
         why = worker_loop(c, &clk);
         /* what this run got of the machine, for the next estimates */
-        double wall = worker_now() - clk.run_started;
-        sizing_note_run(wall - clk.io_waited, sizing_thread_cpu() - cpu_started);
+        double wall = clock_wall_seconds() - clk.run_started;
+        sizing_note_run(wall - clk.io_waited, clock_cpu_seconds() - cpu_started);
         io_note_paced_run(wall, clk.io_waited, clk.snapshots_taken);
         worker_wind_down(c, why, &clk);
         final_state = worker_final_state(why);

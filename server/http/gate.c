@@ -63,6 +63,7 @@
 #include <unistd.h>
 
 #include "http_frame.h"
+#include "common/clock.h"
 
 #define GATE_HEAD_MAX (32 * 1024) /* larger header blocks get 431 */
 #define GATE_MAX_SLOTS 65536      /* descriptors the gate can track */
@@ -110,9 +111,7 @@ static struct {
 
 double gate_now(void)
 {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+    return clock_wall_seconds();
 }
 
 /* ------------------------------------------------------------ counting */

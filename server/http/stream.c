@@ -41,6 +41,7 @@
 #include "cases/case_feed.h"
 #include "gate.h"
 #include "http.h"
+#include "common/clock.h"
 
 #define STREAM_READ_BYTES (16 * 1024) /* feed text taken at a time */
 #define STREAM_HANGUP_CHECK 1.0       /* s between looks for clients gone */
@@ -152,13 +153,6 @@ static void stream_free(void *cls)
 
 /* ---------------------------------------------------------- wake thread */
 
-static double stream_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 /* Marks the suspended streams whose client has hung up. With the hub
  * lock held. */
 static void stream_find_hangups_locked(void)
@@ -200,15 +194,15 @@ static void *stream_main(void *unused)
 {
     (void)unused;
     uint64_t seen = case_feed_last_id();
-    double beat_at = stream_now() + STREAM_KEEPALIVE_SECONDS;
-    double look_at = stream_now() + STREAM_HANGUP_CHECK;
+    double beat_at = clock_wall_seconds() + STREAM_KEEPALIVE_SECONDS;
+    double look_at = clock_wall_seconds() + STREAM_HANGUP_CHECK;
     pthread_mutex_lock(&hub.lock);
     while (!hub.closing) {
         pthread_mutex_unlock(&hub.lock);
-        double wait = (beat_at < look_at ? beat_at : look_at) - stream_now();
+        double wait = (beat_at < look_at ? beat_at : look_at) - clock_wall_seconds();
         seen = case_feed_wait(seen, wait > 0 ? wait : 0);
         pthread_mutex_lock(&hub.lock);
-        double now = stream_now();
+        double now = clock_wall_seconds();
         int beat = now >= beat_at;
         if (beat)
             beat_at = now + STREAM_KEEPALIVE_SECONDS;
