@@ -11,6 +11,7 @@ packages=(
   gmsh clang libclang-rt-14-dev wrk
   python3-paraview xvfb xauth octave
   chromium chromium-driver python3-selenium
+  openmpi-bin libopenmpi-dev libmetis-dev
 )
 
 missing=()
