@@ -327,12 +327,19 @@ int fdem_model_finalize(fdem_model *model, fdem_error *err);
 
 /* ------------------------------------------------------------------- running */
 
-/* Largest stable step of the finalized model: the smallest of the elements'
- * dilatational-wave limit (reduced for damping) and the contact penalty
- * limit (only if some body can touch another). Multiply by a safety factor.
- * Also set when finalize failed only at a constraint's node selection (so a
- * caller can judge its dt in the same answer); 0 after any earlier failure. */
+/* Largest step the finalized model accepts: the smallest of the elements'
+ * fastest-mode limit (reduced for damping), the joints' and the fluid's,
+ * and the contact step (only if some body can touch another). Also set
+ * when finalize failed only at a constraint's node selection (so a caller
+ * can judge its dt in the same answer); 0 after any earlier failure. */
 double fdem_stable_dt(const fdem_model *model);
+
+/* The step of time.dt "auto" for a safety in (0, 1]: safety x each
+ * stability limit (the contact's is twice its step), never above the
+ * contact step (build/finalize.c says why). At most fdem_stable_dt(); a
+ * finalized model starts with the default safety's. */
+#define FDEM_DEFAULT_SAFETY 0.5
+double fdem_auto_dt(const fdem_model *model, double safety);
 
 /* Step size of the next step; may change between steps (central difference
  * with h_current != h_next, seed eq. 5.9). Must be > 0. */

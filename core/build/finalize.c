@@ -128,8 +128,9 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
         double de = element_stable_dt(m, e);
         if (de < dt) dt = de;
     }
-    dt = fmin(dt, contact_stable_dt(m));
-    m->stable_dt = fmin(dt, joint_stable_dt(m));
+    m->eigen_dt = fmin(dt, joint_stable_dt(m));
+    m->contact_dt = contact_stable_dt(m);
+    m->stable_dt = fmin(m->eigen_dt, m->contact_dt);
     m->stage_now = 0; /* the stage of the first step: stage-only constraints of stage 0 hold */
     if (stages_validate(m, err)) return -1;
     /* After the stable step, so a case refused for its constraints can
@@ -139,9 +140,23 @@ int fdem_model_finalize(fdem_model *m, fdem_error *err)
     if (boundary_load_select(m, err)) return -1;
     if (fixed_parts_prepare(m, err)) return -1;
     if (fluid_prepare(m, err)) return -1; /* tightens stable_dt by the fluid's stiffness */
-    m->dt = m->stable_dt * 0.5;
+    m->dt = fdem_auto_dt(m, FDEM_DEFAULT_SAFETY);
     m->dt_prev = 0;
     m->finalized = 1;
     energy_initial(m);
     return 0;
+}
+
+/* The stability limits (elements, joints, fluid) are bounds on the fastest
+ * mode, omega dt <= 2: safety x them keeps a margin. The contact step is
+ * not such a bound: a penalty that switches on within a step adds energy
+ * long before the step goes unstable, so contact_stable_dt is where flat
+ * impacts keep their energy (omega dt about 1), half the contact's own
+ * stability limit. "auto" takes safety x every stability limit, the
+ * contact's too, and never more than the contact step: from the default
+ * safety up, contact runs at its step; below it, at safety x its limit. */
+double fdem_auto_dt(const fdem_model *m, double safety)
+{
+    double contact = fmin(1, safety * CONTACT_STABLE_OVER_STEP) * m->contact_dt;
+    return fmin(safety * m->eigen_dt, contact);
 }

@@ -443,14 +443,18 @@ double contact_stable_dt(const fdem_model *m)
     /* A face pressed a depth d into a triangle of altitude h is pushed back
      * with p 3 d / h from each side, so a corner node of an element of
      * size h, on two such faces, feels a spring of up to about 16 p / (rho
-     * h^2) per unit mass. 0.25 h sqrt(rho / p) keeps omega dt at 1 at
-     * safety 1: measured on flat impacts of shared-node and fracturing
-     * blocks (test_contact.c), the energy after the impact is within 1 % of
-     * the energy before at every safety up to 1 (0.45, the earlier factor,
-     * gained 20 % at safety 1). A tetrahedron's potential is steeper
-     * (p 4 d / h), and its corner node (mass rho h^3 / 24 against rho h^2 / 6)
-     * sits on three faces of area h^2 / 2 (a third each): 8/3 times the
-     * stiffness per unit mass, so the factor is 0.25 sqrt(3/8) = 0.153. */
+     * h^2) per unit mass: omega dt = 2, the stability limit, at
+     * 0.5 h sqrt(rho / p). The contact step is half that, 0.25 h
+     * sqrt(rho / p) (omega dt = 1): a penalty switching on within a step
+     * adds energy well before the step goes unstable, and flat impacts of
+     * shared-node and fracturing blocks (test_contact.c) keep their energy
+     * within 1 % at this step, while 1.8 x it (0.45, the factor of
+     * 7f53400) gained 8-21 %. fdem_auto_dt never exceeds this step and
+     * scales the limit (CONTACT_STABLE_OVER_STEP x it) by the safety. A
+     * tetrahedron's potential is steeper (p 4 d / h), and its corner node
+     * (mass rho h^3 / 24 against rho h^2 / 6) sits on three faces of area
+     * h^2 / 2 (a third each): 8/3 times the stiffness per unit mass, so the
+     * factor is 0.25 sqrt(3/8) = 0.153 (test_contact_3d.c's flat impacts). */
     double dt = INFINITY, factor = m->contact.kernel->dt_factor;
     for (int e = 0; e < m->elem_count; e++) {
         const material *mat = &m->materials[element_material(m, e)];

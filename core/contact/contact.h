@@ -25,6 +25,10 @@
 int contact_init(fdem_model *m, fdem_error *err);
 void contact_free(contact_state *c);
 double contact_stable_dt(const fdem_model *m);
+/* The contact's stability limit (omega dt = 2 on its stiffest estimate)
+ * over its step (omega dt = 1, where flat impacts keep their energy):
+ * fdem_auto_dt scales the limit by the safety and caps it at the step. */
+#define CONTACT_STABLE_OVER_STEP 2.0
 int contact_forces(fdem_model *m);
 /* penetration.c: how deep a node of either element is inside the other,
  * as a fraction of that element's inradius; a touching pair beyond

@@ -314,7 +314,10 @@ int fluid_prepare(fdem_model *m, fdem_error *err)
         double V = fmax(face.opening, f->aperture0[j]) * area;
         f->fluid[j] = V * (1 + f->pressure[j] / f->bulk_modulus);
     }
-    m->stable_dt = fluid_stable_dt(m, f, m->stable_dt);
+    /* both limits, so stable_dt is what one limit of their smaller would be */
+    m->eigen_dt = fluid_stable_dt(m, f, m->eigen_dt);
+    if (isfinite(m->contact_dt)) m->contact_dt = fluid_stable_dt(m, f, m->contact_dt);
+    m->stable_dt = fmin(m->eigen_dt, m->contact_dt);
     fluid_refresh(m);
     return 0;
 }

@@ -342,7 +342,9 @@ struct fdem_model {
     int64_t step;
     double time;
     double time_carry;       /* what rounding took off time, added back next step (model_time_after) */
-    double stable_dt;
+    double stable_dt;        /* the largest step accepted: min(eigen_dt, contact_dt) */
+    double eigen_dt;         /* the elements', joints' and fluid's stability limits */
+    double contact_dt;       /* the contact step (contact_stable_dt), INFINITY without contact */
 
     /* energy accounts (see fdem_energy and energy.c). Work is booked with
      * the step-averaged velocity (v_old + v_new)/2 * havg, which is exactly

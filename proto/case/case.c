@@ -18,7 +18,7 @@
 
 #include "case_internal.h"
 
-#define CASE_DEFAULT_SAFETY 0.5
+#define CASE_DEFAULT_SAFETY FDEM_DEFAULT_SAFETY
 
 static const char *const top_keys[] = {
     "name", "dimension", "materials", "parts", "constraints", "stages", "gravity",
@@ -220,9 +220,9 @@ static int case_check_selections(case_doc *doc, const fdem_model *model)
 
 /* time.end / dt within CASE_MAX_STEPS; else a problem at whichever of the
  * two the user can fix: a given dt when "auto" would do, else the end. */
-static int case_check_steps(case_doc *doc, double dt, double stable)
+static int case_check_steps(case_doc *doc, double dt, double auto_dt)
 {
-    double steps = doc->end_time / dt, auto_dt = doc->safety * stable;
+    double steps = doc->end_time / dt;
     if (steps <= CASE_MAX_STEPS) return 0;
     if (!doc->dt_auto && doc->end_time / auto_dt <= CASE_MAX_STEPS)
         case_problem(doc, "/time/dt", "dt = %g s would take %.3g steps to reach time.end = %g s; "
@@ -239,20 +239,21 @@ static int case_check_steps(case_doc *doc, double dt, double stable)
     return -1;
 }
 
-/* "auto" is safety x the stable step; a given dt must not exceed it. */
+/* "auto" is fdem_auto_dt (safety x the stability limits, at most the
+ * contact step); a given dt must not exceed the stable step. */
 static int case_choose_dt(case_doc *doc, fdem_model *model, case_info *info)
 {
-    double stable = fdem_stable_dt(model);
+    double stable = fdem_stable_dt(model), auto_dt = fdem_auto_dt(model, doc->safety);
     if (!(stable > 0) || !isfinite(stable)) {
         case_problem(doc, "", "the model has no finite stable time step (%g s)", stable);
         return -1;
     }
     if (!doc->dt_auto && doc->dt > stable) {
-        case_dt_problem(doc, stable, "");
+        case_dt_problem(doc, stable, auto_dt, "");
         return -1;
     }
-    double dt = doc->dt_auto ? doc->safety * stable : doc->dt;
-    if (case_check_steps(doc, dt, stable) != 0) return -1;
+    double dt = doc->dt_auto ? auto_dt : doc->dt;
+    if (case_check_steps(doc, dt, auto_dt) != 0) return -1;
     fdem_set_dt(model, dt);
     info->dt = dt;
     info->stable_dt = stable;

@@ -8,7 +8,7 @@
  *    only the first) with its JSON Pointer and the model is not built (422).
  *  - A case whose model would exceed memory_limit bytes (estimated before
  *    building) is rejected with 422 saying how large it would be.
- *  - time.dt "auto" = safety x fdem_stable_dt(); a number above the stable
+ *  - time.dt "auto" = fdem_auto_dt(safety); a number above the stable
  *    step is rejected with 422 naming the stable value.
  *  - On success the model is finalized, its dt set, and `info` filled.
  *  - "stages" (contract 6.1, case_stages.c): the engine gets each stage's

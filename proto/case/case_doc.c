@@ -30,12 +30,11 @@ void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallb
     case_problem(doc, ptr, "%s", err->message[0] ? err->message : "the engine refused the case");
 }
 
-void case_dt_problem(case_doc *doc, double stable, const char *whose)
+void case_dt_problem(case_doc *doc, double stable, double auto_dt, const char *whose)
 {
     case_problem(doc, "/time/dt", "dt = %g s is above the stable time step of this model%s, "
                                   "%.4g s; use at most that, or \"auto\" (%.4g s with safety "
-                                  "%g)", doc->dt, whose, stable, doc->safety * stable,
-                 doc->safety);
+                                  "%g)", doc->dt, whose, stable, auto_dt, doc->safety);
 }
 
 void case_doc_free(case_doc *doc)

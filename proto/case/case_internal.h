@@ -262,9 +262,9 @@ const char *case_did_you_mean(case_doc *doc, char *buf, size_t size, const char 
  * `fallback` is used when the error names nothing more precise. */
 void case_engine_problem(case_doc *doc, const fdem_error *err, const char *fallback);
 
-/* The problem at /time/dt of a dt above `stable`; `whose` qualifies the
- * model ("" or "'s valid parts"). */
-void case_dt_problem(case_doc *doc, double stable, const char *whose);
+/* The problem at /time/dt of a dt above `stable`, naming "auto"'s step
+ * `auto_dt`; `whose` qualifies the model ("" or "'s valid parts"). */
+void case_dt_problem(case_doc *doc, double stable, double auto_dt, const char *whose);
 
 void case_doc_free(case_doc *doc);
 

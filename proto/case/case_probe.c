@@ -52,6 +52,7 @@ static int probe_doc_make(case_doc *doc, int from, case_doc *probe, problems *sc
     memset(probe, 0, sizeof *probe);
     probe->out = scratch;
     probe->dimension = doc->dimension;
+    probe->safety = doc->safety;
     memcpy(probe->gravity, doc->gravity, sizeof probe->gravity);
     int stand_in = -1;
     for (int k = 0; k < doc->material_count && stand_in < 0; k++)
@@ -77,8 +78,9 @@ static int probe_doc_make(case_doc *doc, int from, case_doc *probe, problems *sc
     return probe->part_count > 0;
 }
 
+/* The scratch model's stable step, and in *auto_dt its "auto" step. */
 static double probe_stable_dt(case_doc *probe, size_t memory_limit, case_memory_gate gate,
-                              void *gate_ctx)
+                              void *gate_ctx, double *auto_dt)
 {
     double bytes = case_check_memory(probe, memory_limit);
     if (probe->out->count || (gate && gate(gate_ctx, bytes) != 0)) return 0;
@@ -89,7 +91,10 @@ static double probe_stable_dt(case_doc *probe, size_t memory_limit, case_memory_
     if (fdem_set_dimension(model, probe->dimension, &err) == 0 &&
         case_add_materials(probe, model) == 0 && case_add_parts(probe, model) == 0) {
         fdem_set_gravity_v(model, probe->gravity);
-        if (fdem_model_finalize(model, &err) == 0) stable = fdem_stable_dt(model);
+        if (fdem_model_finalize(model, &err) == 0) {
+            stable = fdem_stable_dt(model);
+            *auto_dt = fdem_auto_dt(model, probe->safety);
+        }
     }
     fdem_model_destroy(model);
     return stable;
@@ -106,8 +111,8 @@ void case_probe_dt(case_doc *doc, int from, size_t memory_limit, case_memory_gat
     problems_init(&scratch);
     case_doc probe;
     if (probe_doc_make(doc, from, &probe, &scratch)) {
-        double stable = probe_stable_dt(&probe, memory_limit, gate, gate_ctx);
-        if (stable > 0 && doc->dt > stable) case_dt_problem(doc, stable, "'s valid parts");
+        double auto_dt = 0, stable = probe_stable_dt(&probe, memory_limit, gate, gate_ctx, &auto_dt);
+        if (stable > 0 && doc->dt > stable) case_dt_problem(doc, stable, auto_dt, "'s valid parts");
     }
     case_doc_free(&probe);
     problems_free(&scratch);

@@ -132,7 +132,7 @@ static inline void build_finalize(fdem_model *m, double safety)
 {
     fdem_error err;
     if (fdem_model_finalize(m, &err)) build_die("finalize", &err);
-    fdem_set_dt(m, safety * fdem_stable_dt(m));
+    fdem_set_dt(m, fdem_auto_dt(m, safety)); /* a case's "auto" */
 }
 
 /* Discs of radius r in hexagonal packing at a spacing of 1.97 r: the
