@@ -273,11 +273,12 @@ static double boxes_flat_impact_gain(int n, int fracture, double safety, double 
 static void boxes_flat_impact_keeps_its_energy_at_every_safety(void)
 {
     for (int fracture = 0; fracture < 2; fracture++) {
-        double step, half, contact, wider = NAN, limit = NAN, dt;
+        double step, half, contact, wider = NAN, limit = NAN;
         double gain = boxes_flat_impact_gain(3, fracture, 1.0, 1.0, &step, &contact);
         CHECK_REL(step, contact, 1e-15);
         double gain_half = boxes_flat_impact_gain(3, fracture, FDEM_DEFAULT_SAFETY, 1.0, &half, &contact);
 #ifndef FDEM_SAN /* figures, not checks: the sanitizer run spares them */
+        double dt;
         wider = boxes_flat_impact_gain(3, fracture, 1.0, 1.8, &dt, &contact);
         limit = boxes_flat_impact_gain(3, fracture, 1.0, 2.0, &dt, &contact);
 #endif
