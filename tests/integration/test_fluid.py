@@ -6,7 +6,9 @@ t = 0) and a source pressure; energy gains fluid_work and
 fluid_dissipation and the residual stays below 1 % of the fluid's work;
 result.h5 has /snapshots/fluid_pressure and /snapshots/aperture (S, J),
 result.xdmf shows them on the joints block, fdemctl status prints a
-`fluid` line; bad input is one 422 with a
+`fluid` line; the history series (GET /cases/ID/history, /history/fluid/*
+and energy/fluid_* in result.h5, fdemctl history's CSV) carry each
+injection's source pressure and injected volume; bad input is one 422 with a
 problem at each pointer. Waits for states, never for wall time."""
 import json
 import os
@@ -85,12 +87,40 @@ class FluidTest(DaemonTestCase):
         self.assertEqual(status, 200)
         self.assertIn(b'Name="fluid_pressure"', xdmf)
         self.assertIn(b'Name="aperture"', xdmf)
+        self.check_history(st, path)
 
-    def test_fluid_2d(self):
-        self.check_case(2)
-
-    def test_fluid_3d(self):
-        self.check_case(3)
+    def check_history(self, st, path):
+        """The injection's source pressure and injected volume as history
+        series: the last row (taken with the last snapshot, at the end) holds
+        the status' figures; a constraint that does not inject has none."""
+        status, body = self.d.json("GET", "/cases/%s/history" % st["id"])
+        self.assertEqual(status, 200, body)
+        rows = body["rows"]
+        self.assertGreater(len(rows), 2)
+        last = rows[-1]
+        self.assertEqual(last["fluid"]["injected_volume"], [st["fluid"]["injected_volume"]])
+        self.assertEqual(last["fluid"]["source_pressure"], [st["fluid"]["source_pressure"]])
+        self.assertEqual(last["energy"]["fluid_work"], st["energy"]["fluid_work"])
+        self.assertEqual(rows[0]["fluid"]["injected_volume"], [0])
+        import h5py
+        with h5py.File(path, "r") as f:
+            h = f["/history"]
+            n = len(h["time"])
+            self.assertEqual(n, len(rows))
+            volume = h["fluid/injected_volume"][:, 0]
+            self.assertEqual(h["fluid/source_pressure"].shape, (n, 1))
+            self.assertTrue((volume[1:] >= volume[:-1]).all())
+            self.assertEqual(volume[-1], st["fluid"]["injected_volume"])
+            self.assertEqual(h["energy/fluid_dissipation"][-1], st["energy"]["fluid_dissipation"])
+        csv = self.d.fdemctl("history", st["id"])
+        self.assertEqual(csv.returncode, 0, csv.stderr)
+        lines = csv.stdout.splitlines()
+        header = lines[0].split(",")
+        for column in ("c0_source_pressure", "c0_injected_volume", "fluid_work",
+                       "fluid_dissipation"):
+            self.assertIn(column, header)
+        values = dict(zip(header, lines[-1].split(",")))
+        self.assertEqual(float(values["c0_injected_volume"]), st["fluid"]["injected_volume"])
 
     def test_no_fluid_no_fluid_status(self):
         case = fluid_case(2)

@@ -100,6 +100,12 @@ static void check_network(const char *doc, int steps)
     CHECK(fabs(e.residual) < 0.01 * e.fluid_work, "residual %.3g of fluid work %.3g", e.residual,
           e.fluid_work);
     CHECK(fabs(p[0]) + fabs(p[1]) + fabs(p[2]) <= 1e-9 * scale, "momentum");
+    /* the history's per-injection figures: the one injection holds the totals */
+    double pressure = 0, injected = 0;
+    fdem_fluid_sources(m, &pressure, &injected);
+    CHECK(injected == f.injected_volume && pressure == f.source_pressure,
+          "per injection %.17g Pa, %.17g; status %.17g Pa, %.17g", pressure, injected,
+          f.source_pressure, f.injected_volume);
     /* the case builder admits a case on the estimate: the fluid's is in it */
     size_t held = fdem_memory_bytes(m);
     size_t priced = fdem_memory_estimate_of(&c) + fdem_fluid_memory_estimate(c.dimension, c.joints);
@@ -140,6 +146,10 @@ static void check_same_bits(const char *doc, int steps)
     ec = fdem_get_energy(c);
     CHECK(ea.fluid_work == ec.fluid_work && ea.fluid_dissipation == ec.fluid_dissipation,
           "fluid accounts %.17g %.17g", ea.fluid_work, ec.fluid_work);
+    double pa = 0, va = 0, pc = 0, vc = 0; /* one constraint: the injection */
+    fdem_fluid_sources(a, &pa, &va);
+    fdem_fluid_sources(c, &pc, &vc);
+    CHECK(pa == pc && va == vc && va > 0, "per injection after the restart: %.17g %.17g", va, vc);
     fdem_model_destroy(a);
     fdem_model_destroy(b);
     fdem_model_destroy(c);
