@@ -8,13 +8,14 @@ result.h5 has /snapshots/fluid_pressure and /snapshots/aperture (S, J),
 result.xdmf shows them on the joints block, fdemctl status prints a
 `fluid` line; the history series (GET /cases/ID/history, /history/fluid/*
 and energy/fluid_* in result.h5, fdemctl history's CSV) carry each
-injection's source pressure and injected volume; bad input is one 422 with a
+injection's source pressure and injected volume; status.json keeps the
+fluid across a restart of the daemon; bad input is one 422 with a
 problem at each pointer. Waits for states, never for wall time."""
 import json
 import os
 import unittest
 
-from fdemd_harness import DaemonTestCase
+from fdemd_harness import Daemon, DaemonTestCase
 
 
 def fluid_case(dimension=2, end=1.5e-3, inject=2e-3):
@@ -121,6 +122,37 @@ class FluidTest(DaemonTestCase):
             self.assertIn(column, header)
         values = dict(zip(header, lines[-1].split(",")))
         self.assertEqual(float(values["c0_injected_volume"]), st["fluid"]["injected_volume"])
+
+    def test_fluid_status_survives_a_restart(self):
+        """status.json keeps the fluid figures: a daemon started again on the
+        same directory shows the finished case's "fluid" and fluid energies
+        (they were dropped before: the status then said "fluid": null)."""
+        first = Daemon().start()
+        again = None
+        try:
+            case = fluid_case(2, end=2e-4)
+            st = first.create(case, start=True)
+            st = first.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=60)
+            self.assertEqual(st["state"], "finished", st.get("error"))
+            code, _ = first.stop()
+            self.assertEqual(code, 0)
+            again = Daemon(data_dir=first.data_dir).start()
+            shown = again.status(st["id"])
+            self.assertEqual(shown["fluid"], st["fluid"])
+            for term in ("fluid_work", "fluid_dissipation"):
+                self.assertEqual(shown["energy"][term], st["energy"][term])
+            code, _ = again.stop()
+            self.assertEqual(code, 0)
+        finally:
+            if again:
+                again.close()
+            first.close()
+
+    def test_fluid_2d(self):
+        self.check_case(2)
+
+    def test_fluid_3d(self):
+        self.check_case(3)
 
     def test_no_fluid_no_fluid_status(self):
         case = fluid_case(2)
