@@ -522,3 +522,74 @@ dump("drift-3d", {
                 "excavate": [{"part": "rock mass", "group": "excavation"}]}],
     "time": {"end": 0.008, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.0005, "fields": ["position", "displacement", "stress"]}})
+
+
+# Borehole breakdown (Hubbert & Willis 1957; issue 36). A disc of rock of
+# radius R = 10 a around a bore of radius a = 0.1 m, meshed on polar lines
+# (64 sectors, rings growing by 1 + 2 pi / 64 so the elements stay about
+# square; a node on each axis, so radial element edges run along
+# theta = 0 and 90 degrees), under the in-situ stress sigma_H = 15 MPa
+# along x and sigma_h = 10 MPa along y (compression positive), held at the
+# outer circle by the matching boundary_stress (and absorbing). The bore
+# starts held by the same traction (in equilibrium at t = 0), which is
+# taken away over 0.3 ms (the bore is drilled); the bore's pressure ramps
+# from 0 to 30 MPa over 1.5 ms, and joints (T = 5 MPa) fill r < 0.35 m.
+# The wall's hoop stress at theta = 0 is 3 sigma_h - sigma_H - p
+# (compression positive), so the wall cracks along x at the breakdown
+# pressure p_b = 3 sigma_h - sigma_H + T = 20 MPa (tests/unit/test_fluid_borehole.c).
+def polar_gmsh(a, R, sectors):
+    """msh 2.2 text of the ring a < r < R: surface group "rock", curve groups
+    "bore" (r = a) and "outer" (r = R)."""
+    growth = 1 + 2 * math.pi / sectors
+    rings = max(1, round(math.log(R / a) / math.log(growth)))
+    radii = [a * (R / a) ** (i / rings) for i in range(rings + 1)]
+    nodes = [(r * math.cos(2 * math.pi * j / sectors), r * math.sin(2 * math.pi * j / sectors))
+             for r in radii for j in range(sectors)]
+    def node(i, j):
+        return i * sectors + j % sectors + 1
+    lines = [(1, node(0, j + 1), node(0, j)) for j in range(sectors)]  # bore, outward normal in
+    lines += [(2, node(rings, j), node(rings, j + 1)) for j in range(sectors)]
+    tris = []
+    for i in range(rings):
+        for j in range(sectors):
+            a0, a1, b0, b1 = node(i, j), node(i, j + 1), node(i + 1, j), node(i + 1, j + 1)
+            # the diagonal alternates in a checkerboard: no preferred direction
+            if (i + j) % 2 == 0:
+                tris += [(a0, a1, b1), (a0, b1, b0)]
+            else:
+                tris += [(a0, a1, b0), (a1, b1, b0)]
+    out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", "3",
+           '1 1 "bore"', '1 2 "outer"', '2 3 "rock"', "$EndPhysicalNames", "$Nodes",
+           str(len(nodes))]
+    out += ["%d %.15g %.15g 0" % (k + 1, x, y) for k, (x, y) in enumerate(nodes)]
+    out += ["$EndNodes", "$Elements", str(len(lines) + len(tris))]
+    k = 0
+    for tag, p, q in lines:
+        k += 1
+        out.append("%d 1 2 %d %d %d %d" % (k, tag, tag, p, q))
+    for t in tris:
+        k += 1
+        out.append("%d 2 2 3 3 %d %d %d" % (k, *t))
+    out += ["$EndElements", ""]
+    return "\n".join(out)
+
+
+bore_a, bore_stress = 0.1, [-15e6, -10e6, 0]
+dump("borehole-breakdown", {
+    "name": "borehole-breakdown",
+    "materials": {"rock": {"density": 2600, "young": 2e10, "poisson": 0.25, "damping": 0.2,
+                           "fracture": {"tensile_strength": 5e6, "cohesion": 3e7,
+                                        "friction_angle": 30, "energy_I": 20,
+                                        "energy_II": 200}}},
+    "parts": [{"name": "rock", "material": "rock",
+               "fracture": {"box": [-0.35, -0.35, 0.35, 0.35]},
+               "initial_stress": {"value": bore_stress},
+               "gmsh": polar_gmsh(bore_a, 10 * bore_a, 64)}],
+    "constraints": [{"part": "rock", "group": "bore", "pressure": 3e7,
+                     "amplitude": [[0, 0], [0.0015, 1]]},
+                    {"part": "rock", "group": "bore", "boundary_stress": {"value": bore_stress},
+                     "amplitude": [[0, 1], [0.0003, 0]]},
+                    {"part": "rock", "group": "outer", "boundary_stress": {"value": bore_stress}},
+                    {"part": "rock", "group": "outer", "absorb": True}],
+    "time": {"end": 0.0015, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.0001, "fields": ["position", "stress", "damage"]}})
