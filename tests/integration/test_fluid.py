@@ -134,6 +134,7 @@ class FluidTest(DaemonTestCase):
             st = first.create(case, start=True)
             st = first.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=60)
             self.assertEqual(st["state"], "finished", st.get("error"))
+            rows = first.json("GET", "/cases/%s/history" % st["id"])[1]["rows"]
             code, _ = first.stop()
             self.assertEqual(code, 0)
             again = Daemon(data_dir=first.data_dir).start()
@@ -141,6 +142,9 @@ class FluidTest(DaemonTestCase):
             self.assertEqual(shown["fluid"], st["fluid"])
             for term in ("fluid_work", "fluid_dissipation"):
                 self.assertEqual(shown["energy"][term], st["energy"][term])
+            # the history's fluid series read back from the file on disk
+            self.assertEqual(again.json("GET", "/cases/%s/history" % st["id"])[1]["rows"], rows)
+            self.assertIn("fluid", rows[-1])
             code, _ = again.stop()
             self.assertEqual(code, 0)
         finally:
