@@ -436,6 +436,9 @@ typedef struct fdem_fluid_status {
     int subcycles, open_joints;
 } fdem_fluid_status;
 fdem_fluid_status fdem_get_fluid(const fdem_model *model);
+/* 1 when the model has fluid (fdem_get_fluid's `enabled`, without its sum
+ * over every joint). */
+int fdem_has_fluid(const fdem_model *model);
 /* Per joint: the fluid pressure of the last evaluation (0 in a sealed
  * joint; NULL without fluid or joints), and the hydraulic aperture
  * max(opening, aperture0) on the current positions into out[joints]

@@ -215,6 +215,8 @@ double fluid_work_reported(const fdem_model *m)
 
 /* ----------------------------------------------------------- the API */
 
+int fdem_has_fluid(const fdem_model *m) { return m->fluid != NULL; }
+
 fdem_fluid_status fdem_get_fluid(const fdem_model *m)
 {
     fdem_fluid_status s = {0};

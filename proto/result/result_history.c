@@ -111,7 +111,7 @@ int history_create(result_file *f, const fdem_model *model, const case_info *inf
     f->history_dimension = fdem_get_dimension(model);
     f->history_points = info->history_point_count;
     f->history_constraints = fdem_get_counts(model).constraints;
-    f->history_fluid = fdem_get_fluid(model).enabled;
+    f->history_fluid = fdem_has_fluid(model);
     f->history_last_time = -INFINITY;
     hid_t group = H5Gcreate2(f->file, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (group < 0) {
