@@ -26,11 +26,10 @@
  * cohesion is 10 kPa) and 6 wet. 2.1 s of CPU for the three.
  * Where the model's threshold lies (daemon runs, phi = 30 deg): arrested at
  * sigma_H = 5 and 5.5 MPa (ratio 1.25, 1.38), crossed at 6, 7.5 and 10 MPa
- * (1.5 - 2.5): the switch is where the criterion puts it within a factor
- * 1.5-1.7 (0.90), not closer, which is why these cases sit far from it.
- * The rock's cohesive zone (E' G_I / T0^2 = 0.12 m) is as long as the
- * fracture's last stretch to the joint (0.15 m, three cells), where
- * Renshaw & Pollard take the LEFM tip field. Not refined further here.
+ * (1.5 - 2.5); with 0.025 m cells arrested at 4, crossed at 5 MPa
+ * (1.0 - 1.25); with 0.0125 m still arrested at 4.5 MPa (1.125): the
+ * switch lies 1.1-1.7 times the criterion's 0.90, which is why these
+ * cases sit far from it (docs/physics.md says what may move it).
  */
 #include <jansson.h>
 #include <math.h>
