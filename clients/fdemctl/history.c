@@ -22,9 +22,10 @@ static const char USAGE_HISTORY[] =
     "usage: fdemctl history ID [--since T] [--csv FILE] [--json]\n"
     "  The history rows of the case as CSV: time, step, each monitoring point's\n"
     "  displacement and velocity, each constraint's force and mean displacement,\n"
-    "  each injection's source pressure and injected volume, every energy account. --csv FILE writes them to FILE instead of stdout;\n"
-    "  --since T only the rows after time T (seconds); --json prints the\n"
-    "  server's JSON instead.\n";
+    "  each injection's source pressure and injected volume, every energy\n"
+    "  account. --csv FILE writes them to FILE instead of stdout; --since T\n"
+    "  only the rows after time T (seconds); --json prints the server's JSON\n"
+    "  instead.\n";
 
 static const char AXES[] = "xyz";
 

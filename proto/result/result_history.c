@@ -49,7 +49,10 @@ static int hist_is_vectors(int k)
 }
 static int hist_is_fluid(int k) { return k >= HIST_FLUID_PRESSURE && k < HIST_TIME; }
 /* (H, C) per constraint: the fluid's source pressure and injected volume */
-static int hist_is_per_constraint(int k) { return k == HIST_FLUID_PRESSURE || k == HIST_FLUID_INJECTED; }
+static int hist_is_per_constraint(int k)
+{
+    return k == HIST_FLUID_PRESSURE || k == HIST_FLUID_INJECTED;
+}
 static int hist_rank(int k) { return hist_is_vectors(k) ? 3 : hist_is_per_constraint(k) ? 2 : 1; }
 
 /* The items per row of series k (points or constraints) in file f. */

@@ -190,7 +190,8 @@ void case_fluid_from_json(case_figures *f, const json_t *fluid, const json_t *en
     const json_t *work = json_object_get(energy, "fluid_work");
     const json_t *dissipation = json_object_get(energy, "fluid_dissipation");
     f->energy.fluid_work = json_is_number(work) ? json_number_value(work) : NAN;
-    f->energy.fluid_dissipation = json_is_number(dissipation) ? json_number_value(dissipation) : NAN;
+    f->energy.fluid_dissipation =
+        json_is_number(dissipation) ? json_number_value(dissipation) : NAN;
 }
 
 json_t *case_status_json(server_case *c)
