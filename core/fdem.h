@@ -443,12 +443,20 @@ typedef struct fdem_fluid_status {
     int subcycles, open_joints;
 } fdem_fluid_status;
 fdem_fluid_status fdem_get_fluid(const fdem_model *model);
+/* 1 when the model has fluid (fdem_get_fluid's `enabled`, without its sum
+ * over every joint). */
+int fdem_has_fluid(const fdem_model *model);
 /* Per joint: the fluid pressure of the last evaluation (0 in a sealed
  * joint; NULL without fluid or joints), and the hydraulic aperture
  * max(opening, aperture0) on the current positions into out[joints]
  * (the opening itself without fluid). */
 const double *fdem_fluid_pressure(const fdem_model *model);
 void fdem_fluid_apertures(const fdem_model *model, double *out);
+/* Per constraint, in case order (the history series, contract 6.2/6.4):
+ * the mean fluid pressure of the joints an "inject" constraint feeds into
+ * pressure[k] and the volume it injected since t = 0 into injected[k]; NAN
+ * for a constraint that does not inject. Writes nothing without fluid. */
+void fdem_fluid_sources(const fdem_model *model, double *pressure, double *injected);
 /* For run-time estimates only, on a model that is thrown away afterwards
  * (core/joint/joint_crack.c): breaks every intact joint between two active
  * elements whose centroids lie on either side of the plane
@@ -603,7 +611,7 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
 /* The format version a checkpoint buffer says it is in (1 to the current
  * one, FDEM_CHECKPOINT_VERSION), or -1 when it does not start like one. */
-#define FDEM_CHECKPOINT_VERSION 9
+#define FDEM_CHECKPOINT_VERSION 10
 int fdem_checkpoint_version(const void *buf, size_t size);
 
 /* Seconds spent in each stage of fdem_step() since the model was built

@@ -522,3 +522,159 @@ dump("drift-3d", {
                 "excavate": [{"part": "rock mass", "group": "excavation"}]}],
     "time": {"end": 0.008, "dt": "auto", "safety": 0.5},
     "output": {"interval": 0.0005, "fields": ["position", "displacement", "stress"]}})
+
+
+# Borehole breakdown (Hubbert & Willis 1957; issue 36). A disc of rock of
+# radius R = 10 a around a bore of radius a = 0.1 m, meshed on polar lines
+# (64 sectors, rings growing by 1 + 2 pi / 64 so the elements stay about
+# square; a node on each axis, so radial element edges run along
+# theta = 0 and 90 degrees), under the in-situ stress sigma_H = 15 MPa
+# along x and sigma_h = 10 MPa along y (compression positive), held at the
+# outer circle by the matching boundary_stress (and absorbing). The bore
+# starts held by the same traction (in equilibrium at t = 0), which is
+# taken away over 0.3 ms (the bore is drilled); the bore's pressure ramps
+# from 0 to 30 MPa over 1.5 ms, and joints (T = 5 MPa) fill r < 0.35 m.
+# The wall's hoop stress at theta = 0 is 3 sigma_h - sigma_H - p
+# (compression positive), so the wall cracks along x at the breakdown
+# pressure p_b = 3 sigma_h - sigma_H + T = 20 MPa (tests/unit/test_fluid_borehole.c).
+def polar_gmsh(a, R, sectors):
+    """msh 2.2 text of the ring a < r < R: surface group "rock", curve groups
+    "bore" (r = a) and "outer" (r = R)."""
+    growth = 1 + 2 * math.pi / sectors
+    rings = max(1, round(math.log(R / a) / math.log(growth)))
+    radii = [a * (R / a) ** (i / rings) for i in range(rings + 1)]
+    nodes = [(r * math.cos(2 * math.pi * j / sectors), r * math.sin(2 * math.pi * j / sectors))
+             for r in radii for j in range(sectors)]
+    def node(i, j):
+        return i * sectors + j % sectors + 1
+    lines = [(1, node(0, j + 1), node(0, j)) for j in range(sectors)]  # bore, outward normal in
+    lines += [(2, node(rings, j), node(rings, j + 1)) for j in range(sectors)]
+    tris = []
+    for i in range(rings):
+        for j in range(sectors):
+            a0, a1, b0, b1 = node(i, j), node(i, j + 1), node(i + 1, j), node(i + 1, j + 1)
+            # the diagonal alternates in a checkerboard: no preferred direction
+            if (i + j) % 2 == 0:
+                tris += [(a0, a1, b1), (a0, b1, b0)]
+            else:
+                tris += [(a0, a1, b0), (a1, b1, b0)]
+    out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", "3",
+           '1 1 "bore"', '1 2 "outer"', '2 3 "rock"', "$EndPhysicalNames", "$Nodes",
+           str(len(nodes))]
+    out += ["%d %.15g %.15g 0" % (k + 1, x, y) for k, (x, y) in enumerate(nodes)]
+    out += ["$EndNodes", "$Elements", str(len(lines) + len(tris))]
+    k = 0
+    for tag, p, q in lines:
+        k += 1
+        out.append("%d 1 2 %d %d %d %d" % (k, tag, tag, p, q))
+    for t in tris:
+        k += 1
+        out.append("%d 2 2 3 3 %d %d %d" % (k, *t))
+    out += ["$EndElements", ""]
+    return "\n".join(out)
+
+
+bore_a, bore_stress = 0.1, [-15e6, -10e6, 0]
+dump("borehole-breakdown", {
+    "name": "borehole-breakdown",
+    "materials": {"rock": {"density": 2600, "young": 2e10, "poisson": 0.25, "damping": 0.2,
+                           "fracture": {"tensile_strength": 5e6, "cohesion": 3e7,
+                                        "friction_angle": 30, "energy_I": 20,
+                                        "energy_II": 200}}},
+    "parts": [{"name": "rock", "material": "rock",
+               "fracture": {"box": [-0.35, -0.35, 0.35, 0.35]},
+               "initial_stress": {"value": bore_stress},
+               "gmsh": polar_gmsh(bore_a, 10 * bore_a, 64)}],
+    "constraints": [{"part": "rock", "group": "bore", "pressure": 3e7,
+                     "amplitude": [[0, 0], [0.0015, 1]]},
+                    {"part": "rock", "group": "bore", "boundary_stress": {"value": bore_stress},
+                     "amplitude": [[0, 1], [0.0003, 0]]},
+                    {"part": "rock", "group": "outer", "boundary_stress": {"value": bore_stress}},
+                    {"part": "rock", "group": "outer", "absorb": True}],
+    "time": {"end": 0.0015, "dt": "auto", "safety": 0.5},
+    "output": {"interval": 0.0001, "fields": ["position", "stress", "damage"]}})
+
+
+# A hydraulic fracture meeting a natural joint (issue 36 item 6). A 1 x 1 m
+# plane-strain square (20 x 20 cells), its edges fixed, under the in-situ
+# stress sigma_H along x and sigma_h = 1 MPa along y (compression
+# positive); fluid injected at the centre drives a fracture along y = 0
+# (the fracture region's band two elements high) towards a vertical natural
+# joint at x = 0.15 m (a physical curve group with its own weak, frictional
+# fracture parameters, in a band of its own). Renshaw & Pollard (1995): the
+# fracture crosses a frictional interface it meets at right angles when
+# sigma_H / (T0 + sigma_h) > (0.35 + 0.35 / mu) / 1.06, mu = tan(phi) of
+# the joint, T0 the rock's tensile strength; otherwise the joint opens or
+# slips and holds it. The example crosses (sigma_H = 10 MPa, phi = 30
+# degrees: 2.5 against 0.90); the test and examples/README.md run it on
+# the other side too (sigma_H = 2 MPa: 0.5; phi = 5 degrees: 2.5 against 4.1).
+def square_gmsh(half, cells, joint_x):
+    """msh 2.2 text of the square [-half, half]^2 in cells x cells squares
+    of two triangles (diagonals alternating): surface group "rock", curve
+    groups "left", "right", "bottom", "top" and "natural joint" (the
+    vertical line x = joint_x, on the grid)."""
+    n = cells + 1
+    h = 2 * half / cells
+    def node(i, j):
+        return j * n + i + 1
+    nodes = [(-half + i * h, -half + j * h) for j in range(n) for i in range(n)]
+    column = round((joint_x + half) / h)
+    groups = {"left": [(node(0, j), node(0, j + 1)) for j in range(cells)],
+              "right": [(node(cells, j), node(cells, j + 1)) for j in range(cells)],
+              "bottom": [(node(i, 0), node(i + 1, 0)) for i in range(cells)],
+              "top": [(node(i, cells), node(i + 1, cells)) for i in range(cells)],
+              "natural joint": [(node(column, j), node(column, j + 1)) for j in range(cells)]}
+    tris = []
+    for j in range(cells):
+        for i in range(cells):
+            a0, a1, b0, b1 = node(i, j), node(i + 1, j), node(i, j + 1), node(i + 1, j + 1)
+            if (i + j) % 2 == 0:
+                tris += [(a0, a1, b1), (a0, b1, b0)]
+            else:
+                tris += [(a0, a1, b0), (a1, b1, b0)]
+    names = list(groups)
+    out = ["$MeshFormat", "2.2 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names) + 1)]
+    out += ['1 %d "%s"' % (k + 1, g) for k, g in enumerate(names)]
+    out += ['2 %d "rock"' % (len(names) + 1), "$EndPhysicalNames", "$Nodes", str(len(nodes))]
+    out += ["%d %.15g %.15g 0" % (k + 1, x, y) for k, (x, y) in enumerate(nodes)]
+    lines = [(k + 1, p, q) for k, g in enumerate(names) for p, q in groups[g]]
+    out += ["$EndNodes", "$Elements", str(len(lines) + len(tris))]
+    k = 0
+    for tag, p, q in lines:
+        k += 1
+        out.append("%d 1 2 %d %d %d %d" % (k, tag, tag, p, q))
+    for t in tris:
+        k += 1
+        out.append("%d 2 2 %d %d %d %d %d" % (k, len(names) + 1, len(names) + 1, *t))
+    out += ["$EndElements", ""]
+    return "\n".join(out)
+
+
+def hf_natural_joint(sigma_H, friction_angle, half=0.5, cells=20, joint_x=0.15, end=0.008):
+    """The case with sigma_H (Pa) and the joint's friction angle (degrees)
+    (tests/unit/test_hf_natural_joint.c changes those two of the example)."""
+    h = 2 * half / cells
+    stress = [-sigma_H, -1e6, 0]
+    return {
+        "name": "hf-natural-joint",
+        "materials": {"rock": {"density": 2500, "young": 1e10, "poisson": 0.2, "damping": 0.1,
+                               "fracture": {"tensile_strength": 3e6, "cohesion": 6e6,
+                                            "friction_angle": 30, "energy_I": 100,
+                                            "energy_II": 1000, "aperture0": 1e-5}}},
+        "fluid": {"viscosity": 1e-5, "bulk_modulus": 1e8, "density": 0},
+        "parts": [{"name": "rock", "material": "rock",
+                   "fracture": [{"box": [-half, -h, half, h]},
+                                {"box": [joint_x - h, -half, joint_x + h, half]}],
+                   "initial_stress": {"value": stress},
+                   "gmsh": square_gmsh(half, cells, joint_x),
+                   "discontinuities": {"natural joint": {
+                       "tensile_strength": 1e4, "cohesion": 1e4,
+                       "friction_angle": friction_angle, "energy_I": 1, "energy_II": 1}}}],
+        "constraints": [{"part": "rock", "group": side, "fix": ["x", "y"]}
+                        for side in ("left", "right", "bottom", "top")] +
+                       [{"box": [-1e-6, -1e-6, 1e-6, 1e-6], "inject": 8e-3}],
+        "time": {"end": end},
+        "output": {"interval": end / 10, "fields": ["position", "damage"]}}
+
+
+dump("hf-natural-joint", hf_natural_joint(10e6, 30))

@@ -6,7 +6,9 @@
  *
  * Columns: time, step; per point <name>_u<axis> then <name>_v<axis>; per
  * constraint c<k>_f<axis> then c<k>_u<axis> (its force and the mean
- * displacement of its nodes); then every energy account by name.
+ * displacement of its nodes); with fluid, per "inject" constraint
+ * c<k>_source_pressure then c<k>_injected_volume; then every energy
+ * account by name.
  */
 #include "fdemctl.h"
 
@@ -20,9 +22,10 @@ static const char USAGE_HISTORY[] =
     "usage: fdemctl history ID [--since T] [--csv FILE] [--json]\n"
     "  The history rows of the case as CSV: time, step, each monitoring point's\n"
     "  displacement and velocity, each constraint's force and mean displacement,\n"
-    "  every energy account. --csv FILE writes them to FILE instead of stdout;\n"
-    "  --since T only the rows after time T (seconds); --json prints the\n"
-    "  server's JSON instead.\n";
+    "  each injection's source pressure and injected volume, every energy\n"
+    "  account. --csv FILE writes them to FILE instead of stdout; --since T\n"
+    "  only the rows after time T (seconds); --json prints the server's JSON\n"
+    "  instead.\n";
 
 static const char AXES[] = "xyz";
 
@@ -54,6 +57,31 @@ static void row_vectors(FILE *out, const json_t *list)
     }
 }
 
+/* The constraints that inject (their figures not null in the first row's
+ * "fluid"): a mark per constraint in `injects` (at most `room`). */
+static void injections(const json_t *first, char *injects, size_t room)
+{
+    const json_t *p = json_object_get(json_object_get(first, "fluid"), "source_pressure");
+    for (size_t k = 0; k < room; k++) injects[k] = json_is_number(json_array_get(p, k));
+}
+
+static void header_fluid(FILE *out, const char *injects, size_t constraints)
+{
+    for (size_t k = 0; k < constraints; k++)
+        if (injects[k]) fprintf(out, ",c%zu_source_pressure,c%zu_injected_volume", k, k);
+}
+
+static void row_fluid(FILE *out, const json_t *row, const char *injects, size_t constraints)
+{
+    const json_t *fluid = json_object_get(row, "fluid");
+    const json_t *p = json_object_get(fluid, "source_pressure");
+    const json_t *v = json_object_get(fluid, "injected_volume");
+    for (size_t k = 0; k < constraints; k++)
+        if (injects[k])
+            fprintf(out, ",%.17g,%.17g", json_number_value(json_array_get(p, k)),
+                    json_number_value(json_array_get(v, k)));
+}
+
 static void write_csv(FILE *out, const json_t *body)
 {
     const json_t *rows = json_object_get(body, "rows"), *names = json_object_get(body, "names");
@@ -67,6 +95,9 @@ static void write_csv(FILE *out, const json_t *body)
     header_vectors(out, "p", points, names, "v", dim);
     header_vectors(out, "c", constraints, NULL, "f", dim);
     header_vectors(out, "c", constraints, NULL, "u", dim);
+    char *injects = calloc(constraints ? constraints : 1, 1);
+    if (injects) injections(first, injects, constraints);
+    if (injects) header_fluid(out, injects, constraints);
     const char *term;
     const json_t *value;
     json_object_foreach((json_t *)energy, term, value) fprintf(out, ",%s", term);
@@ -80,10 +111,12 @@ static void write_csv(FILE *out, const json_t *body)
         row_vectors(out, json_object_get(p, "velocity"));
         row_vectors(out, json_object_get(row, "constraint_force"));
         row_vectors(out, json_object_get(row, "constraint_displacement"));
+        if (injects) row_fluid(out, row, injects, constraints);
         json_object_foreach((json_t *)energy, term, value)
             fprintf(out, ",%.17g", json_number_value(json_object_get(e, term)));
         fputc('\n', out);
     }
+    free(injects);
 }
 
 int cmd_history(const ctl_options *o, int argc, char **argv)

@@ -405,8 +405,9 @@ class Client:
         """Columns of a history() answer: {"time" (H), "step" (H),
         "point_displacement" and "point_velocity" (H, P, dim),
         "constraint_force" and "constraint_displacement" (H, C, dim),
-        "energy": {account: (H)}, "names"}: numpy arrays where numpy
-        exists, else nested lists."""
+        "energy": {account: (H)}, "names"}, and with fluid "source_pressure"
+        and "injected_volume" (H, C; None/NaN for a constraint that does
+        not inject): numpy arrays where numpy exists, else nested lists."""
         rows = history["rows"]
         columns = {
             "names": list(history.get("names", [])),
@@ -419,12 +420,15 @@ class Client:
             "energy": {k: [r["energy"][k] for r in rows]
                        for k in (rows[0]["energy"] if rows else {})},
         }
+        fluid = [k for k in ("source_pressure", "injected_volume") if rows and "fluid" in rows[0]]
+        for key in fluid:
+            columns[key] = [r["fluid"][key] for r in rows]
         try:
             import numpy as np
         except ImportError:
             return columns
         for key in ("time", "step", "point_displacement", "point_velocity",
-                    "constraint_force", "constraint_displacement"):
+                    "constraint_force", "constraint_displacement") + tuple(fluid):
             columns[key] = np.asarray(columns[key], dtype=float if key != "step" else int)
         columns["energy"] = {k: np.asarray(v, dtype=float) for k, v in columns["energy"].items()}
         return columns

@@ -97,7 +97,8 @@ typedef struct checkpoint_header {
      * Version 8: the same header; a model with stages has its stage
      * section (step/stages.c) after the slip. Version 9: the same header;
      * a model with fluid has its fluid section (fluid/fluid_checkpoint.c)
-     * between the slip and the stages. */
+     * between the slip and the stages. Version 10: the same header; the
+     * fluid section adds each constraint's injected volume. */
     double time_carry;
 } checkpoint_header;
 
@@ -132,8 +133,8 @@ size_t fdem_checkpoint_size(const fdem_model *m)
     return sizeof(checkpoint_header) +
            checkpoint_body_size(m, checkpoint_has_detection(m), m->elem_viscous != NULL,
                                 contact_history_checkpoint_size(&m->contact)) +
-           events_checkpoint_size(m) + checkpoint_slip_size(m) + fluid_checkpoint_size(m) +
-           stages_checkpoint_size(m);
+           events_checkpoint_size(m) + checkpoint_slip_size(m) +
+           fluid_checkpoint_size(m, CHECKPOINT_VERSION) + stages_checkpoint_size(m);
 }
 
 int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
@@ -187,7 +188,7 @@ int fdem_checkpoint_write(const fdem_model *m, void *buf, size_t size)
     if (m->joint_count) memcpy(p, m->joint_slip, checkpoint_slip_size(m));
     p += m->joint_count ? checkpoint_slip_size(m) : 0;
     fluid_checkpoint_write(m, p);
-    p += fluid_checkpoint_size(m);
+    p += fluid_checkpoint_size(m, CHECKPOINT_VERSION);
     stages_checkpoint_write(m, p);
     return 0;
 }
@@ -286,7 +287,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
             expected += sizeof(double) * (size_t)m->joint_count +
                         sizeof(fdem_event) * (size_t)h.pending_events;
         if (h1.version >= 7) expected += checkpoint_slip_size(m);
-        if (h1.version >= 9) expected += fluid_checkpoint_size(m);
+        if (h1.version >= 9) expected += fluid_checkpoint_size(m, h1.version);
     }
     /* the stage section's size depends on its ramps: it is checked as it
      * is read, and takes what follows the fixed part */
@@ -324,7 +325,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     }
     const unsigned char *fluid = events + events_checkpoint_size(m) +
                                  (m->joint_count ? checkpoint_slip_size(m) : 0);
-    size_t fluid_bytes = h1.version >= 9 ? fluid_checkpoint_size(m) : 0;
+    size_t fluid_bytes = h1.version >= 9 ? fluid_checkpoint_size(m, h1.version) : 0;
     /* the stages before the counts below: they leave excavated joints out */
     size_t stage_used = 0;
     if (stage_bytes &&
@@ -378,7 +379,7 @@ int fdem_checkpoint_read(fdem_model *m, const void *buf, size_t size, fdem_error
     }
     m->contact.max_disp2 = h.max_disp2;
     /* after the positions: pressures and apertures follow from them */
-    if (fluid_bytes) fluid_checkpoint_read(m, fluid);
+    if (fluid_bytes) fluid_checkpoint_read(m, fluid, h1.version);
     if (h1.version == 1) { /* no accounts stored: those of the restored positions */
         element_forces(m);
         memset(m->force, 0, nb);

@@ -83,6 +83,7 @@ typedef struct fluid_net {
     int source_count;
     int32_t *source_joint, *source_constraint;
     double *source_share; /* 1 / the number of joints the constraint touches */
+    double *constraint_injected; /* per constraint: the volume it injected since t = 0 (history) */
     /* accounts */
     double injected;      /* volume injected since t = 0 */
     double work_booked;   /* the fluid's work on the solid up to the start of the last step */
@@ -112,10 +113,12 @@ void fluid_forces_at_rest(fdem_model *m);
 double fluid_work_reported(const fdem_model *m);
 double fluid_work_completed(const fdem_model *m);
 
-/* fluid_checkpoint.c: the fluid section of a checkpoint (version 9) */
-size_t fluid_checkpoint_size(const fdem_model *m);
+/* fluid_checkpoint.c: the fluid section of a checkpoint (version 9 on;
+ * version 10 adds each constraint's injected volume), as written by a
+ * file of `version` */
+size_t fluid_checkpoint_size(const fdem_model *m, unsigned version);
 void fluid_checkpoint_write(const fdem_model *m, unsigned char *p);
-void fluid_checkpoint_read(fdem_model *m, const unsigned char *p);
+void fluid_checkpoint_read(fdem_model *m, const unsigned char *p, unsigned version);
 
 /* fluid_face_2d.c, fluid_face_3d.c: the dimension's kernel */
 void fluid_face_2d(const fdem_model *m, int j, fluid_face *out);

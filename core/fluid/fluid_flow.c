@@ -153,6 +153,7 @@ static void flow_subcycle(fdem_model *m, fluid_net *f, double dt, int gravity)
         double v = c->value_now[0] * f->source_share[s] * dt;
         f->inflow[f->source_joint[s]] += v;
         f->injected += v;
+        f->constraint_injected[f->source_constraint[s]] += v;
     }
     for (int a = 0; a < f->active_count; a++) {
         const int l = f->active[a];
@@ -214,6 +215,8 @@ double fluid_work_reported(const fdem_model *m)
 
 /* ----------------------------------------------------------- the API */
 
+int fdem_has_fluid(const fdem_model *m) { return m->fluid != NULL; }
+
 fdem_fluid_status fdem_get_fluid(const fdem_model *m)
 {
     fdem_fluid_status s = {0};
@@ -231,6 +234,28 @@ fdem_fluid_status fdem_get_fluid(const fdem_model *m)
                                                         : f->subcycles;
     s.open_joints = f->open_count;
     return s;
+}
+
+void fdem_fluid_sources(const fdem_model *m, double *pressure, double *injected)
+{
+    const fluid_net *f = m->fluid;
+    if (!f) return;
+    for (int k = 0; k < m->constraint_count; k++) {
+        int inject = m->constraints[k].def.kind == FDEM_CONSTRAINT_INJECT;
+        pressure[k] = inject ? 0 : NAN;
+        injected[k] = inject ? f->constraint_injected[k] : NAN;
+    }
+    /* the mean over each constraint's joints (fdem_get_fluid's, one
+     * constraint at a time): sources are listed constraint by constraint */
+    for (int s = 0, count = 0; s < f->source_count; s++) {
+        const int k = f->source_constraint[s];
+        pressure[k] += f->pressure[f->source_joint[s]];
+        count++;
+        if (s + 1 == f->source_count || f->source_constraint[s + 1] != k) {
+            pressure[k] /= count;
+            count = 0;
+        }
+    }
 }
 
 const double *fdem_fluid_pressure(const fdem_model *m)

@@ -52,6 +52,7 @@ void fluid_free(fdem_model *m)
     free(f->outgoing); free(f->wet); free(f->open); free(f->links);
     free(f->link_begin); free(f->link_of); free(f->open_list); free(f->active);
     free(f->source_joint); free(f->source_constraint); free(f->source_share);
+    free(f->constraint_injected);
     free(f);
     m->fluid = NULL;
 }
@@ -63,7 +64,8 @@ size_t fluid_memory_bytes(const fdem_model *m)
     size_t D = (size_t)m->dim, J = (size_t)f->joints;
     return sizeof *f + J * ((7 + 2 * D) * sizeof(double) + 2 + 2 * sizeof(int32_t)) +
            (size_t)f->link_count * (sizeof(fluid_link) + sizeof(double) + 3 * sizeof(int32_t)) +
-           (size_t)f->source_count * (2 * sizeof(int32_t) + sizeof(double));
+           (size_t)f->source_count * (2 * sizeof(int32_t) + sizeof(double)) +
+           (size_t)m->constraint_count * sizeof(double);
 }
 
 /* Links per joint in the densest meshes measured: a 2D vertex joins about
@@ -185,7 +187,10 @@ static int sources_build(fdem_model *m, fluid_net *f, fdem_error *err)
     f->source_joint = malloc(sizeof(int32_t) * (room ? room : 1));
     f->source_constraint = malloc(sizeof(int32_t) * (room ? room : 1));
     f->source_share = malloc(sizeof(double) * (room ? room : 1));
-    if (!selected || !f->source_joint || !f->source_constraint || !f->source_share) {
+    f->constraint_injected = calloc((size_t)(m->constraint_count ? m->constraint_count : 1),
+                                    sizeof(double));
+    if (!selected || !f->source_joint || !f->source_constraint || !f->source_share ||
+        !f->constraint_injected) {
         free(selected);
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the fluid network");
         return -1;

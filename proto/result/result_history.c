@@ -4,7 +4,11 @@
  * /history/points/velocity (H, P, dimension) with the point names in the
  * attribute `names` of /history/points, /history/constraint_force and
  * /history/constraint_displacement (H, C, dimension), and
- * /history/energy/<term> (H) for every energy account.
+ * /history/energy/<term> (H) for every energy account; with fluid
+ * (contract 6.4) also /history/fluid/source_pressure and
+ * /history/fluid/injected_volume (H, C) (NaN for a constraint that does
+ * not inject) and energy/fluid_work, energy/fluid_dissipation (H). A file
+ * written before the fluid's series keeps on without them.
  *
  * The discipline is /snapshots' and /events' (result_h5.c,
  * result_events.c): the datasets are made with the file, before SWMR
@@ -32,23 +36,33 @@ const char *const history_series_names[HISTORY_SERIES] = {
     "constraint_displacement", "energy/kinetic", "energy/elastic", "energy/joint",
     "energy/contact", "energy/friction", "energy/fracture", "energy/damping",
     "energy/gravity_work", "energy/external_work", "energy/excavated", "energy/residual",
-    "time",
+    "fluid/source_pressure", "fluid/injected_volume", "energy/fluid_work",
+    "energy/fluid_dissipation", "time",
 };
 
 #define HISTORY_CHUNK_ROWS 256
 
 static int hist_is_points(int k) { return k == HIST_POINT_DISPLACEMENT || k == HIST_POINT_VELOCITY; }
-static int hist_is_constraints(int k)
+static int hist_is_vectors(int k)
 {
-    return k == HIST_CONSTRAINT_FORCE || k == HIST_CONSTRAINT_DISPLACEMENT;
+    return hist_is_points(k) || k == HIST_CONSTRAINT_FORCE || k == HIST_CONSTRAINT_DISPLACEMENT;
 }
-static int hist_rank(int k) { return hist_is_points(k) || hist_is_constraints(k) ? 3 : 1; }
+static int hist_is_fluid(int k) { return k >= HIST_FLUID_PRESSURE && k < HIST_TIME; }
+/* (H, C) per constraint: the fluid's source pressure and injected volume */
+static int hist_is_per_constraint(int k)
+{
+    return k == HIST_FLUID_PRESSURE || k == HIST_FLUID_INJECTED;
+}
+static int hist_rank(int k) { return hist_is_vectors(k) ? 3 : hist_is_per_constraint(k) ? 2 : 1; }
 
 /* The items per row of series k (points or constraints) in file f. */
 static hsize_t hist_items(const result_file *f, int k)
 {
     return hist_is_points(k) ? (hsize_t)f->history_points : (hsize_t)f->history_constraints;
 }
+
+/* Series k is in file f (the fluid's only with fluid). */
+static int hist_present(const result_file *f, int k) { return f->history[k] >= 0; }
 
 static int hist_create_one(result_file *f, hid_t group, int k)
 {
@@ -100,6 +114,7 @@ int history_create(result_file *f, const fdem_model *model, const case_info *inf
     f->history_dimension = fdem_get_dimension(model);
     f->history_points = info->history_point_count;
     f->history_constraints = fdem_get_counts(model).constraints;
+    f->history_fluid = fdem_has_fluid(model);
     f->history_last_time = -INFINITY;
     hid_t group = H5Gcreate2(f->file, "history", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (group < 0) {
@@ -108,7 +123,8 @@ int history_create(result_file *f, const fdem_model *model, const case_info *inf
     }
     int rc = 0;
     for (int k = 0; k < HISTORY_SERIES && rc == 0; k++)
-        if (hist_create_one(f, group, k) < 0) {
+        if (hist_is_fluid(k) && !f->history_fluid) f->history[k] = H5I_INVALID_HID;
+        else if (hist_create_one(f, group, k) < 0) {
             result_fail(err, errlen, "cannot create /history/%s", history_series_names[k]);
             rc = -1;
         }
@@ -132,6 +148,7 @@ static hsize_t hist_length(hid_t id)
 
 static int hist_set_length(const result_file *f, int k, hsize_t length)
 {
+    if (!hist_present(f, k)) return 0;
     hsize_t dims[3] = {length, hist_items(f, k), (hsize_t)f->history_dimension};
     return H5Dset_extent(f->history[k], dims) < 0 ? -1 : 0;
 }
@@ -141,7 +158,7 @@ static int hist_rows(const result_file *f, int k, hsize_t start, hsize_t count, 
                      int write)
 {
     hsize_t n = hist_items(f, k), D = (hsize_t)f->history_dimension;
-    if (count == 0 || (hist_rank(k) == 3 && n == 0)) return 0;
+    if (count == 0 || !hist_present(f, k) || (hist_rank(k) > 1 && n == 0)) return 0;
     hsize_t offset[3] = {start, 0, 0}, extent[3] = {count, n, D};
     hid_t id = f->history[k];
     hid_t file_space = H5Dget_space(id), mem_space = H5Screate_simple(hist_rank(k), extent, NULL);
@@ -166,7 +183,10 @@ static void *hist_field(history_row *row, int k)
     case HIST_CONSTRAINT_FORCE: return row->constraint_force;
     case HIST_CONSTRAINT_DISPLACEMENT: return row->constraint_displacement;
     case HIST_TIME: return &row->time;
+    case HIST_FLUID_PRESSURE: return row->source_pressure;
+    case HIST_FLUID_INJECTED: return row->injected_volume;
     }
+    if (k >= HIST_FLUID_ENERGY) return &row->fluid_energy[k - HIST_FLUID_ENERGY];
     return &row->energy[k - HIST_ENERGY];
 }
 
@@ -175,7 +195,7 @@ static void *hist_field(history_row *row, int k)
 static int hist_fits(const result_file *f, const history_row *row)
 {
     return row->points == f->history_points && row->constraints == f->history_constraints &&
-           row->dimension == f->history_dimension;
+           row->dimension == f->history_dimension && (row->fluid || !f->history_fluid);
 }
 
 int result_append_history(result_file *f, history_row *const *rows, int count, char *err,
@@ -225,14 +245,24 @@ static int hist_open(result_file *f, hid_t file)
 {
     hid_t group = H5Gopen2(file, "history", H5P_DEFAULT);
     if (group < 0) return -1;
-    int rc = 0;
+    int rc = 0, fluid = 0;
     for (int k = 0; k < HISTORY_SERIES; k++) {
-        f->history[k] = H5Lexists(group, history_series_names[k], H5P_DEFAULT) > 0
-                            ? H5Dopen2(group, history_series_names[k], H5P_DEFAULT)
-                            : H5I_INVALID_HID;
-        if (f->history[k] < 0) rc = -1;
+        /* H5Lexists on "fluid/..." needs the group "fluid" to exist */
+        int exists = (!hist_is_per_constraint(k) || H5Lexists(group, "fluid", H5P_DEFAULT) > 0) &&
+                     H5Lexists(group, history_series_names[k], H5P_DEFAULT) > 0;
+        f->history[k] = exists ? H5Dopen2(group, history_series_names[k], H5P_DEFAULT)
+                               : H5I_INVALID_HID;
+        if (f->history[k] >= 0) fluid += hist_is_fluid(k);
+        else if (!hist_is_fluid(k)) rc = -1; /* the fluid's: only in a file with fluid */
     }
     H5Gclose(group);
+    /* all of the fluid's series or none of them */
+    f->history_fluid = fluid == HIST_TIME - HIST_FLUID_PRESSURE;
+    for (int k = HIST_FLUID_PRESSURE; !f->history_fluid && k < HIST_TIME; k++)
+        if (f->history[k] >= 0) {
+            H5Dclose(f->history[k]);
+            f->history[k] = H5I_INVALID_HID;
+        }
     if (rc < 0) return -1;
     hsize_t dims[3] = {0, 0, 0};
     hid_t space = H5Dget_space(f->history[HIST_POINT_DISPLACEMENT]);
@@ -246,7 +276,8 @@ static int hist_open(result_file *f, hid_t file)
     f->history_constraints = (int)dims[1];
     hsize_t committed = hist_length(f->history[HIST_TIME]);
     for (int k = 0; k < HISTORY_SERIES; k++)
-        if (hist_length(f->history[k]) < committed) committed = hist_length(f->history[k]);
+        if (hist_present(f, k) && hist_length(f->history[k]) < committed)
+            committed = hist_length(f->history[k]);
     f->history_count = committed;
     return 0;
 }
@@ -341,7 +372,8 @@ static int hist_read(result_file *f, double since, history_row ***out, int *coun
     history_row **rows = calloc(m ? (size_t)m : 1, sizeof *rows);
     int rc = rows ? 0 : -1;
     for (int i = 0; rc == 0 && i < m; i++) {
-        rows[i] = history_alloc(f->history_dimension, f->history_points, f->history_constraints);
+        rows[i] = history_alloc(f->history_dimension, f->history_points, f->history_constraints,
+                                f->history_fluid);
         if (!rows[i]) rc = -1;
         for (int k = 0; rc == 0 && k < HISTORY_SERIES; k++)
             if (hist_rows(f, k, first + (hsize_t)i, 1, hist_field(rows[i], k), 0) < 0) rc = -1;

@@ -59,10 +59,14 @@ enum event_series_kind { EVENT_JOINT, EVENT_POSITION, EVENT_MODE, EVENT_ENERGY, 
 extern const char *const event_series_names[EVENT_SERIES];
 
 /* The /history datasets in append order: time, the commit marker, last
- * (result_history.c); the energy terms in history_energy_names order. */
+ * (result_history.c); the energy terms in history_energy_names order; the
+ * fluid's series (from HIST_FLUID_PRESSURE to time) only with fluid. */
 enum history_series_kind { HIST_STEP, HIST_POINT_DISPLACEMENT, HIST_POINT_VELOCITY,
                            HIST_CONSTRAINT_FORCE, HIST_CONSTRAINT_DISPLACEMENT, HIST_ENERGY,
-                           HIST_TIME = HIST_ENERGY + HISTORY_ENERGY_TERMS, HISTORY_SERIES };
+                           HIST_FLUID_PRESSURE = HIST_ENERGY + HISTORY_ENERGY_TERMS,
+                           HIST_FLUID_INJECTED, HIST_FLUID_ENERGY,
+                           HIST_TIME = HIST_FLUID_ENERGY + HISTORY_FLUID_ENERGY_TERMS,
+                           HISTORY_SERIES };
 extern const char *const history_series_names[HISTORY_SERIES];
 
 struct result_file {
@@ -78,6 +82,7 @@ struct result_file {
     hid_t history[HISTORY_SERIES];
     hsize_t history_count; /* complete rows (= len(/history/time)) */
     int history_dimension, history_points, history_constraints;
+    int history_fluid;    /* the fluid's series are in the file */
     double history_last_time; /* of the last committed row, -inf before any */
 };
 

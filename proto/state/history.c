@@ -18,6 +18,10 @@ const char *const history_energy_names[HISTORY_ENERGY_TERMS] = {
     "damping", "gravity_work", "external_work", "excavated", "residual",
 };
 
+const char *const history_fluid_energy_names[HISTORY_FLUID_ENERGY_TERMS] = {
+    "fluid_work", "fluid_dissipation",
+};
+
 static void energy_terms(const fdem_energy *e, double *out)
 {
     const double terms[HISTORY_ENERGY_TERMS] = {
@@ -27,11 +31,11 @@ static void energy_terms(const fdem_energy *e, double *out)
     memcpy(out, terms, sizeof terms);
 }
 
-history_row *history_alloc(int dimension, int points, int constraints)
+history_row *history_alloc(int dimension, int points, int constraints, int fluid)
 {
     size_t D = (size_t)dimension, P = (size_t)(points > 0 ? points : 0);
     size_t C = (size_t)(constraints > 0 ? constraints : 0);
-    size_t doubles = 2 * D * P + 2 * D * C;
+    size_t doubles = 2 * D * P + 2 * D * C + (fluid ? 2 * C : 0);
     history_row *row = calloc(1, sizeof *row + doubles * sizeof(double));
     if (!row) return NULL;
     double *at = (double *)(row + 1);
@@ -42,6 +46,11 @@ history_row *history_alloc(int dimension, int points, int constraints)
     row->point_velocity = at + D * P;
     row->constraint_force = at + 2 * D * P;
     row->constraint_displacement = at + 2 * D * P + D * C;
+    row->fluid = fluid != 0;
+    if (fluid) {
+        row->source_pressure = at + 2 * D * P + 2 * D * C;
+        row->injected_volume = row->source_pressure + C;
+    }
     return row;
 }
 
@@ -51,7 +60,8 @@ history_row *history_take(const fdem_model *model, const int32_t *point_nodes, i
 {
     int D = fdem_get_dimension(model);
     int C = fdem_get_counts(model).constraints;
-    history_row *row = history_alloc(D, points, C);
+    int fluid = fdem_has_fluid(model); /* O(1): fdem_get_fluid sums every joint */
+    history_row *row = history_alloc(D, points, C, fluid);
     if (!row) return NULL;
     row->step = fdem_get_step(model);
     row->time = fdem_get_time(model);
@@ -77,6 +87,11 @@ history_row *history_take(const fdem_model *model, const int32_t *point_nodes, i
     }
     fdem_energy e = fdem_get_energy(model);
     energy_terms(&e, row->energy);
+    if (fluid) {
+        fdem_fluid_sources(model, row->source_pressure, row->injected_volume);
+        row->fluid_energy[0] = e.fluid_work;
+        row->fluid_energy[1] = e.fluid_dissipation;
+    }
     return row;
 }
 
@@ -96,12 +111,22 @@ static json_t *vectors(const double *a, int count, int dimension)
     return list;
 }
 
+/* [x, ...] of `count` scalars, null where not finite */
+static json_t *scalars(const double *a, int count)
+{
+    json_t *list = json_array();
+    for (int i = 0; list && i < count; i++) json_array_append_new(list, number(a[i]));
+    return list;
+}
+
 static json_t *row_json(const history_row *r)
 {
     json_t *energy = json_object();
     for (int k = 0; energy && k < HISTORY_ENERGY_TERMS; k++)
         json_object_set_new(energy, history_energy_names[k], number(r->energy[k]));
-    return json_pack("{s:o, s:I, s:{s:o, s:o}, s:o, s:o, s:o}", "time", number(r->time),
+    for (int k = 0; energy && r->fluid && k < HISTORY_FLUID_ENERGY_TERMS; k++)
+        json_object_set_new(energy, history_fluid_energy_names[k], number(r->fluid_energy[k]));
+    json_t *o = json_pack("{s:o, s:I, s:{s:o, s:o}, s:o, s:o, s:o}", "time", number(r->time),
                      "step", (json_int_t)r->step, "points", "displacement",
                      vectors(r->point_displacement, r->points, r->dimension), "velocity",
                      vectors(r->point_velocity, r->points, r->dimension), "constraint_force",
@@ -109,6 +134,13 @@ static json_t *row_json(const history_row *r)
                      "constraint_displacement",
                      vectors(r->constraint_displacement, r->constraints, r->dimension),
                      "energy", energy);
+    if (o && r->fluid)
+        json_object_set_new(o, "fluid",
+                            json_pack("{s:o, s:o}", "source_pressure",
+                                      scalars(r->source_pressure, r->constraints),
+                                      "injected_volume",
+                                      scalars(r->injected_volume, r->constraints)));
+    return o;
 }
 
 json_t *history_rows_json(history_row *const *rows, int count, const history_names *names)

@@ -167,6 +167,33 @@ static json_t *case_fluid_json(const fdem_fluid_status *f)
     return o;
 }
 
+/* Read back by case_load_figures: a case loaded from status.json shows its
+ * fluid (and writes it again) without a model. */
+void case_fluid_from_json(case_figures *f, const json_t *fluid, const json_t *energy)
+{
+    memset(&f->fluid, 0, sizeof f->fluid);
+    if (!json_is_object(fluid)) return;
+    static const struct { const char *key; size_t offset; } figures[] = {
+        {"injected_volume", offsetof(fdem_fluid_status, injected_volume)},
+        {"stored_volume", offsetof(fdem_fluid_status, stored_volume)},
+        {"source_pressure", offsetof(fdem_fluid_status, source_pressure)},
+        {"fluid_step", offsetof(fdem_fluid_status, flow_step)},
+    };
+    f->fluid.enabled = 1;
+    for (size_t i = 0; i < sizeof figures / sizeof figures[0]; i++) {
+        const json_t *v = json_object_get(fluid, figures[i].key);
+        *(double *)((char *)&f->fluid + figures[i].offset) =
+            json_is_number(v) ? json_number_value(v) : NAN;
+    }
+    f->fluid.subcycles = (int)json_integer_value(json_object_get(fluid, "fluid_subcycles"));
+    f->fluid.open_joints = (int)json_integer_value(json_object_get(fluid, "open_joints"));
+    const json_t *work = json_object_get(energy, "fluid_work");
+    const json_t *dissipation = json_object_get(energy, "fluid_dissipation");
+    f->energy.fluid_work = json_is_number(work) ? json_number_value(work) : NAN;
+    f->energy.fluid_dissipation =
+        json_is_number(dissipation) ? json_number_value(dissipation) : NAN;
+}
+
 json_t *case_status_json(server_case *c)
 {
     pthread_mutex_lock(&c->lock);

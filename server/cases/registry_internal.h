@@ -27,6 +27,9 @@ void case_publish_from_model(server_case *c);
 void case_stage_from_json(case_figures *f, const json_t *stage);
 /* The status' energy object back into an fdem_energy (missing: NaN). */
 void case_energy_from_json(fdem_energy *energy, const json_t *o);
+/* The status' "fluid" object (null: no fluid) back into f->fluid, and
+ * energy's fluid_work and fluid_dissipation into f->energy. */
+void case_fluid_from_json(case_figures *f, const json_t *fluid, const json_t *energy);
 
 /* case_warnings.c: the case's "warnings" (contract 6.2), each kept once
  * (pointer and message), at most 100; a JSON copy for the status; read

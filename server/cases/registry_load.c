@@ -65,6 +65,7 @@ static void case_load_figures(server_case *c, const json_t *st)
         *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
     case_energy_from_json(&f->energy, json_object_get(st, "energy"));
     case_stage_from_json(f, json_object_get(st, "stage"));
+    case_fluid_from_json(f, json_object_get(st, "fluid"), json_object_get(st, "energy"));
     f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
     f->time = status_number(st, "time");
     f->dt = status_number(st, "dt");

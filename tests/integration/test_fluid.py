@@ -6,13 +6,16 @@ t = 0) and a source pressure; energy gains fluid_work and
 fluid_dissipation and the residual stays below 1 % of the fluid's work;
 result.h5 has /snapshots/fluid_pressure and /snapshots/aperture (S, J),
 result.xdmf shows them on the joints block, fdemctl status prints a
-`fluid` line; bad input is one 422 with a
+`fluid` line; the history series (GET /cases/ID/history, /history/fluid/*
+and energy/fluid_* in result.h5, fdemctl history's CSV) carry each
+injection's source pressure and injected volume; status.json keeps the
+fluid across a restart of the daemon; bad input is one 422 with a
 problem at each pointer. Waits for states, never for wall time."""
 import json
 import os
 import unittest
 
-from fdemd_harness import DaemonTestCase
+from fdemd_harness import Daemon, DaemonTestCase
 
 
 def fluid_case(dimension=2, end=1.5e-3, inject=2e-3):
@@ -85,6 +88,69 @@ class FluidTest(DaemonTestCase):
         self.assertEqual(status, 200)
         self.assertIn(b'Name="fluid_pressure"', xdmf)
         self.assertIn(b'Name="aperture"', xdmf)
+        self.check_history(st, path)
+
+    def check_history(self, st, path):
+        """The injection's source pressure and injected volume as history
+        series: the last row (taken with the last snapshot, at the end) holds
+        the status' figures; a constraint that does not inject has none."""
+        status, body = self.d.json("GET", "/cases/%s/history" % st["id"])
+        self.assertEqual(status, 200, body)
+        rows = body["rows"]
+        self.assertGreater(len(rows), 2)
+        last = rows[-1]
+        self.assertEqual(last["fluid"]["injected_volume"], [st["fluid"]["injected_volume"]])
+        self.assertEqual(last["fluid"]["source_pressure"], [st["fluid"]["source_pressure"]])
+        self.assertEqual(last["energy"]["fluid_work"], st["energy"]["fluid_work"])
+        self.assertEqual(rows[0]["fluid"]["injected_volume"], [0])
+        import h5py
+        with h5py.File(path, "r") as f:
+            h = f["/history"]
+            n = len(h["time"])
+            self.assertEqual(n, len(rows))
+            volume = h["fluid/injected_volume"][:, 0]
+            self.assertEqual(h["fluid/source_pressure"].shape, (n, 1))
+            self.assertTrue((volume[1:] >= volume[:-1]).all())
+            self.assertEqual(volume[-1], st["fluid"]["injected_volume"])
+            self.assertEqual(h["energy/fluid_dissipation"][-1], st["energy"]["fluid_dissipation"])
+        csv = self.d.fdemctl("history", st["id"])
+        self.assertEqual(csv.returncode, 0, csv.stderr)
+        lines = csv.stdout.splitlines()
+        header = lines[0].split(",")
+        for column in ("c0_source_pressure", "c0_injected_volume", "fluid_work",
+                       "fluid_dissipation"):
+            self.assertIn(column, header)
+        values = dict(zip(header, lines[-1].split(",")))
+        self.assertEqual(float(values["c0_injected_volume"]), st["fluid"]["injected_volume"])
+
+    def test_fluid_status_survives_a_restart(self):
+        """status.json keeps the fluid figures: a daemon started again on the
+        same directory shows the finished case's "fluid" and fluid energies
+        (they were dropped before: the status then said "fluid": null)."""
+        first = Daemon().start()
+        again = None
+        try:
+            case = fluid_case(2, end=2e-4)
+            st = first.create(case, start=True)
+            st = first.wait_state(st["id"], ("finished", "failed", "stopped"), timeout=60)
+            self.assertEqual(st["state"], "finished", st.get("error"))
+            rows = first.json("GET", "/cases/%s/history" % st["id"])[1]["rows"]
+            code, _ = first.stop()
+            self.assertEqual(code, 0)
+            again = Daemon(data_dir=first.data_dir).start()
+            shown = again.status(st["id"])
+            self.assertEqual(shown["fluid"], st["fluid"])
+            for term in ("fluid_work", "fluid_dissipation"):
+                self.assertEqual(shown["energy"][term], st["energy"][term])
+            # the history's fluid series read back from the file on disk
+            self.assertEqual(again.json("GET", "/cases/%s/history" % st["id"])[1]["rows"], rows)
+            self.assertIn("fluid", rows[-1])
+            code, _ = again.stop()
+            self.assertEqual(code, 0)
+        finally:
+            if again:
+                again.close()
+            first.close()
 
     def test_fluid_2d(self):
         self.check_case(2)

@@ -216,10 +216,10 @@ class StoredFilesTest(unittest.TestCase):
         good = open(path, "rb").read()
         # what that daemon wrote: checkpoint version 5, whose header ends
         # before version 6's time_carry (a double at byte 240), no trailer
-        # (versions 7, 8 and 9 only add sections at the end, the joints'
+        # (versions 7, 8, 9 and 10 only add sections at the end, the joints'
         # slip, the stages and the fluid: this case has none of them)
         body = good[:-8]
-        self.assertEqual(int.from_bytes(body[4:8], "little"), 9)
+        self.assertEqual(int.from_bytes(body[4:8], "little"), 10)
         with open(path, "wb") as f:
             f.write(body[:4] + (5).to_bytes(4, "little") + body[8:240] + body[248:])
         self.assert_back_as_paused(cid, paused)
