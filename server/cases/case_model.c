@@ -18,9 +18,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "io_thread.h"
-#include "store/persist.h"
+#include "files/persist.h"
 
 #define CASE_MODEL_MAX_CHECKPOINT ((size_t)1 << 40)
 

@@ -18,31 +18,18 @@
 #include "case_model.h"
 #include "sizing_probe.h"
 #include "state/snapshot.h"
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "common/clock.h"
 
-
-int sizing_is_last_step(double t0, double dt, double end)
-{
-    return t0 + dt >= end - 1e-9 * dt; /* no sliver of a step left over */
-}
 
 double sizing_steps_to_end(double t0, double end, double dt)
 {
     if (!(dt > 0) || !(end > t0))
         return 0;
     /* Step k (from 0) starts at t0 + k dt and is the last one when
-     * sizing_is_last_step() holds: the first k >= (end - 1e-9 dt - t0)/dt - 1. */
+     * output_is_last_step() (proto/state/output_grid.h) holds: the first k >= (end - 1e-9 dt - t0)/dt - 1. */
     double k = ceil((end - 1e-9 * dt - t0) / dt - 1.0);
     return (k > 0 ? k : 0) + 1;
-}
-
-double sizing_output_interval(const case_info *info)
-{
-    double interval = info->output_interval;
-    if (!(interval > 0))
-        interval = info->end_time / 100.0;
-    return interval > 0 ? interval : 1.0;
 }
 
 /* Snapshot 0, one at the first step at or after each output time (several
@@ -52,7 +39,7 @@ double sizing_output_interval(const case_info *info)
  * the worker's tolerance of 1e-9 dt. */
 static double sizing_snapshots(const case_info *info, double t0, double dt, double steps)
 {
-    double interval = sizing_output_interval(info);
+    double interval = output_snapshot_interval(info);
     double last_start = t0 + (steps - 1) * dt + 1e-9 * dt;
     double done_before = floor(t0 / interval * (1 + 1e-12) + 1e-9);
     double inside = floor(last_start / interval * (1 + 1e-12)) - done_before;

@@ -22,7 +22,7 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "common/clock.h"
 
 typedef enum io_job_kind {

@@ -19,14 +19,8 @@ server_case *case_new(void);
  * -1 when the list cannot grow (the case is not listed). */
 int registry_admit(server_case *c, int start, membudget_lease *lease, size_t cost);
 int case_state_is_terminal(case_state s);
-void iso_time_now(char *out, size_t size);
 /* Figures of the case's model into its published figures. */
 void case_publish_from_model(server_case *c);
-/* The status' "stage" back into fig->stage and fig->stage_name (null or
- * missing: -1, no stages). */
-void case_stage_from_json(case_figures *f, const json_t *stage);
-/* The status' energy object back into an fdem_energy (missing: NaN). */
-void case_energy_from_json(fdem_energy *energy, const json_t *o);
 
 /* case_warnings.c: the case's "warnings" (contract 6.2), each kept once
  * (pointer and message), at most 100; a JSON copy for the status; read

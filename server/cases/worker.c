@@ -19,12 +19,13 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "case_sizing.h"
 #include "sizing_probe.h"
 #include "io_thread.h"
 #include "registry_internal.h"
 #include "worker_history.h"
+#include "worker_ranked.h"
 #include "common/clock.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
@@ -65,9 +66,7 @@ typedef struct worker_clock {
 /* The first output time strictly after `t` on the grid k * interval. */
 static double worker_next_output(const server_case *c, double t)
 {
-    double interval = sizing_output_interval(&c->info);
-    double k = floor(t / interval * (1.0 + 1e-12) + 1e-9);
-    return (k + 1.0) * interval;
+    return output_next_time(output_snapshot_interval(&c->info), t);
 }
 
 /* Elements the engine found passing into one another since the last
@@ -140,7 +139,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.eta = running ? worker_eta(clk, now, fig.time, c->info.end_time) : NAN;
     fig.snapshots = -1; /* owned by the I/O thread */
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
-    case_figures_stage(&fig, m, &c->info);
+    status_figures_stage(&fig, m, &c->info);
     case_publish(c, &fig);
     worker_take_warnings(c);
 }
@@ -246,7 +245,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * exactly at time.end (a shorter step is always stable, and central
          * difference takes a changing step). */
         double t0 = fdem_get_time(m);
-        int cut = sizing_is_last_step(t0, dt, end);
+        int cut = output_is_last_step(t0, dt, end);
         if (cut)
             worker_keep_end_checkpoint(c);
         if (cut)
@@ -268,7 +267,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
         size_t ckpt_size = 0;
         fdem_event *events = NULL;
         int event_count = 0;
-        if (done || t >= c->next_output - 1e-9 * dt) {
+        if (done || output_is_due(t, c->next_output, dt)) {
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
@@ -384,7 +383,12 @@ static void *worker_main(void *arg)
     const fdemd_config *cfg = registry_config();
     worker_exit why = EXIT_FAILED;
     case_state final_state = CASE_FAILED;
-    if (worker_take_model(c, &final_state) == 0) {
+    int taken = worker_take_model(c, &final_state) == 0;
+    if (taken && c->info.ranks > 1) {
+        final_state = worker_ranked_run(c); /* the ranks step it (worker_ranked.h) */
+        if (atomic_load(&c->command) == WORKER_ABANDON)
+            why = EXIT_ABANDON;
+    } else if (taken) {
         fdem_set_threads(c->model, cfg->threads);
         double now = clock_wall_seconds();
         pthread_mutex_lock(&c->lock);

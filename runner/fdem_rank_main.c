@@ -1,0 +1,112 @@
+/*
+ * fdem_rank_main.c - bin/fdem-rank: one MPI rank of a case run on N ranks
+ * (contract 6.5), started by a launcher line (launch.h) from bin/fdem-run
+ * or the daemon, with fdem-run's arguments (--out, --threads, --ranks,
+ * --control stdin). Every rank runs the same batch loop (run_case.h);
+ * rank 0 writes the files.
+ *
+ * The stepper below is the seam to the rank engine (runner/mpi/,
+ * rank_engine.h): until it is linked, rank 0 steps the whole model itself
+ * (fdem_step) and the other ranks wait for it without spinning, so the
+ * launcher, the daemon's process handling and the files are the same as
+ * they will be. Swapping in the engine changes only rank_stepper_* here.
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <mpi.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "run_case.h"
+
+typedef struct rank_stepper_ctx {
+    MPI_Comm comm;
+    int rank, size;
+} rank_stepper_ctx;
+
+static int rank_stepper_step(void *ctx, fdem_model *m, fdem_error *err)
+{
+    (void)ctx;
+    return fdem_step(m, err);
+}
+
+static int rank_stepper_gather(void *ctx, fdem_model *m, fdem_error *err)
+{
+    (void)ctx;
+    (void)m;
+    (void)err;
+    return 0;
+}
+
+static int rank_stepper_agree(void *ctx, int local)
+{
+    rank_stepper_ctx *s = ctx;
+    int all = local;
+    MPI_Allreduce(&local, &all, 1, MPI_INT, MPI_MAX, s->comm);
+    return all;
+}
+
+/* Ranks other than 0 until the engine is linked: they wait for rank 0's
+ * end in a barrier polled every 20 ms (OpenMPI's blocking calls spin). */
+static void rank_wait_for_writer(MPI_Comm comm)
+{
+    MPI_Request req;
+    int done = 0;
+    MPI_Ibarrier(comm, &req);
+    while (!done) {
+        MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+        struct timespec ts = {0, 20 * 1000 * 1000};
+        if (!done)
+            nanosleep(&ts, NULL);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    enum { OPT_CONTROL = 256, OPT_QUIET };
+    static const struct option longs[] = {
+        {"out", required_argument, 0, 'o'}, {"ranks", required_argument, 0, 'n'},
+        {"threads", required_argument, 0, 'j'}, {"control", required_argument, 0, OPT_CONTROL},
+        {"quiet", no_argument, 0, OPT_QUIET}, {0, 0, 0, 0},
+    };
+    run_options o = {.threads = 1, .ranks = 1, .control_fd = -1};
+    int c;
+    while ((c = getopt_long(argc, argv, "o:n:j:", longs, NULL)) != -1) {
+        switch (c) {
+        case 'o': o.out_dir = optarg; break;
+        case 'n': o.ranks = atoi(optarg); break;
+        case 'j': o.threads = atoi(optarg); break;
+        case OPT_CONTROL: o.control_fd = strcmp(optarg, "stdin") == 0 ? 0 : -1; break;
+        case OPT_QUIET: o.quiet = 1; break;
+        default: return 2;
+        }
+    }
+    if (optind != argc - 1 || !o.out_dir) {
+        fprintf(stderr, "usage: fdem-rank CASE.json --out DIR [--threads T] [--ranks N] "
+                "[--control stdin] (started by fdem-run --ranks N or the daemon)\n");
+        return 2;
+    }
+    o.case_path = argv[optind];
+    MPI_Init(&argc, &argv);
+    rank_stepper_ctx ctx = {.comm = MPI_COMM_WORLD};
+    MPI_Comm_rank(ctx.comm, &ctx.rank);
+    MPI_Comm_size(ctx.comm, &ctx.size);
+    o.ranks = ctx.size;
+    if (ctx.rank != 0)
+        o.control_fd = -1; /* the launcher gives stdin to rank 0 */
+    int status = 0;
+    if (ctx.rank == 0) {
+        runner_stepper st = {.ctx = &ctx, .step = rank_stepper_step,
+                             .gather = rank_stepper_gather, .is_writer = 1,
+                             .agree = NULL /* alone until the engine is linked */};
+        status = run_exit_status(run_case(&o, &st));
+        (void)rank_stepper_agree;
+    }
+    rank_wait_for_writer(ctx.comm);
+    /* every rank ends with rank 0's outcome, which the launcher reports */
+    MPI_Bcast(&status, 1, MPI_INT, 0, ctx.comm);
+    MPI_Finalize();
+    return status;
+}
