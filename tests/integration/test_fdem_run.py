@@ -17,6 +17,7 @@ not exist fails the case with a sentence naming it; when the daemon is
 killed its ranks checkpoint and exit, and the restarted daemon lists the
 case paused.
 """
+import contextlib
 import json
 import os
 import shutil
@@ -128,6 +129,32 @@ class FdemRunFiles(DaemonTestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assert_same_files(whole, parts, "paused at step 37 and resumed")
 
+    def test_pause_and_stop_lines_on_stdin(self):
+        path = self.write_case(tiny_case("lines", end=5.0, divisions=(4, 4), interval=1e-3),
+                               "lines.json")
+        out = os.path.join(self.tmp, "lines")
+        for line, code, state in (("pause", 3, "paused"), ("stop", 4, "stopped")):
+            p = subprocess.Popen([FDEM_RUN, path, "--out", out, "--control", "stdin",
+                                  "--quiet"], stdin=subprocess.PIPE, stderr=subprocess.PIPE)
+            status_path = os.path.join(out, "status.json")
+            deadline = time.monotonic() + 30 * SLOW
+            step = 0
+            while step == 0 and time.monotonic() < deadline:
+                with contextlib.suppress(OSError, ValueError):
+                    with open(status_path) as f:
+                        st = json.load(f)
+                    step = st["step"] if st["state"] == "running" else 0
+                time.sleep(0.02)
+            p.stdin.write((line + "\n").encode())
+            p.stdin.flush()
+            self.assertEqual(p.wait(30 * SLOW), code, p.stderr.read())
+            p.stdin.close()
+            p.stderr.close()
+            with open(status_path) as f:
+                st = json.load(f)
+            self.assertEqual(st["state"], state)
+            self.assertGreaterEqual(st["step"], step)
+
     def test_a_bad_case_names_its_pointers(self):
         case = tiny_case("bad")
         case["time"]["end"] = -1
@@ -216,23 +243,6 @@ class RankedCases(DaemonTestCase):
         self.assertEqual(status, 200)
         self.assertEqual(len(body["events"]), two["broken_joints"])
 
-    def test_pause_and_start_again(self):
-        case = self.ranked(tiny_case("long", end=5.0, divisions=(4, 4), interval=1e-4))
-        st = self.d.create(case, start=True)
-        self.d.wait(st["id"], lambda s: s["step"] > 0, timeout=30, what="the ranks step")
-        status, body = self.d.json("POST", "/cases/%s/pause" % st["id"])
-        self.assertEqual(status, 200, body)
-        paused = self.d.wait_state(st["id"], "paused")
-        self.assertGreater(paused["step"], 0)
-        status, body = self.d.json("POST", "/cases/%s/start" % st["id"])
-        self.assertEqual(status, 200, body)
-        self.d.wait(st["id"], lambda s: s["step"] > paused["step"] and s["state"] == "running",
-                    timeout=30, what="the relaunched ranks step on")
-        status, body = self.d.json("POST", "/cases/%s/stop" % st["id"])
-        self.assertEqual(status, 200, body)
-        stopped = self.d.wait_state(st["id"], "stopped")
-        self.assertGreater(stopped["step"], paused["step"])
-
     def test_a_missing_launcher_fails_the_case_with_a_sentence(self):
         d = Daemon(args=("--launcher", "/nonexistent/mpirun -np {ranks}")).start()
         try:
@@ -245,13 +255,14 @@ class RankedCases(DaemonTestCase):
             d.stop()
             d.close()
 
-    def test_ranks_pause_when_the_daemon_dies(self):
+    def test_ranks_pause_when_the_daemon_dies_and_go_on_after_a_restart(self):
         d = Daemon(args=("--max-ranks", "2")).start()
         try:
             st = d.create(self.ranked(tiny_case("orphan", end=5.0, divisions=(4, 4),
-                                                interval=1e-4)), start=True)
+                                                interval=1e-3)), start=True)
             d.wait(st["id"], lambda s: s["step"] > 0, timeout=30, what="the ranks step")
             d.kill()
+            # the pipe's end of file: rank 0 checkpoints and the ranks exit
             status_path = os.path.join(d.data_dir, st["id"], "status.json")
             deadline = time.monotonic() + 30 * SLOW
             state = None
@@ -263,7 +274,19 @@ class RankedCases(DaemonTestCase):
                 time.sleep(0.05)
             self.assertEqual(state, "paused")
             d.start()
-            self.assertEqual(d.status(st["id"])["state"], "paused")
+            paused = d.status(st["id"])
+            self.assertEqual((paused["state"], paused["ranks"]), ("paused", 2))
+            self.assertGreater(paused["step"], 0)
+            # start relaunches the ranks from the checkpoint; stop goes down the pipe
+            status, body = d.json("POST", "/cases/%s/start" % st["id"])
+            self.assertEqual(status, 200, body)
+            d.wait(st["id"], lambda s: s["step"] > paused["step"], timeout=30,
+                   what="the relaunched ranks step on")
+            status, body = d.json("POST", "/cases/%s/stop" % st["id"])
+            self.assertEqual(status, 200, body)
+            stopped = d.wait_state(st["id"], "stopped")
+            self.assertGreater(stopped["step"], paused["step"])
+            self.assertEqual(stopped["error"], None)
         finally:
             d.stop()
             d.close()
