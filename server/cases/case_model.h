@@ -74,6 +74,9 @@ case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_mode
 int case_model_attach(server_case *c, fdem_model *model, const case_info *info, int close_after,
                       char *err, size_t errlen);
 void case_model_drop(server_case *c);
+/* case_model_drop() but for the reserve, which stays: a ranked case's
+ * ranks hold the model in their own processes meanwhile. */
+void case_model_free(server_case *c);
 /* Removes CASE_RESUME_CHECKPOINT (a newer checkpoint.bin is durable). */
 void case_model_forget_resume(server_case *c);
 

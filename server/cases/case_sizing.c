@@ -9,6 +9,7 @@
  * every contact-heavy case.
  */
 #include "case_sizing.h"
+#include "state/status_json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -277,37 +278,32 @@ static json_t *sizing_count_json(double n)
     return n < 9007199254740992.0 ? json_integer((json_int_t)n) : json_real(n);
 }
 
-static json_t *sizing_number_json(double x)
-{
-    return isfinite(x) ? json_real(x) : json_null();
-}
-
 json_t *case_sizing_json(const case_sizing *s)
 {
     json_t *o = json_object();
     json_object_set_new(o, "nodes", json_integer(s->nodes));
     json_object_set_new(o, "elements", json_integer(s->elements));
     json_object_set_new(o, "joints", json_integer(s->joints));
-    json_object_set_new(o, "dt", sizing_number_json(s->dt));
+    json_object_set_new(o, "dt", status_number_or_null(s->dt));
     json_object_set_new(o, "steps", sizing_count_json(s->steps));
     json_object_set_new(o, "snapshots", sizing_count_json(s->snapshots));
     json_object_set_new(o, "memory_bytes", sizing_count_json(s->memory_bytes));
     json_object_set_new(o, "result_bytes", sizing_count_json(ceil(s->result_bytes)));
-    json_object_set_new(o, "estimated_seconds", sizing_number_json(s->estimated_seconds));
+    json_object_set_new(o, "estimated_seconds", status_number_or_null(s->estimated_seconds));
     if (s->fluid) { /* the flow's step: null while no fluid can flow yet */
-        json_object_set_new(o, "fluid_step", sizing_number_json(s->fluid_step));
+        json_object_set_new(o, "fluid_step", status_number_or_null(s->fluid_step));
         json_object_set_new(o, "fluid_subcycles", json_integer(s->fluid_subcycles));
     }
     /* what the estimate was made of (docs/api.md), to judge it by */
     json_t *parts = json_object();
-    json_object_set_new(parts, "step_seconds", sizing_number_json(s->step_seconds));
-    json_object_set_new(parts, "load_factor", sizing_number_json(s->load_factor));
-    json_object_set_new(parts, "probe_wall_over_cpu", sizing_number_json(s->probe_wall_over_cpu));
-    json_object_set_new(parts, "later_step_seconds", sizing_number_json(s->later_step_seconds));
-    json_object_set_new(parts, "cracked_step_seconds", sizing_number_json(s->cracked_step_seconds));
+    json_object_set_new(parts, "step_seconds", status_number_or_null(s->step_seconds));
+    json_object_set_new(parts, "load_factor", status_number_or_null(s->load_factor));
+    json_object_set_new(parts, "probe_wall_over_cpu", status_number_or_null(s->probe_wall_over_cpu));
+    json_object_set_new(parts, "later_step_seconds", status_number_or_null(s->later_step_seconds));
+    json_object_set_new(parts, "cracked_step_seconds", status_number_or_null(s->cracked_step_seconds));
     json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
-    json_object_set_new(parts, "broken_joints", sizing_number_json(s->broken_joints));
-    json_object_set_new(parts, "snapshot_seconds", sizing_number_json(s->snapshot_copy_seconds));
+    json_object_set_new(parts, "broken_joints", status_number_or_null(s->broken_joints));
+    json_object_set_new(parts, "snapshot_seconds", status_number_or_null(s->snapshot_copy_seconds));
     json_object_set_new(o, "estimate", parts);
     char warning[400];
     if (case_sizing_warning(s, warning, sizeof warning))

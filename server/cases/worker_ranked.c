@@ -247,13 +247,7 @@ static void ranked_sleep(double seconds)
 case_state worker_ranked_run(server_case *c)
 {
     /* the start's checks are done: the ranks own the files from here */
-    io_close(c);
-    pthread_mutex_lock(&c->model_lock);
-    fdem_model *model = c->model;
-    c->model = NULL;
-    pthread_mutex_unlock(&c->model_lock);
-    if (model)
-        fdem_model_destroy(model);
+    case_model_free(c);
     pthread_mutex_lock(&c->lock);
     c->error[0] = '\0';
     pthread_mutex_unlock(&c->lock);
