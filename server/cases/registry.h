@@ -111,6 +111,7 @@ typedef struct server_case {
     _Atomic int io_failed;
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
+    _Atomic int ranks_running; /* a ranked case's processes write its files (worker_ranked.c) */
 
     json_t *warnings;          /* contract 6.2 "warnings" (`lock`, case_warnings.c) */
     int stop_pending;          /* a stop is making `stopped` durable: the queue skips the

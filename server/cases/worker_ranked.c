@@ -257,6 +257,7 @@ case_state worker_ranked_run(server_case *c)
         case_log(c, "its ranks could not be started: %s", c->error);
         return CASE_FAILED;
     }
+    atomic_store(&c->ranks_running, 1);
     case_log(c, "started on %d ranks (process group %d)", c->info.ranks, (int)pid);
     struct timespec seen = {0, 0};
     int sent = WORKER_GO, status = 0;
@@ -276,6 +277,7 @@ case_state worker_ranked_run(server_case *c)
         ranked_sleep(RANKED_POLL_SECONDS);
     }
     close(control);
+    atomic_store(&c->ranks_running, 0);
     seen.tv_sec = seen.tv_nsec = 0;
     ranked_follow_status(c, &seen);
     if (atomic_load(&c->command) == WORKER_ABANDON)

@@ -15,7 +15,7 @@ case runs through the --launcher line and bin/fdem-rank and ends with the
 files of a one-process run; it pauses and resumes; a launcher that does
 not exist fails the case with a sentence naming it; when the daemon is
 killed its ranks checkpoint and exit, and the restarted daemon lists the
-case paused.
+case paused; the results routes read the file while the ranks write it.
 """
 import contextlib
 import json
@@ -263,7 +263,15 @@ class RankedCases(DaemonTestCase):
         try:
             st = d.create(self.ranked(tiny_case("orphan", end=5.0, divisions=(4, 4),
                                                 interval=1e-3)), start=True)
-            d.wait(st["id"], lambda s: s["step"] > 0, timeout=30, what="the ranks step")
+            d.wait(st["id"], lambda s: s["snapshots"] > 1, timeout=30, what="the ranks step")
+            # while the ranks write, the routes read their file (SWMR); a byte
+            # copy of it could catch a write half done: 409 with a sentence
+            for route in ("events", "history", "mesh.bin?snapshot=1", "state"):
+                status, _, body = d.request("GET", "/cases/%s/%s" % (st["id"], route))
+                self.assertEqual(status, 200, (route, body[:200]))
+            status, _, body = d.request("GET", "/cases/%s/result.h5" % st["id"])
+            self.assertEqual(status, 409, body[:200])
+            self.assertIn(b"once the case is paused", body)
             d.kill()
             # the pipe's end of file: rank 0 checkpoints and the ranks exit
             status_path = os.path.join(d.data_dir, st["id"], "status.json")
