@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "case/case.h"
+#include "files/checkpoint_file.h"
 #include "files/persist.h"
 #include "result/result.h"
 #include "run_files.h"
@@ -67,6 +68,7 @@ typedef struct run_ctx {
     double elapsed_before, run_started, last_status, last_progress, last_xdmf, last_look;
     int steps_since_agree;
     int snapshots;              /* rows in result.h5 (kept after it is closed) */
+    int extending;              /* resumed from CHECKPOINT_FILE_RESUME */
     char control_line[64];
     int control_len;
     char error[768];
@@ -276,11 +278,18 @@ static int run_write_outputs(run_ctx *r, int snap, const char *state, double now
         persist_fsync_path(r->h5_path);
     }
     char err[300];
-    if (run_checkpoint_write(r->o->out_dir, "checkpoint.bin", r->m, err, sizeof err) != 0) {
+    if (run_checkpoint_write(r->o->out_dir, CHECKPOINT_FILE_LATEST, r->m, err, sizeof err) != 0) {
         run_fail(r, err);
         return -1;
     }
     r->last_checkpoint_step = fdem_get_step(r->m);
+    if (r->extending) { /* a later checkpoint.bin is durable: the resume point goes */
+        char path[1200];
+        snprintf(path, sizeof path, "%s/%s", r->o->out_dir, CHECKPOINT_FILE_RESUME);
+        if (unlink(path) == 0)
+            persist_fsync_dir(r->o->out_dir);
+        r->extending = 0;
+    }
     run_write_status(r, state, now);
     return 0;
 }
@@ -296,7 +305,7 @@ static int run_keep_end_checkpoint(run_ctx *r)
         return 0;
     char err[300];
     if (run_append_events(r) != 0 ||
-        run_checkpoint_write(r->o->out_dir, "checkpoint-end.bin", r->m, err, sizeof err) != 0) {
+        run_checkpoint_write(r->o->out_dir, CHECKPOINT_FILE_END, r->m, err, sizeof err) != 0) {
         run_fail(r, r->error[0] ? r->error : err);
         return -1;
     }
@@ -467,7 +476,8 @@ static int run_reopen_files(run_ctx *r, double now)
     int64_t step = fdem_get_step(r->m);
     r->last_snapshot_step = r->last_checkpoint_step = step;
     if (access(r->h5_path, F_OK) == 0) {
-        r->result = result_reopen(r->h5_path, r->m, &r->info, step, err, sizeof err);
+        int64_t keep = r->extending ? step + 1 : step; /* the old end's row */
+        r->result = result_reopen(r->h5_path, r->m, &r->info, keep, err, sizeof err);
         if (!r->result) {
             run_fail(r, err);
             return -1;
@@ -505,7 +515,12 @@ static int run_start(run_ctx *r, run_outcome *failed)
         *failed = RUN_BAD_CASE;
         return -1;
     }
-    if (resume && run_checkpoint_restore(o->out_dir, r->m, err, sizeof err) != 0) {
+    /* an extended case goes on from the step before its old end, on the
+     * grid of an uninterrupted run, as a daemon's start does (server's
+     * case_model.h); its end's row is kept */
+    r->extending = resume && run_has_file(o->out_dir, CHECKPOINT_FILE_RESUME);
+    const char *from_checkpoint = r->extending ? CHECKPOINT_FILE_RESUME : CHECKPOINT_FILE_LATEST;
+    if (resume && run_checkpoint_restore(o->out_dir, from_checkpoint, r->m, err, sizeof err) != 0) {
         run_fail(r, err);
         free(doc);
         return -1;

@@ -110,11 +110,12 @@ int run_checkpoint_write(const char *dir, const char *name, const fdem_model *m,
     return rc;
 }
 
-int run_checkpoint_restore(const char *dir, fdem_model *m, char *err, size_t errlen)
+int run_checkpoint_restore(const char *dir, const char *name, fdem_model *m, char *err,
+                           size_t errlen)
 {
     char path[1200], *bytes = NULL;
     size_t size = 0, payload = 0;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    snprintf(path, sizeof path, "%s/%s", dir, name);
     if (persist_read_file(path, &bytes, &size, RUN_MAX_CHECKPOINT) != 0) {
         snprintf(err, errlen, "%.400s could not be read: %s", path, strerror(errno));
         return -1;
@@ -135,12 +136,19 @@ int run_checkpoint_restore(const char *dir, fdem_model *m, char *err, size_t err
     return rc != 0 ? -1 : 0;
 }
 
+int run_has_file(const char *dir, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return access(path, F_OK) == 0;
+}
+
 int run_dir_resumable(const char *dir)
 {
     char path[1200];
     snprintf(path, sizeof path, "%s/case.json", dir);
     if (access(path, R_OK) != 0)
         return 0;
-    snprintf(path, sizeof path, "%s/checkpoint.bin", dir);
+    snprintf(path, sizeof path, "%s/%s", dir, CHECKPOINT_FILE_LATEST);
     return access(path, R_OK) == 0;
 }

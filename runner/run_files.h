@@ -13,8 +13,8 @@
  *  - run_status_read_times() reads back created/started/elapsed of a
  *    directory being resumed (missing: left as they are).
  *  - run_checkpoint_write() seals and writes the model's checkpoint as
- *    `name`; run_checkpoint_restore() restores checkpoint.bin into a model
- *    just built from the same document. Both 0, or -1 with err.
+ *    `name`; run_checkpoint_restore() restores `name` into a model just
+ *    built from the same document. Both 0, or -1 with err.
  */
 #ifndef FDEM_RUN_FILES_H
 #define FDEM_RUN_FILES_H
@@ -37,7 +37,9 @@ int run_status_write(const char *dir, const case_info *info, const run_figures *
 void run_status_read_times(const char *dir, run_status *s, double *elapsed);
 int run_checkpoint_write(const char *dir, const char *name, const fdem_model *m, char *err,
                          size_t errlen);
-int run_checkpoint_restore(const char *dir, fdem_model *m, char *err, size_t errlen);
+int run_checkpoint_restore(const char *dir, const char *name, fdem_model *m, char *err,
+                           size_t errlen);
+int run_has_file(const char *dir, const char *name);
 /* Whether `dir` holds a run to resume (case.json and checkpoint.bin). */
 int run_dir_resumable(const char *dir);
 

@@ -31,11 +31,12 @@
 #define FDEMD_CASE_MODEL_H
 
 #include "common/memory_budget.h"
+#include "files/checkpoint_file.h"
 #include "registry.h"
 
-#define CASE_CHECKPOINT "checkpoint.bin"
-#define CASE_END_CHECKPOINT "checkpoint-end.bin"
-#define CASE_RESUME_CHECKPOINT "checkpoint-resume.bin"
+#define CASE_CHECKPOINT CHECKPOINT_FILE_LATEST
+#define CASE_END_CHECKPOINT CHECKPOINT_FILE_END
+#define CASE_RESUME_CHECKPOINT CHECKPOINT_FILE_RESUME
 
 /* The largest case.json read back (the upload limit is far below it). */
 #define CASE_MODEL_MAX_DOCUMENT ((size_t)1 << 34)

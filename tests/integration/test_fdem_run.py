@@ -12,7 +12,7 @@ daemon that starts on it.
 "parallel": {"ranks": N}: not a positive integer or above --max-ranks is a
 422 at /parallel/ranks; the dry run and the status show `ranks`. A ranked
 case runs through the --launcher line and bin/fdem-rank and ends with the
-files of a one-process run; it pauses and resumes; a launcher that does
+files of a one-process run, also once extended; it pauses and resumes; a launcher that does
 not exist fails the case with a sentence naming it; when the daemon is
 killed its ranks checkpoint and exit, and the restarted daemon lists the
 case paused; the results routes read the file while the ranks write it.
@@ -245,6 +245,22 @@ class RankedCases(DaemonTestCase):
         status, body = self.d.json("GET", "/cases/%s/events" % two["id"])
         self.assertEqual(status, 200)
         self.assertEqual(len(body["events"]), two["broken_joints"])
+        # extended, both go on from the step before their old end (the grid
+        # of an uninterrupted run) to the same files again
+        for st in (one, two):
+            status, body = self.d.json("POST", "/cases/%s/extend" % st["id"],
+                                       {"end": 1.5 * case["time"]["end"]})
+            self.assertEqual(status, 200, body)
+            status, body = self.d.json("POST", "/cases/%s/start" % st["id"])
+            self.assertEqual(status, 200, body)
+        one = self.d.wait_state(one["id"], ("finished", "failed", "stopped"), timeout=60)
+        two = self.d.wait_state(two["id"], ("finished", "failed", "stopped"), timeout=60)
+        self.assertEqual(two["state"], "finished", two.get("error"))
+        self.assertEqual((one["step"], one["snapshots"]), (two["step"], two["snapshots"]))
+        a = datasets(os.path.join(self.d.data_dir, one["id"], "result.h5"))
+        b = datasets(os.path.join(self.d.data_dir, two["id"], "result.h5"))
+        for name in a:
+            self.assertEqual(a[name].tobytes(), b[name].tobytes(), "extended: " + name)
 
     def test_a_missing_launcher_fails_the_case_with_a_sentence(self):
         d = Daemon(args=("--launcher", "/nonexistent/mpirun -np {ranks}")).start()
