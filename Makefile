@@ -122,11 +122,11 @@ $(BIN)/fdemctl: $(CTL_OBJ)
 	@mkdir -p $(BIN)
 	$(CC) $(LDSAN) -o $@ $(CTL_OBJ) $(PKG_LIBS) -lm
 
-# Unit tests link everything below the server; each file is one binary.
-$(BUILD)/tests/%: tests/unit/%.c tests/unit/check.h $(LIBPROTO) $(LIBCORE)
+# Unit tests link everything below the server (runner/ too); each file is one binary.
+$(BUILD)/tests/%: tests/unit/%.c tests/unit/check.h $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TESTSAN) $(PKG_CFLAGS) -Icore -Iproto -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
-	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+	$(CC) $(CFLAGS) $(TESTSAN) $(PKG_CFLAGS) -Icore -Iproto -Irunner -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
+	    $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
 
 $(BUILD)/bench/%: bench/%.c $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)

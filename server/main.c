@@ -211,10 +211,16 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
             if (!*optarg || strlen(optarg) >= sizeof cfg->web_dir) bad = "--web takes a directory path";
             else strcpy(cfg->web_dir, optarg);
             break;
-        case OPT_LAUNCHER:
-            if (!*optarg || strlen(optarg) >= sizeof cfg->launcher) bad = "--launcher takes a command line, e.g. \"mpirun -np {ranks}\"";
+        case OPT_LAUNCHER: {
+            static char launcher_error[400];
+            char **words = strlen(optarg) < sizeof cfg->launcher
+                ? launch_argv(optarg, 1, NULL, launcher_error, sizeof launcher_error) : NULL;
+            if (!words && strlen(optarg) >= sizeof cfg->launcher) bad = "--launcher: the line is too long";
+            else if (!words) bad = launcher_error; /* refused now, not at each ranked start */
             else strcpy(cfg->launcher, optarg);
+            launch_argv_free(words);
             break;
+        }
         case OPT_MAX_RANKS:
             if (parse_int(optarg, 1, &cfg->max_ranks)) bad = "--max-ranks takes a positive integer";
             break;
