@@ -94,7 +94,7 @@ $(BUILD)/runner/%.o: runner/%.c | $(BUILD)/.deps
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner -c $< -o $@
 $(BUILD)/mpi-runner/%.o: runner/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
-	$(MPICC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner -fopenmp -c $< -o $@
+	$(MPICC) $(CFLAGS) $(PKG_CFLAGS) $(if $(wildcard runner/mpi/*.c),-DFDEM_RANK_ENGINE) -Icore -Iproto -Irunner -fopenmp -c $< -o $@
 $(BUILD)/clients/%.o: clients/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -c $< -o $@

@@ -6,10 +6,12 @@
  * rank 0 writes the files.
  *
  * The stepper below is the seam to the rank engine (runner/mpi/,
- * rank_engine.h): until it is linked, rank 0 steps the whole model itself
- * (fdem_step) and the other ranks wait for it without spinning, so the
- * launcher, the daemon's process handling and the files are the same as
- * they will be. Swapping in the engine changes only rank_stepper_* here.
+ * rank_engine.h): built with it (the Makefile defines FDEM_RANK_ENGINE
+ * when runner/mpi/ has sources), every rank steps its share of the model
+ * and they agree on commands every few steps; built without it, rank 0
+ * steps the whole model itself (fdem_step) and the other ranks wait for it
+ * without spinning, so the launcher, the daemon's process handling and the
+ * files are the same either way.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -20,6 +22,9 @@
 #include <time.h>
 
 #include "run_case.h"
+#ifdef FDEM_RANK_ENGINE
+#include "mpi/rank_engine.h"
+#endif
 
 #if defined(__SANITIZE_ADDRESS__)
 /* OpenMPI keeps what MPI_Init allocated past MPI_Finalize, in components
@@ -37,8 +42,26 @@ const char *__asan_default_options(void)
 typedef struct rank_stepper_ctx {
     MPI_Comm comm;
     int rank, size;
+#ifdef FDEM_RANK_ENGINE
+    rank_engine *engine;        /* made at the first step, from the model run_case built */
+#endif
 } rank_stepper_ctx;
 
+#ifdef FDEM_RANK_ENGINE
+static int rank_stepper_step(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_stepper_ctx *s = ctx;
+    if (!s->engine && !(s->engine = rank_engine_create(m, s->comm, err)))
+        return -1;
+    return rank_engine_step(s->engine, m, err);
+}
+
+static int rank_stepper_gather(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_stepper_ctx *s = ctx;
+    return s->engine ? rank_engine_gather(s->engine, m, err) : 0; /* no step yet: whole */
+}
+#else
 static int rank_stepper_step(void *ctx, fdem_model *m, fdem_error *err)
 {
     (void)ctx;
@@ -52,6 +75,7 @@ static int rank_stepper_gather(void *ctx, fdem_model *m, fdem_error *err)
     (void)err;
     return 0;
 }
+#endif
 
 static int rank_stepper_agree(void *ctx, int local)
 {
@@ -110,13 +134,21 @@ int main(int argc, char **argv)
     if (ctx.rank != 0)
         o.control_fd = -1; /* the launcher gives stdin to rank 0 */
     int status = 0;
+#ifdef FDEM_RANK_ENGINE
+    runner_stepper st = {.ctx = &ctx, .step = rank_stepper_step, .gather = rank_stepper_gather,
+                         .is_writer = ctx.rank == 0, .agree = rank_stepper_agree};
+    status = run_exit_status(run_case(&o, &st));
+    if (ctx.engine)
+        rank_engine_free(ctx.engine);
+#else
     if (ctx.rank == 0) {
         runner_stepper st = {.ctx = &ctx, .step = rank_stepper_step,
                              .gather = rank_stepper_gather, .is_writer = 1,
-                             .agree = NULL /* alone until the engine is linked */};
+                             .agree = NULL /* alone: the other ranks only wait */};
         status = run_exit_status(run_case(&o, &st));
         (void)rank_stepper_agree;
     }
+#endif
     rank_wait_for_writer(ctx.comm);
     /* every rank ends with rank 0's outcome, which the launcher reports */
     MPI_Bcast(&status, 1, MPI_INT, 0, ctx.comm);

@@ -256,12 +256,22 @@ static int run_append_events(run_ctx *r)
     return rc;
 }
 
+/* The other ranks' copies of the events rank 0 writes: dropped where rank 0
+ * drains its own, so they never pile up. */
+static int run_drop_events(run_ctx *r)
+{
+    fdem_event dropped[64];
+    while (fdem_drain_events(r->m, dropped, 64) > 0) {
+    }
+    return 0;
+}
+
 /* History rows, events, the snapshot (when `snap`), the checkpoint and
  * status.json, in the daemon's order: a checkpoint's rows before it. */
 static int run_write_outputs(run_ctx *r, int snap, const char *state, double now)
 {
     if (!r->writer)
-        return 0;
+        return run_drop_events(r);
     if (run_flush_history(r) != 0 || run_append_events(r) != 0)
         return -1;
     if (snap) {
@@ -302,7 +312,7 @@ static int run_keep_end_checkpoint(run_ctx *r)
     if (run_gather(r) != 0)
         return -1;
     if (!r->writer)
-        return 0;
+        return run_drop_events(r);
     char err[300];
     if (run_append_events(r) != 0 ||
         run_checkpoint_write(r->o->out_dir, CHECKPOINT_FILE_END, r->m, err, sizeof err) != 0) {
