@@ -7,11 +7,12 @@
  *
  * The stepper below is the seam to the rank engine (runner/mpi/,
  * rank_engine.h): built with it (the Makefile defines FDEM_RANK_ENGINE
- * when runner/mpi/ has sources), every rank steps its share of the model
- * and they agree on commands every few steps; built without it, rank 0
- * steps the whole model itself (fdem_step) and the other ranks wait for it
- * without spinning, so the launcher, the daemon's process handling and the
- * files are the same either way.
+ * when runner/mpi/ has sources), every rank steps its share of the model;
+ * built without it, every rank steps the whole model (fdem_step: the same
+ * bits on every rank, N times the work). Either way every rank runs the
+ * loop, rank 0 writes, and the ranks agree on commands and failures, so
+ * the launcher, the daemon's process handling, the files and the
+ * collective control flow are the ones the engine runs under.
  */
 #include <errno.h>
 #include <getopt.h>
@@ -85,8 +86,8 @@ static int rank_stepper_agree(void *ctx, int local)
     return all;
 }
 
-/* Ranks other than 0 until the engine is linked: they wait for rank 0's
- * end in a barrier polled every 20 ms (OpenMPI's blocking calls spin). */
+/* The other ranks wait for rank 0's last writes in a barrier polled every
+ * 20 ms (OpenMPI's blocking calls spin, taking a core from rank 0). */
 static void rank_wait_for_writer(MPI_Comm comm)
 {
     MPI_Request req;
@@ -133,21 +134,12 @@ int main(int argc, char **argv)
     o.ranks = ctx.size;
     if (ctx.rank != 0)
         o.control_fd = -1; /* the launcher gives stdin to rank 0 */
-    int status = 0;
-#ifdef FDEM_RANK_ENGINE
     runner_stepper st = {.ctx = &ctx, .step = rank_stepper_step, .gather = rank_stepper_gather,
                          .is_writer = ctx.rank == 0, .agree = rank_stepper_agree};
-    status = run_exit_status(run_case(&o, &st));
+    int status = run_exit_status(run_case(&o, &st));
+#ifdef FDEM_RANK_ENGINE
     if (ctx.engine)
         rank_engine_free(ctx.engine);
-#else
-    if (ctx.rank == 0) {
-        runner_stepper st = {.ctx = &ctx, .step = rank_stepper_step,
-                             .gather = rank_stepper_gather, .is_writer = 1,
-                             .agree = NULL /* alone: the other ranks only wait */};
-        status = run_exit_status(run_case(&o, &st));
-        (void)rank_stepper_agree;
-    }
 #endif
     rank_wait_for_writer(ctx.comm);
     /* every rank ends with rank 0's outcome, which the launcher reports */

@@ -69,6 +69,7 @@ typedef struct run_ctx {
     int steps_since_agree;
     int snapshots;              /* rows in result.h5 (kept after it is closed) */
     int extending;              /* resumed from CHECKPOINT_FILE_RESUME */
+    int history_failed;         /* appending history rows failed (the writer) */
     char control_line[64];
     int control_len;
     char error[768];
@@ -333,6 +334,15 @@ static void run_progress(run_ctx *r, double now)
             fdem_get_time(r->m), r->info.end_time);
 }
 
+/* Whether this rank or any other failed: a rank that stopped alone would
+ * leave the others waiting in their next collective call. Called at the
+ * same steps on every rank (outputs fall on the same steps). */
+static int run_any_failed(run_ctx *r, int failed)
+{
+    failed |= r->history_failed;
+    return r->st && r->st->agree ? r->st->agree(r->st->ctx, failed) : failed;
+}
+
 /* Steps until the end, a command or a failure. */
 static run_outcome run_loop(run_ctx *r)
 {
@@ -348,7 +358,7 @@ static run_outcome run_loop(run_ctx *r)
             return RUN_STOPPED;
         double dt = fdem_get_dt(r->m), t0 = fdem_get_time(r->m);
         int cut = output_is_last_step(t0, dt, end);
-        if (cut && run_keep_end_checkpoint(r) != 0)
+        if (cut && run_any_failed(r, run_keep_end_checkpoint(r) != 0))
             return RUN_FAILED;
         if (cut)
             fdem_set_dt(r->m, end - t0);
@@ -375,13 +385,14 @@ static run_outcome run_loop(run_ctx *r)
         now = run_wall();
         if (snap) {
             r->last_snapshot_step = fdem_get_step(r->m);
-            if (run_write_outputs(r, 1, done ? "finished" : "running", now) != 0)
+            if (run_any_failed(r, run_write_outputs(r, 1, done ? "finished" : "running",
+                                                    now) != 0))
                 return RUN_FAILED;
         } else if (cmd == CMD_STATUS) {
             run_write_status(r, "running", now);
         }
-        if (r->writer && r->row_count >= RUN_HISTORY_BATCH && run_flush_history(r) != 0)
-            return RUN_FAILED;
+        if (r->row_count >= RUN_HISTORY_BATCH && run_flush_history(r) != 0)
+            r->history_failed = 1; /* ends the run at the next snapshot, on every rank */
         run_progress(r, now);
         if (done)
             return RUN_FINISHED;
@@ -585,8 +596,13 @@ run_outcome run_case(const run_options *o, runner_stepper *stepper)
     sigaction(SIGINT, &sa, NULL);
 
     run_outcome why = RUN_FAILED;
-    if (run_start(&r, &why) == 0)
+    int started = run_start(&r, &why) == 0;
+    if (!run_any_failed(&r, !started))
         why = run_loop(&r);
+    else if (started) {
+        why = RUN_FAILED;
+        run_fail(&r, "another rank could not build the case or open its files (see its output)");
+    }
     if (r.m) {
         run_wind_down(&r, why);
         why = r.error[0] && why != RUN_BAD_CASE ? RUN_FAILED : why;
