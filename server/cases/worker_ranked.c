@@ -120,7 +120,19 @@ static pid_t ranked_spawn(server_case *c, int *control)
         /* its own group: a stop or delete signals the launcher and the
          * ranks it forked, and a terminal's ^C to the daemon does not */
         posix_spawnattr_setpgroup(&attr, 0);
-        posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+        /* the daemon blocks SIGTERM and SIGINT (main.c waits for them) and
+         * ignores SIGPIPE; a child would inherit both, and mpirun with
+         * SIGTERM blocked never ends its ranks on a delete */
+        sigset_t none, defaults;
+        sigemptyset(&none);
+        sigemptyset(&defaults);
+        sigaddset(&defaults, SIGTERM);
+        sigaddset(&defaults, SIGINT);
+        sigaddset(&defaults, SIGPIPE);
+        posix_spawnattr_setsigmask(&attr, &none);
+        posix_spawnattr_setsigdefault(&attr, &defaults);
+        posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP | POSIX_SPAWN_SETSIGMASK |
+                                 POSIX_SPAWN_SETSIGDEF);
         rc = posix_spawnp(&pid, argv[0], &fa, &attr, argv, env);
     }
     if (rc != 0) {

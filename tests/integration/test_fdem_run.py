@@ -15,7 +15,8 @@ case runs through the --launcher line and bin/fdem-rank and ends with the
 files of a one-process run, also once extended; it pauses and resumes; a launcher that does
 not exist fails the case with a sentence naming it; when the daemon is
 killed its ranks checkpoint and exit, and the restarted daemon lists the
-case paused; the results routes read the file while the ranks write it.
+case paused, which pauses and is deleted like any other; the results
+routes read the file while the ranks write it.
 """
 import contextlib
 import json
@@ -304,16 +305,26 @@ class RankedCases(DaemonTestCase):
             paused = d.status(st["id"])
             self.assertEqual((paused["state"], paused["ranks"]), ("paused", 2))
             self.assertGreater(paused["step"], 0)
-            # start relaunches the ranks from the checkpoint; stop goes down the pipe
+            # start relaunches the ranks from the checkpoint; pause goes down the pipe
             status, body = d.json("POST", "/cases/%s/start" % st["id"])
             self.assertEqual(status, 200, body)
             d.wait(st["id"], lambda s: s["step"] > paused["step"], timeout=30,
                    what="the relaunched ranks step on")
-            status, body = d.json("POST", "/cases/%s/stop" % st["id"])
+            status, body = d.json("POST", "/cases/%s/pause" % st["id"])
             self.assertEqual(status, 200, body)
-            stopped = d.wait_state(st["id"], "stopped")
-            self.assertGreater(stopped["step"], paused["step"])
-            self.assertEqual(stopped["error"], None)
+            again = d.wait_state(st["id"], "paused")
+            self.assertGreater(again["step"], paused["step"])
+            self.assertEqual(again["error"], None)
+            # a delete ends the launcher's process group: the daemon blocks
+            # SIGTERM for itself, and an mpirun that inherited the mask never
+            # ended its ranks (the DELETE hung)
+            status, body = d.json("POST", "/cases/%s/start" % st["id"])
+            self.assertEqual(status, 200, body)
+            d.wait(st["id"], lambda s: s["step"] > again["step"], timeout=30,
+                   what="the ranks step on once more")
+            status, _, _ = d.request("DELETE", "/cases/" + st["id"])
+            self.assertEqual(status, 204)
+            self.assertFalse(os.path.exists(os.path.join(d.data_dir, st["id"])))
         finally:
             d.stop()
             d.close()
