@@ -189,7 +189,18 @@ static void ranked_follow_status(server_case *c, struct timespec *seen)
     case_publish(c, &f);
 }
 
-/* The last line of ranks.log, for an error that names what went wrong. */
+/* Whether a line of ranks.log says something (mpirun frames its messages
+ * in lines of dashes). */
+static int ranked_line_says_something(const char *line, size_t length)
+{
+    for (size_t i = 0; i < length; i++)
+        if (line[i] != '-' && line[i] != ' ' && line[i] != '\t' && line[i] != '\r')
+            return 1;
+    return 0;
+}
+
+/* The last line of ranks.log that says something, for an error that names
+ * what went wrong. */
 static void ranked_log_tail(server_case *c, char *out, size_t size)
 {
     char path[1200], buf[4096];
@@ -203,13 +214,19 @@ static void ranked_log_tail(server_case *c, char *out, size_t size)
     size_t n = fread(buf, 1, sizeof buf - 1, f);
     fclose(f);
     buf[n] = '\0';
-    while (n > 0 && (buf[n - 1] == '\n' || buf[n - 1] == '\r'))
-        buf[--n] = '\0';
-    const char *last = strrchr(buf, '\n');
-    last = last ? last + 1 : buf;
-    size_t keep = strlen(last) < size ? strlen(last) : size - 1;
-    memcpy(out, last, keep);
-    out[keep] = '\0';
+    size_t end = n;
+    while (end > 0) {
+        size_t start = end;
+        while (start > 0 && buf[start - 1] != '\n')
+            start--;
+        if (ranked_line_says_something(buf + start, end - start)) {
+            size_t keep = end - start < size ? end - start : size - 1;
+            memcpy(out, buf + start, keep);
+            out[keep] = '\0';
+            return;
+        }
+        end = start > 0 ? start - 1 : 0;
+    }
 }
 
 static void ranked_send(int control, const char *line)

@@ -274,6 +274,19 @@ class RankedCases(DaemonTestCase):
         finally:
             d.stop()
             d.close()
+        # a launcher that fails: its exit status and the last line of its
+        # output that says something (mpirun frames its messages in dashes)
+        failing = "sh -c 'echo ----; echo launcher: no slots >&2; echo ----; exit 7'"
+        d = Daemon(args=("--launcher", failing)).start()
+        try:
+            st = d.create(self.ranked(tiny_case("failing")), start=True)
+            st = d.wait_state(st["id"], ("failed", "finished"), timeout=30)
+            self.assertEqual(st["state"], "failed")
+            self.assertIn("exit status 7", st["error"])
+            self.assertIn("says: launcher: no slots", st["error"])
+        finally:
+            d.stop()
+            d.close()
 
     def test_ranks_pause_when_the_daemon_dies_and_go_on_after_a_restart(self):
         d = Daemon(args=("--max-ranks", "2")).start()
