@@ -31,7 +31,7 @@ import unittest
 import h5py
 import numpy as np
 
-from fdemd_harness import FDEMD_BIN, SLOW, Daemon, DaemonTestCase, tiny_case
+from fdemd_harness import FDEMD_BIN, SLOW, Daemon, DaemonTestCase, boom_case, tiny_case
 from test_events import pulled_bar
 
 BIN = os.path.dirname(FDEMD_BIN)
@@ -166,6 +166,17 @@ class FdemRunFiles(DaemonTestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("/time/end", r.stderr)
         self.assertIn("/parallel/ranks", r.stderr)
+        # a case that goes non-finite fails with the engine's sentence, its
+        # results so far kept and closed
+        out = os.path.join(self.tmp, "boom")
+        r = fdem_run([self.write_case(boom_case(), "boom.json"), "--out", out, "--quiet"])
+        self.assertEqual(r.returncode, 1, r.stderr)
+        with open(os.path.join(out, "status.json")) as f:
+            st = json.load(f)
+        self.assertEqual(st["state"], "failed")
+        self.assertIn("non-finite", st["error"])
+        self.assertIn(st["error"], r.stderr)
+        self.assertGreaterEqual(len(datasets(os.path.join(out, "result.h5"))["snapshots/time"]), 1)
 
     def test_the_daemon_lists_a_directory_fdem_run_wrote(self):
         data = os.path.join(self.tmp, "data")
