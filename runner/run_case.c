@@ -186,6 +186,8 @@ static void run_write_status(run_ctx *r, const char *state, double now)
 {
     if (!r->writer)
         return;
+    if (r->m)
+        status_take_penetrations(r->status.warnings, r->m);
     run_figures f;
     run_figures_now(r, &f, now);
     r->status.state = state;
@@ -456,7 +458,13 @@ static fdem_model *run_build(run_ctx *r, const char *doc, size_t size, const cha
     problems p;
     problems_init(&p);
     memset(&r->info, 0, sizeof r->info);
-    fdem_model *m = case_build(doc, size, (size_t)-1, &r->info, &p);
+    problems warnings;
+    problems_init(&warnings);
+    fdem_model *m = case_build_gated(doc, size, (size_t)-1, NULL, NULL, &r->info, &p, &warnings);
+    for (int i = 0; i < warnings.count; i++) /* the document's, as a daemon's upload lists them */
+        status_warning_add(r->status.warnings, warnings.items[i].pointer,
+                           warnings.items[i].message);
+    problems_free(&warnings);
     if (!m && r->writer) {
         fprintf(stderr, "fdem-run: %s is not a valid case (%d problem%s):\n", from, p.count,
                 p.count == 1 ? "" : "s");
@@ -579,6 +587,7 @@ run_outcome run_case(const run_options *o, runner_stepper *stepper)
     r.st = stepper;
     r.writer = !stepper || stepper->is_writer;
     r.status.ranks = opts.ranks;
+    r.status.warnings = json_array();
     r.status.eta = NAN;
     status_time_now(r.status.created, sizeof r.status.created);
     snprintf(r.h5_path, sizeof r.h5_path, "%s/result.h5", opts.out_dir);
@@ -612,6 +621,7 @@ run_outcome run_case(const run_options *o, runner_stepper *stepper)
     }
     if (r.error[0] && r.writer)
         fprintf(stderr, "fdem-run: %s: %s\n", run_outcome_state(why), r.error);
+    json_decref(r.status.warnings);
     return why;
 }
 

@@ -61,7 +61,7 @@ int run_status_write(const char *dir, const case_info *info, const run_figures *
     json_object_set_new(o, "elapsed", status_number_or_null(f->elapsed > 0 ? f->elapsed : 0.0));
     json_object_set_new(o, "estimated_seconds", json_null());
     json_object_set_new(o, "eta", status_number_or_null(running ? s->eta : NAN));
-    json_object_set_new(o, "warnings", json_array());
+    json_object_set_new(o, "warnings", s->warnings ? json_deep_copy(s->warnings) : json_array());
     json_object_set_new(o, "runner", json_string("fdem-run"));
     char *text = json_dumps(o, JSON_COMPACT);
     json_decref(o);
@@ -91,6 +91,14 @@ void run_status_read_times(const char *dir, run_status *s, double *elapsed)
         snprintf(s->started, sizeof s->started, "%s", started);
     if (json_is_number(e) && json_number_value(e) >= 0)
         *elapsed = json_number_value(e);
+    size_t i;
+    const json_t *w;
+    json_array_foreach(json_object_get(st, "warnings"), i, w) {
+        const char *pointer = json_string_value(json_object_get(w, "pointer"));
+        const char *message = json_string_value(json_object_get(w, "message"));
+        if (pointer && message)
+            status_warning_add(s->warnings, pointer, message);
+    }
     json_decref(st);
 }
 

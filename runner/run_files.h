@@ -8,10 +8,11 @@
  *  - run_status_write() writes status.json atomically (proto/files/persist.h):
  *    "id" (the directory's name), "name", "state", the figures, "ranks",
  *    "error", "created", "started", "finished_at", "elapsed",
- *    "estimated_seconds" (null), "eta", "warnings" ([]) and "runner":
+ *    "estimated_seconds" (null), "eta", "warnings" and "runner":
  *    "fdem-run"; a daemon lists such a directory as one of its cases.
- *  - run_status_read_times() reads back created/started/elapsed of a
- *    directory being resumed (missing: left as they are).
+ *  - run_status_read_times() reads back created/started/elapsed and the
+ *    warnings (added to s->warnings) of a directory being resumed
+ *    (missing: left as they are).
  *  - run_checkpoint_write() seals and writes the model's checkpoint as
  *    `name`; run_checkpoint_restore() restores `name` into a model just
  *    built from the same document. Both 0, or -1 with err.
@@ -20,6 +21,7 @@
 #define FDEM_RUN_FILES_H
 
 #include <stddef.h>
+#include <jansson.h>
 #include "case/case.h"
 #include "fdem.h"
 #include "state/status_json.h"
@@ -29,6 +31,7 @@ typedef struct run_status {
     const char *error;         /* NULL or "" = none */
     int ranks;
     double eta;                /* NAN: unknown */
+    json_t *warnings;          /* contract 6.2's list (status_json.h); NULL: [] */
     char created[40], started[40], finished_at[40];
 } run_status;
 

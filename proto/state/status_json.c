@@ -203,3 +203,60 @@ void status_time_now(char *out, size_t size)
     strftime(base, sizeof base, "%Y-%m-%dT%H:%M:%S", &tm);
     snprintf(out, size, "%.19s.%03dZ", base, (int)(ts.tv_nsec / 1000000L));
 }
+
+static int status_warning_known(const json_t *list, const char *pointer, const char *message)
+{
+    size_t i;
+    const json_t *w;
+    json_array_foreach(list, i, w)
+        if (strcmp(json_string_value(json_object_get(w, "pointer")), pointer) == 0 &&
+            strcmp(json_string_value(json_object_get(w, "message")), message) == 0)
+            return 1;
+    return 0;
+}
+
+void status_warning_add(json_t *list, const char *pointer, const char *message)
+{
+    if (!list || json_array_size(list) >= STATUS_WARNINGS_MAX ||
+        status_warning_known(list, pointer, message))
+        return;
+    json_t *w = json_object();
+    json_object_set_new(w, "pointer", json_string(pointer));
+    json_object_set_new(w, "message", json_string(message));
+    json_array_append_new(list, w);
+}
+
+static int status_warning_starting(const json_t *list, const char *start)
+{
+    size_t i, n = strlen(start);
+    const json_t *w;
+    json_array_foreach(list, i, w)
+        if (strncmp(json_string_value(json_object_get(w, "message")), start, n) == 0)
+            return 1;
+    return 0;
+}
+
+/* At the part of the first element, each pair once; their step is in the
+ * message. */
+void status_take_penetrations(json_t *list, fdem_model *model)
+{
+    fdem_penetration pen[FDEM_PENETRATIONS_MAX];
+    long more = 0;
+    int n = fdem_take_penetrations(model, pen, FDEM_PENETRATIONS_MAX, &more);
+    const int32_t *part = fdem_element_parts(model);
+    for (int i = 0; i < n; i++) {
+        char ptr[32], msg[300], pair[64];
+        /* the engine lists each pair once a run; a run resumed from a
+         * checkpoint may find a pair it had found before the restart */
+        snprintf(pair, sizeof pair, "elements %d and %d passed", pen[i].a, pen[i].b);
+        if (status_warning_starting(list, pair)) continue;
+        snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
+        snprintf(msg, sizeof msg, "%s into one another at step %lld (t = %.6g s): a node "
+                 "%.2f of the other's inradius deep (warned beyond %.2f); a body too fast or a "
+                 "penalty too soft for contact to hold it", pair, (long long)pen[i].step,
+                 pen[i].time, pen[i].depth, FDEM_PENETRATION_WARN);
+        status_warning_add(list, ptr, msg);
+    }
+    if (more > 0)
+        status_warning_add(list, "", "more element pairs passed into one another than are listed");
+}

@@ -14,6 +14,10 @@
  *  - status_figures_from_json() reads those members back (a status.json
  *    written by the daemon or by fdem-run): what a listing shows without
  *    building the model. Missing or null numbers read as NaN (counts as 0).
+ *  - "warnings" (contract 6.2): a JSON array of {"pointer", "message"},
+ *    each kept once, at most STATUS_WARNINGS_MAX; status_take_penetrations()
+ *    moves the engine's pairs of elements found passing into one another
+ *    into it, each pair once across restarts (the message names it).
  *  - status_progress(): 1 only when finished; otherwise at most
  *    STATUS_PROGRESS_UNFINISHED_MAX, so no client prints "running 100 %".
  *
@@ -28,6 +32,8 @@
 #include "fdem.h"
 
 #define STATUS_PROGRESS_UNFINISHED_MAX 0.999
+/* A status stays small whatever a document or a run does. */
+#define STATUS_WARNINGS_MAX 100
 
 /* Figures of one step of a run (the status object's). */
 typedef struct run_figures {
@@ -61,6 +67,10 @@ void status_stage_from_json(run_figures *f, const json_t *stage);
 /* The status' energy object back into an fdem_energy (missing: NaN). */
 void status_energy_from_json(fdem_energy *energy, const json_t *o);
 json_t *status_number_or_null(double x);
+/* Appends {"pointer", "message"} to `list` unless it is there or the list is full. */
+void status_warning_add(json_t *list, const char *pointer, const char *message);
+/* Takes the model's penetrations (fdem_take_penetrations) into `list`. */
+void status_take_penetrations(json_t *list, fdem_model *model);
 /* Now as ISO 8601 UTC with milliseconds ("2026-12-06T18:00:00.123Z"): the
  * status' created, started and finished_at; sorts like time. */
 void status_time_now(char *out, size_t size);

@@ -27,9 +27,6 @@ void case_publish_from_model(server_case *c);
  * back from status.json's "warnings"; a problem list as such an array. */
 void case_add_warning(server_case *c, const char *pointer, const char *message);
 void case_add_warnings(server_case *c, const problems *w);
-/* Whether some warning's message starts with `start` (a pair of elements
- * found again after a restart, at another step, is not listed twice). */
-int case_has_warning_starting(server_case *c, const char *start);
 json_t *case_warnings_json(server_case *c);
 void case_warnings_from_json(server_case *c, const json_t *list);
 json_t *problems_warnings_json(const problems *w);

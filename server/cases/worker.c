@@ -70,29 +70,15 @@ static double worker_next_output(const server_case *c, double t)
 }
 
 /* Elements the engine found passing into one another since the last
- * publish become status warnings (contract 6.2), at the part of the first
- * element, each pair once; their step is in the message. */
+ * publish become status warnings (contract 6.2, status_take_penetrations).
+ * With model_lock held. */
 static void worker_take_warnings(server_case *c)
 {
-    fdem_penetration pen[FDEM_PENETRATIONS_MAX];
-    long more = 0;
-    int n = fdem_take_penetrations(c->model, pen, FDEM_PENETRATIONS_MAX, &more);
-    const int32_t *part = fdem_element_parts(c->model);
-    for (int i = 0; i < n; i++) {
-        char ptr[32], msg[300], pair[64];
-        /* the engine lists each pair once a run; a run resumed from a
-         * checkpoint may find a pair it had found before the restart */
-        snprintf(pair, sizeof pair, "elements %d and %d passed", pen[i].a, pen[i].b);
-        if (case_has_warning_starting(c, pair)) continue;
-        snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
-        snprintf(msg, sizeof msg, "%s into one another at step %lld (t = %.6g s): a node "
-                 "%.2f of the other's inradius deep (warned beyond %.2f); a body too fast or a "
-                 "penalty too soft for contact to hold it", pair, (long long)pen[i].step,
-                 pen[i].time, pen[i].depth, FDEM_PENETRATION_WARN);
-        case_add_warning(c, ptr, msg);
-    }
-    if (more > 0)
-        case_add_warning(c, "", "more element pairs passed into one another than are listed");
+    pthread_mutex_lock(&c->lock);
+    if (!c->warnings)
+        c->warnings = json_array();
+    status_take_penetrations(c->warnings, c->model);
+    pthread_mutex_unlock(&c->lock);
 }
 
 /* Wall seconds left at the speed of the recent window (see

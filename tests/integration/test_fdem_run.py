@@ -42,11 +42,13 @@ HAVE_RANKS = os.path.exists(FDEM_RANK) and shutil.which("mpirun") is not None
 # status.json members that belong to the run, not to who ran it or when
 RUN_FIGURES = ("name", "state", "step", "time", "end_time", "progress", "dt", "dimension",
                "nodes", "elements", "joints", "broken_joints", "fragments", "contacts",
-               "stage", "fluid", "snapshots", "energy", "error")
+               "stage", "fluid", "snapshots", "energy", "error", "warnings")
 
 
 def bar_with_history(dimension):
     case = pulled_bar(dimension, end=1.2e-4, interval=2e-5)
+    # a penalty below young: a document warning both status.json files list
+    case["materials"]["rock"]["penalty"] = 2e10
     at = [0.05, 0.005] if dimension == 2 else [0.05, 0.005, 0.005]
     case["history"] = {"interval": 1e-5, "points": [{"name": "middle", "at": at}]}
     return case
@@ -112,10 +114,13 @@ class FdemRunFiles(DaemonTestCase):
                               "--quiet"])
                 self.assertEqual(r.returncode, 0, r.stderr)
                 d = self.assert_same_files(expected, out, "%dD" % dimension)
-                # the comparison saw fracture, history and several snapshots
+                # the comparison saw fracture, history, several snapshots and a warning
                 self.assertGreater(len(d["events/time"]), 0)
                 self.assertGreater(len(d["history/time"]), 5)
                 self.assertGreater(len(d["snapshots/time"]), 5)
+                with open(os.path.join(out, "status.json")) as f:
+                    warnings = json.load(f)["warnings"]
+                self.assertIn("/materials/rock/penalty", [w["pointer"] for w in warnings])
 
     def test_a_paused_run_goes_on_to_the_same_files(self):
         case = bar_with_history(2)
