@@ -43,6 +43,11 @@ PKG_LIBS   = $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CORE_SRC   := $(wildcard core/*.c core/*/*.c)
 PROTO_SRC  := $(wildcard proto/*.c proto/*/*.c)
 SERVER_SRC := $(wildcard server/*.c server/*/*.c)
+# runner/: the batch loop (a library) and the mains of bin/fdem-run and,
+# where mpicc exists, bin/fdem-rank (MPI lives only in runner/mpi and there)
+RUNNER_SRC := $(filter-out runner/fdem_%_main.c,$(wildcard runner/*.c))
+RANK_SRC   := runner/fdem_rank_main.c $(wildcard runner/mpi/*.c)
+MPICC      := $(shell command -v mpicc 2>/dev/null)
 CTL_SRC    := $(wildcard clients/fdemctl/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
 BENCH_SRC  := $(wildcard bench/*.c)
@@ -51,15 +56,22 @@ FUZZ_SRC   := $(wildcard tests/fuzz/*.c)
 CORE_OBJ   := $(CORE_SRC:%.c=$(BUILD)/%.o)
 PROTO_OBJ  := $(PROTO_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
+RUNNER_OBJ := $(RUNNER_SRC:%.c=$(BUILD)/%.o)
+RANK_OBJ   := $(RANK_SRC:%.c=$(BUILD)/mpi-%.o)
 CTL_OBJ    := $(CTL_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
 LIBCORE    := $(BUILD)/libfdemcore.a
 LIBPROTO   := $(BUILD)/libfdemproto.a
+LIBRUNNER  := $(BUILD)/libfdemrunner.a
+RANK_BIN   := $(if $(MPICC),$(BIN)/fdem-rank)
 
 .PHONY: all deps test test-unit test-integration test-san bench demo limits estimates fuzz clean
 
-all: deps $(BIN)/fdemd $(BIN)/fdemctl
+all: deps $(BIN)/fdemd $(BIN)/fdemctl $(BIN)/fdem-run $(RANK_BIN)
+ifeq ($(MPICC),)
+	@echo "mpicc not found: bin/fdem-rank not built (ranked cases need openmpi-bin libopenmpi-dev)"
+endif
 
 # Installs what is missing (apt-get) once; a stamp keeps later runs quiet.
 deps: $(BUILD)/.deps
@@ -76,7 +88,13 @@ $(BUILD)/proto/%.o: proto/%.c | $(BUILD)/.deps
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -c $< -o $@
 $(BUILD)/server/%.o: server/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Iserver -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Iserver -Irunner -c $< -o $@
+$(BUILD)/runner/%.o: runner/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner -c $< -o $@
+$(BUILD)/mpi-runner/%.o: runner/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(MPICC) $(CFLAGS) $(PKG_CFLAGS) $(if $(wildcard runner/mpi/*.c),-DFDEM_RANK_ENGINE) -Icore -Iproto -Irunner -fopenmp -c $< -o $@
 $(BUILD)/clients/%.o: clients/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -c $< -o $@
@@ -88,18 +106,27 @@ $(LIBPROTO): $(PROTO_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BIN)/fdemd: $(SERVER_OBJ) $(LIBPROTO) $(LIBCORE)
+$(LIBRUNNER): $(RUNNER_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+$(BIN)/fdemd: $(SERVER_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(BIN)
-	$(CC) $(LDSAN) -fopenmp -o $@ $(SERVER_OBJ) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+	$(CC) $(LDSAN) -fopenmp -o $@ $(SERVER_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+$(BIN)/fdem-run: $(BUILD)/runner/fdem_run_main.o $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(BIN)
+	$(CC) $(LDSAN) -fopenmp -o $@ $< $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+$(BIN)/fdem-rank: $(RANK_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(BIN)
+	$(MPICC) $(LDSAN) -fopenmp -o $@ $(RANK_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) $(if $(wildcard runner/mpi/*.c),-lmetis) -lpthread -lm
 $(BIN)/fdemctl: $(CTL_OBJ)
 	@mkdir -p $(BIN)
 	$(CC) $(LDSAN) -o $@ $(CTL_OBJ) $(PKG_LIBS) -lm
 
-# Unit tests link everything below the server; each file is one binary.
-$(BUILD)/tests/%: tests/unit/%.c tests/unit/check.h $(LIBPROTO) $(LIBCORE)
+# Unit tests link everything below the server (runner/ too); each file is one binary.
+$(BUILD)/tests/%: tests/unit/%.c tests/unit/check.h $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(TESTSAN) $(PKG_CFLAGS) -Icore -Iproto -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
-	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
+	$(CC) $(CFLAGS) $(TESTSAN) $(PKG_CFLAGS) -Icore -Iproto -Irunner -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
+	    $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
 
 $(BUILD)/bench/%: bench/%.c $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)

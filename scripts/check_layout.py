@@ -26,7 +26,7 @@ import re
 import subprocess
 import sys
 
-ROOTS = ("core", "proto", "server")
+ROOTS = ("core", "proto", "server", "runner")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 LONG_FILE = 800
 
@@ -126,6 +126,23 @@ def circles(edges):
     return out
 
 
+# Trees that may not lean on another at all (the folder graph alone allows
+# any one-way edge): the engine knows nothing above it, proto/ nothing of
+# the daemon or the runners, and runner/ drives the engine without the daemon.
+FORBIDDEN = {"core": ("proto", "server", "runner"), "proto": ("server", "runner"),
+             "runner": ("server",)}
+
+
+def report_forbidden(kind, edges):
+    ok = True
+    for (a, b), why in sorted(edges.items()):
+        ta, tb = a.split(os.sep)[0], b.split(os.sep)[0]
+        if tb in FORBIDDEN.get(ta, ()):
+            print(f"{ta}/ must not use {tb}/ ({kind}): {a} -> {b}: {why[0]}")
+            ok = False
+    return ok
+
+
 def report(kind, edges):
     bad = circles(edges)
     for comp in bad:
@@ -168,15 +185,17 @@ def main():
     args = ap.parse_args()
     if args.self_test:
         return self_test()
-    ok = report("includes", include_edges(args.top))
+    includes = include_edges(args.top)
+    ok = report("includes", includes) and report_forbidden("includes", includes)
     if args.objects and os.path.isdir(os.path.join(args.objects, "core")):
-        ok = report("calls", call_edges(args.top, args.objects)) and ok
+        calls = call_edges(args.top, args.objects)
+        ok = report("calls", calls) and report_forbidden("calls", calls) and ok
     for src in sources(args.top):
         with open(os.path.join(args.top, src), encoding="utf-8") as f:
             n = sum(1 for _ in f)
         if n > LONG_FILE:
             print(f"note: {src} has {n} lines (split by job past ~{LONG_FILE})")
-    print(("PASS" if ok else "FAIL") + " layout: no circle of folders in core/, proto/, server/")
+    print(("PASS" if ok else "FAIL") + " layout: no circle of folders in core/, proto/, server/, runner/")
     return 0 if ok else 1
 
 

@@ -22,6 +22,7 @@
 #include "cases/io_thread.h"
 #include "common/memory_budget.h"
 #include "cases/registry.h"
+#include "launch.h"
 
 static void usage(FILE *out)
 {
@@ -31,6 +32,7 @@ static void usage(FILE *out)
             "             [--max-case-memory BYTES] [--max-memory BYTES]\n"
             "             [--checkpoint-every SECONDS] [--max-connections-per-ip N]\n"
             "             [--request-timeout SECONDS] [--max-streams N] [--web DIR]\n"
+            "             [--launcher LINE] [--max-ranks N]\n"
             "\n"
             "  --listen HOST:PORT      address to serve on (default 127.0.0.1:8080; port 0 picks one)\n"
             "  --data DIR              where cases are kept (default ./fdemd-data)\n"
@@ -46,6 +48,9 @@ static void usage(FILE *out)
             "                          within this time, or is cut (default 30)\n"
             "  --max-streams N         GET /stream event streams open at once (default 64)\n"
             "  --web DIR               the web page's files (default: web/ beside bin/)\n"
+            "  --launcher LINE         starts the N ranks of a case with \"parallel\": {\"ranks\": N},\n"
+            "                          {ranks} replaced by N (default \"" LAUNCH_DEFAULT "\")\n"
+            "  --max-ranks N           most ranks a case may ask for (default: cores)\n"
             "\n"
             "Sizes accept a K, M or G suffix (powers of 1024). fdemd %s\n", FDEM_VERSION);
 }
@@ -120,7 +125,7 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
 {
     enum { OPT_MAX_CASE_MEMORY = 1000, OPT_MAX_MEMORY, OPT_CHECKPOINT_EVERY,
            OPT_MAX_CONNECTIONS_PER_IP, OPT_REQUEST_TIMEOUT, OPT_MAX_STREAMS,
-           OPT_WEB };
+           OPT_WEB, OPT_LAUNCHER, OPT_MAX_RANKS };
     static const struct option opts[] = {
         {"listen", required_argument, 0, 'l'},  {"data", required_argument, 0, 'd'},
         {"token", required_argument, 0, 't'},   {"max-upload", required_argument, 0, 'u'},
@@ -132,6 +137,8 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         {"request-timeout", required_argument, 0, OPT_REQUEST_TIMEOUT},
         {"max-streams", required_argument, 0, OPT_MAX_STREAMS},
         {"web", required_argument, 0, OPT_WEB},
+        {"launcher", required_argument, 0, OPT_LAUNCHER},
+        {"max-ranks", required_argument, 0, OPT_MAX_RANKS},
         {"help", no_argument, 0, 'h'},          {0, 0, 0, 0},
     };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
@@ -147,6 +154,8 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
     cfg->max_connections_per_ip = 16;
     cfg->request_timeout = 30;
     cfg->max_streams = 64;
+    snprintf(cfg->launcher, sizeof cfg->launcher, "%s", LAUNCH_DEFAULT);
+    cfg->max_ranks = cores > 0 ? (int)cores : 1;
     int request_timeout = 30;
     const char *env_token = getenv("FDEMD_TOKEN");
     cfg->token = env_token && *env_token ? env_token : NULL;
@@ -201,6 +210,19 @@ static int parse_options(int argc, char **argv, fdemd_config *cfg)
         case OPT_WEB:
             if (!*optarg || strlen(optarg) >= sizeof cfg->web_dir) bad = "--web takes a directory path";
             else strcpy(cfg->web_dir, optarg);
+            break;
+        case OPT_LAUNCHER: {
+            static char launcher_error[400];
+            char **words = strlen(optarg) < sizeof cfg->launcher
+                ? launch_argv(optarg, 1, NULL, launcher_error, sizeof launcher_error) : NULL;
+            if (!words && strlen(optarg) >= sizeof cfg->launcher) bad = "--launcher: the line is too long";
+            else if (!words) bad = launcher_error; /* refused now, not at each ranked start */
+            else strcpy(cfg->launcher, optarg);
+            launch_argv_free(words);
+            break;
+        }
+        case OPT_MAX_RANKS:
+            if (parse_int(optarg, 1, &cfg->max_ranks)) bad = "--max-ranks takes a positive integer";
             break;
         case 'h': usage(stdout); exit(0);
         default: usage(stderr); return -1;

@@ -22,10 +22,11 @@
 
 static const char *const top_keys[] = {
     "name", "dimension", "materials", "parts", "constraints", "stages", "gravity",
-    "gravity_amplitude", "time", "output", "history", "fluid", NULL,
+    "gravity_amplitude", "time", "output", "history", "fluid", "parallel", NULL,
 };
 static const char *const time_keys[] = {"end", "dt", "safety", NULL};
 static const char *const output_keys[] = {"interval", "fields", NULL};
+static const char *const parallel_keys[] = {"ranks", NULL};
 /* In CASE_FIELD_* bit order: names[k] is bit 1u << k. */
 static const char *const field_names[] = {"position", "velocity", "stress", "damage",
                                           "strain", "principal_stress", "displacement"};
@@ -143,6 +144,22 @@ static void case_read_output(case_doc *doc, const json_t *output)
     if (fields) case_read_fields(doc, fields);
 }
 
+/* "parallel": {"ranks": N} (contract 6.5): how many MPI ranks run the
+ * case, 1 (in the daemon's process) by default. Whether N is allowed here
+ * (--max-ranks) is the daemon's to say: the document is the same case on
+ * any machine. */
+static void case_read_parallel(case_doc *doc, const json_t *parallel)
+{
+    doc->ranks = 1;
+    if (!parallel) return;
+    if (!case_expect_object(doc, parallel, "/parallel")) return;
+    case_check_keys(doc, parallel, "/parallel", parallel_keys, "\"parallel\"");
+    json_t *ranks = json_object_get(parallel, "ranks");
+    long n = 1;
+    if (ranks && case_read_integer(doc, ranks, "/parallel/ranks", 1, CASE_MAX_RANKS, &n))
+        doc->ranks = (int)n;
+}
+
 /* 2 (the default) or 3. Everything with vectors or shapes depends on it,
  * so it is read first; an invalid value leaves 2 so the rest of the
  * document is still checked. */
@@ -201,6 +218,7 @@ static void case_read(case_doc *doc, const json_t *root)
     json_t *history = json_object_get(root, "history");
     if (history) case_read_history(doc, history);
     case_check_history_rows(doc);
+    case_read_parallel(doc, json_object_get(root, "parallel"));
 }
 
 /* ---------------------------------------------------------------- pass 3 */
@@ -368,6 +386,7 @@ static void case_fill_info(const case_doc *doc, case_info *info)
     info->fields = doc->fields;
     info->part_count = doc->part_count;
     info->constraint_count = doc->constraint_count;
+    info->ranks = doc->ranks;
     info->fracture = 0;
     for (int i = 0; i < doc->part_count; i++) info->fracture |= doc->parts[i].fracture;
     info->stage_count = doc->stage_count;

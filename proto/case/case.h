@@ -70,6 +70,9 @@ enum case_field {
  * per point and constraint). */
 #define CASE_MAX_HISTORY_POINTS 64
 #define CASE_HISTORY_NAME 64
+/* The most ranks a case may ask for in "parallel" (the daemon's --max-ranks
+ * is usually far lower). */
+#define CASE_MAX_RANKS 65536
 /* Room in case_info for the part and material names: 64 names of 127
  * bytes, or many more short ones. */
 #define CASE_NAMES_BYTES 8192
@@ -85,6 +88,7 @@ typedef struct case_info {
     unsigned fields;        /* CASE_FIELD_* written to snapshots */
     int part_count;
     int constraint_count;
+    int ranks;              /* "parallel": {"ranks"} (contract 6.5), 1 without it */
     int fracture;           /* some part fractures */
     int stage_count;        /* entries of "stages" (0: the case has none) */
     char stage_names[CASE_MAX_STAGES][CASE_STAGE_NAME]; /* each stage's "name" */

@@ -165,6 +165,7 @@ typedef struct case_doc {
     int history_point_count;
     int has_fluid;           /* "fluid" was in the document (case_fluid.c) */
     fdem_fluid_def fluid;
+    int ranks;               /* "parallel": {"ranks"}, 1 without it */
 } case_doc;
 
 /* case_fluid.c: the top-level "fluid" (read before the materials and

@@ -327,7 +327,7 @@ int result_read_events(result_file *f, const char *path, double since, fdem_even
     if (err && errlen) err[0] = '\0';
     *dimension = 0;
     if (f) return events_read_open(f->file, f->events, since, out, count, dimension, err, errlen);
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t file = result_open_read(path);
     if (file < 0) {
         result_fail(err, errlen, "cannot open %s to read its events", path);
         return -1;

@@ -345,7 +345,7 @@ int result_read_frame(result_file *f, const char *path, const result_frame_reque
     if (err && errlen) err[0] = '\0';
     if (f)
         return frame_build(f->file, f, q, out, size, err, errlen);
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t file = result_open_read(path);
     if (file < 0) {
         result_fail(err, errlen, "cannot open %s to read a snapshot", path);
         return -1;

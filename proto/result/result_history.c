@@ -401,7 +401,7 @@ int result_read_history(result_file *f, const char *path, double since, history_
         hist_read_names(f->file, names);
         return hist_read(f, since, out, count, err, errlen);
     }
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t file = result_open_read(path);
     if (file < 0) {
         result_fail(err, errlen, "cannot open %s to read its history", path);
         return -1;

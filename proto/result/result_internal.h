@@ -97,6 +97,11 @@ hid_t utf8_string_type(void);
 int write_string_attribute(hid_t obj, const char *name, const char *value);
 /* 1 when the file's root says format = RESULT_FORMAT. */
 int has_result_format(hid_t file);
+/* Opens a result file read-only from another process than its writer:
+ * with SWMR reading (a file a rank process is still writing opens), else
+ * plainly (a file of an HDF5 without SWMR's format). H5I_INVALID_HID when
+ * neither opens. */
+hid_t result_open_read(const char *path);
 hid_t series_mem_type(int kind);
 hid_t series_file_type(int kind);
 /* Which /snapshots datasets this model has, and their per-snapshot shape. */

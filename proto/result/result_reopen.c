@@ -223,7 +223,7 @@ int result_check_file(const char *path, char *err, size_t errlen)
         snprintf(err, errlen, "%s is not a regular file", path);
         return -1;
     }
-    hid_t file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    hid_t file = result_open_read(path);
     if (file < 0) {
         result_fail(err, errlen, "%s does not open as HDF5", path);
         return -1;
@@ -237,4 +237,14 @@ int result_check_file(const char *path, char *err, size_t errlen)
         return -1;
     }
     return 0;
+}
+
+hid_t result_open_read(const char *path)
+{
+    hid_t file = H5Fopen(path, H5F_ACC_RDONLY | H5F_ACC_SWMR_READ, H5P_DEFAULT);
+    if (file < 0) {
+        H5Eclear2(H5E_DEFAULT);
+        file = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    }
+    return file;
 }

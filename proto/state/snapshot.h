@@ -19,9 +19,11 @@
  *
  * Folder proto/state/, a model's state on its way out of the engine: owns
  * this header (the copy, snapshot.c) and the JSON of GET /cases/ID/state
- * (state_json.h) and /cases/ID/events (events_json.h). May call core/ and
- * proto/case/ (only the CASE_FIELD_* bits of case.h). Called by
- * proto/result/ (which writes snapshots), server/ and the unit tests.
+ * (state_json.h) and /cases/ID/events (events_json.h), the status
+ * figures (status_json.h) and the steps outputs fall on (output_grid.h).
+ * May call core/ and proto/case/ (the CASE_FIELD_* bits and case_info of
+ * case.h). Called by proto/result/ (which writes snapshots), server/,
+ * runner/ and the unit tests.
  */
 #ifndef FDEM_SNAPSHOT_H
 #define FDEM_SNAPSHOT_H

@@ -28,7 +28,7 @@
 #include "io_thread.h"
 #include "json/json_patch.h"
 #include "common/memory_budget.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "registry_internal.h"
 
 /* ---------------------------------------------------------------- reading */

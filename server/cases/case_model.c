@@ -18,9 +18,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "io_thread.h"
-#include "store/persist.h"
+#include "files/persist.h"
 
 #define CASE_MODEL_MAX_CHECKPOINT ((size_t)1 << 40)
 
@@ -268,7 +268,7 @@ int case_model_attach(server_case *c, fdem_model *model, const case_info *info, 
     return 0;
 }
 
-void case_model_drop(server_case *c)
+void case_model_free(server_case *c)
 {
     io_close(c);
     pthread_mutex_lock(&c->model_lock);
@@ -277,6 +277,11 @@ void case_model_drop(server_case *c)
     pthread_mutex_unlock(&c->model_lock);
     if (model)
         fdem_model_destroy(model);
+}
+
+void case_model_drop(server_case *c)
+{
+    case_model_free(c);
     membudget_release(&c->reserve);
 }
 

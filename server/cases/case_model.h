@@ -31,11 +31,12 @@
 #define FDEMD_CASE_MODEL_H
 
 #include "common/memory_budget.h"
+#include "files/checkpoint_file.h"
 #include "registry.h"
 
-#define CASE_CHECKPOINT "checkpoint.bin"
-#define CASE_END_CHECKPOINT "checkpoint-end.bin"
-#define CASE_RESUME_CHECKPOINT "checkpoint-resume.bin"
+#define CASE_CHECKPOINT CHECKPOINT_FILE_LATEST
+#define CASE_END_CHECKPOINT CHECKPOINT_FILE_END
+#define CASE_RESUME_CHECKPOINT CHECKPOINT_FILE_RESUME
 
 /* The largest case.json read back (the upload limit is far below it). */
 #define CASE_MODEL_MAX_DOCUMENT ((size_t)1 << 34)
@@ -74,6 +75,9 @@ case_model_rc case_model_build(server_case *c, membudget_lease *lease, fdem_mode
 int case_model_attach(server_case *c, fdem_model *model, const case_info *info, int close_after,
                       char *err, size_t errlen);
 void case_model_drop(server_case *c);
+/* case_model_drop() but for the reserve, which stays: a ranked case's
+ * ranks hold the model in their own processes meanwhile. */
+void case_model_free(server_case *c);
 /* Removes CASE_RESUME_CHECKPOINT (a newer checkpoint.bin is durable). */
 void case_model_forget_resume(server_case *c);
 

@@ -48,17 +48,6 @@ int id_is_valid(const char *s)
     return s[CASE_ID_LEN] == '\0';
 }
 
-void iso_time_now(char *out, size_t size)
-{
-    struct timespec ts;
-    struct tm tm;
-    clock_gettime(CLOCK_REALTIME, &ts);
-    gmtime_r(&ts.tv_sec, &tm);
-    char base[24];
-    strftime(base, sizeof base, "%Y-%m-%dT%H:%M:%S", &tm);
-    snprintf(out, size, "%.19s.%03dZ", base, (int)(ts.tv_nsec / 1000000L));
-}
-
 /* ------------------------------------------------------------ lifetime */
 
 server_case *case_new(void)

@@ -9,6 +9,7 @@
  * every contact-heavy case.
  */
 #include "case_sizing.h"
+#include "state/status_json.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -18,31 +19,18 @@
 #include "case_model.h"
 #include "sizing_probe.h"
 #include "state/snapshot.h"
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "common/clock.h"
 
-
-int sizing_is_last_step(double t0, double dt, double end)
-{
-    return t0 + dt >= end - 1e-9 * dt; /* no sliver of a step left over */
-}
 
 double sizing_steps_to_end(double t0, double end, double dt)
 {
     if (!(dt > 0) || !(end > t0))
         return 0;
     /* Step k (from 0) starts at t0 + k dt and is the last one when
-     * sizing_is_last_step() holds: the first k >= (end - 1e-9 dt - t0)/dt - 1. */
+     * output_is_last_step() (proto/state/output_grid.h) holds: the first k >= (end - 1e-9 dt - t0)/dt - 1. */
     double k = ceil((end - 1e-9 * dt - t0) / dt - 1.0);
     return (k > 0 ? k : 0) + 1;
-}
-
-double sizing_output_interval(const case_info *info)
-{
-    double interval = info->output_interval;
-    if (!(interval > 0))
-        interval = info->end_time / 100.0;
-    return interval > 0 ? interval : 1.0;
 }
 
 /* Snapshot 0, one at the first step at or after each output time (several
@@ -52,7 +40,7 @@ double sizing_output_interval(const case_info *info)
  * the worker's tolerance of 1e-9 dt. */
 static double sizing_snapshots(const case_info *info, double t0, double dt, double steps)
 {
-    double interval = sizing_output_interval(info);
+    double interval = output_snapshot_interval(info);
     double last_start = t0 + (steps - 1) * dt + 1e-9 * dt;
     double done_before = floor(t0 / interval * (1 + 1e-12) + 1e-9);
     double inside = floor(last_start / interval * (1 + 1e-12)) - done_before;
@@ -290,37 +278,32 @@ static json_t *sizing_count_json(double n)
     return n < 9007199254740992.0 ? json_integer((json_int_t)n) : json_real(n);
 }
 
-static json_t *sizing_number_json(double x)
-{
-    return isfinite(x) ? json_real(x) : json_null();
-}
-
 json_t *case_sizing_json(const case_sizing *s)
 {
     json_t *o = json_object();
     json_object_set_new(o, "nodes", json_integer(s->nodes));
     json_object_set_new(o, "elements", json_integer(s->elements));
     json_object_set_new(o, "joints", json_integer(s->joints));
-    json_object_set_new(o, "dt", sizing_number_json(s->dt));
+    json_object_set_new(o, "dt", status_number_or_null(s->dt));
     json_object_set_new(o, "steps", sizing_count_json(s->steps));
     json_object_set_new(o, "snapshots", sizing_count_json(s->snapshots));
     json_object_set_new(o, "memory_bytes", sizing_count_json(s->memory_bytes));
     json_object_set_new(o, "result_bytes", sizing_count_json(ceil(s->result_bytes)));
-    json_object_set_new(o, "estimated_seconds", sizing_number_json(s->estimated_seconds));
+    json_object_set_new(o, "estimated_seconds", status_number_or_null(s->estimated_seconds));
     if (s->fluid) { /* the flow's step: null while no fluid can flow yet */
-        json_object_set_new(o, "fluid_step", sizing_number_json(s->fluid_step));
+        json_object_set_new(o, "fluid_step", status_number_or_null(s->fluid_step));
         json_object_set_new(o, "fluid_subcycles", json_integer(s->fluid_subcycles));
     }
     /* what the estimate was made of (docs/api.md), to judge it by */
     json_t *parts = json_object();
-    json_object_set_new(parts, "step_seconds", sizing_number_json(s->step_seconds));
-    json_object_set_new(parts, "load_factor", sizing_number_json(s->load_factor));
-    json_object_set_new(parts, "probe_wall_over_cpu", sizing_number_json(s->probe_wall_over_cpu));
-    json_object_set_new(parts, "later_step_seconds", sizing_number_json(s->later_step_seconds));
-    json_object_set_new(parts, "cracked_step_seconds", sizing_number_json(s->cracked_step_seconds));
+    json_object_set_new(parts, "step_seconds", status_number_or_null(s->step_seconds));
+    json_object_set_new(parts, "load_factor", status_number_or_null(s->load_factor));
+    json_object_set_new(parts, "probe_wall_over_cpu", status_number_or_null(s->probe_wall_over_cpu));
+    json_object_set_new(parts, "later_step_seconds", status_number_or_null(s->later_step_seconds));
+    json_object_set_new(parts, "cracked_step_seconds", status_number_or_null(s->cracked_step_seconds));
     json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
-    json_object_set_new(parts, "broken_joints", sizing_number_json(s->broken_joints));
-    json_object_set_new(parts, "snapshot_seconds", sizing_number_json(s->snapshot_copy_seconds));
+    json_object_set_new(parts, "broken_joints", status_number_or_null(s->broken_joints));
+    json_object_set_new(parts, "snapshot_seconds", status_number_or_null(s->snapshot_copy_seconds));
     json_object_set_new(o, "estimate", parts);
     char warning[400];
     if (case_sizing_warning(s, warning, sizeof warning))

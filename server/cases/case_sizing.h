@@ -4,10 +4,10 @@
  * run for hours (contract 5.4).
  *
  * Contract:
- *  - sizing_is_last_step() is the worker's rule for the one step that is
- *    cut to land on time.end; sizing_steps_to_end() counts steps under the
- *    same rule, so a dry run's `steps` is the number the run then takes.
- *  - sizing_output_interval() is the snapshot interval the worker uses.
+ *  - sizing_steps_to_end() counts steps under output_is_last_step()
+ *    (proto/state/output_grid.h), the rule of the one step cut to land on
+ *    time.end, so a dry run's `steps` is the number the run then takes;
+ *    the snapshots are counted on output_snapshot_interval() likewise.
  *  - case_sizing_measure() sizes a model just built from a case document
  *    (model_bytes: the builder's own estimate, see case_model_build_upload):
  *    counts, dt, steps, snapshots, memory charged while it runs, result.h5
@@ -30,6 +30,7 @@
 #include <stdint.h>
 
 #include "case/case.h"
+#include "state/output_grid.h"
 #include "fdem.h"
 
 /* A case whose estimated run is at least this long gets a warning. */
@@ -56,9 +57,7 @@ typedef struct case_sizing {
     int fluid_subcycles;      /* flow steps a mechanical step takes, at t = 0 */
 } case_sizing;
 
-int sizing_is_last_step(double t0, double dt, double end);
 double sizing_steps_to_end(double t0, double end, double dt);
-double sizing_output_interval(const case_info *info);
 
 void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
                          int threads, double snapshot_seconds, case_sizing *out);

@@ -12,9 +12,10 @@
 #include <string.h>
 
 #include "case_feed.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
+#include "state/status_json.h"
 
 void case_publish(server_case *c, const case_figures *fig)
 {
@@ -36,162 +37,35 @@ void case_set_snapshots(server_case *c, int snapshots)
     pthread_mutex_unlock(&c->lock);
 }
 
-void case_figures_stage(case_figures *fig, const fdem_model *model, const case_info *info)
-{
-    fig->stage = fdem_stage_index(model);
-    const char *name = case_stage_name(info, fig->stage);
-    snprintf(fig->stage_name, sizeof fig->stage_name, "%s", name ? name : "");
-}
-
 /* Figures straight from the model, for cases no worker is stepping. */
 void case_publish_from_model(server_case *c)
 {
     if (!c->model)
         return;
     case_figures fig;
-    memset(&fig, 0, sizeof fig);
-    fig.step = fdem_get_step(c->model);
-    fig.time = fdem_get_time(c->model);
-    fig.dt = fdem_get_dt(c->model);
-    fig.counts = fdem_get_counts(c->model);
-    fig.energy = fdem_get_energy(c->model);
-    fig.fluid = fdem_get_fluid(c->model);
-    fig.snapshots = -1;
-    fig.elapsed = -1;
-    fig.eta = NAN;
-    case_figures_stage(&fig, c->model, &c->info);
+    status_figures_of_model(&fig, c->model, &c->info);
     case_publish(c, &fig);
-}
-
-/* JSON has no NaN or infinity; a failed case may hold them. */
-static json_t *json_number_or_null(double x)
-{
-    return isfinite(x) ? json_real(x) : json_null();
-}
-
-/* The status' energy object, member by member (contract 5.1): written by
- * case_status_json, read back from status.json by case_load_figures. */
-static const struct { const char *key; size_t offset; } energy_accounts[] = {
-    {"kinetic", offsetof(fdem_energy, kinetic)}, {"elastic", offsetof(fdem_energy, elastic)},
-    {"joint", offsetof(fdem_energy, joint)}, {"contact", offsetof(fdem_energy, contact)},
-    {"friction", offsetof(fdem_energy, friction)}, {"fracture", offsetof(fdem_energy, fracture)},
-    {"damping", offsetof(fdem_energy, damping)},
-    {"gravity_work", offsetof(fdem_energy, gravity_work)},
-    {"external_work", offsetof(fdem_energy, external_work)},
-    {"excavated", offsetof(fdem_energy, excavated)},
-    {"residual", offsetof(fdem_energy, residual)},
-};
-#define ENERGY_ACCOUNT_COUNT (sizeof energy_accounts / sizeof energy_accounts[0])
-
-void case_energy_from_json(fdem_energy *energy, const json_t *o)
-{
-    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++) {
-        const json_t *v = json_object_get(o, energy_accounts[i].key);
-        /* a status.json from before stages has no "excavated": nothing was */
-        double missing = strcmp(energy_accounts[i].key, "excavated") == 0 && o && !v ? 0.0 : NAN;
-        *(double *)((char *)energy + energy_accounts[i].offset) =
-            json_is_number(v) ? json_number_value(v) : missing;
-    }
 }
 
 void case_mark_ended_locked(server_case *c, case_state state)
 {
     if (case_state_is_terminal(state) && !c->finished_at[0])
-        iso_time_now(c->finished_at, sizeof c->finished_at);
+        status_time_now(c->finished_at, sizeof c->finished_at);
 }
-
-/* Progress 1 means finished: a case that has stepped to its end but is
- * still writing its last snapshot (or was stopped there) shows just under
- * it, so no client prints "running 100 %". */
-#define CASE_PROGRESS_UNFINISHED_MAX 0.999
 
 static double case_progress(case_state state, double time, double end)
 {
-    if (state == CASE_FINISHED)
-        return 1.0;
-    double progress = end > 0 ? time / end : 0.0;
-    if (!(progress >= 0))
-        progress = 0;
-    return progress > CASE_PROGRESS_UNFINISHED_MAX ? CASE_PROGRESS_UNFINISHED_MAX : progress;
+    return status_progress(state == CASE_FINISHED, time, end);
 }
 
-/* A running case shows its current speed; any other the mean over every
- * step it took (step / elapsed), so a finished case does not show 0. */
 static double case_steps_per_second(case_state state, const case_figures *f)
 {
-    if (state == CASE_RUNNING)
-        return f->steps_per_second;
-    return f->elapsed > 0 ? (double)f->step / f->elapsed : 0.0;
+    return status_steps_per_second(state == CASE_RUNNING, f);
 }
 
 static json_t *json_string_or_null(const char *s)
 {
     return s[0] ? json_string(s) : json_null();
-}
-
-/* "stage": {"index", "name"} of a case with stages (contract 6.1), null
- * without them. Written to status.json too: a case loaded from it shows
- * its last stage without a model (case_stage_from_json). */
-static json_t *case_stage_json(const case_figures *f)
-{
-    if (f->stage < 0) return json_null();
-    json_t *o = json_object();
-    if (!o) return NULL;
-    json_object_set_new(o, "index", json_integer(f->stage));
-    json_object_set_new(o, "name", json_string(f->stage_name));
-    return o;
-}
-
-void case_stage_from_json(case_figures *f, const json_t *stage)
-{
-    const json_t *given = json_object_get(stage, "index");
-    json_int_t index = json_integer_value(given);
-    const char *name = json_string_value(json_object_get(stage, "name"));
-    f->stage = json_is_integer(given) && index >= 0 && index < CASE_MAX_STAGES ? (int)index : -1;
-    snprintf(f->stage_name, sizeof f->stage_name, "%s", f->stage >= 0 && name ? name : "");
-}
-
-/* "fluid" (contract 6.4): null without fluid; the flow's step and subcycle
- * count beside the contract's three (docs/api.md). */
-static json_t *case_fluid_json(const fdem_fluid_status *f)
-{
-    if (!f->enabled) return json_null();
-    json_t *o = json_object();
-    if (!o) return NULL;
-    json_object_set_new(o, "injected_volume", json_number_or_null(f->injected_volume));
-    json_object_set_new(o, "stored_volume", json_number_or_null(f->stored_volume));
-    json_object_set_new(o, "source_pressure", json_number_or_null(f->source_pressure));
-    json_object_set_new(o, "fluid_step", json_number_or_null(f->flow_step));
-    json_object_set_new(o, "fluid_subcycles", json_integer(f->subcycles));
-    json_object_set_new(o, "open_joints", json_integer(f->open_joints));
-    return o;
-}
-
-/* Read back by case_load_figures: a case loaded from status.json shows its
- * fluid (and writes it again) without a model. */
-void case_fluid_from_json(case_figures *f, const json_t *fluid, const json_t *energy)
-{
-    memset(&f->fluid, 0, sizeof f->fluid);
-    if (!json_is_object(fluid)) return;
-    static const struct { const char *key; size_t offset; } figures[] = {
-        {"injected_volume", offsetof(fdem_fluid_status, injected_volume)},
-        {"stored_volume", offsetof(fdem_fluid_status, stored_volume)},
-        {"source_pressure", offsetof(fdem_fluid_status, source_pressure)},
-        {"fluid_step", offsetof(fdem_fluid_status, flow_step)},
-    };
-    f->fluid.enabled = 1;
-    for (size_t i = 0; i < sizeof figures / sizeof figures[0]; i++) {
-        const json_t *v = json_object_get(fluid, figures[i].key);
-        *(double *)((char *)&f->fluid + figures[i].offset) =
-            json_is_number(v) ? json_number_value(v) : NAN;
-    }
-    f->fluid.subcycles = (int)json_integer_value(json_object_get(fluid, "fluid_subcycles"));
-    f->fluid.open_joints = (int)json_integer_value(json_object_get(fluid, "open_joints"));
-    const json_t *work = json_object_get(energy, "fluid_work");
-    const json_t *dissipation = json_object_get(energy, "fluid_dissipation");
-    f->energy.fluid_work = json_is_number(work) ? json_number_value(work) : NAN;
-    f->energy.fluid_dissipation =
-        json_is_number(dissipation) ? json_number_value(dissipation) : NAN;
 }
 
 json_t *case_status_json(server_case *c)
@@ -207,46 +81,20 @@ json_t *case_status_json(server_case *c)
     pthread_mutex_unlock(&c->lock);
 
     double end = c->info.end_time;
-    double progress = case_progress(state, f.time, end);
-    json_t *energy = json_object();
-    for (size_t i = 0; i < ENERGY_ACCOUNT_COUNT; i++)
-        json_object_set_new(energy, energy_accounts[i].key,
-                            json_number_or_null(*(const double *)((const char *)&f.energy +
-                                                                  energy_accounts[i].offset)));
-    if (energy && f.fluid.enabled) {
-        json_object_set_new(energy, "fluid_work", json_number_or_null(f.energy.fluid_work));
-        json_object_set_new(energy, "fluid_dissipation",
-                            json_number_or_null(f.energy.fluid_dissipation));
-    }
     json_t *o = json_object();
     json_object_set_new(o, "id", json_string(c->id));
     json_object_set_new(o, "name", json_string(c->info.name));
     json_object_set_new(o, "state", json_string(case_state_name(state)));
-    json_object_set_new(o, "step", json_integer((json_int_t)f.step));
-    json_object_set_new(o, "time", json_number_or_null(f.time));
-    json_object_set_new(o, "end_time", json_number_or_null(end));
-    json_object_set_new(o, "progress", json_number_or_null(progress));
-    json_object_set_new(o, "dt", json_number_or_null(f.dt));
-    json_object_set_new(o, "dimension", json_integer(f.counts.dimension ? f.counts.dimension : 2));
-    json_object_set_new(o, "nodes", json_integer(f.counts.nodes));
-    json_object_set_new(o, "elements", json_integer(f.counts.elements));
-    json_object_set_new(o, "joints", json_integer(f.counts.joints));
-    json_object_set_new(o, "broken_joints", json_integer(f.counts.broken_joints));
-    json_object_set_new(o, "fragments", json_integer(f.counts.fragments));
-    json_object_set_new(o, "contacts", json_integer(f.counts.contacts));
-    json_object_set_new(o, "stage", case_stage_json(&f));
-    json_object_set_new(o, "fluid", case_fluid_json(&f.fluid));
-    json_object_set_new(o, "snapshots", json_integer(f.snapshots));
-    json_object_set_new(o, "energy", energy ? energy : json_null());
-    json_object_set_new(o, "steps_per_second",
-                        json_number_or_null(case_steps_per_second(state, &f)));
+    status_put_figures(o, &f, end, case_progress(state, f.time, end),
+                       case_steps_per_second(state, &f));
+    json_object_set_new(o, "ranks", json_integer(c->info.ranks > 1 ? c->info.ranks : 1));
     json_object_set_new(o, "error", error[0] ? json_string(error) : json_null());
     json_object_set_new(o, "created", json_string(c->created));
     json_object_set_new(o, "started", json_string_or_null(started));
     json_object_set_new(o, "finished_at", json_string_or_null(finished_at));
-    json_object_set_new(o, "elapsed", json_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
-    json_object_set_new(o, "estimated_seconds", json_number_or_null(estimated_seconds));
-    json_object_set_new(o, "eta", json_number_or_null(state == CASE_RUNNING ? f.eta : NAN));
+    json_object_set_new(o, "elapsed", status_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
+    json_object_set_new(o, "estimated_seconds", status_number_or_null(estimated_seconds));
+    json_object_set_new(o, "eta", status_number_or_null(state == CASE_RUNNING ? f.eta : NAN));
     json_object_set_new(o, "warnings", case_warnings_json(c));
     return o;
 }
@@ -368,7 +216,7 @@ int case_persist_status_as(server_case *c, case_state state, char *ended, size_t
         snprintf(ended, ended_size, "%s", c->finished_at);
         pthread_mutex_unlock(&c->lock);
         if (!ended[0])
-            iso_time_now(ended, ended_size);
+            status_time_now(ended, ended_size);
         if (o)
             json_object_set_new(o, "finished_at", json_string(ended));
     }

@@ -12,30 +12,10 @@
 #include "registry.h"
 #include "registry_internal.h"
 
-/* A status stays small whatever a document or a run does. */
-#define CASE_WARNINGS_MAX 100
-
-static int warning_known(const json_t *list, const char *pointer, const char *message)
-{
-    size_t i;
-    const json_t *w;
-    json_array_foreach(list, i, w)
-        if (strcmp(json_string_value(json_object_get(w, "pointer")), pointer) == 0 &&
-            strcmp(json_string_value(json_object_get(w, "message")), message) == 0)
-            return 1;
-    return 0;
-}
-
 static void warning_add_locked(server_case *c, const char *pointer, const char *message)
 {
     if (!c->warnings) c->warnings = json_array();
-    if (!c->warnings || json_array_size(c->warnings) >= CASE_WARNINGS_MAX ||
-        warning_known(c->warnings, pointer, message))
-        return;
-    json_t *w = json_object();
-    json_object_set_new(w, "pointer", json_string(pointer));
-    json_object_set_new(w, "message", json_string(message));
-    json_array_append_new(c->warnings, w);
+    status_warning_add(c->warnings, pointer, message);
 }
 
 void case_add_warning(server_case *c, const char *pointer, const char *message)
@@ -43,18 +23,6 @@ void case_add_warning(server_case *c, const char *pointer, const char *message)
     pthread_mutex_lock(&c->lock);
     warning_add_locked(c, pointer, message);
     pthread_mutex_unlock(&c->lock);
-}
-
-int case_has_warning_starting(server_case *c, const char *start)
-{
-    size_t i, n = strlen(start);
-    const json_t *w;
-    int found = 0;
-    pthread_mutex_lock(&c->lock);
-    json_array_foreach(c->warnings, i, w)
-        found |= strncmp(json_string_value(json_object_get(w, "message")), start, n) == 0;
-    pthread_mutex_unlock(&c->lock);
-    return found;
 }
 
 void case_add_warnings(server_case *c, const problems *w)

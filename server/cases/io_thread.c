@@ -22,7 +22,7 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "common/clock.h"
 
 typedef enum io_job_kind {
@@ -279,6 +279,14 @@ static void io_do_fetch(io_job *j)
     struct stat st;
     j->rc = -1;
     j->http_status = 500;
+    if (!c->result && atomic_load(&c->ranks_running)) {
+        /* another process writes it: a byte copy could catch a write half done */
+        snprintf(j->err, sizeof j->err, "the case runs on %d ranks, which write result.h5 "
+                 "themselves: read it in place (HDF5 SWMR, e.g. h5py's swmr=True) or download "
+                 "it once the case is paused, stopped or finished", c->info.ranks);
+        j->http_status = 409;
+        return;
+    }
     if (c->result) {
         if (result_flush(c->result, j->err, sizeof j->err) != 0)
             return;

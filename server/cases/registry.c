@@ -25,7 +25,7 @@
 #include "case_model.h"
 #include "case_sizing.h"
 #include "io_thread.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "registry_internal.h"
 #include "worker.h"
 
@@ -117,7 +117,7 @@ static int case_start_locked(server_case *c)
         reg_running++;
         c->state = CASE_RUNNING;
         if (!c->started[0])
-            iso_time_now(c->started, sizeof c->started);
+            status_time_now(c->started, sizeof c->started);
     } else {
         c->state = CASE_QUEUED;
         c->queue_seq = ++reg_next_queue_seq;

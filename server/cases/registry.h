@@ -10,7 +10,7 @@
  *    (io_thread.c); the feed of case events GET /stream serves
  *    (case_feed.c). The state machine, the workers and the I/O thread call
  *    each other: that circle stays inside this folder.
- *  - May call: store/ (persist.h, checkpoint_file.h, fault_point.h),
+ *  - May call: store/ (fault_point.h), proto/files/ (persist.h, checkpoint_file.h),
  *    common/ (config.h, memory_budget.h), proto/ and core/.
  *  - Called by: http/ and main.c; it never calls http/.
  */
@@ -48,6 +48,7 @@
 #include "json/problems.h"
 #include "result/result.h"
 #include "state/snapshot.h"
+#include "state/status_json.h"
 
 typedef enum case_state {
     CASE_CREATED, CASE_QUEUED, CASE_RUNNING, CASE_PAUSED,
@@ -59,20 +60,8 @@ typedef enum worker_command {
     WORKER_GO = 0, WORKER_PAUSE, WORKER_STOP, WORKER_ABANDON, /* abandon: case is being deleted */
 } worker_command;
 
-/* Figures of the last published step (status object). */
-typedef struct case_figures {
-    int64_t step;
-    double time, dt;
-    fdem_counts counts;
-    fdem_energy energy;
-    double steps_per_second;
-    int snapshots;
-    double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
-    double eta;                /* wall seconds left at the recent speed; NAN: unknown */
-    int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
-    char stage_name[CASE_STAGE_NAME];
-    fdem_fluid_status fluid;   /* contract 6.4; enabled 0 without fluid */
-} case_figures;
+/* Figures of the last published step (status object, proto/state/status_json.h). */
+typedef run_figures case_figures;
 
 #define CASE_ID_LEN 16
 
@@ -122,6 +111,7 @@ typedef struct server_case {
     _Atomic int io_failed;
     char io_error[512];        /* guarded by `lock` */
     _Atomic int io_hold;       /* downloads copying result.h5: writes wait */
+    _Atomic int ranks_running; /* a ranked case's processes write its files (worker_ranked.c) */
 
     json_t *warnings;          /* contract 6.2 "warnings" (`lock`, case_warnings.c) */
     int stop_pending;          /* a stop is making `stopped` durable: the queue skips the
@@ -228,8 +218,6 @@ void case_record_io_failure(server_case *c, const char *file, const char *reason
 
 /* Called by the worker and the I/O thread. */
 void case_publish(server_case *c, const case_figures *fig);
-/* fig->stage and fig->stage_name of `model`, the names from `info`. */
-void case_figures_stage(case_figures *fig, const fdem_model *model, const case_info *info);
 void case_set_snapshots(server_case *c, int snapshots);
 /* The worker's last words: sets the final state, frees its slot, persists
  * the status and starts queued cases (the worker then clears worker_active). */

@@ -17,10 +17,10 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "case_sizing.h"
 #include "io_thread.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "registry_internal.h"
 
 /* A case id: CASE_ID_LEN hex digits from the kernel's random source. */
@@ -102,6 +102,15 @@ static fdem_model *registry_build_upload(const char *body, size_t size, membudge
         if (p->count == 0)
             problems_add(p, 422, "", "the case could not be built");
     }
+    int max_ranks = registry_config()->max_ranks;
+    if (model && info->ranks > max_ranks) {
+        /* the document is a valid case; this daemon runs it on fewer ranks */
+        fdem_model_destroy(model);
+        model = NULL;
+        *http_status = 422;
+        problems_add(p, 422, "/parallel/ranks", "this daemon runs a case on at most %d ranks "
+                     "(--max-ranks), got %d", max_ranks, info->ranks);
+    }
     return model;
 }
 
@@ -144,7 +153,7 @@ static server_case *registry_store_upload(const char *body, size_t size, int sta
     /* they join the case before its first status.json is written */
     case_add_warnings(c, &w);
     problems_free(&w);
-    iso_time_now(c->created, sizeof c->created);
+    status_time_now(c->created, sizeof c->created);
     *http_status = 500;
     char final_dir[sizeof c->dir];
     if (case_make_dir(c, final_dir, sizeof final_dir) != 0) {
@@ -242,6 +251,7 @@ json_t *registry_dry_run(const char *body, size_t size, problems *p, int *http_s
                         &sizing);
         fdem_model_destroy(model);
         answer = case_sizing_json(&sizing);
+        if (answer) json_object_set_new(answer, "ranks", json_integer(info.ranks));
         if (answer) json_object_set_new(answer, "warnings", problems_warnings_json(&w));
         *http_status = 200;
     }

@@ -19,26 +19,14 @@ server_case *case_new(void);
  * -1 when the list cannot grow (the case is not listed). */
 int registry_admit(server_case *c, int start, membudget_lease *lease, size_t cost);
 int case_state_is_terminal(case_state s);
-void iso_time_now(char *out, size_t size);
 /* Figures of the case's model into its published figures. */
 void case_publish_from_model(server_case *c);
-/* The status' "stage" back into fig->stage and fig->stage_name (null or
- * missing: -1, no stages). */
-void case_stage_from_json(case_figures *f, const json_t *stage);
-/* The status' energy object back into an fdem_energy (missing: NaN). */
-void case_energy_from_json(fdem_energy *energy, const json_t *o);
-/* The status' "fluid" object (null: no fluid) back into f->fluid, and
- * energy's fluid_work and fluid_dissipation into f->energy. */
-void case_fluid_from_json(case_figures *f, const json_t *fluid, const json_t *energy);
 
 /* case_warnings.c: the case's "warnings" (contract 6.2), each kept once
  * (pointer and message), at most 100; a JSON copy for the status; read
  * back from status.json's "warnings"; a problem list as such an array. */
 void case_add_warning(server_case *c, const char *pointer, const char *message);
 void case_add_warnings(server_case *c, const problems *w);
-/* Whether some warning's message starts with `start` (a pair of elements
- * found again after a restart, at another step, is not listed twice). */
-int case_has_warning_starting(server_case *c, const char *start);
 json_t *case_warnings_json(server_case *c);
 void case_warnings_from_json(server_case *c, const json_t *list);
 json_t *problems_warnings_json(const problems *w);

@@ -22,7 +22,7 @@
 #include "case_model.h"
 #include "case_continue.h"
 #include "common/memory_budget.h"
-#include "store/persist.h"
+#include "files/persist.h"
 #include "registry.h"
 #include "registry_internal.h"
 
@@ -44,38 +44,16 @@ static double status_number(const json_t *o, const char *key)
     return json_is_number(v) ? json_number_value(v) : NAN;
 }
 
-static int status_count(const json_t *o, const char *key)
-{
-    json_int_t v = json_integer_value(json_object_get(o, key));
-    return v >= 0 && v <= INT32_MAX ? (int)v : 0;
-}
-
 /* The figures the case last published: what its status shows until it
  * runs again (no model is built to find them). */
 static void case_load_figures(server_case *c, const json_t *st)
 {
-    static const struct { const char *key; size_t offset; } counts[] = {
-        {"dimension", offsetof(fdem_counts, dimension)}, {"nodes", offsetof(fdem_counts, nodes)}, {"elements", offsetof(fdem_counts, elements)},
-        {"joints", offsetof(fdem_counts, joints)},
-        {"broken_joints", offsetof(fdem_counts, broken_joints)},
-        {"fragments", offsetof(fdem_counts, fragments)}, {"contacts", offsetof(fdem_counts, contacts)},
-    };
-    case_figures *f = &c->fig;
-    for (size_t i = 0; i < sizeof counts / sizeof *counts; i++)
-        *(int *)((char *)&f->counts + counts[i].offset) = status_count(st, counts[i].key);
-    case_energy_from_json(&f->energy, json_object_get(st, "energy"));
-    case_stage_from_json(f, json_object_get(st, "stage"));
-    case_fluid_from_json(f, json_object_get(st, "fluid"), json_object_get(st, "energy"));
-    f->step = (int64_t)json_integer_value(json_object_get(st, "step"));
-    f->time = status_number(st, "time");
-    f->dt = status_number(st, "dt");
-    f->snapshots = status_count(st, "snapshots");
-    f->elapsed = status_number(st, "elapsed");
-    if (!(f->elapsed >= 0))
-        f->elapsed = 0; /* written by an fdemd from before `elapsed` */
+    status_figures_from_json(&c->fig, st);
     const char *name = json_string_value(json_object_get(st, "name"));
     snprintf(c->info.name, sizeof c->info.name, "%s", name ? name : "");
     c->info.end_time = status_number(st, "end_time");
+    json_int_t ranks = json_integer_value(json_object_get(st, "ranks"));
+    c->info.ranks = ranks > 1 && ranks <= CASE_MAX_RANKS ? (int)ranks : 1;
     c->estimated_seconds = status_number(st, "estimated_seconds"); /* NAN before it was kept */
 }
 
@@ -207,7 +185,7 @@ server_case *registry_load_case(const fdemd_config *cfg, const char *id)
     int status_broken = 0;
     case_state stored = case_load_status(c, path, &status_broken);
     if (!c->created[0])
-        iso_time_now(c->created, sizeof c->created);
+        status_time_now(c->created, sizeof c->created);
     if (c->state == CASE_RUNNING || c->state == CASE_QUEUED)
         c->state = CASE_PAUSED;
     registry_extend_recover(c); /* before the check: it rebuilds with the new end */

@@ -19,12 +19,13 @@
 
 #include "case_feed.h"
 #include "case_model.h"
-#include "store/checkpoint_file.h"
+#include "files/checkpoint_file.h"
 #include "case_sizing.h"
 #include "sizing_probe.h"
 #include "io_thread.h"
 #include "registry_internal.h"
 #include "worker_history.h"
+#include "worker_ranked.h"
 #include "common/clock.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
@@ -65,35 +66,19 @@ typedef struct worker_clock {
 /* The first output time strictly after `t` on the grid k * interval. */
 static double worker_next_output(const server_case *c, double t)
 {
-    double interval = sizing_output_interval(&c->info);
-    double k = floor(t / interval * (1.0 + 1e-12) + 1e-9);
-    return (k + 1.0) * interval;
+    return output_next_time(output_snapshot_interval(&c->info), t);
 }
 
 /* Elements the engine found passing into one another since the last
- * publish become status warnings (contract 6.2), at the part of the first
- * element, each pair once; their step is in the message. */
+ * publish become status warnings (contract 6.2, status_take_penetrations).
+ * With model_lock held. */
 static void worker_take_warnings(server_case *c)
 {
-    fdem_penetration pen[FDEM_PENETRATIONS_MAX];
-    long more = 0;
-    int n = fdem_take_penetrations(c->model, pen, FDEM_PENETRATIONS_MAX, &more);
-    const int32_t *part = fdem_element_parts(c->model);
-    for (int i = 0; i < n; i++) {
-        char ptr[32], msg[300], pair[64];
-        /* the engine lists each pair once a run; a run resumed from a
-         * checkpoint may find a pair it had found before the restart */
-        snprintf(pair, sizeof pair, "elements %d and %d passed", pen[i].a, pen[i].b);
-        if (case_has_warning_starting(c, pair)) continue;
-        snprintf(ptr, sizeof ptr, "/parts/%d", part ? (int)part[pen[i].a] : 0);
-        snprintf(msg, sizeof msg, "%s into one another at step %lld (t = %.6g s): a node "
-                 "%.2f of the other's inradius deep (warned beyond %.2f); a body too fast or a "
-                 "penalty too soft for contact to hold it", pair, (long long)pen[i].step,
-                 pen[i].time, pen[i].depth, FDEM_PENETRATION_WARN);
-        case_add_warning(c, ptr, msg);
-    }
-    if (more > 0)
-        case_add_warning(c, "", "more element pairs passed into one another than are listed");
+    pthread_mutex_lock(&c->lock);
+    if (!c->warnings)
+        c->warnings = json_array();
+    status_take_penetrations(c->warnings, c->model);
+    pthread_mutex_unlock(&c->lock);
 }
 
 /* Wall seconds left at the speed of the recent window (see
@@ -140,7 +125,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     fig.eta = running ? worker_eta(clk, now, fig.time, c->info.end_time) : NAN;
     fig.snapshots = -1; /* owned by the I/O thread */
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
-    case_figures_stage(&fig, m, &c->info);
+    status_figures_stage(&fig, m, &c->info);
     case_publish(c, &fig);
     worker_take_warnings(c);
 }
@@ -246,7 +231,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
          * exactly at time.end (a shorter step is always stable, and central
          * difference takes a changing step). */
         double t0 = fdem_get_time(m);
-        int cut = sizing_is_last_step(t0, dt, end);
+        int cut = output_is_last_step(t0, dt, end);
         if (cut)
             worker_keep_end_checkpoint(c);
         if (cut)
@@ -268,7 +253,7 @@ static worker_exit worker_loop(server_case *c, worker_clock *clk)
         size_t ckpt_size = 0;
         fdem_event *events = NULL;
         int event_count = 0;
-        if (done || t >= c->next_output - 1e-9 * dt) {
+        if (done || output_is_due(t, c->next_output, dt)) {
             snap = snapshot_take(m, c->info.fields);
             c->last_snapshot_step = fdem_get_step(m);
             c->next_output = worker_next_output(c, t);
@@ -384,7 +369,12 @@ static void *worker_main(void *arg)
     const fdemd_config *cfg = registry_config();
     worker_exit why = EXIT_FAILED;
     case_state final_state = CASE_FAILED;
-    if (worker_take_model(c, &final_state) == 0) {
+    int taken = worker_take_model(c, &final_state) == 0;
+    if (taken && c->info.ranks > 1) {
+        final_state = worker_ranked_run(c); /* the ranks step it (worker_ranked.h) */
+        if (atomic_load(&c->command) == WORKER_ABANDON)
+            why = EXIT_ABANDON;
+    } else if (taken) {
         fdem_set_threads(c->model, cfg->threads);
         double now = clock_wall_seconds();
         pthread_mutex_lock(&c->lock);

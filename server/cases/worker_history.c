@@ -4,18 +4,10 @@
  */
 #include "worker_history.h"
 
-#include <math.h>
 #include <stdlib.h>
 
 #include "io_thread.h"
-
-/* The first history time strictly after `t` on the grid k * interval (as
- * worker_next_output does for snapshots). */
-static double history_next(double interval, double t)
-{
-    double k = floor(t / interval * (1.0 + 1e-12) + 1e-9);
-    return (k + 1.0) * interval;
-}
+#include "state/output_grid.h"
 
 static void history_take_row(server_case *c)
 {
@@ -33,23 +25,16 @@ static void history_take_row(server_case *c)
 
 void worker_history_start(server_case *c)
 {
-    double t = fdem_get_time(c->model);
-    if (c->info.history_interval > 0) c->next_history = history_next(c->info.history_interval, t);
-    if (fdem_get_step(c->model) == 0) history_take_row(c);
+    if (output_history_start(c->info.history_interval, fdem_get_time(c->model),
+                             fdem_get_step(c->model), &c->next_history))
+        history_take_row(c);
 }
 
 void worker_history_after_step(server_case *c, double dt, int snapshot_taken, int done)
 {
-    double interval = c->info.history_interval;
-    if (!(interval > 0)) {
-        if (snapshot_taken) history_take_row(c);
-        return;
-    }
-    double t = fdem_get_time(c->model);
-    if (done || t >= c->next_history - 1e-9 * dt) {
+    if (output_history_due(c->info.history_interval, fdem_get_time(c->model), dt, snapshot_taken,
+                           done, &c->next_history))
         history_take_row(c);
-        c->next_history = history_next(interval, t);
-    }
 }
 
 int worker_history_batch_full(const server_case *c)

@@ -32,6 +32,8 @@ typedef struct fdemd_config {
     double request_timeout;   /* s for a whole request, headers and body */
     int max_streams;          /* GET /stream streams open at once */
     char web_dir[1024];       /* --web: the page's files; "" = web/ beside bin/ */
+    char launcher[1024];      /* --launcher: starts a ranked case's ranks ({ranks}) */
+    int max_ranks;            /* --max-ranks: most "parallel" ranks a case may ask for */
 } fdemd_config;
 
 #endif

@@ -283,10 +283,11 @@ enum MHD_Result download_reply(struct MHD_Connection *conn, server_case *c, int 
     size_t size = 0;
     char err[600] = "";
     if (io_fetch_result(c, &fd, &size, &held, &status, err, sizeof err) != 0) {
-        if (status != 404)
+        if (status != 404 && status != 409)
             fprintf(stderr, "fdemd: case %s: serving result.h5 failed: %s\n", c->id, err);
         return http_reply_problem(conn, (unsigned)status,
-                                  status == 404 ? "Not found" : "Damaged result file", err, NULL);
+                                  status == 404 ? "Not found" : status == 409 ? "Conflict"
+                                  : "Damaged result file", err, NULL);
     }
     /* HEAD: the size a GET would get now; the file is never read. */
     if (head && held)

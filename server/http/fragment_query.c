@@ -16,7 +16,7 @@
 
 #include "cases/case_model.h"
 #include "common/memory_budget.h"
-#include "store/persist.h"
+#include "files/persist.h"
 
 /* The case's "parts" array (a new reference), or NULL with a status. */
 static json_t *query_read_parts(const server_case *c, char *detail, size_t detail_size,

@@ -22,6 +22,14 @@
 
 #include "fdem.h"
 
+/* The checkpoints of a case directory: the latest state; the state before
+ * the step cut to land on time.end; and, after a daemon's extend of a
+ * finished case, that state renamed, which the next run resumes from (the
+ * daemon's server/cases/case_model.h, the runner's runner/run_case.c). */
+#define CHECKPOINT_FILE_LATEST "checkpoint.bin"
+#define CHECKPOINT_FILE_END "checkpoint-end.bin"
+#define CHECKPOINT_FILE_RESUME "checkpoint-resume.bin"
+
 #define CHECKPOINT_FILE_TRAILER 8
 /* The engine's checkpoint version (fdem_checkpoint_version) the first sealing
  * daemon wrote: no daemon ever wrote it bare. */

@@ -1,13 +1,12 @@
 /*
- * server/store/ - the files of the data directory, below the case
- * lifecycle.
+ * proto/files/ - a case directory's plain files, written the same way by
+ *    the daemon (server/) and by the batch runner (runner/, bin/fdem-run),
+ *    so that both leave the same bytes.
  *  - Owns: atomic, fsynced writes, reads and removals (this header,
- *    persist.c); checkpoint.bin sealed with a CRC-32 (checkpoint_file.c);
- *    the named crash points tests place between durable writes
- *    (fault_point.c).
+ *    persist.c); checkpoint.bin sealed with a CRC-32 (checkpoint_file.c).
  *  - May call: core/ (the checkpoint's types), zlib and the C library; no
- *    other server folder.
- *  - Called by: cases/.
+ *    other proto folder.
+ *  - Called by: server/ and runner/.
  */
 /*
  * persist.h - durable files in the data directory.

@@ -1,0 +1,28 @@
+/*
+ * launch.h - the command line that starts a case's ranks: the launcher
+ * (`--launcher`, FDEM_LAUNCHER, default LAUNCH_DEFAULT: any line with
+ * {ranks}, e.g. Slurm's `srun -n {ranks}`) followed by bin/fdem-rank and its
+ * arguments. bin/fdem-run --ranks N and the daemon's ranked cases build it
+ * here, so both start the same processes.
+ *
+ * Contract: launch_argv() replaces every {ranks} with N, splits the line as
+ * a shell would split words (wordexp(3) without command substitution:
+ * quotes and $VARIABLES work, `$(...)` is refused) and appends `extra`
+ * (NULL-terminated). A NULL-terminated argv to free with
+ * launch_argv_free(), or NULL with a sentence in err.
+ */
+#ifndef FDEM_LAUNCH_H
+#define FDEM_LAUNCH_H
+
+#include <stddef.h>
+
+#define LAUNCH_DEFAULT "mpirun -np {ranks} --oversubscribe"
+
+char **launch_argv(const char *line, int ranks, const char *const *extra, char *err,
+                   size_t errlen);
+void launch_argv_free(char **argv);
+/* The path of bin/fdem-rank beside the running executable (/proc/self/exe),
+ * into out; 0, or -1 when it cannot be found. */
+int launch_rank_binary(char *out, size_t size);
+
+#endif
