@@ -26,7 +26,7 @@ import re
 import subprocess
 import sys
 
-ROOTS = ("core", "proto", "server")
+ROOTS = ("core", "proto", "server", "runner")
 INCLUDE = re.compile(r'^\s*#\s*include\s+"([^"]+)"', re.M)
 LONG_FILE = 800
 
