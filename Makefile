@@ -124,12 +124,16 @@ $(BUILD)/rank-engine/%.o: runner/mpi/%.c | $(BUILD)/.deps
 $(BUILD)/tests/mpi/%: tests/mpi/%.c $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)
 	$(MPI_LINK)
-.PHONY: mpi mpi-missing
+.PHONY: mpi mpi-missing test-ranks
 $(BUILD)/bench/mpi/%: bench/mpi/%.c $(LIBCORE)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -O3 -Icore -fopenmp -o $@ $< $(LIBCORE) -lmetis -lm
 # make bench runs bench/mpi/run.sh after the others when these exist
 bench: $(if $(MPICC),$(MPI_TESTS) $(BUILD)/bench/mpi/bench_partition)
+# the rank engine's same-bits test with 8 ranks too (minutes on a loaded
+# machine, so not in make test)
+test-ranks: mpi all
+	@FDEM_RANKS_FULL=1 FDEMD_BIN=$(BIN)/fdemd FDEMCTL_BIN=$(BIN)/fdemctl $(PYTHON) tests/integration/run.py 'test_ranks.py'
 mpi: $(if $(MPICC),$(MPI_TESTS),mpi-missing)
 mpi-missing:
 	@echo "mpicc not found: the MPI rank engine is not built (scripts/install-deps.sh installs it)"

@@ -72,8 +72,10 @@ static void share_block_sums(void *ctx, fdem_model *m, scatter_plan *plan)
     for (int k = 0; k < count; k++)
         memcpy(out + (size_t)k * SCATTER_SUMS, plan->block_sum + (size_t)mine[k] * SCATTER_SUMS,
                sizeof(double) * SCATTER_SUMS);
+    double t0 = MPI_Wtime();
     MPI_Allgatherv(out, re->block_counts[me], MPI_DOUBLE, re->recv, re->block_counts,
                    re->block_displs, MPI_DOUBLE, re->comm);
+    re->fig.exchange_seconds += MPI_Wtime() - t0;
     for (int k = 0; k < re->blocks; k++)
         memcpy(plan->block_sum + (size_t)re->block_order[k] * SCATTER_SUMS,
                re->recv + (size_t)k * SCATTER_SUMS, sizeof(double) * SCATTER_SUMS);
@@ -103,9 +105,11 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     re->send[0] = ok;
     for (int k = 0; k < count; k++)
         memcpy(re->send + 1 + (size_t)D * k, m->force + (size_t)D * mine[k], sizeof(double) * D);
-    if (MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv, re->flag_counts,
-                       re->flag_displs, MPI_DOUBLE, re->comm) != MPI_SUCCESS)
-        return -1;
+    double t0 = MPI_Wtime();
+    int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
+                            re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
+    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    if (rc != MPI_SUCCESS) return -1;
     for (int r = 0; r < re->size; r++)
         if (re->recv[re->flag_displs[r]] != 1) return -1;
     for (int r = 0; r < re->size; r++) {
@@ -283,6 +287,7 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
 int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
     re->exchanged = 0;
+    if (re->size == 1) return fdem_step(m, err); /* nothing to share */
     m->share = &re->share; /* only while stepping: outside a step nothing is collective */
     int rc = fdem_step(m, err);
     m->share = NULL;

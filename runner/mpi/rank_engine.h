@@ -36,6 +36,7 @@ typedef struct rank_figures {
     long owned_nodes;
     double partition_seconds;   /* METIS on the block graph, rank 0 */
     double bytes_sent_per_step; /* this rank's share of the exchanges */
+    double exchange_seconds;    /* wall time in the step's two exchanges, all steps */
 } rank_figures;
 
 rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err);

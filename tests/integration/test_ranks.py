@@ -6,10 +6,12 @@ where mpicc exists) steps small 2D and 3D cases with contact, friction,
 damping and fracture and prints, every few steps, a hash of the whole state
 rank 0 would write (the checkpoint bytes: positions, velocities, element
 history, joints, contact history, energies) and whether every rank holds
-the same positions and velocities. The lines of 1, 2, 3, 4 and 8 ranks (8
-oversubscribed; 2 ranks also with 2 threads each) must equal those of one
+the same positions and velocities. The lines of 1, 2 (of 2 threads each), 3
+and 4 ranks, and with FDEM_RANKS_FULL=1 (make test-ranks) of 8
+oversubscribed and 2 of one thread, must equal those of one
 plain process stepping with fdem_step; a rank engine that adds its halo
-elements after its own (rank_compare --fault) must not.
+elements after its own (rank_compare --fault) must not. A checkpoint written
+on 3 ranks restarts on 2 with the same bits.
 
 mpirun as root needs OMPI_ALLOW_RUN_AS_ROOT=1 and
 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 (set here).
@@ -24,6 +26,8 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 STEPS, EVERY = "24", "4"
+# 8 ranks (oversubscribed) and 2 ranks of one thread too: make test-ranks
+FULL = os.environ.get("FDEM_RANKS_FULL") == "1"
 
 
 def build_dir():
@@ -77,6 +81,9 @@ def case_3d():
 
 
 class RanksSameBits(unittest.TestCase):
+    """Every run is made once, in setUpClass, in this order (the restart
+    needs the 3-rank run's checkpoint); the tests compare their lines."""
+
     @classmethod
     def setUpClass(cls):
         cls.exe = os.path.join(build_dir(), "tests", "mpi", "rank_compare")
@@ -91,16 +98,28 @@ class RanksSameBits(unittest.TestCase):
             with open(path, "w") as f:
                 json.dump(doc, f)
             cls.cases.append(path)
+        cls.checkpoint = os.path.join(cls.tmp, "2d-step10-3-ranks.bin")
         cls.plain = cls.run_ranks(0, "--plain")
+        # 2 ranks of 2 threads each; the 3-rank run saves the 2D case after
+        # step 10 ("--save-at 0 -" then turns saving off for the 3D case)
+        cls.ranked = {1: cls.run_ranks(1), 2: cls.run_ranks(2, "--threads", "2"),
+                      3: cls.run_ranks(3, cases=["--save-at", "10", cls.checkpoint, cls.cases[0],
+                                                 "--save-at", "0", "-", cls.cases[1]]),
+                      4: cls.run_ranks(4)}
+        if FULL:
+            cls.ranked[8] = cls.run_ranks(8)
+            cls.ranked["2, one thread"] = cls.run_ranks(2)
+        cls.restarted = cls.run_ranks(2, "--restore", cls.checkpoint, cases=cls.cases[:1])
+        cls.fault = cls.run_ranks(4, "--fault")
 
     @classmethod
     def tearDownClass(cls):
         shutil.rmtree(getattr(cls, "tmp", ""), ignore_errors=True)
 
     @classmethod
-    def run_ranks(cls, ranks, *flags):
+    def run_ranks(cls, ranks, *flags, cases=None):
         """The driver's lines on `ranks` ranks (0: one process, no mpirun)."""
-        cmd = [cls.exe, STEPS, EVERY] + list(flags) + cls.cases
+        cmd = [cls.exe, STEPS, EVERY] + list(flags) + (cases or cls.cases)
         if ranks:
             cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd
         p = subprocess.run(cmd, env=mpi_env(), capture_output=True, text=True, timeout=300)
@@ -121,18 +140,25 @@ class RanksSameBits(unittest.TestCase):
             self.assertGreater(int(last[last.index("broken") + 1]), 0, half[-1])
             self.assertGreater(int(last[last.index("contacts") + 1]), 0, half[-1])
 
-    def test_same_bits_on_1_2_3_4_8_ranks(self):
-        for ranks in (1, 2, 3, 4, 8):
+    def test_same_bits_on_1_2_3_4_ranks(self):
+        """(and 8, and 2 of one thread, with FDEM_RANKS_FULL=1: make test-ranks)"""
+        for ranks, lines in self.ranked.items():
             with self.subTest(ranks=ranks):
-                self.assertEqual(self.run_ranks(ranks), self.plain)
+                if ranks == 3:  # the line of the step it saved after
+                    lines = [l for l in lines if not l.startswith("step 10 ")]
+                self.assertEqual(lines, self.plain)
 
-    def test_same_bits_on_2_ranks_of_2_threads(self):
-        self.assertEqual(self.run_ranks(2, "--threads", "2"), self.plain)
+    def test_checkpoint_of_3_ranks_restarts_on_2(self):
+        """The 2D case saved after step 10 on 3 ranks and restarted from that
+        checkpoint on 2 goes on with the plain run's bits."""
+        plain_2d = self.plain[:self.plain.index("case " + self.cases[1])]
+        self.assertEqual(self.restarted, [plain_2d[0]] + [
+            l for l in plain_2d if l.startswith("step") and int(l.split()[1]) > 10])
 
     def test_border_sums_in_another_order_differ(self):
         """Each rank adding its halo elements after its own blocks forms
         border nodes' sums in another order: the comparison must see it."""
-        self.assertNotEqual(self.run_ranks(4, "--fault"), self.plain)
+        self.assertNotEqual(self.fault, self.plain)
 
 
 if __name__ == "__main__":
