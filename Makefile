@@ -125,6 +125,7 @@ $(BUILD)/tests/mpi/%: tests/mpi/%.c $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(dir $@)
 	$(MPI_LINK)
 .PHONY: mpi mpi-missing test-ranks
+.SECONDARY: $(RANK_ENGINE_OBJ)
 $(BUILD)/bench/mpi/%: bench/mpi/%.c $(LIBCORE)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -O3 -Icore -fopenmp -o $@ $< $(LIBCORE) -lmetis -lm
