@@ -344,6 +344,30 @@ int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err)
     return 0;
 }
 
+int rank_engine_lazy_step(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_engine_lazy *lazy = ctx;
+    if (lazy->re && lazy->model != m) rank_engine_lazy_free(lazy);
+    if (!lazy->re) {
+        if (!(lazy->re = rank_engine_create(m, lazy->comm, err))) return -1;
+        lazy->model = m;
+    }
+    return rank_engine_step(lazy->re, m, err);
+}
+
+int rank_engine_lazy_gather(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_engine_lazy *lazy = ctx;
+    return lazy->re && lazy->model == m ? rank_engine_gather(lazy->re, m, err) : 0;
+}
+
+void rank_engine_lazy_free(rank_engine_lazy *lazy)
+{
+    rank_engine_free(lazy->re);
+    lazy->re = NULL;
+    lazy->model = NULL;
+}
+
 rank_figures rank_engine_figures(const rank_engine *re) { return re->fig; }
 
 /* Turning the fault on keeps only the owned blocks' marks in the pass

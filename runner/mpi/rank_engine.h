@@ -45,6 +45,23 @@ int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err);
 void rank_engine_free(rank_engine *re);
 rank_figures rank_engine_figures(const rank_engine *re);
 
+/* The engine as a batch loop's stepper (runner/run_case.h's
+ * runner_stepper: ctx = a rank_engine_lazy, step = rank_engine_lazy_step,
+ * gather = rank_engine_lazy_gather). The engine is made at the first step,
+ * collectively, so a model restored from a checkpoint before it is split
+ * as it is then; a different model (a rebuild) gets a new engine. Before
+ * the first step every rank holds the whole state: gather has nothing to
+ * do. */
+typedef struct rank_engine_lazy {
+    MPI_Comm comm;
+    rank_engine *re;
+    const fdem_model *model; /* the model re was made for */
+} rank_engine_lazy;
+
+int rank_engine_lazy_step(void *lazy, fdem_model *m, fdem_error *err);
+int rank_engine_lazy_gather(void *lazy, fdem_model *m, fdem_error *err);
+void rank_engine_lazy_free(rank_engine_lazy *lazy);
+
 /* rank_partition.c: owner[b] in [0, parts) for each of `blocks` element
  * blocks of block_size consecutive elements (K nodes each), balanced by
  * element count and cut where the fewest nodes are shared; METIS k-way on

@@ -160,18 +160,23 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         MPI_Abort(MPI_COMM_WORLD, 2);
     }
     const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
-    rank_engine *re = plain ? NULL : rank_engine_create(m, MPI_COMM_WORLD, &err);
-    if (!plain && !re) {
-        fprintf(stderr, "rank %d: %s\n", rank, err.message);
-        MPI_Abort(MPI_COMM_WORLD, 2);
+    /* the batch loop's way (made at the first step), but for the fault,
+     * which is set before it */
+    rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
+    if (!plain && o->fault) {
+        if (!(lazy.re = rank_engine_create(m, MPI_COMM_WORLD, &err))) {
+            fprintf(stderr, "rank %d: %s\n", rank, err.message);
+            MPI_Abort(MPI_COMM_WORLD, 2);
+        }
+        lazy.model = m;
+        rank_engine_set_border_order_fault(lazy.re, 1);
     }
-    if (re && o->fault) rank_engine_set_border_order_fault(re, 1);
     if (rank == 0) printf("case %s\n", path);
     int status = 0;
     double t_step = 0, c_step = 0;
     for (int s = first; s <= steps && !status; s++) {
         double ts = MPI_Wtime(), cs = cpu_seconds();
-        int rc = re ? rank_engine_step(re, m, &err) : fdem_step(m, &err);
+        int rc = plain ? fdem_step(m, &err) : rank_engine_lazy_step(&lazy, m, &err);
         t_step += MPI_Wtime() - ts;
         c_step += cpu_seconds() - cs;
         if (rc) {
@@ -180,16 +185,16 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
             break;
         }
         if (s % every && s != steps && s != o->save_at) continue;
-        int agree = re ? ranks_agree(m, MPI_COMM_WORLD) : 1;
-        if (re && rank_engine_gather(re, m, &err)) status = 1;
+        int agree = plain || ranks_agree(m, MPI_COMM_WORLD);
+        if (!plain && rank_engine_lazy_gather(&lazy, m, &err)) status = 1;
         if (rank == 0) {
             if (!agree) printf("step %d ranks disagree\n", s);
             print_state(m, s);
             if (s == o->save_at && save_checkpoint(m, o->save_path)) status = 1;
         }
     }
-    if (figures && re) {
-        rank_figures f = rank_engine_figures(re);
+    if (figures && lazy.re) {
+        rank_figures f = rank_engine_figures(lazy.re);
         double most = f.bytes_sent_per_step, step_s = t_step / steps;
         MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
@@ -213,7 +218,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
                st.detection / steps, st.contact / steps, st.integration / steps, t_step / steps,
                c_step / steps);
     }
-    rank_engine_free(re);
+    rank_engine_lazy_free(&lazy);
     fdem_model_destroy(m);
     return status;
 }
