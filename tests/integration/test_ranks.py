@@ -168,5 +168,30 @@ class RanksSameBits(unittest.TestCase):
         self.assertNotEqual(self.fault, self.plain)
 
 
+@unittest.skipUnless(FULL, "the bundled examples on 3 ranks: make test-ranks")
+class ExamplesSameBits(unittest.TestCase):
+    """Every bundled example (fluid, stages and excavation, ramps,
+    constraints, absorbing boundaries, fracture regions, gmsh meshes, piles,
+    2D and 3D) stepped 40 steps on 3 ranks gives one process's bits."""
+
+    def test_examples_on_3_ranks(self):
+        exe = os.path.join(build_dir(), "tests", "mpi", "rank_compare")
+        if not os.access(exe, os.X_OK) or not shutil.which("mpirun"):
+            self.skipTest("rank_compare or mpirun missing")
+        examples = sorted(f for f in os.listdir(os.path.join(ROOT, "examples")) if f.endswith(".json"))
+        for name in examples:
+            path = os.path.join(ROOT, "examples", name)
+            with self.subTest(example=name):
+                runs = []
+                for cmd in ([exe, "40", "10", "--plain", path],
+                            ["mpirun", "-np", "3", "--oversubscribe", exe, "40", "10", path]):
+                    p = subprocess.run(cmd, env=mpi_env(), capture_output=True, text=True,
+                                       timeout=600)
+                    self.assertEqual(p.returncode, 0, p.stderr[-2000:])
+                    runs.append(p.stdout.splitlines())
+                self.assertEqual(len(runs[0]), 5)
+                self.assertEqual(runs[1], runs[0])
+
+
 if __name__ == "__main__":
     unittest.main()
