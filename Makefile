@@ -138,10 +138,38 @@ $(BUILD)/scripts/%: scripts/%.c $(LIBPROTO) $(LIBCORE)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto $(LDSAN) -fopenmp -o $@ $< \
 	    $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
 
-test: all $(UNIT_BIN)
+# MPI (issue 37): runner/mpi and the programs that link it build with
+# mpicc, only where it exists; elsewhere they are left out with a message.
+MPICC      := $(shell command -v mpicc 2>/dev/null)
+RANK_ENGINE_OBJ := $(patsubst runner/mpi/%.c,$(BUILD)/rank-engine/%.o,$(wildcard runner/mpi/*.c))
+MPI_TESTS  := $(if $(MPICC),$(BUILD)/tests/mpi/rank_compare)
+MPI_LINK    = $(MPICC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner $(LDSAN) -fopenmp -o $@ $< \
+              $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lmetis -lpthread -lm
+$(BUILD)/rank-engine/%.o: runner/mpi/%.c | $(BUILD)/.deps
+	@mkdir -p $(dir $@)
+	$(MPICC) $(CFLAGS) -Icore -Iproto -Irunner -c $< -o $@
+$(BUILD)/tests/mpi/%: tests/mpi/%.c $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE)
+	@mkdir -p $(dir $@)
+	$(MPI_LINK)
+.PHONY: mpi mpi-missing test-ranks
+.SECONDARY: $(RANK_ENGINE_OBJ)
+$(BUILD)/bench/mpi/%: bench/mpi/%.c $(LIBCORE)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -O3 -Icore -fopenmp -o $@ $< $(LIBCORE) -lmetis -lm
+# make bench runs bench/mpi/run.sh after the others when these exist
+bench: $(if $(MPICC),$(MPI_TESTS) $(BUILD)/bench/mpi/bench_partition)
+# the rank engine's same-bits test with 8 ranks too (minutes on a loaded
+# machine, so not in make test)
+test-ranks: mpi all
+	@FDEM_RANKS_FULL=1 FDEMD_BIN=$(BIN)/fdemd FDEMCTL_BIN=$(BIN)/fdemctl $(PYTHON) tests/integration/run.py 'test_ranks.py'
+mpi: $(if $(MPICC),$(MPI_TESTS),mpi-missing)
+mpi-missing:
+	@echo "mpicc not found: the MPI rank engine is not built (scripts/install-deps.sh installs it)"
+
+test: all $(UNIT_BIN) mpi
 	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
-test-unit: deps $(UNIT_BIN)
+test-unit: deps $(UNIT_BIN) mpi
 	@BUILD=$(BUILD) BIN=$(BIN) PYTHON=$(PYTHON) UNIT_ONLY=1 bash tests/run_tests.sh
 
 test-san:

@@ -16,6 +16,11 @@ for b in "$BUILD"/bench/*; do
   echo "==== $(basename "$b")"
   "$b" || echo "(exit $?)"
 done
+if [ -x "$BUILD/tests/mpi/rank_compare" ] && [ -x "$BUILD/bench/mpi/bench_partition" ]; then
+  echo
+  echo "==== bench/mpi/run.sh (the engine on MPI ranks)"
+  BUILD="$BUILD" PYTHON="$PYTHON" bash bench/mpi/run.sh || echo "(exit $?)"
+fi
 echo
 echo "==== bench_http.py"
 FDEMD_BIN="$BIN/fdemd" "$PYTHON" bench/bench_http.py || echo "(exit $?)"

@@ -65,6 +65,37 @@ static void forces_of_active_runs(fdem_model *m, int begin, int end, double sums
     }
 }
 
+/* The loop a block of this model runs: the one function per model kind
+ * that every path below ends in. */
+static scatter_block_fn element_forces_loop(const fdem_model *m)
+{
+    return m->elem_active                        ? forces_of_active_runs
+           : m->elem_stress0 || fixed_parts_kept(m) ? forces_by_part_runs
+           : m->dim == 3                         ? tet_element_forces_range
+                                                 : tri_element_forces_range;
+}
+
+/* A step shared between processes (step_share, model/model.h): the runs of
+ * the elements this process computes, each as its model's loop runs a
+ * block. A block whose elements are all marked is one run, the block
+ * exactly as one process runs it (its sums too); the sums of a block
+ * partly marked are another process's to give (step_share.block_sums). */
+static void forces_of_marked_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
+{
+    const uint8_t *mark = m->share->elem_mark;
+    const scatter_block_fn loop = element_forces_loop(m);
+    for (int e = begin; e < end;) {
+        if (!mark[e]) {
+            e++;
+            continue;
+        }
+        int stop = e + 1;
+        while (stop < end && mark[stop]) stop++;
+        loop(m, e, stop, sums);
+        e = stop;
+    }
+}
+
 /* Runs the element blocks through the model's scatter plan (threads side
  * by side within a colour). A block hands back the strain energy (sums[0])
  * and the power of the viscous stresses with the velocities before this
@@ -78,10 +109,8 @@ void element_forces(fdem_model *m)
 {
     double sums[SCATTER_SUMS] = {0};
     const int kept = fixed_parts_kept(m);
-    scatter_block_fn run = m->elem_active               ? forces_of_active_runs
-                           : m->elem_stress0 || kept ? forces_by_part_runs
-                           : m->dim == 3             ? tet_element_forces_range
-                                                     : tri_element_forces_range;
+    scatter_block_fn run = m->share && m->share->elem_mark ? forces_of_marked_runs
+                                                           : element_forces_loop(m);
     scatter_plan_run(&m->elem_plan, m, m->threads, run, sums);
     double elastic = kept ? sums[0] + fixed_parts_forces(m) : sums[0];
     m->elastic_energy = m->elem_stress0 ? elastic + m->stress0_energy : elastic;

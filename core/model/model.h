@@ -235,6 +235,28 @@ typedef struct contact_state {
     nbs_pairs pairs;
 } contact_state;
 
+/* A step split between processes (runner/mpi/rank_engine.c: one MPI rank
+ * each): the engine stays one process's code, and these hooks let a driver
+ * decide which elements this process computes and complete what the others
+ * computed. Absent (NULL), the process computes the whole step. No
+ * communication happens here: the callbacks are the driver's.
+ *  - elem_mark: per element, 1 if this process computes its forces. The
+ *    driver marks every element of the element blocks it owns (so their
+ *    block sums are whole) and every element touching a node it owns (so
+ *    that node's force is summed over all its elements in plan order).
+ *  - block_sums: called by scatter_plan_run after its blocks ran and before
+ *    they are totalled in block order; fills in the sums of the blocks
+ *    computed elsewhere. Called for every plan; the driver picks its own.
+ *  - forces_done: called by fdem_step once every force of the step is
+ *    added and before the update; makes m->force whole (each node's from
+ *    its owner). Nonzero fails the step. */
+typedef struct step_share {
+    void *ctx;
+    const uint8_t *elem_mark;
+    void (*block_sums)(void *ctx, fdem_model *m, scatter_plan *plan);
+    int (*forces_done)(void *ctx, fdem_model *m);
+} step_share;
+
 struct fdem_model {
     int finalized;
     int dim;                 /* 2 or 3: numbers per node in every node array */
@@ -392,6 +414,7 @@ struct fdem_model {
     int threads;
     scatter_plan elem_plan, node_plan;
     joint_sweep joint_sweep;
+    const step_share *share; /* NULL: one process computes the whole step */
 };
 
 /* model.c: the stage clock (seconds, monotonic) the stage times are read on */

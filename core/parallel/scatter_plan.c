@@ -17,7 +17,9 @@
  * The plan, not the thread count, fixes the order in which each node's sum
  * is formed (colour by colour, each block in item order), and per-block
  * partial sums are added in block order: a run gives the same bits on one
- * thread or on eight.
+ * thread or on eight. When several processes share a step (step_share in
+ * model/model.h), each runs the blocks it is given and a driver fills in
+ * the others' block sums before the same totalling.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -162,6 +164,8 @@ void scatter_plan_run(scatter_plan *plan, fdem_model *m, int threads, scatter_bl
     } else { /* the same blocks in the same order, without a thread team's start-up */
         for (int k = 0; k < plan->block_count; k++) scatter_run_block(plan, m, fn, k);
     }
+    if (m->share && m->share->block_sums) /* blocks another process ran (model.h) */
+        m->share->block_sums(m->share->ctx, m, plan);
     for (int b = 0; b < plan->block_count; b++) { /* block order: the same bits for any T */
         scatter_sums_add(totals, &plan->block_sum[SCATTER_SUMS * (size_t)b]);
     }

@@ -441,6 +441,11 @@ int fdem_step(fdem_model *m, fdem_error *err)
                     (long long)m->step + 1);
         return -1;
     }
+    if (m->share && m->share->forces_done && m->share->forces_done(m->share->ctx, m)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "exchanging the forces between processes failed "
+                    "at step %lld", (long long)m->step + 1);
+        return -1;
+    }
     double t2 = stage_clock();
     constraint_apply_forces(m);
     boundary_load_apply(m);

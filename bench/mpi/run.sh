@@ -1,0 +1,60 @@
+#!/usr/bin/env bash
+# bench/mpi/run.sh - the rank engine's figures (issue 37 item 5), run by
+# bench/run.sh when mpicc built them: one and two ranks taking turns on a
+# 1e6-element 2D elastic block and a 2D contact pile (the machine's load
+# printed before each run: on a loaded machine the ratio means little),
+# the bytes each rank sends a step, the halo and peak memory per element;
+# then METIS on the element dual graph at 2-64 parts (bench_partition.c),
+# 1e6 elements and, with 16 GB free, 1e7. Figures only.
+set -u
+BUILD=${BUILD:-build}
+PYTHON=${PYTHON:-/usr/bin/python3}
+exe=$BUILD/tests/mpi/rank_compare
+STEPS=${RANK_BENCH_STEPS:-20}
+ROUNDS=${RANK_BENCH_ROUNDS:-3}
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl=self,vader
+export OMPI_MCA_btl_vader_single_copy_mechanism=none OMPI_MCA_mpi_yield_when_idle=1
+export OMP_NUM_THREADS=1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+"$PYTHON" - "$tmp" <<'PY'
+import json, sys
+out = sys.argv[1]
+rock = {"density": 2000, "young": 1e8, "poisson": 0.25, "friction": 0.4}
+block = {"name": "block-1e6", "materials": {"rock": rock},
+         "parts": [{"name": "block", "material": "rock",
+                    "rectangle": {"origin": [0, 0], "size": [1, 1], "divisions": [708, 708]},
+                    "velocity": [1.0, 0.5]}],
+         "time": {"end": 1, "dt": "auto", "safety": 0.5}}
+parts = [{"name": "floor", "material": "wall",
+          "rectangle": {"origin": [-0.05, -0.05], "size": [2.35, 0.05], "divisions": [47, 1]}}]
+for i in range(30):
+    for j in range(30):
+        parts.append({"name": "d%d-%d" % (i, j), "material": "rock",
+                      "disc": {"center": [0.04 + 0.0755 * i, 0.04 + 0.0755 * j],
+                               "radius": 0.037, "divisions": 24}})
+pile = {"name": "pile", "materials": {"rock": dict(rock, damping=0.2), "wall": rock},
+        "parts": parts, "gravity": [0, -9.81],
+        "time": {"end": 1, "dt": "auto", "safety": 0.5}}
+for name, doc in (("block", block), ("pile", pile)):
+    with open("%s/%s.json" % (out, name), "w") as f:
+        json.dump(doc, f)
+PY
+for c in block pile; do
+  echo "-- $c: $STEPS steps, ranks 1 and 2 taking turns, $ROUNDS rounds"
+  for r in $(seq "$ROUNDS"); do
+    for n in 1 2; do
+      echo "load $(cut -d' ' -f1-3 /proc/loadavg)"
+      mpirun -np "$n" --oversubscribe "$exe" "$STEPS" "$STEPS" --figures "$tmp/$c.json" 2>&1 |
+        grep -E "^figures|^rank [0-9]+:|failed"
+    done
+  done
+done
+echo "-- METIS on the element dual graph"
+"$BUILD/bench/mpi/bench_partition" 1e6
+free_kb=$(awk '/MemAvailable/ {print $2}' /proc/meminfo)
+if [ "${free_kb:-0}" -gt 16000000 ]; then
+  "$BUILD/bench/mpi/bench_partition" 1e7
+else
+  echo "1e7: skipped, under 16 GB available"
+fi

@@ -1,0 +1,395 @@
+/*
+ * rank_engine.c - the engine on N MPI ranks with the same bits as one
+ * process: which rank computes what, and the two exchanges of a step.
+ *
+ * Why the bits match. One process forms each node's element force by
+ * adding its elements colour by colour, block by block, each block in
+ * element order (core/parallel/scatter_plan.c), and totals the blocks'
+ * energy sums in block order. Here the blocks of that same plan are the
+ * unit of ownership (rank_partition.c): a rank computes every element of
+ * its blocks, so their block sums are whole, and it owns the nodes whose
+ * first element (lowest index) lies in one of its blocks. It also computes
+ * every element touching an owned node (the halo), in the same plan order
+ * (step_share.elem_mark, core/element/element.c), so an owned node's force
+ * is the one process's sum, bit for bit. Two exchanges complete a step:
+ *  - block sums: after the element blocks ran, each rank's blocks' partial
+ *    sums go to every rank (MPI_Allgatherv, SCATTER_SUMS doubles a block,
+ *    at most 64 blocks: under 4 KB), and every rank totals them in block
+ *    order as one process does;
+ *  - forces: once every force is added, each rank's owned nodes' forces go
+ *    to every rank (MPI_Allgatherv), so every rank holds the whole force.
+ * Everything after (the update, constraints, energies) and the joints,
+ * contact and fluid run on every rank on the same numbers: the whole state
+ * stays replicated, bit-identical on every rank, and nothing of it needs
+ * moving when bodies travel. Exchanging the forces (dim doubles a node)
+ * rather than positions and velocities (twice that) is what lets the
+ * update run everywhere; the price is that only the element stage is split
+ * (docs/parallel.md has the figures and what a halo-only version takes).
+ *
+ * The elements' viscous history (elem_viscous) is kept only where an
+ * element is computed; rank_engine_gather hands rank 0 the owners' values.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "model/model.h"
+#include "element/element.h"
+#include "rank_engine.h"
+
+struct rank_engine {
+    MPI_Comm comm;
+    int rank, size, dim, elem_count;
+    int blocks, block_size;          /* of m->elem_plan; blocks 1 when it has none */
+    int32_t *block_owner;            /* per block */
+    int32_t *block_order;            /* blocks rank by rank, each rank's ascending */
+    int *block_counts, *block_displs; /* per rank, in doubles of block sums */
+    int32_t *node_order;             /* nodes rank by rank (owned), ascending in each */
+    int *node_counts, *node_displs;  /* per rank, in doubles (dim a node) */
+    int *flag_counts, *flag_displs;  /* the same with each rank's leading flag */
+    uint8_t *mark;                   /* elements this rank computes */
+    uint8_t *halo;                   /* the border-order fault: halo elements only */
+    double *send, *recv;             /* force and block-sum buffers */
+    size_t send_len, recv_len;
+    step_share share, halo_share;
+    int border_fault;
+    int exchanged;                   /* the force exchange ran in this step */
+    rank_figures fig;
+};
+
+/* Element block of element e, as scatter_plan.c cuts them. */
+static inline int block_of(const rank_engine *re, int e) { return e / re->block_size; }
+
+/* The blocks' sums of the other ranks into plan->block_sum: each rank's
+ * own blocks packed in rank order, every rank the same lists. */
+static void share_block_sums(void *ctx, fdem_model *m, scatter_plan *plan)
+{
+    rank_engine *re = ctx;
+    if (plan != &m->elem_plan || plan->block_count != re->blocks) return;
+    const int me = re->rank;
+    double *out = re->send;
+    const int32_t *mine = re->block_order + re->block_displs[me] / SCATTER_SUMS;
+    const int count = re->block_counts[me] / SCATTER_SUMS;
+    for (int k = 0; k < count; k++)
+        memcpy(out + (size_t)k * SCATTER_SUMS, plan->block_sum + (size_t)mine[k] * SCATTER_SUMS,
+               sizeof(double) * SCATTER_SUMS);
+    double t0 = MPI_Wtime();
+    MPI_Allgatherv(out, re->block_counts[me], MPI_DOUBLE, re->recv, re->block_counts,
+                   re->block_displs, MPI_DOUBLE, re->comm);
+    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    for (int k = 0; k < re->blocks; k++)
+        memcpy(plan->block_sum + (size_t)re->block_order[k] * SCATTER_SUMS,
+               re->recv + (size_t)k * SCATTER_SUMS, sizeof(double) * SCATTER_SUMS);
+}
+
+/* The border-order fault (rank_engine.h): the halo elements' forces added
+ * after the owned blocks' whole pass; energies as they were. */
+static void add_halo_after(rank_engine *re, fdem_model *m)
+{
+    double elastic = m->elastic_energy, damping = m->damping_work;
+    m->share = &re->halo_share;
+    element_forces(m);
+    m->share = &re->share;
+    m->elastic_energy = elastic;
+    m->damping_work = damping;
+}
+
+/* Every rank's owned nodes' forces to every rank, each rank's list led by
+ * one number saying whether it got here in order (1) or failed before (0,
+ * sent by rank_engine_step): a failure on one rank fails the step on all,
+ * in the same one collective, and no rank waits for a partner that left. */
+static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
+{
+    const int D = re->dim, me = re->rank;
+    const int32_t *mine = re->node_order + re->node_displs[me] / D;
+    const int count = ok ? re->node_counts[me] / D : 0;
+    re->send[0] = ok;
+    for (int k = 0; k < count; k++)
+        memcpy(re->send + 1 + (size_t)D * k, m->force + (size_t)D * mine[k], sizeof(double) * D);
+    double t0 = MPI_Wtime();
+    int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
+                            re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
+    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    if (rc != MPI_SUCCESS) return -1;
+    for (int r = 0; r < re->size; r++)
+        if (re->recv[re->flag_displs[r]] != 1) return -1;
+    for (int r = 0; r < re->size; r++) {
+        const double *from = re->recv + re->flag_displs[r] + 1;
+        const int32_t *nodes = re->node_order + re->node_displs[r] / D;
+        for (int k = 0; k < re->node_counts[r] / D; k++)
+            memcpy(m->force + (size_t)D * nodes[k], from + (size_t)D * k, sizeof(double) * D);
+    }
+    return 0;
+}
+
+static int share_forces_done(void *ctx, fdem_model *m)
+{
+    rank_engine *re = ctx;
+    re->exchanged = 1;
+    if (re->border_fault) add_halo_after(re, m);
+    return exchange_forces(re, m, 1);
+}
+
+/* Lists of owned items rank by rank (owner[i] of n items), with the
+ * counts and offsets in units of `width` doubles. */
+static int list_by_owner(const int32_t *owner, int n, int size, int width, int32_t *order,
+                         int *counts, int *displs)
+{
+    for (int r = 0; r < size; r++) counts[r] = 0;
+    for (int i = 0; i < n; i++) counts[owner[i]]++;
+    int at = 0;
+    for (int r = 0; r < size; r++) {
+        displs[r] = at;
+        at += counts[r];
+    }
+    for (int r = 0; r < size; r++) counts[r] = 0;
+    for (int i = 0; i < n; i++) order[displs[owner[i]] + counts[owner[i]]++] = i;
+    for (int r = 0; r < size; r++) {
+        counts[r] *= width;
+        displs[r] *= width;
+    }
+    return 0;
+}
+
+/* Node owners (the owner of the block of each node's first element; rank
+ * 0 for a node of no element) and the marks of the elements this rank
+ * computes: its blocks' and those touching a node it owns. */
+static int assign_nodes_and_marks(rank_engine *re, const fdem_model *m, int32_t *node_owner)
+{
+    const int K = m->elem_nodes, E = m->elem_count;
+    for (int i = 0; i < m->node_count; i++) node_owner[i] = -1;
+    for (int e = 0; e < E; e++)
+        for (int c = 0; c < K; c++) {
+            int32_t n = m->elem_node[(size_t)K * e + c];
+            if (node_owner[n] < 0) node_owner[n] = re->block_owner[block_of(re, e)];
+        }
+    long owned_nodes = 0;
+    for (int i = 0; i < m->node_count; i++) {
+        if (node_owner[i] < 0) node_owner[i] = 0;
+        owned_nodes += node_owner[i] == re->rank;
+    }
+    long owned = 0, computed = 0;
+    for (int e = 0; e < E; e++) {
+        int own = re->block_owner[block_of(re, e)] == re->rank, touch = own;
+        for (int c = 0; c < K && !touch; c++)
+            touch = node_owner[m->elem_node[(size_t)K * e + c]] == re->rank;
+        re->mark[e] = (uint8_t)touch;
+        re->halo[e] = (uint8_t)(touch && !own);
+        owned += own;
+        computed += touch;
+    }
+    re->fig.owned_elements = owned;
+    re->fig.computed_elements = computed;
+    re->fig.owned_nodes = owned_nodes;
+    return 0;
+}
+
+/* Rank 0 partitions the blocks and tells the others (one partition even if
+ * METIS were to differ between machines). */
+static int partition(rank_engine *re, const fdem_model *m)
+{
+    double t0 = MPI_Wtime();
+    int rc = 0;
+    if (re->rank == 0) {
+        if (m->elem_plan.color_count == 0 || re->size == 1)
+            memset(re->block_owner, 0, sizeof(int32_t) * (size_t)re->blocks);
+        else
+            rc = rank_partition_blocks(m->elem_node, m->elem_count, m->elem_nodes, m->node_count,
+                                       re->block_size, re->blocks, re->size, re->block_owner);
+    }
+    MPI_Bcast(&rc, 1, MPI_INT, 0, re->comm);
+    MPI_Bcast(re->block_owner, re->blocks, MPI_INT32_T, 0, re->comm);
+    re->fig.partition_seconds = MPI_Wtime() - t0;
+    return rc;
+}
+
+static int setup(rank_engine *re, fdem_model *m)
+{
+    const int N = m->node_count, D = re->dim;
+    const scatter_plan *plan = &m->elem_plan;
+    re->blocks = plan->color_count ? plan->block_count : 1;
+    re->block_size = plan->color_count ? plan->block_size : (m->elem_count > 0 ? m->elem_count : 1);
+    re->block_owner = malloc(sizeof(int32_t) * (size_t)re->blocks);
+    re->block_order = malloc(sizeof(int32_t) * (size_t)re->blocks);
+    re->block_counts = malloc(sizeof(int) * (size_t)re->size * 6);
+    re->node_order = malloc(sizeof(int32_t) * ((size_t)N + 1));
+    re->mark = malloc((size_t)m->elem_count + 1);
+    re->halo = malloc((size_t)m->elem_count + 1);
+    int32_t *node_owner = malloc(sizeof(int32_t) * ((size_t)N + 1));
+    re->send_len = re->recv_len = (size_t)D * N + (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
+    re->send = malloc(sizeof(double) * re->send_len);
+    re->recv = malloc(sizeof(double) * re->recv_len);
+    int rc = -1;
+    if (!re->block_owner || !re->block_order || !re->block_counts || !re->node_order ||
+        !re->mark || !re->halo || !node_owner || !re->send || !re->recv)
+        goto done;
+    re->block_displs = re->block_counts + re->size;
+    re->node_counts = re->block_counts + 2 * re->size;
+    re->node_displs = re->block_counts + 3 * re->size;
+    re->flag_counts = re->block_counts + 4 * re->size;
+    re->flag_displs = re->block_counts + 5 * re->size;
+    if (partition(re, m)) goto done;
+    if (m->elem_plan.color_count == 0) { /* no blocks: every rank computes every element */
+        memset(re->mark, 1, (size_t)m->elem_count + 1);
+        memset(re->halo, 0, (size_t)m->elem_count + 1);
+        for (int i = 0; i < N; i++) node_owner[i] = 0;
+        re->fig.owned_elements = re->rank == 0 ? m->elem_count : 0;
+        re->fig.computed_elements = m->elem_count;
+        re->fig.owned_nodes = re->rank == 0 ? N : 0;
+    } else {
+        assign_nodes_and_marks(re, m, node_owner);
+    }
+    list_by_owner(re->block_owner, re->blocks, re->size, SCATTER_SUMS, re->block_order,
+                  re->block_counts, re->block_displs);
+    list_by_owner(node_owner, N, re->size, D, re->node_order, re->node_counts, re->node_displs);
+    for (int r = 0; r < re->size; r++) {
+        re->flag_counts[r] = re->node_counts[r] + 1;
+        re->flag_displs[r] = re->node_displs[r] + r;
+    }
+    re->fig.ranks = re->size;
+    re->fig.blocks = re->blocks;
+    re->fig.owned_blocks = re->block_counts[re->rank] / SCATTER_SUMS;
+    const double others = re->size - 1;
+    re->fig.bytes_sent_per_step =
+        others * 8.0 * (re->node_counts[re->rank] +
+                        (m->elem_plan.color_count ? re->block_counts[re->rank] : 0));
+    rc = 0;
+done:
+    free(node_owner);
+    return rc;
+}
+
+rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
+{
+    rank_engine *re = calloc(1, sizeof *re);
+    if (!re) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the rank engine");
+        return NULL;
+    }
+    re->comm = comm;
+    MPI_Comm_rank(comm, &re->rank);
+    MPI_Comm_size(comm, &re->size);
+    re->dim = m->dim;
+    re->elem_count = m->elem_count;
+    int ok = m->finalized && setup(re, m) == 0;
+    MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, comm);
+    if (!ok) {
+        model_error(err, FDEM_ITEM_NONE, -1, "the rank engine could not be set up on %d ranks "
+                    "(a model not finalized, or out of memory on some rank)", re->size);
+        rank_engine_free(re);
+        return NULL;
+    }
+    re->share = (step_share){re, re->mark, share_block_sums, share_forces_done};
+    re->halo_share = (step_share){re, re->halo, NULL, NULL};
+    if (m->elem_plan.color_count == 0) re->share.block_sums = NULL;
+    return re;
+}
+
+int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
+{
+    re->exchanged = 0;
+    if (re->size == 1) return fdem_step(m, err); /* nothing to share */
+    m->share = &re->share; /* only while stepping: outside a step nothing is collective */
+    int rc = fdem_step(m, err);
+    m->share = NULL;
+    if (rc && !re->exchanged) exchange_forces(re, m, 0); /* the others wait there */
+    return rc;
+}
+
+/* The viscous history of each block from its owner to rank 0. */
+int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err)
+{
+    if (!m->elem_viscous || m->elem_plan.color_count == 0 || re->size == 1) return 0;
+    const int C = model_stress_comps(m), me = re->rank;
+    const size_t per_block = (size_t)C * re->block_size;
+    int *counts = malloc(sizeof(int) * 2 * (size_t)re->size);
+    double *all = me == 0 ? malloc(sizeof(double) * (size_t)C * m->elem_count + 1) : NULL;
+    double *mine = malloc(sizeof(double) * (per_block * re->fig.owned_blocks + 1));
+    int ok = counts && mine && (me != 0 || all);
+    MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, re->comm);
+    if (!ok) {
+        free(counts), free(all), free(mine);
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory gathering the ranks' element state");
+        return -1;
+    }
+    int *displs = counts + re->size, at = 0;
+    for (int r = 0; r < re->size; r++) { /* each rank's blocks' elements, in block order */
+        int n = 0;
+        for (int k = re->block_displs[r] / SCATTER_SUMS;
+             k < (re->block_displs[r] + re->block_counts[r]) / SCATTER_SUMS; k++) {
+            int b = re->block_order[k], begin = b * re->block_size;
+            int end = begin + re->block_size < m->elem_count ? begin + re->block_size
+                                                             : m->elem_count;
+            if (r == me)
+                memcpy(mine + n, m->elem_viscous + (size_t)C * begin,
+                       sizeof(double) * (size_t)C * (end - begin));
+            n += C * (end - begin);
+        }
+        counts[r] = n;
+        displs[r] = at;
+        at += n;
+    }
+    MPI_Gatherv(mine, counts[me], MPI_DOUBLE, all, counts, displs, MPI_DOUBLE, 0, re->comm);
+    if (me == 0) {
+        size_t from = 0;
+        for (int k = 0; k < re->blocks; k++) {
+            int b = re->block_order[k], begin = b * re->block_size;
+            int end = begin + re->block_size < m->elem_count ? begin + re->block_size
+                                                             : m->elem_count;
+            memcpy(m->elem_viscous + (size_t)C * begin, all + from,
+                   sizeof(double) * (size_t)C * (end - begin));
+            from += (size_t)C * (end - begin);
+        }
+    }
+    free(counts), free(all), free(mine);
+    return 0;
+}
+
+int rank_engine_lazy_step(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_engine_lazy *lazy = ctx;
+    if (lazy->re && lazy->model != m) rank_engine_lazy_free(lazy);
+    if (!lazy->re) {
+        if (!(lazy->re = rank_engine_create(m, lazy->comm, err))) return -1;
+        lazy->model = m;
+    }
+    return rank_engine_step(lazy->re, m, err);
+}
+
+int rank_engine_lazy_gather(void *ctx, fdem_model *m, fdem_error *err)
+{
+    rank_engine_lazy *lazy = ctx;
+    return lazy->re && lazy->model == m ? rank_engine_gather(lazy->re, m, err) : 0;
+}
+
+void rank_engine_lazy_free(rank_engine_lazy *lazy)
+{
+    rank_engine_free(lazy->re);
+    lazy->re = NULL;
+    lazy->model = NULL;
+}
+
+rank_figures rank_engine_figures(const rank_engine *re) { return re->fig; }
+
+/* Turning the fault on keeps only the owned blocks' marks in the pass
+ * (the halo comes after, add_halo_after); it is never turned off. */
+void rank_engine_set_border_order_fault(rank_engine *re, int on)
+{
+    if (!on || re->border_fault) return;
+    re->border_fault = 1;
+    for (int e = 0; e < re->elem_count; e++)
+        if (re->halo[e]) re->mark[e] = 0;
+}
+
+void rank_engine_free(rank_engine *re)
+{
+    if (!re) return;
+    free(re->block_owner);
+    free(re->block_order);
+    free(re->block_counts);
+    free(re->node_order);
+    free(re->mark);
+    free(re->halo);
+    free(re->send);
+    free(re->recv);
+    free(re);
+}

@@ -1,0 +1,255 @@
+/*
+ * rank_compare.c - steps a case on the ranks it is started on and prints,
+ * every `every` steps, a hash of the whole state as rank 0 would write it
+ * (the checkpoint bytes after rank_engine_gather: nodes, element history,
+ * joints, contact history, energies) and of the energies, plus whether
+ * every rank holds the same positions and velocities.
+ * tests/integration/test_ranks.py runs it on 1, 2, 3, 4 and 8 ranks and
+ * in one plain process (fdem_step, no rank engine) and compares the
+ * lines: the same bits or a failure.
+ *
+ *   rank_compare STEPS EVERY [--plain] [--threads T] [--fault] [--figures]
+ *                CASE.json...   (flags apply to the cases after them)
+ *
+ * --save-at K FILE writes the checkpoint after step K (one file: use it
+ * with one case); --restore FILE starts every rank from one, so a run
+ * saved on N ranks goes on on M.
+ *
+ * --fault turns on rank_engine_set_border_order_fault (each rank sums its
+ * halo elements after its own blocks): its lines must differ from the
+ * plain run's, which shows the comparison can fail.
+ */
+#include <mpi.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "case/case.h"
+#include "mpi/rank_engine.h"
+
+static uint64_t fnv1a(const void *data, size_t size, uint64_t h)
+{
+    const unsigned char *p = data;
+    for (size_t i = 0; i < size; i++) h = (h ^ p[i]) * 1099511628211ull;
+    return h;
+}
+
+static char *read_text(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = malloc((size_t)n + 1);
+    if (text && fread(text, 1, (size_t)n, f) != (size_t)n) {
+        free(text);
+        text = NULL;
+    }
+    fclose(f);
+    if (text) text[n] = 0;
+    *length = (size_t)n;
+    return text;
+}
+
+/* The hash of the checkpoint (rank 0) and of the energies. */
+static void print_state(fdem_model *m, int step)
+{
+    size_t size = fdem_checkpoint_size(m);
+    void *buf = malloc(size);
+    if (!buf || fdem_checkpoint_write(m, buf, size)) {
+        printf("step %d checkpoint failed\n", step);
+        free(buf);
+        return;
+    }
+    fdem_energy en = fdem_get_energy(m);
+    fdem_counts c = fdem_get_counts(m);
+    printf("step %d state %016llx energy %016llx elastic %.17g kinetic %.17g broken %d "
+           "contacts %d\n", step,
+           (unsigned long long)fnv1a(buf, size, 1469598103934665603ull),
+           (unsigned long long)fnv1a(&en, sizeof en, 1469598103934665603ull), en.elastic,
+           en.kinetic, c.broken_joints, c.contacts);
+    free(buf);
+}
+
+static double cpu_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* This process's peak resident memory, bytes (Linux; 0 elsewhere). */
+static double peak_bytes(void)
+{
+    FILE *f = fopen("/proc/self/status", "r");
+    char line[256];
+    double kb = 0;
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "VmHWM:", 6)) kb = atof(line + 6);
+    if (f) fclose(f);
+    return kb * 1024;
+}
+
+/* Whether every rank holds rank 0's positions and velocities. */
+static int ranks_agree(const fdem_model *m, MPI_Comm comm)
+{
+    fdem_counts c = fdem_get_counts(m);
+    size_t bytes = sizeof(double) * (size_t)c.dimension * (size_t)c.nodes;
+    uint64_t h = fnv1a(fdem_positions(m), bytes, 1469598103934665603ull);
+    h = fnv1a(fdem_velocities(m), bytes, h);
+    uint64_t least[2] = {h, ~h}; /* the smallest h and the largest, in one reduction */
+    MPI_Allreduce(MPI_IN_PLACE, least, 2, MPI_UINT64_T, MPI_MIN, comm);
+    return least[0] == ~least[1];
+}
+
+typedef struct compare_options {
+    int steps, every, plain, fault, threads, figures;
+    int save_at;              /* the step after which rank 0 writes save_path; 0: none */
+    const char *save_path;
+    const char *restore_path; /* a checkpoint every rank starts from; NULL: step 0 */
+} compare_options;
+
+/* Rank 0 writes the model's checkpoint (after rank_engine_gather). */
+static int save_checkpoint(const fdem_model *m, const char *path)
+{
+    size_t size = fdem_checkpoint_size(m);
+    void *buf = malloc(size);
+    FILE *f = buf ? fopen(path, "wb") : NULL;
+    int rc = !f || fdem_checkpoint_write(m, buf, size) || fwrite(buf, 1, size, f) != size;
+    if (f && fclose(f)) rc = 1;
+    free(buf);
+    return rc;
+}
+
+/* Every rank reads the same checkpoint into its model. */
+static int restore_checkpoint(fdem_model *m, const char *path, fdem_error *err)
+{
+    size_t size;
+    char *buf = read_text(path, &size);
+    int rc = !buf || fdem_checkpoint_read(m, buf, size, err);
+    free(buf);
+    return rc;
+}
+
+/* Steps one case; prints its lines (rank 0). Returns nonzero on failure. */
+static int run_case(const char *path, const compare_options *o, int rank, int size)
+{
+    const int steps = o->steps, every = o->every, plain = o->plain, figures = o->figures;
+    size_t length;
+    char *text = read_text(path, &length);
+    problems out;
+    problems_init(&out);
+    case_info info;
+    double t0 = MPI_Wtime();
+    fdem_model *m = text ? case_build(text, length, (size_t)1 << 36, &info, &out) : NULL;
+    free(text);
+    if (!m) {
+        fprintf(stderr, "rank %d: %s does not build: %s\n", rank, path,
+                out.count ? out.items[0].message : "unreadable");
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+    problems_free(&out);
+    fdem_set_threads(m, o->threads);
+    double t_build = MPI_Wtime() - t0;
+    fdem_error err = {0};
+    if (o->restore_path && restore_checkpoint(m, o->restore_path, &err)) {
+        fprintf(stderr, "rank %d: %s does not restore: %s\n", rank, o->restore_path, err.message);
+        MPI_Abort(MPI_COMM_WORLD, 2);
+    }
+    const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
+    /* the batch loop's way (made at the first step), but for the fault,
+     * which is set before it */
+    rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
+    if (!plain && o->fault) {
+        if (!(lazy.re = rank_engine_create(m, MPI_COMM_WORLD, &err))) {
+            fprintf(stderr, "rank %d: %s\n", rank, err.message);
+            MPI_Abort(MPI_COMM_WORLD, 2);
+        }
+        lazy.model = m;
+        rank_engine_set_border_order_fault(lazy.re, 1);
+    }
+    if (rank == 0) printf("case %s\n", path);
+    int status = 0;
+    double t_step = 0, c_step = 0;
+    for (int s = first; s <= steps && !status; s++) {
+        double ts = MPI_Wtime(), cs = cpu_seconds();
+        int rc = plain ? fdem_step(m, &err) : rank_engine_lazy_step(&lazy, m, &err);
+        t_step += MPI_Wtime() - ts;
+        c_step += cpu_seconds() - cs;
+        if (rc) {
+            if (rank == 0) printf("step %d failed: %s\n", s, err.message);
+            status = 1;
+            break;
+        }
+        if (s % every && s != steps && s != o->save_at) continue;
+        int agree = plain || ranks_agree(m, MPI_COMM_WORLD);
+        if (!plain && rank_engine_lazy_gather(&lazy, m, &err)) status = 1;
+        if (rank == 0) {
+            if (!agree) printf("step %d ranks disagree\n", s);
+            print_state(m, s);
+            if (s == o->save_at && save_checkpoint(m, o->save_path)) status = 1;
+        }
+    }
+    if (figures && lazy.re) {
+        rank_figures f = rank_engine_figures(lazy.re);
+        double most = f.bytes_sent_per_step, step_s = t_step / steps;
+        MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        fprintf(stderr, "rank %d: blocks %d of %d, elements owned %ld computed %ld (halo %.3f), "
+                "nodes owned %ld, bytes sent/step %.0f, partition %.4f s, build %.2f s, "
+                "step %.6f s (cpu %.6f s, exchanges %.6f s), peak %.0f bytes/element\n", rank, f.owned_blocks, f.blocks, f.owned_elements,
+                f.computed_elements,
+                f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
+                                       (double)f.owned_elements : 0.0,
+                f.owned_nodes, f.bytes_sent_per_step, f.partition_seconds, t_build,
+                t_step / steps, c_step / steps, f.exchange_seconds / steps,
+                peak_bytes() / fdem_get_counts(m).elements);
+        if (rank == 0)
+            printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
+                   most);
+    }
+    if (figures && rank == 0) {
+        fdem_stage_times st = fdem_get_stage_times(m);
+        printf("stages per step (s): elements %.6f joints %.6f detection %.6f contact %.6f "
+               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / steps, st.joints / steps,
+               st.detection / steps, st.contact / steps, st.integration / steps, t_step / steps,
+               c_step / steps);
+    }
+    rank_engine_lazy_free(&lazy);
+    fdem_model_destroy(m);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    int rank, size;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (argc < 4) {
+        if (rank == 0) fprintf(stderr, "usage: rank_compare STEPS EVERY [--plain] [--threads T] "
+                                       "[--fault] [--figures] [--save-at K FILE] [--restore FILE] "
+                                       "CASE.json...\n");
+        MPI_Finalize();
+        return 2;
+    }
+    compare_options o = {.steps = atoi(argv[1]), .every = atoi(argv[2]), .threads = 1};
+    int status = 0;
+    if (o.steps < 1 || o.every < 1) MPI_Abort(MPI_COMM_WORLD, 2);
+    for (int i = 3; i < argc; i++) {
+        if (!strcmp(argv[i], "--plain")) o.plain = 1;
+        else if (!strcmp(argv[i], "--fault")) o.fault = 1;
+        else if (!strcmp(argv[i], "--figures")) o.figures = 1;
+        else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--save-at") && i + 2 < argc) {
+            o.save_at = atoi(argv[++i]);
+            o.save_path = argv[++i];
+        } else if (!strcmp(argv[i], "--restore") && i + 1 < argc) o.restore_path = argv[++i];
+        else status |= run_case(argv[i], &o, rank, size);
+    }
+    MPI_Finalize();
+    return status;
+}
