@@ -46,7 +46,7 @@ SERVER_SRC := $(wildcard server/*.c server/*/*.c)
 # runner/: the batch loop (a library) and the mains of bin/fdem-run and,
 # where mpicc exists, bin/fdem-rank (MPI lives only in runner/mpi and there)
 RUNNER_SRC := $(filter-out runner/fdem_%_main.c,$(wildcard runner/*.c))
-RANK_SRC   := runner/fdem_rank_main.c $(wildcard runner/mpi/*.c)
+RANK_SRC   := runner/fdem_rank_main.c
 MPICC      := $(shell command -v mpicc 2>/dev/null)
 CTL_SRC    := $(wildcard clients/fdemctl/*.c)
 UNIT_SRC   := $(wildcard tests/unit/test_*.c)
@@ -58,6 +58,7 @@ PROTO_OBJ  := $(PROTO_SRC:%.c=$(BUILD)/%.o)
 SERVER_OBJ := $(SERVER_SRC:%.c=$(BUILD)/%.o)
 RUNNER_OBJ := $(RUNNER_SRC:%.c=$(BUILD)/%.o)
 RANK_OBJ   := $(RANK_SRC:%.c=$(BUILD)/mpi-%.o)
+RANK_ENGINE_OBJ := $(patsubst runner/mpi/%.c,$(BUILD)/rank-engine/%.o,$(wildcard runner/mpi/*.c))
 CTL_OBJ    := $(CTL_SRC:%.c=$(BUILD)/%.o)
 UNIT_BIN   := $(UNIT_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
@@ -115,9 +116,9 @@ $(BIN)/fdemd: $(SERVER_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 $(BIN)/fdem-run: $(BUILD)/runner/fdem_run_main.o $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(BIN)
 	$(CC) $(LDSAN) -fopenmp -o $@ $< $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lpthread -lm
-$(BIN)/fdem-rank: $(RANK_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
+$(BIN)/fdem-rank: $(RANK_OBJ) $(RANK_ENGINE_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE)
 	@mkdir -p $(BIN)
-	$(MPICC) $(LDSAN) -fopenmp -o $@ $(RANK_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) $(if $(wildcard runner/mpi/*.c),-lmetis) -lpthread -lm
+	$(MPICC) $(LDSAN) -fopenmp -o $@ $(RANK_OBJ) $(RANK_ENGINE_OBJ) $(LIBRUNNER) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) $(if $(RANK_ENGINE_OBJ),-lmetis) -lpthread -lm
 $(BIN)/fdemctl: $(CTL_OBJ)
 	@mkdir -p $(BIN)
 	$(CC) $(LDSAN) -o $@ $(CTL_OBJ) $(PKG_LIBS) -lm
@@ -140,8 +141,6 @@ $(BUILD)/scripts/%: scripts/%.c $(LIBPROTO) $(LIBCORE)
 
 # MPI (issue 37): runner/mpi and the programs that link it build with
 # mpicc, only where it exists; elsewhere they are left out with a message.
-MPICC      := $(shell command -v mpicc 2>/dev/null)
-RANK_ENGINE_OBJ := $(patsubst runner/mpi/%.c,$(BUILD)/rank-engine/%.o,$(wildcard runner/mpi/*.c))
 MPI_TESTS  := $(if $(MPICC),$(BUILD)/tests/mpi/rank_compare)
 MPI_LINK    = $(MPICC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner $(LDSAN) -fopenmp -o $@ $< \
               $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lmetis -lpthread -lm

@@ -44,23 +44,19 @@ typedef struct rank_stepper_ctx {
     MPI_Comm comm;
     int rank, size;
 #ifdef FDEM_RANK_ENGINE
-    rank_engine *engine;        /* made at the first step, from the model run_case built */
+    rank_engine_lazy engine; /* made at the first step of each model run_case builds */
 #endif
 } rank_stepper_ctx;
 
 #ifdef FDEM_RANK_ENGINE
 static int rank_stepper_step(void *ctx, fdem_model *m, fdem_error *err)
 {
-    rank_stepper_ctx *s = ctx;
-    if (!s->engine && !(s->engine = rank_engine_create(m, s->comm, err)))
-        return -1;
-    return rank_engine_step(s->engine, m, err);
+    return rank_engine_lazy_step(&((rank_stepper_ctx *)ctx)->engine, m, err);
 }
 
 static int rank_stepper_gather(void *ctx, fdem_model *m, fdem_error *err)
 {
-    rank_stepper_ctx *s = ctx;
-    return s->engine ? rank_engine_gather(s->engine, m, err) : 0; /* no step yet: whole */
+    return rank_engine_lazy_gather(&((rank_stepper_ctx *)ctx)->engine, m, err);
 }
 #else
 static int rank_stepper_step(void *ctx, fdem_model *m, fdem_error *err)
@@ -129,6 +125,9 @@ int main(int argc, char **argv)
     o.case_path = argv[optind];
     MPI_Init(&argc, &argv);
     rank_stepper_ctx ctx = {.comm = MPI_COMM_WORLD};
+#ifdef FDEM_RANK_ENGINE
+    ctx.engine.comm = ctx.comm;
+#endif
     MPI_Comm_rank(ctx.comm, &ctx.rank);
     MPI_Comm_size(ctx.comm, &ctx.size);
     o.ranks = ctx.size;
@@ -138,8 +137,7 @@ int main(int argc, char **argv)
                          .is_writer = ctx.rank == 0, .agree = rank_stepper_agree};
     int status = run_exit_status(run_case(&o, &st));
 #ifdef FDEM_RANK_ENGINE
-    if (ctx.engine)
-        rank_engine_free(ctx.engine);
+    rank_engine_lazy_free(&ctx.engine);
 #endif
     rank_wait_for_writer(ctx.comm);
     /* every rank ends with rank 0's outcome, which the launcher reports */
