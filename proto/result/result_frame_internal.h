@@ -1,0 +1,63 @@
+/*
+ * result_frame_internal.h - what the two forms of the web page's binary
+ * frame share (docs/api.md, "Binary mesh frames"): result_frame.c reads
+ * result.h5 and writes the header and sections; result_frame_shape.c
+ * gives the mesh's shape, whole or only the facets that can be seen. A frame
+ * is built as a list of sections (named typed arrays, each owning its
+ * buffer), then written in one piece. I/O thread only.
+ */
+#ifndef FDEM_RESULT_FRAME_INTERNAL_H
+#define FDEM_RESULT_FRAME_INTERNAL_H
+
+#include <stdint.h>
+
+#include "result_internal.h"
+
+/* Where a section's items live, and its value type (the header codes). */
+enum { FRAME_AT_NODE = 0, FRAME_AT_ELEMENT = 1, FRAME_AT_JOINT = 2, FRAME_AT_FACE = 3 };
+enum { FRAME_F32 = 0, FRAME_U32 = 1 };
+#define FRAME_NONE 0xffffffffu /* a u32 index that points nowhere */
+#define FRAME_MAX_SECTIONS 32
+
+typedef struct frame_section {
+    char name[16];
+    uint32_t at, width, type, items;
+    int shape;     /* 1: part of the mesh's shape, left out when the client holds it */
+    void *data;    /* items * width 4-byte values, malloc'd */
+} frame_section;
+
+/* The items a frame carries: every one (id NULL) or those listed. */
+enum { CARRY_NODES, CARRY_ELEMENTS, CARRY_JOINTS, CARRY_KINDS };
+typedef struct frame_carry {
+    uint32_t count[CARRY_KINDS];
+    uint32_t *id[CARRY_KINDS]; /* the original index of each carried item, or NULL */
+} frame_carry;
+
+typedef struct frame_build {
+    int dimension, surface;
+    uint32_t faces;         /* facets carried (surface form) */
+    frame_carry carry;
+    int count;
+    frame_section section[FRAME_MAX_SECTIONS];
+} frame_build;
+
+/* A new section of items x width values, zeroed; NULL when out of memory
+ * or past FRAME_MAX_SECTIONS. */
+void *frame_add(frame_build *b, const char *name, uint32_t at, uint32_t width, uint32_t type,
+                uint32_t items, int shape);
+
+/* The mesh's shape as sections, and what the frame carries (b->carry):
+ * the whole mesh (cells, joints, joint_elements), or with b->surface the
+ * visible facets (faces, face_element, face_joint, node_id, element_id,
+ * joint_id, joint_elements) and only the nodes, elements and joints they
+ * touch. cells, joint_nodes: the /mesh arrays of E and J rows; broken[J]
+ * and active[E] of the snapshot (NULL: none broken, all there). 0, or -1
+ * with err (out of memory, a bad mesh). */
+int frame_shape(frame_build *b, uint32_t nodes, uint32_t elements, uint32_t joints,
+                const int32_t *cells, const int32_t *joint_nodes, const unsigned char *broken,
+                const unsigned char *active, char *err, size_t errlen);
+
+/* The peak bytes frame_shape allocates besides its sections. */
+size_t frame_shape_bytes(int dimension, uint32_t nodes, uint32_t elements, uint32_t joints);
+
+#endif
