@@ -55,6 +55,7 @@ export class CaseView {
     ];
     for (const [el, ev, fn] of this.listeners) el.addEventListener(ev, fn);
     $("events").querySelector("tbody").textContent = "";
+    for (const k of ["frameDrawn", "frameField", "frameShownMs"]) delete document.body.dataset[k];
     $("field").textContent = "";
     this.showParentDiff(parent);
     // the frame first: the sieve curve of a case that is not running
@@ -186,6 +187,7 @@ export class CaseView {
     const col = this.view.draw(this.frame, $("field").value, isFinite(scale) ? scale : 1);
     $("legend-lo").textContent = col.categorical ? "ids" : col.lo.toPrecision(3);
     $("legend-hi").textContent = col.categorical ? "" : col.hi.toPrecision(3);
+    document.body.dataset.frameField = $("field").value; // what the view shows, for the tests
     return true;
   }
 

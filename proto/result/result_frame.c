@@ -217,7 +217,8 @@ void *frame_add(frame_build *b, const char *name, uint32_t at, uint32_t width, u
         return NULL;
     frame_section *s = &b->section[b->count];
     memset(s, 0, sizeof *s);
-    snprintf(s->name, sizeof s->name, "%s", name);
+    size_t n = strlen(name); /* NUL-padded, not terminated: "principal_stress" fills it */
+    memcpy(s->name, name, n < sizeof s->name ? n : sizeof s->name);
     s->at = at;
     s->width = width;
     s->type = type;
@@ -321,7 +322,7 @@ static void frame_write(const frame_build *b, const frame_head *h, unsigned char
         if (s->shape && !h->with_shape)
             continue;
         memset(p, 0, FRAME_SECTION_HEADER_BYTES);
-        memcpy(p, s->name, strlen(s->name));
+        memcpy(p, s->name, sizeof s->name);
         put_u32(p + FRAME_NAME_BYTES, s->at);
         put_u32(p + FRAME_NAME_BYTES + 4, s->width);
         put_u32(p + FRAME_NAME_BYTES + 8, s->type);

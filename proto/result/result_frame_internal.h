@@ -20,7 +20,7 @@ enum { FRAME_F32 = 0, FRAME_U32 = 1 };
 #define FRAME_MAX_SECTIONS 32
 
 typedef struct frame_section {
-    char name[16];
+    char name[16];  /* NUL-padded, not terminated when 16 long */
     uint32_t at, width, type, items;
     int shape;     /* 1: part of the mesh's shape, left out when the client holds it */
     void *data;    /* items * width 4-byte values, malloc'd */

@@ -596,13 +596,14 @@ class WebBrowserTest(unittest.TestCase):
         self.wait_for("return document.body.dataset.frameDrawn === 'yes' && "
                       "document.getElementById('view-title').textContent.includes('%s')"
                       % self.fluid["id"], "the fluid case's frame")
-        options = b.execute_script("return [...document.getElementById('field').options].map(o => o.value)")
+        options = self.wait_for("const o = [...document.getElementById('field').options]"
+                                ".map(o => o.value); return o.length && o", "the field menu")
         self.assertIn("fluid_pressure", options)
         self.assertIn("aperture", options)
-        b.execute_script("document.body.dataset.frameDrawn = 'no';"
-                         "const m = document.getElementById('field'); m.value = 'fluid_pressure';"
+        b.execute_script("const m = document.getElementById('field'); m.value = 'fluid_pressure';"
                          "m.dispatchEvent(new Event('change'));")
-        self.wait_for("return document.body.dataset.frameDrawn === 'yes'", "the fluid pressure")
+        self.wait_for("return document.body.dataset.frameField === 'fluid_pressure'",
+                      "the fluid pressure drawn")
         lo, hi = b.execute_script("return [document.getElementById('legend-lo').textContent,"
                                   "document.getElementById('legend-hi').textContent]")
         self.assertGreater(float(hi), float(lo))
