@@ -33,9 +33,9 @@ void facet_nodes(int dimension, const int32_t *cells, int32_t f, int32_t *nodes)
 
 typedef struct facet_table {
     int dimension;
-    uint32_t mask;   /* size - 1, size a power of two at least twice the facets */
-    int32_t *slot;   /* facet index, or -1 */
-    const int32_t *cells;
+    uint32_t mask;      /* size - 1, size a power of two at least twice the facets */
+    int32_t *slot;      /* facet index, or -1 */
+    const int32_t *key; /* each facet's sorted node ids, 3 per facet */
 } facet_table;
 
 static uint32_t facet_hash(const int32_t *key, int n)
@@ -48,6 +48,7 @@ static uint32_t facet_hash(const int32_t *key, int n)
 
 static void facet_key(int dimension, const int32_t *cells, int32_t f, int32_t *key)
 {
+    key[2] = -1; /* an edge's third id, so that every key compares as three */
     facet_nodes(dimension, cells, f, key);
     node_ids_sort(key, dimension);
 }
@@ -59,11 +60,7 @@ static uint32_t facet_find(const facet_table *t, const int32_t *key)
     uint32_t h = facet_hash(key, t->dimension) & t->mask;
     for (;;) {
         int32_t f = t->slot[h];
-        if (f < 0)
-            return h;
-        int32_t other[3];
-        facet_key(t->dimension, t->cells, f, other);
-        if (node_ids_compare(key, other, t->dimension) == 0)
+        if (f < 0 || node_ids_compare(key, t->key + 3 * (size_t)f, 3) == 0)
             return h;
         h = (h + 1) & t->mask;
     }
@@ -82,7 +79,7 @@ static uint32_t facet_table_size(int facets)
 size_t facet_map_bytes(int dimension, int elements, int joints)
 {
     size_t facets = (size_t)(dimension + 1) * (size_t)elements;
-    return sizeof(int32_t) * (2 * facets + 2 * (size_t)joints + facet_table_size((int)facets));
+    return sizeof(int32_t) * (5 * facets + 2 * (size_t)joints + facet_table_size((int)facets));
 }
 
 void facet_map_free(facet_map *m)
@@ -98,9 +95,7 @@ void facet_map_free(facet_map *m)
 static void facet_map_twins(facet_map *m, facet_table *t, int facets)
 {
     for (int32_t f = 0; f < facets; f++) {
-        int32_t key[3];
-        facet_key(m->dimension, t->cells, f, key);
-        uint32_t h = facet_find(t, key);
+        uint32_t h = facet_find(t, t->key + 3 * (size_t)f);
         int32_t first = t->slot[h];
         if (first < 0) {
             t->slot[h] = f;
@@ -116,7 +111,7 @@ static void facet_map_joints(facet_map *m, const facet_table *t, const int32_t *
     int d = m->dimension;
     for (int j = 0; j < m->joints; j++)
         for (int side = 0; side < 2; side++) {
-            int32_t key[3];
+            int32_t key[3] = {-1, -1, -1};
             memcpy(key, joint_nodes + (size_t)j * 2 * d + side * d, sizeof(int32_t) * d);
             node_ids_sort(key, d);
             int32_t f = t->slot[facet_find(t, key)];
@@ -146,22 +141,28 @@ int facet_map_build(facet_map *m, int dimension, int elements, const int32_t *ce
     m->dimension = dimension;
     m->elements = elements;
     m->joints = joints;
-    facet_table t = {dimension, facet_table_size(facets) - 1, NULL, cells};
+    facet_table t = {dimension, facet_table_size(facets) - 1, NULL, NULL};
+    int32_t *key = malloc(sizeof(int32_t) * 3 * (size_t)(facets ? facets : 1));
     m->twin = malloc(sizeof(int32_t) * (size_t)(facets ? facets : 1));
     m->joint = malloc(sizeof(int32_t) * (size_t)(facets ? facets : 1));
     m->joint_facet = malloc(sizeof(int32_t) * (size_t)(joints ? 2 * joints : 1));
     t.slot = malloc(sizeof(int32_t) * ((size_t)t.mask + 1));
-    if (!m->twin || !m->joint || !m->joint_facet || !t.slot) {
+    if (!key || !m->twin || !m->joint || !m->joint_facet || !t.slot) {
+        free(key);
         free(t.slot);
         facet_map_free(m);
         return -1;
     }
+    for (int32_t f = 0; f < facets; f++)
+        facet_key(dimension, cells, f, key + 3 * (size_t)f);
+    t.key = key;
     memset(t.slot, 0xff, sizeof(int32_t) * ((size_t)t.mask + 1)); /* -1 everywhere */
     memset(m->twin, 0xff, sizeof(int32_t) * (size_t)facets);
     memset(m->joint, 0xff, sizeof(int32_t) * (size_t)facets);
     facet_map_twins(m, &t, facets);
     facet_map_joints(m, &t, joint_nodes);
     free(t.slot);
+    free(key);
     return 0;
 }
 

@@ -98,6 +98,14 @@ void result_free_history(history_row **rows, int count);
  * fragment, active, fluid_pressure, aperture: bit k of
  * result_frame_request.fields */
 extern const char *const result_frame_field_names[RESULT_FRAME_FIELDS];
+/* One case's mesh tables kept between its frames (the mesh of a case never
+ * changes): its cells, joints and which facets face which; owned by the
+ * caller, used by one thread (the I/O thread), holding one mesh at a time. */
+typedef struct result_frame_cache result_frame_cache;
+result_frame_cache *result_frame_cache_new(void);
+void result_frame_cache_free(result_frame_cache *cache);
+void result_frame_cache_clear(result_frame_cache *cache);
+size_t result_frame_cache_bytes(const result_frame_cache *cache);
 typedef struct result_frame_request {
     int snapshot;      /* index, or -1 for the last complete one */
     unsigned fields;   /* bit k: result_frame_field_names[k]; those the file lacks are left out */
@@ -108,6 +116,8 @@ typedef struct result_frame_request {
     int surface;       /* 1: only the facets that can be seen (the surface form) */
     int has_shape_key; /* 1: the client holds the shape of key shape_key */
     uint64_t shape_key; /* the shape sections are left out when the frame's key equals it */
+    result_frame_cache *cache; /* NULL, or the tables to use and keep when owner's */
+    const char *cache_owner;   /* who the mesh is (the case id) */
 } result_frame_request;
 /* Reads the frame from the open file f, or the closed file at path (f
  * NULL): *out (free() it) gets *size bytes. Returns 0; 404 (no such

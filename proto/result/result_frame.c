@@ -354,13 +354,13 @@ static void frame_write(const frame_build *b, const frame_head *h, unsigned char
 
 /* ------------------------------------------------------------- reading */
 
-/* The deformed positions: /snapshots/position, else position0 plus
- * /snapshots/displacement, else position0 (header flag 0). */
-static int frame_positions(const frame_source *s, int index, float *x0, float *x, int *deformed)
+/* The deformed positions from position0 (x0, given): /snapshots/position,
+ * else position0 plus /snapshots/displacement, else position0 (header
+ * flag 0). */
+static int frame_positions(const frame_source *s, int index, const float *x0, float *x,
+                           int *deformed)
 {
     size_t n = (size_t)(s->position0.items * s->position0.width);
-    if (frame_read(&s->position0, -1, H5T_NATIVE_FLOAT, x0) != 0)
-        return -1;
     frame_array disp;
     if (s->position.ds >= 0 && s->position.items * s->position.width == n) {
         *deformed = 1;
@@ -405,47 +405,87 @@ static int frame_state(const frame_source *s, int index, unsigned char *broken,
     return 0;
 }
 
-/* The shape: the /mesh arrays read, the surface chosen. */
-static int frame_read_shape(frame_build *b, const frame_source *s, int index, void *scratch,
-                            char *err, size_t errlen)
+/* The /mesh arrays of the file and their facet map, into m. */
+static int frame_mesh_read(frame_mesh *m, const frame_source *s, const char *owner, char *err,
+                           size_t errlen)
 {
-    uint32_t N = (uint32_t)s->position0.items, E = (uint32_t)s->cells.items;
-    uint32_t J = (uint32_t)s->joints.items;
-    int32_t *cells = malloc(sizeof(int32_t) * ((size_t)E * (b->dimension + 1) + 1));
-    int32_t *joints = malloc(sizeof(int32_t) * ((size_t)J * 2 * b->dimension + 1));
+    frame_mesh_clear(m);
+    m->dimension = s->dimension;
+    m->nodes = (uint32_t)s->position0.items;
+    m->elements = (uint32_t)s->cells.items;
+    m->joints = (uint32_t)s->joints.items;
+    m->cells = malloc(sizeof(int32_t) * ((size_t)m->elements * (m->dimension + 1) + 1));
+    m->joint_nodes = malloc(sizeof(int32_t) * ((size_t)m->joints * 2 * m->dimension + 1));
+    m->position0 = malloc(sizeof(float) * ((size_t)m->nodes * m->dimension + 1));
+    if (!m->cells || !m->joint_nodes || !m->position0) {
+        frame_mesh_clear(m);
+        snprintf(err, errlen, "out of memory for the frame's mesh");
+        return -1;
+    }
+    if (frame_read(&s->cells, -1, H5T_NATIVE_INT32, m->cells) != 0 ||
+        frame_read(&s->position0, -1, H5T_NATIVE_FLOAT, m->position0) != 0 ||
+        (m->joints && frame_read(&s->joints, -1, H5T_NATIVE_INT32, m->joint_nodes) != 0)) {
+        frame_mesh_clear(m);
+        result_fail(err, errlen, "cannot read the result file's /mesh");
+        return -1;
+    }
+    if (frame_mesh_map(m, err, errlen) != 0) {
+        frame_mesh_clear(m);
+        return -1;
+    }
+    snprintf(m->owner, sizeof m->owner, "%s", owner ? owner : "");
+    return 0;
+}
+
+/* The cached mesh when it is this one's (same owner, same sizes). */
+static int frame_mesh_cached(const result_frame_request *q, const frame_source *s)
+{
+    const frame_mesh *m = q->cache ? &q->cache->mesh : NULL;
+    return m && m->cells && q->cache_owner && q->cache_owner[0] &&
+           strcmp(m->owner, q->cache_owner) == 0 && m->dimension == s->dimension &&
+           m->nodes == s->position0.items && m->elements == s->cells.items &&
+           m->joints == s->joints.items;
+}
+
+/* The shape: the mesh (kept in the cache, or read into *mesh), the surface
+ * chosen. */
+static int frame_read_shape(frame_build *b, const frame_source *s, int index, frame_mesh *mesh,
+                            const result_frame_request *q, void *scratch, char *err,
+                            size_t errlen)
+{
+    int rc = frame_mesh_cached(q, s) ? 0 : frame_mesh_read(mesh, s, q->cache_owner, err, errlen);
+    uint32_t E = (uint32_t)s->cells.items, J = (uint32_t)s->joints.items;
     unsigned char *broken = malloc((size_t)J + 1), *active = malloc((size_t)E + 1);
     int has_broken = 0, has_active = 0;
-    int rc = cells && joints && broken && active ? 0 : -1;
-    if (rc != 0)
+    if (rc == 0 && (!broken || !active)) {
         snprintf(err, errlen, "out of memory for the frame's mesh");
-    else if (frame_read(&s->cells, -1, H5T_NATIVE_INT32, cells) != 0 ||
-             (J && frame_read(&s->joints, -1, H5T_NATIVE_INT32, joints) != 0) ||
-             frame_state(s, index, broken, active, scratch, &has_broken, &has_active) != 0) {
-        result_fail(err, errlen, "cannot read the mesh of snapshot %d", index);
+        rc = -1;
+    } else if (rc == 0 &&
+               frame_state(s, index, broken, active, scratch, &has_broken, &has_active) != 0) {
+        result_fail(err, errlen, "cannot read the damage of snapshot %d", index);
         rc = -1;
     }
     if (rc == 0)
-        rc = frame_shape(b, N, E, J, cells, joints, has_broken ? broken : NULL,
-                         has_active ? active : NULL, err, errlen);
-    free(cells);
-    free(joints);
+        rc = frame_shape(b, mesh, has_broken ? broken : NULL, has_active ? active : NULL, err,
+                         errlen);
     free(broken);
     free(active);
     return rc;
 }
 
 /* Positions and the fields asked for, of the carried items. */
-static int frame_read_values(frame_build *b, const frame_source *s, int index, unsigned wanted,
-                             float *scratch, float *scratch2, int *deformed)
+static int frame_read_values(frame_build *b, const frame_source *s, int index,
+                             const frame_mesh *mesh, unsigned wanted, float *scratch,
+                             int *deformed)
 {
     const frame_carry *c = &b->carry;
     uint32_t d = (uint32_t)b->dimension, n = c->count[CARRY_NODES];
     float *x0 = frame_add(b, "position0", FRAME_AT_NODE, d, FRAME_F32, n, 1);
     float *x = frame_add(b, "position", FRAME_AT_NODE, d, FRAME_F32, n, 0);
-    if (!x0 || !x || frame_positions(s, index, scratch, scratch2, deformed) != 0)
+    if (!x0 || !x || frame_positions(s, index, mesh->position0, scratch, deformed) != 0)
         return -1;
-    frame_gather(x0, scratch, d, c, CARRY_NODES);
-    frame_gather(x, scratch2, d, c, CARRY_NODES);
+    frame_gather(x0, mesh->position0, d, c, CARRY_NODES);
+    frame_gather(x, scratch, d, c, CARRY_NODES);
     for (int k = 0; k < RESULT_FRAME_FIELDS; k++) {
         if (!(wanted & (1u << k)) || !frame_field_fits(s, k))
             continue;
@@ -500,8 +540,11 @@ static int frame_make(const frame_source *s, int index, const result_frame_reque
 {
     frame_build b;
     frame_head h;
+    frame_mesh local; /* the mesh when there is no cache to keep it in */
     memset(&b, 0, sizeof b);
     memset(&h, 0, sizeof h);
+    memset(&local, 0, sizeof local);
+    frame_mesh *mesh = q->cache ? &q->cache->mesh : &local;
     b.dimension = s->dimension;
     b.surface = q->surface;
     size_t row = 2 * (size_t)s->joints.items + 1;
@@ -510,20 +553,20 @@ static int frame_make(const frame_source *s, int index, const result_frame_reque
             row = (size_t)(s->field[k].items * s->field[k].width);
     if (s->position0.items * s->position0.width > row)
         row = (size_t)(s->position0.items * s->position0.width);
-    float *scratch = malloc(sizeof(float) * row), *scratch2 = malloc(sizeof(float) * row);
+    float *scratch = malloc(sizeof(float) * row);
     int rc = frame_head_read(s, index, &h, err, errlen);
-    if (rc == 0 && (!scratch || !scratch2)) {
+    if (rc == 0 && !scratch) {
         snprintf(err, errlen, "out of memory for a frame");
         rc = 503;
     }
     if (rc == 0)
-        rc = frame_read_shape(&b, s, index, scratch, err, errlen);
-    if (rc == 0 && frame_read_values(&b, s, index, q->fields, scratch, scratch2, &h.deformed) != 0) {
+        rc = frame_read_shape(&b, s, index, mesh, q, scratch, err, errlen);
+    if (rc == 0 && frame_read_values(&b, s, index, mesh, q->fields, scratch, &h.deformed) != 0) {
         result_fail(err, errlen, "cannot read snapshot %d of the result file", index);
         rc = -1;
     }
     free(scratch);
-    free(scratch2);
+    frame_mesh_clear(&local);
     unsigned char *buf = NULL;
     if (rc == 0) {
         h.key = frame_shape_key(&b);

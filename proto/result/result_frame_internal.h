@@ -11,6 +11,7 @@
 
 #include <stdint.h>
 
+#include "analysis/boundary_facets.h"
 #include "result_internal.h"
 
 /* Where a section's items live, and its value type (the header codes). */
@@ -46,18 +47,39 @@ typedef struct frame_build {
 void *frame_add(frame_build *b, const char *name, uint32_t at, uint32_t width, uint32_t type,
                 uint32_t items, int shape);
 
+/* A mesh as /mesh gives it, with its facet map: what the cache keeps. */
+typedef struct frame_mesh {
+    char owner[64];       /* whose mesh (the cache's key), "" when empty */
+    int dimension;
+    uint32_t nodes, elements, joints;
+    int32_t *cells;       /* E rows of D+1 */
+    int32_t *joint_nodes; /* J rows of 2D */
+    float *position0;     /* N rows of D */
+    facet_map map;
+} frame_mesh;
+
+struct result_frame_cache {
+    frame_mesh mesh;
+};
+
+void frame_mesh_clear(frame_mesh *m);
+/* Its bytes held (the cache's size). */
+size_t frame_mesh_bytes(const frame_mesh *m);
+
 /* The mesh's shape as sections, and what the frame carries (b->carry):
  * the whole mesh (cells, joints, joint_elements), or with b->surface the
  * visible facets (faces, face_element, face_joint, node_id, element_id,
  * joint_id, joint_elements) and only the nodes, elements and joints they
- * touch. cells, joint_nodes: the /mesh arrays of E and J rows; broken[J]
- * and active[E] of the snapshot (NULL: none broken, all there). 0, or -1
- * with err (out of memory, a bad mesh). */
-int frame_shape(frame_build *b, uint32_t nodes, uint32_t elements, uint32_t joints,
-                const int32_t *cells, const int32_t *joint_nodes, const unsigned char *broken,
+ * touch. broken[J] and active[E] of the snapshot (NULL: none broken, all
+ * there). 0, or -1 with err (out of memory). */
+int frame_shape(frame_build *b, const frame_mesh *mesh, const unsigned char *broken,
                 const unsigned char *active, char *err, size_t errlen);
 
-/* The peak bytes frame_shape allocates besides its sections. */
+/* Checks the mesh's node ids and builds its facet map. 0, or -1 with err. */
+int frame_mesh_map(frame_mesh *m, char *err, size_t errlen);
+
+/* The peak bytes frame_shape and frame_mesh_map allocate besides the
+ * sections and the mesh arrays. */
 size_t frame_shape_bytes(int dimension, uint32_t nodes, uint32_t elements, uint32_t joints);
 
 #endif

@@ -17,7 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "analysis/boundary_facets.h"
 
 size_t frame_shape_bytes(int dimension, uint32_t nodes, uint32_t elements, uint32_t joints)
 {
@@ -142,38 +141,85 @@ static int shape_surface(frame_build *b, const facet_map *m, uint32_t N, const i
     return shape_joint_elements(b, m, elem);
 }
 
-int frame_shape(frame_build *b, uint32_t nodes, uint32_t elements, uint32_t joints,
-                const int32_t *cells, const int32_t *joint_nodes, const unsigned char *broken,
+int frame_mesh_map(frame_mesh *m, char *err, size_t errlen)
+{
+    size_t ids = (size_t)(m->dimension + 1) * m->elements;
+    for (size_t i = 0; i < ids; i++)
+        if (m->cells[i] < 0 || (uint32_t)m->cells[i] >= m->nodes) {
+            snprintf(err, errlen, "the result file's /mesh names node %d of %u", m->cells[i],
+                     m->nodes);
+            return -1;
+        }
+    if (facet_map_build(&m->map, m->dimension, (int)m->elements, m->cells, (int)m->joints,
+                        m->joint_nodes) != 0) {
+        snprintf(err, errlen, "the result file's /mesh cannot be read as a mesh (out of memory, "
+                 "or a negative node id in /mesh/joints)");
+        return -1;
+    }
+    return 0;
+}
+
+void frame_mesh_clear(frame_mesh *m)
+{
+    free(m->cells);
+    free(m->joint_nodes);
+    free(m->position0);
+    facet_map_free(&m->map);
+    memset(m, 0, sizeof *m);
+}
+
+size_t frame_mesh_bytes(const frame_mesh *m)
+{
+    if (!m->cells)
+        return 0;
+    size_t facets = (size_t)(m->dimension + 1) * m->elements;
+    return sizeof(int32_t) * (facets + (size_t)m->joints * 2 * m->dimension) +
+           sizeof(float) * (size_t)m->nodes * m->dimension +
+           sizeof(int32_t) * (2 * facets + 2 * (size_t)m->joints);
+}
+
+result_frame_cache *result_frame_cache_new(void)
+{
+    return calloc(1, sizeof(result_frame_cache));
+}
+
+void result_frame_cache_clear(result_frame_cache *cache)
+{
+    if (cache)
+        frame_mesh_clear(&cache->mesh);
+}
+
+void result_frame_cache_free(result_frame_cache *cache)
+{
+    result_frame_cache_clear(cache);
+    free(cache);
+}
+
+size_t result_frame_cache_bytes(const result_frame_cache *cache)
+{
+    return cache ? frame_mesh_bytes(&cache->mesh) : 0;
+}
+
+int frame_shape(frame_build *b, const frame_mesh *mesh, const unsigned char *broken,
                 const unsigned char *active, char *err, size_t errlen)
 {
-    facet_map m;
+    const facet_map *m = &mesh->map;
+    uint32_t nodes = mesh->nodes, elements = mesh->elements, joints = mesh->joints;
     b->carry.count[CARRY_NODES] = nodes;
     b->carry.count[CARRY_ELEMENTS] = elements;
     b->carry.count[CARRY_JOINTS] = joints;
-    if (facet_map_build(&m, b->dimension, (int)elements, cells, (int)joints, joint_nodes) != 0) {
-        snprintf(err, errlen, "the result file's /mesh cannot be read as a mesh (out of memory, "
-                 "or a negative node id)");
-        return -1;
-    }
-    for (uint32_t i = 0; i < (uint32_t)(b->dimension + 1) * elements; i++)
-        if (cells[i] < 0 || (uint32_t)cells[i] >= nodes) {
-            facet_map_free(&m);
-            snprintf(err, errlen, "the result file's /mesh names node %d of %u", cells[i], nodes);
-            return -1;
-        }
     int rc;
     if (!b->surface) {
-        rc = shape_whole(b, &m, elements, joints, cells, joint_nodes);
+        rc = shape_whole(b, m, elements, joints, mesh->cells, mesh->joint_nodes);
     } else {
         size_t facets = (size_t)(b->dimension + 1) * elements;
         int32_t *facet = malloc(sizeof(int32_t) * (facets ? facets : 1));
-        uint32_t *slot = malloc(sizeof(uint32_t) * (elements + nodes + joints + 1));
-        rc = facet && slot ? shape_surface(b, &m, nodes, cells, broken, active, facet, slot)
+        uint32_t *slot = malloc(sizeof(uint32_t) * ((size_t)elements + nodes + joints + 1));
+        rc = facet && slot ? shape_surface(b, m, nodes, mesh->cells, broken, active, facet, slot)
                            : -1;
         free(facet);
         free(slot);
     }
-    facet_map_free(&m);
     if (rc != 0)
         snprintf(err, errlen, "out of memory for the frame's mesh");
     return rc;

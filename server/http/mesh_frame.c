@@ -93,7 +93,8 @@ static int mesh_frame_reserve(void *lease, size_t bytes)
 enum MHD_Result mesh_frame_reply(struct MHD_Connection *conn, server_case *c)
 {
     result_frame_request q = {mesh_frame_snapshot(conn), 0, mesh_frame_reserve,
-                              membudget_request_lease(), mesh_frame_surface(conn), 0, 0};
+                              membudget_request_lease(), mesh_frame_surface(conn), 0, 0,
+                              NULL, NULL};
     char detail[400] = "";
     if (q.snapshot == -2)
         return http_reply_problem(conn, 400, "Bad request",
