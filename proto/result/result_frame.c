@@ -95,18 +95,28 @@ static void frame_close(frame_array *a)
 }
 
 /* Reads row `index` of a /snapshots series (or the whole of a /mesh array
- * when index < 0) converted to `type` into dst. */
+ * when index < 0) converted to `type` into dst. The memory space has the
+ * shape of the row read, so HDF5 copies it in blocks: a flat one made it
+ * walk the selection element by element, 90 % of a frame's time. */
 static int frame_read(const frame_array *a, int index, hid_t type, void *dst)
 {
     hsize_t count = a->items * a->width;
     if (count == 0)
         return 0;
     hid_t file_space = H5Dget_space(a->ds);
-    hid_t mem_space = H5Screate_simple(1, &count, NULL);
-    int ok = file_space >= 0 && mem_space >= 0;
-    if (ok && index >= 0) {
-        hsize_t start[3] = {(hsize_t)index, 0, 0}, rows[3] = {1, a->items, a->width};
-        ok = H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, NULL, rows, NULL) >= 0;
+    hsize_t dims[3] = {0, 0, 0};
+    int rank = file_space >= 0 ? H5Sget_simple_extent_ndims(file_space) : -1;
+    int ok = rank >= 1 && rank <= 3;
+    hid_t mem_space = H5I_INVALID_HID;
+    if (ok) {
+        hsize_t start[3] = {(hsize_t)(index >= 0 ? index : 0), 0, 0};
+        H5Sget_simple_extent_dims(file_space, dims, NULL);
+        if (index >= 0)
+            dims[0] = 1; /* one snapshot's row */
+        mem_space = H5Screate_simple(rank, dims, NULL);
+        ok = mem_space >= 0;
+        if (ok && index >= 0)
+            ok = H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, NULL, dims, NULL) >= 0;
     }
     ok = ok && H5Dread(a->ds, type, mem_space, file_space, H5P_DEFAULT, dst) >= 0;
     if (mem_space >= 0) H5Sclose(mem_space);
@@ -240,16 +250,27 @@ static void frame_build_free(frame_build *b)
     memset(b, 0, sizeof *b);
 }
 
-/* The carried items of a whole row of `width` floats per item. */
-static void frame_gather(float *out, const float *all, uint32_t width, const frame_carry *c,
+/* The carried items of a whole row of `width` doubles per item, rounded
+ * to float. The rows are read as stored (double), which HDF5 copies
+ * straight from its chunks: converting a 1e5-element mesh's row to float
+ * in HDF5 cost more than reading it, and only the carried items need it. */
+static void frame_gather(float *out, const double *all, uint32_t width, const frame_carry *c,
                          int kind)
 {
-    if (!c->id[kind]) {
-        memcpy(out, all, sizeof(float) * (size_t)c->count[kind] * width);
-        return;
+    const uint32_t *id = c->id[kind];
+    for (uint32_t i = 0; i < c->count[kind]; i++) {
+        const double *row = all + (size_t)(id ? id[i] : i) * width;
+        for (uint32_t k = 0; k < width; k++)
+            out[(size_t)i * width + k] = (float)row[k];
     }
+}
+
+static void frame_gather_float(float *out, const float *all, uint32_t width,
+                               const frame_carry *c, int kind)
+{
+    const uint32_t *id = c->id[kind];
     for (uint32_t i = 0; i < c->count[kind]; i++)
-        memcpy(out + (size_t)i * width, all + (size_t)c->id[kind][i] * width,
+        memcpy(out + (size_t)i * width, all + (size_t)(id ? id[i] : i) * width,
                sizeof(float) * width);
 }
 
@@ -354,27 +375,28 @@ static void frame_write(const frame_build *b, const frame_head *h, unsigned char
 
 /* ------------------------------------------------------------- reading */
 
-/* The deformed positions from position0 (x0, given): /snapshots/position,
- * else position0 plus /snapshots/displacement, else position0 (header
- * flag 0). */
-static int frame_positions(const frame_source *s, int index, const float *x0, float *x,
+/* The deformed positions (doubles) from position0 (x0, given):
+ * /snapshots/position, else position0 plus /snapshots/displacement, else
+ * position0 (header flag 0). */
+static int frame_positions(const frame_source *s, int index, const float *x0, double *x,
                            int *deformed)
 {
     size_t n = (size_t)(s->position0.items * s->position0.width);
     frame_array disp;
     if (s->position.ds >= 0 && s->position.items * s->position.width == n) {
         *deformed = 1;
-        return frame_read(&s->position, index, H5T_NATIVE_FLOAT, x);
+        return frame_read(&s->position, index, H5T_NATIVE_DOUBLE, x);
     }
     frame_open(s->file, "/snapshots/displacement", 1, &disp);
     int rc = 0;
     *deformed = disp.ds >= 0 && disp.items * disp.width == n;
     if (*deformed) {
-        rc = frame_read(&disp, index, H5T_NATIVE_FLOAT, x);
+        rc = frame_read(&disp, index, H5T_NATIVE_DOUBLE, x);
         for (size_t i = 0; rc == 0 && i < n; i++)
             x[i] += x0[i];
     } else {
-        memcpy(x, x0, n * sizeof *x);
+        for (size_t i = 0; i < n; i++)
+            x[i] = x0[i];
     }
     frame_close(&disp);
     return rc;
@@ -475,7 +497,7 @@ static int frame_read_shape(frame_build *b, const frame_source *s, int index, fr
 
 /* Positions and the fields asked for, of the carried items. */
 static int frame_read_values(frame_build *b, const frame_source *s, int index,
-                             const frame_mesh *mesh, unsigned wanted, float *scratch,
+                             const frame_mesh *mesh, unsigned wanted, double *scratch,
                              int *deformed)
 {
     const frame_carry *c = &b->carry;
@@ -484,7 +506,7 @@ static int frame_read_values(frame_build *b, const frame_source *s, int index,
     float *x = frame_add(b, "position", FRAME_AT_NODE, d, FRAME_F32, n, 0);
     if (!x0 || !x || frame_positions(s, index, mesh->position0, scratch, deformed) != 0)
         return -1;
-    frame_gather(x0, mesh->position0, d, c, CARRY_NODES);
+    frame_gather_float(x0, mesh->position0, d, c, CARRY_NODES);
     frame_gather(x, scratch, d, c, CARRY_NODES);
     for (int k = 0; k < RESULT_FRAME_FIELDS; k++) {
         if (!(wanted & (1u << k)) || !frame_field_fits(s, k))
@@ -494,7 +516,7 @@ static int frame_read_values(frame_build *b, const frame_source *s, int index,
                    : at == FRAME_AT_JOINT ? CARRY_JOINTS : CARRY_ELEMENTS;
         float *out = frame_add(b, result_frame_field_names[k], at, width, FRAME_F32,
                                c->count[kind], 0);
-        if (!out || frame_read(&s->field[k], index, H5T_NATIVE_FLOAT, scratch) != 0)
+        if (!out || frame_read(&s->field[k], index, H5T_NATIVE_DOUBLE, scratch) != 0)
             return -1;
         frame_gather(out, scratch, width, c, kind);
     }
@@ -516,7 +538,7 @@ static size_t frame_peak_bytes(const frame_source *s)
             whole += FRAME_SECTION_HEADER_BYTES + 4 * values;
             row = values > row ? values : row;
         }
-    row = row > 2 * J ? row : 2 * J; /* damage is read as double */
+    row = row > J ? row : J; /* damage, as double */
     return 2 * whole + 8 * row + frame_shape_bytes((int)d, (uint32_t)N, (uint32_t)E, (uint32_t)J);
 }
 
@@ -553,7 +575,7 @@ static int frame_make(const frame_source *s, int index, const result_frame_reque
             row = (size_t)(s->field[k].items * s->field[k].width);
     if (s->position0.items * s->position0.width > row)
         row = (size_t)(s->position0.items * s->position0.width);
-    float *scratch = malloc(sizeof(float) * row);
+    double *scratch = malloc(sizeof(double) * row);
     int rc = frame_head_read(s, index, &h, err, errlen);
     if (rc == 0 && !scratch) {
         snprintf(err, errlen, "out of memory for a frame");
