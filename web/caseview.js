@@ -55,7 +55,7 @@ export class CaseView {
     ];
     for (const [el, ev, fn] of this.listeners) el.addEventListener(ev, fn);
     $("events").querySelector("tbody").textContent = "";
-    for (const k of ["frameDrawn", "frameField", "frameShownMs"]) delete document.body.dataset[k];
+    for (const k of ["frameDrawn", "frameField", "frameShownMs", "frameShape"]) delete document.body.dataset[k];
     $("field").textContent = "";
     this.showParentDiff(parent);
     // the frame first: the sieve curve of a case that is not running
@@ -115,6 +115,7 @@ export class CaseView {
         data.frameDecodeMs = (t2 - t1).toFixed(1);
         data.frameDrawMs = (t3 - t2).toFixed(1);
         data.frameBytes = String(buffer.byteLength);
+        data.frameShape = f.shapeKept ? "kept" : "sent";
         data.frameIndex = String(f.index);
         data.frameDrawn = drawn ? "yes" : "no";
         // shown: the next animation frame, once the browser has painted it

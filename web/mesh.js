@@ -27,7 +27,8 @@ export function decodeFrame(buffer, previous) {
     version: u32(8), dimension: u32(12), nodes: u32(16), elements: u32(20), joints: u32(24),
     index: u32(28), snapshots: u32(32), time: dv.getFloat64(40, true),
     step: Number(dv.getBigInt64(48, true)), deformed: u32(56) === 1, faces: u32(60),
-    key: hex(68) + hex(64), surface: (flags & FLAG_SURFACE) !== 0, fields: {}, shape: {},
+    key: hex(68) + hex(64), surface: (flags & FLAG_SURFACE) !== 0, shapeKept: !(flags & FLAG_SHAPE),
+    fields: {}, shape: {},
   };
   const sections = u32(36), names = new TextDecoder();
   let o = HEADER;

@@ -589,6 +589,18 @@ class WebBrowserTest(unittest.TestCase):
         self.assertGreater(drawn, total * 0.02, "the 3D canvas is (nearly) blank")
         self.assertGreater(colours, 5, "the 3D canvas has one colour")
         self.shot("3d", "case-view")
+        # the same snapshot again: the page holds its shape, so the daemon
+        # sends positions and fields only, and the view is drawn from them
+        self.assertEqual(b.execute_script("return document.body.dataset.frameShape"), "sent")
+        sent = int(b.execute_script("return document.body.dataset.frameBytes"))
+        b.execute_script("document.body.dataset.frameDrawn = 'no';"
+                         "const s = document.getElementById('snapshot');"
+                         "s.dispatchEvent(new Event('change'));")
+        self.wait_for("return document.body.dataset.frameDrawn === 'yes' && "
+                      "document.body.dataset.frameShape === 'kept'", "a frame without the shape")
+        self.assertLess(int(b.execute_script("return document.body.dataset.frameBytes")), sent)
+        again = b.execute_script(PIXELS_JS, "view3d")
+        self.assertEqual(again[:2], [drawn, colours])
 
         # 5b. a case with fluid: fluid pressure on the crack lines, and the
         # source pressure's plot when the daemon writes that history series
