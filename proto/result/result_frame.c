@@ -472,26 +472,22 @@ static int frame_mesh_cached(const result_frame_request *q, const frame_source *
 /* The shape: the mesh (kept in the cache, or read into *mesh), the surface
  * chosen. */
 static int frame_read_shape(frame_build *b, const frame_source *s, int index, frame_mesh *mesh,
-                            const result_frame_request *q, void *scratch, char *err,
+                            const result_frame_request *q, size_t row, char *err,
                             size_t errlen)
 {
     int rc = frame_mesh_cached(q, s) ? 0 : frame_mesh_read(mesh, s, q->cache_owner, err, errlen);
-    uint32_t E = (uint32_t)s->cells.items, J = (uint32_t)s->joints.items;
-    unsigned char *broken = malloc((size_t)J + 1), *active = malloc((size_t)E + 1);
     int has_broken = 0, has_active = 0;
-    if (rc == 0 && (!broken || !active)) {
+    if (rc == 0 && frame_mesh_work(mesh, row) != 0) {
         snprintf(err, errlen, "out of memory for the frame's mesh");
-        rc = -1;
-    } else if (rc == 0 &&
-               frame_state(s, index, broken, active, scratch, &has_broken, &has_active) != 0) {
+        rc = 503;
+    } else if (rc == 0 && frame_state(s, index, mesh->broken, mesh->active, mesh->row,
+                                      &has_broken, &has_active) != 0) {
         result_fail(err, errlen, "cannot read the damage of snapshot %d", index);
         rc = -1;
     }
     if (rc == 0)
-        rc = frame_shape(b, mesh, has_broken ? broken : NULL, has_active ? active : NULL, err,
-                         errlen);
-    free(broken);
-    free(active);
+        rc = frame_shape(b, mesh, has_broken ? mesh->broken : NULL,
+                         has_active ? mesh->active : NULL, err, errlen);
     return rc;
 }
 
@@ -575,19 +571,13 @@ static int frame_make(const frame_source *s, int index, const result_frame_reque
             row = (size_t)(s->field[k].items * s->field[k].width);
     if (s->position0.items * s->position0.width > row)
         row = (size_t)(s->position0.items * s->position0.width);
-    double *scratch = malloc(sizeof(double) * row);
     int rc = frame_head_read(s, index, &h, err, errlen);
-    if (rc == 0 && !scratch) {
-        snprintf(err, errlen, "out of memory for a frame");
-        rc = 503;
-    }
     if (rc == 0)
-        rc = frame_read_shape(&b, s, index, mesh, q, scratch, err, errlen);
-    if (rc == 0 && frame_read_values(&b, s, index, mesh, q->fields, scratch, &h.deformed) != 0) {
+        rc = frame_read_shape(&b, s, index, mesh, q, row, err, errlen);
+    if (rc == 0 && frame_read_values(&b, s, index, mesh, q->fields, mesh->row, &h.deformed) != 0) {
         result_fail(err, errlen, "cannot read snapshot %d of the result file", index);
         rc = -1;
     }
-    free(scratch);
     frame_mesh_clear(&local);
     unsigned char *buf = NULL;
     if (rc == 0) {

@@ -56,7 +56,18 @@ typedef struct frame_mesh {
     int32_t *joint_nodes; /* J rows of 2D */
     float *position0;     /* N rows of D */
     facet_map map;
+    /* work space of one frame, kept with the mesh so that the next frame
+     * does not fault in fresh pages (tens of ms per 10 MB on this VM) */
+    double *row;          /* one /snapshots row as read */
+    size_t row_values;
+    int32_t *facet;       /* (D+1)E: the facets shown */
+    uint32_t *slot;       /* E + N + J: carried numbering */
+    unsigned char *broken, *active; /* J, E */
 } frame_mesh;
+
+/* The mesh's work space, with room for a row of `values` doubles; 0 or -1
+ * when out of memory. */
+int frame_mesh_work(frame_mesh *m, size_t values);
 
 struct result_frame_cache {
     frame_mesh mesh;

@@ -164,6 +164,11 @@ void frame_mesh_clear(frame_mesh *m)
     free(m->cells);
     free(m->joint_nodes);
     free(m->position0);
+    free(m->row);
+    free(m->facet);
+    free(m->slot);
+    free(m->broken);
+    free(m->active);
     facet_map_free(&m->map);
     memset(m, 0, sizeof *m);
 }
@@ -173,9 +178,30 @@ size_t frame_mesh_bytes(const frame_mesh *m)
     if (!m->cells)
         return 0;
     size_t facets = (size_t)(m->dimension + 1) * m->elements;
+    size_t items = (size_t)m->elements + m->nodes + m->joints;
     return sizeof(int32_t) * (facets + (size_t)m->joints * 2 * m->dimension) +
            sizeof(float) * (size_t)m->nodes * m->dimension +
-           sizeof(int32_t) * (2 * facets + 2 * (size_t)m->joints);
+           sizeof(int32_t) * (2 * facets + 2 * (size_t)m->joints) +
+           (m->row ? sizeof(double) * m->row_values : 0) +
+           (m->facet ? sizeof(int32_t) * facets + sizeof(uint32_t) * items +
+                           (size_t)m->elements + m->joints : 0);
+}
+
+int frame_mesh_work(frame_mesh *m, size_t values)
+{
+    size_t facets = (size_t)(m->dimension + 1) * m->elements;
+    if (!m->facet) {
+        m->facet = malloc(sizeof(int32_t) * (facets + 1));
+        m->slot = malloc(sizeof(uint32_t) * ((size_t)m->elements + m->nodes + m->joints + 1));
+        m->broken = malloc((size_t)m->joints + 1);
+        m->active = malloc((size_t)m->elements + 1);
+    }
+    if (values > m->row_values) {
+        free(m->row);
+        m->row = malloc(sizeof(double) * values);
+        m->row_values = m->row ? values : 0;
+    }
+    return m->facet && m->slot && m->broken && m->active && m->row ? 0 : -1;
 }
 
 result_frame_cache *result_frame_cache_new(void)
@@ -209,17 +235,10 @@ int frame_shape(frame_build *b, const frame_mesh *mesh, const unsigned char *bro
     b->carry.count[CARRY_ELEMENTS] = elements;
     b->carry.count[CARRY_JOINTS] = joints;
     int rc;
-    if (!b->surface) {
+    if (!b->surface)
         rc = shape_whole(b, m, elements, joints, mesh->cells, mesh->joint_nodes);
-    } else {
-        size_t facets = (size_t)(b->dimension + 1) * elements;
-        int32_t *facet = malloc(sizeof(int32_t) * (facets ? facets : 1));
-        uint32_t *slot = malloc(sizeof(uint32_t) * ((size_t)elements + nodes + joints + 1));
-        rc = facet && slot ? shape_surface(b, m, nodes, mesh->cells, broken, active, facet, slot)
-                           : -1;
-        free(facet);
-        free(slot);
-    }
+    else
+        rc = shape_surface(b, m, nodes, mesh->cells, broken, active, mesh->facet, mesh->slot);
     if (rc != 0)
         snprintf(err, errlen, "out of memory for the frame's mesh");
     return rc;
