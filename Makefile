@@ -139,7 +139,7 @@ estimates: all
 # (headless Chromium; issue 35): minutes, so not part of make test
 web-figures: all
 	@cd tests/integration && FDEMD_WEB_FIGURES=1 FDEMD_BIN=$(CURDIR)/$(BIN)/fdemd \
-	    FDEMCTL_BIN=$(CURDIR)/$(BIN)/fdemctl $(PYTHON) -m unittest -v test_web.WebFiguresTest
+	    FDEMCTL_BIN=$(CURDIR)/$(BIN)/fdemctl $(PYTHON) -m unittest -v test_web_figures
 
 fuzz: deps
 	@bash tests/fuzz/run.sh
