@@ -33,6 +33,10 @@
 #define FRAME_NAME_BYTES 16u
 #define FRAME_FLAG_SURFACE 1u
 #define FRAME_FLAG_SHAPE 2u
+/* fluid_pressure, aperture: asking for either shows the faces of the
+ * joints holding fluid in the surface form, so the fluid inside a body can
+ * be drawn */
+#define FRAME_WET_FIELDS ((1u << 8) | (1u << 9))
 
 const char *const result_frame_field_names[RESULT_FRAME_FIELDS] = {
     "velocity", "displacement", "stress", "strain", "principal_stress", "damage", "fragment",
@@ -148,8 +152,8 @@ static void frame_source_close(frame_source *s)
         frame_close(&s->field[k]);
 }
 
-/* Opens what the frame reads; `wanted` bit k asks for field k (damage
- * and active are opened anyway: the surface form needs them). */
+/* Opens what the frame reads; `wanted` bit k asks for field k (damage,
+ * active and fluid_pressure are opened anyway: the surface form needs them). */
 static int frame_source_open(frame_source *s, hid_t file, const result_file *f, unsigned wanted,
                              char *err, size_t errlen)
 {
@@ -165,7 +169,7 @@ static int frame_source_open(frame_source *s, hid_t file, const result_file *f, 
         snprintf(name, sizeof name, "/snapshots/%s", series_names[frame_series[k]]);
         s->field[k].ds = H5I_INVALID_HID;
         if (wanted & (1u << k) || frame_series[k] == SERIES_DAMAGE ||
-            frame_series[k] == SERIES_ACTIVE)
+            frame_series[k] == SERIES_ACTIVE || frame_series[k] == SERIES_FLUID_PRESSURE)
             frame_open(file, name, 1, &s->field[k]);
     }
     frame_array time;
@@ -402,20 +406,32 @@ static int frame_positions(const frame_source *s, int index, const float *x0, do
     return rc;
 }
 
-/* Which joints are broken (damage 1, read as double: a float would round
- * 0.99999999 up) and which elements are there, in this snapshot. */
-static int frame_state(const frame_source *s, int index, unsigned char *broken,
+/* Which joints open their faces (broken: damage 1, read as double: a
+ * float would round 0.99999999 up; and with `wet`, holding fluid:
+ * pressure not 0) and which elements are there, in this snapshot. */
+static int frame_state(const frame_source *s, int index, int wet, unsigned char *broken,
                        unsigned char *active, void *scratch, int *has_broken, int *has_active)
 {
-    const frame_array *dmg = &s->field[5], *act = &s->field[7];
-    *has_broken = frame_field_fits(s, 5);
+    const frame_array *dmg = &s->field[5], *act = &s->field[7], *p = &s->field[8];
+    int fits_damage = frame_field_fits(s, 5);
+    wet = wet && frame_field_fits(s, 8) && p->width == 1;
+    *has_broken = fits_damage || wet;
     *has_active = frame_field_fits(s, 7) && act->width == 1;
-    if (*has_broken) {
+    if (*has_broken)
+        memset(broken, 0, (size_t)s->joints.items);
+    if (fits_damage) {
         if (frame_read(dmg, index, H5T_NATIVE_DOUBLE, scratch) != 0)
             return -1;
         const double *d = scratch;
         for (hsize_t j = 0; j < s->joints.items; j++)
             broken[j] = d[j] >= 1.0;
+    }
+    if (wet) {
+        if (frame_read(p, index, H5T_NATIVE_DOUBLE, scratch) != 0)
+            return -1;
+        const double *pressure = scratch;
+        for (hsize_t j = 0; j < s->joints.items; j++)
+            broken[j] |= pressure[j] != 0.0;
     }
     if (*has_active) {
         if (frame_read(act, index, H5T_NATIVE_INT32, scratch) != 0)
@@ -480,7 +496,8 @@ static int frame_read_shape(frame_build *b, const frame_source *s, int index, fr
     if (rc == 0 && frame_mesh_work(mesh, row) != 0) {
         snprintf(err, errlen, "out of memory for the frame's mesh");
         rc = 503;
-    } else if (rc == 0 && frame_state(s, index, mesh->broken, mesh->active, mesh->row,
+    } else if (rc == 0 && frame_state(s, index, q->fields & FRAME_WET_FIELDS, mesh->broken,
+                                      mesh->active, mesh->row,
                                       &has_broken, &has_active) != 0) {
         result_fail(err, errlen, "cannot read the damage of snapshot %d", index);
         rc = -1;

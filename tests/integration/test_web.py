@@ -342,7 +342,20 @@ class MeshFrameTest(DaemonTestCase):
                         want = want[fr["shape"][ids][:, 0]]
                     self.assertEqual(at, 2)
                     np.testing.assert_array_equal(values[:, 0], want.astype(np.float32), name)
-            self.assertGreater(f["/snapshots/fluid_pressure"][index].max(), 0)
+            pressure = f["/snapshots/fluid_pressure"][index]
+            self.assertGreater(pressure.max(), 0)
+            # the surface form asked for a fluid field shows the faces of
+            # the joints holding fluid too, as it shows those of cracks
+            shape = fr["shape"]
+            cells, joints = f["/mesh/triangles"][:], f["/mesh/joints"][:]
+            opened = np.where(pressure != 0, 1.0, f["/snapshots/damage"][index])
+            want = visible_facets(cells, joints, opened, None)
+            got = [(int(shape["element_id"][e, 0]), tuple(shape["node_id"][v, 0].tolist()))
+                   for e, v in zip(shape["face_element"][:, 0], shape["faces"])]
+            self.assertEqual(sorted(got), sorted(want))
+            wet = [j for j in shape["face_joint"][:, 0].tolist()
+                   if j != NONE and pressure[shape["joint_id"][j, 0]] != 0]
+            self.assertGreater(len(wet), 0, "no face of a joint holding fluid")
 
     def test_large_frame_loads_quickly(self):
         """A 2D mesh of 100,352 triangles, created (snapshot 0): the whole
