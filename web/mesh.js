@@ -4,34 +4,52 @@
 // a field means the same in both.
 
 const MAGIC = "FDEMMESH";
-const HEADER = 64, FIELD_HEADER = 24;
-export const AT_NODE = 0, AT_ELEMENT = 1, AT_JOINT = 2;
+const VERSION = 2, HEADER = 80, SECTION_HEADER = 32;
+export const AT_NODE = 0, AT_ELEMENT = 1, AT_JOINT = 2, AT_FACE = 3;
+export const NONE = 0xffffffff; // a u32 index that points nowhere
+const FLAG_SURFACE = 1, FLAG_SHAPE = 2;
+// The sections that make the mesh's shape: a frame leaves them out when
+// the page said (?shape=KEY) that it holds the shape of that key.
+const SHAPE = ["cells", "joints", "joint_elements", "faces", "face_element", "face_joint",
+  "node_id", "element_id", "joint_id", "position0"];
 
-// Maps the frame's bytes without copying them (every array is 4-aligned).
-export function decodeFrame(buffer) {
+// Maps the frame's bytes without copying them (every array is 4-aligned);
+// a frame without its shape takes it from `previous`, which must hold the
+// same key.
+export function decodeFrame(buffer, previous) {
   const dv = new DataView(buffer);
   const magic = new TextDecoder().decode(new Uint8Array(buffer, 0, 8));
   if (magic !== MAGIC) throw new Error("not an fdemd mesh frame");
-  const u32 = o => dv.getUint32(o, true);
+  const u32 = o => dv.getUint32(o, true), hex = o => u32(o).toString(16).padStart(8, "0");
+  if (u32(8) !== VERSION) throw new Error(`mesh frame version ${u32(8)}; this page reads ${VERSION}`);
+  const flags = u32(72);
   const f = {
     version: u32(8), dimension: u32(12), nodes: u32(16), elements: u32(20), joints: u32(24),
     index: u32(28), snapshots: u32(32), time: dv.getFloat64(40, true),
-    step: Number(dv.getBigInt64(48, true)), deformed: u32(56) === 1, fields: {},
+    step: Number(dv.getBigInt64(48, true)), deformed: u32(56) === 1, faces: u32(60),
+    key: hex(68) + hex(64), surface: (flags & FLAG_SURFACE) !== 0, shapeKept: !(flags & FLAG_SHAPE),
+    fields: {}, shape: {},
   };
-  const fieldCount = u32(36), d = f.dimension, k = d + 1;
+  const sections = u32(36), names = new TextDecoder();
   let o = HEADER;
-  f.cells = new Uint32Array(buffer, o, f.elements * k); o += 4 * f.elements * k;
-  f.jointNodes = new Uint32Array(buffer, o, f.joints * 2 * d); o += 4 * f.joints * 2 * d;
-  f.position0 = new Float32Array(buffer, o, f.nodes * d); o += 4 * f.nodes * d;
-  f.position = new Float32Array(buffer, o, f.nodes * d); o += 4 * f.nodes * d;
-  for (let i = 0; i < fieldCount; i++) {
-    const name = new TextDecoder().decode(new Uint8Array(buffer, o, 16)).replace(/\0+$/, "");
-    const at = u32(o + 16), width = u32(o + 20);
-    o += FIELD_HEADER;
-    const items = at === AT_NODE ? f.nodes : at === AT_ELEMENT ? f.elements : f.joints;
-    f.fields[name] = { at, width, data: new Float32Array(buffer, o, items * width) };
+  for (let i = 0; i < sections; i++) {
+    const name = names.decode(new Uint8Array(buffer, o, 16)).replace(/\0+$/, "");
+    const at = u32(o + 16), width = u32(o + 20), type = u32(o + 24), items = u32(o + 28);
+    o += SECTION_HEADER;
+    const data = type === 1 ? new Uint32Array(buffer, o, items * width) : new Float32Array(buffer, o, items * width);
     o += 4 * items * width;
+    if (SHAPE.includes(name)) f.shape[name] = data;
+    else if (name === "position") f.position = data;
+    else f.fields[name] = { at, width, data };
   }
+  if (!(flags & FLAG_SHAPE)) {
+    if (!previous || previous.key !== f.key) throw new Error("a frame without the shape the page holds");
+    f.shape = previous.shape;
+  }
+  const s = f.shape;
+  f.cells = s.cells; f.jointNodes = s.joints; f.jointElements = s.joint_elements;
+  f.faceNodes = s.faces; f.faceElement = s.face_element; f.faceJoint = s.face_joint;
+  f.position0 = s.position0;
   return f;
 }
 
@@ -55,19 +73,23 @@ export function fieldChoices(f, names) {
       out.push({ key: "principal:" + c, label: `principal stress ${c + 1} of ${w} (tension +)` });
   }
   if (has("damage") && f.joints) out.push({ key: "damage", label: "damage (joints)" });
+  if (has("fluid_pressure") && f.joints) out.push({ key: "fluid_pressure", label: "fluid pressure (joints)" });
+  if (has("aperture") && f.joints) out.push({ key: "aperture", label: "hydraulic aperture (joints)" });
   out.push({ key: "displacement", label: "displacement magnitude" });
   if (has("velocity")) out.push({ key: "velocity", label: "velocity magnitude" });
   if (has("fragment")) out.push({ key: "fragment", label: "fragment id" });
   return out;
 }
 
-// The frame's node -> element map: each node's first element.
-function nodeElement(f) {
-  if (f._nodeElement) return f._nodeElement;
-  const k = f.dimension + 1, m = new Int32Array(f.nodes).fill(-1);
-  for (let e = 0; e < f.elements; e++)
-    for (let j = 0; j < k; j++) if (m[f.cells[e * k + j]] < 0) m[f.cells[e * k + j]] = e;
-  return (f._nodeElement = m);
+// Per element, the largest value of a joint field over its joints.
+function jointMax(f, values) {
+  const out = new Float32Array(f.elements), je = f.jointElements;
+  for (let j = 0; j < f.joints; j++) {
+    const v = values[j], a = je[2 * j], b = je[2 * j + 1];
+    if (a !== NONE && v > out[a]) out[a] = v;
+    if (b !== NONE && v > out[b]) out[b] = v;
+  }
+  return out;
 }
 
 function vonMises(s, e, d) {
@@ -79,21 +101,23 @@ function vonMises(s, e, d) {
   return Math.sqrt(0.5 * ((x - y) ** 2 + (y - z) ** 2 + (z - x) ** 2) + 3 * (yz * yz + xz * xz + xy * xy));
 }
 
-// Per-node vector magnitude, averaged over each element's nodes.
+// Per-node vector magnitude, averaged over each element's nodes (over the
+// nodes of its faces shown, in a surface frame, which carries no cells).
 function nodeMagnitude(f, get) {
-  const d = f.dimension, k = d + 1, out = new Float32Array(f.elements);
-  for (let e = 0; e < f.elements; e++) {
-    let sum = 0;
-    for (let j = 0; j < k; j++) {
-      const n = f.cells[e * k + j];
-      let m = 0;
-      for (let c = 0; c < d; c++) m += get(n * d + c) ** 2;
-      sum += Math.sqrt(m);
-    }
-    out[e] = sum / k;
+  const d = f.dimension, sum = new Float32Array(f.elements), count = new Float32Array(f.elements);
+  const magnitude = n => { let m = 0; for (let c = 0; c < d; c++) m += get(n * d + c) ** 2; return Math.sqrt(m); };
+  const [items, per, nodes, owner] = f.cells ? [f.elements, d + 1, f.cells, null]
+    : [f.faces, d, f.faceNodes, f.faceElement];
+  for (let i = 0; i < items; i++) {
+    const e = owner ? owner[i] : i;
+    for (let j = 0; j < per; j++) { sum[e] += magnitude(nodes[i * per + j]); count[e]++; }
   }
-  return out;
+  for (let e = 0; e < f.elements; e++) sum[e] = count[e] ? sum[e] / count[e] : 0;
+  return sum;
 }
+
+// The fields that live on joints: an element shows the largest of its joints'.
+export const JOINT_FIELDS = ["damage", "fluid_pressure", "aperture"];
 
 // One value per element for the field `key`: {values, categorical}.
 export function elementValues(f, key) {
@@ -105,13 +129,8 @@ export function elementValues(f, key) {
     const fld = key.startsWith("stress:") ? f.fields.stress : f.fields.principal_stress;
     const c = Number(key.split(":")[1]);
     for (let e = 0; e < E; e++) out[e] = fld.data[e * fld.width + c];
-  } else if (key === "damage") {
-    const dmg = f.fields.damage.data, ne = nodeElement(f), w = 2 * d;
-    for (let j = 0; j < f.joints; j++) {
-      const a = ne[f.jointNodes[j * w]], b = ne[f.jointNodes[j * w + d]];
-      if (a >= 0 && dmg[j] > out[a]) out[a] = dmg[j];
-      if (b >= 0 && dmg[j] > out[b]) out[b] = dmg[j];
-    }
+  } else if (JOINT_FIELDS.includes(key)) {
+    return { values: jointMax(f, f.fields[key].data), categorical: false };
   } else if (key === "displacement") {
     return { values: nodeMagnitude(f, i => f.position[i] - f.position0[i]), categorical: false };
   } else if (key === "velocity") {

@@ -119,6 +119,23 @@ export function loadDisplacement(history) {
   return [{ label: `constraint ${c} (fixed): F${axis}`, xLabel: "time (s)", x: rows.map(r => r.time), y }];
 }
 
+// The source pressure of each injection (a constraint that injects fluid,
+// contract 6.4) over time, from the history rows' "fluid" member; none
+// when the case has no fluid or the daemon writes no such series.
+export function sourcePressure(history) {
+  const rows = history.rows;
+  const first = rows.length && rows[0].fluid && rows[0].fluid.source_pressure;
+  if (!Array.isArray(first)) return [];
+  const out = [];
+  first.forEach((_, c) => {
+    const y = rows.map(r => { const v = r.fluid && r.fluid.source_pressure ? r.fluid.source_pressure[c] : null;
+      return typeof v === "number" ? v : null; });
+    if (y.some(v => v !== null))
+      out.push({ label: `constraint ${c}: source pressure`, constraint: c, x: rows.map(r => r.time), y });
+  });
+  return out;
+}
+
 export function energies(history) {
   const rows = history.rows;
   if (!rows.length) return [];
@@ -149,6 +166,7 @@ export function historyChoices(history) {
   Object.keys(rows[0].energy).forEach(t => out.push({ key: "energy:" + t, label: "energy " + t }));
   (rows[0].constraint_force || []).forEach((v, c) => v.forEach((_, k) =>
     out.push({ key: `force:${c}:${k}`, label: `constraint ${c} force ${"xyz"[k]}` })));
+  sourcePressure(history).forEach(s => out.push({ key: "pressure:" + s.constraint, label: s.label }));
   ((rows[0].points || {}).displacement || []).forEach((v, p) => v.forEach((_, k) =>
     out.push({ key: `point:${p}:${k}`, label: `point ${(history.names || [])[p] || p} displacement ${"xyz"[k]}` })));
   return out;
@@ -157,6 +175,7 @@ export function historyChoices(history) {
 export function historySeries(history, key, label) {
   const rows = history.rows, [kind, a, b] = key.split(":");
   const pick = kind === "energy" ? r => r.energy[a]
+    : kind === "pressure" ? r => (r.fluid && r.fluid.source_pressure ? r.fluid.source_pressure[+a] : null)
     : kind === "force" ? r => r.constraint_force[+a][+b]
     : r => r.points.displacement[+a][+b];
   return { label, x: rows.map(r => r.time), y: rows.map(pick) };

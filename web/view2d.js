@@ -1,5 +1,8 @@
 // view2d.js - a 2D snapshot on a canvas: triangles filled by the colour of
-// their element, broken joints drawn as black cracks.
+// their element, broken joints drawn as black cracks. A fluid field (fluid
+// pressure, aperture: one value per joint) colours the lines of the joints
+// the fluid can flow through (damaged or broken, or holding pressure) on a
+// grey mesh.
 //
 // The triangles are filled into the pixels directly (edge functions over
 // each triangle's bounding box): Path2D fills of 1e5 triangles took 30 s
@@ -7,9 +10,11 @@
 // the work is the canvas' area plus a few operations per triangle. Element
 // edges are stroked only on meshes small enough for them to be seen.
 
-import { brokenJoints, deformedPositions, elementColours } from "./mesh.js";
+import { brokenJoints, deformedPositions, elementColours, range, viridis } from "./mesh.js";
 
 const EDGES_BELOW = 5000; // elements; above this the edges would be a grey wash
+const CRACK_FIELDS = ["fluid_pressure", "aperture"];
+const BINS = 32; // colour steps of the joint lines: one stroke each
 
 export class View2D {
   constructor(canvas) {
@@ -56,7 +61,8 @@ export class View2D {
 
   draw(f, key, scale) {
     const ctx = this.ctx, x = deformedPositions(f, scale), [s, ox, oy] = this.transform(x);
-    const col = elementColours(f, key), w = this.canvas.width, h = this.canvas.height;
+    const fluid = CRACK_FIELDS.includes(key) && f.fields[key];
+    const col = fluid ? grey(f) : elementColours(f, key), w = this.canvas.width, h = this.canvas.height;
     const image = ctx.createImageData(w, h), pixels = new Uint32Array(image.data.buffer);
     pixels.fill(0xffffffff);
     const X = n => ox + s * x[2 * n], Y = n => oy - s * x[2 * n + 1];
@@ -85,6 +91,36 @@ export class View2D {
     ctx.strokeStyle = "#000000";
     ctx.lineWidth = 1.5;
     ctx.stroke(cracks);
-    return col;
+    return fluid ? this.jointLines(f, f.fields[key].data, x, s, ox, oy) : col;
   }
+
+  // The joints of the flow network coloured by their value, in BINS strokes.
+  jointLines(f, values, x, s, ox, oy) {
+    const damage = f.fields.damage ? f.fields.damage.data : null;
+    const pressure = f.fields.fluid_pressure ? f.fields.fluid_pressure.data : null;
+    const net = [];
+    for (let j = 0; j < f.joints; j++)
+      if ((damage && damage[j] > 0) || (pressure && pressure[j] !== 0)) net.push(j);
+    const [lo, hi] = range(net.map(j => values[j])), paths = [];
+    for (let b = 0; b < BINS; b++) paths.push(new Path2D());
+    for (const j of net) {
+      const b = Math.min(BINS - 1, Math.floor((values[j] - lo) / (hi - lo) * BINS));
+      const a = f.jointNodes[4 * j], c = f.jointNodes[4 * j + 1];
+      paths[b].moveTo(ox + s * x[2 * a], oy - s * x[2 * a + 1]);
+      paths[b].lineTo(ox + s * x[2 * c], oy - s * x[2 * c + 1]);
+    }
+    this.ctx.lineWidth = 3;
+    paths.forEach((p, b) => {
+      const c = viridis((b + 0.5) / BINS);
+      this.ctx.strokeStyle = `rgb(${c[0] | 0},${c[1] | 0},${c[2] | 0})`;
+      this.ctx.stroke(p);
+    });
+    this.jointsDrawn = net.length;
+    return { lo, hi, categorical: false };
+  }
+}
+
+// Every element light grey: the ground the joint lines are drawn on.
+function grey(f) {
+  return { rgb: new Uint8Array(3 * f.elements).fill(215), lo: 0, hi: 1, categorical: false };
 }

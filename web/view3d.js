@@ -1,86 +1,24 @@
 // view3d.js - a 3D snapshot in WebGL through three.js: the outer faces of
 // the tetrahedra and the faces of broken joints (the crack surfaces),
-// flat-coloured by their element, lit so the shape reads, with broken
-// joints outlined as cracks; the camera orbits with the mouse.
+// flat-coloured by their element, lit so the shape reads, with the edges of
+// the crack faces drawn black; the camera orbits with the mouse.
 //
-// A fracturing part has nodes of its own per tetrahedron, so the skin
-// cannot be told from node ids: nodes that started at one point are first
-// made one vertex (a hash of their initial coordinates' bits), and a face
-// is outer when no other tetrahedron has the same three vertices. For
-// 1e5 tetrahedra that leaves ~2 % of the 4e5 faces, which is what makes
-// a software-rendered (headless) frame take a second instead of several.
+// The daemon sends only those faces (GET /cases/ID/mesh.bin?surface=true:
+// ~2 % of the faces of a 1e5-tetrahedron fracturing block, ~1 MB instead
+// of 20), so the page neither receives nor searches the inside of the
+// mesh: before that, finding the surface here took most of the 3.4-4.6 s a
+// frame took to show in a headless browser. Choosing a fluid field (fluid
+// pressure, aperture) colours the crack faces by their own joint and shows
+// the rest of the surface as a grey veil, so the cracks inside show.
 // The drawing buffer is kept so the page's tests can read its pixels.
 
 import * as THREE from "./vendor/three/three.module.js";
 import { OrbitControls } from "./vendor/three/OrbitControls.js";
-import { brokenJoints, deformedPositions, elementColours } from "./mesh.js";
+import { NONE, deformedPositions, elementColours, range, viridis } from "./mesh.js";
 
-const FACES = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]; // outward for positive volume
-
-// One vertex id per initial position: nodes with the same initial
-// coordinates (bit for bit) share it. Open addressing on the bits.
-function vertexIds(f) {
-  const n = f.nodes, bits = new Uint32Array(f.position0.buffer, f.position0.byteOffset, 3 * n);
-  let size = 1;
-  while (size < 2 * n) size <<= 1;
-  const table = new Int32Array(size).fill(-1), id = new Int32Array(n);
-  let count = 0;
-  for (let i = 0; i < n; i++) {
-    const a = bits[3 * i], b = bits[3 * i + 1], c = bits[3 * i + 2];
-    let h = (Math.imul(a, 0x9e3779b1) ^ Math.imul(b, 0x85ebca77) ^ Math.imul(c, 0xc2b2ae3d)) & (size - 1);
-    for (;;) {
-      const j = table[h];
-      if (j < 0) { table[h] = i; id[i] = count++; break; }
-      if (bits[3 * j] === a && bits[3 * j + 1] === b && bits[3 * j + 2] === c) { id[i] = id[j]; break; }
-      h = (h + 1) & (size - 1);
-    }
-  }
-  return { id, count };
-}
-
-// A face's key from its three vertex ids, the same whatever their order.
-function faceKey(v, count, a, b, c) {
-  let p = v[a], q = v[b], r = v[c], t;
-  if (p > q) { t = p; p = q; q = t; }
-  if (q > r) { t = q; q = r; r = t; }
-  if (p > q) { t = p; p = q; q = t; }
-  return (p * count + q) * count + r;
-}
-
-// [element, face] pairs of the outer faces (every face when the keys would
-// not be exact doubles, past 2e5 distinct vertices).
-function outerFaces(f) {
-  const { id, count } = vertexIds(f), E = f.elements, out = [];
-  if (count ** 3 > Number.MAX_SAFE_INTEGER) {
-    for (let e = 0; e < E; e++) for (let k = 0; k < 4; k++) out.push(e, k);
-    return { faces: Int32Array.from(out), id, count };
-  }
-  const seen = new Map();
-  for (let e = 0; e < E; e++)
-    for (let k = 0; k < 4; k++) {
-      const F = FACES[k], key = faceKey(id, count, f.cells[4 * e + F[0]], f.cells[4 * e + F[1]], f.cells[4 * e + F[2]]);
-      seen.set(key, seen.has(key) ? -1 : 4 * e + k);
-    }
-  for (const v of seen.values()) if (v >= 0) out.push(v >> 2, v & 3);
-  return { faces: Int32Array.from(out), id, count };
-}
-
-// [element, face] pairs of the faces on broken joints (both sides).
-function crackFaces(f, skin, broken) {
-  if (!broken.length || skin.count ** 3 > Number.MAX_SAFE_INTEGER) return new Int32Array(0);
-  const keys = new Set(), out = [];
-  for (const j of broken) {
-    const a = f.jointNodes.subarray(6 * j, 6 * j + 3);
-    keys.add(faceKey(skin.id, skin.count, a[0], a[1], a[2]));
-  }
-  for (let e = 0; e < f.elements; e++)
-    for (let k = 0; k < 4; k++) {
-      const F = FACES[k];
-      if (keys.has(faceKey(skin.id, skin.count, f.cells[4 * e + F[0]], f.cells[4 * e + F[1]], f.cells[4 * e + F[2]])))
-        out.push(e, k);
-    }
-  return Int32Array.from(out);
-}
+// The joint fields drawn on the crack faces themselves (damage colours
+// each element by its most damaged joint, as in 2D, where it shows).
+const CRACK_FIELDS = ["fluid_pressure", "aperture"];
 
 export class View3D {
   constructor(canvas) {
@@ -96,8 +34,7 @@ export class View3D {
     this.scene.add(this.light);
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.addEventListener("change", () => this.render());
-    this.mesh = null;
-    this.cracks = null;
+    this.mesh = this.veil = this.cracks = null;
     this.framed = false;
   }
 
@@ -108,13 +45,13 @@ export class View3D {
   }
 
   clear() {
-    for (const o of [this.mesh, this.cracks]) {
+    for (const o of [this.mesh, this.veil, this.cracks]) {
       if (!o) continue;
       this.scene.remove(o);
       o.geometry.dispose();
       o.material.dispose();
     }
-    this.mesh = this.cracks = null;
+    this.mesh = this.veil = this.cracks = null;
   }
 
   render() {
@@ -122,64 +59,100 @@ export class View3D {
     this.renderer.render(this.scene, this.camera);
   }
 
-  // The outer faces depend on the mesh only: kept while it stays the same.
-  skin(f) {
-    const key = `${f.nodes}:${f.elements}`;
-    if (!this.skinCache || this.skinCache.key !== key) this.skinCache = { key, skin: outerFaces(f) };
-    return this.skinCache.skin;
-  }
-
   draw(f, key, scale) {
-    const x = deformedPositions(f, scale), col = elementColours(f, key), skin = this.skin(f);
-    const broken = brokenJoints(f), cracked = crackFaces(f, skin, broken);
-    const faces = skin.faces.length + cracked.length;
-    const pos = new Float32Array(faces / 2 * 9), rgb = new Float32Array(faces / 2 * 9);
+    if (!f.faceNodes) throw new Error("a 3D frame without its surface (ask ?surface=true)");
+    const x = deformedPositions(f, scale), joints = CRACK_FIELDS.includes(key);
+    const col = joints ? this.jointColours(f, key) : elementColours(f, key);
+    const S = f.faces, fn = f.faceNodes, fe = f.faceElement, fj = f.faceJoint;
+    const pos = new Float32Array(S * 9), rgb = new Uint8Array(S * 9);
+    const veil = [];
     let o = 0;
-    for (const list of [skin.faces, cracked])
-      for (let i = 0; i < list.length; i += 2) {
-        const e = list[i], r = col.rgb[3 * e] / 255, g = col.rgb[3 * e + 1] / 255, b = col.rgb[3 * e + 2] / 255;
-        for (const v of FACES[list[i + 1]]) {
-          const n = f.cells[4 * e + v];
-          pos[o] = x[3 * n]; pos[o + 1] = x[3 * n + 1]; pos[o + 2] = x[3 * n + 2];
-          rgb[o] = r; rgb[o + 1] = g; rgb[o + 2] = b;
-          o += 3;
-        }
+    for (let i = 0; i < S; i++) {
+      const c = joints ? (fj[i] === NONE ? null : col.joint[fj[i]]) : 3 * fe[i];
+      for (let k = 0; k < 3; k++) {
+        const n = fn[3 * i + k];
+        pos[o] = x[3 * n]; pos[o + 1] = x[3 * n + 1]; pos[o + 2] = x[3 * n + 2];
+        if (c !== null) { rgb[o] = col.rgb[c]; rgb[o + 1] = col.rgb[c + 1]; rgb[o + 2] = col.rgb[c + 2]; }
+        o += 3;
       }
+      if (c === null) veil.push(i);
+    }
     this.clear();
-    const geometry = new THREE.BufferGeometry();
-    geometry.setAttribute("position", new THREE.BufferAttribute(pos, 3));
-    geometry.setAttribute("color", new THREE.BufferAttribute(rgb, 3));
-    geometry.computeVertexNormals();
-    this.mesh = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial({ vertexColors: true }));
-    this.scene.add(this.mesh);
-    this.cracks = this.crackLines(f, x, broken);
-    if (this.cracks) this.scene.add(this.cracks);
-    if (!this.framed) this.frame(geometry);
+    const solid = joints ? this.keep(pos, rgb, veil, false) : { pos, rgb };
+    this.mesh = this.surfaceMesh(solid.pos, solid.rgb, 1);
+    if (joints && veil.length) {
+      const v = this.keep(pos, rgb, veil, true);
+      this.veil = this.surfaceMesh(v.pos, null, 0.15);
+    }
+    this.cracks = this.crackLines(f, x);
+    for (const m of [this.mesh, this.veil, this.cracks]) if (m) this.scene.add(m);
+    if (!this.framed) this.frame(x);
     this.render();
     return col;
   }
 
-  // The edges of each broken joint's first face, in black.
-  crackLines(f, x, broken) {
-    if (!broken.length) return null;
-    const pos = new Float32Array(broken.length * 18);
+  // The faces listed in `which` (keep true) or all the others (false).
+  keep(pos, rgb, which, keep) {
+    const mark = new Uint8Array(pos.length / 9);
+    for (const i of which) mark[i] = 1;
+    const n = keep ? which.length : mark.length - which.length;
+    const p = new Float32Array(9 * n), c = new Uint8Array(9 * n);
     let o = 0;
-    for (const j of broken) {
-      const a = f.jointNodes.subarray(6 * j, 6 * j + 3);
+    for (let i = 0; i < mark.length; i++) {
+      if (mark[i] !== (keep ? 1 : 0)) continue;
+      p.set(pos.subarray(9 * i, 9 * i + 9), o);
+      c.set(rgb.subarray(9 * i, 9 * i + 9), o);
+      o += 9;
+    }
+    return { pos: p, rgb: c };
+  }
+
+  surfaceMesh(pos, rgb, opacity) {
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute("position", new THREE.BufferAttribute(pos, 3));
+    if (rgb) geometry.setAttribute("color", new THREE.BufferAttribute(rgb, 3, true));
+    geometry.computeVertexNormals();
+    const material = new THREE.MeshLambertMaterial(rgb ? { vertexColors: true }
+      : { color: 0x9a9a9a, transparent: true, opacity, depthWrite: false });
+    return new THREE.Mesh(geometry, material);
+  }
+
+  // Colours of the joints a joint field gives: {rgb (3 per joint), joint
+  // (its offset in rgb), lo, hi}.
+  jointColours(f, key) {
+    const values = f.fields[key].data, [lo, hi] = range(values), rgb = new Uint8Array(3 * f.joints);
+    const joint = new Int32Array(f.joints);
+    for (let j = 0; j < f.joints; j++) {
+      const c = viridis((values[j] - lo) / (hi - lo));
+      rgb[3 * j] = c[0]; rgb[3 * j + 1] = c[1]; rgb[3 * j + 2] = c[2];
+      joint[j] = 3 * j;
+    }
+    return { rgb, joint, lo, hi, categorical: false };
+  }
+
+  // The edges of the faces on broken joints (both sides), in black.
+  crackLines(f, x) {
+    const fj = f.faceJoint, damage = f.fields.damage ? f.fields.damage.data : null, list = [];
+    for (let i = 0; i < f.faces; i++)
+      if (fj[i] !== NONE && (!damage || damage[fj[i]] >= 1)) list.push(i);
+    if (!list.length) return null;
+    const pos = new Float32Array(list.length * 18), fn = f.faceNodes;
+    let o = 0;
+    for (const i of list)
       for (const [p, q] of [[0, 1], [1, 2], [2, 0]])
-        for (const n of [a[p], a[q]]) {
+        for (const n of [fn[3 * i + p], fn[3 * i + q]]) {
           pos[o++] = x[3 * n]; pos[o++] = x[3 * n + 1]; pos[o++] = x[3 * n + 2];
         }
-    }
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute("position", new THREE.BufferAttribute(pos, 3));
     return new THREE.LineSegments(geometry, new THREE.LineBasicMaterial({ color: 0x000000 }));
   }
 
   // Points the camera at the model once; later frames keep the user's view.
-  frame(geometry) {
-    geometry.computeBoundingSphere();
-    const { center, radius } = geometry.boundingSphere;
+  frame(x) {
+    const sphere = new THREE.Sphere().setFromPoints(Array.from({ length: x.length / 3 },
+      (_, n) => new THREE.Vector3(x[3 * n], x[3 * n + 1], x[3 * n + 2])));
+    const { center, radius } = sphere;
     const r = Math.max(radius, 1e-6);
     this.camera.near = r / 100;
     this.camera.far = r * 100;

@@ -44,6 +44,7 @@
 #define FDEM_RESULT_H
 
 #include <stddef.h>
+#include <stdint.h>
 #include <sys/types.h>
 #include "case/case.h"
 #include "fdem.h"
@@ -90,18 +91,33 @@ int result_read_history(result_file *f, const char *path, double since, history_
                         int *count, history_names *names, char *err, size_t errlen);
 void result_free_history(history_row **rows, int count);
 /* One snapshot as the web page's binary frame (result_frame.c; the layout
- * is in docs/api.md, "Binary mesh frames"): the mesh, the deformed
- * positions and the fields asked for, float32. */
-#define RESULT_FRAME_FIELDS 8
+ * is in docs/api.md, "Binary mesh frames"): the mesh, or only its visible
+ * facets, the deformed positions and the fields asked for, float32. */
+#define RESULT_FRAME_FIELDS 10
 /* velocity, displacement, stress, strain, principal_stress, damage,
- * fragment, active: bit k of result_frame_request.fields */
+ * fragment, active, fluid_pressure, aperture: bit k of
+ * result_frame_request.fields */
 extern const char *const result_frame_field_names[RESULT_FRAME_FIELDS];
+/* One case's mesh tables kept between its frames (the mesh of a case never
+ * changes): its cells, joints and which facets face which; owned by the
+ * caller, used by one thread (the I/O thread), holding one mesh at a time. */
+typedef struct result_frame_cache result_frame_cache;
+result_frame_cache *result_frame_cache_new(void);
+void result_frame_cache_free(result_frame_cache *cache);
+void result_frame_cache_clear(result_frame_cache *cache);
+size_t result_frame_cache_bytes(const result_frame_cache *cache);
 typedef struct result_frame_request {
     int snapshot;      /* index, or -1 for the last complete one */
     unsigned fields;   /* bit k: result_frame_field_names[k]; those the file lacks are left out */
-    /* called with the frame's size before it is allocated; non-zero refuses (503) */
+    /* called with the bytes building the frame may hold, before any is allocated;
+     * non-zero refuses (503) */
     int (*reserve)(void *ctx, size_t bytes);
     void *reserve_ctx;
+    int surface;       /* 1: only the facets that can be seen (the surface form) */
+    int has_shape_key; /* 1: the client holds the shape of key shape_key */
+    uint64_t shape_key; /* the shape sections are left out when the frame's key equals it */
+    result_frame_cache *cache; /* NULL, or the tables to use and keep when owner's */
+    const char *cache_owner;   /* who the mesh is (the case id) */
 } result_frame_request;
 /* Reads the frame from the open file f, or the closed file at path (f
  * NULL): *out (free() it) gets *size bytes. Returns 0; 404 (no such

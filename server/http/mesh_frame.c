@@ -58,6 +58,32 @@ static int mesh_frame_fields(struct MHD_Connection *conn, unsigned *bits, char *
     return 0;
 }
 
+/* ?surface=true|false (also 1/0, yes/no, empty for true): 0 or 1, -1 when
+ * it is none of them. */
+static int mesh_frame_surface(struct MHD_Connection *conn)
+{
+    const char *v = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "surface");
+    if (!v)
+        return 0;
+    if (!*v || !strcmp(v, "true") || !strcmp(v, "1") || !strcmp(v, "yes"))
+        return 1;
+    return !strcmp(v, "false") || !strcmp(v, "0") || !strcmp(v, "no") ? 0 : -1;
+}
+
+/* ?shape=KEY: the 16 hex digits of a shape key the client holds. 0 and
+ * q->has_shape_key set when given, -1 when it is not 16 hex digits. */
+static int mesh_frame_shape(struct MHD_Connection *conn, result_frame_request *q)
+{
+    const char *v = MHD_lookup_connection_value(conn, MHD_GET_ARGUMENT_KIND, "shape");
+    if (!v)
+        return 0;
+    if (strlen(v) != 16 || strspn(v, "0123456789abcdefABCDEF") != 16)
+        return -1;
+    q->has_shape_key = 1;
+    q->shape_key = strtoull(v, NULL, 16);
+    return 0;
+}
+
 /* Called on the I/O thread with the frame's size, before it is allocated. */
 static int mesh_frame_reserve(void *lease, size_t bytes)
 {
@@ -67,11 +93,18 @@ static int mesh_frame_reserve(void *lease, size_t bytes)
 enum MHD_Result mesh_frame_reply(struct MHD_Connection *conn, server_case *c)
 {
     result_frame_request q = {mesh_frame_snapshot(conn), 0, mesh_frame_reserve,
-                              membudget_request_lease()};
+                              membudget_request_lease(), mesh_frame_surface(conn), 0, 0,
+                              NULL, NULL};
     char detail[400] = "";
     if (q.snapshot == -2)
         return http_reply_problem(conn, 400, "Bad request",
                                   "?snapshot= takes a snapshot index, 0 or more", NULL);
+    if (q.surface < 0)
+        return http_reply_problem(conn, 400, "Bad request", "?surface= takes true or false",
+                                  NULL);
+    if (mesh_frame_shape(conn, &q) != 0)
+        return http_reply_problem(conn, 400, "Bad request",
+                                  "?shape= takes the 16 hex digits of a frame's shape key", NULL);
     if (mesh_frame_fields(conn, &q.fields, detail, sizeof detail) != 0)
         return http_reply_problem(conn, 400, "Bad request", detail, NULL);
     unsigned char *bytes = NULL;

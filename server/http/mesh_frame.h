@@ -6,8 +6,9 @@
  * Contract: the frame is read on the I/O thread (io_read_frame), charged
  * to the request's memory lease while it is held; ?snapshot= is a
  * non-negative index (the last complete snapshot without it) and ?fields=
- * names from result_frame_field_names (all the file has without it); a bad
- * value is a 400 naming it, a snapshot the case does not have a 404.
+ * names from result_frame_field_names (all the file has without it),
+ * ?surface= a flag, ?shape= 16 hex digits; a bad value is a 400 naming
+ * it, a snapshot the case does not have a 404.
  */
 #ifndef FDEMD_MESH_FRAME_H
 #define FDEMD_MESH_FRAME_H

@@ -181,7 +181,7 @@ static const char *const *routes_query_names(route_kind kind, const char *method
     static const char *const events[] = {"since", NULL};
     static const char *const fragments[] = {"parts", "exclude_host", NULL};
     static const char *const stream[] = {"case", NULL};
-    static const char *const mesh[] = {"snapshot", "fields", NULL};
+    static const char *const mesh[] = {"snapshot", "fields", "surface", "shape", NULL};
     static const char *const none[] = {NULL};
     if (kind == ROUTE_CASES)
         return strcmp(method, "POST") == 0 ? create : list;

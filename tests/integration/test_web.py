@@ -19,39 +19,70 @@ import time
 import unittest
 
 from fdemd_harness import ROOT, SLOW, Daemon, DaemonTestCase, fetched_result, tiny_case
+from test_fluid import fluid_case
 
 TOKEN = "web-test-token-7f3a"
-HEADER = struct.Struct("<8sIIIIIIIIdqII")
-FIELD = struct.Struct("<16sII")
+HEADER = struct.Struct("<8sIIIIIIIIdqIIQII")
+SECTION = struct.Struct("<16sIIII")
+SHAPE = ("cells", "joints", "joint_elements", "faces", "face_element", "face_joint", "node_id",
+         "element_id", "joint_id", "position0")
+NONE = 0xFFFFFFFF
+# each facet's local nodes, outward (core/analysis/boundary_facets.c)
+LOCAL_FACETS = {2: [[0, 1], [1, 2], [2, 0]], 3: [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}
 
 
 def decode_frame(data):
-    """The frame as numpy arrays (docs/api.md, "Binary mesh frames")."""
+    """The frame as numpy arrays (docs/api.md, "Binary mesh frames"):
+    header values, "shape" (the mesh's sections), "fields", "position"."""
     import numpy as np
-    (magic, version, dim, nodes, elements, joints, index, snapshots, fields, time_, step,
-     deformed, _) = HEADER.unpack_from(data, 0)
+    (magic, version, dim, nodes, elements, joints, index, snapshots, sections, time_, step,
+     deformed, faces, key, flags, _) = HEADER.unpack_from(data, 0)
     assert magic == b"FDEMMESH", magic
     out = {"version": version, "dimension": dim, "nodes": nodes, "elements": elements,
            "joints": joints, "index": index, "snapshots": snapshots, "time": time_,
-           "step": step, "deformed": deformed, "fields": {}}
+           "step": step, "deformed": deformed, "faces": faces, "key": "%016x" % key,
+           "surface": bool(flags & 1), "with_shape": bool(flags & 2), "fields": {}, "shape": {}}
     o = HEADER.size
-
-    def take(dtype, count, shape):
-        nonlocal o
-        a = np.frombuffer(data, dtype=dtype, count=count, offset=o).reshape(shape)
-        o += 4 * count
-        return a
-    out["cells"] = take("<u4", elements * (dim + 1), (elements, dim + 1))
-    out["joints_nodes"] = take("<u4", joints * 2 * dim, (joints, 2 * dim))
-    out["position0"] = take("<f4", nodes * dim, (nodes, dim))
-    out["position"] = take("<f4", nodes * dim, (nodes, dim))
-    for _ in range(fields):
-        name, at, width = FIELD.unpack_from(data, o)
-        o += FIELD.size
-        items = (nodes, elements, joints)[at]
-        out["fields"][name.rstrip(b"\0").decode()] = (at, take("<f4", items * width, (items, width)))
+    for _ in range(sections):
+        name, at, width, kind, items = SECTION.unpack_from(data, o)
+        o += SECTION.size
+        name = name.rstrip(b"\0").decode()
+        count = (nodes, elements, joints, faces)[at]
+        assert items == count, (name, items, count)
+        a = np.frombuffer(data, dtype="<u4" if kind == 1 else "<f4", count=items * width,
+                          offset=o).reshape(items, width)
+        o += 4 * items * width
+        if name in SHAPE:
+            out["shape"][name] = a
+        elif name == "position":
+            out["position"] = a
+        else:
+            out["fields"][name] = (at, a)
     assert o == len(data), (o, len(data))
     return out
+
+
+def visible_facets(cells, joints, damage, active):
+    """The facets a surface frame must carry, found here independently of
+    the daemon (dicts of sorted node ids): [(element, outward nodes)]."""
+    import numpy as np
+    d = cells.shape[1] - 1
+    facets = cells[:, LOCAL_FACETS[d]].reshape(-1, d)
+    element = np.repeat(np.arange(len(cells)), d + 1)
+    alive = np.ones(len(cells), bool) if active is None else active != 0
+    where = {}
+    for f, row in enumerate(facets.tolist()):
+        where.setdefault(tuple(sorted(row)), []).append(f)
+    hidden = np.zeros(len(facets), bool)
+    for fs in where.values():
+        if len(fs) == 2 and alive[element[fs]].all():
+            hidden[fs] = True
+    for j, row in enumerate(joints.tolist()):
+        a, b = where.get(tuple(sorted(row[:d]))), where.get(tuple(sorted(row[d:])))
+        if (damage is None or damage[j] < 1) and a and b and alive[element[[a[0], b[0]]]].all():
+            hidden[[a[0], b[0]]] = True
+    return [(int(element[f]), tuple(facets[f].tolist()))
+            for f in range(len(facets)) if alive[element[f]] and not hidden[f]]
 
 
 def fracturing_case(name="frac", end=2e-4):
@@ -158,15 +189,18 @@ class MeshFrameTest(DaemonTestCase):
         self.assertEqual(headers["content-type"], "application/octet-stream")
         fr = decode_frame(data)
         dim = st["dimension"]
-        self.assertEqual((fr["version"], fr["dimension"], fr["index"]), (1, dim, index))
+        self.assertEqual((fr["version"], fr["dimension"], fr["index"]), (2, dim, index))
+        self.assertEqual((fr["surface"], fr["with_shape"], fr["faces"]), (False, True, 0))
         self.assertEqual(fr["snapshots"], st["snapshots"])
         self.assertEqual(fr["time"], f["/snapshots/time"][index])
         self.assertEqual(fr["step"], f["/snapshots/step"][index])
         cells = f["/mesh/tetrahedra" if dim == 3 else "/mesh/triangles"][:]
-        np.testing.assert_array_equal(fr["cells"], cells)
-        np.testing.assert_array_equal(fr["joints_nodes"], f["/mesh/joints"][:])
+        shape = fr["shape"]
+        np.testing.assert_array_equal(shape["cells"], cells)
+        np.testing.assert_array_equal(shape["joints"], f["/mesh/joints"][:])
+        self.check_joint_elements(shape["joint_elements"], shape["joints"], cells, dim)
         # float32 of the stored float64: exactly what numpy's rounding gives
-        np.testing.assert_array_equal(fr["position0"], f["/mesh/position0"][:].astype(np.float32))
+        np.testing.assert_array_equal(shape["position0"], f["/mesh/position0"][:].astype(np.float32))
         np.testing.assert_array_equal(fr["position"], f["/snapshots/position"][index].astype(np.float32))
         self.assertEqual(fr["deformed"], 1)
         for name in ("velocity", "stress", "damage", "fragment", "principal_stress", "displacement",
@@ -177,6 +211,70 @@ class MeshFrameTest(DaemonTestCase):
             at, values = fr["fields"][name]
             want = f["/snapshots/" + name][index].astype(np.float32)
             np.testing.assert_array_equal(values, want.reshape(values.shape), name)
+        return fr
+
+    def check_joint_elements(self, joint_elements, joint_nodes, cells, dim):
+        """Each joint side's nodes are nodes of the element given for it."""
+        for j, (a, b) in enumerate(joint_elements.tolist()):
+            for side, e in ((0, a), (1, b)):
+                self.assertNotEqual(e, NONE, "joint %d side %d" % (j, side))
+                self.assertTrue(set(joint_nodes[j][side * dim:(side + 1) * dim].tolist())
+                                <= set(cells[e].tolist()), (j, side, e))
+
+    def check_surface(self, st, f, index):
+        """The surface form against result.h5: the facets found here
+        independently, the carried items' values number for number; then
+        the same frame for a page that holds its shape."""
+        import numpy as np
+        url = "/cases/%s/mesh.bin?snapshot=%d&surface=true" % (st["id"], index)
+        status, _, data = self.d.request("GET", url)
+        self.assertEqual(status, 200, data[:300])
+        fr = decode_frame(data)
+        self.assertTrue(fr["surface"] and fr["with_shape"])
+        dim, shape = st["dimension"], fr["shape"]
+        cells = f["/mesh/tetrahedra" if dim == 3 else "/mesh/triangles"][:]
+        joints = f["/mesh/joints"][:]
+        damage = f["/snapshots/damage"][index]
+        active = f["/snapshots/active"][index] if "/snapshots/active" in f else None
+        want = visible_facets(cells, joints, damage, active)
+        node_id, element_id = shape["node_id"][:, 0], shape["element_id"][:, 0]
+        joint_id = shape["joint_id"][:, 0]
+        got = [(int(element_id[e]), tuple(node_id[v].tolist()))
+               for e, v in zip(shape["face_element"][:, 0], shape["faces"])]
+        self.assertEqual(sorted(got), sorted(want))
+        self.assertEqual(fr["faces"], len(want))
+        # a face on a joint says which (a broken one, here)
+        for k, j in enumerate(shape["face_joint"][:, 0].tolist()):
+            if j != NONE:
+                self.assertGreaterEqual(damage[joint_id[j]], 1.0)
+        self.assertEqual(sorted(set(node_id.tolist())), sorted(set(v for _, vs in want for v in vs)))
+        self.assertEqual(sorted(element_id.tolist()), sorted(set(e for e, _ in want)))
+        je = shape["joint_elements"]
+        local = np.full(len(cells), NONE, dtype=np.int64)
+        local[element_id] = np.arange(len(element_id))
+        for row, j in zip(je.tolist(), joint_id.tolist()):
+            self.assertTrue(any(e != NONE for e in row))
+            for side, e in enumerate(row):
+                if e != NONE:
+                    self.assertTrue(set(joints[j][side * dim:(side + 1) * dim].tolist())
+                                    <= set(cells[element_id[e]].tolist()))
+        np.testing.assert_array_equal(shape["position0"],
+                                      f["/mesh/position0"][:][node_id].astype(np.float32))
+        np.testing.assert_array_equal(fr["position"],
+                                      f["/snapshots/position"][index][node_id].astype(np.float32))
+        np.testing.assert_array_equal(fr["fields"]["stress"][1],
+                                      f["/snapshots/stress"][index][element_id].astype(np.float32))
+        np.testing.assert_array_equal(fr["fields"]["damage"][1][:, 0],
+                                      damage[joint_id].astype(np.float32))
+        # the page holds this shape: only positions and fields come
+        status, _, again = self.d.request("GET", url + "&shape=" + fr["key"])
+        kept = decode_frame(again)
+        self.assertEqual((kept["with_shape"], kept["key"], kept["shape"]), (False, fr["key"], {}))
+        np.testing.assert_array_equal(kept["position"], fr["position"])
+        self.assertLess(len(again), len(data))
+        # a key of another shape gets the shape
+        other = "%016x" % (int(fr["key"], 16) ^ 1)
+        self.assertTrue(decode_frame(self.d.request("GET", url + "&shape=" + other)[2])["with_shape"])
         return fr
 
     def test_frame_2d_matches_result_file(self):
@@ -190,13 +288,16 @@ class MeshFrameTest(DaemonTestCase):
                                                     "principal_stress", "strain", "stress",
                                                     "velocity"])
             self.assertGreater(fr["fields"]["damage"][1].max(), 0)
+            self.check_surface(st, f, st["snapshots"] - 1)
         # the last snapshot without ?snapshot=, and only the fields asked for
         status, _, data = self.d.request("GET", "/cases/%s/mesh.bin?fields=damage,stress" % st["id"])
         fr = decode_frame(data)
         self.assertEqual(fr["index"], st["snapshots"] - 1)
         self.assertEqual(sorted(fr["fields"]), ["damage", "stress"])
         for query, code in (("?snapshot=%d" % st["snapshots"], 404), ("?snapshot=-1", 400),
-                            ("?snapshot=x", 400), ("?fields=pressure", 400), ("?frame=1", 400)):
+                            ("?snapshot=x", 400), ("?fields=pressure", 400), ("?frame=1", 400),
+                            ("?surface=maybe", 400), ("?shape=12", 400),
+                            ("?shape=0123456789abcdeg", 400)):
             status, body = self.d.json("GET", "/cases/%s/mesh.bin%s" % (st["id"], query))
             self.assertEqual(status, code, query)
             self.assertIn(body["title"], ("Not found", "Bad request"))
@@ -204,7 +305,7 @@ class MeshFrameTest(DaemonTestCase):
         self.assertEqual(self.d.json("POST", "/cases/%s/mesh.bin" % st["id"])[0], 405)
 
     def test_frame_3d_while_running_and_after(self):
-        st = self.d.create(box_case_3d(end=2e-3), start=True)
+        st = self.d.create(box_case_3d(end=2.5e-4), start=True)  # 2e-3 took 57 s here
         # read from the open file of the running case
         st = self.d.wait(st["id"], lambda s: s["snapshots"] >= 2 or s["state"] == "finished",
                          timeout=60, what="a second snapshot")
@@ -216,6 +317,45 @@ class MeshFrameTest(DaemonTestCase):
             fr = self.check_frame(st, f, 1)
             self.assertEqual(running["position"].tobytes(), fr["position"].tobytes())
             self.check_frame(st, f, st["snapshots"] - 1)
+            surface = self.check_surface(st, f, st["snapshots"] - 1)
+            self.assertGreater(len([j for j in surface["shape"]["face_joint"][:, 0] if j != NONE]),
+                               0, "no crack face in the last snapshot")
+
+    def test_frame_fluid_fields(self):
+        """A case with fluid: fluid_pressure and aperture per joint, as in
+        result.h5, in both forms."""
+        import numpy as np
+        st = self.d.create(fluid_case(2), start=True)
+        st = self.d.wait_state(st["id"], "finished", timeout=60)
+        with fetched_result(self.d, st["id"]) as f:
+            index = st["snapshots"] - 1
+            for query, ids in (("", None), ("&surface=true", "joint_id")):
+                status, _, data = self.d.request(
+                    "GET", "/cases/%s/mesh.bin?fields=fluid_pressure,aperture%s" % (st["id"], query))
+                self.assertEqual(status, 200, data[:300])
+                fr = decode_frame(data)
+                self.assertEqual(sorted(fr["fields"]), ["aperture", "fluid_pressure"])
+                for name in ("fluid_pressure", "aperture"):
+                    at, values = fr["fields"][name]
+                    want = f["/snapshots/" + name][index]
+                    if ids:
+                        want = want[fr["shape"][ids][:, 0]]
+                    self.assertEqual(at, 2)
+                    np.testing.assert_array_equal(values[:, 0], want.astype(np.float32), name)
+            pressure = f["/snapshots/fluid_pressure"][index]
+            self.assertGreater(pressure.max(), 0)
+            # the surface form asked for a fluid field shows the faces of
+            # the joints holding fluid too, as it shows those of cracks
+            shape = fr["shape"]
+            cells, joints = f["/mesh/triangles"][:], f["/mesh/joints"][:]
+            opened = np.where(pressure != 0, 1.0, f["/snapshots/damage"][index])
+            want = visible_facets(cells, joints, opened, None)
+            got = [(int(shape["element_id"][e, 0]), tuple(shape["node_id"][v, 0].tolist()))
+                   for e, v in zip(shape["face_element"][:, 0], shape["faces"])]
+            self.assertEqual(sorted(got), sorted(want))
+            wet = [j for j in shape["face_joint"][:, 0].tolist()
+                   if j != NONE and pressure[shape["joint_id"][j, 0]] != 0]
+            self.assertGreater(len(wet), 0, "no face of a joint holding fluid")
 
     def test_large_frame_loads_quickly(self):
         """A 2D mesh of 100,352 triangles, created (snapshot 0): the whole
@@ -301,7 +441,8 @@ class WebBrowserTest(unittest.TestCase):
         weaker = fracturing_case("frac weaker")
         weaker["materials"]["rock"]["fracture"]["tensile_strength"] = 5e4
         cls.weaker = cls.d.create(weaker, start=True)
-        for st in (cls.box, cls.frac, cls.weaker):
+        cls.fluid = cls.d.create(fluid_case(2), start=True)
+        for st in (cls.box, cls.frac, cls.weaker, cls.fluid):
             cls.d.wait_state(st["id"], "finished", timeout=120)
         cls.long = cls.d.create(cls.d.case_lasting(60.0, name="long running"), start=True)
         cls.browser = start_browser()
@@ -350,6 +491,58 @@ class WebBrowserTest(unittest.TestCase):
     def click(self, selector):
         self.browser.execute_script("document.querySelector(arguments[0]).click()", selector)
 
+    def command(self, case_id, name):
+        self.wait_for("return document.querySelector(arguments[0]) !== null", "the %s button" % name,
+                      20.0, '#cases tr[data-id="%s"] button[data-command="%s"]' % (case_id, name))
+        self.click('#cases tr[data-id="%s"] button[data-command="%s"]' % (case_id, name))
+
+    def extend_stop_delete(self, case_id):
+        """The extend, stop and delete buttons, each checked at the daemon
+        (the page's prompt and confirm answered as a user would)."""
+        b = self.browser
+        end = self.d.status(case_id)["end_time"]
+        b.execute_script("window.prompt = () => arguments[0]; window.confirm = () => true;",
+                         repr(2 * end))
+        self.command(case_id, "extend")
+        st = self.d.wait(case_id, lambda s: s["end_time"] == 2 * end, what="the extended end")
+        self.assertEqual(st["state"], "paused")
+        self.command(case_id, "stop")
+        self.d.wait_state(case_id, "stopped")
+        self.wait_for("return %s.querySelector('.state').textContent === 'stopped'"
+                      % self.row(case_id), "the row to say stopped")
+        self.command(case_id, "delete")
+        self.wait_deleted(case_id)
+        self.wait_for("return %s === null" % self.row(case_id), "the row to go")
+
+    def wait_deleted(self, case_id):
+        deadline = time.monotonic() + 20 * SLOW
+        while self.d.json("GET", "/cases/" + case_id)[0] != 404:
+            self.assertLess(time.monotonic(), deadline, "the case is still there")
+            time.sleep(0.05)
+
+    def downloads(self, case_id):
+        """The download buttons: the files the browser saves are the
+        daemon's, byte for byte."""
+        folder = tempfile.mkdtemp(prefix="fdemd-web-dl-")
+        try:
+            self.browser.execute_cdp_cmd("Browser.setDownloadBehavior",
+                                         {"behavior": "allow", "downloadPath": folder})
+            for label, route, saved in (("case", "case", case_id + ".json"),
+                                        ("result.h5", "result.h5", case_id + "-result.h5")):
+                want = self.d.request("GET", "/cases/%s/%s" % (case_id, route))[2]
+                self.browser.execute_script(
+                    "[...%s.querySelectorAll('.files button')].find(b => b.textContent === "
+                    "arguments[0]).click()" % self.row(case_id), label)
+                path = os.path.join(folder, saved)
+                deadline = time.monotonic() + 20 * SLOW
+                while not (os.path.exists(path) and os.path.getsize(path) == len(want)):
+                    self.assertLess(time.monotonic(), deadline, "no download of " + saved)
+                    time.sleep(0.05)
+                with open(path, "rb") as f:
+                    self.assertEqual(f.read(), want, saved)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+
     def test_page(self):
         b = self.browser
         # 1. the token prompt, then the list
@@ -379,6 +572,8 @@ class WebBrowserTest(unittest.TestCase):
         self.wait_for("return %s.querySelector('.state').textContent === 'paused'"
                       % self.row(self.long["id"]), "the row to say paused")
         self.assertTrue(b.execute_script("return window.notReloaded === true"))
+        self.extend_stop_delete(self.long["id"])
+        self.downloads(self.frac["id"])
 
         # 4. the 2D view of the fracturing case, drawn, and its plots
         self.click('#cases tr[data-id="%s"] td.name' % self.frac["id"])
@@ -407,6 +602,49 @@ class WebBrowserTest(unittest.TestCase):
         self.assertGreater(drawn, total * 0.02, "the 3D canvas is (nearly) blank")
         self.assertGreater(colours, 5, "the 3D canvas has one colour")
         self.shot("3d", "case-view")
+        # the same snapshot again: the page holds its shape, so the daemon
+        # sends positions and fields only, and the view is drawn from them
+        self.assertEqual(b.execute_script("return document.body.dataset.frameShape"), "sent")
+        sent = int(b.execute_script("return document.body.dataset.frameBytes"))
+        b.execute_script("document.body.dataset.frameDrawn = 'no';"
+                         "const s = document.getElementById('snapshot');"
+                         "s.dispatchEvent(new Event('change'));")
+        self.wait_for("return document.body.dataset.frameDrawn === 'yes' && "
+                      "document.body.dataset.frameShape === 'kept'", "a frame without the shape")
+        self.assertLess(int(b.execute_script("return document.body.dataset.frameBytes")), sent)
+        again = b.execute_script(PIXELS_JS, "view3d")
+        self.assertEqual(again[:2], [drawn, colours])
+
+        # 5b. a case with fluid: fluid pressure on the crack lines, and the
+        # source pressure's plot when the daemon writes that history series
+        self.click('#cases tr[data-id="%s"] td.name' % self.fluid["id"])
+        self.wait_for("return document.body.dataset.frameDrawn === 'yes' && "
+                      "document.getElementById('view-title').textContent.includes('%s')"
+                      % self.fluid["id"], "the fluid case's frame")
+        options = self.wait_for("const o = [...document.getElementById('field').options]"
+                                ".map(o => o.value); return o.length && o", "the field menu")
+        self.assertIn("fluid_pressure", options)
+        self.assertIn("aperture", options)
+        b.execute_script("const m = document.getElementById('field'); m.value = 'fluid_pressure';"
+                         "m.dispatchEvent(new Event('change'));")
+        self.wait_for("return document.body.dataset.frameField === 'fluid_pressure'",
+                      "the fluid pressure drawn")
+        lo, hi = b.execute_script("return [document.getElementById('legend-lo').textContent,"
+                                  "document.getElementById('legend-hi').textContent]")
+        self.assertGreater(float(hi), float(lo))
+        self.assertGreater(float(hi), 0)
+        drawn, colours, total = b.execute_script(PIXELS_JS, "view2d")
+        self.assertGreater(colours, 5, "no coloured joint lines")
+        rows = self.d.json("GET", "/cases/%s/history" % self.fluid["id"])[1]["rows"]
+        if rows and "fluid" in rows[0]:
+            self.wait_for("return !document.getElementById('plot-fluid').hidden && Number(("
+                          "document.querySelector('#plot-fluid .uplot') || {dataset: {}})"
+                          ".dataset.points) > 1", "the source pressure plot")
+        else:
+            self.wait_for("return Number((document.querySelector('#plot-energy .uplot') || "
+                          "{dataset: {}}).dataset.points) > 1", "the fluid case's plots")
+            self.assertTrue(b.execute_script("return document.getElementById('plot-fluid').hidden"))
+        self.shot("fluid", "case-view")
 
         # 6. a clone: the document edited, its diff against the parent shown,
         # the new case made from it and showing the same diff
