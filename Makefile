@@ -142,7 +142,7 @@ $(BUILD)/scripts/%: scripts/%.c $(LIBPROTO) $(LIBCORE)
 # MPI (issue 37): runner/mpi and the programs that link it build with
 # mpicc, only where it exists; elsewhere they are left out with a message.
 MPI_TESTS  := $(if $(MPICC),$(BUILD)/tests/mpi/rank_compare)
-MPI_LINK    = $(MPICC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner $(LDSAN) -fopenmp -o $@ $< \
+MPI_LINK    = $(MPICC) $(CFLAGS) $(PKG_CFLAGS) -Icore -Iproto -Irunner -Itests/unit $(LDSAN) -fopenmp -o $@ $< \
               $(RANK_ENGINE_OBJ) $(LIBPROTO) $(LIBCORE) $(PKG_LIBS) -lmetis -lpthread -lm
 $(BUILD)/rank-engine/%.o: runner/mpi/%.c | $(BUILD)/.deps
 	@mkdir -p $(dir $@)

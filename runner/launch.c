@@ -83,7 +83,7 @@ void launch_argv_free(char **argv)
     free(argv);
 }
 
-int launch_rank_binary(char *out, size_t size)
+int launch_beside_binary(const char *name, char *out, size_t size)
 {
     char self[4096];
     ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
@@ -94,7 +94,12 @@ int launch_rank_binary(char *out, size_t size)
     if (!slash)
         return -1;
     *slash = '\0';
-    if ((size_t)snprintf(out, size, "%s/fdem-rank", self) >= size)
+    return (size_t)snprintf(out, size, "%s/%s", self, name) < size ? 0 : -1;
+}
+
+int launch_rank_binary(char *out, size_t size)
+{
+    if (launch_beside_binary("fdem-rank", out, size) != 0)
         return -1;
     return access(out, X_OK) == 0 ? 0 : -1;
 }

@@ -24,5 +24,9 @@ void launch_argv_free(char **argv);
 /* The path of bin/fdem-rank beside the running executable (/proc/self/exe),
  * into out; 0, or -1 when it cannot be found. */
 int launch_rank_binary(char *out, size_t size);
+/* out = NAME in the folder of the running binary ("../web" from bin/fdemd
+ * finds the web page); -1 when /proc/self/exe cannot be read or out is
+ * too small. */
+int launch_beside_binary(const char *name, char *out, size_t size);
 
 #endif

@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "http.h"
+#include "launch.h"
 
 #define WEB_PREFIX "/ui/"
 #define WEB_MAX_PATH 256
@@ -26,27 +27,12 @@
 static char web_root[PATH_MAX]; /* resolved, no trailing slash; "" when absent */
 static char web_looked[PATH_MAX];
 
-/* DIR/../web of the running binary (bin/fdemd -> ./web). */
-static int web_default(char *out, size_t size)
-{
-    char exe[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0)
-        return -1;
-    exe[n] = '\0';
-    char *slash = strrchr(exe, '/');
-    if (!slash)
-        return -1;
-    *slash = '\0';
-    return snprintf(out, size, "%s/../web", exe) < (int)size ? 0 : -1;
-}
-
 int web_init(const char *configured)
 {
     web_root[0] = '\0';
     if (configured && *configured)
         snprintf(web_looked, sizeof web_looked, "%s", configured);
-    else if (web_default(web_looked, sizeof web_looked) != 0)
+    else if (launch_beside_binary("../web", web_looked, sizeof web_looked) != 0) /* bin/fdemd -> ./web */
         snprintf(web_looked, sizeof web_looked, "web");
     struct stat st;
     if (!realpath(web_looked, web_root) || stat(web_root, &st) != 0 || !S_ISDIR(st.st_mode)) {

@@ -28,30 +28,13 @@
 
 #include "case/case.h"
 #include "mpi/rank_engine.h"
+#include "read_file.h"
 
 static uint64_t fnv1a(const void *data, size_t size, uint64_t h)
 {
     const unsigned char *p = data;
     for (size_t i = 0; i < size; i++) h = (h ^ p[i]) * 1099511628211ull;
     return h;
-}
-
-static char *read_text(const char *path, size_t *length)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)n + 1);
-    if (text && fread(text, 1, (size_t)n, f) != (size_t)n) {
-        free(text);
-        text = NULL;
-    }
-    fclose(f);
-    if (text) text[n] = 0;
-    *length = (size_t)n;
-    return text;
 }
 
 /* The hash of the checkpoint (rank 0) and of the energies. */

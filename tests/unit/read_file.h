@@ -27,4 +27,24 @@ static inline char *read_file(const char *path, size_t *length)
     return text;
 }
 
+/* The same as a NUL-terminated string (case documents for the JSON
+ * parser); NULL without a check when the file is missing. */
+static inline char *read_text(const char *path, size_t *length)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *text = n >= 0 ? malloc((size_t)n + 1) : NULL;
+    if (text && fread(text, 1, (size_t)n, f) != (size_t)n) {
+        free(text);
+        text = NULL;
+    }
+    fclose(f);
+    if (text) text[n] = 0;
+    *length = (size_t)n;
+    return text;
+}
+
 #endif

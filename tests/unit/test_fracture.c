@@ -39,26 +39,9 @@
 #include "check.h"
 #include "joint_face_3d.h"
 #include "model/model.h"
+#include "read_file.h"
 
 #define WINDOW 2e-6
-
-static char *read_text(const char *path, size_t *length)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *text = malloc((size_t)n + 1);
-    if (text && fread(text, 1, (size_t)n, f) != (size_t)n) {
-        free(text);
-        text = NULL;
-    }
-    fclose(f);
-    if (text) text[n] = 0;
-    *length = (size_t)n;
-    return text;
-}
 
 /* The example at `path`, with the JSON at `pointer` replaced by `value`
  * when both are given (a coarser mesh for the sanitizer build). */
