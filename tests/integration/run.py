@@ -81,7 +81,8 @@ MODULE_SECONDS = {"test_paraview": 70, "test_observation_3d": 47, "test_hostile_
                   "test_hostile_requests": 16, "test_crash_consistency": 13,
                   "test_hostile_resources": 12, "test_results_displacement": 11,
                   "test_history": 10, "test_memory": 8, "test_3d": 8, "test_stream": 32,
-                  "test_web": 60, "test_fluid": 20, "test_estimate": 15}
+                  "test_web": 20, "test_fluid": 22, "test_estimate": 15, "test_ranks": 30,
+                  "test_fdem_run": 20}
 
 
 def module_of(test):
