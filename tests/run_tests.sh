@@ -31,7 +31,7 @@ done
 # asks for threads, and writes only under its own mkdtemp directory.
 unit_out=$(mktemp -d)
 jobs=${TEST_JOBS:-$(nproc 2>/dev/null || echo 1)}
-longest="test_fluid_kgd test_excavation test_fracture test_contact test_groups test_joint_slip"
+longest="test_fluid_kgd test_fluid_penny test_excavation test_fracture test_contact test_groups test_joint_slip"
 ordered=()
 for name in $longest; do [ -x "$BUILD/tests/$name" ] && ordered+=("$BUILD/tests/$name"); done
 for t in "$BUILD"/tests/test_*; do
