@@ -44,7 +44,8 @@
  * Measured 2026-12-06 (17 s of CPU; M = mu' (Q^3 E'^13 / (K'^18 t^2))^(1/5)
  * 0.022 to 0.016, toughness-dominated): at t = 2, 3, 4, 5 ms the radius
  * -1.9, -4.4, -1.7, -1.4 %; at 5 ms the opening at the well -9.6 %, the
- * pressure +1.6 %; growth exponent 0.412 (2/5) over 2-5 ms.
+ * pressure +1.6 %; growth exponent 0.412 (2/5) over 2-5 ms. Under the
+ * sanitizers the radius at 1 ms alone: -9.1 % (about 20 s of CPU).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -329,11 +330,17 @@ static void penny_toughness_dominated(void)
     fprintf(stderr, "  %d tetrahedra, %d joints; dt %.3g s\n", c.elements, c.joints,
             fdem_get_dt(m));
 #ifdef FDEM_SAN
+    /* under the sanitizers (40 s of CPU to 2 ms): the radius at 1 ms
+     * only (measured -9.1 %: R is 3 cells and the process zone a larger
+     * share of it); the later samples, the opening, the pressure and the
+     * growth exponent are checked by the normal build */
     enum { SAMPLES = 1 };
-    const double times[SAMPLES] = {0.002};
+    const double times[SAMPLES] = {0.001};
+    const int checks_well = 0;
 #else
     enum { SAMPLES = 4 };
     const double times[SAMPLES] = {0.002, 0.003, 0.004, 0.005};
+    const int checks_well = 1;
 #endif
     double *aperture = malloc(sizeof(double) * (size_t)c.joints);
     fdem_error err;
@@ -359,7 +366,7 @@ static void penny_toughness_dominated(void)
                 100 * (k.opening / w - 1), k.pressure, p, 100 * (k.pressure / p - 1),
                 f.flow_step, f.subcycles);
         CHECK_REL(k.radius, R, 0.20);
-        if (s == SAMPLES - 1) {
+        if (checks_well && s == SAMPLES - 1) {
             CHECK_REL(k.opening, w, 0.20);
             CHECK_REL(k.pressure, p, 0.20);
         }
