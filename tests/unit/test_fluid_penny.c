@@ -22,8 +22,9 @@
  * the joints on z = 0 are a weak joint set, the rest far stronger. The
  * joints' penalty is 2 E (the default 10 E) and aperture0 3e-5 m, both
  * softer than test_fluid_kgd's to lengthen the step 2.1 times (0.83 us):
- * the opening at the well is 3 aperture0 at the first sample, the intact
- * joints' compliance h / penalty a fortieth of an element's.
+ * the opening at the well is 3 aperture0 at the first sample, and an
+ * intact joint's compliance h / penalty is half an element's, in the one
+ * layer of joints on the plane.
  *
  * The closed form is LEFM's: it holds once the crack's cohesive process
  * zone is small against R. The zone is about the cohesive length
