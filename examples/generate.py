@@ -678,3 +678,20 @@ def hf_natural_joint(sigma_H, friction_angle, half=0.5, cells=20, joint_x=0.15, 
 
 
 dump("hf-natural-joint", hf_natural_joint(10e6, 30))
+# ------------------------------------------------- hydraulic fracture, 3D
+# Contract 6.4: the radial (penny-shaped) hydraulic fracture, the 3D
+# companion of kgd.json (tests/unit/test_fluid_penny.c measures the same
+# set-up with the joints off the plane made strong). A quarter of it by
+# symmetry (x, y >= 0: the planes x = 0 and y = 0 held normal to
+# themselves, so the quarter takes Q/4), meshed by penny_mesh.py: 0.05 m
+# cells out to 0.4 m across and 0.1 m from the plane z = 0, growing by 1.4
+# a cell to fixed faces 1.17 m across and 0.87 m above and below (14,196
+# tetrahedra). Fracture only in the tetrahedra with a face on z = 0; the
+# joints' penalty 2 E and aperture0 3e-5 m make the step 2.1 times the
+# default's; f_t = 4 MPa keeps the cohesive zone small against R.
+import sys  # noqa: E402
+sys.path.insert(0, OUT)
+import penny_mesh  # noqa: E402
+
+dump("penny", penny_mesh.quarter_case("penny", 0.05, 8, 5, 2, 5, 1.4, penny_mesh.ROCK,
+                                     penny_mesh.FLUID, penny_mesh.Q, 0.005, 0.00025))

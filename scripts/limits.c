@@ -16,6 +16,9 @@
  *   limits energy < CASE     the energy balance at every output time: the worst residual
  *                            against the work put in so far, the lowest friction and
  *                            fracture accounts, the largest kinetic energy against that work
+ *   limits hydraulic < CASE  a hydraulic fracture on y = 0 (3D: z = 0) fed at the origin,
+ *                            at every output time: the volume injected, how far the crack
+ *                            has run, the opening and the fluid pressure at the well
  *
  * Both dimensions: a 3D case (tetrahedra, joints on faces) is measured the
  * same way, with the load along y and the thickness along z.
@@ -478,13 +481,116 @@ static int run_energy(void)
     return 0;
 }
 
+/* ------------------------------------------------------------- hydraulic */
+
+/* What a hydraulic fracture on the plane y = 0 (3D: z = 0) fed at the
+ * origin has done by one output time. How far it runs: in 2D the
+ * farthest end of a broken (D = 1) and of a damaged (D > 0) joint on the
+ * line; in 3D the areas of the broken and of the damaged joints on the
+ * plane (the radius follows from the area, whatever the mesh's symmetry).
+ * At the well: the mean aperture and pressure of the plane's joints with
+ * a corner at the origin. Broken joints off the plane are counted: a
+ * crack that left it is not the one the closed form describes. */
+typedef struct hydraulic_sample {
+    double time, volume, broken, damaged, opening, pressure;
+    int broken_off_plane;
+} hydraulic_sample;
+
+/* Joint j's face A lies on the plane (height 0), and its extent there. */
+static int plane_joint(const fdem_model *m, int j, double *reach, double *area, int *at_origin)
+{
+    const int D = m->dim;
+    const int32_t *nd = m->joint_node + 2 * D * (size_t)j;
+    *reach = 0;
+    *at_origin = 0;
+    for (int i = 0; i < D; i++) {
+        const double *x = m->pos0 + D * (size_t)nd[i];
+        if (fabs(x[D - 1]) > 1e-9) return 0;
+        double r = D == 3 ? hypot(x[0], x[1]) : fabs(x[0]);
+        *reach = fmax(*reach, r);
+        *at_origin |= r < 1e-9;
+    }
+    if (D == 3) {
+        const double *a = m->pos0 + 3 * (size_t)nd[0], *b = m->pos0 + 3 * (size_t)nd[1],
+                     *c = m->pos0 + 3 * (size_t)nd[2];
+        *area = 0.5 * fabs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]));
+    } else {
+        *area = 0;
+    }
+    return 1;
+}
+
+static hydraulic_sample hydraulic_measure(const fdem_model *m, double *aperture)
+{
+    hydraulic_sample s = {0};
+    const double *pressure = fdem_fluid_pressure(m);
+    fdem_fluid_apertures(m, aperture);
+    int beside = 0;
+    for (int j = 0; j < m->joint_count; j++) {
+        double reach, area;
+        int origin;
+        const double damage = m->joint_damage[j];
+        if (!plane_joint(m, j, &reach, &area, &origin)) {
+            s.broken_off_plane += damage >= 1;
+            continue;
+        }
+        double extent = m->dim == 3 ? area : reach;
+        if (damage >= 1) s.broken = m->dim == 3 ? s.broken + extent : fmax(s.broken, extent);
+        if (damage > 0) s.damaged = m->dim == 3 ? s.damaged + extent : fmax(s.damaged, extent);
+        if (!origin) continue;
+        s.opening += aperture[j];
+        s.pressure += pressure[j];
+        beside++;
+    }
+    s.time = fdem_get_time(m);
+    s.volume = fdem_get_fluid(m).injected_volume;
+    if (beside) s.opening /= beside, s.pressure /= beside;
+    return s;
+}
+
+static int run_hydraulic(void)
+{
+    case_info info;
+    fdem_model *m = load_case(&info);
+    if (!m) return 1;
+    if (!m->fluid) {
+        fprintf(stderr, "limits: the case has no fluid\n");
+        return 1;
+    }
+    double *aperture = malloc(sizeof(double) * (size_t)(m->joint_count ? m->joint_count : 1));
+    double t0 = cpu_seconds(), next = info.output_interval;
+    printf("{\"case\": \"%s\", \"dimension\": %d, \"elements\": %d, \"joints\": %d, \"dt\": %.6g, "
+           "\"samples\": [", info.name, m->dim, m->elem_count, m->joint_count, fdem_get_dt(m));
+    int first = 1;
+    for (;;) {
+        double t = fdem_get_time(m);
+        if (t >= next || t >= info.end_time) {
+            hydraulic_sample s = hydraulic_measure(m, aperture);
+            printf("%s{\"time\": %.6g, \"volume\": %.8g, \"broken\": %.8g, \"damaged\": %.8g, "
+                   "\"opening\": %.8g, \"pressure\": %.8g, \"broken_off_plane\": %d, "
+                   "\"subcycles\": %d}", first ? "" : ", ", s.time, s.volume, s.broken,
+                   s.damaged, s.opening, s.pressure, s.broken_off_plane,
+                   fdem_get_fluid(m).subcycles);
+            first = 0;
+            while (next <= t) next += info.output_interval;
+        }
+        if (t >= info.end_time) break;
+        if (step_or_report(m)) return 1;
+    }
+    printf("], \"steps\": %lld, \"seconds\": %.3f}\n", (long long)m->step, cpu_seconds() - t0);
+    free(aperture);
+    fdem_model_destroy(m);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
-        fprintf(stderr, "usage: limits beam|brazilian|uniaxial|energy < CASE.json\n");
+        fprintf(stderr, "usage: limits beam|brazilian|uniaxial|energy|hydraulic < CASE.json\n");
         return 2;
     }
     if (strcmp(argv[1], "energy") == 0) return run_energy();
+    if (strcmp(argv[1], "hydraulic") == 0) return run_hydraulic();
     if (strcmp(argv[1], "beam") == 0) return run_beam();
     if (strcmp(argv[1], "brazilian") == 0 || strcmp(argv[1], "uniaxial") == 0)
         return run_fracture(argv[1]);

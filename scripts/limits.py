@@ -10,7 +10,9 @@ the 3D Brazilian disc, with the platen speed, G_I and the joint penalty).
 It builds each case document (beams with the built-in rectangle; the
 Brazilian disc and uniaxial specimen exactly as examples/*.json, with only
 the gmsh mesh size of examples/*.geo changed, or the mesh algorithm or the
-loading where a row's name says so), pipes it to the C driver
+loading where a row's name says so; the hydraulic fractures, `kgd` and
+`penny`, as examples/kgd.json and examples/penny.json at several cell
+sizes), pipes it to the C driver
 scripts/limits.c (case_build + the engine, the daemon's own path without
 HTTP), and prints markdown tables.
 """
@@ -321,6 +323,121 @@ def prism_3d_table(cells):
                  1e3 * r["peak_time"], r["seconds"]), flush=True)
 
 
+# --------------------------------------------------------- hydraulic fracture
+# The toughness-dominated hydraulic fractures of docs/physics.md "Fluid in
+# fractures" (Detournay 2016): the plane-strain KGD of examples/kgd.json in
+# the 6 m block of tests/unit/test_fluid_kgd.c, and the radial (penny)
+# crack of examples/penny.json, each at several cell sizes h with all else
+# fixed (the fracture region is the elements with an edge / a face on the
+# crack plane, so it thins with h). Closed forms on the injected volume
+# V: KGD l = (E'V/(2 sqrt(pi) K_Ic))^(2/3), p = K_Ic/sqrt(pi l), w(0) = 4pl/E';
+# penny R = (3E'V/(8 sqrt(pi) K_Ic))^(2/5), p = K_Ic sqrt(pi/(4R)),
+# w(0) = 8pR/(pi E'); K_Ic = sqrt(E' G_I). The crack's extent is the middle
+# of its process zone, between the broken and the damaged joints (2D: the
+# farthest ends on the line; 3D: the radii of their areas).
+HF_ROCK = {"density": 2500, "young": 1e10, "poisson": 0.2, "damping": 0.1,
+           "fracture": {"tensile_strength": 3e6, "cohesion": 6e6, "friction_angle": 30,
+                        "energy_I": 100, "energy_II": 1000, "aperture0": 1e-5}}
+HF_FLUID = {"viscosity": 1e-5, "bulk_modulus": 1e8, "density": 0}
+HF_Q = 8e-3
+PENNY_Q = 4.5e-3  # examples/penny_mesh.py's Q
+
+
+def hf_constants():
+    r = HF_ROCK  # examples/penny_mesh.py's ROCK differs in its penalty and aperture0 only
+    ep = r["young"] / (1 - r["poisson"] ** 2)
+    return ep, math.sqrt(ep * r["fracture"]["energy_I"])
+
+
+def kgd_case(cells, half=3.0, end=0.03, interval=0.006):
+    h = 2 * half / cells
+    e = 1e-3 * h
+    return {
+        "name": "kgd-%d" % cells, "dimension": 2,
+        "materials": {"rock": HF_ROCK}, "fluid": HF_FLUID,
+        "parts": [{"name": "rock", "material": "rock",
+                   "rectangle": {"origin": [-half, -half], "size": [2 * half, 2 * half],
+                                 "divisions": [cells, cells]},
+                   # the triangles with an edge on y = 0 (centroids h/3 off it): the
+                   # joints on the line and no other, so the source at the centre
+                   # feeds the crack only (tests/unit/test_fluid_penny.c)
+                   "fracture": {"box": [-half, -0.5 * h, half, 0.5 * h]}}],
+        "constraints": [{"box": [-half - e, -half - e, half + e, -half + e], "fix": ["x", "y"]},
+                        {"box": [-half - e, half - e, half + e, half + e], "fix": ["x", "y"]},
+                        {"box": [-half - e, -half - e, -half + e, half + e], "fix": ["x", "y"]},
+                        {"box": [half - e, -half - e, half + e, half + e], "fix": ["x", "y"]},
+                        {"box": [-1e-6, -1e-6, 1e-6, 1e-6], "inject": HF_Q}],
+        "time": {"end": end}, "output": {"interval": interval, "fields": ["position"]}}
+
+
+def penny_case(h, end=0.005, interval=0.001, reach=(1.1, 0.85)):
+    """examples/penny.json's quarter at cell size h: fine cells to 0.4 m
+    across and 0.1 m from the plane, then growing by 1.4 a cell to
+    reach[0] m across and reach[1] m from the plane or more (at h = 0.05 m
+    the example's mesh)."""
+    sys.path.insert(0, os.path.join(ROOT, "examples"))
+    import penny_mesh
+    fine, fine_z = round(0.4 / h), round(0.1 / h)
+
+    def graded(start, far):
+        n, x, size = 0, start, h
+        while x < far:
+            size *= 1.4
+            x += size
+            n += 1
+        return n
+    return penny_mesh.quarter_case("penny-%gmm" % (h * 1e3), h, fine, graded(fine * h, reach[0]), fine_z,
+                                   graded(fine_z * h, reach[1]), 1.4, penny_mesh.ROCK, penny_mesh.FLUID,
+                                   penny_mesh.Q, end, interval, fields=("position",))
+
+
+def slope(xs, ys):
+    xs, ys = np.log(xs), np.log(ys)
+    return float(np.polyfit(xs, ys, 1)[0])
+
+
+def hydraulic_table(kind, runs):
+    ep, kic = hf_constants()
+    penny = kind == "penny"
+    print("\n%s, toughness-dominated (mu 1e-5 Pa s, Q %g m%s/s%s): extent, opening at the well "
+          "and net pressure against the closed form on the injected volume at the last "
+          "output time; growth exponent of the extent on V (%s)"
+          % ("Radial (penny) fracture, a quarter by symmetry" if penny else "KGD, 6 m block",
+             PENNY_Q if penny else HF_Q, "³" if penny else "²", "" if penny else " per m", "2/5" if penny else "2/3"))
+    print("\n| mesh | elements | joints | t | %s (closed form) | error | opening at the well "
+          "| error | pressure | error | exponent | broken off the plane | steps | CPU time |"
+          % ("radius R" if penny else "half-length l"))
+    print("|---" * 14 + "|")
+    for label, doc in runs:
+        r = run("hydraulic", doc)
+        rows = []
+        for s in r["samples"]:
+            if s["volume"] <= 0:
+                continue
+            if penny:
+                V = 4 * s["volume"]
+                ext = 0.5 * (math.sqrt(4 * s["broken"] / math.pi) + math.sqrt(4 * s["damaged"] / math.pi))
+                L = (3 * ep * V / (8 * math.sqrt(math.pi) * kic)) ** 0.4
+                p = kic * math.sqrt(math.pi / (4 * L))
+                w = 8 * p * L / (math.pi * ep)
+            else:
+                V = s["volume"]
+                ext = 0.5 * (s["broken"] + s["damaged"])
+                L = (ep * V / (2 * math.sqrt(math.pi) * kic)) ** (2 / 3)
+                p = kic / math.sqrt(math.pi * L)
+                w = 4 * p * L / ep
+            rows.append((s, V, ext, L, w, p))
+        fit = [row for row in rows[1:] if row[2] > 0]  # after the start (the flaw's breakdown)
+        exponent = slope([row[1] for row in fit], [row[2] for row in fit]) if len(fit) > 1 else float("nan")
+        s, V, ext, L, w, p = rows[-1]
+        print("| %s | %d | %d | %.4g s | %.4g m (%.4g) | %+.1f %% | %.4g mm (%.4g) | %+.1f %% | "
+              "%.4g MPa (%.4g) | %+.1f %% | %.3f | %d | %d | %.0f s |"
+              % (label, r["elements"], r["joints"], s["time"], ext, L, 100 * (ext / L - 1),
+                 1e3 * s["opening"], 1e3 * w, 100 * (s["opening"] / w - 1), 1e-6 * s["pressure"],
+                 1e-6 * p, 100 * (s["pressure"] / p - 1), exponent, s["broken_off_plane"],
+                 r["steps"], r["seconds"]), flush=True)
+
+
 def run(kind, doc):
     out = subprocess.run([DRIVER, kind], input=json.dumps(doc), check=True, stdout=subprocess.PIPE,
                          text=True)
@@ -354,7 +471,14 @@ def main(groups):
                        [(h, delaunay) for h in (3e-3, 2.2e-3, 2e-3, 1.9e-3, 1.5e-3, 1e-3)] +
                        [(1.8e-3, frictionless), (1e-3, frictionless),
                         (2e-3, delaunay, frictionless)], 0.025)
+    if "kgd" in groups:
+        # three cell sizes in the 6 m block, then the 0.05 m cells in a 12 m
+        # block: the fixed edges' share of the error apart from the mesh's
+        hydraulic_table("kgd", [("%d (%g m)" % (n, 6.0 / n), kgd_case(n)) for n in (60, 120, 240)] +
+                        [("240 (0.05 m), 12 m block", kgd_case(240, half=6.0))])
+    if "penny" in groups:
+        hydraulic_table("penny", [("%g m" % h, penny_case(h)) for h in (0.05, 0.035, 0.025)])
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial", "brazilian3d", "prism3d"])
+    main(sys.argv[1:] or ["beam", "brazilian", "uniaxial", "brazilian3d", "prism3d", "kgd", "penny"])
