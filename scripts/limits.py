@@ -4,7 +4,8 @@ docs/physics.md: how far constant-strain triangles are from beam theory in
 bending, and how the fracture examples' peaks move with the mesh (and, for
 the 3D Brazilian disc, with the platen speed, G_I and the joint penalty).
 
-    make limits                                  # everything, ~25 min of CPU on one core
+    make limits                                  # everything, ~55 min of CPU on one core
+                                                 # (kgd ~7, penny ~20 of them)
     LIMITS=build/scripts/limits /usr/bin/python3 scripts/limits.py beam brazilian brazilian3d
 
 It builds each case document (beams with the built-in rectangle; the
