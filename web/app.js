@@ -83,7 +83,7 @@ function renderCases() {
       tr.dataset.id = s.id;
       tr.innerHTML = "<td><input type=checkbox title='compare'></td><td class=name></td><td class=id></td>" +
         "<td class=state></td><td class=progress><progress max=1></progress> <span></span></td>" +
-        "<td class=speed></td><td class=eta></td><td class=stage></td><td class=commands></td><td class=files></td>";
+        "<td class=speed></td><td class=cpu></td><td class=eta></td><td class=stage></td><td class=commands></td><td class=files></td>";
       tr.addEventListener("click", () => openCase(s.id));
       tr.querySelector("input").addEventListener("click", ev => { ev.stopPropagation(); if (compare) compare.refresh(); });
       const files = tr.querySelector(".files");
@@ -106,6 +106,7 @@ function fillRow(tr, s) {
   tr.querySelector("progress").value = s.progress || 0;
   tr.querySelector(".progress span").textContent = ((s.progress || 0) * 100).toFixed(1) + " %";
   tr.querySelector(".speed").textContent = s.steps_per_second ? Math.round(s.steps_per_second) : "";
+  tr.querySelector(".cpu").textContent = typeof s.cpu_share === "number" ? Math.round(s.cpu_share * 100) + " %" : "";
   tr.querySelector(".eta").textContent = formatSeconds(eta(s));
   tr.querySelector(".stage").textContent = s.stage ? `${s.stage.index} ${s.stage.name}` : "";
   tr.classList.toggle("selected", !!(view && view.id === s.id));

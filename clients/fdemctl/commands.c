@@ -224,8 +224,9 @@ int cmd_submit(const ctl_options *o, int argc, char **argv)
 static const char USAGE_LIST[] =
     "usage: fdemctl list [--state STATE]\n"
     "  One line per case, oldest first: id, name, state, progress, step, time,\n"
-    "  speed (steps per second: now while running, else the mean of the run)\n"
-    "  and ETA (wall time left from the recent speed; '-' unless running).\n"
+    "  CPU (the share of a core the case's stepping got of late; '-' unless\n"
+    "  running), speed (steps per second: now while running, else the mean of\n"
+    "  the run) and ETA (wall time left from the recent speed; '-' unless running).\n"
     "  --state S   only the cases in state S (created, queued, running, paused,\n"
     "              finished, stopped or failed)\n";
 
@@ -247,12 +248,15 @@ static void list_duration_text(json_t *value, char *out, size_t size)
 
 static void list_print_row(json_t *c, int id_width, int name_width)
 {
-    char eta[32];
+    char eta[32], cpu[16] = "-";
     list_duration_text(json_object_get(c, "eta"), eta, sizeof eta);
-    printf("%-*s  %-*s  %-9s %6.1f%%  %10lld  %-10.4g  %10.4g  %s\n", id_width,
+    json_t *share = json_object_get(c, "cpu_share");
+    if (json_is_number(share))
+        snprintf(cpu, sizeof cpu, "%.0f%%", 100.0 * json_number_value(share));
+    printf("%-*s  %-*s  %-9s %6.1f%%  %10lld  %-10.4g  %4s  %10.4g  %s\n", id_width,
            status_text(c, "id", "?"), name_width, status_text(c, "name", ""),
            status_text(c, "state", "?"), 100.0 * status_number(c, "progress"),
-           json_integer_value(json_object_get(c, "step")), status_number(c, "time"),
+           json_integer_value(json_object_get(c, "step")), status_number(c, "time"), cpu,
            status_number(c, "steps_per_second"), eta);
 }
 
@@ -295,8 +299,8 @@ int cmd_list(const ctl_options *o, int argc, char **argv)
         if (w > name_width) name_width = w;
     }
     if (name_width > 40) name_width = 40;
-    printf("%-*s  %-*s  %-9s %7s  %10s  %-10s  %10s  %s\n", id_width, "ID", name_width, "NAME",
-           "STATE", "PROGRESS", "STEP", "TIME [s]", "STEPS/S", "ETA");
+    printf("%-*s  %-*s  %-9s %7s  %10s  %-10s  %4s  %10s  %s\n", id_width, "ID", name_width,
+           "NAME", "STATE", "PROGRESS", "STEP", "TIME [s]", "CPU", "STEPS/S", "ETA");
     json_array_foreach(cases, i, c) list_print_row(c, id_width, name_width);
     json_decref(doc);
     return CTL_OK;

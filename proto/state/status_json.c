@@ -36,6 +36,7 @@ void status_figures_of_model(run_figures *f, const fdem_model *m, const case_inf
     f->snapshots = -1;
     f->elapsed = -1;
     f->eta = NAN;
+    f->cpu_share = NAN;
     status_figures_stage(f, m, info);
 }
 

@@ -45,6 +45,7 @@ typedef struct run_figures {
     int snapshots;
     double elapsed;            /* wall seconds spent stepping, all runs; < 0: keep */
     double eta;                /* wall seconds left at the recent speed; NAN: unknown */
+    double cpu_share;          /* CPU seconds of the stepping thread a wall second; NAN: unknown */
     int stage;                 /* the stage the case is in (contract 6.1), -1: no stages */
     char stage_name[CASE_STAGE_NAME];
     fdem_fluid_status fluid;   /* contract 6.4; enabled 0 without fluid */

@@ -71,6 +71,7 @@ server_case *case_new(void)
     c->resume_rows_until = -1;
     c->fig.stage = -1; /* no stages until a model or status.json says */
     c->fig.eta = NAN;
+    c->fig.cpu_share = NAN;
     c->estimated_seconds = NAN;
     return c;
 }

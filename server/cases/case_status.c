@@ -95,6 +95,8 @@ json_t *case_status_json(server_case *c)
     json_object_set_new(o, "elapsed", status_number_or_null(f.elapsed > 0 ? f.elapsed : 0.0));
     json_object_set_new(o, "estimated_seconds", status_number_or_null(estimated_seconds));
     json_object_set_new(o, "eta", status_number_or_null(state == CASE_RUNNING ? f.eta : NAN));
+    json_object_set_new(o, "cpu_share",
+                        status_number_or_null(state == CASE_RUNNING ? f.cpu_share : NAN));
     json_object_set_new(o, "warnings", case_warnings_json(c));
     return o;
 }

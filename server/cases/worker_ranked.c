@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "case_model.h"
+#include "files/persist.h"
 #include "io_thread.h"
 #include "launch.h"
 #include "registry_internal.h"
@@ -33,6 +34,11 @@ extern char **environ;
 
 #define RANKED_POLL_SECONDS 0.05   /* between looks at the ranks and their status */
 #define RANKED_LOG "ranks.log"
+/* The process group of the ranks last launched for this case, while they
+ * run: a daemon killed under them does not see them end (they checkpoint
+ * and exit on the pipe's end of file), so the next launch waits for them. */
+#define RANKED_PID "ranks.pid"
+#define RANKED_EARLIER_WAIT_SECONDS 30
 
 /* Exit statuses of bin/fdem-rank (runner/run_case.h: run_exit_status). */
 enum { RANKED_FINISHED = 0, RANKED_FAILED = 1, RANKED_BAD_CASE = 2, RANKED_PAUSED = 3,
@@ -179,6 +185,7 @@ static void ranked_follow_status(server_case *c, struct timespec *seen)
     const json_t *sps = json_object_get(o, "steps_per_second");
     f.steps_per_second = json_is_number(sps) ? json_number_value(sps) : 0.0;
     f.eta = NAN;
+    f.cpu_share = NAN;
     const char *error = json_string_value(json_object_get(o, "error"));
     if (error && error[0]) {
         pthread_mutex_lock(&c->lock);
@@ -273,6 +280,48 @@ static void ranked_sleep(double seconds)
     nanosleep(&ts, NULL);
 }
 
+static void ranked_pid_path(const server_case *c, char *out, size_t size)
+{
+    snprintf(out, size, "%s/%s", c->dir, RANKED_PID);
+}
+
+/* Ranks of an earlier daemon may still be writing their checkpoint and
+ * closing result.h5 after status.json said "paused" (the pipe's end of
+ * file reached them when that daemon died): new ranks started then would
+ * find the file locked. Wait (bounded) until their process group is gone;
+ * a group id reused by something else is only waited for, never
+ * signalled. */
+static void ranked_wait_for_earlier(server_case *c)
+{
+    char path[1200];
+    ranked_pid_path(c, path, sizeof path);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return;
+    long group = 0;
+    int read = fscanf(f, "%ld", &group);
+    fclose(f);
+    if (read != 1 || group <= 1)
+        return;
+    double waited = 0;
+    while (kill(-(pid_t)group, 0) == 0 && waited < RANKED_EARLIER_WAIT_SECONDS) {
+        ranked_sleep(RANKED_POLL_SECONDS);
+        waited += RANKED_POLL_SECONDS;
+    }
+    if (waited > 0)
+        case_log(c, "waited %.1f s for the ranks of an earlier run (process group %ld) to end%s",
+                 waited, group, kill(-(pid_t)group, 0) == 0 ? ": they still run" : "");
+}
+
+static void ranked_note_group(server_case *c, pid_t pid)
+{
+    char text[32];
+    int n = snprintf(text, sizeof text, "%ld\n", (long)pid);
+    if (persist_write_atomic(c->dir, RANKED_PID, text, (size_t)n) != 0)
+        case_log(c, "could not write %s/%s: a later launch will not wait for these ranks",
+                 c->dir, RANKED_PID);
+}
+
 case_state worker_ranked_run(server_case *c)
 {
     /* the start's checks are done: the ranks own the files from here */
@@ -281,11 +330,13 @@ case_state worker_ranked_run(server_case *c)
     c->error[0] = '\0';
     pthread_mutex_unlock(&c->lock);
     int control = -1;
+    ranked_wait_for_earlier(c);
     pid_t pid = ranked_spawn(c, &control);
     if (pid < 0) {
         case_log(c, "its ranks could not be started: %s", c->error);
         return CASE_FAILED;
     }
+    ranked_note_group(c, pid);
     atomic_store(&c->ranks_running, 1);
     case_log(c, "started on %d ranks (process group %d)", c->info.ranks, (int)pid);
     struct timespec seen = {0, 0};
@@ -306,6 +357,9 @@ case_state worker_ranked_run(server_case *c)
         ranked_sleep(RANKED_POLL_SECONDS);
     }
     close(control);
+    char pid_path[1200];
+    ranked_pid_path(c, pid_path, sizeof pid_path);
+    unlink(pid_path); /* they are gone: nothing for a later launch to wait for */
     atomic_store(&c->ranks_running, 0);
     seen.tv_sec = seen.tv_nsec = 0;
     ranked_follow_status(c, &seen);

@@ -1,6 +1,6 @@
 """test_estimate.py - run times a user can plan with (contract 6.2, issue 33
 item 5, issue 34 item 4): `estimated_seconds` against the measured run,
-`eta` while running, and shortened case ids in fdemctl and the Python client.
+`eta` and `cpu_share` while running, and shortened case ids in fdemctl and the Python client.
 
 Every bundled example is sized by a dry run and then run through the daemon,
 and the wall time it took (the status' `elapsed`) must be within a factor
@@ -145,16 +145,17 @@ class EstimateTest(DaemonTestCase):
         status = self.client.status(case_id)
         self.assertGreater(status["estimated_seconds"], 0)
         self.assertIsNone(status["eta"])
+        self.assertIsNone(status["cpu_share"])
         # a restart reads it back from status.json
         self.assertEqual(self.d.stop()[0], 0)
         self.d.start()
         again = Client(self.url()).status(case_id)
         self.assertEqual(again["estimated_seconds"], status["estimated_seconds"])
 
-    def test_eta_falls_while_running_and_is_null_after(self):
+    def test_eta_and_cpu_share_while_running_null_after(self):
         case = self.d.case_lasting(4.0 * SLOW, name="eta")
         case_id = self.client.submit(case, start=True)
-        etas = []
+        etas, shares = [], []
         deadline = time.monotonic() + 60 * SLOW
         while time.monotonic() < deadline:
             s = self.client.status(case_id)
@@ -162,6 +163,8 @@ class EstimateTest(DaemonTestCase):
                 break
             if s["eta"] is not None:
                 etas.append((time.monotonic(), s["eta"], s["progress"]))
+            if s["cpu_share"] is not None:
+                shares.append(s["cpu_share"])
             time.sleep(0.25)
         self.assertGreaterEqual(len(etas), 5, etas)
         self.assertTrue(all(e >= 0 for _, e, _ in etas), etas)
@@ -177,6 +180,11 @@ class EstimateTest(DaemonTestCase):
         final = self.client.wait(case_id, interval=0.1, timeout=60 * SLOW)
         self.assertEqual(final["state"], "finished")
         self.assertIsNone(final["eta"])
+        # the stepping thread's CPU a wall second: a share of one core
+        # (the clocks are read a few instructions apart: 1 % of slack)
+        self.assertGreater(len(shares), 0)
+        self.assertTrue(all(0 < x <= 1.01 for x in shares), shares)
+        self.assertIsNone(final["cpu_share"])
 
 
 class ShortIdTest(DaemonTestCase):
@@ -243,7 +251,7 @@ class ShortIdTest(DaemonTestCase):
         with self.assertRaises(ValueError):
             self.client.resolve_id("")
 
-    def test_fdemctl_list_shows_speed_and_eta(self):
+    def test_fdemctl_list_shows_cpu_speed_and_eta(self):
         case_id = self.client.submit(self.d.case_lasting(3.0 * SLOW, name="listed"), start=True)
         deadline = time.monotonic() + 30 * SLOW
         row = None
@@ -251,7 +259,7 @@ class ShortIdTest(DaemonTestCase):
             r = self.d.fdemctl("list")
             self.assertEqual(r.returncode, 0, r.stderr)
             header = r.stdout.splitlines()[0].split()
-            self.assertEqual(header[-2:], ["STEPS/S", "ETA"])
+            self.assertEqual(header[-3:], ["CPU", "STEPS/S", "ETA"])
             rows = [line.split() for line in r.stdout.splitlines()[1:]]
             row = next(x for x in rows if x[0] == case_id)
             if row[-1] != "-":
@@ -259,6 +267,7 @@ class ShortIdTest(DaemonTestCase):
             time.sleep(0.2)
         self.assertRegex(row[-1], r"^\d+s$|^\d+m\d\ds$")
         self.assertGreater(float(row[-2]), 0)
+        self.assertRegex(row[-3], r"^\d+%$")
         self.client.stop(case_id)
 
 

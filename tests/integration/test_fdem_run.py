@@ -340,7 +340,7 @@ class RankedCases(DaemonTestCase):
             d.wait(st["id"], lambda s: s["step"] > paused["step"], timeout=30,
                    what="the relaunched ranks step on")
             status, body = d.json("POST", "/cases/%s/pause" % st["id"])
-            self.assertEqual(status, 200, body)
+            self.assertEqual(status, 200, (body, d.status(st["id"]).get("error")))
             again = d.wait_state(st["id"], "paused")
             self.assertGreater(again["step"], paused["step"])
             self.assertEqual(again["error"], None)

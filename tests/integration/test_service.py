@@ -21,7 +21,7 @@ import fdemd_client  # noqa: E402
 
 # "warnings" (contract 6.2) is always there, empty for a plausible case
 SIZING_KEYS = {"nodes", "elements", "joints", "dt", "steps", "snapshots", "memory_bytes",
-               "result_bytes", "estimated_seconds", "estimate", "warnings"}
+               "result_bytes", "estimated_seconds", "estimate", "warnings", "ranks"}
 STATES = ("created", "queued", "running", "paused", "finished", "stopped", "failed")
 LONG = 1e3  # simulated seconds: never finishes within a test
 
