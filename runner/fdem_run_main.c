@@ -62,6 +62,9 @@ static int run_ranks(const run_options *o, const char *launcher, int control)
         fprintf(stderr, "fdem-run: %s\n", err);
         return 2;
     }
+    char *asan = launch_rank_asan_options();
+    if (asan)
+        putenv(asan); /* kept: the environment owns it until exec */
     execvp(argv[0], argv);
     fprintf(stderr, "fdem-run: cannot start the launcher \"%s\": %s; install it (Debian: "
             "openmpi-bin) or name another with --launcher or FDEM_LAUNCHER\n", argv[0],

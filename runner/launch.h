@@ -28,5 +28,12 @@ int launch_rank_binary(char *out, size_t size);
  * finds the web page); -1 when /proc/self/exe cannot be read or out is
  * too small. */
 int launch_beside_binary(const char *name, char *out, size_t size);
+/* "ASAN_OPTIONS=<the caller's>:detect_leaks=0" for the ranks (malloc'd),
+ * NULL when the caller has no ASAN_OPTIONS. A sanitizer build of
+ * bin/fdem-rank turns leak checks off in __asan_default_options, since
+ * OpenMPI keeps allocations past MPI_Finalize in modules it has unloaded,
+ * but an ASAN_OPTIONS in the environment (CI sets detect_leaks=1) wins
+ * over that and failed every ranked run at its exit (status 134). */
+char *launch_rank_asan_options(void);
 
 #endif

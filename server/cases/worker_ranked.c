@@ -54,16 +54,34 @@ static char **ranked_environment(void)
     size_t n = 0;
     while (environ[n])
         n++;
-    char **env = calloc(n + 3, sizeof *env);
+    char **env = calloc(n + 4, sizeof *env);
     if (!env)
         return NULL;
     size_t k = 0;
     for (size_t i = 0; i < n; i++)
-        if (strncmp(environ[i], "OMPI_ALLOW_RUN_AS_ROOT", 22) != 0)
+        if (strncmp(environ[i], "OMPI_ALLOW_RUN_AS_ROOT", 22) != 0 &&
+            strncmp(environ[i], "ASAN_OPTIONS=", 13) != 0)
             env[k++] = environ[i];
     env[k++] = (char *)added[0];
     env[k++] = (char *)added[1];
+    char *asan = launch_rank_asan_options(); /* freed with env (ranked_environment_free) */
+    if (asan)
+        env[k++] = asan;
     return env;
+}
+
+/* env of ranked_environment: only its last entry, the ASAN_OPTIONS it made,
+ * is its own. */
+static void ranked_environment_free(char **env)
+{
+    if (!env)
+        return;
+    size_t n = 0;
+    while (env[n])
+        n++;
+    if (n > 0 && strncmp(env[n - 1], "ASAN_OPTIONS=", 13) == 0)
+        free(env[n - 1]);
+    free(env);
 }
 
 static void ranked_set_error(server_case *c, const char *message)
@@ -160,7 +178,7 @@ static pid_t ranked_spawn(server_case *c, int *control)
     *control = pid < 0 ? -1 : fds[1];
     posix_spawn_file_actions_destroy(&fa);
     posix_spawnattr_destroy(&attr);
-    free(env);
+    ranked_environment_free(env);
     launch_argv_free(argv);
     return pid;
 }
