@@ -53,10 +53,11 @@ typedef struct worker_clock {
     double speed_since;
     int64_t steps_at_speed;
     double steps_per_second;
-    /* the stepping thread's CPU seconds at speed_since, and its CPU per
-     * wall second over the last window: what this case gets of a core
-     * while other cases share the machine */
-    double cpu_at_speed, cpu_share;
+    /* the stepping thread's CPU and wall seconds read together at the
+     * start of the share's window, and its CPU per wall second over the
+     * last window: what this case gets of a core while other cases share
+     * the machine */
+    double cpu_at_speed, wall_at_cpu, cpu_share;
     double run_started;     /* when this run began stepping */
     double elapsed_before;  /* wall seconds spent stepping in earlier runs */
     /* the eta's window: (wall, simulated time) once every
@@ -122,10 +123,15 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     if (wall > 0.2 || (wall > 0 && fig.step - clk->steps_at_speed > 100))
         clk->steps_per_second = (double)(fig.step - clk->steps_at_speed) / wall;
     if (wall > 0.2 || fig.step - clk->steps_at_speed > 100) {
-        double cpu = clock_cpu_seconds();
-        if (wall > 0)
-            clk->cpu_share = (cpu - clk->cpu_at_speed) / wall;
-        clk->cpu_at_speed = cpu;
+        /* read side by side: `now` came before the figures were taken, and
+         * their varying cost between two windows read against it gave
+         * shares of 1.09 */
+        double cpu = clock_cpu_seconds(), wall_now = clock_wall_seconds();
+        if (wall_now - clk->wall_at_cpu > 0.02) {
+            clk->cpu_share = (cpu - clk->cpu_at_speed) / (wall_now - clk->wall_at_cpu);
+            clk->cpu_at_speed = cpu;
+            clk->wall_at_cpu = wall_now;
+        }
         clk->speed_since = now;
         clk->steps_at_speed = fig.step;
     }
@@ -391,7 +397,8 @@ static void *worker_main(void *arg)
         pthread_mutex_unlock(&c->lock);
         worker_clock clk = {.last_publish = now, .last_checkpoint = now, .speed_since = now,
                             .steps_at_speed = fdem_get_step(c->model), .run_started = now,
-                            .cpu_at_speed = clock_cpu_seconds(), .cpu_share = NAN,
+                            .cpu_at_speed = clock_cpu_seconds(), .wall_at_cpu = now,
+                            .cpu_share = NAN,
                             .elapsed_before = elapsed_before};
         case_log(c, "started at step %lld (t = %.6g of %.6g s, dt = %.3g s)",
                  (long long)fdem_get_step(c->model), fdem_get_time(c->model), c->info.end_time,
