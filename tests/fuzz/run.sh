@@ -30,7 +30,7 @@ mkdir -p "$out" "$corpus" "$http_corpus" "$patch_corpus"
 # correctness and libFuzzer + libomp threads only slow the fuzzer down.
 cflags="-std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE -g -O1 -fno-omit-frame-pointer
         -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -Wno-unknown-pragmas"
-pkg=$(pkg-config --cflags --libs jansson hdf5)
+pkg=$(pkg-config --cflags --libs jansson hdf5 zlib)
 # every source of core/ and proto/, whatever folder it sits in
 engine=$(find core proto -name '*.c' | sort)
 # shellcheck disable=SC2086
