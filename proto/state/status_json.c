@@ -122,15 +122,25 @@ void status_stage_from_json(run_figures *f, const json_t *stage)
 
 /* "fluid" (contract 6.4): null without fluid; the flow's step and subcycle
  * count beside the contract's three (docs/api.md). */
+/* The fluid's figures that are numbers, written and read back by the same
+ * table (as the energy accounts are). */
+static const struct { const char *key; size_t offset; } fluid_figures[] = {
+    {"injected_volume", offsetof(fdem_fluid_status, injected_volume)},
+    {"stored_volume", offsetof(fdem_fluid_status, stored_volume)},
+    {"source_pressure", offsetof(fdem_fluid_status, source_pressure)},
+    {"fluid_step", offsetof(fdem_fluid_status, flow_step)},
+};
+#define FLUID_FIGURE_COUNT (sizeof fluid_figures / sizeof fluid_figures[0])
+
 static json_t *status_fluid_json(const fdem_fluid_status *f)
 {
     if (!f->enabled) return json_null();
     json_t *o = json_object();
     if (!o) return NULL;
-    json_object_set_new(o, "injected_volume", status_number_or_null(f->injected_volume));
-    json_object_set_new(o, "stored_volume", status_number_or_null(f->stored_volume));
-    json_object_set_new(o, "source_pressure", status_number_or_null(f->source_pressure));
-    json_object_set_new(o, "fluid_step", status_number_or_null(f->flow_step));
+    for (size_t i = 0; i < FLUID_FIGURE_COUNT; i++)
+        json_object_set_new(o, fluid_figures[i].key,
+                            status_number_or_null(*(const double *)((const char *)f +
+                                                                    fluid_figures[i].offset)));
     json_object_set_new(o, "fluid_subcycles", json_integer(f->subcycles));
     json_object_set_new(o, "open_joints", json_integer(f->open_joints));
     return o;
@@ -142,16 +152,10 @@ static void status_fluid_from_json(run_figures *f, const json_t *fluid, const js
 {
     memset(&f->fluid, 0, sizeof f->fluid);
     if (!json_is_object(fluid)) return;
-    static const struct { const char *key; size_t offset; } figures[] = {
-        {"injected_volume", offsetof(fdem_fluid_status, injected_volume)},
-        {"stored_volume", offsetof(fdem_fluid_status, stored_volume)},
-        {"source_pressure", offsetof(fdem_fluid_status, source_pressure)},
-        {"fluid_step", offsetof(fdem_fluid_status, flow_step)},
-    };
     f->fluid.enabled = 1;
-    for (size_t i = 0; i < sizeof figures / sizeof figures[0]; i++) {
-        const json_t *v = json_object_get(fluid, figures[i].key);
-        *(double *)((char *)&f->fluid + figures[i].offset) =
+    for (size_t i = 0; i < FLUID_FIGURE_COUNT; i++) {
+        const json_t *v = json_object_get(fluid, fluid_figures[i].key);
+        *(double *)((char *)&f->fluid + fluid_figures[i].offset) =
             json_is_number(v) ? json_number_value(v) : NAN;
     }
     f->fluid.subcycles = (int)json_integer_value(json_object_get(fluid, "fluid_subcycles"));
