@@ -28,7 +28,7 @@
 #include "case/case.h"
 #include "model/model.h"
 #include "pair_kinds.h"
-#include "clock.h"
+#include "math/clock.h"
 
 static char *read_file(const char *path, size_t *length)
 {
@@ -106,7 +106,7 @@ static int run_case(const char *path, int window, int threads, long max_steps)
     while (fdem_get_time(m) < info.end_time && total_steps < max_steps) {
         fdem_stage_times before = fdem_get_stage_times(m);
         long det0 = m->contact.detections;
-        double c0 = bench_cpu_seconds(), w0 = bench_wall_seconds();
+        double c0 = clock_cpu_seconds(), w0 = clock_wall_seconds();
         int steps = 0;
         fdem_error err;
         for (; steps < window && fdem_get_time(m) < info.end_time &&
@@ -117,9 +117,9 @@ static int run_case(const char *path, int window, int threads, long max_steps)
                 fdem_model_destroy(m);
                 return -1;
             }
-        double cpu = bench_cpu_seconds() - c0;
+        double cpu = clock_cpu_seconds() - c0;
         total_cpu += cpu;
-        total_wall += bench_wall_seconds() - w0;
+        total_wall += clock_wall_seconds() - w0;
         total_steps += steps;
         fdem_stage_times t = fdem_get_stage_times(m);
         double fe = t.elements - before.elements, jo = t.joints - before.joints;

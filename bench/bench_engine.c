@@ -48,7 +48,7 @@
 #include "pair_kinds.h"
 #include "stream.h"
 #include "fluid/fluid.h"
-#include "clock.h"
+#include "math/clock.h"
 
 /* The elastic block in either dimension: one builder and one bytes count,
  * so the 2D and 3D figures are measured the same way and printed alike. */
@@ -141,9 +141,9 @@ static void window_rewind(fdem_model *m, const window_start *w)
 static step_time timed_steps(fdem_model *m, int steps)
 {
     fdem_error err;
-    double t0 = bench_wall_seconds(), c0 = bench_cpu_seconds();
+    double t0 = clock_wall_seconds(), c0 = clock_cpu_seconds();
     for (int s = 0; s < steps; s++) fdem_step(m, &err);
-    return (step_time){bench_wall_seconds() - t0, bench_cpu_seconds() - c0};
+    return (step_time){clock_wall_seconds() - t0, clock_cpu_seconds() - c0};
 }
 
 /* The best of three runs of the same `steps` steps from m's state; m is
@@ -199,9 +199,9 @@ static void bench_disc_pile(void)
         fdem_stage_times before = fdem_get_stage_times(m);
         int steps = (int)(2e7 / m->elem_count);
         if (steps < 100) steps = 100;
-        double t0 = bench_wall_seconds();
+        double t0 = clock_wall_seconds();
         for (int s = 0; s < steps; s++) fdem_step(m, &err);
-        double total = bench_wall_seconds() - t0;
+        double total = clock_wall_seconds() - t0;
         fdem_stage_times after = fdem_get_stage_times(m);
         double fe = after.elements + after.joints - before.elements - before.joints;
         double de = after.detection - before.detection;
@@ -218,13 +218,13 @@ static void bench_disc_pile(void)
         nbs_pairs brute;
         nbs_pairs_init(&brute);
         int reps = 20;
-        double tn = bench_wall_seconds();
+        double tn = clock_wall_seconds();
         for (int s = 0; s < reps; s++)
             nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &cs->pairs);
-        tn = (bench_wall_seconds() - tn) / reps;
-        double tb = bench_wall_seconds();
+        tn = (clock_wall_seconds() - tn) / reps;
+        double tb = clock_wall_seconds();
         nbs_detect_brute((size_t)m->elem_count, cs->cx, cs->cy, cs->r, cs->body, &brute);
-        tb = bench_wall_seconds() - tb;
+        tb = clock_wall_seconds() - tb;
         printf("         detection on these circles: NBS %.1f ns/element, all-pairs %.1f ns/element "
                "(%.0fx), same pairs: %s\n",
                tn * 1e9 / m->elem_count, tb * 1e9 / m->elem_count, tb / tn,

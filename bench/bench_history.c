@@ -20,7 +20,7 @@
 #include "case/case.h"
 #include "result/result.h"
 #include "state/history.h"
-#include "clock.h"
+#include "math/clock.h"
 
 #define BATCH 64 /* WORKER_HISTORY_BATCH */
 
@@ -70,19 +70,19 @@ static void bench(const char *title, const char *layout, int dim)
     problems_free(&p);
     fdem_error err;
     int steps = 200, rows = 4096;
-    double t0 = bench_wall_seconds();
+    double t0 = clock_wall_seconds();
     for (int s = 0; s < steps; s++) fdem_step(m, &err);
-    double step_ns = (bench_wall_seconds() - t0) / steps * 1e9;
+    double step_ns = (clock_wall_seconds() - t0) / steps * 1e9;
 
     history_row **batch = calloc(rows, sizeof *batch);
-    t0 = bench_wall_seconds();
+    t0 = clock_wall_seconds();
     for (int r = 0; r < rows; r++) batch[r] = history_take(m, info.history_nodes, 8);
-    double take_ns = (bench_wall_seconds() - t0) / rows * 1e9;
+    double take_ns = (clock_wall_seconds() - t0) / rows * 1e9;
     /* the part of a row that is the engine's energy accounts (O(nodes)) */
     double sink = 0;
-    t0 = bench_wall_seconds();
+    t0 = clock_wall_seconds();
     for (int r = 0; r < rows; r++) sink += fdem_get_energy(m).kinetic;
-    double energy_ns = (bench_wall_seconds() - t0) / rows * 1e9 + 0 * sink;
+    double energy_ns = (clock_wall_seconds() - t0) / rows * 1e9 + 0 * sink;
 
     char path[] = "/tmp/bench_history_XXXXXX";
     int fd = mkstemp(path);
@@ -92,10 +92,10 @@ static void bench(const char *title, const char *layout, int dim)
     double write_ns = NAN;
     if (f) {
         for (int r = 0; r < rows; r++) batch[r]->time = r + 1.0; /* strictly growing */
-        t0 = bench_wall_seconds();
+        t0 = clock_wall_seconds();
         for (int r = 0; r < rows; r += BATCH)
             if (result_append_history(f, batch + r, BATCH, e, sizeof e) != 0) break;
-        write_ns = (bench_wall_seconds() - t0) / rows * 1e9;
+        write_ns = (clock_wall_seconds() - t0) / rows * 1e9;
         result_close(f);
     } else {
         fprintf(stderr, "bench_history: %s\n", e);

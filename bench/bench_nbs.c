@@ -25,7 +25,7 @@
 #include "nbs/nbs.h"
 #include "nbs/nbs_internal.h" /* the sphere test NBS uses, for the baseline */
 #include "stream.h"
-#include "clock.h"
+#include "math/clock.h"
 
 #define GRID_MAX_CELLS ((int64_t)1 << 26) /* 256 MB of int32 counts */
 #define BRUTE_MAX_N 10000
@@ -369,17 +369,17 @@ static double time_method(runner *u, method m, size_t *pairs)
 {
     if (run_once(u, m) != 0) return -1; /* warm-up: reach the high-water mark */
     *pairs = u->pairs.count;
-    double t0 = bench_cpu_seconds();
+    double t0 = clock_cpu_seconds();
     run_once(u, m);
-    double once = bench_cpu_seconds() - t0;
+    double once = clock_cpu_seconds() - t0;
     int reps = once > 0 ? (int)(TARGET_SECONDS / once) : 1000;
     if (reps < 1) reps = 1;
     int batches = m == M_BRUTE || m == M_BRUTE3 ? 1 : BATCHES;
     double best = 1e30;
     for (int b = 0; b < batches; b++) {
-        t0 = bench_cpu_seconds();
+        t0 = clock_cpu_seconds();
         for (int k = 0; k < reps; k++) run_once(u, m);
-        double t = (bench_cpu_seconds() - t0) / reps;
+        double t = (clock_cpu_seconds() - t0) / reps;
         if (t < best) best = t;
     }
     return best * 1e9 / (double)u->c->n;

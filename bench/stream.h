@@ -17,7 +17,7 @@
 #include <stdlib.h>
 #include <time.h>
 
-#include "clock.h"
+#include "math/clock.h"
 
 #define STREAM_LENGTH ((size_t)4 << 20) /* doubles per array: 32 MB */
 #define STREAM_REPEATS 8
@@ -38,12 +38,12 @@ static inline double stream_run(int kernel)
     }
     double best = 1e30, scalar = 3.0;
     for (int rep = 0; rep < STREAM_REPEATS; rep++) {
-        double t0 = bench_wall_seconds();
+        double t0 = clock_wall_seconds();
         if (kernel == 0)
             for (size_t i = 0; i < n; i++) a[i] = b[i];
         else
             for (size_t i = 0; i < n; i++) a[i] = b[i] + scalar * c[i];
-        double t = bench_wall_seconds() - t0;
+        double t = clock_wall_seconds() - t0;
         if (t < best) best = t;
         /* keep the result observable so the loop is not optimised away */
         scalar += a[(size_t)rep * 977 % n] * 1e-300;

@@ -25,6 +25,7 @@
 #include <unistd.h>
 
 #include "case/case.h"
+#include "math/clock.h"
 #include "files/checkpoint_file.h"
 #include "files/persist.h"
 #include "result/result.h"
@@ -74,13 +75,6 @@ typedef struct run_ctx {
     int control_len;
     char error[768];
 } run_ctx;
-
-static double run_wall(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 static void run_fail(run_ctx *r, const char *what)
 {
@@ -350,7 +344,7 @@ static run_outcome run_loop(run_ctx *r)
 {
     const double end = r->info.end_time;
     for (;;) {
-        double now = run_wall();
+        double now = clock_wall_seconds();
         int cmd = run_poll(r, now);
         if (r->o->pause_at_step > 0 && fdem_get_step(r->m) >= r->o->pause_at_step)
             cmd = CMD_PAUSE; /* the same step on every rank */
@@ -384,7 +378,7 @@ static run_outcome run_loop(run_ctx *r)
             return RUN_FAILED;
         if (row)
             run_take_history_row(r);
-        now = run_wall();
+        now = clock_wall_seconds();
         if (snap) {
             r->last_snapshot_step = fdem_get_step(r->m);
             if (run_any_failed(r, run_write_outputs(r, 1, done ? "finished" : "running",
@@ -409,7 +403,7 @@ static void run_wind_down(run_ctx *r, run_outcome why)
     int stopping = why == RUN_STOPPED, pausing = why == RUN_PAUSED;
     if ((stopping || pausing) && run_gather(r) != 0)
         why = RUN_FAILED;
-    double now = run_wall();
+    double now = clock_wall_seconds();
     if (r->writer && r->result) {
         if (stopping && step != r->last_snapshot_step) {
             r->last_snapshot_step = step;
@@ -555,7 +549,7 @@ static int run_start(run_ctx *r, run_outcome *failed)
         return -1;
     }
     fdem_set_threads(r->m, o->threads > 0 ? o->threads : 1);
-    double now = run_wall();
+    double now = clock_wall_seconds();
     r->run_started = r->last_status = r->last_progress = now;
     int rc = 0;
     if (r->writer) {
@@ -617,7 +611,7 @@ run_outcome run_case(const run_options *o, runner_stepper *stepper)
         why = r.error[0] && why != RUN_BAD_CASE ? RUN_FAILED : why;
         fdem_model_destroy(r.m);
     } else {
-        run_write_status(&r, run_outcome_state(why), run_wall());
+        run_write_status(&r, run_outcome_state(why), clock_wall_seconds());
     }
     if (r.error[0] && r.writer)
         fprintf(stderr, "fdem-run: %s: %s\n", run_outcome_state(why), r.error);

@@ -9,9 +9,9 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
 
 #include "model.h"
+#include "math/clock.h"
 
 void model_error(fdem_error *err, fdem_item_kind kind, int item, const char *fmt, ...)
 {
@@ -36,12 +36,7 @@ int model_reserve(void **array, size_t *capacity, size_t need, size_t size, size
     return 0;
 }
 
-double stage_clock(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+double stage_clock(void) { return clock_wall_seconds(); }
 
 /* ------------------------------------------------------------ accessors */
 

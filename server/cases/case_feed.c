@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include "common/clock.h"
+#include "math/clock.h"
 
 typedef struct feed_event {
     uint64_t id;

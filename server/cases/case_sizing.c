@@ -20,7 +20,7 @@
 #include "sizing_probe.h"
 #include "state/snapshot.h"
 #include "files/checkpoint_file.h"
-#include "common/clock.h"
+#include "math/clock.h"
 
 
 double sizing_steps_to_end(double t0, double end, double dt)

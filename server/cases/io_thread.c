@@ -23,7 +23,7 @@
 #include "case_feed.h"
 #include "case_model.h"
 #include "files/persist.h"
-#include "common/clock.h"
+#include "math/clock.h"
 #include "common/memory_budget.h"
 
 typedef enum io_job_kind {

@@ -34,7 +34,7 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
-#include "common/clock.h"
+#include "math/clock.h"
 
 /* Untimed warm-up: at least this many steps and this long. */
 #define PROBE_WARM_STEPS 2

@@ -26,7 +26,7 @@
 #include "registry_internal.h"
 #include "worker_history.h"
 #include "worker_ranked.h"
-#include "common/clock.h"
+#include "math/clock.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */

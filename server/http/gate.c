@@ -63,7 +63,7 @@
 #include <unistd.h>
 
 #include "http_frame.h"
-#include "common/clock.h"
+#include "math/clock.h"
 
 #define GATE_HEAD_MAX (32 * 1024) /* larger header blocks get 431 */
 #define GATE_MAX_SLOTS 65536      /* descriptors the gate can track */

@@ -41,7 +41,7 @@
 #include "cases/case_feed.h"
 #include "gate.h"
 #include "http.h"
-#include "common/clock.h"
+#include "math/clock.h"
 
 #define STREAM_READ_BYTES (16 * 1024) /* feed text taken at a time */
 #define STREAM_HANGUP_CHECK 1.0       /* s between looks for clients gone */
