@@ -464,6 +464,8 @@ void fdem_fluid_sources(const fdem_model *model, double *pressure, double *injec
  * would, with no fracture event and no energy booked. Returns how many
  * broke, or -1 out of memory. */
 int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
+/* How many joints fdem_break_joints_across would break, breaking none. */
+int fdem_joints_across(const fdem_model *model, const double *normal, double offset);
 
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);

@@ -84,18 +84,31 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
     return mesh + snapshots * row;
 }
 
-/* Broken joints cost a run through the contact their faces make (the
- * faces of a crack, and in 3D every pair of tetrahedra around its
- * vertices): a step costs about intact + (broken joints) x (the cost of one),
- * measured on the model with a crack cut through it
- * (sizing_cracked_step_seconds). How many break, and when, is not known
- * before the run; the bundled examples break 0 to 16 % of their joints by
- * the end, late in some runs and early in others, and 0 to 5 % on average
- * over their steps: tunnel-region 1.6 % (none until 80 % of the run, then
- * 1000; each step then 55x an intact one), staged-tunnel 5 %, drift-3d
- * 2 %, the arc-loaded 3D disc 2 % (27x a step after its split), the 3D
- * disc 2 %, the 3D prism none (it only softens). The estimate takes this
- * share of the joints as broken through the whole run. */
+/* Broken joints cost a run twice (issue 34's figures). Through contact:
+ * the faces of a crack, and in 3D every pair of tetrahedra around its
+ * vertices, are pairs from then on, so a step costs about intact +
+ * (broken joints) x (the cost of one), measured on the model with a crack
+ * cut through it (sizing_cracked_step_seconds). And through detection:
+ * every step in which a joint breaks reruns the whole contact detection
+ * (core/step/integrator.c), which after the split of a 2D tunnel wall was
+ * 82 % of its CPU (1,100 joints broke, one detection each, at 8 ms a
+ * detection of 4,678 triangles against 38 ns an element-step intact): so
+ * each joint that breaks is priced one step with a break in it, timed
+ * on the crack as it is cut.
+ *
+ * How many break: when the model's own steps up to the last look (below)
+ * broke some, as many again at that rate through the rest of the run
+ * (a crack driven by injected fluid grows from the first steps: the
+ * penny breaks its first joint at step 68 of 4,336). Otherwise a share
+ * of the joints, not known before the run: the bundled examples break 0
+ * to 5 % of their joints on average over their steps and 0 to 23 % by
+ * the end, late in some runs and early in others: tunnel-region 1.6 %
+ * on average (none until 80 % of the run, then 1,100 of 4,834),
+ * staged-tunnel 5 %, drift-3d 2 %, the arc-loaded 3D disc 2 % (27x a step
+ * after its split), the 3D disc 2 %, the 3D prism none (it only softens).
+ * The estimate takes this share of the joints as broken through the
+ * whole run, and twice it (a count growing from none) as broken by the
+ * end. */
 #define SIZING_BROKEN_SHARE 0.02
 
 /* Later looks: the model is stepped on, untimed, to SIZING_LOOKS evenly
@@ -127,20 +140,52 @@ static void sizing_joint_centre(const fdem_model *model, double centre[3])
     for (int d = 0; d < dim; d++) centre[d] /= J;
 }
 
-/* Wall seconds per step once the rock has broken: the model is cut by
- * a crack through the middle of its joints, along the plane x = centre
- * (a vertical crack: through a disc or a specimen loaded along y or z,
- * through the crown and invert of a tunnel), and timed again. NAN when
- * no joint crosses it or a step fails. */
-static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
-                                          sizing_load *load)
+/* The plane of the probe's crack: through the joints' centre, normal to
+ * the axis whose plane crosses the most joints (a disc's or a tunnel's
+ * joints fill a region, which any axis cuts; a fluid-driven crack's lie
+ * on its plane, which only the axis normal to it crosses). Returns how
+ * many joints it crosses. */
+static int sizing_crack_plane(const fdem_model *model, double normal[3], double *offset)
 {
-    double centre[3], normal[3] = {1, 0, 0};
+    double centre[3];
     sizing_joint_centre(model, centre);
-    *broke = fdem_break_joints_across(model, normal, centre[0]);
+    int dim = fdem_get_dimension(model), most = 0;
+    for (int d = 0; d < dim; d++) {
+        double axis[3] = {0, 0, 0};
+        axis[d] = 1;
+        int crossed = fdem_joints_across(model, axis, centre[d]);
+        if (crossed > most) {
+            most = crossed;
+            memcpy(normal, axis, sizeof axis);
+            *offset = centre[d];
+        }
+    }
+    return most;
+}
+
+/* CPU seconds a step once the rock has broken: the model is cut by a
+ * crack through the middle of its joints (sizing_crack_plane) and timed
+ * again. The step that follows the cut is timed alone first: the one
+ * in which joints broke, which reruns the detection (*break_step).
+ * NAN when no joint crosses it or a step fails. */
+static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
+                                          double *break_step, sizing_load *load)
+{
+    double normal[3] = {1, 0, 0}, offset = 0;
+    *break_step = NAN;
+    *broke = 0;
+    if (sizing_crack_plane(model, normal, &offset) <= 0 || steps_left < 2)
+        return NAN;
+    *broke = fdem_break_joints_across(model, normal, offset);
     if (*broke <= 0) return NAN;
+    fdem_error err;
+    memset(&err, 0, sizeof err);
+    double cpu0 = clock_cpu_seconds();
+    if (fdem_step(model, &err) != 0)
+        return NAN;
+    *break_step = clock_cpu_seconds() - cpu0;
     int taken = 0;
-    return sizing_probe_step_seconds(model, steps_left, &taken, load);
+    return sizing_probe_step_seconds(model, steps_left - 1, &taken, load);
 }
 
 /* The pace of the run after the first probe (later_step_seconds, the
@@ -201,6 +246,24 @@ static double sizing_snapshot_copy_seconds(const fdem_model *model, const case_i
     return best;
 }
 
+/* How many joints the run breaks (out->breaks, each priced one step with
+ * a break) and how many it holds broken on average over its steps
+ * (out->broken_joints, each priced its contact every step), from the
+ * `seen` that its first `taken` steps broke or, when none did, from
+ * SIZING_BROKEN_SHARE. */
+static void sizing_price_breaks(case_sizing *out, int joints, int seen, int taken)
+{
+    double by_end;
+    if (seen > 0 && taken > 0)
+        by_end = seen * (out->steps / taken);
+    else
+        by_end = 2 * SIZING_BROKEN_SHARE * joints;
+    if (by_end > joints) by_end = joints;
+    if (by_end > out->steps) by_end = out->steps;
+    out->breaks = by_end;
+    out->broken_joints = 0.5 * by_end;
+}
+
 void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
                          int threads, double snapshot_seconds, case_sizing *out)
 {
@@ -224,15 +287,22 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     sizing_load load = {0, 0};
     out->step_seconds = sizing_probe_step_seconds(model, out->steps, &taken, &load);
     double per_step = sizing_later_step_seconds(model, out, &taken, &load);
-    out->cracked_step_seconds = NAN;
+    /* joints the run's own steps broke so far (before the probe's crack) */
+    int seen = fdem_get_counts(model).broken_joints;
+    out->broken_seen = seen;
+    double breaking = 0; /* CPU seconds of the steps in which joints break */
+    out->cracked_step_seconds = out->break_step_seconds = NAN;
     if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
         out->cracked_step_seconds = sizing_cracked_step_seconds(
-            model, out->steps - taken, &out->cracked_joints, &load);
+            model, out->steps - taken, &out->cracked_joints, &out->break_step_seconds, &load);
         if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {
+            sizing_price_breaks(out, c.joints, seen, taken);
             double each = (out->cracked_step_seconds - per_step) / out->cracked_joints;
-            out->broken_joints = SIZING_BROKEN_SHARE * c.joints;
             if (each > 0)
                 per_step += out->broken_joints * each;
+            double extra = out->break_step_seconds - out->cracked_step_seconds;
+            if (extra > 0)
+                breaking = out->breaks * extra;
         }
     }
     /* CPU seconds so far; the machine's present load turns them into wall
@@ -243,7 +313,8 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->steps_per_second = per_step > 0 ? 1.0 / per_step : 0.0;
     /* Snapshots are written on the I/O thread while the worker steps on:
      * the slower of the two sets the pace; the worker's copies add. */
-    double stepping = per_step > 0 ? out->steps * per_step + out->snapshots * copy : NAN;
+    breaking *= out->load_factor;
+    double stepping = per_step > 0 ? out->steps * per_step + breaking + out->snapshots * copy : NAN;
     double writing = out->snapshots * snapshot_seconds;
     out->estimated_seconds = writing > stepping ? writing : stepping;
 }
@@ -303,6 +374,9 @@ json_t *case_sizing_json(const case_sizing *s)
     json_object_set_new(parts, "cracked_step_seconds", status_number_or_null(s->cracked_step_seconds));
     json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
     json_object_set_new(parts, "broken_joints", status_number_or_null(s->broken_joints));
+    json_object_set_new(parts, "broken_seen", json_integer(s->broken_seen));
+    json_object_set_new(parts, "breaks", status_number_or_null(s->breaks));
+    json_object_set_new(parts, "break_step_seconds", status_number_or_null(s->break_step_seconds));
     json_object_set_new(parts, "snapshot_seconds", status_number_or_null(s->snapshot_copy_seconds));
     json_object_set_new(o, "estimate", parts);
     char warning[400];

@@ -50,6 +50,9 @@ typedef struct case_sizing {
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
     int cracked_joints;       /* joints the crack broke */
     double broken_joints;     /* joints priced as broken through the run */
+    int broken_seen;          /* joints the probe's own steps broke (before its crack) */
+    double breaks;            /* joints priced as breaking during the run */
+    double break_step_seconds; /* CPU seconds of the step right after the crack (NAN: none) */
     double snapshot_copy_seconds; /* the worker's share of one snapshot */
     double estimated_seconds;
     int fluid;                /* the case has fluid (contract 6.4): then fluid_step and */
