@@ -140,6 +140,45 @@ class EstimateTest(DaemonTestCase):
             self.client.delete(case_id)
         self.assertEqual(bad, [])
 
+    def fracturing_band(self, name, velocity):
+        """tiny_case() with joints only in a band two cells high around
+        y = 0.05 (a fluid-driven crack's region): 48 joints, 10 of them on
+        the line y = 0.05, 2 on the vertical x = 0.05 (kgd's layout)."""
+        case = tiny_case(name, end=0.004)
+        case["materials"]["rock"]["fracture"] = {
+            "tensile_strength": 2e6, "cohesion": 6e6, "friction_angle": 30,
+            "energy_I": 50, "energy_II": 250}
+        case["parts"][0]["fracture"] = {"box": [-1, 0.04, 1, 0.06]}
+        case["parts"][0]["velocity"] = velocity
+        return case
+
+    def test_dry_run_prices_breaks_on_the_joints_plane_and_repeats(self):
+        # at rest: nothing breaks in the probe's own steps, so the share
+        # (docs/api.md, Dry run): 2 % of the joints held broken on
+        # average, twice that breaking, each with its detection
+        first = self.client.dry_run(self.fracturing_band("band", [0, 0]))
+        second = self.client.dry_run(self.fracturing_band("band", [0, 0]))
+        self.assertEqual(first["joints"], 48)
+        for r in (first, second):
+            e = r["estimate"]
+            # the crack runs along the band (y), not across it (x: 2)
+            self.assertEqual(e["cracked_joints"], 10, e)
+            self.assertEqual(e["broken_seen"], 0, e)
+            self.assertAlmostEqual(e["broken_joints"], 0.02 * 48, places=9)
+            self.assertAlmostEqual(e["breaks"], 2 * 0.02 * 48, places=9)
+            self.assertGreater(e["break_step_seconds"], 0, e)
+        # a repeated dry run gives the same figure within the stated band
+        pair = (first["estimated_seconds"], second["estimated_seconds"])
+        self.assertLessEqual(max(pair) / min(pair), 1.3, pair)
+        # crushed against its base from the first step: the joints its own
+        # steps broke set how many break, at that rate, at most all
+        crushed = self.client.dry_run(self.fracturing_band("crushed", [0, -1]))
+        e = crushed["estimate"]
+        self.assertGreater(e["broken_seen"], 0, e)
+        self.assertGreaterEqual(e["breaks"], e["broken_seen"], e)
+        self.assertLessEqual(e["breaks"], crushed["joints"], e)
+        self.assertAlmostEqual(e["broken_joints"], 0.5 * e["breaks"], places=9)
+
     def test_status_keeps_the_estimate(self):
         case_id = self.client.submit(tiny_case("estimated", end=0.002))
         status = self.client.status(case_id)
