@@ -67,3 +67,8 @@ int fdem_break_joints_across(fdem_model *m, const double *normal, double offset)
     m->contact.need_detect = 1; /* the crack's faces meet through contact */
     return broke;
 }
+
+void fdem_force_detection(fdem_model *m)
+{
+    m->contact.need_detect = m->contact.enabled;
+}

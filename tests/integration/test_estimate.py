@@ -54,8 +54,9 @@ SHORT_ENDS = {
     "jointed-block": 0.002,
     # the lower spheres reach the floor in the first 0.07 s (0.7 s)
     "sphere-pile": 0.2,
-    # excavation at 2 ms; the wall breaks during the 10 ms release (40 ms)
-    "staged-tunnel": 0.008,
+    # excavation at 2 ms; the wall breaks during the 10 ms release (40 ms
+    # in all): 16 joints by 8 ms, 364 by 15.4 ms, 446 by the end
+    "staged-tunnel": 0.016,
     # peak at 0.22 ms, shear failure after it (0.4 ms)
     "uniaxial-compression": 0.0003,
     # joints soften from 0.15 ms, the load falls by 0.33 ms (0.4 ms)
@@ -166,7 +167,7 @@ class EstimateTest(DaemonTestCase):
             self.assertEqual(e["broken_seen"], 0, e)
             self.assertAlmostEqual(e["breaks"], 0.03 * 48, places=9)
             self.assertAlmostEqual(e["broken_joints"], 0.5 * 0.03 * 48, places=9)
-            self.assertGreater(e["break_step_seconds"], 0, e)
+            self.assertGreater(e["break_detection_seconds"], 0, e)
         # a repeated dry run gives the same figure within the stated band
         pair = (first["estimated_seconds"], second["estimated_seconds"])
         self.assertLessEqual(max(pair) / min(pair), 1.3, pair)
