@@ -19,8 +19,8 @@
  *    on a crack cut through the model (fdem_break_joints_across, on the
  *    axis plane that crosses the most joints): 3 % of its joints (or more,
  *    at the rate its own steps broke them) each breaking once, at the
- *    cost of the detection the cut set off (a break reruns the contact
- *    detection), and half of them held broken through the whole run, each
+ *    cost of a detection (a break reruns it; timed before the cut and on
+ *    it, interpolated to the joints held broken), and half of them held broken through the whole run, each
  *    at the cost a joint of the crack adds to a step; plus the worker's
  *    copy of each snapshot and its checkpoint. Steps are timed in CPU seconds and turned into
  *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
@@ -55,7 +55,8 @@ typedef struct case_sizing {
     double broken_joints;     /* joints priced as broken through the run */
     int broken_seen;          /* joints the probe's own steps broke (before its crack) */
     double breaks;            /* joints priced as breaking during the run */
-    double break_detection_seconds; /* CPU seconds of the detection the crack set off (NAN: none) */
+    double intact_detection_seconds; /* CPU seconds of a detection before the crack (NAN: none) */
+    double break_detection_seconds; /* the same on the crack (NAN: none) */
     double snapshot_copy_seconds; /* the worker's share of one snapshot */
     double estimated_seconds;
     int fluid;                /* the case has fluid (contract 6.4): then fluid_step and */
