@@ -118,10 +118,13 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
  * fall a few millimetres: a sphere pile's step costs 20 us at rest and
  * 1-3 ms once they touch, from about step 700) is priced from then on.
  * How far they go is set in steps from the first pace (as far as
- * SIZING_ADVANCE_CPU seconds of it reach), not by a clock, so that two dry
- * runs look at the same steps; and the looks are averaged, so that one
- * that lands in a short impact (a 3D collision's contact: 30x a step for
- * a few hundred steps) does not price the whole run at it. */
+ * SIZING_ADVANCE_CPU seconds of it reach, down to a power of 2, so that a
+ * first pace 1.5x slower on a busier machine moves it seldom), not by a
+ * clock, so that two dry runs look at the same steps; and the later pace
+ * is the looks' median, so that one that lands in a short impact (a 3D
+ * collision's contact: 30x a step for ~200 steps of 3,922) does not price
+ * the whole run at it (their mean priced collision-3d at 5-10x its CPU,
+ * 4.3 and 8.1 s for two dry runs of one document). */
 #define SIZING_ADVANCE_SHARE 0.3
 #define SIZING_ADVANCE_CPU 0.1
 #define SIZING_LOOKS 3
@@ -234,11 +237,11 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
     if (!isfinite(first) || !(first > 0))
         return first;
     double reach = SIZING_ADVANCE_SHARE * out->steps;
-    if (reach > SIZING_ADVANCE_CPU / first)
-        reach = SIZING_ADVANCE_CPU / first;
+    if (reach > SIZING_ADVANCE_CPU / first) /* down to a power of 2: two dry runs */
+        reach = exp2(floor(log2(SIZING_ADVANCE_CPU / first))); /* look at the same steps */
     if (reach <= *taken || out->steps - reach < 16)
         return first;
-    double sum = 0;
+    double pace_at[SIZING_LOOKS];
     int looks = 0;
     for (int k = 1; k <= SIZING_LOOKS; k++) {
         double target = reach * k / SIZING_LOOKS;
@@ -254,10 +257,10 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
         *taken += more;
         if (!isfinite(pace))
             return first;
-        sum += pace;
-        looks++;
+        pace_at[looks++] = pace;
     }
-    double later = out->later_step_seconds = sum / looks;
+    qsort(pace_at, (size_t)looks, sizeof *pace_at, compare_seconds);
+    double later = out->later_step_seconds = pace_at[looks / 2];
     double done = *taken / out->steps;
     return done * first + (1 - done) * later;
 }
