@@ -338,18 +338,18 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->step_seconds = sizing_probe_step_seconds(model, out->steps, &taken, &load);
     double per_step = sizing_later_step_seconds(model, out, &taken, &load);
     /* joints the run's own steps broke so far (before the probe's crack) */
-    int seen = fdem_get_counts(model).broken_joints;
+    int seen = fdem_get_counts(model).broken_joints, looked = taken;
     out->broken_seen = seen;
-    double breaking = 0; /* CPU seconds of the steps in which joints break */
+    double breaking = 0; /* CPU seconds of the detections breaks set off */
     out->cracked_step_seconds = out->break_detection_seconds = NAN;
     out->intact_detection_seconds = NAN;
     if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
-        /* the detection before the cut: what one costs with no joint broken */
+        /* a detection before the cut: what one costs with (nearly) none broken */
         out->intact_detection_seconds = sizing_detection_seconds(model, out->steps - taken, &taken);
         out->cracked_step_seconds = sizing_cracked_step_seconds(
             model, out->steps - taken, &out->cracked_joints, &out->break_detection_seconds, &load);
         if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {
-            sizing_price_breaks(out, c.joints, seen, taken);
+            sizing_price_breaks(out, c.joints, seen, looked);
             double each = (out->cracked_step_seconds - per_step) / out->cracked_joints;
             if (each > 0)
                 per_step += out->broken_joints * each;
