@@ -464,6 +464,11 @@ void fdem_fluid_sources(const fdem_model *model, double *pressure, double *injec
  * would, with no fracture event and no energy booked. Returns how many
  * broke, or -1 out of memory. */
 int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
+/* How many joints fdem_break_joints_across would break, breaking none. */
+int fdem_joints_across(const fdem_model *model, const double *normal, double offset);
+/* The next step reruns the whole contact detection, as one in which a
+ * joint breaks does (for timing it). */
+void fdem_force_detection(fdem_model *model);
 
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);

@@ -33,15 +33,29 @@ static double plane_side(const fdem_model *m, const double *normal, double offse
     return s;
 }
 
+/* Intact joint j of two active elements whose centroids lie on either
+ * side of the plane. */
+static int joint_crosses(const fdem_model *m, int j, const double *normal, double offset)
+{
+    if (m->joint_damage[j] >= 1.0) return 0;
+    int a = m->joint_elem[2 * j], b = m->joint_elem[2 * j + 1];
+    if (!element_is_active(m, a) || !element_is_active(m, b)) return 0;
+    double sa = plane_side(m, normal, offset, a), sb = plane_side(m, normal, offset, b);
+    return (sa < 0 && sb >= 0) || (sa >= 0 && sb < 0);
+}
+
+int fdem_joints_across(const fdem_model *m, const double *normal, double offset)
+{
+    int n = 0;
+    for (int j = 0; j < m->joint_count; j++) n += joint_crosses(m, j, normal, offset);
+    return n;
+}
+
 int fdem_break_joints_across(fdem_model *m, const double *normal, double offset)
 {
     int broke = 0;
     for (int j = 0; j < m->joint_count; j++) {
-        if (m->joint_damage[j] >= 1.0) continue;
-        int a = m->joint_elem[2 * j], b = m->joint_elem[2 * j + 1];
-        if (!element_is_active(m, a) || !element_is_active(m, b)) continue;
-        double sa = plane_side(m, normal, offset, a), sb = plane_side(m, normal, offset, b);
-        if (!((sa < 0 && sb >= 0) || (sa >= 0 && sb < 0))) continue;
+        if (!joint_crosses(m, j, normal, offset)) continue;
         m->joint_damage[j] = 1.0;
         broke++;
     }
@@ -52,4 +66,9 @@ int fdem_break_joints_across(fdem_model *m, const double *normal, double offset)
     m->fragments = fragments;
     m->contact.need_detect = 1; /* the crack's faces meet through contact */
     return broke;
+}
+
+void fdem_force_detection(fdem_model *m)
+{
+    m->contact.need_detect = m->contact.enabled;
 }

@@ -84,19 +84,33 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
     return mesh + snapshots * row;
 }
 
-/* Broken joints cost a run through the contact their faces make (the
- * faces of a crack, and in 3D every pair of tetrahedra around its
- * vertices): a step costs about intact + (broken joints) x (the cost of one),
- * measured on the model with a crack cut through it
- * (sizing_cracked_step_seconds). How many break, and when, is not known
- * before the run; the bundled examples break 0 to 16 % of their joints by
- * the end, late in some runs and early in others, and 0 to 5 % on average
- * over their steps: tunnel-region 1.6 % (none until 80 % of the run, then
- * 1000; each step then 55x an intact one), staged-tunnel 5 %, drift-3d
- * 2 %, the arc-loaded 3D disc 2 % (27x a step after its split), the 3D
- * disc 2 %, the 3D prism none (it only softens). The estimate takes this
- * share of the joints as broken through the whole run. */
-#define SIZING_BROKEN_SHARE 0.02
+/* Broken joints cost a run twice (issue 34's figures). Through contact:
+ * the faces of a crack, and in 3D every pair of tetrahedra around its
+ * vertices, are pairs from then on, so a step costs about intact +
+ * (broken joints) x (the cost of one), measured on the model with a crack
+ * cut through it (sizing_cracked_step_seconds). And through detection:
+ * every step in which a joint breaks reruns the whole contact detection
+ * (core/step/integrator.c), which after the split of a 2D tunnel wall was
+ * 82 % of its CPU (1,100 joints broke, one detection each, at 8 ms a
+ * detection of 4,678 triangles against 38 ns an element-step intact): so
+ * each joint that breaks is priced one detection, timed before the cut
+ * and on it (sizing_detection_at).
+ *
+ * How many break by the end: a share of the joints, not known before the
+ * run. The bundled examples break 0 to 23 % of their joints by the end
+ * (the median 2 %), late in some runs and early in others: tunnel-region
+ * 23 % (none until 80 % of the run, then 1,100 of 4,834), staged-tunnel
+ * 7 %, kgd and hf-natural-joint 5 %, the arc-loaded 3D disc 4 % (27x a
+ * step after its split), the 3D disc 3.6 %, drift-3d 2.7 %, the 2D disc
+ * 1.2 %, jointed-block 1 %, borehole-breakdown 0.7 %, the 3D prism none
+ * (it only softens). Priced at SIZING_BROKEN_SHARE, a run within a
+ * factor of 2 breaks about 1 to 10 % (where breaks set the pace). When
+ * the model's own steps up to the last look (below) broke more than that
+ * share at their rate (a crack driven by injected fluid grows from the
+ * first steps: the penny breaks its first joint at step 68 of 4,336),
+ * as many at that rate. Held broken on average over the steps: half of
+ * them (a count growing from none). */
+#define SIZING_BROKEN_SHARE 0.03
 
 /* Later looks: the model is stepped on, untimed, to SIZING_LOOKS evenly
  * spaced points up to this share of the run's steps and timed at each, so
@@ -104,10 +118,13 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
  * fall a few millimetres: a sphere pile's step costs 20 us at rest and
  * 1-3 ms once they touch, from about step 700) is priced from then on.
  * How far they go is set in steps from the first pace (as far as
- * SIZING_ADVANCE_CPU seconds of it reach), not by a clock, so that two dry
- * runs look at the same steps; and the looks are averaged, so that one
- * that lands in a short impact (a 3D collision's contact: 30x a step for
- * a few hundred steps) does not price the whole run at it. */
+ * SIZING_ADVANCE_CPU seconds of it reach, down to a power of 2, so that a
+ * first pace 1.5x slower on a busier machine moves it seldom), not by a
+ * clock, so that two dry runs look at the same steps; and the later pace
+ * is the looks' median, so that one that lands in a short impact (a 3D
+ * collision's contact: 30x a step for ~200 steps of 3,922) does not price
+ * the whole run at it (their mean priced collision-3d at 5-10x its CPU,
+ * 4.3 and 8.1 s for two dry runs of one document). */
 #define SIZING_ADVANCE_SHARE 0.3
 #define SIZING_ADVANCE_CPU 0.1
 #define SIZING_LOOKS 3
@@ -127,20 +144,86 @@ static void sizing_joint_centre(const fdem_model *model, double centre[3])
     for (int d = 0; d < dim; d++) centre[d] /= J;
 }
 
-/* Wall seconds per step once the rock has broken: the model is cut by
- * a crack through the middle of its joints, along the plane x = centre
- * (a vertical crack: through a disc or a specimen loaded along y or z,
- * through the crown and invert of a tunnel), and timed again. NAN when
- * no joint crosses it or a step fails. */
-static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
-                                          sizing_load *load)
+/* The plane of the probe's crack: through the joints' centre, normal to
+ * the axis whose plane crosses the most joints (a disc's or a tunnel's
+ * joints fill a region, which any axis cuts; a fluid-driven crack's lie
+ * on its plane, which only the axis normal to it crosses). Returns how
+ * many joints it crosses. */
+static int sizing_crack_plane(const fdem_model *model, double normal[3], double *offset)
 {
-    double centre[3], normal[3] = {1, 0, 0};
+    double centre[3];
     sizing_joint_centre(model, centre);
-    *broke = fdem_break_joints_across(model, normal, centre[0]);
+    int dim = fdem_get_dimension(model), most = 0;
+    for (int d = 0; d < dim; d++) {
+        double axis[3] = {0, 0, 0};
+        axis[d] = 1;
+        int crossed = fdem_joints_across(model, axis, centre[d]);
+        if (crossed > most) {
+            most = crossed;
+            memcpy(normal, axis, sizeof axis);
+            *offset = centre[d];
+        }
+    }
+    return most;
+}
+
+/* The detection a break sets off, timed: up to SIZING_DETECTIONS steps
+ * each made to rerun it (fdem_force_detection), as long as they take no
+ * more than SIZING_DETECTION_CPU seconds in all; each counts its CPU
+ * seconds times the detection's share of its wall time (the engine's
+ * stage clock reads wall time). The median; NAN when a step fails. */
+#define SIZING_DETECTIONS 5
+#define SIZING_DETECTION_CPU 0.3
+
+static int compare_seconds(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double sizing_detection_seconds(fdem_model *model, double steps_left, int *taken)
+{
+    double seconds[SIZING_DETECTIONS], spent = 0;
+    int n = 0;
+    while (n < SIZING_DETECTIONS && n < steps_left && (n == 0 || spent < SIZING_DETECTION_CPU)) {
+        fdem_error err;
+        memset(&err, 0, sizeof err);
+        fdem_force_detection(model);
+        double detected0 = fdem_get_stage_times(model).detection;
+        double wall0 = clock_wall_seconds(), cpu0 = clock_cpu_seconds();
+        if (fdem_step(model, &err) != 0)
+            return NAN;
+        double cpu = clock_cpu_seconds() - cpu0, wall = clock_wall_seconds() - wall0;
+        double share = wall > 0 ? (fdem_get_stage_times(model).detection - detected0) / wall : 1;
+        seconds[n++] = cpu * (share < 0 ? 0 : share > 1 ? 1 : share);
+        spent += cpu;
+        (*taken)++;
+    }
+    if (n == 0) return NAN;
+    qsort(seconds, (size_t)n, sizeof *seconds, compare_seconds);
+    return seconds[n / 2];
+}
+
+/* CPU seconds a step once the rock has broken: the model is cut by a
+ * crack through the middle of its joints (sizing_crack_plane) and timed
+ * again; then the detection every step in which a joint breaks reruns,
+ * on the cracked model (*detection). NAN when no joint crosses the
+ * plane or a step fails. */
+static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
+                                          double *detection, sizing_load *load)
+{
+    double normal[3] = {1, 0, 0}, offset = 0;
+    *detection = NAN;
+    *broke = 0;
+    if (sizing_crack_plane(model, normal, &offset) <= 0 || steps_left < 2)
+        return NAN;
+    *broke = fdem_break_joints_across(model, normal, offset);
     if (*broke <= 0) return NAN;
     int taken = 0;
-    return sizing_probe_step_seconds(model, steps_left, &taken, load);
+    double pace = sizing_probe_step_seconds(model, steps_left, &taken, load);
+    if (isfinite(pace))
+        *detection = sizing_detection_seconds(model, steps_left - taken, &taken);
+    return pace;
 }
 
 /* The pace of the run after the first probe (later_step_seconds, the
@@ -154,11 +237,11 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
     if (!isfinite(first) || !(first > 0))
         return first;
     double reach = SIZING_ADVANCE_SHARE * out->steps;
-    if (reach > SIZING_ADVANCE_CPU / first)
-        reach = SIZING_ADVANCE_CPU / first;
+    if (reach > SIZING_ADVANCE_CPU / first) /* down to a power of 2: two dry runs */
+        reach = exp2(floor(log2(SIZING_ADVANCE_CPU / first))); /* look at the same steps */
     if (reach <= *taken || out->steps - reach < 16)
         return first;
-    double sum = 0;
+    double pace_at[SIZING_LOOKS];
     int looks = 0;
     for (int k = 1; k <= SIZING_LOOKS; k++) {
         double target = reach * k / SIZING_LOOKS;
@@ -174,10 +257,10 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
         *taken += more;
         if (!isfinite(pace))
             return first;
-        sum += pace;
-        looks++;
+        pace_at[looks++] = pace;
     }
-    double later = out->later_step_seconds = sum / looks;
+    qsort(pace_at, (size_t)looks, sizeof *pace_at, compare_seconds);
+    double later = out->later_step_seconds = pace_at[looks / 2];
     double done = *taken / out->steps;
     return done * first + (1 - done) * later;
 }
@@ -199,6 +282,36 @@ static double sizing_snapshot_copy_seconds(const fdem_model *model, const case_i
         if (seconds < best) best = seconds;
     }
     return best;
+}
+
+/* How many joints the run breaks (out->breaks, each priced one
+ * detection) and how many it holds broken on average over its steps
+ * (out->broken_joints, each priced its contact every step): the
+ * SIZING_BROKEN_SHARE of them, or more when the `seen` that its first
+ * `taken` steps broke go on at that rate. */
+static void sizing_price_breaks(case_sizing *out, int joints, int seen, int taken)
+{
+    double by_end = SIZING_BROKEN_SHARE * joints;
+    if (seen > 0 && taken > 0 && seen * (out->steps / taken) > by_end)
+        by_end = seen * (out->steps / taken);
+    if (by_end > joints) by_end = joints;
+    if (by_end > out->steps) by_end = out->steps;
+    out->breaks = by_end;
+    out->broken_joints = 0.5 * by_end;
+}
+
+/* CPU seconds of one detection while the run holds out->broken_joints
+ * broken: a detection's candidate pairs grow with the crack, so it is
+ * interpolated between the one timed intact and the one timed on the cut
+ * (drift-3d: 119 ms with 426 joints cut, 41 ms in its run with 143
+ * broken). Either alone when the other was not timed; 0 when neither. */
+static double sizing_detection_at(const case_sizing *out)
+{
+    double intact = out->intact_detection_seconds, cut = out->break_detection_seconds;
+    if (!isfinite(intact)) return isfinite(cut) ? cut : 0;
+    if (!isfinite(cut) || out->cracked_joints <= 0) return intact;
+    double at = intact + (cut - intact) * (out->broken_joints / out->cracked_joints);
+    return at > 0 ? at : 0;
 }
 
 void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
@@ -224,15 +337,23 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     sizing_load load = {0, 0};
     out->step_seconds = sizing_probe_step_seconds(model, out->steps, &taken, &load);
     double per_step = sizing_later_step_seconds(model, out, &taken, &load);
-    out->cracked_step_seconds = NAN;
+    /* joints the run's own steps broke so far (before the probe's crack) */
+    int seen = fdem_get_counts(model).broken_joints, looked = taken;
+    out->broken_seen = seen;
+    double breaking = 0; /* CPU seconds of the detections breaks set off */
+    out->cracked_step_seconds = out->break_detection_seconds = NAN;
+    out->intact_detection_seconds = NAN;
     if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
+        /* a detection before the cut: what one costs with (nearly) none broken */
+        out->intact_detection_seconds = sizing_detection_seconds(model, out->steps - taken, &taken);
         out->cracked_step_seconds = sizing_cracked_step_seconds(
-            model, out->steps - taken, &out->cracked_joints, &load);
+            model, out->steps - taken, &out->cracked_joints, &out->break_detection_seconds, &load);
         if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {
+            sizing_price_breaks(out, c.joints, seen, looked);
             double each = (out->cracked_step_seconds - per_step) / out->cracked_joints;
-            out->broken_joints = SIZING_BROKEN_SHARE * c.joints;
             if (each > 0)
                 per_step += out->broken_joints * each;
+            breaking = out->breaks * sizing_detection_at(out);
         }
     }
     /* CPU seconds so far; the machine's present load turns them into wall
@@ -243,7 +364,8 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->steps_per_second = per_step > 0 ? 1.0 / per_step : 0.0;
     /* Snapshots are written on the I/O thread while the worker steps on:
      * the slower of the two sets the pace; the worker's copies add. */
-    double stepping = per_step > 0 ? out->steps * per_step + out->snapshots * copy : NAN;
+    breaking *= out->load_factor;
+    double stepping = per_step > 0 ? out->steps * per_step + breaking + out->snapshots * copy : NAN;
     double writing = out->snapshots * snapshot_seconds;
     out->estimated_seconds = writing > stepping ? writing : stepping;
 }
@@ -303,6 +425,12 @@ json_t *case_sizing_json(const case_sizing *s)
     json_object_set_new(parts, "cracked_step_seconds", status_number_or_null(s->cracked_step_seconds));
     json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
     json_object_set_new(parts, "broken_joints", status_number_or_null(s->broken_joints));
+    json_object_set_new(parts, "broken_seen", json_integer(s->broken_seen));
+    json_object_set_new(parts, "breaks", status_number_or_null(s->breaks));
+    json_object_set_new(parts, "intact_detection_seconds",
+                        status_number_or_null(s->intact_detection_seconds));
+    json_object_set_new(parts, "break_detection_seconds",
+                        status_number_or_null(s->break_detection_seconds));
     json_object_set_new(parts, "snapshot_seconds", status_number_or_null(s->snapshot_copy_seconds));
     json_object_set_new(o, "estimate", parts);
     char warning[400];

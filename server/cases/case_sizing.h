@@ -15,11 +15,14 @@
  *    snapshots (snapshot_seconds each, see io_snapshot_seconds). Stepping
  *    is priced from the model's own steps timed here (sizing_probe.h: a
  *    warm-up, then the median of short windows) at t = 0 and at three points up to 30 %
- *    into the run when that is quickly reached; for a fracturing model 2 %
- *    of its joints broken through the whole run, each at the cost a joint
- *    of a crack cut through the model adds to its step
- *    (fdem_break_joints_across); plus the worker's copy of each snapshot
- *    and its checkpoint. Steps are timed in CPU seconds and turned into
+ *    into the run when that is quickly reached; for a fracturing model,
+ *    on a crack cut through the model (fdem_break_joints_across, on the
+ *    axis plane that crosses the most joints): 3 % of its joints (or more,
+ *    at the rate its own steps broke them) each breaking once, at the
+ *    cost of a detection (a break reruns it; timed before the cut and on
+ *    it, interpolated to the joints held broken), and half of them held broken through the whole run, each
+ *    at the cost a joint of the crack adds to a step; plus the worker's
+ *    copy of each snapshot and its checkpoint. Steps are timed in CPU seconds and turned into
  *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
  *    call it only on a model that is thrown away.
  */
@@ -50,6 +53,10 @@ typedef struct case_sizing {
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
     int cracked_joints;       /* joints the crack broke */
     double broken_joints;     /* joints priced as broken through the run */
+    int broken_seen;          /* joints the probe's own steps broke (before its crack) */
+    double breaks;            /* joints priced as breaking during the run */
+    double intact_detection_seconds; /* CPU seconds of a detection before the crack (NAN: none) */
+    double break_detection_seconds; /* the same on the crack (NAN: none) */
     double snapshot_copy_seconds; /* the worker's share of one snapshot */
     double estimated_seconds;
     int fluid;                /* the case has fluid (contract 6.4): then fluid_step and */

@@ -146,6 +146,28 @@ static double recent_run_factor(void)
     return v[n / 2];
 }
 
+/* The probes' own wall / CPU seconds swing 1x to 4x between two dry runs a
+ * second apart on a busy machine (a neighbour's burst lands in one probe's
+ * windows and not in the next's): before any run, the median of the last
+ * RUN_SHARE_SAMPLES probes' figures stands for them, so a repeated dry run
+ * sees nearly the same machine. */
+static double probe_share[RUN_SHARE_SAMPLES];
+static int probe_share_count, probe_share_next;
+
+static double recent_probe_factor(double seen)
+{
+    double v[RUN_SHARE_SAMPLES];
+    pthread_mutex_lock(&run_share_lock);
+    probe_share[probe_share_next] = seen;
+    probe_share_next = (probe_share_next + 1) % RUN_SHARE_SAMPLES;
+    if (probe_share_count < RUN_SHARE_SAMPLES) probe_share_count++;
+    int n = probe_share_count;
+    memcpy(v, probe_share, sizeof(double) * (size_t)n);
+    pthread_mutex_unlock(&run_share_lock);
+    qsort(v, (size_t)n, sizeof *v, compare_doubles);
+    return v[n / 2];
+}
+
 double sizing_load_factor(const sizing_load *load)
 {
     double recent = recent_run_factor();
@@ -156,6 +178,7 @@ double sizing_load_factor(const sizing_load *load)
     double seen = load->cpu > 0 && load->wall > 0 ? load->wall / load->cpu : 1.0;
     if (seen < 1.0)
         seen = 1.0;
+    seen = recent_probe_factor(seen);
     if (getloadavg(average, 1) != 1 || !(average[0] >= 0) || cores < 1)
         return seen;
     /* the run is one more task among those the load average counts */

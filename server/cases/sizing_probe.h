@@ -16,7 +16,8 @@
  *    over the daemon's last 9 runs of at least 0.2 s (sizing_note_run,
  *    called by the worker as a run ends), or before any the geometric
  *    mean of (one-minute load average + 1) / cores and the windows' own
- *    wall / CPU seconds in *load; at least 1.
+ *    wall / CPU seconds (the median of the last 9 probes' including
+ *    *load's); at least 1.
  *  The clocks are common/clock.h's.
  */
 #ifndef FDEMD_SIZING_PROBE_H

@@ -318,7 +318,8 @@ static void broken_joints_make_fragments(void)
 /* fdem_break_joints_across (the daemon's cracked estimate): a plane
  * between two columns of cells breaks exactly the joints on it, ny in 2D
  * (one vertical edge a row) and 2 ny nz in 3D (two triangles a cube face),
- * no joint inside a column, and leaves two fragments; a second cut along
+ * no joint inside a column (fdem_joints_across counts them first and breaks
+ * none), and leaves two fragments; a second cut along
  * the same plane finds nothing left, and the cracked block steps. */
 static void crack_across_a_plane_breaks_the_joints_on_it(void)
 {
@@ -333,6 +334,10 @@ static void crack_across_a_plane_breaks_the_joints_on_it(void)
         build_finalize(m, 0.5);
         const double normal[3] = {1, 0, 0};
         int want = dim == 2 ? div[1] : 2 * div[1] * div[2];
+        /* counting first breaks nothing, and counts what the cut breaks */
+        int counted = fdem_joints_across(m, normal, 0.02);
+        CHECK(counted == want, "%dD: %d joints across, want %d", dim, counted, want);
+        CHECK(fdem_get_counts(m).broken_joints == 0, "%dD: counting broke some", dim);
         int broke = fdem_break_joints_across(m, normal, 0.02);
         CHECK(broke == want, "%dD: %d joints broke, want %d", dim, broke, want);
         fdem_counts c = fdem_get_counts(m);
