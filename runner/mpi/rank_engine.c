@@ -23,8 +23,15 @@
  * stays replicated, bit-identical on every rank, and nothing of it needs
  * moving when bodies travel. Exchanging the forces (dim doubles a node)
  * rather than positions and velocities (twice that) is what lets the
- * update run everywhere; the price is that only the element stage is split
- * (docs/parallel.md has the figures and what a halo-only version takes).
+ * update run everywhere.
+ *
+ * In a model where nothing after the forces reads nodes anywhere (no
+ * contact, joints, fluid, stages: rank_halo_wanted) the update is split
+ * too (rank_halo.c): a rank updates only the nodes it keeps (its own, its
+ * computed elements', the constraints'), the force exchange sends only
+ * border nodes to the neighbours that keep them, and one reduction a step
+ * makes a non-finite value on one rank fail the step on all. Rank 0 gets
+ * the nodes from their owners at rank_engine_gather.
  *
  * The elements' viscous history (elem_viscous) is kept only where an
  * element is computed; rank_engine_gather hands rank 0 the owners' values.
@@ -35,6 +42,7 @@
 #include "model/model.h"
 #include "element/element.h"
 #include "rank_engine.h"
+#include "rank_halo.h"
 
 struct rank_engine {
     MPI_Comm comm;
@@ -53,6 +61,9 @@ struct rank_engine {
     step_share share, halo_share;
     int border_fault;
     int exchanged;                   /* the force exchange ran in this step */
+    int split;                       /* the update is split (rank_halo.c): border forces only */
+    rank_halo border;                /* its nodes and lists */
+    int agreed, local_bad, others_bad; /* this step's update verdicts (split) */
     rank_figures fig;
 };
 
@@ -121,12 +132,31 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     return 0;
 }
 
+/* The forces every rank needs: all of them (replicated update) or the
+ * border nodes' to the neighbours that keep them (split update). */
 static int share_forces_done(void *ctx, fdem_model *m)
 {
     rank_engine *re = ctx;
     re->exchanged = 1;
     if (re->border_fault) add_halo_after(re, m);
-    return exchange_forces(re, m, 1);
+    return re->split ? rank_halo_exchange(&re->border, m, 1, &re->fig.exchange_seconds)
+                     : exchange_forces(re, m, 1);
+}
+
+/* Split update: each rank checked only the nodes it updated; they fail
+ * together (one small reduction a step). */
+static int share_update_done(void *ctx, fdem_model *m, int bad)
+{
+    (void)m;
+    rank_engine *re = ctx;
+    re->agreed = 1;
+    re->local_bad = bad != 0;
+    int any = re->local_bad;
+    double t0 = MPI_Wtime();
+    if (MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, re->comm) != MPI_SUCCESS) any = 1;
+    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    re->others_bad = any && !re->local_bad;
+    return any;
 }
 
 /* Lists of owned items rank by rank (owner[i] of n items), with the
@@ -215,7 +245,11 @@ static int setup(rank_engine *re, fdem_model *m)
     re->mark = malloc((size_t)m->elem_count + 1);
     re->halo = malloc((size_t)m->elem_count + 1);
     int32_t *node_owner = malloc(sizeof(int32_t) * ((size_t)N + 1));
-    re->send_len = re->recv_len = (size_t)D * N + (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
+    re->split = plan->color_count && rank_halo_wanted(m, re->size);
+    /* the replicated update's buffers hold every force; the split one's
+     * only block sums (rank_halo.c has its own) */
+    re->send_len = re->recv_len = (re->split ? 0 : (size_t)D * N) +
+                                  (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
     re->send = malloc(sizeof(double) * re->send_len);
     re->recv = malloc(sizeof(double) * re->recv_len);
     int rc = -1;
@@ -237,6 +271,9 @@ static int setup(rank_engine *re, fdem_model *m)
         re->fig.owned_nodes = re->rank == 0 ? N : 0;
     } else {
         assign_nodes_and_marks(re, m, node_owner);
+        if (re->split && rank_halo_setup(&re->border, m, re->comm, node_owner, re->block_owner,
+                                         re->block_size))
+            goto done;
     }
     list_by_owner(re->block_owner, re->blocks, re->size, SCATTER_SUMS, re->block_order,
                   re->block_counts, re->block_displs);
@@ -249,9 +286,11 @@ static int setup(rank_engine *re, fdem_model *m)
     re->fig.blocks = re->blocks;
     re->fig.owned_blocks = re->block_counts[re->rank] / SCATTER_SUMS;
     const double others = re->size - 1;
-    re->fig.bytes_sent_per_step =
-        others * 8.0 * (re->node_counts[re->rank] +
-                        (m->elem_plan.color_count ? re->block_counts[re->rank] : 0));
+    const double sums = m->elem_plan.color_count ? re->block_counts[re->rank] : 0;
+    re->fig.bytes_sent_per_step = re->split ? re->border.bytes_per_step + others * 8.0 * sums
+                                            : others * 8.0 * (re->node_counts[re->rank] + sums);
+    re->fig.split_update = re->split;
+    re->fig.kept_nodes = re->split ? re->border.kept_nodes : N;
     rc = 0;
 done:
     free(node_owner);
@@ -278,26 +317,53 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
         rank_engine_free(re);
         return NULL;
     }
-    re->share = (step_share){re, re->mark, share_block_sums, share_forces_done};
-    re->halo_share = (step_share){re, re->halo, NULL, NULL};
+    re->share = (step_share){.ctx = re, .elem_mark = re->mark, .block_sums = share_block_sums,
+                             .forces_done = share_forces_done,
+                             .node_mark = re->split ? re->border.node_mark : NULL,
+                             .update_done = re->split ? share_update_done : NULL};
+    re->halo_share = (step_share){.ctx = re, .elem_mark = re->halo};
     if (m->elem_plan.color_count == 0) re->share.block_sums = NULL;
     return re;
 }
 
+/* A step that failed on this rank before the others' collectives of the
+ * step: it takes part in them saying so, so that none waits for it. */
+static void fail_collectives(rank_engine *re, fdem_model *m)
+{
+    if (!re->exchanged) {
+        if (re->split) rank_halo_exchange(&re->border, m, 0, &re->fig.exchange_seconds);
+        else exchange_forces(re, m, 0);
+    }
+    if (re->split && !re->agreed) {
+        int any = 1;
+        MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, re->comm);
+    }
+}
+
 int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
-    re->exchanged = 0;
+    re->exchanged = re->agreed = re->local_bad = re->others_bad = 0;
     if (re->size == 1) return fdem_step(m, err); /* nothing to share */
     m->share = &re->share; /* only while stepping: outside a step nothing is collective */
     int rc = fdem_step(m, err);
     m->share = NULL;
-    if (rc && !re->exchanged) exchange_forces(re, m, 0); /* the others wait there */
+    if (rc) fail_collectives(re, m);
+    if (rc && re->others_bad) /* this rank's nodes are finite: say whose are not */
+        model_error(err, FDEM_ITEM_NONE, -1, "the solution became non-finite at step %lld on "
+                    "another rank (t = %.6g s, dt = %.6g s; the stable step is %.6g s): reduce "
+                    "time.safety or check the material stiffness, penalty and applied loads",
+                    (long long)m->step + 1, m->time + m->dt, m->dt, m->stable_dt);
     return rc;
 }
 
 /* The viscous history of each block from its owner to rank 0. */
 int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err)
 {
+    if (re->split &&
+        rank_halo_gather(&re->border, m, re->node_order, re->node_counts, re->node_displs)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory gathering the ranks' nodes");
+        return -1;
+    }
     if (!m->elem_viscous || m->elem_plan.color_count == 0 || re->size == 1) return 0;
     const int C = model_stress_comps(m), me = re->rank;
     const size_t per_block = (size_t)C * re->block_size;
@@ -370,6 +436,11 @@ void rank_engine_lazy_free(rank_engine_lazy *lazy)
 
 rank_figures rank_engine_figures(const rank_engine *re) { return re->fig; }
 
+const uint8_t *rank_engine_node_mark(const rank_engine *re)
+{
+    return re->split ? re->border.node_mark : NULL;
+}
+
 /* Turning the fault on keeps only the owned blocks' marks in the pass
  * (the halo comes after, add_halo_after); it is never turned off. */
 void rank_engine_set_border_order_fault(rank_engine *re, int on)
@@ -391,5 +462,6 @@ void rank_engine_free(rank_engine *re)
     free(re->halo);
     free(re->send);
     free(re->recv);
+    if (re->split) rank_halo_free(&re->border);
     free(re);
 }
