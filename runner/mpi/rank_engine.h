@@ -40,6 +40,7 @@ typedef struct rank_figures {
     double partition_seconds;   /* METIS on the block graph, rank 0 */
     double bytes_sent_per_step; /* this rank's share of the exchanges */
     double exchange_seconds;    /* wall time in the step's exchanges, all steps */
+    double exchange_cpu_seconds; /* CPU time there (MPI polling), all steps */
     int split_update;           /* 1: the update is split (rank_halo.h), 0: replicated */
     long kept_nodes;            /* nodes this rank updates (all when replicated) */
 } rank_figures;

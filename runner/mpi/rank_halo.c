@@ -161,10 +161,9 @@ static inline size_t recv_at(const rank_halo *h, int k)
     return (size_t)h->dim * (size_t)h->recv_begin[k] + (size_t)k;
 }
 
-int rank_halo_exchange(rank_halo *h, fdem_model *m, int ok, double *seconds)
+int rank_halo_exchange(rank_halo *h, fdem_model *m, int ok)
 {
     const int D = h->dim, nb = h->neighbours;
-    const double t0 = MPI_Wtime();
     for (int k = 0; k < nb; k++) {
         int count = 1 + D * (h->recv_begin[k + 1] - h->recv_begin[k]);
         MPI_Irecv(h->recv_buf + recv_at(h, k), count, MPI_DOUBLE, h->peer[k], HALO_TAG, h->comm,
@@ -184,7 +183,6 @@ int rank_halo_exchange(rank_halo *h, fdem_model *m, int ok, double *seconds)
                   &h->requests[nb + k]);
     }
     int rc = MPI_Waitall(2 * nb, h->requests, MPI_STATUSES_IGNORE);
-    *seconds += MPI_Wtime() - t0;
     if (rc != MPI_SUCCESS) return -1;
     for (int k = 0; k < nb; k++)
         if (h->recv_buf[recv_at(h, k)] != 1) return -1;

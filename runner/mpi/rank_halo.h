@@ -48,7 +48,7 @@ typedef struct rank_halo {
 int rank_halo_wanted(const fdem_model *m, int ranks);
 int rank_halo_setup(rank_halo *h, const fdem_model *m, MPI_Comm comm, const int32_t *node_owner,
                     const int32_t *block_owner, int block_size);
-int rank_halo_exchange(rank_halo *h, fdem_model *m, int ok, double *seconds);
+int rank_halo_exchange(rank_halo *h, fdem_model *m, int ok);
 int rank_halo_gather(const rank_halo *h, fdem_model *m, const int32_t *node_order,
                      const int *node_counts, const int *node_displs);
 void rank_halo_free(rank_halo *h);

@@ -158,16 +158,18 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     }
     const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
     /* the batch loop's way (made at the first step), but for the fault,
-     * which is set before it */
+     * which is set before it, and the figures, which time steps only */
     rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
-    if (!plain && o->fault) {
+    double t_setup = MPI_Wtime();
+    if (!plain && (o->fault || figures)) {
         if (!(lazy.re = rank_engine_create(m, MPI_COMM_WORLD, &err))) {
             fprintf(stderr, "rank %d: %s\n", rank, err.message);
             MPI_Abort(MPI_COMM_WORLD, 2);
         }
         lazy.model = m;
-        rank_engine_set_border_order_fault(lazy.re, 1);
+        if (o->fault) rank_engine_set_border_order_fault(lazy.re, 1);
     }
+    t_setup = MPI_Wtime() - t_setup;
     if (rank == 0) printf("case %s\n", path);
     int status = 0;
     double t_step = 0, c_step = 0;
@@ -202,14 +204,16 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         fprintf(stderr, "rank %d: blocks %d of %d, elements owned %ld computed %ld (halo %.3f), "
-                "nodes owned %ld kept %ld (update %s), bytes sent/step %.0f, partition %.4f s, build %.2f s, "
-                "step %.6f s (cpu %.6f s, exchanges %.6f s), peak %.0f bytes/element\n", rank, f.owned_blocks, f.blocks, f.owned_elements,
+                "nodes owned %ld kept %ld (update %s), bytes sent/step %.0f, partition %.4f s, engine set-up %.2f s, "
+                "build %.2f s, "
+                "step %.6f s (cpu %.6f s, exchanges %.6f s, cpu there %.6f s), peak %.0f bytes/element\n", rank, f.owned_blocks, f.blocks, f.owned_elements,
                 f.computed_elements,
                 f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
                                        (double)f.owned_elements : 0.0,
                 f.owned_nodes, f.kept_nodes, f.split_update ? "split" : "replicated",
-                f.bytes_sent_per_step, f.partition_seconds, t_build,
+                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build,
                 t_step / steps, c_step / steps, f.exchange_seconds / steps,
+                f.exchange_cpu_seconds / steps,
                 peak_bytes() / fdem_get_counts(m).elements);
         if (rank == 0)
             printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
