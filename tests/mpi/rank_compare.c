@@ -11,6 +11,9 @@
  *   rank_compare STEPS EVERY [--plain] [--threads T] [--fault] [--figures]
  *                CASE.json...   (flags apply to the cases after them)
  *
+ * --expect-failure: the cases after it must fail (a non-finite step):
+ * the run then passes, and its lines say where they failed.
+ *
  * --save-at K FILE writes the checkpoint after step K (one file: use it
  * with one case); --restore FILE starts every rank from one, so a run
  * saved on N ranks goes on on M.
@@ -104,6 +107,7 @@ static int ranks_agree(const fdem_model *m, const uint8_t *mark, MPI_Comm comm)
 
 typedef struct compare_options {
     int steps, every, plain, fault, threads, figures;
+    int expect_failure;       /* the cases must fail at some step (and then pass) */
     int save_at;              /* the step after which rank 0 writes save_path; 0: none */
     const char *save_path;
     const char *restore_path; /* a checkpoint every rank starts from; NULL: step 0 */
@@ -250,13 +254,18 @@ int main(int argc, char **argv)
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--plain")) o.plain = 1;
         else if (!strcmp(argv[i], "--fault")) o.fault = 1;
+        else if (!strcmp(argv[i], "--expect-failure")) o.expect_failure = 1;
         else if (!strcmp(argv[i], "--figures")) o.figures = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--save-at") && i + 2 < argc) {
             o.save_at = atoi(argv[++i]);
             o.save_path = argv[++i];
         } else if (!strcmp(argv[i], "--restore") && i + 1 < argc) o.restore_path = argv[++i];
-        else status |= run_case(argv[i], &o, rank, size);
+        else if (o.expect_failure) { /* its lines say where it failed; not failing fails */
+            int failed = run_case(argv[i], &o, rank, size);
+            if (!failed && rank == 0) printf("no step failed\n");
+            status |= !failed;
+        } else status |= run_case(argv[i], &o, rank, size);
     }
     MPI_Finalize();
     return status;
