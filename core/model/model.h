@@ -253,8 +253,9 @@ typedef struct contact_state {
  *    process updates whole (each node's from its owner). Nonzero fails the
  *    step.
  *  - node_mark: NULL, or per node 1 if this process clears its force and
- *    updates it (its own nodes and those of the elements it computes); the
- *    others' state is left as it was, for their owners to hand on.
+ *    updates it (its own nodes, those of the elements it computes and any
+ *    a later stage reads, such as constraints'); the others' state is left
+ *    as it was, for their owners to hand on.
  *  - update_done: called by fdem_step after the update with this
  *    process's verdict (nonzero: some value it updated is not finite);
  *    returns the verdict of all processes, so that they fail together. */
