@@ -3,7 +3,8 @@
  * 1e7 element meshes, for the parallel-efficiency model of docs/parallel.md
  * (issue 37 item 5). METIS k-way on the element dual graph (elements
  * sharing an edge in 2D, a face in 3D); then, with each node owned by the
- * part of its first element as runner/mpi/rank_engine.c owns them:
+ * part of its first element and the border of two parts split between
+ * them, as runner/mpi/rank_engine.c owns them (split_borders):
  *   halo    elements a part computes beside its own (they touch a node it
  *           owns), as a fraction of its own: the redundant work;
  *   bytes   what a part receives each step in a halo-only exchange of
@@ -32,6 +33,26 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+/* rank_engine.c's split_borders: each node on the border of exactly two
+ * parts a < b, the first half of the pair's (in node order) to a, the rest
+ * to b (parts <= 64). */
+static void split_borders(const int32_t *en, int ne, int K, int nn, const idx_t *part,
+                          int parts, int32_t *owner)
+{
+    uint64_t *touch = calloc((size_t)nn, sizeof *touch);
+    int *count = calloc((size_t)parts * parts * 2, sizeof(int)), *seen = count + parts * parts;
+    for (int e = 0; e < ne; e++)
+        for (int c = 0; c < K; c++) touch[en[(size_t)K * e + c]] |= (uint64_t)1 << part[e];
+    for (int pass = 0; pass < 2; pass++)
+        for (int n = 0; n < nn; n++) {
+            if (__builtin_popcountll(touch[n]) != 2) continue;
+            int a = __builtin_ctzll(touch[n]), b = 63 - __builtin_clzll(touch[n]);
+            if (pass == 0) count[a * parts + b]++;
+            else owner[n] = seen[a * parts + b]++ < count[a * parts + b] / 2 ? a : b;
+        }
+    free(touch), free(count);
+}
+
 /* Halo and bytes of one partition (part per element). */
 static void halo_figures(const int32_t *en, int ne, int K, int nn, int D, const idx_t *part,
                          int parts, double *halo_frac, double *halo_max, double *bytes_max,
@@ -45,6 +66,7 @@ static void halo_figures(const int32_t *en, int ne, int K, int nn, int D, const 
     for (int e = 0; e < ne; e++)
         for (int c = 0; c < K; c++)
             if (owner[en[(size_t)K * e + c]] < 0) owner[en[(size_t)K * e + c]] = (int32_t)part[e];
+    split_borders(en, ne, K, nn, part, parts, owner);
     for (int e = 0; e < ne; e++) own[part[e]]++;
     /* per part p: the elements touching a node of p that are not p's */
     for (int p = 0; p < parts; p++) {

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # bench/mpi/run.sh - the rank engine's figures (issue 37 item 5), run by
 # bench/run.sh when mpicc built them: one and two ranks taking turns on a
-# 1e6-element 2D elastic block and a 2D contact pile (the machine's load
+# 1e6-element 2D elastic block, a 384k-tetrahedron 3D elastic box (both
+# take the split update: border forces only) and a 2D contact pile (the
+# replicated update; the machine's load
 # printed before each run: on a loaded machine the ratio means little),
 # the bytes each rank sends a step, the halo and peak memory per element;
 # then METIS on the element dual graph at 2-64 parts (bench_partition.c),
@@ -33,14 +35,19 @@ for i in range(30):
         parts.append({"name": "d%d-%d" % (i, j), "material": "rock",
                       "disc": {"center": [0.04 + 0.0755 * i, 0.04 + 0.0755 * j],
                                "radius": 0.037, "divisions": 24}})
+box = {"name": "box-384k", "dimension": 3, "materials": {"rock": rock},
+       "parts": [{"name": "box", "material": "rock",
+                  "box": {"origin": [0, 0, 0], "size": [1, 1, 1], "divisions": [40, 40, 40]},
+                  "velocity": [1.0, 0.5, 0.2]}],
+       "time": {"end": 1, "dt": "auto", "safety": 0.5}}
 pile = {"name": "pile", "materials": {"rock": dict(rock, damping=0.2), "wall": rock},
         "parts": parts, "gravity": [0, -9.81],
         "time": {"end": 1, "dt": "auto", "safety": 0.5}}
-for name, doc in (("block", block), ("pile", pile)):
+for name, doc in (("block", block), ("box", box), ("pile", pile)):
     with open("%s/%s.json" % (out, name), "w") as f:
         json.dump(doc, f)
 PY
-for c in block pile; do
+for c in block box pile; do
   echo "-- $c: $STEPS steps, ranks 1 and 2 taking turns, $ROUNDS rounds"
   for r in $(seq "$ROUNDS"); do
     for n in 1 2; do

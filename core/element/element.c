@@ -84,16 +84,10 @@ static void forces_of_marked_runs(fdem_model *m, int begin, int end, double sums
 {
     const uint8_t *mark = m->share->elem_mark;
     const scatter_block_fn loop = element_forces_loop(m);
-    for (int e = begin; e < end;) {
-        if (!mark[e]) {
-            e++;
-            continue;
-        }
-        int stop = e + 1;
-        while (stop < end && mark[stop]) stop++;
+    int stop;
+    for (int e = share_next_run(mark, begin, end, &stop); e < end;
+         e = share_next_run(mark, stop, end, &stop))
         loop(m, e, stop, sums);
-        e = stop;
-    }
 }
 
 /* Runs the element blocks through the model's scatter plan (threads side

@@ -18,6 +18,7 @@
 #define FDEM_MODEL_H
 
 #include <stdint.h>
+#include <string.h>
 
 #include "fdem.h"
 #include "kernel/contact_pair.h"
@@ -248,14 +249,40 @@ typedef struct contact_state {
  *    they are totalled in block order; fills in the sums of the blocks
  *    computed elsewhere. Called for every plan; the driver picks its own.
  *  - forces_done: called by fdem_step once every force of the step is
- *    added and before the update; makes m->force whole (each node's from
- *    its owner). Nonzero fails the step. */
+ *    added and before the update; makes the force of every node this
+ *    process updates whole (each node's from its owner). Nonzero fails the
+ *    step.
+ *  - node_mark: NULL, or per node 1 if this process clears its force and
+ *    updates it (its own nodes, those of the elements it computes and any
+ *    a later stage reads, such as constraints'); the others' state is left
+ *    as it was, for their owners to hand on.
+ *  - update_done: called by fdem_step after the update with this
+ *    process's verdict (nonzero: some value it updated is not finite);
+ *    returns the verdict of all processes, so that they fail together. */
 typedef struct step_share {
     void *ctx;
     const uint8_t *elem_mark;
     void (*block_sums)(void *ctx, fdem_model *m, scatter_plan *plan);
     int (*forces_done)(void *ctx, fdem_model *m);
+    const uint8_t *node_mark;
+    int (*update_done)(void *ctx, fdem_model *m, int bad);
 } step_share;
+
+/* The next run of marked items (mark[i] 1, others 0) in [from, end): its
+ * first item, end when there is none, and in *stop the item past its last.
+ * memchr finds the ends: a process's items come in long runs. */
+static inline int share_next_run(const uint8_t *mark, int from, int end, int *stop)
+{
+    const uint8_t *first = from < end ? memchr(mark + from, 1, (size_t)(end - from)) : NULL;
+    if (!first) {
+        *stop = end;
+        return end;
+    }
+    const int begin = (int)(first - mark);
+    const uint8_t *past = memchr(first, 0, (size_t)(end - begin));
+    *stop = past ? (int)(past - mark) : end;
+    return begin;
+}
 
 struct fdem_model {
     int finalized;

@@ -295,6 +295,32 @@ central_difference_pass(fdem_model *m, int begin, int end, const int D, int with
 CENTRAL_DIFFERENCE_PASSES(2)
 CENTRAL_DIFFERENCE_PASSES(3)
 
+/* The update a block of this model's nodes runs. */
+static scatter_block_fn central_difference_pass_of(const fdem_model *m)
+{
+    const int three = m->dim == 3;
+    return !m->contact.enabled
+               ? (three ? central_difference_nodes_3 : central_difference_nodes_2)
+           : m->contact.force_is_zero
+               ? (three ? central_difference_tracked_3 : central_difference_tracked_2)
+               : (three ? central_difference_contact_3 : central_difference_contact_2);
+}
+
+/* A step shared between processes that split the update (step_share.
+ * node_mark): the runs of the nodes this process updates, each as a block
+ * runs them. The sums serve this process's finiteness check; the driver
+ * splits the update only where no other of them is read (no contact). */
+static void central_difference_marked_runs(fdem_model *m, int begin, int end,
+                                           double sums[SCATTER_SUMS])
+{
+    const uint8_t *mark = m->share->node_mark;
+    const scatter_block_fn pass = central_difference_pass_of(m);
+    int stop;
+    for (int i = share_next_run(mark, begin, end, &stop); i < end;
+         i = share_next_run(mark, stop, end, &stop))
+        pass(m, i, stop, sums);
+}
+
 /* Advances every free dof by m->dt (h_next) after a step of m->dt_prev
  * (h_current). Returns -1 if some new value is not finite. */
 int central_difference_step(fdem_model *m)
@@ -302,12 +328,8 @@ int central_difference_step(fdem_model *m)
     double havg = 0.5 * (m->dt_prev + m->dt);
     double sums[SCATTER_SUMS] = {0};
     sums[SCATTER_MAX + 1] = m->contact.near_disp2;
-    const int three = m->dim == 3;
-    scatter_block_fn pass = !m->contact.enabled
-                                 ? (three ? central_difference_nodes_3 : central_difference_nodes_2)
-                             : m->contact.force_is_zero
-                                 ? (three ? central_difference_tracked_3 : central_difference_tracked_2)
-                                 : (three ? central_difference_contact_3 : central_difference_contact_2);
+    scatter_block_fn pass = m->share && m->share->node_mark ? central_difference_marked_runs
+                                                            : central_difference_pass_of(m);
     scatter_plan_run(&m->node_plan, m, m->threads, pass, sums);
     if (m->contact.enabled) contact_travel_step(m, sums[SCATTER_MAX]);
     m->contact.near_disp2 = sums[SCATTER_MAX + 1];
@@ -394,6 +416,13 @@ static void report_non_finite(fdem_model *m, double h, fdem_error *err)
 static void forces_clear(fdem_model *m)
 {
     const size_t D = (size_t)m->dim;
+    if (m->share && m->share->node_mark) { /* only the nodes this process updates */
+        int stop, N = m->node_count;
+        for (int i = share_next_run(m->share->node_mark, 0, N, &stop); i < N;
+             i = share_next_run(m->share->node_mark, stop, N, &stop))
+            memset(m->force + D * (size_t)i, 0, sizeof(double) * D * (size_t)(stop - i));
+        return;
+    }
     int from = 0; /* the first node not zeroed yet */
     for (int k = 0; k < m->part_count; k++) {
         const part *p = &m->parts[k];
@@ -451,6 +480,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
     boundary_load_apply(m);
     if (m->stages_started) stages_ramp_apply(m);
     int bad = central_difference_step(m);
+    if (m->share && m->share->update_done) bad = m->share->update_done(m->share->ctx, m, bad);
     constraint_enforce(m, h, havg);
     if (m->stages_started) stages_ramp_account(m, havg);
     boundary_load_account(m, havg);

@@ -8,7 +8,8 @@
  * energy sums in block order. Here the blocks of that same plan are the
  * unit of ownership (rank_partition.c): a rank computes every element of
  * its blocks, so their block sums are whole, and it owns the nodes whose
- * first element (lowest index) lies in one of its blocks. It also computes
+ * first element (lowest index) lies in one of its blocks, but for the
+ * border of two ranks, which they split (split_borders). It also computes
  * every element touching an owned node (the halo), in the same plan order
  * (step_share.elem_mark, core/element/element.c), so an owned node's force
  * is the one process's sum, bit for bit. Two exchanges complete a step:
@@ -23,18 +24,27 @@
  * stays replicated, bit-identical on every rank, and nothing of it needs
  * moving when bodies travel. Exchanging the forces (dim doubles a node)
  * rather than positions and velocities (twice that) is what lets the
- * update run everywhere; the price is that only the element stage is split
- * (docs/parallel.md has the figures and what a halo-only version takes).
+ * update run everywhere.
+ *
+ * In a model where nothing after the forces reads nodes anywhere (no
+ * contact, joints, fluid, stages: rank_halo_wanted) the update is split
+ * too (rank_halo.c): a rank updates only the nodes it keeps (its own, its
+ * computed elements', the constraints'), the force exchange sends only
+ * border nodes to the neighbours that keep them, and one reduction a step
+ * makes a non-finite value on one rank fail the step on all. Rank 0 gets
+ * the nodes from their owners at rank_engine_gather.
  *
  * The elements' viscous history (elem_viscous) is kept only where an
  * element is computed; rank_engine_gather hands rank 0 the owners' values.
  */
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "model/model.h"
 #include "element/element.h"
 #include "rank_engine.h"
+#include "rank_halo.h"
 
 struct rank_engine {
     MPI_Comm comm;
@@ -53,8 +63,31 @@ struct rank_engine {
     step_share share, halo_share;
     int border_fault;
     int exchanged;                   /* the force exchange ran in this step */
+    int split;                       /* the update is split (rank_halo.c): border forces only */
+    rank_halo border;                /* its nodes and lists */
+    int agreed, local_bad, others_bad; /* this step's update verdicts (split) */
     rank_figures fig;
 };
+
+/* Wall and CPU time spent in exchanges (rank_figures): the CPU a rank
+ * burns there is MPI polling for a partner, not work. */
+typedef struct stopwatch {
+    double wall, cpu;
+} stopwatch;
+
+static stopwatch stopwatch_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (stopwatch){MPI_Wtime(), (double)t.tv_sec + 1e-9 * (double)t.tv_nsec};
+}
+
+static void stopwatch_add(rank_engine *re, stopwatch since)
+{
+    stopwatch now = stopwatch_now();
+    re->fig.exchange_seconds += now.wall - since.wall;
+    re->fig.exchange_cpu_seconds += now.cpu - since.cpu;
+}
 
 /* Element block of element e, as scatter_plan.c cuts them. */
 static inline int block_of(const rank_engine *re, int e) { return e / re->block_size; }
@@ -72,10 +105,10 @@ static void share_block_sums(void *ctx, fdem_model *m, scatter_plan *plan)
     for (int k = 0; k < count; k++)
         memcpy(out + (size_t)k * SCATTER_SUMS, plan->block_sum + (size_t)mine[k] * SCATTER_SUMS,
                sizeof(double) * SCATTER_SUMS);
-    double t0 = MPI_Wtime();
+    stopwatch t0 = stopwatch_now();
     MPI_Allgatherv(out, re->block_counts[me], MPI_DOUBLE, re->recv, re->block_counts,
                    re->block_displs, MPI_DOUBLE, re->comm);
-    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    stopwatch_add(re, t0);
     for (int k = 0; k < re->blocks; k++)
         memcpy(plan->block_sum + (size_t)re->block_order[k] * SCATTER_SUMS,
                re->recv + (size_t)k * SCATTER_SUMS, sizeof(double) * SCATTER_SUMS);
@@ -105,10 +138,10 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     re->send[0] = ok;
     for (int k = 0; k < count; k++)
         memcpy(re->send + 1 + (size_t)D * k, m->force + (size_t)D * mine[k], sizeof(double) * D);
-    double t0 = MPI_Wtime();
+    stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
                             re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
-    re->fig.exchange_seconds += MPI_Wtime() - t0;
+    stopwatch_add(re, t0);
     if (rc != MPI_SUCCESS) return -1;
     for (int r = 0; r < re->size; r++)
         if (re->recv[re->flag_displs[r]] != 1) return -1;
@@ -121,12 +154,34 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     return 0;
 }
 
+/* The forces every rank needs: all of them (replicated update) or the
+ * border nodes' to the neighbours that keep them (split update). */
 static int share_forces_done(void *ctx, fdem_model *m)
 {
     rank_engine *re = ctx;
     re->exchanged = 1;
     if (re->border_fault) add_halo_after(re, m);
-    return exchange_forces(re, m, 1);
+    if (!re->split) return exchange_forces(re, m, 1);
+    stopwatch t0 = stopwatch_now();
+    int rc = rank_halo_exchange(&re->border, m, 1);
+    stopwatch_add(re, t0);
+    return rc;
+}
+
+/* Split update: each rank checked only the nodes it updated; they fail
+ * together (one small reduction a step). */
+static int share_update_done(void *ctx, fdem_model *m, int bad)
+{
+    (void)m;
+    rank_engine *re = ctx;
+    re->agreed = 1;
+    re->local_bad = bad != 0;
+    int any = re->local_bad;
+    stopwatch t0 = stopwatch_now();
+    if (MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, re->comm) != MPI_SUCCESS) any = 1;
+    stopwatch_add(re, t0);
+    re->others_bad = any && !re->local_bad;
+    return any;
 }
 
 /* Lists of owned items rank by rank (owner[i] of n items), with the
@@ -150,9 +205,45 @@ static int list_by_owner(const int32_t *owner, int n, int size, int width, int32
     return 0;
 }
 
-/* Node owners (the owner of the block of each node's first element; rank
- * 0 for a node of no element) and the marks of the elements this rank
- * computes: its blocks' and those touching a node it owns. */
+/* The nodes on the border of exactly two ranks a < b, split between them:
+ * the first half of each pair's (in node order) to a, the rest to b. The
+ * owner of a node computes the other rank's elements around it, so giving
+ * all of a border to one side (its first element's, as node_owner holds
+ * on entry) puts the whole halo on that side: 5 % more elements on one of
+ * two ranks for a 384k-tetrahedron box. Meshes numbered in space order
+ * make each half one piece of the border, so the halo splits in two
+ * rather than growing. Every rank gets the same owners. Up to 64 ranks
+ * (a mask per node); -1 when out of memory. */
+static int split_borders(const rank_engine *re, const fdem_model *m, int32_t *node_owner)
+{
+    if (re->size > 64 || re->size < 2) return 0;
+    const int K = m->elem_nodes, N = m->node_count, P = re->size;
+    uint64_t *touch = calloc((size_t)N + 1, sizeof *touch);
+    int *pair_count = calloc((size_t)P * P * 2, sizeof(int));
+    if (!touch || !pair_count) {
+        free(touch), free(pair_count);
+        return -1;
+    }
+    int *pair_seen = pair_count + P * P;
+    for (int e = 0; e < m->elem_count; e++)
+        for (int c = 0; c < K; c++)
+            touch[m->elem_node[(size_t)K * e + c]] |= (uint64_t)1 << re->block_owner[block_of(re, e)];
+    for (int pass = 0; pass < 2; pass++)
+        for (int n = 0; n < N; n++) {
+            uint64_t t = touch[n];
+            if (__builtin_popcountll(t) != 2) continue;
+            int a = __builtin_ctzll(t), b = 63 - __builtin_clzll(t), k = a * P + b;
+            if (pass == 0) pair_count[k]++;
+            else node_owner[n] = pair_seen[k]++ < pair_count[k] / 2 ? a : b;
+        }
+    free(touch), free(pair_count);
+    return 0;
+}
+
+/* Node owners (the owner of the block of each node's first element, the
+ * border of two ranks split between them, rank 0 for a node of no
+ * element) and the marks of the elements this rank computes: its blocks'
+ * and those touching a node it owns. */
 static int assign_nodes_and_marks(rank_engine *re, const fdem_model *m, int32_t *node_owner)
 {
     const int K = m->elem_nodes, E = m->elem_count;
@@ -162,6 +253,7 @@ static int assign_nodes_and_marks(rank_engine *re, const fdem_model *m, int32_t 
             int32_t n = m->elem_node[(size_t)K * e + c];
             if (node_owner[n] < 0) node_owner[n] = re->block_owner[block_of(re, e)];
         }
+    if (split_borders(re, m, node_owner)) return -1;
     long owned_nodes = 0;
     for (int i = 0; i < m->node_count; i++) {
         if (node_owner[i] < 0) node_owner[i] = 0;
@@ -215,7 +307,11 @@ static int setup(rank_engine *re, fdem_model *m)
     re->mark = malloc((size_t)m->elem_count + 1);
     re->halo = malloc((size_t)m->elem_count + 1);
     int32_t *node_owner = malloc(sizeof(int32_t) * ((size_t)N + 1));
-    re->send_len = re->recv_len = (size_t)D * N + (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
+    re->split = plan->color_count && rank_halo_wanted(m, re->size);
+    /* the replicated update's buffers hold every force; the split one's
+     * only block sums (rank_halo.c has its own) */
+    re->send_len = re->recv_len = (re->split ? 0 : (size_t)D * N) +
+                                  (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
     re->send = malloc(sizeof(double) * re->send_len);
     re->recv = malloc(sizeof(double) * re->recv_len);
     int rc = -1;
@@ -236,7 +332,10 @@ static int setup(rank_engine *re, fdem_model *m)
         re->fig.computed_elements = m->elem_count;
         re->fig.owned_nodes = re->rank == 0 ? N : 0;
     } else {
-        assign_nodes_and_marks(re, m, node_owner);
+        if (assign_nodes_and_marks(re, m, node_owner)) goto done;
+        if (re->split && rank_halo_setup(&re->border, m, re->comm, node_owner, re->block_owner,
+                                         re->block_size))
+            goto done;
     }
     list_by_owner(re->block_owner, re->blocks, re->size, SCATTER_SUMS, re->block_order,
                   re->block_counts, re->block_displs);
@@ -249,9 +348,11 @@ static int setup(rank_engine *re, fdem_model *m)
     re->fig.blocks = re->blocks;
     re->fig.owned_blocks = re->block_counts[re->rank] / SCATTER_SUMS;
     const double others = re->size - 1;
-    re->fig.bytes_sent_per_step =
-        others * 8.0 * (re->node_counts[re->rank] +
-                        (m->elem_plan.color_count ? re->block_counts[re->rank] : 0));
+    const double sums = m->elem_plan.color_count ? re->block_counts[re->rank] : 0;
+    re->fig.bytes_sent_per_step = re->split ? re->border.bytes_per_step + others * 8.0 * sums
+                                            : others * 8.0 * (re->node_counts[re->rank] + sums);
+    re->fig.split_update = re->split;
+    re->fig.kept_nodes = re->split ? re->border.kept_nodes : N;
     rc = 0;
 done:
     free(node_owner);
@@ -278,26 +379,53 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
         rank_engine_free(re);
         return NULL;
     }
-    re->share = (step_share){re, re->mark, share_block_sums, share_forces_done};
-    re->halo_share = (step_share){re, re->halo, NULL, NULL};
+    re->share = (step_share){.ctx = re, .elem_mark = re->mark, .block_sums = share_block_sums,
+                             .forces_done = share_forces_done,
+                             .node_mark = re->split ? re->border.node_mark : NULL,
+                             .update_done = re->split ? share_update_done : NULL};
+    re->halo_share = (step_share){.ctx = re, .elem_mark = re->halo};
     if (m->elem_plan.color_count == 0) re->share.block_sums = NULL;
     return re;
 }
 
+/* A step that failed on this rank before the others' collectives of the
+ * step: it takes part in them saying so, so that none waits for it. */
+static void fail_collectives(rank_engine *re, fdem_model *m)
+{
+    if (!re->exchanged) {
+        if (re->split) rank_halo_exchange(&re->border, m, 0);
+        else exchange_forces(re, m, 0);
+    }
+    if (re->split && !re->agreed) {
+        int any = 1;
+        MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, re->comm);
+    }
+}
+
 int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
-    re->exchanged = 0;
+    re->exchanged = re->agreed = re->local_bad = re->others_bad = 0;
     if (re->size == 1) return fdem_step(m, err); /* nothing to share */
     m->share = &re->share; /* only while stepping: outside a step nothing is collective */
     int rc = fdem_step(m, err);
     m->share = NULL;
-    if (rc && !re->exchanged) exchange_forces(re, m, 0); /* the others wait there */
+    if (rc) fail_collectives(re, m);
+    if (rc && re->others_bad) /* this rank's nodes are finite: say whose are not */
+        model_error(err, FDEM_ITEM_NONE, -1, "the solution became non-finite at step %lld on "
+                    "another rank (t = %.6g s, dt = %.6g s; the stable step is %.6g s): reduce "
+                    "time.safety or check the material stiffness, penalty and applied loads",
+                    (long long)m->step + 1, m->time + m->dt, m->dt, m->stable_dt);
     return rc;
 }
 
 /* The viscous history of each block from its owner to rank 0. */
 int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err)
 {
+    if (re->split &&
+        rank_halo_gather(&re->border, m, re->node_order, re->node_counts, re->node_displs)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory gathering the ranks' nodes");
+        return -1;
+    }
     if (!m->elem_viscous || m->elem_plan.color_count == 0 || re->size == 1) return 0;
     const int C = model_stress_comps(m), me = re->rank;
     const size_t per_block = (size_t)C * re->block_size;
@@ -370,6 +498,11 @@ void rank_engine_lazy_free(rank_engine_lazy *lazy)
 
 rank_figures rank_engine_figures(const rank_engine *re) { return re->fig; }
 
+const uint8_t *rank_engine_node_mark(const rank_engine *re)
+{
+    return re->split ? re->border.node_mark : NULL;
+}
+
 /* Turning the fault on keeps only the owned blocks' marks in the pass
  * (the halo comes after, add_halo_after); it is never turned off. */
 void rank_engine_set_border_order_fault(rank_engine *re, int on)
@@ -391,5 +524,6 @@ void rank_engine_free(rank_engine *re)
     free(re->halo);
     free(re->send);
     free(re->recv);
+    if (re->split) rank_halo_free(&re->border);
     free(re);
 }

@@ -6,15 +6,18 @@
  *  - Every rank builds the same whole model (replicated set-up) and calls
  *    rank_engine_create with it, collectively; then rank_engine_step in
  *    place of fdem_step, collectively, every rank the same number of times.
- *  - After each step every rank holds the whole state (positions,
- *    velocities, joints, contact, energies) bit-identical to one process,
- *    except the elements' viscous history (elem_viscous), which only the
- *    ranks that compute an element keep: rank_engine_gather (collective)
+ *  - After each step every rank holds bit-identical to one process the
+ *    joints, contact, energies and the nodes it keeps (rank_engine_node_mark:
+ *    NULL when it keeps all); the elements' viscous history (elem_viscous)
+ *    only where an element is computed. rank_engine_gather (collective)
  *    makes rank 0's model whole before it writes output or a checkpoint.
  *  - What is split: the element forces (the element blocks of the model's
  *    scatter plan are partitioned with METIS; a rank computes the elements
- *    of its blocks and every element touching a node it owns). Joints,
- *    contact, fluid and the update run on every rank (see rank_engine.c).
+ *    of its blocks and every element touching a node it owns) and, in
+ *    models without contact, joints, fluid, stages, fixed parts or a
+ *    gravity amplitude (rank_halo.h), the update: a rank updates the nodes
+ *    it keeps and receives only border forces. Otherwise joints, contact,
+ *    fluid and the update run on every rank (see rank_engine.c).
  *  - Errors: -1 with err filled; an error on one rank fails the step on
  *    every rank (collective). MPI and METIS live only in runner/mpi.
  */
@@ -36,7 +39,10 @@ typedef struct rank_figures {
     long owned_nodes;
     double partition_seconds;   /* METIS on the block graph, rank 0 */
     double bytes_sent_per_step; /* this rank's share of the exchanges */
-    double exchange_seconds;    /* wall time in the step's two exchanges, all steps */
+    double exchange_seconds;    /* wall time in the step's exchanges, all steps */
+    double exchange_cpu_seconds; /* CPU time there (MPI polling), all steps */
+    int split_update;           /* 1: the update is split (rank_halo.h), 0: replicated */
+    long kept_nodes;            /* nodes this rank updates (all when replicated) */
 } rank_figures;
 
 rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err);
@@ -44,6 +50,7 @@ int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err);
 int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err);
 void rank_engine_free(rank_engine *re);
 rank_figures rank_engine_figures(const rank_engine *re);
+const uint8_t *rank_engine_node_mark(const rank_engine *re);
 
 /* The engine as a batch loop's stepper (runner/run_case.h's
  * runner_stepper: ctx = a rank_engine_lazy, step = rank_engine_lazy_step,

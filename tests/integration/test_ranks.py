@@ -72,6 +72,48 @@ def case_2d():
             "time": {"end": 1.0, "dt": "auto", "safety": 0.5}}
 
 
+def elastic_material():
+    return {"density": 2000, "young": 1e8, "poisson": 0.25, "damping": 0.3}
+
+
+def case_2d_elastic():
+    """One damped elastic block, no contact: the split update (border
+    forces only); 2160 triangles, three element blocks. Fixed on its left edge, pressed on top, absorbing on the right,
+    under gravity: the nodes every rank keeps."""
+    return {"name": "ranks-2d-elastic", "materials": {"rock": elastic_material()},
+            "parts": [{"name": "block", "material": "rock",
+                       "rectangle": {"origin": [0, 0], "size": [0.1, 0.1], "divisions": [36, 30]},
+                       "velocity": [3.0, -2.0]}],
+            "gravity": [0, -9.81],
+            "constraints": [{"box": [-0.001, -0.001, 0.001, 0.101], "fix": ["x", "y"]},
+                            {"box": [-0.001, 0.099, 0.101, 0.101], "pressure": 1e6},
+                            {"box": [0.099, -0.001, 0.101, 0.101], "absorb": True}],
+            "time": {"end": 1.0, "dt": "auto", "safety": 0.5}}
+
+
+def case_2d_blowing_up():
+    """The elastic block under a pressure it cannot take: non-finite at
+    step 6."""
+    case = case_2d_elastic()
+    case["name"] = "ranks-2d-blowing-up"
+    case["constraints"][1]["pressure"] = 1e12
+    return case
+
+
+def case_3d_elastic():
+    return {"name": "ranks-3d-elastic", "dimension": 3,
+            "materials": {"rock": elastic_material()},
+            "parts": [{"name": "block", "material": "rock",
+                       "box": {"origin": [0, 0, 0], "size": [0.1, 0.1, 0.1],
+                               "divisions": [7, 7, 7]},
+                       "velocity": [3.0, -2.0, 1.0]}],
+            "constraints": [{"box": [-0.001, -0.001, -0.001, 0.001, 0.101, 0.101],
+                             "fix": ["x", "y", "z"]},
+                            {"box": [-0.001, -0.001, 0.099, 0.101, 0.101, 0.101],
+                             "pressure": 1e6}],
+            "time": {"end": 1.0, "dt": "auto", "safety": 0.5}}
+
+
 def case_3d():
     return {"name": "ranks-3d", "dimension": 3, "materials": {"rock": material()},
             "parts": [{"name": "left", "material": "rock",
@@ -82,6 +124,13 @@ def case_3d():
                        "box": {"origin": [0.00002, 0.035, 0.035], "size": [0.03, 0.03, 0.03],
                                "divisions": [3, 3, 3]}}],
             "time": {"end": 1.0, "dt": "auto", "safety": 0.5}}
+
+
+def same_failure(lines):
+    """The lines without the element a failure names: each rank looks for
+    the first non-finite value among the nodes it updates, one process
+    among all."""
+    return [l.split(" in element")[0] if " failed: " in l else l for l in lines]
 
 
 class RanksSameBits(unittest.TestCase):
@@ -97,25 +146,38 @@ class RanksSameBits(unittest.TestCase):
             raise unittest.SkipTest("mpirun not found (openmpi-bin, scripts/install-deps.sh)")
         cls.tmp = tempfile.mkdtemp(prefix="fdem-ranks-")
         cls.cases = []
-        for name, doc in (("2d", case_2d()), ("3d", case_3d())):
+        for name, doc in (("2d", case_2d()), ("3d", case_3d()), ("2d-elastic", case_2d_elastic()),
+                          ("3d-elastic", case_3d_elastic())):
             path = os.path.join(cls.tmp, name + ".json")
             with open(path, "w") as f:
                 json.dump(doc, f)
             cls.cases.append(path)
+        # the last case must fail (rank_compare --expect-failure), on every
+        # rank count at the same step
+        cls.blowing = os.path.join(cls.tmp, "2d-blowing-up.json")
+        with open(cls.blowing, "w") as f:
+            json.dump(case_2d_blowing_up(), f)
+        cls.failing = ["--expect-failure", cls.blowing]
         cls.checkpoint = os.path.join(cls.tmp, "2d-step10-3-ranks.bin")
+        cls.checkpoint_split = os.path.join(cls.tmp, "2d-elastic-step10-3-ranks.bin")
+        cls.stderr = {}
         cls.plain = cls.run_ranks(0, "--plain")
-        # 2 ranks of 2 threads each; the 3-rank run saves the 2D case after
-        # step 10 ("--save-at 0 -" then turns saving off for the 3D case)
+        # 2 ranks of 2 threads each; the 3-rank run saves the 2D cases after
+        # step 10 ("--save-at 0 -" then turns saving off for the 3D cases)
         cls.ranked = {2: cls.run_ranks(2, "--threads", "2"),
                       3: cls.run_ranks(3, cases=["--save-at", "10", cls.checkpoint, cls.cases[0],
-                                                 "--save-at", "0", "-", cls.cases[1]])}
+                                                 "--save-at", "0", "-", cls.cases[1],
+                                                 "--save-at", "10", cls.checkpoint_split,
+                                                 cls.cases[2], "--save-at", "0", "-",
+                                                 cls.cases[3]] + cls.failing)}
         if not SANITIZED:  # the same code paths as 2 and 3 ranks, for ASan
             cls.ranked[1] = cls.run_ranks(1)
             cls.ranked[4] = cls.run_ranks(4)
         if FULL:
             cls.ranked[8] = cls.run_ranks(8)
             cls.ranked["2, one thread"] = cls.run_ranks(2)
-        cls.restarted = cls.run_ranks(2, "--restore", cls.checkpoint, cases=cls.cases[:1])
+        cls.restarted = cls.run_ranks(2, cases=["--restore", cls.checkpoint, cls.cases[0],
+                                                "--restore", cls.checkpoint_split, cls.cases[2]])
         cls.fault = cls.run_ranks(4, "--fault")
 
     @classmethod
@@ -125,26 +187,45 @@ class RanksSameBits(unittest.TestCase):
     @classmethod
     def run_ranks(cls, ranks, *flags, cases=None):
         """The driver's lines on `ranks` ranks (0: one process, no mpirun)."""
-        cmd = [cls.exe, STEPS, EVERY] + list(flags) + (cases or cls.cases)
+        cmd = [cls.exe, STEPS, EVERY] + list(flags) + (cases or cls.cases + cls.failing)
         if ranks:
             cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd
         p = subprocess.run(cmd, env=mpi_env(), capture_output=True, text=True, timeout=300)
         if p.returncode:
             raise AssertionError("%s failed (%d): %s %s" % (" ".join(cmd), p.returncode,
                                                            p.stdout[-2000:], p.stderr[-2000:]))
+        cls.stderr[(ranks,) + flags] = p.stderr
         return p.stdout.splitlines()
+
+    def case_lines(self, lines, case):
+        """The lines of one case: its "case" line and its steps."""
+        start = lines.index("case " + case)
+        rest = [i for i, l in enumerate(lines) if l.startswith("case ") and i > start]
+        return lines[start:rest[0] if rest else len(lines)]
 
     def test_plain_run_contacts_and_breaks(self):
         """The cases exercise what the comparison claims: every state line
-        differs from the last, contact forces act and joints break."""
-        lines = [l for l in self.plain if l.startswith("step")]
-        self.assertEqual(len(lines), 2 * int(STEPS) // int(EVERY))
-        for half in (lines[:len(lines) // 2], lines[len(lines) // 2:]):
-            states = [l.split()[3] for l in half]
+        differs from the last; in the first two contact forces act and
+        joints break, in the elastic ones the block deforms."""
+        for k, case in enumerate(self.cases):
+            lines = self.case_lines(self.plain, case)[1:]
+            self.assertEqual(len(lines), int(STEPS) // int(EVERY))
+            states = [l.split()[3] for l in lines]
             self.assertEqual(len(set(states)), len(states))
-            last = half[-1].split()
-            self.assertGreater(int(last[last.index("broken") + 1]), 0, half[-1])
-            self.assertGreater(int(last[last.index("contacts") + 1]), 0, half[-1])
+            last = lines[-1].split()
+            if k < 2:
+                self.assertGreater(int(last[last.index("broken") + 1]), 0, lines[-1])
+                self.assertGreater(int(last[last.index("contacts") + 1]), 0, lines[-1])
+            else:
+                self.assertGreater(float(last[last.index("elastic") + 1]), 0, lines[-1])
+
+    def test_update_split_without_contact(self):
+        """The elastic cases ran the split update (border forces only), the
+        contact cases the replicated one: the comparison covers both."""
+        err = self.stderr[(2, "--threads", "2")]
+        for k, case in enumerate(self.cases):
+            mode = "split" if k >= 2 else "replicated"
+            self.assertIn("update %s: %s" % (mode, case), err)
 
     def test_same_bits_on_1_2_3_4_ranks(self):
         """(and 8, and 2 of one thread, with FDEM_RANKS_FULL=1: make test-ranks;
@@ -153,14 +234,32 @@ class RanksSameBits(unittest.TestCase):
             with self.subTest(ranks=ranks):
                 if ranks == 3:  # the line of the step it saved after
                     lines = [l for l in lines if not l.startswith("step 10 ")]
-                self.assertEqual(lines, self.plain)
+                self.assertEqual(same_failure(lines), same_failure(self.plain))
 
     def test_checkpoint_of_3_ranks_restarts_on_2(self):
-        """The 2D case saved after step 10 on 3 ranks and restarted from that
-        checkpoint on 2 goes on with the plain run's bits."""
-        plain_2d = self.plain[:self.plain.index("case " + self.cases[1])]
-        self.assertEqual(self.restarted, [plain_2d[0]] + [
-            l for l in plain_2d if l.startswith("step") and int(l.split()[1]) > 10])
+        """The 2D cases (replicated and split update) saved after step 10 on
+        3 ranks and restarted from that checkpoint on 2 go on with the plain
+        run's bits."""
+        expected = []
+        for case in (self.cases[0], self.cases[2]):
+            lines = self.case_lines(self.plain, case)
+            expected += [lines[0]] + [l for l in lines[1:] if int(l.split()[1]) > 10]
+        self.assertEqual(self.restarted, expected)
+
+    def test_a_non_finite_step_fails_every_rank_together(self):
+        """A split run that goes non-finite (on 1, 2, 3 and 4 ranks) fails on
+        every rank at the step one process fails, with its bits until then,
+        and the run goes on to end (no rank left waiting in a collective). Here every rank sees it at once (the
+        elastic energy, totalled from all blocks, is not finite); a value
+        going non-finite on one rank's nodes alone reaches the others
+        through the update's verdict (step_share.update_done), which this
+        case does not single out."""
+        plain = self.case_lines(self.plain, self.blowing)
+        self.assertRegex(plain[-1], r"^step 6 failed: the solution became non-finite at step 6 ")
+        for ranks, lines in self.ranked.items():
+            with self.subTest(ranks=ranks):
+                self.assertEqual(same_failure(self.case_lines(lines, self.blowing)),
+                                 same_failure(plain))
 
     def test_border_sums_in_another_order_differ(self):
         """Each rank adding its halo elements after its own blocks forms

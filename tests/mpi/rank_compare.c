@@ -11,6 +11,9 @@
  *   rank_compare STEPS EVERY [--plain] [--threads T] [--fault] [--figures]
  *                CASE.json...   (flags apply to the cases after them)
  *
+ * --expect-failure: the cases after it must fail (a non-finite step):
+ * the run then passes, and its lines say where they failed.
+ *
  * --save-at K FILE writes the checkpoint after step K (one file: use it
  * with one case); --restore FILE starts every rank from one, so a run
  * saved on N ranks goes on on M.
@@ -76,20 +79,35 @@ static double peak_bytes(void)
     return kb * 1024;
 }
 
-/* Whether every rank holds rank 0's positions and velocities. */
-static int ranks_agree(const fdem_model *m, MPI_Comm comm)
+/* Whether every rank holds, of every node it keeps (mark; NULL: all),
+ * the position and velocity rank 0 holds after the gather. */
+static int ranks_agree(const fdem_model *m, const uint8_t *mark, MPI_Comm comm)
 {
     fdem_counts c = fdem_get_counts(m);
-    size_t bytes = sizeof(double) * (size_t)c.dimension * (size_t)c.nodes;
-    uint64_t h = fnv1a(fdem_positions(m), bytes, 1469598103934665603ull);
-    h = fnv1a(fdem_velocities(m), bytes, h);
-    uint64_t least[2] = {h, ~h}; /* the smallest h and the largest, in one reduction */
-    MPI_Allreduce(MPI_IN_PLACE, least, 2, MPI_UINT64_T, MPI_MIN, comm);
-    return least[0] == ~least[1];
+    const size_t D = (size_t)c.dimension, n = D * (size_t)c.nodes;
+    double *x = malloc(sizeof(double) * (2 * n + 1));
+    int rank, same = x != NULL;
+    MPI_Comm_rank(comm, &rank);
+    MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_MIN, comm);
+    if (!same) return free(x), 0;
+    if (rank == 0) {
+        memcpy(x, fdem_positions(m), sizeof(double) * n);
+        memcpy(x + n, fdem_velocities(m), sizeof(double) * n);
+    }
+    MPI_Bcast(x, (int)(2 * n), MPI_DOUBLE, 0, comm);
+    const double *pos = fdem_positions(m), *vel = fdem_velocities(m);
+    for (int i = 0; i < c.nodes; i++)
+        if (!mark || mark[i])
+            same &= !memcmp(pos + D * i, x + D * i, sizeof(double) * D) &&
+                    !memcmp(vel + D * i, x + n + D * i, sizeof(double) * D);
+    free(x);
+    MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_MIN, comm);
+    return same;
 }
 
 typedef struct compare_options {
     int steps, every, plain, fault, threads, figures;
+    int expect_failure;       /* the cases must fail at some step (and then pass) */
     int save_at;              /* the step after which rank 0 writes save_path; 0: none */
     const char *save_path;
     const char *restore_path; /* a checkpoint every rank starts from; NULL: step 0 */
@@ -144,19 +162,22 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     }
     const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
     /* the batch loop's way (made at the first step), but for the fault,
-     * which is set before it */
+     * which is set before it, and the figures, which time steps only */
     rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
-    if (!plain && o->fault) {
+    double t_setup = MPI_Wtime();
+    if (!plain && (o->fault || figures)) {
         if (!(lazy.re = rank_engine_create(m, MPI_COMM_WORLD, &err))) {
             fprintf(stderr, "rank %d: %s\n", rank, err.message);
             MPI_Abort(MPI_COMM_WORLD, 2);
         }
         lazy.model = m;
-        rank_engine_set_border_order_fault(lazy.re, 1);
+        if (o->fault) rank_engine_set_border_order_fault(lazy.re, 1);
     }
+    t_setup = MPI_Wtime() - t_setup;
     if (rank == 0) printf("case %s\n", path);
     int status = 0;
     double t_step = 0, c_step = 0;
+    int told = 0;
     for (int s = first; s <= steps && !status; s++) {
         double ts = MPI_Wtime(), cs = cpu_seconds();
         int rc = plain ? fdem_step(m, &err) : rank_engine_lazy_step(&lazy, m, &err);
@@ -168,8 +189,13 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
             break;
         }
         if (s % every && s != steps && s != o->save_at) continue;
-        int agree = plain || ranks_agree(m, MPI_COMM_WORLD);
         if (!plain && rank_engine_lazy_gather(&lazy, m, &err)) status = 1;
+        int agree = plain || ranks_agree(m, lazy.re ? rank_engine_node_mark(lazy.re) : NULL,
+                                         MPI_COMM_WORLD);
+        if (!plain && !told++ && rank == 0) /* which update ran, for the test */
+            fprintf(stderr, "update %s: %s\n",
+                    lazy.re && rank_engine_figures(lazy.re).split_update ? "split" : "replicated",
+                    path);
         if (rank == 0) {
             if (!agree) printf("step %d ranks disagree\n", s);
             print_state(m, s);
@@ -181,14 +207,19 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         double most = f.bytes_sent_per_step, step_s = t_step / steps;
         MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        /* work: the CPU outside the exchanges, where MPI polls for a
+         * partner (load-independent where the CPU a step is not) */
         fprintf(stderr, "rank %d: blocks %d of %d, elements owned %ld computed %ld (halo %.3f), "
-                "nodes owned %ld, bytes sent/step %.0f, partition %.4f s, build %.2f s, "
-                "step %.6f s (cpu %.6f s, exchanges %.6f s), peak %.0f bytes/element\n", rank, f.owned_blocks, f.blocks, f.owned_elements,
-                f.computed_elements,
+                "nodes owned %ld kept %ld (update %s), bytes sent/step %.0f, "
+                "partition %.4f s, engine set-up %.2f s, build %.2f s, step %.6f s (cpu %.6f s, "
+                "exchanges %.6f s, cpu there %.6f s: work %.6f s), peak %.0f bytes/element\n",
+                rank, f.owned_blocks, f.blocks, f.owned_elements, f.computed_elements,
                 f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
                                        (double)f.owned_elements : 0.0,
-                f.owned_nodes, f.bytes_sent_per_step, f.partition_seconds, t_build,
-                t_step / steps, c_step / steps, f.exchange_seconds / steps,
+                f.owned_nodes, f.kept_nodes, f.split_update ? "split" : "replicated",
+                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build, t_step / steps,
+                c_step / steps, f.exchange_seconds / steps, f.exchange_cpu_seconds / steps,
+                (c_step - f.exchange_cpu_seconds) / steps,
                 peak_bytes() / fdem_get_counts(m).elements);
         if (rank == 0)
             printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
@@ -225,13 +256,18 @@ int main(int argc, char **argv)
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--plain")) o.plain = 1;
         else if (!strcmp(argv[i], "--fault")) o.fault = 1;
+        else if (!strcmp(argv[i], "--expect-failure")) o.expect_failure = 1;
         else if (!strcmp(argv[i], "--figures")) o.figures = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--save-at") && i + 2 < argc) {
             o.save_at = atoi(argv[++i]);
             o.save_path = argv[++i];
         } else if (!strcmp(argv[i], "--restore") && i + 1 < argc) o.restore_path = argv[++i];
-        else status |= run_case(argv[i], &o, rank, size);
+        else if (o.expect_failure) { /* its lines say where it failed; not failing fails */
+            int failed = run_case(argv[i], &o, rank, size);
+            if (!failed && rank == 0) printf("no step failed\n");
+            status |= !failed;
+        } else status |= run_case(argv[i], &o, rank, size);
     }
     MPI_Finalize();
     return status;
