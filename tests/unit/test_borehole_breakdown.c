@@ -1,33 +1,35 @@
 /*
- * test_borehole_breakdown.c - the breakdown of a pressurised borehole under
- * anisotropic in-situ stress against Hubbert & Willis (1957), issue 36:
- * the bore's wall cracks when its hoop stress, 3 sigma_h - sigma_H - p
- * (compression positive, Kirsch plus Lame at theta = 0, the direction of
- * sigma_H), falls to -T, i.e. at
+ * test_borehole_breakdown.c - the breakdown of a borehole fed with fluid
+ * under anisotropic in-situ stress, against Hubbert & Willis (1957),
+ * issue 36: the bore's wall cracks when its hoop stress,
+ * 3 sigma_h - sigma_H - p (compression positive, Kirsch plus Lame at
+ * theta = 0, the direction of sigma_H), falls to -T, i.e. at
  *     p_b = 3 sigma_h - sigma_H + T,
- * for a fluid that does not enter the rock (the pressure loads the wall
- * only), and the crack runs along sigma_H, normal to the least stress.
+ * for a fluid that does not enter the rock (an intact wall is sealed), and
+ * the crack runs along sigma_H, normal to the least stress.
  *
  * The model is examples/borehole-breakdown.json as it is committed (so the
  * example is what is checked): a disc of radius 10 a around a bore of
  * a = 0.1 m, sigma_H = 15 MPa along x, sigma_h = 10 MPa, joints of
- * T = 5 MPa within r < 0.35 m, the bore drilled over 0.3 ms and its
- * pressure ramped 0 -> 30 MPa over 1.5 ms (20 MPa/ms, slow against the
- * 36 us a wave takes to cross the bore's radius): p_b = 20 MPa, reached at
- * 1 ms. The ramp and the pressure are read from the document.
+ * T = 5 MPa within |x|, |y| < 0.6 m, the bore drilled over 0.3 ms, and
+ * fluid injected into the bore (constraint 0: "inject" with "bore": true)
+ * at a constant rate, so its pressure rises by about 20 MPa/ms:
+ * p_b = 20 MPa near 1 ms. The bore's pressure is the injection's source
+ * pressure.
  *
- * Measured: the pressure when the first joint on the wall starts to soften
- * (damage > 0) and when the first one breaks (damage 1, the breakdown);
- * then, at the ramp's end (30 MPa, 1.5 p_b), the broken joints'
- * orientation (the principal axis of their centres) and extent along x
- * against y. Measured 2026-12-06: softening from 18.76 MPa (-6.2 %), the
- * first wall joint broken at 21.96 MPa (+9.8 %), 20 broken joints at
- * 30 MPa on both sides, their axis 0.0 deg from x, reaching |x| = 0.151 m
- * (|y| <= 0.015 m). The broken figure lags by the cohesive zone
- * (E' G_I / T^2 = 0.017 m, 0.17 a): with G_I = 5 J/m^2 (0.04 a) the first
- * joint breaks at 19.22 MPa (-3.9 %); 96 sectors instead of 64 give
- * 19.07 / 22.21 MPa; a ramp half as fast 18.57 / 21.61 MPa
- * (FDEM_BOREHOLE_CASE runs such a variant). 2.8 s of CPU.
+ * Measured: the peak of the bore's pressure (the breakdown), the pressure
+ * when the first wall joint starts to soften (damage > 0) and breaks, the
+ * least pressure after the peak (the cracks take the fluid faster than
+ * the pump brings it), and at the end the broken joints' orientation
+ * (the principal axis of their centres), extent and mean pressure (the
+ * fluid followed the cracks). Measured 2026-12-06: peak 18.92 MPa at
+ * 0.81 ms (-5.4 %), the first wall joint softening at 18.89 MPa and
+ * broken at 18.85 MPa at theta = 0, the pressure down to 15.49 MPa by
+ * 1.5 ms; 60 broken joints on both sides, their axis 0.2 deg from x,
+ * reaching |x| = 0.603 m (|y| <= 0.034 m), holding fluid at 11.6 MPa.
+ * 4.5 s of CPU. FDEM_BOREHOLE_CASE runs another document (a finer mesh,
+ * another fluid, for docs/physics.md); FDEM_BOREHOLE_TRACE prints the
+ * curve every 50 us.
  */
 #include <jansson.h>
 #include <math.h>
