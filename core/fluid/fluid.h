@@ -96,6 +96,7 @@ typedef struct fluid_net {
      * model the force the bore's pressure put on each of its nodes */
     int32_t *bore_constraint;
     double *bore_origin;  /* dim per bore */
+    double *bore_axis;    /* dim per bore: the axis a slab's wall is open along, else 0 */
     double *wall_force;   /* dim per boundary facet (bores' facets only) */
     /* the wall's corners: each wall vertex (node_origin) is one corner, at
      * the mean of the node copies on the wall there (a fracturing part

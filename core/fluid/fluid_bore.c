@@ -17,8 +17,12 @@
  *  - its volume, by the divergence theorem on the corners' current
  *    positions, V = -(1/dim) sum (c - o) . S over the facets (S the area
  *    vector pointing out of the rock, c the centroid, o a fixed point: the
- *    wall's centroid at t = 0 for a closed wall, the origin for one a
- *    symmetry plane cuts, whose planes must then pass through the origin);
+ *    wall's centroid at t = 0 for a closed wall); a 3D wall open at a rim
+ *    in planes normal to one axis e (a bore through a slab between
+ *    rollers, a bore cut by one symmetry plane) takes the part of c - o
+ *    normal to e and 1/(dim - 1), so the missing caps add nothing; any
+ *    other open wall is measured from the origin, which its cuts must
+ *    then pass through (bore_measure_frame);
  *  - its forces, -p S / dim on each node of each facet (into the rock),
  *    and their power for fluid_work;
  *  - its links: a wall facet's keys (2D its vertices, 3D its edges) link
@@ -33,6 +37,7 @@
 
 #include "model/model.h"
 #include "joint/joint.h"
+#include "math/vec3.h"
 #include "fluid.h"
 
 static int is_bore(const constraint *c)
@@ -128,8 +133,9 @@ int fluid_bores_count(fdem_model *m, fluid_net *f, fdem_error *err)
     const size_t D = (size_t)m->dim;
     f->bore_constraint = malloc(sizeof(int32_t) * (size_t)bores);
     f->bore_origin = calloc(D * (size_t)bores, sizeof(double));
+    f->bore_axis = calloc(D * (size_t)bores, sizeof(double));
     f->wall_force = calloc(D * (size_t)(m->bfacet_count ? m->bfacet_count : 1), sizeof(double));
-    if (!f->bore_constraint || !f->bore_origin || !f->wall_force) {
+    if (!f->bore_constraint || !f->bore_origin || !f->bore_axis || !f->wall_force) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the bores");
         return -1;
     }
@@ -142,19 +148,125 @@ int fluid_bores_count(fdem_model *m, fluid_net *f, fdem_error *err)
     return 0;
 }
 
-/* The space bore b's wall encloses, on the current positions. */
+/* The space bore b's wall encloses, on the current positions: the
+ * divergence theorem on x - o, or, for a wall open along an axis e, on its
+ * part normal to e (divergence dim - 1), whose flux through the missing
+ * caps is zero. */
 static double bore_volume(const fdem_model *m, const fluid_net *f, int b)
 {
     const int D = m->dim;
     const constraint *c = &m->constraints[f->bore_constraint[b]];
-    const double *o = f->bore_origin + D * b;
+    const double *o = f->bore_origin + D * b, *e = f->bore_axis + D * b;
+    const int slab = e[0] != 0 || e[1] != 0 || (D == 3 && e[2] != 0);
     double sum = 0;
     for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++) {
-        double s[3], x[3];
+        double s[3], x[3], along = 0;
         facet_geometry(m, f, j, s, x);
-        for (int d = 0; d < D; d++) sum += (x[d] - o[d]) * s[d];
+        for (int d = 0; d < D; d++) x[d] -= o[d];
+        for (int d = 0; slab && d < D; d++) along += x[d] * e[d];
+        for (int d = 0; d < D; d++) sum += (x[d] - along * e[d]) * s[d];
     }
-    return -sum / D;
+    return -sum / (slab ? D - 1 : D);
+}
+
+static int pair_compare(const void *pa, const void *pb)
+{
+    const int32_t *a = pa, *b = pb;
+    if (a[0] != b[0]) return a[0] < b[0] ? -1 : 1;
+    return (a[1] > b[1]) - (a[1] < b[1]);
+}
+
+/* A 3D wall's rim: the corner pairs of its facets' edges that only one
+ * wall facet has (none for a closed wall). Returns their count, the edges
+ * into rim (2 corners each; room for 3 per facet). */
+static int wall_rim_3d(const fluid_net *f, const constraint *c, int32_t *rim)
+{
+    int n = 0;
+    for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++)
+        for (int a = 0; a < 3; a++) {
+            int32_t p = f->wall_corner[3 * (size_t)j + a], q = f->wall_corner[3 * (size_t)j + (a + 1) % 3];
+            rim[2 * n] = p < q ? p : q;
+            rim[2 * n + 1] = p < q ? q : p;
+            n++;
+        }
+    /* keep the pairs that occur once */
+    qsort(rim, (size_t)n, 2 * sizeof *rim, pair_compare);
+    int kept = 0;
+    for (int i = 0; i < n;) {
+        int k = i + 1;
+        while (k < n && rim[2 * k] == rim[2 * i] && rim[2 * k + 1] == rim[2 * i + 1]) k++;
+        if (k == i + 1) {
+            rim[2 * kept] = rim[2 * i];
+            rim[2 * kept + 1] = rim[2 * i + 1];
+            kept++;
+        }
+        i = k;
+    }
+    return kept;
+}
+
+/* The unit axis every rim edge is normal to, 0 when there is none. */
+static int rim_axis(const fluid_net *f, const int32_t *rim, int n, double axis[3])
+{
+    double best = 0;
+    for (int i = 0; i < n; i++)
+        for (int k = i + 1; k < n; k++) {
+            double u[3], v[3], w[3];
+            vec3_sub(f->corner_pos + 3 * (size_t)rim[2 * i + 1], f->corner_pos + 3 * (size_t)rim[2 * i], u);
+            vec3_sub(f->corner_pos + 3 * (size_t)rim[2 * k + 1], f->corner_pos + 3 * (size_t)rim[2 * k], v);
+            vec3_cross(u, v, w);
+            double size = vec3_dot(w, w) / (vec3_dot(u, u) * vec3_dot(v, v));
+            if (size > best) {
+                best = size;
+                memcpy(axis, w, sizeof(double) * 3);
+            }
+        }
+    if (!(best > 1e-6)) return 0;
+    double len = sqrt(vec3_dot(axis, axis));
+    for (int d = 0; d < 3; d++) axis[d] /= len;
+    for (int i = 0; i < n; i++) {
+        double u[3];
+        vec3_sub(f->corner_pos + 3 * (size_t)rim[2 * i + 1], f->corner_pos + 3 * (size_t)rim[2 * i], u);
+        if (fabs(vec3_dot(u, axis)) > 1e-9 * sqrt(vec3_dot(u, u))) return 0;
+    }
+    return 1;
+}
+
+/* How bore b's volume is measured (bore_volume): a closed wall from its
+ * centroid; a 3D wall whose open rim lies in planes normal to one axis e
+ * (a slab's bore between rollers, a bore cut by one symmetry plane) from
+ * its centroid, normal to e; any other open wall from the origin, which
+ * its cuts must pass through (docs/case-format.md). */
+static void bore_measure_frame(const fdem_model *m, fluid_net *f, int b, const double *centre)
+{
+    const int D = m->dim;
+    const constraint *c = &m->constraints[f->bore_constraint[b]];
+    double *o = f->bore_origin + D * b, *e = f->bore_axis + D * b;
+    int open = 0;
+    for (int d = 0; d < D; d++) {
+        o[d] = centre[d];
+        e[d] = 0;
+    }
+    if (D == 2) {
+        for (int k = 0; k < f->corner_count; k++) {
+            int uses = 0;
+            for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++)
+                uses += f->wall_corner[2 * (size_t)j] == k || f->wall_corner[2 * (size_t)j + 1] == k;
+            open |= uses == 1;
+        }
+    } else {
+        int32_t *rim = malloc(sizeof(int32_t) * 6 * (size_t)c->facet_count);
+        int n = rim ? wall_rim_3d(f, c, rim) : 0;
+        double axis[3] = {0, 0, 0};
+        open = n > 0 || !rim;
+        int slab = n > 1 && rim_axis(f, rim, n, axis);
+        free(rim);
+        if (slab) {
+            memcpy(e, axis, sizeof axis);
+            return;
+        }
+    }
+    for (int d = 0; open && d < D; d++) o[d] = 0;
 }
 
 /* Each bore's origin (see the top of the file), centre (the mean of its
@@ -167,19 +279,14 @@ void fluid_bores_init(fdem_model *m, fluid_net *f)
     for (int b = 0; b < f->bores; b++) {
         const constraint *c = &m->constraints[f->bore_constraint[b]];
         const int cav = f->joints + b;
-        double net[3] = {0, 0, 0}, size = 0, *centre = f->centre + D * cav;
+        double *centre = f->centre + D * cav;
         for (int d = 0; d < D; d++) centre[d] = 0;
         for (int j = c->facet_begin; j < c->facet_begin + c->facet_count; j++) {
             double s[3], x[3];
             facet_geometry(m, f, j, s, x);
-            for (int d = 0; d < D; d++) {
-                net[d] += s[d];
-                centre[d] += x[d] / c->facet_count;
-            }
-            size += sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+            for (int d = 0; d < D; d++) centre[d] += x[d] / c->facet_count;
         }
-        int closed = sqrt(net[0] * net[0] + net[1] * net[1] + net[2] * net[2]) <= 1e-9 * size;
-        for (int d = 0; d < D; d++) f->bore_origin[D * b + d] = closed ? centre[d] : 0;
+        bore_measure_frame(m, f, b, centre);
         f->wet[cav] = 1;
         f->floor[cav] = 0;
         f->pressure[cav] = 0;

@@ -55,7 +55,7 @@ void fluid_free(fdem_model *m)
     free(f->link_begin); free(f->link_of); free(f->open_list); free(f->active);
     free(f->source_joint); free(f->source_constraint); free(f->source_share);
     free(f->constraint_injected);
-    free(f->bore_constraint); free(f->bore_origin); free(f->wall_force);
+    free(f->bore_constraint); free(f->bore_origin); free(f->bore_axis); free(f->wall_force);
     free(f->wall_corner); free(f->corner_begin); free(f->corner_node); free(f->corner_pos);
     free(f);
     m->fluid = NULL;
@@ -67,7 +67,7 @@ size_t fluid_memory_bytes(const fdem_model *m)
     if (!f) return 0;
     size_t D = (size_t)m->dim, J = (size_t)f->cavities, B = (size_t)f->bores;
     size_t facets = (size_t)m->bfacet_count + 1, corners = (size_t)f->corner_count + 1;
-    size_t bores = B ? B * (sizeof(int32_t) + D * sizeof(double)) +
+    size_t bores = B ? B * (sizeof(int32_t) + 2 * D * sizeof(double)) +
                            D * facets * (sizeof(double) + 2 * sizeof(int32_t)) +
                            corners * (sizeof(int32_t) + D * sizeof(double))
                      : 0;

@@ -59,30 +59,32 @@ static fdem_model *network(const char *doc)
 
 /* Cell (i, j, k) of an n-cell square (cube) is in the hole: the middle
  * 2 x 2 (x 2) cells. */
-static int in_hole(int dim, int n, const int *c)
+static int in_hole(int dim, int n, const int *c, int slab)
 {
     int in = 1;
-    for (int d = 0; d < dim; d++) in &= c[d] == n / 2 - 1 || c[d] == n / 2;
+    for (int d = 0; d < (slab ? 2 : dim); d++) in &= c[d] == n / 2 - 1 || c[d] == n / 2;
     return in;
 }
 
-static int grid_node(json_t *nodes, int *index, int dim, int n, const int *c)
+static int grid_node(json_t *nodes, int *index, int dim, int n, const int *c, int slab)
 {
     int key = c[0] + (n + 1) * (c[1] + (dim == 3 ? (n + 1) * c[2] : 0));
     if (index[key] < 0) {
         json_t *x = json_array();
-        for (int d = 0; d < dim; d++) json_array_append_new(x, json_real(-0.5 + (double)c[d] / n));
+        for (int d = 0; d < dim; d++)
+            json_array_append_new(x, json_real(d == 2 && slab ? c[d] - 0.5 : -0.5 + (double)c[d] / n));
         index[key] = (int)json_array_size(nodes);
         json_array_append_new(nodes, x);
     }
     return index[key];
 }
 
-static json_t *cell_element(json_t *nodes, int *index, int dim, int n, int corners[][3], int count)
+static json_t *cell_element(json_t *nodes, int *index, int dim, int n, int corners[][3], int count,
+                            int slab)
 {
     json_t *e = json_array();
     for (int i = 0; i < count; i++)
-        json_array_append_new(e, json_integer(grid_node(nodes, index, dim, n, corners[i])));
+        json_array_append_new(e, json_integer(grid_node(nodes, index, dim, n, corners[i], slab)));
     return e;
 }
 
@@ -90,23 +92,24 @@ static json_t *cell_element(json_t *nodes, int *index, int dim, int n, int corne
  * its middle 2 x 2 (x 2) cells: the elements of a fracturing part
  * (triangles; 3D the six Kuhn tetrahedra of each cell, as
  * examples/penny_mesh.py), a bore fed at Q with "bore": true on the box
- * around the hole (it selects the hole's wall and nothing else). */
-static char *bore_doc(int dim, double Q)
+ * around the hole (it selects the hole's wall and nothing else). A slab
+ * (3D) is one cell of 1 m in z, the hole through it, open at its faces. */
+static char *bore_doc_of(int dim, double Q, int slab)
 {
     const int n = dim == 3 ? BORE_CELLS_3D : BORE_CELLS_2D;
     int *index = malloc(sizeof(int) * (size_t)((n + 1) * (n + 1) * (n + 1)));
     for (int i = 0; i < (n + 1) * (n + 1) * (n + 1); i++) index[i] = -1;
     json_t *nodes = json_array(), *elements = json_array();
-    for (int k = 0; k < (dim == 3 ? n : 1); k++)
+    for (int k = 0; k < (dim == 3 ? (slab ? 1 : n) : 1); k++)
         for (int j = 0; j < n; j++)
             for (int i = 0; i < n; i++) {
                 int c[3] = {i, j, k};
-                if (in_hole(dim, n, c)) continue;
+                if (in_hole(dim, n, c, slab)) continue;
                 if (dim == 2) {
                     int t0[3][3] = {{i, j}, {i + 1, j}, {i + 1, j + 1}};
                     int t1[3][3] = {{i, j}, {i + 1, j + 1}, {i, j + 1}};
-                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t0, 3));
-                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t1, 3));
+                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t0, 3, 0));
+                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t1, 3, 0));
                     continue;
                 }
                 static const int orders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
@@ -117,7 +120,7 @@ static char *bore_doc(int dim, double Q)
                         memcpy(path[s + 1], path[s], sizeof path[s]);
                         path[s + 1][orders[o][s]] += orders[o][s] == 0 ? -1 : 1;
                     }
-                    json_array_append_new(elements, cell_element(nodes, index, 3, n, path, 4));
+                    json_array_append_new(elements, cell_element(nodes, index, 3, n, path, 4, slab));
                 }
             }
     free(index);
@@ -132,8 +135,8 @@ static char *bore_doc(int dim, double Q)
     char inject[160];
     if (dim == 3)
         snprintf(inject, sizeof inject,
-                 "[{'box': [%g, %g, %g, %g, %g, %g], 'inject': %g, 'bore': true}]", -e, -e, -e, e,
-                 e, e, Q);
+                 "[{'box': [%g, %g, %g, %g, %g, %g], 'inject': %g, 'bore': true}]", -e, -e,
+                 slab ? -1.0 : -e, e, e, slab ? 1.0 : e, Q);
     else
         snprintf(inject, sizeof inject, "[{'box': [%g, %g, %g, %g], 'inject': %g, 'bore': true}]",
                  -e, -e, e, e, Q);
@@ -141,10 +144,15 @@ static char *bore_doc(int dim, double Q)
     /* a thin fluid, so the wall joints fill within the test's few steps
      * (a cavity of aperture0 fills in 12 mu l L / (aperture0^2 dp)) */
     json_object_set_new(json_object_get(doc, "fluid"), "viscosity", json_real(1e-5));
+    if (slab) /* between rollers */
+        json_array_append_new(json_object_get(doc, "constraints"),
+                              load("{'part': 'rock', 'fix': ['z']}"));
     char *text = json_dumps(doc, JSON_COMPACT);
     json_decref(doc);
     return text;
 }
+
+static char *bore_doc(int dim, double Q) { return bore_doc_of(dim, Q, 0); }
 
 static int run(fdem_model *m, int steps)
 {
@@ -324,6 +332,25 @@ static void check_bore(int dim, double Q, int steps)
 }
 
 static void fluid_bore_2d(void) { check_bore(2, BORE_Q_2D, 300); }
+
+/* A bore through a slab between rollers: its wall is open at the slab's
+ * faces, and the volume it encloses is measured normal to their axis
+ * (fluid_bore.c), exactly the hole's; then, fed, what the bore holds
+ * stays the hole's current volume (z held) times 1 + p / K_f. */
+static void fluid_bore_slab(void)
+{
+    char *doc = bore_doc_of(3, BORE_Q_3D, 1);
+    fdem_model *m = network(doc);
+    free(doc);
+    if (!m) return;
+    const double hole = 0.5 * 0.5 * 1.0;
+    CHECK_REL(fdem_get_fluid(m).stored_volume, hole, 1e-12);
+    run(m, 20);
+    fdem_fluid_status f = fdem_get_fluid(m);
+    CHECK_REL(f.stored_volume - hole, f.injected_volume, 1e-9);
+    CHECK(f.source_pressure > 0, "the slab's bore is under pressure: %.3g Pa", f.source_pressure);
+    fdem_model_destroy(m);
+}
 static void fluid_bore_3d(void) { check_bore(3, BORE_Q_3D, 200); }
 
 /* ------------------------------------------------------- a wet joint */
@@ -518,5 +545,6 @@ static void fluid_bad_input(void)
 
 CHECK_MAIN(T(fluid_network_2d), T(fluid_network_3d), T(fluid_same_bits_2d), T(fluid_same_bits_3d),
            T(fluid_checkpoint_version_9), T(fluid_bore_2d), T(fluid_bore_3d),
+           T(fluid_bore_slab),
            T(wet_joint_slides_at_effective_stress), T(pore_pressure_starts_at_rest),
            T(fluid_bad_input))
