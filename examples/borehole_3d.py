@@ -84,12 +84,14 @@ def case(sectors, thickness):
         "materials": {"rock": {"density": 2600, "young": 2e10, "poisson": 0.25, "damping": 0.2,
                                "fracture": {"tensile_strength": 5e6, "cohesion": 3e7,
                                             "friction_angle": 30, "energy_I": 20,
-                                            "energy_II": 200}}},
+                                            "energy_II": 200, "aperture0": 1e-4}}},
+        "fluid": {"viscosity": 1e-4, "bulk_modulus": 2e9, "density": 0},
         "parts": [{"name": "rock", "material": "rock",
-                   "fracture": {"box": [-0.35, -0.35, -1, 0.35, 0.35, 1]},
+                   "fracture": {"box": [-0.6, -0.6, -1, 0.6, 0.6, 1]},
                    "initial_stress": {"value": s}, "gmsh": msh}],
         "constraints": [
-            {"part": "rock", "group": "bore", "pressure": 3e7, "amplitude": [[0, 0], [0.0015, 1]]},
+            # the 2D example's 0.4 m^2/s per m of thickness
+            {"part": "rock", "group": "bore", "inject": round(0.4 * thickness, 6), "bore": True},
             {"part": "rock", "group": "bore", "boundary_stress": {"value": s},
              "amplitude": [[0, 1], [0.0003, 0]]},
             {"part": "rock", "group": "outer", "boundary_stress": {"value": s}},

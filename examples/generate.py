@@ -597,7 +597,8 @@ dump("borehole-breakdown", {
                     {"part": "rock", "group": "outer", "boundary_stress": {"value": bore_stress}},
                     {"part": "rock", "group": "outer", "absorb": True}],
     "time": {"end": 0.0015, "dt": "auto", "safety": 0.5},
-    "output": {"interval": 0.0001, "fields": ["position", "stress", "damage"]}})
+    "output": {"interval": 0.0001, "fields": ["position", "stress", "damage"]},
+    "history": {"interval": 1e-5}})
 
 
 # A hydraulic fracture meeting a natural joint (issue 36 item 6). A 1 x 1 m
