@@ -27,8 +27,8 @@
  * joint softening at 18.89 MPa and broken at 18.85 MPa at theta = 0, the
  * pressure down to 16.65 MPa by 1.18 ms; 47 broken joints on both sides,
  * their axis 0.0 deg from x, reaching |x| = 0.458 m (|y| <= 0.024 m),
- * holding fluid at 9.5 MPa on average. 2.7 s of CPU (17 s under the
- * sanitizers to 1.5 ms before the stop at 0.88). FDEM_BOREHOLE_CASE runs
+ * holding fluid at 9.5 MPa on average. 2.7 s of CPU (8.6 s under the
+ * sanitizers). FDEM_BOREHOLE_CASE runs
  * another document (a finer mesh,
  * another fluid, for docs/physics.md); FDEM_BOREHOLE_TRACE prints the
  * curve every 50 us.
