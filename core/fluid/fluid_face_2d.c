@@ -1,8 +1,8 @@
 /*
  * fluid_face_2d.c - the 2D kernel of the fluid network: a joint's mean
  * edge as the fluid sees it, and which joints are neighbours (those that
- * share a mesh vertex), and a bore's wall edge. Everything else is shared with 3D (fluid_flow.c,
- * fluid_network.c).
+ * share a mesh vertex), and a bore's wall edge. Everything else is shared
+ * with 3D (fluid_flow.c, fluid_network.c, fluid_bore.c).
  *
  * The mean face is the one the joint law uses (joint.c): A's edge a0 -> a1
  * plus half the gap change, tangent t of length L, normal (t_y, -t_x)

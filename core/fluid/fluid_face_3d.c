@@ -2,8 +2,8 @@
  * fluid_face_3d.c - the 3D kernel of the fluid network: a joint's mean
  * triangle as the fluid sees it, and which joints are neighbours (those
  * that share an edge of the mesh, through which the fluid passes with the
- * edge's length as its width), and a bore's wall triangle. Everything else is shared with 2D
- * (fluid_flow.c, fluid_network.c).
+ * edge's length as its width), and a bore's wall triangle. Everything
+ * else is shared with 2D (fluid_flow.c, fluid_network.c, fluid_bore.c).
  *
  * The mean face is the joint law's (joint_tet.h): corners a_i + d_i / 2,
  * d_i = b_i - a_i; its area vector is half the cross product of its edges,
