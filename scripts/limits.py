@@ -413,7 +413,9 @@ def penny_case(h, end=0.005, interval=0.001, reach=(1.1, 0.85)):
 # 0.2 m across it, then cells growing by 1.4 to the edge at D_k, every
 # cell split into 2^(k-1) x 2^(k-1): every cell's size halves with each
 # level (a true h-refinement, not only near the crack). Half the block
-# (x >= 0, the plane x = 0 held normal to itself), Q/2 injected.
+# (x >= 0, the plane x = 0 held normal to itself), Q/2 injected. The
+# fluid is E/10 stiff (kgd.json's is E/100): a softer fluid leaves the
+# opening 2 % thin and the crack 3 % long at every level (docs/physics.md).
 KGD_LEFM_LEVELS = 3
 KGD_LEFM_BULK = 1e9
 
