@@ -249,7 +249,8 @@ typedef enum fdem_constraint_kind {
                                  area of the same boundary edges (faces), |S|/dim per vertex */
     FDEM_CONSTRAINT_INJECT,   /* value[0]: fluid injected (m^3/s in 3D, m^2/s per unit thickness
                                  in 2D), shared equally by the joints touching a selected node
-                                 (contract 6.4; needs fdem_set_fluid) */
+                                 (contract 6.4; needs fdem_set_fluid), or with def.bore into a
+                                 bore */
 } fdem_constraint_kind;
 
 typedef struct fdem_constraint_def {
@@ -263,6 +264,8 @@ typedef struct fdem_constraint_def {
     double value[3];            /* VELOCITY: v; FORCE: f (2D: N per unit thickness);
                                    PRESSURE: p in value[0]; TRACTION: t (Pa) */
     int free_x, free_y, free_z; /* VELOCITY: component left free (JSON null) */
+    int bore;                   /* INJECT: into a bore whose wall is the boundary edges (faces)
+                                   the selection spans, its pressure on them (fluid_bore.c) */
     /* BOUNDARY_STRESS: the field, fdem_stress_components numbers each in the layout of
      * fdem_element_stress (2D: xx, yy, xy; 3D: xx, yy, zz, yz, xz, xy), as
      * fdem_set_part_initial_stress takes it; all finite (checked at finalize). */
@@ -616,7 +619,7 @@ int fdem_checkpoint_write(const fdem_model *model, void *buf, size_t size);
 int fdem_checkpoint_read(fdem_model *model, const void *buf, size_t size, fdem_error *err);
 /* The format version a checkpoint buffer says it is in (1 to the current
  * one, FDEM_CHECKPOINT_VERSION), or -1 when it does not start like one. */
-#define FDEM_CHECKPOINT_VERSION 10
+#define FDEM_CHECKPOINT_VERSION 11
 int fdem_checkpoint_version(const void *buf, size_t size);
 
 /* Seconds spent in each stage of fdem_step() since the model was built

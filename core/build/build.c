@@ -603,6 +603,11 @@ int fdem_add_constraint(fdem_model *m, const fdem_constraint_def *def, fdem_erro
                     "constraint %d: an absorbing boundary acts throughout, not during one stage", k);
         return -1;
     }
+    if (def->bore && def->kind != FDEM_CONSTRAINT_INJECT) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    "constraint %d: only an injection goes into a bore", k);
+        return -1;
+    }
     int has_amplitude = def->amplitude != NULL || def->amplitude_count != 0;
     if (has_amplitude && (def->kind == FDEM_CONSTRAINT_FIX || def->kind == FDEM_CONSTRAINT_ABSORB)) {
         model_error(err, FDEM_ITEM_CONSTRAINT, k,

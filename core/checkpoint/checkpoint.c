@@ -98,7 +98,8 @@ typedef struct checkpoint_header {
      * section (step/stages.c) after the slip. Version 9: the same header;
      * a model with fluid has its fluid section (fluid/fluid_checkpoint.c)
      * between the slip and the stages. Version 10: the same header; the
-     * fluid section adds each constraint's injected volume. */
+     * fluid section adds each constraint's injected volume. Version 11:
+     * the same header; the fluid section adds each bore's fluid volume. */
     double time_carry;
 } checkpoint_header;
 

@@ -4,7 +4,11 @@
  *
  * Every joint is a cavity. A cavity is in the network (open) while its
  * joint is damaged or broken, carries a pore pressure, or is a source of
- * an "inject" constraint; an intact joint is sealed. Neighbouring open
+ * an "inject" constraint; an intact joint is sealed. A bore (an "inject"
+ * with def.bore, fluid_bore.c) is one more cavity after the joints: its
+ * wall is the constraint's boundary facets, its volume the space they
+ * enclose, its pressure presses on them, and it is linked to the joints
+ * that meet the wall, so fluid enters a wall joint once it opens. Neighbouring open
  * cavities (2D: joints sharing a mesh vertex; 3D: joints sharing an edge)
  * exchange fluid by the cubic law. What the cavity holds is a fluid
  * volume (its mass over the fluid's density): the pressure follows from it
@@ -40,7 +44,9 @@
 
 /* Two cavities that exchange fluid; conductance = geometry a^3 / (12 mu),
  * geometry = w / l: the shared edge's width (1 in 2D) over the distance
- * between the two cavities' centres (initial positions). */
+ * between the two cavities' centres (initial positions). a < b; when b is
+ * a bore, l runs from the joint's centre to the wall and a is the joint's
+ * aperture (the bore is no constriction). */
 typedef struct fluid_link {
     int32_t a, b;
     double geometry;
@@ -57,7 +63,8 @@ typedef struct fluid_face {
 typedef struct fluid_net {
     double viscosity, bulk_modulus, density;
     int joints;
-    /* per cavity */
+    int bores, cavities;  /* cavities = joints, then the bores */
+    /* per cavity (joints + bores) */
     double *fluid;       /* fluid volume (mass / density) */
     double *pressure;    /* of the last evaluation */
     double *volume;      /* cavity volume of the last evaluation: aperture times area */
@@ -84,6 +91,20 @@ typedef struct fluid_net {
     int32_t *source_joint, *source_constraint;
     double *source_share; /* 1 / the number of joints the constraint touches */
     double *constraint_injected; /* per constraint: the volume it injected since t = 0 (history) */
+    /* bores: the constraint whose boundary facets (model.bfacet_*) are its
+     * wall, the point its volume is measured from, and per facet of the
+     * model the force the bore's pressure put on each of its nodes */
+    int32_t *bore_constraint;
+    double *bore_origin;  /* dim per bore */
+    double *bore_axis;    /* dim per bore: the axis a slab's wall is open along, else 0 */
+    double *wall_force;   /* dim per boundary facet (bores' facets only) */
+    /* the wall's corners: each wall vertex (node_origin) is one corner, at
+     * the mean of the node copies on the wall there (a fracturing part
+     * has a copy per element), so the wall stays closed when a wall joint
+     * opens; wall_corner: per node of each boundary facet (bores' only) */
+    int corner_count;
+    int32_t *wall_corner, *corner_begin, *corner_node;
+    double *corner_pos;   /* dim per corner, of the last evaluation */
     /* accounts */
     double injected;      /* volume injected since t = 0 */
     double work_booked;   /* the fluid's work on the solid up to the start of the last step */
@@ -113,9 +134,22 @@ void fluid_forces_at_rest(fdem_model *m);
 double fluid_work_reported(const fdem_model *m);
 double fluid_work_completed(const fdem_model *m);
 
+/* fluid_bore.c: the bores, cavities joints .. cavities - 1 */
+int fluid_bores_count(fdem_model *m, fluid_net *f, fdem_error *err);
+void fluid_bores_init(fdem_model *m, fluid_net *f);
+void fluid_bore_measure(fdem_model *m, fluid_net *f, int b, int with_forces);
+double fluid_bores_power(const fdem_model *m, const fluid_net *f);
+double fluid_bores_stable_dt(const fdem_model *m, fluid_net *f);
+/* The keys of every bore's wall facets, each with its bore's cavity
+ * (fluid_bore_key_count of them at most), and the point a key stands for
+ * at t = 0 (a vertex, an edge's middle): where a wall link starts. */
+int fluid_bore_key_count(const fdem_model *m, const fluid_net *f);
+int fluid_bore_keys(const fdem_model *m, const fluid_net *f, int32_t (*keys)[2], int32_t *cavity);
+void fluid_key_point(const fdem_model *m, const int32_t key[2], double *x);
+
 /* fluid_checkpoint.c: the fluid section of a checkpoint (version 9 on;
- * version 10 adds each constraint's injected volume), as written by a
- * file of `version` */
+ * version 10 adds each constraint's injected volume, 11 each bore's fluid
+ * volume), as written by a file of `version` */
 size_t fluid_checkpoint_size(const fdem_model *m, unsigned version);
 void fluid_checkpoint_write(const fdem_model *m, unsigned char *p);
 void fluid_checkpoint_read(fdem_model *m, const unsigned char *p, unsigned version);
@@ -128,10 +162,25 @@ void fluid_face_3d(const fdem_model *m, int j, fluid_face *out);
  * their count. */
 int fluid_keys_2d(const fdem_model *m, int j, int32_t keys[3][2]);
 int fluid_keys_3d(const fdem_model *m, int j, int32_t keys[3][2]);
+/* The same of a boundary facet of nodes n (a bore's wall). */
+int fluid_facet_keys_2d(const fdem_model *m, const int32_t *n, int32_t keys[3][2]);
+int fluid_facet_keys_3d(const fdem_model *m, const int32_t *n, int32_t keys[3][2]);
+/* The area vector of a boundary facet of corners x (outward order),
+ * pointing out of the body (into a bore), and its centroid. */
+void fluid_facet_2d(const double *const x[3], double area[3], double centroid[3]);
+void fluid_facet_3d(const double *const x[3], double area[3], double centroid[3]);
 /* The width of a link through key (1 in 2D, the edge's initial length in
  * 3D). */
 double fluid_key_width_2d(const fdem_model *m, const int32_t key[2]);
 double fluid_key_width_3d(const fdem_model *m, const int32_t key[2]);
+
+/* A cavity's pressure from its fluid and its volume of the last
+ * evaluation, never below its floor. */
+static inline double fluid_cavity_pressure(const fluid_net *f, int j)
+{
+    double p = f->bulk_modulus * (f->fluid[j] / f->volume[j] - 1);
+    return p > f->floor[j] ? p : f->floor[j];
+}
 
 static inline void fluid_face_of(const fdem_model *m, int j, fluid_face *out)
 {

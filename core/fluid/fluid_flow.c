@@ -10,7 +10,8 @@
  *  2. each open cavity is measured: hydraulic aperture a = max(opening,
  *     aperture0), volume V = a |S|, pressure p = K_f (V_fluid / V - 1), not
  *     below its floor; p S / dim goes to each node of face B and its
- *     negative to each node of face A;
+ *     negative to each node of face A; a bore (fluid_bore.c) is measured
+ *     on its wall and presses on it;
  *  3. the fluid moves over h at fixed V: between open neighbours i, j the
  *     cubic law q = c (phi_i - phi_j), c = (w / l) a_m^3 / (12 mu), a_m
  *     the mean of their apertures, phi = p - rho_f g . x the potential
@@ -38,13 +39,8 @@ static double face_size(const fluid_face *face)
                 face->area[2] * face->area[2]);
 }
 
-static inline double cavity_pressure(const fluid_net *f, int j)
-{
-    double p = f->bulk_modulus * (f->fluid[j] / f->volume[j] - 1);
-    return p > f->floor[j] ? p : f->floor[j];
-}
-
-/* Sum over open cavities of F . (sum of B's velocities - sum of A's). */
+/* Sum over open joints of F . (sum of B's velocities - sum of A's), and
+ * the bores' walls' F . v. */
 static double fluid_power(const fdem_model *m)
 {
     const fluid_net *f = m->fluid;
@@ -52,6 +48,7 @@ static double fluid_power(const fdem_model *m)
     double power = 0;
     for (int k = 0; k < f->open_count; k++) {
         const int j = f->open_list[k];
+        if (j >= f->joints) break; /* the bores, listed last */
         const int32_t *n = m->joint_node + 2 * (size_t)D * (size_t)j;
         const double *F = f->force + (size_t)D * (size_t)j;
         double p = 0;
@@ -60,7 +57,7 @@ static double fluid_power(const fdem_model *m)
                 p += F[d] * (m->vel[(size_t)D * n[D + i] + d] - m->vel[(size_t)D * n[i] + d]);
         power += p;
     }
-    return power;
+    return f->bores ? power + fluid_bores_power(m, f) : power;
 }
 
 /* Step 2 without the forces: open flags, apertures, volumes, pressures;
@@ -85,7 +82,7 @@ static void cavities_measure(fdem_model *m, int with_forces)
         f->aperture[j] = fmax(face.opening, f->aperture0[j]);
         f->volume[j] = f->aperture[j] * face_size(&face);
         if (!(f->volume[j] > 0)) f->volume[j] = f->aperture[j] * 1e-300; /* a degenerate face */
-        double p = cavity_pressure(f, j);
+        double p = fluid_cavity_pressure(f, j);
         f->pressure[j] = p;
         if (!with_forces) continue;
         for (int d = 0; d < D; d++) F[d] = p * face.area[d] / D;
@@ -96,6 +93,7 @@ static void cavities_measure(fdem_model *m, int with_forces)
                 m->force[(size_t)D * n[D + i] + d] += F[d];
             }
     }
+    for (int b = 0; b < f->bores; b++) fluid_bore_measure(m, f, b, with_forces);
 }
 
 /* The links between two open cavities (each once, from its first end, in
@@ -112,7 +110,9 @@ static void links_conduct(fluid_net *f)
             const int l = f->link_of[e];
             const fluid_link *link = &f->links[l];
             if (link->a != i || !f->open[link->b]) continue;
-            double a = 0.5 * (f->aperture[link->a] + f->aperture[link->b]);
+            /* a < b: only b can be a bore, which is no constriction */
+            double a = link->b >= f->joints ? f->aperture[link->a]
+                                            : 0.5 * (f->aperture[link->a] + f->aperture[link->b]);
             double c = link->geometry * a * a * a * inv;
             f->conductance[l] = c;
             f->outgoing[link->a] += c;
@@ -167,7 +167,7 @@ static void flow_subcycle(fdem_model *m, fluid_net *f, double dt, int gravity)
     for (int k = 0; k < f->open_count; k++) {
         const int j = f->open_list[k];
         f->fluid[j] += f->inflow[j];
-        f->pressure[j] = cavity_pressure(f, j);
+        f->pressure[j] = fluid_cavity_pressure(f, j);
     }
 }
 
@@ -224,7 +224,7 @@ fdem_fluid_status fdem_get_fluid(const fdem_model *m)
     if (!f) return s;
     s.enabled = 1;
     s.injected_volume = f->injected;
-    for (int j = 0; j < f->joints; j++) s.stored_volume += f->fluid[j];
+    for (int j = 0; j < f->cavities; j++) s.stored_volume += f->fluid[j];
     double p = 0;
     for (int k = 0; k < f->source_count; k++) p += f->pressure[f->source_joint[k]];
     s.source_pressure = f->source_count ? p / f->source_count : 0;
@@ -232,7 +232,7 @@ fdem_fluid_status fdem_get_fluid(const fdem_model *m)
     /* before the first step: what the step chosen now will take */
     s.subcycles = m->step == 0 && f->flow_step < m->dt ? (int)fmin(ceil(m->dt / f->flow_step), 1e9)
                                                         : f->subcycles;
-    s.open_joints = f->open_count;
+    s.open_joints = f->open_count - f->bores; /* the bores are always open */
     return s;
 }
 

@@ -8,7 +8,9 @@
  * a joint's vertices, 3D: its edges): every two joints with a key in
  * common are linked, whether they are open now or not, so a joint that
  * breaks during the run joins the network without any rebuilding. A link
- * carries flow only while both its cavities are open.
+ * carries flow only while both its cavities are open. A bore's wall
+ * hands out the same keys (fluid_bore.c), which link it to the joints that
+ * meet the wall.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -53,6 +55,8 @@ void fluid_free(fdem_model *m)
     free(f->link_begin); free(f->link_of); free(f->open_list); free(f->active);
     free(f->source_joint); free(f->source_constraint); free(f->source_share);
     free(f->constraint_injected);
+    free(f->bore_constraint); free(f->bore_origin); free(f->bore_axis); free(f->wall_force);
+    free(f->wall_corner); free(f->corner_begin); free(f->corner_node); free(f->corner_pos);
     free(f);
     m->fluid = NULL;
 }
@@ -61,8 +65,13 @@ size_t fluid_memory_bytes(const fdem_model *m)
 {
     const fluid_net *f = m->fluid;
     if (!f) return 0;
-    size_t D = (size_t)m->dim, J = (size_t)f->joints;
-    return sizeof *f + J * ((7 + 2 * D) * sizeof(double) + 2 + 2 * sizeof(int32_t)) +
+    size_t D = (size_t)m->dim, J = (size_t)f->cavities, B = (size_t)f->bores;
+    size_t facets = (size_t)m->bfacet_count + 1, corners = (size_t)f->corner_count + 1;
+    size_t bores = B ? B * (sizeof(int32_t) + 2 * D * sizeof(double)) +
+                           D * facets * (sizeof(double) + 2 * sizeof(int32_t)) +
+                           corners * (sizeof(int32_t) + D * sizeof(double))
+                     : 0;
+    return sizeof *f + bores + J * ((7 + 2 * D) * sizeof(double) + 2 + 2 * sizeof(int32_t)) +
            (size_t)f->link_count * (sizeof(fluid_link) + sizeof(double) + 3 * sizeof(int32_t)) +
            (size_t)f->source_count * (2 * sizeof(int32_t) + sizeof(double)) +
            (size_t)m->constraint_count * sizeof(double);
@@ -116,19 +125,57 @@ static double centre_distance(const fluid_net *f, int D, int a, int b)
     return sqrt(s);
 }
 
-/* Every two joints with a key in common, in key order then joint order. */
-static int links_build(fdem_model *m, fluid_net *f)
+/* The keys of every joint and every bore's wall, sorted, each (key,
+ * cavity) once: a bore's wall facets share their keys with each other. */
+static key_entry *keys_sorted(const fdem_model *m, const fluid_net *f, size_t *count)
 {
     const int D = m->dim, J = f->joints;
-    key_entry *keys = malloc(sizeof *keys * 3 * (size_t)(J ? J : 1));
-    if (!keys) return -1;
+    const size_t walls = (size_t)fluid_bore_key_count(m, f);
+    key_entry *keys = malloc(sizeof *keys * (3 * (size_t)J + walls + 1));
+    int32_t(*wall)[2] = malloc(sizeof *wall * (walls + 1));
+    int32_t *cavity = malloc(sizeof *cavity * (walls + 1));
+    if (!keys || !wall || !cavity) {
+        free(keys), free(wall), free(cavity);
+        return NULL;
+    }
     size_t n = 0;
     for (int j = 0; j < J; j++) {
         int32_t k[3][2];
-        int count = D == 3 ? fluid_keys_3d(m, j, k) : fluid_keys_2d(m, j, k);
-        for (int i = 0; i < count; i++) keys[n++] = (key_entry){{k[i][0], k[i][1]}, j};
+        int got = D == 3 ? fluid_keys_3d(m, j, k) : fluid_keys_2d(m, j, k);
+        for (int i = 0; i < got; i++) keys[n++] = (key_entry){{k[i][0], k[i][1]}, j};
     }
+    int w = fluid_bore_keys(m, f, wall, cavity);
+    for (int i = 0; i < w; i++) keys[n++] = (key_entry){{wall[i][0], wall[i][1]}, cavity[i]};
+    free(wall), free(cavity);
     qsort(keys, n, sizeof *keys, key_compare);
+    size_t kept = 0;
+    for (size_t i = 0; i < n; i++)
+        if (!kept || key_compare(&keys[kept - 1], &keys[i])) keys[kept++] = keys[i];
+    *count = kept;
+    return keys;
+}
+
+/* The length of link a - b through key: between the two cavities'
+ * centres, or, to a bore (b), from the joint's centre to the wall. */
+static double link_length(const fdem_model *m, const fluid_net *f, int a, int b,
+                          const int32_t key[2])
+{
+    const int D = m->dim;
+    if (b < f->joints) return centre_distance(f, D, a, b);
+    double x[3], s = 0;
+    fluid_key_point(m, key, x);
+    for (int d = 0; d < D; d++) s += (f->centre[D * a + d] - x[d]) * (f->centre[D * a + d] - x[d]);
+    return sqrt(s);
+}
+
+/* Every two cavities with a key in common, in key order then cavity
+ * order; never two bores. */
+static int links_build(fdem_model *m, fluid_net *f)
+{
+    const int D = m->dim, J = f->joints, C = f->cavities;
+    size_t n = 0;
+    key_entry *keys = keys_sorted(m, f, &n);
+    if (!keys) return -1;
     size_t links = 0;
     for (int pass = 0; pass < 2; pass++) {
         links = 0;
@@ -136,11 +183,11 @@ static int links_build(fdem_model *m, fluid_net *f)
             size_t e = s + 1;
             while (e < n && keys[e].key[0] == keys[s].key[0] && keys[e].key[1] == keys[s].key[1]) e++;
             double width = D == 3 ? fluid_key_width_3d(m, keys[s].key) : fluid_key_width_2d(m, keys[s].key);
-            for (size_t i = s; i < e; i++)
+            for (size_t i = s; i < e && keys[i].joint < J; i++)
                 for (size_t k = i + 1; k < e; k++) {
                     if (pass) {
                         int a = keys[i].joint, b = keys[k].joint;
-                        double l = centre_distance(f, D, a, b);
+                        double l = link_length(m, f, a, b, keys[s].key);
                         f->links[links] = (fluid_link){a, b, l > 0 ? width / l : 0};
                     }
                     links++;
@@ -156,7 +203,7 @@ static int links_build(fdem_model *m, fluid_net *f)
     f->link_count = (int)links;
     f->conductance = malloc(sizeof(double) * (links ? links : 1));
     f->active = malloc(sizeof(int32_t) * (links ? links : 1));
-    f->link_begin = calloc((size_t)J + 1, sizeof(int32_t));
+    f->link_begin = calloc((size_t)C + 1, sizeof(int32_t));
     f->link_of = malloc(sizeof(int32_t) * 2 * (links ? links : 1));
     if (!f->conductance || !f->active || !f->link_begin || !f->link_of) return -1;
     /* each cavity's links, in link order (counting sort) */
@@ -164,10 +211,10 @@ static int links_build(fdem_model *m, fluid_net *f)
         f->link_begin[f->links[l].a + 1]++;
         f->link_begin[f->links[l].b + 1]++;
     }
-    for (int j = 0; j < J; j++) f->link_begin[j + 1] += f->link_begin[j];
-    int32_t *fill = malloc(sizeof(int32_t) * (size_t)(J ? J : 1));
+    for (int j = 0; j < C; j++) f->link_begin[j + 1] += f->link_begin[j];
+    int32_t *fill = malloc(sizeof(int32_t) * (size_t)(C ? C : 1));
     if (!fill) return -1;
-    memcpy(fill, f->link_begin, sizeof(int32_t) * (size_t)J);
+    memcpy(fill, f->link_begin, sizeof(int32_t) * (size_t)C);
     for (size_t l = 0; l < links; l++) {
         f->link_of[fill[f->links[l].a]++] = (int32_t)l;
         f->link_of[fill[f->links[l].b]++] = (int32_t)l;
@@ -176,14 +223,33 @@ static int links_build(fdem_model *m, fluid_net *f)
     return 0;
 }
 
-/* The joints touching each "inject" constraint's nodes, each its share. */
+/* A bore injection's one source: its bore, which must meet a joint. */
+static int bore_source(fdem_model *m, fluid_net *f, int k, fdem_error *err)
+{
+    int b = 0;
+    while (f->bore_constraint[b] != k) b++;
+    const int cav = f->joints + b;
+    if (f->link_begin[cav + 1] == f->link_begin[cav]) {
+        model_error(err, FDEM_ITEM_CONSTRAINT, k,
+                    "constraint %d injects into a bore whose wall no joint meets (the wall must "
+                    "bound a fracturing part)", k);
+        return -1;
+    }
+    f->source_joint[f->source_count] = cav;
+    f->source_share[f->source_count] = 1;
+    f->source_constraint[f->source_count++] = k;
+    return 0;
+}
+
+/* The joints touching each "inject" constraint's nodes, each its share
+ * (a bore's injection: the bore). */
 static int sources_build(fdem_model *m, fluid_net *f, fdem_error *err)
 {
     const int D = m->dim, J = f->joints;
     uint8_t *selected = calloc((size_t)(m->node_count ? m->node_count : 1), 1);
     size_t room = 0;
     for (int k = 0; k < m->constraint_count; k++)
-        if (m->constraints[k].def.kind == FDEM_CONSTRAINT_INJECT) room += (size_t)J;
+        if (m->constraints[k].def.kind == FDEM_CONSTRAINT_INJECT) room += (size_t)J + 1;
     f->source_joint = malloc(sizeof(int32_t) * (room ? room : 1));
     f->source_constraint = malloc(sizeof(int32_t) * (room ? room : 1));
     f->source_share = malloc(sizeof(double) * (room ? room : 1));
@@ -198,6 +264,13 @@ static int sources_build(fdem_model *m, fluid_net *f, fdem_error *err)
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
         if (c->def.kind != FDEM_CONSTRAINT_INJECT) continue;
+        if (c->def.bore) {
+            if (bore_source(m, f, k, err)) {
+                free(selected);
+                return -1;
+            }
+            continue;
+        }
         for (int e = c->entry_begin; e < c->entry_begin + c->entry_count; e++) selected[m->cnode[e]] = 1;
         int first = f->source_count;
         for (int j = 0; j < J; j++) {
@@ -256,7 +329,7 @@ static void cavities_init(fdem_model *m, fluid_net *f)
  * of its element: K A / (dim a) per node, at its stiffest (a = aperture0).
  * It acts beside the joint's own spring, so it is added to whichever limit
  * binds: 1 / dt^2 of springs in parallel add up. */
-static double fluid_stable_dt(const fdem_model *m, const fluid_net *f, double dt)
+static double fluid_stable_dt(const fdem_model *m, fluid_net *f, double dt)
 {
     const int D = m->dim;
     double fluid_dt = INFINITY;
@@ -271,6 +344,7 @@ static double fluid_stable_dt(const fdem_model *m, const fluid_net *f, double dt
         double k = f->bulk_modulus * area / (D * f->aperture0[j]);
         if (k > 0) fluid_dt = fmin(fluid_dt, joint_spring_dt(mass, k));
     }
+    if (f->bores) fluid_dt = fmin(fluid_dt, fluid_bores_stable_dt(m, f));
     if (!isfinite(fluid_dt)) return dt;
     if (!isfinite(dt)) return fluid_dt;
     return 1 / sqrt(1 / (dt * dt) + 1 / (fluid_dt * fluid_dt));
@@ -286,8 +360,9 @@ int fluid_prepare(fdem_model *m, fdem_error *err)
             return -1;
         }
     if (!f) return 0;
-    const size_t J = (size_t)m->joint_count, D = (size_t)m->dim, room = J ? J : 1;
     f->joints = m->joint_count;
+    if (fluid_bores_count(m, f, err)) return -1;
+    const size_t C = (size_t)f->cavities, D = (size_t)m->dim, room = C ? C : 1;
     double **arrays[] = {&f->fluid, &f->pressure, &f->volume, &f->aperture, &f->aperture0,
                          &f->floor, &f->inflow, &f->outgoing};
     int ok = 1;
@@ -303,6 +378,7 @@ int fluid_prepare(fdem_model *m, fdem_error *err)
         return -1;
     }
     cavities_init(m, f);
+    fluid_bores_init(m, f);
     if (links_build(m, f)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for the fluid network");
         return -1;

@@ -15,6 +15,8 @@
  * the boundary facets whose nodes it all selects; the facets are found once
  * at finalize, their forces are recomputed on the deformed geometry at
  * every step. Nothing here runs for a model without such constraints.
+ * An injection into a bore (fluid/fluid_bore.c) has its wall's facets
+ * found here too; the fluid network presses on them, not this file.
  *
  * Excavation (stages.c) changes the boundary: a facet between an element
  * that stays and one a stage removes becomes boundary when that stage
@@ -65,10 +67,19 @@ static int is_boundary_load(const constraint *c)
     }
 }
 
+/* A constraint that needs its boundary facets: a boundary load, or a
+ * fluid injection into a bore, whose wall they are (fluid/fluid_bore.c
+ * presses on them; the loops below that apply and book loads skip it). */
+static int has_facets(const constraint *c)
+{
+    return is_boundary_load(c) || (c->def.kind == FDEM_CONSTRAINT_INJECT && c->def.bore);
+}
+
 /* "a pressure", ... for messages that name what a constraint does. */
 static const char *load_name(const constraint *c)
 {
     switch (c->def.kind) {
+    case FDEM_CONSTRAINT_INJECT: return "a bore's injection";
     case FDEM_CONSTRAINT_PRESSURE: return "a pressure";
     case FDEM_CONSTRAINT_BOUNDARY_STRESS: return "a boundary stress";
     case FDEM_CONSTRAINT_TRACTION: return "a traction";
@@ -218,7 +229,7 @@ static void facets_assign(fdem_model *m, const facet_key *keys, int count,
     int at = 0;
     for (int k = 0; k < m->constraint_count; k++) {
         constraint *c = &m->constraints[k];
-        if (!is_boundary_load(c)) continue;
+        if (!has_facets(c)) continue;
         c->facet_begin = at;
         for (int i = 0; i < count; i++) {
             int32_t n[3];
@@ -259,7 +270,7 @@ static int stress_fields_finite(const fdem_model *m, fdem_error *err)
 int boundary_load_select(fdem_model *m, fdem_error *err)
 {
     int wanted = 0;
-    for (int k = 0; k < m->constraint_count; k++) wanted |= is_boundary_load(&m->constraints[k]);
+    for (int k = 0; k < m->constraint_count; k++) wanted |= has_facets(&m->constraints[k]);
     if (!wanted) return 0;
     if (!stress_fields_finite(m, err)) return -1;
     int count = 0, failed = 0;
@@ -287,7 +298,7 @@ int boundary_load_select(fdem_model *m, fdem_error *err)
     free(removed_by);
     for (int k = 0; k < m->constraint_count; k++) {
         const constraint *c = &m->constraints[k];
-        if (is_boundary_load(c) && c->facet_count == 0) {
+        if (has_facets(c) && c->facet_count == 0) {
             model_error(err, FDEM_ITEM_CONSTRAINT, k,
                         "constraint %d selects no boundary %s: %s acts on the %s of a body "
                         "whose nodes are all selected",

@@ -5,7 +5,8 @@
  * velocity, apply a force; press on, load with the traction of a stress
  * field or a fixed traction, or absorb waves through the boundary they
  * span), every value but a fix and an absorb optionally scaled by an
- * "amplitude" table in time.
+ * "amplitude" table in time. An "inject" with "bore": true fills a bore
+ * whose wall is the selected boundary (core/fluid/fluid_bore.c).
  *
  * The same reader serves the top-level list and each stage's own
  * (contract 6.1: those act during their stage only, def.only_stage); every
@@ -29,7 +30,8 @@
 static const char *const constraint_keys[] = {"part",     "group",    "box",
                                               "fix",      "velocity", "force",
                                               "pressure", "absorb",   "boundary_stress",
-                                              "traction", "inject",   "amplitude", NULL};
+                                              "traction", "inject",   "amplitude",
+                                              "bore",     NULL};
 
 int case_part_by_name(case_doc *doc, const json_t *name, const char *ptr)
 {
@@ -237,6 +239,23 @@ static void constraint_read_inject(case_doc *doc, fdem_constraint_def *def, cons
                                "{\"viscosity\", \"bulk_modulus\", \"density\"}");
 }
 
+/* "bore": true with "inject": the fluid goes into a bore whose wall is the
+ * boundary edges (faces) the selection spans (docs/case-format.md). */
+static void constraint_read_bore(case_doc *doc, case_constraint *c, const json_t *value,
+                                 const char *ptr)
+{
+    char at[CASE_POINTER];
+    json_t *bore = case_member(value, ptr, "bore", at);
+    if (!bore) return;
+    int on = 0;
+    if (!case_read_bool(doc, bore, at, &on)) return;
+    if (c->def.kind != FDEM_CONSTRAINT_INJECT)
+        case_problem(doc, at, "\"bore\" says where an \"inject\" puts its fluid: give it "
+                              "with \"inject\" only");
+    else
+        c->def.bore = on;
+}
+
 /* "amplitude" only scales a value: not a fix or an absorbing boundary. */
 static void constraint_read_amplitude(case_doc *doc, case_constraint *c, const json_t *value,
                                       const char *ptr)
@@ -311,6 +330,7 @@ static void constraint_read(case_doc *doc, case_constraint *c, int index, const 
         case_read_axes(doc, a, at, c->def.value);
     }
     constraint_read_amplitude(doc, c, value, ptr);
+    constraint_read_bore(doc, c, value, ptr);
 }
 
 void case_read_constraint_list(case_doc *doc, const json_t *list, const char *ptr,

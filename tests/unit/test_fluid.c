@@ -6,6 +6,10 @@
  *    body stays zero;
  *  - the fluid's work closes the energy balance (residual < 1 % of it);
  *  - 1 and 2 threads, and a restart from a checkpoint, give the same bits;
+ *  - a bore (an "inject" with "bore": true, core/fluid/fluid_bore.c) holds
+ *    the fluid injected into it, its volume is the hole's, its pressure
+ *    pushes its wall apart until a wall joint breaks and takes fluid; the
+ *    same accounts, momentum and bits as the joints' network, 2D and 3D;
  *  - a wet joint sheared under a normal stress sigma_n slides at
  *    c + (sigma_n - p) tan(phi) (Terzaghi's effective stress), within 3 %;
  *  - bad input: one 422 with a problem at each pointer.
@@ -45,6 +49,110 @@ static fdem_model *network(const char *doc)
 {
     return expect_built(load(doc), NULL);
 }
+
+/* ------------------------------------------------------- a bore */
+
+#define BORE_CELLS_2D 6
+#define BORE_CELLS_3D 4
+#define BORE_Q_2D 3.0
+#define BORE_Q_3D 8.0
+
+/* Cell (i, j, k) of an n-cell square (cube) is in the hole: the middle
+ * 2 x 2 (x 2) cells. */
+static int in_hole(int dim, int n, const int *c, int slab)
+{
+    int in = 1;
+    for (int d = 0; d < (slab ? 2 : dim); d++) in &= c[d] == n / 2 - 1 || c[d] == n / 2;
+    return in;
+}
+
+static int grid_node(json_t *nodes, int *index, int dim, int n, const int *c, int slab)
+{
+    int key = c[0] + (n + 1) * (c[1] + (dim == 3 ? (n + 1) * c[2] : 0));
+    if (index[key] < 0) {
+        json_t *x = json_array();
+        for (int d = 0; d < dim; d++)
+            json_array_append_new(x, json_real(d == 2 && slab ? c[d] - 0.5 : -0.5 + (double)c[d] / n));
+        index[key] = (int)json_array_size(nodes);
+        json_array_append_new(nodes, x);
+    }
+    return index[key];
+}
+
+static json_t *cell_element(json_t *nodes, int *index, int dim, int n, int corners[][3], int count,
+                            int slab)
+{
+    json_t *e = json_array();
+    for (int i = 0; i < count; i++)
+        json_array_append_new(e, json_integer(grid_node(nodes, index, dim, n, corners[i], slab)));
+    return e;
+}
+
+/* A unit square (cube) of n cells a side, centred on the origin, without
+ * its middle 2 x 2 (x 2) cells: the elements of a fracturing part
+ * (triangles; 3D the six Kuhn tetrahedra of each cell, as
+ * examples/penny_mesh.py), a bore fed at Q with "bore": true on the box
+ * around the hole (it selects the hole's wall and nothing else). A slab
+ * (3D) is one cell of 1 m in z, the hole through it, open at its faces. */
+static char *bore_doc_of(int dim, double Q, int slab)
+{
+    const int n = dim == 3 ? BORE_CELLS_3D : BORE_CELLS_2D;
+    int *index = malloc(sizeof(int) * (size_t)((n + 1) * (n + 1) * (n + 1)));
+    for (int i = 0; i < (n + 1) * (n + 1) * (n + 1); i++) index[i] = -1;
+    json_t *nodes = json_array(), *elements = json_array();
+    for (int k = 0; k < (dim == 3 ? (slab ? 1 : n) : 1); k++)
+        for (int j = 0; j < n; j++)
+            for (int i = 0; i < n; i++) {
+                int c[3] = {i, j, k};
+                if (in_hole(dim, n, c, slab)) continue;
+                if (dim == 2) {
+                    int t0[3][3] = {{i, j}, {i + 1, j}, {i + 1, j + 1}};
+                    int t1[3][3] = {{i, j}, {i + 1, j + 1}, {i, j + 1}};
+                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t0, 3, 0));
+                    json_array_append_new(elements, cell_element(nodes, index, 2, n, t1, 3, 0));
+                    continue;
+                }
+                static const int orders[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2},
+                                                 {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+                for (int o = 0; o < 6; o++) {
+                    int path[4][3] = {{i + 1, j, k}};
+                    for (int s = 0; s < 3; s++) {
+                        memcpy(path[s + 1], path[s], sizeof path[s]);
+                        path[s + 1][orders[o][s]] += orders[o][s] == 0 ? -1 : 1;
+                    }
+                    json_array_append_new(elements, cell_element(nodes, index, 3, n, path, 4, slab));
+                }
+            }
+    free(index);
+    json_t *doc = load(dim == 3 ? network_3d : network_2d);
+    json_t *part = json_array_get(json_object_get(doc, "parts"), 0);
+    json_object_del(part, dim == 3 ? "box" : "rectangle");
+    json_t *mesh = json_object();
+    json_object_set_new(mesh, "nodes", nodes);
+    json_object_set_new(mesh, dim == 3 ? "tetrahedra" : "triangles", elements);
+    json_object_set_new(part, "mesh", mesh);
+    const double e = 1.0 / n + 1e-6;
+    char inject[160];
+    if (dim == 3)
+        snprintf(inject, sizeof inject,
+                 "[{'box': [%g, %g, %g, %g, %g, %g], 'inject': %g, 'bore': true}]", -e, -e,
+                 slab ? -1.0 : -e, e, e, slab ? 1.0 : e, Q);
+    else
+        snprintf(inject, sizeof inject, "[{'box': [%g, %g, %g, %g], 'inject': %g, 'bore': true}]",
+                 -e, -e, e, e, Q);
+    json_object_set_new(doc, "constraints", load(inject));
+    /* a thin fluid, so the wall joints fill within the test's few steps
+     * (a cavity of aperture0 fills in 12 mu l L / (aperture0^2 dp)) */
+    json_object_set_new(json_object_get(doc, "fluid"), "viscosity", json_real(1e-5));
+    if (slab) /* between rollers */
+        json_array_append_new(json_object_get(doc, "constraints"),
+                              load("{'part': 'rock', 'fix': ['z']}"));
+    char *text = json_dumps(doc, JSON_COMPACT);
+    json_decref(doc);
+    return text;
+}
+
+static char *bore_doc(int dim, double Q) { return bore_doc_of(dim, Q, 0); }
 
 static int run(fdem_model *m, int steps)
 {
@@ -184,6 +292,66 @@ static void fluid_checkpoint_version_9(void)
 
 static void fluid_same_bits_2d(void) { check_same_bits(network_2d, 400); }
 static void fluid_same_bits_3d(void) { check_same_bits(network_3d, 200); }
+
+/* The bore holds the hole's volume at t = 0 and nothing else does; fed,
+ * its pressure rises as its fluid over its volume says, with every joint
+ * on its wall sealed, until a wall joint breaks and takes fluid. */
+static void check_bore(int dim, double Q, int steps)
+{
+    char *doc = bore_doc(dim, Q);
+    fdem_model *m = network(doc);
+    if (!m) {
+        free(doc);
+        return;
+    }
+    const double hole = pow(2.0 / (dim == 3 ? BORE_CELLS_3D : BORE_CELLS_2D), dim);
+    fdem_fluid_status f0 = fdem_get_fluid(m);
+    CHECK_REL(f0.stored_volume, hole, 1e-12);
+    CHECK(f0.open_joints == 0 && f0.source_pressure == 0, "only the bore holds fluid at t = 0");
+    int sealed_until = -1, joints = fdem_get_counts(m).joints;
+    double peak = 0, wet = 0;
+    for (int s = 0; s < steps && !run(m, 1); s++) {
+        fdem_fluid_status f = fdem_get_fluid(m);
+        peak = fmax(peak, f.source_pressure);
+        if (f.open_joints == 0) sealed_until = s;
+    }
+    const double *p = fdem_fluid_pressure(m), *damage = fdem_joint_damage(m);
+    for (int j = 0; j < joints; j++)
+        if (damage[j] > 0) wet = fmax(wet, p[j]);
+    fdem_fluid_status f = fdem_get_fluid(m);
+    fprintf(stderr, "  %dD bore: hole %.6g, sealed for %d steps, peak %.4g Pa, now %.4g Pa; "
+                    "a wall joint at %.4g Pa; %d open, %d broken\n",
+            dim, hole, sealed_until + 1, peak, f.source_pressure, wet, f.open_joints,
+            fdem_get_counts(m).broken_joints);
+    CHECK(sealed_until > 0 && sealed_until < steps - 1, "the wall holds, then gives");
+    CHECK(peak > 0 && wet > 0, "the bore's fluid enters the broken wall joints");
+    fdem_model_destroy(m);
+    check_network(doc, steps);
+    check_same_bits(doc, steps);
+    free(doc);
+}
+
+static void fluid_bore_2d(void) { check_bore(2, BORE_Q_2D, 300); }
+
+/* A bore through a slab between rollers: its wall is open at the slab's
+ * faces, and the volume it encloses is measured normal to their axis
+ * (fluid_bore.c), exactly the hole's; then, fed, what the bore holds
+ * stays the hole's current volume (z held) times 1 + p / K_f. */
+static void fluid_bore_slab(void)
+{
+    char *doc = bore_doc_of(3, BORE_Q_3D, 1);
+    fdem_model *m = network(doc);
+    free(doc);
+    if (!m) return;
+    const double hole = 0.5 * 0.5 * 1.0;
+    CHECK_REL(fdem_get_fluid(m).stored_volume, hole, 1e-12);
+    run(m, 20);
+    fdem_fluid_status f = fdem_get_fluid(m);
+    CHECK_REL(f.stored_volume - hole, f.injected_volume, 1e-9);
+    CHECK(f.source_pressure > 0, "the slab's bore is under pressure: %.3g Pa", f.source_pressure);
+    fdem_model_destroy(m);
+}
+static void fluid_bore_3d(void) { check_bore(3, BORE_Q_3D, 200); }
 
 /* ------------------------------------------------------- a wet joint */
 
@@ -358,9 +526,25 @@ static void fluid_bad_input(void)
     doc = load(network_2d);
     edit(doc, "/parts/0/fracture", json_false());
     expect_doc(doc, GiB, 422, "/constraints/0", "none of the nodes");
+
+    /* "bore": not a boolean, not with an injection; a bore whose selection
+     * spans no boundary edge; a bore whose wall no joint meets */
+    expect_variant_of(network_2d, "/constraints/0/bore", "'yes'", "/constraints/0/bore",
+                      "true or false");
+    expect_variant_of(network_2d, "/constraints/0",
+                      "{'box': [-1, -1, 1, 1], 'pressure': 1e6, 'bore': true}",
+                      "/constraints/0/bore", "with \"inject\" only");
+    expect_variant_of(network_2d, "/constraints/0/bore", "true", "/constraints/0",
+                      "selects no boundary edge");
+    char *bore = bore_doc(2, 1);
+    doc = load(bore);
+    free(bore);
+    edit(doc, "/parts/0/fracture", json_false());
+    expect_doc(doc, GiB, 422, "/constraints/0", "no joint meets");
 }
 
 CHECK_MAIN(T(fluid_network_2d), T(fluid_network_3d), T(fluid_same_bits_2d), T(fluid_same_bits_3d),
-           T(fluid_checkpoint_version_9),
+           T(fluid_checkpoint_version_9), T(fluid_bore_2d), T(fluid_bore_3d),
+           T(fluid_bore_slab),
            T(wet_joint_slides_at_effective_stress), T(pore_pressure_starts_at_rest),
            T(fluid_bad_input))
