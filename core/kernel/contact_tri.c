@@ -232,8 +232,12 @@ static double tri_clearance(const tri_now *t, const tri_now *other, const double
         double nearest = max3(lam[0][k], lam[1][k], lam[2][k]);
         if (!(nearest < 0)) continue;
         int i = (k + 1) % 3, j = (k + 2) % 3;
-        double altitude = t->area2 / hypot(t->x[j] - t->x[i], t->y[j] - t->y[i]);
-        best = max2(best, -nearest * altitude);
+        double dx = t->x[j] - t->x[i], dy = t->y[j] - t->y[i], edge2 = dx * dx + dy * dy;
+        /* the distance, -nearest area2 / |edge|, under 1e-7 |edge| (never
+         * over the margin): let go without a root - broken rock's pairs
+         * apart are mostly a hair apart across a crack */
+        if (!(-nearest * t->area2 > 1e-7 * edge2)) continue;
+        best = max2(best, -nearest * t->area2 / sqrt(edge2));
     }
     if (!(best > 0)) return 0;
     double lt = tri_longest_edge(t), lo = tri_longest_edge(other);
