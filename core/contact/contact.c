@@ -178,6 +178,18 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     else
         for (int s = 0; s < slots; s++) fresh[s] = 0;
     int touched = contact_pair_force(m, a, b, h, springs, out, memo);
+    /* Apart with a clearance c (contact_pair.h): the kernel keeps returning
+     * 0, every spring let go, while the two elements' nodes travel less
+     * than c together. Each node is within sqrt(near_disp2) of its place at
+     * the list's build, now and later, so between now and a later step it
+     * moves less than the two figures' sum, and a node of either element
+     * less than near_apart / 2 now plus near_apart / 2 then (near_apart is
+     * twice the figure, a hair over). As the gap c - near_apart_now the
+     * pair then passes the walk's test above (gap > near_apart) exactly
+     * while c > near_apart_now + near_apart_then: skipped only where the
+     * kernel would have found what it found now, the same bits. The list's
+     * rebuild (and a restore, which rebuilds it) starts from box gaps. */
+    if (!touched && out[0] > 0 && !cs->clearance_off) np->gap = max2(np->gap, out[0] - cs->near_apart);
     /* a pair that did not touch has let every spring go (contact_pair.h):
      * the springs are read only after a touch */
     int any = 0;

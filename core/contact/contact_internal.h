@@ -24,7 +24,9 @@ typedef struct contact_kernel {
  * as it lets springs go or adopts them, so a pair apart without springs
  * (nearly all) reads nothing else. */
 typedef struct near_pair {
-    double gap;      /* its boxes' gap when the list was built */
+    double gap;      /* apart while the travel since the list was built (near_apart)
+                        stays under it: its boxes' gap then, raised by a clearance
+                        its kernel found (pair_evaluate) */
     uint32_t pair;   /* its index among the candidate pairs */
     int32_t a, b;    /* its elements */
     int32_t sprung;  /* some stick spring of it holds a force */

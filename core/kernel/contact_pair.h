@@ -16,7 +16,13 @@
  *    touch has them all at zero.
  *  - It returns 1 if the pair touched; out then holds the forces on a's
  *    nodes (dim per node, node by node), then on b's, then the energy
- *    friction dissipated. It returns 0 if not (out is then undefined). An
+ *    friction dissipated. It returns 0 if not, every spring let go, and
+ *    out[0] then holds the pair's clearance: a distance the two elements
+ *    are apart by, less the kernel's rounding, such that while their nodes
+ *    together travel less than it (and no element gets flatter than its
+ *    kernel allows for) the kernel would keep returning 0 - or 0 when it
+ *    cannot tell (the rest of out is undefined). The contact stage skips
+ *    the pair until then (contact.c, pair_evaluate): the same bits. An
  *    inverted element has no potential: no force, springs let go.
  *  - Action equals reaction at one point per boundary: linear and angular
  *    momentum are conserved to round-off. Kernels write nothing else (but

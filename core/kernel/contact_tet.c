@@ -530,6 +530,78 @@ static void tet_frame_memo(const double *pos, const int32_t n[4], contact_pair_m
     memcpy(memo->numbers[slot], &t->bary, sizeof t->bary);
 }
 
+/* The clearance of a pair found apart by a face plane of t (the corners
+ * of `other` all outside it, their coordinates in t's map ci): how far
+ * they are from that plane, less a margin for rounding, or 0 when either
+ * element is too flat for the figure to be trusted. What the contact
+ * stage does with it (contact_pair.h) is exact only if, while the two
+ * elements stay further apart than the margin, this kernel cannot find
+ * them touching, whatever path it takes:
+ *  - the distance is -lambda_f / |grad lambda_f|, from the map's rows;
+ *    rounding puts the corners' lambdas and the rows within some hundred
+ *    ulps of their values, relative to the coordinates' size S (x - x0
+ *    is formed from them) and amplified by the shape, L^3 / (6 V) at most
+ *    (L the longest edge): with 6 V >= 1e-6 L^3 (QUALITY) that is under
+ *    1e-10 (S + L) of distance, against a margin of 1e-8 S + 1e-7 L;
+ *  - two elements apart by more than that margin can never give this
+ *    kernel a clipped polygon of 3 vertices: every vertex it forms lies
+ *    within such rounding of the face and of the target's planes it kept
+ *    it by, so the integral is exactly 0 and every spring let go, as the
+ *    early-outs do; the elements stay that shape (the stage skips only
+ *    while no node has moved a hundredth of an element).
+ * An inverted element has no potential (apart in any case). */
+#define CLEARANCE_QUALITY 1e-6
+static double tet_longest_edge2(const double *const p[4])
+{
+    double most = 0;
+    for (int i = 0; i < 4; i++)
+        for (int k = i + 1; k < 4; k++) {
+            double d[3];
+            vec3_sub(p[k], p[i], d);
+            most = max2(most, vec3_dot(d, d));
+        }
+    return most;
+}
+
+static double tet_six_volume(const double *const p[4])
+{
+    double e[3][3], c[3];
+    for (int k = 0; k < 3; k++) vec3_sub(p[k + 1], p[0], e[k]);
+    vec3_cross(e[1], e[2], c);
+    return vec3_dot(e[0], c);
+}
+
+static double pair_clearance(const tet_frame *t, const tet_frame *other, const corners_in *ci)
+{
+    unsigned common = ci->outside[0] & ci->outside[1] & ci->outside[2] & ci->outside[3];
+    const double(*r)[3] = t->bary.rows;
+    /* most pairs found apart are far apart or all but touching (broken
+     * rock: a hair apart across a crack); these last are let go before the
+     * square roots, on one edge of t, never longer than L */
+    double e01[3];
+    vec3_sub(t->p[1], t->p[0], e01);
+    double floor2 = 1e-14 * vec3_dot(e01, e01), best = 0;
+    for (int f = 0; f < 4; f++) {
+        if (!(common & 1u << f)) continue;
+        double g[3];
+        for (int i = 0; i < 3; i++) g[i] = f ? r[f - 1][i] : -(r[0][i] + r[1][i] + r[2][i]);
+        double nearest = -INFINITY, g2 = vec3_dot(g, g);
+        for (int v = 0; v < 4; v++) nearest = max2(nearest, ci->lambda[v][f]);
+        if (nearest * nearest > floor2 * g2) best = max2(best, -nearest / sqrt(g2));
+    }
+    if (!(best > 0)) return 0;
+    double lt2 = tet_longest_edge2(t->p), lo2 = tet_longest_edge2(other->p);
+    double lt = sqrt(lt2), lo = sqrt(lo2);
+    if (!(t->bary.det >= CLEARANCE_QUALITY * lt2 * lt) ||
+        !(tet_six_volume(other->p) >= CLEARANCE_QUALITY * lo2 * lo))
+        return 0;
+    double size = 0;
+    for (int v = 0; v < 4; v++)
+        for (int i = 0; i < 3; i++) size = max2(size, max2(fabs(t->p[v][i]), fabs(other->p[v][i])));
+    double clear = best - (1e-8 * size + 1e-7 * max2(lt, lo));
+    return clear > 0 ? clear : 0;
+}
+
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tet_frame a, b;
@@ -539,16 +611,23 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
      * apart by one of a's faces, never look at b's. */
     tet_frame_memo(in->pos, in->node_a, in->memo, &a);
     int apart = !(a.bary.valid && a.bary.det > 0);
+    double clear = 0;
     if (!apart) {
         tet_corners_of(in->pos, in->node_b, &b);
         apart = corners_in_target(&b, &a, &b_in_a);
+        if (apart) clear = pair_clearance(&a, &b, &b_in_a);
     }
     if (!apart) {
         tet_frame_memo(in->pos, in->node_b, in->memo, &b);
-        apart = !(b.bary.valid && b.bary.det > 0) || corners_in_target(&a, &b, &a_in_b);
+        apart = !(b.bary.valid && b.bary.det > 0);
+        if (!apart && corners_in_target(&a, &b, &a_in_b)) {
+            apart = 1;
+            clear = pair_clearance(&b, &a, &a_in_b);
+        }
     }
     if (apart) {
         memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
+        out[0] = clear;
         return 0;
     }
     for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
@@ -558,5 +637,6 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
                        springs + TET_CONTACT_SLOTS / 2, dissipated};
     double touched = contact_one_way(&a, &b, &a_in_b, in->penalty, &ab, out, out + 12);
     touched += contact_one_way(&b, &a, &b_in_a, in->penalty, &ba, out + 12, out);
+    /* untouched, no face has added anything: out[0] is 0, no clearance */
     return touched > 0;
 }

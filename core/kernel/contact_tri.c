@@ -40,6 +40,7 @@ typedef struct tri_now {
     int node[3];
     double x[3], y[3];
     double area2;       /* twice the signed area (> 0 unless inverted) */
+    double inv_area2;   /* 1 / area2, divided once a pair, not once a corner */
 } tri_now;
 
 /* The triangle's corners now, and twice its signed area. */
@@ -51,12 +52,13 @@ static inline void tri_gather(const double *pos, const int32_t node[3], tri_now 
         t->y[c] = pos[2 * node[c] + 1];
     }
     t->area2 = (t->x[1] - t->x[0]) * (t->y[2] - t->y[0]) - (t->y[1] - t->y[0]) * (t->x[2] - t->x[0]);
+    t->inv_area2 = t->area2 > 0 ? 1.0 / t->area2 : 0.0; /* inverted: never used */
 }
 
 /* Area coordinates of (px, py) in t: lambda_k belongs to node k. */
 static inline void area_coordinates(const tri_now *t, double px, double py, double l[3])
 {
-    double inv = 1.0 / t->area2;
+    double inv = t->inv_area2;
     for (int k = 0; k < 3; k++) {
         int i = (k + 1) % 3, j = (k + 2) % 3;
         l[k] = ((t->x[i] - px) * (t->y[j] - py) - (t->y[i] - py) * (t->x[j] - px)) * inv;
@@ -141,12 +143,16 @@ static double friction_force(const double *v, const tri_now *t, int na, int nb, 
  * stick springs of c's three edges against t (updated; an edge that does not
  * touch lets its spring go) and *dissipated gets what friction dissipated.
  * Returns 1 if any force acted. */
-static int contactor_against_target(const double *vel, const tri_now *c, const tri_now *t,
-                                    double penalty, double friction, double h, double springs[3],
-                                    double fc[6], double ft[6], double *dissipated)
+static void corners_in(const tri_now *c, const tri_now *t, double lam[3][3])
 {
-    double lam[3][3];
     for (int i = 0; i < 3; i++) area_coordinates(t, c->x[i], c->y[i], lam[i]);
+}
+
+static int contactor_against_target(const double *vel, const tri_now *c, const tri_now *t,
+                                    const double lam[3][3], double penalty, double friction,
+                                    double h, double springs[3], double fc[6], double ft[6],
+                                    double *dissipated)
+{
     double stiffness = 0; /* p / (h_t / 3), h_t the target's smallest altitude */
     int acted = 0;
     for (int i = 0; i < 3; i++) {
@@ -195,6 +201,57 @@ static int contactor_against_target(const double *vel, const tri_now *c, const t
     return acted;
 }
 
+/* The clearance (contact_pair.h) of two triangles that did not touch:
+ * how far the corners of `other` (their area coordinates lam in t) are
+ * outside an edge line of t that has them all outside, less a margin for
+ * rounding; 0 if there is none or either triangle is too flat to trust
+ * the figure. As in 3D (contact_tet.c, pair_clearance): the distance is
+ * -lambda_k times t's altitude over edge k; rounding puts it within some
+ * hundred ulps relative to the coordinates' size S, amplified by the shape
+ * (L^2 / 2A at most, L the longest edge): with 2A >= 1e-6 L^2 under
+ * 1e-10 (S + L), against a margin of 1e-8 S + 1e-7 L; and two triangles
+ * further apart than that give this kernel no edge with a positive
+ * integral (each clipped interval is within such rounding of the target),
+ * so it returns 0 with every spring let go, exactly. */
+#define CLEARANCE_QUALITY 1e-6
+static double tri_longest_edge(const tri_now *t)
+{
+    double most = 0;
+    for (int k = 0; k < 3; k++) {
+        int j = (k + 1) % 3;
+        double dx = t->x[j] - t->x[k], dy = t->y[j] - t->y[k];
+        most = max2(most, dx * dx + dy * dy);
+    }
+    return sqrt(most);
+}
+
+static double tri_clearance(const tri_now *t, const tri_now *other, const double lam[3][3])
+{
+    double best = 0;
+    for (int k = 0; k < 3; k++) {
+        double nearest = max3(lam[0][k], lam[1][k], lam[2][k]);
+        if (!(nearest < 0)) continue;
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        double dx = t->x[j] - t->x[i], dy = t->y[j] - t->y[i], edge2 = dx * dx + dy * dy;
+        /* the distance, -nearest area2 / |edge|, under 1e-7 |edge| (never
+         * over the margin): let go without a root - broken rock's pairs
+         * apart are mostly a hair apart across a crack */
+        if (!(-nearest * t->area2 > 1e-7 * edge2)) continue;
+        best = max2(best, -nearest * t->area2 / sqrt(edge2));
+    }
+    if (!(best > 0)) return 0;
+    double lt = tri_longest_edge(t), lo = tri_longest_edge(other);
+    if (!(t->area2 >= CLEARANCE_QUALITY * lt * lt) ||
+        !(other->area2 >= CLEARANCE_QUALITY * lo * lo))
+        return 0;
+    double size = 0;
+    for (int v = 0; v < 3; v++)
+        size = max2(size, max2(max2(fabs(t->x[v]), fabs(t->y[v])),
+                               max2(fabs(other->x[v]), fabs(other->y[v]))));
+    double clear = best - (1e-8 * size + 1e-7 * max2(lt, lo));
+    return clear > 0 ? clear : 0;
+}
+
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tri_now a, b;
@@ -202,13 +259,23 @@ int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     tri_gather(in->pos, in->node_b, &b);
     if (!(a.area2 > 0) || !(b.area2 > 0)) { /* inverted: no potential defined */
         memset(springs, 0, sizeof(double) * TRI_CONTACT_SLOTS);
+        out[0] = 0;
         return 0;
     }
     for (int k = 0; k < TRI_PAIR_OUT; k++) out[k] = 0;
     double *dissipated = &out[TRI_PAIR_OUT - 1];
-    int touched = contactor_against_target(in->vel, &a, &b, in->penalty, in->friction, in->h,
-                                           springs, out, out + 6, dissipated);
-    touched |= contactor_against_target(in->vel, &b, &a, in->penalty, in->friction, in->h,
-                                        springs + 3, out + 6, out, dissipated);
+    double a_in_b[3][3], b_in_a[3][3];
+    corners_in(&a, &b, a_in_b);
+    corners_in(&b, &a, b_in_a);
+    int touched = contactor_against_target(in->vel, &a, &b, (const double(*)[3])a_in_b,
+                                           in->penalty, in->friction, in->h, springs, out,
+                                           out + 6, dissipated);
+    touched |= contactor_against_target(in->vel, &b, &a, (const double(*)[3])b_in_a,
+                                        in->penalty, in->friction, in->h, springs + 3, out + 6,
+                                        out, dissipated);
+    /* untouched, nothing was added: out[0] is 0 unless a clearance is found */
+    if (!touched)
+        out[0] = max2(tri_clearance(&a, &b, (const double(*)[3])b_in_a),
+                      tri_clearance(&b, &a, (const double(*)[3])a_in_b));
     return touched;
 }

@@ -229,6 +229,7 @@ typedef struct contact_state {
     int near_active_count;   /* are all a step needs while the list holds */
     double *elem_gap;        /* per element: the smallest gap of its near pairs */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
+    int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;           /* 2D detection */

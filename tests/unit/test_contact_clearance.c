@@ -1,0 +1,170 @@
+/*
+ * test_contact_clearance.c - the contact stage skips a pair its kernel
+ * found apart by a clearance (contact.c, pair_evaluate; contact_pair.h)
+ * until the nodes' travel could close it. That is allowed only where the
+ * kernel would have returned exactly what it returned then (no force,
+ * every spring let go), so a run with the skips gives the bits of the same
+ * run without them (contact.clearance_off), in both dimensions: a block
+ * with every joint broken in place, squeezed so that its pieces press on
+ * each other, and two blocks colliding. Each test also checks that the
+ * skips happened (kernel calls saved), or it could not fail. A checkpoint
+ * taken mid-run restores to the same bits (the clearances start afresh),
+ * and the 3D broken block's run with the skips is on two threads.
+ */
+#include "build_model.h"
+#include "check.h"
+#include "contact/contact_internal.h"
+#include "fdem.h"
+#include "model/model.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* A unit block of n cells a side, every joint broken where it stands (as
+ * bench_engine.c's broken block), squeezed along x at rate `squeeze` (1/s)
+ * and sheared: its pieces press on and slide along each other. */
+static fdem_model *broken_block(int dim, int n, double squeeze)
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err = {0};
+    if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
+    int mat = build_fracturing_rock(m, 0.0);
+    const double size[3] = {1, 1, 1};
+    const int div[3] = {n, n, n};
+    build_box_part(m, mat, dim, size, div, 1);
+    build_finalize(m, 0.5);
+    for (int i = 0; i < m->node_count; i++) {
+        double *v = m->vel + (size_t)dim * i, *x = m->pos0 + (size_t)dim * i;
+        v[0] = -squeeze * (x[0] - 0.5) + 0.3 * squeeze * x[1];
+        v[1] = 0.2 * squeeze * (x[0] - 0.5);
+    }
+    for (int j = 0; j < m->joint_count; j++) m->joint_damage[j] = 1;
+    m->broken_joints = m->joint_count;
+    m->contact.need_detect = 1;
+    return m;
+}
+
+/* Two blocks about to meet (the 2D pair of build_model.h, or its 3D like). */
+static fdem_model *colliding_blocks(int dim)
+{
+    if (dim == 2) {
+        int a, b;
+        return build_colliding_blocks(&a, &b);
+    }
+    fdem_model *m = fdem_model_create();
+    fdem_error err = {0};
+    if (fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
+    int mat = build_material(m, 2700, 1e9, 0.25, 0, 0.3);
+    const double oa[3] = {0, 0, 0}, sa[3] = {0.1, 0.05, 0.05}, ob[3] = {0.1002, 0.01, 0.01},
+                 sb[3] = {0.06, 0.05, 0.05};
+    const int da[3] = {4, 2, 2}, db[3] = {3, 2, 2};
+    int a = build_box_at(m, mat, 3, oa, sa, da, 0), b = build_box_at(m, mat, 3, ob, sb, db, 0);
+    const double va[3] = {2.0, 0.1, 0.05}, vb[3] = {-3.0, 0, 0};
+    if (fdem_set_part_velocity_v(m, a, va, &err) || fdem_set_part_velocity_v(m, b, vb, &err))
+        build_die("velocity", &err);
+    build_finalize(m, 0.5);
+    return m;
+}
+
+/* Near pairs the walk of the coming step skips on a clearance alone: their
+ * boxes, as of now, overlap, so without the clearance the kernel would run. */
+static int skipped_on_clearance(const fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    double apart = 2.0 * sqrt(cs->near_disp2) * (1 + 1e-9);
+    int skipped = 0;
+    for (size_t i = 0; i < cs->near_count; i++) {
+        const near_pair *np = &cs->near[i];
+        double ba[6] = {0}, bb[6] = {0};
+        element_box(m, np->a, ba);
+        element_box(m, np->b, bb);
+        skipped += np->gap > apart && boxes_overlap(ba, bb, m->dim);
+    }
+    return skipped;
+}
+
+static void same_bits(const fdem_model *a, const fdem_model *b, const char *what)
+{
+    size_t n = sizeof(double) * (size_t)a->dim * (size_t)a->node_count;
+    CHECK(memcmp(a->pos, b->pos, n) == 0, "%s: positions differ", what);
+    CHECK(memcmp(a->vel, b->vel, n) == 0, "%s: velocities differ", what);
+    fdem_energy ea = fdem_get_energy(a), eb = fdem_get_energy(b);
+    CHECK(memcmp(&ea, &eb, sizeof ea) == 0, "%s: energies differ", what);
+}
+
+/* The model built twice, stepped `steps` times with the clearance skips
+ * and without them (the first on 2 threads when it is to have
+ * near_at_least near pairs, the threaded walk's): the same bits, contact
+ * made, and some kernel calls skipped along the way. */
+static void same_bits_with_and_without(fdem_model *(*build)(int), int dim, int steps,
+                                       size_t near_at_least, const char *what)
+{
+    fdem_model *on = build(dim), *off = build(dim);
+    off->contact.clearance_off = 1;
+    if (near_at_least) fdem_set_threads(on, 2); /* enough near pairs for the threaded walk */
+    fdem_error err = {0};
+    long skipped = 0, touching = 0;
+    for (int s = 0; s < steps; s++) {
+        CHECK(fdem_step(on, &err) == 0 && fdem_step(off, &err) == 0, "step %d: %s", s, err.message);
+        skipped += skipped_on_clearance(on);
+        touching += on->contact.touching;
+    }
+    same_bits(on, off, what);
+    CHECK(on->contact.near_count >= near_at_least, "%s: %zu near pairs, the threaded walk needs %zu",
+          what, on->contact.near_count, near_at_least);
+    CHECK(touching > 0, "%s: no pair touched", what);
+    CHECK(skipped > 0, "%s: no kernel call skipped on a clearance", what);
+    fprintf(stderr, "  %s: %ld pair-steps touching, %ld skipped on a clearance\n", what,
+            touching, skipped);
+    fdem_model_destroy(on);
+    fdem_model_destroy(off);
+}
+
+static fdem_model *broken_block_2d(int dim) { return broken_block(dim, 6, 20.0); }
+static fdem_model *broken_block_3d(int dim) { return broken_block(dim, 3, 20.0); }
+
+static void broken_block_2d_gives_the_same_bits(void)
+{
+    same_bits_with_and_without(broken_block_2d, 2, 200, 0, "2D broken block");
+}
+
+static void broken_block_3d_gives_the_same_bits(void)
+{
+    same_bits_with_and_without(broken_block_3d, 3, 40, 2048, "3D broken block");
+}
+
+static void colliding_blocks_give_the_same_bits(void)
+{
+    same_bits_with_and_without(colliding_blocks, 2, 600, 0, "2D blocks colliding");
+    same_bits_with_and_without(colliding_blocks, 3, 300, 0, "3D blocks colliding");
+}
+
+/* A checkpoint mid-run, while pairs are being skipped: the restored model
+ * starts its near list (and so its clearances) afresh, and steps on to the
+ * bits of the run that went on. */
+static void restored_broken_block_steps_on_to_the_same_bits(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *a = dim == 2 ? broken_block_2d(2) : broken_block_3d(3);
+        fdem_model *b = dim == 2 ? broken_block_2d(2) : broken_block_3d(3);
+        fdem_error err = {0};
+        for (int s = 0; s < 30; s++) CHECK(fdem_step(a, &err) == 0, "%s", err.message);
+        CHECK(skipped_on_clearance(a) > 0, "%dD: nothing skipped at the checkpoint", dim);
+        size_t size = fdem_checkpoint_size(a);
+        void *buf = malloc(size);
+        CHECK(buf && fdem_checkpoint_write(a, buf, size) == 0, "write");
+        CHECK(buf && fdem_checkpoint_read(b, buf, size, &err) == 0, "%s", err.message);
+        free(buf);
+        for (int s = 0; s < 30; s++) {
+            CHECK(fdem_step(a, &err) == 0, "%s", err.message);
+            CHECK(fdem_step(b, &err) == 0, "%s", err.message);
+        }
+        same_bits(a, b, dim == 2 ? "2D restored" : "3D restored");
+        fdem_model_destroy(a);
+        fdem_model_destroy(b);
+    }
+}
+
+CHECK_MAIN(T(broken_block_2d_gives_the_same_bits), T(broken_block_3d_gives_the_same_bits),
+           T(colliding_blocks_give_the_same_bits),
+           T(restored_broken_block_steps_on_to_the_same_bits))
