@@ -24,22 +24,13 @@
 #include "sizing_probe.h"
 #include "io_thread.h"
 #include "registry_internal.h"
+#include "eta_window.h"
 #include "worker_history.h"
 #include "worker_ranked.h"
 #include "math/clock.h"
 
 #define WORKER_PUBLISH_INTERVAL 0.05   /* s of wall time between status figures */
 #define WORKER_MAX_IO_BACKLOG 8        /* snapshot jobs in flight per case */
-/* The eta (contract 6.2) divides the simulated time left by the simulated
- * seconds per wall second over the last WORKER_ETA_SAMPLES x
- * WORKER_ETA_SAMPLE_EVERY (8 s) of this run: long enough that one slow
- * step or a snapshot write does not swing it, short enough to follow a
- * case that slows once it breaks. Unknown (null) before
- * WORKER_ETA_MIN_WINDOW of the run. */
-#define WORKER_ETA_SAMPLES 32
-#define WORKER_ETA_SAMPLE_EVERY 0.25
-#define WORKER_ETA_MIN_WINDOW 0.2
-
 typedef enum worker_exit {
     EXIT_PAUSE, EXIT_STOP, EXIT_ABANDON, EXIT_FINISHED, EXIT_FAILED,
 } worker_exit;
@@ -60,10 +51,7 @@ typedef struct worker_clock {
     double cpu_at_speed, wall_at_cpu, cpu_share;
     double run_started;     /* when this run began stepping */
     double elapsed_before;  /* wall seconds spent stepping in earlier runs */
-    /* the eta's window: (wall, simulated time) once every
-     * WORKER_ETA_SAMPLE_EVERY, the oldest overwritten (worker_eta) */
-    double eta_wall[WORKER_ETA_SAMPLES], eta_time[WORKER_ETA_SAMPLES];
-    int eta_count, eta_next;
+    eta_window eta;         /* this run's (eta_window.h) */
     double io_waited;       /* wall seconds this run waited for its snapshot writes */
     int snapshots_taken;    /* by this run */
 } worker_clock;
@@ -84,26 +72,6 @@ static void worker_take_warnings(server_case *c)
         c->warnings = json_array();
     status_take_penetrations(c->warnings, c->model);
     pthread_mutex_unlock(&c->lock);
-}
-
-/* Wall seconds left at the speed of the recent window (see
- * WORKER_ETA_SAMPLES), NAN while the window is too short or the case is not
- * advancing; takes the sample of `now` when one is due. */
-static double worker_eta(worker_clock *clk, double now, double time, double end)
-{
-    int newest = (clk->eta_next + WORKER_ETA_SAMPLES - 1) % WORKER_ETA_SAMPLES;
-    if (clk->eta_count == 0 || now - clk->eta_wall[newest] >= WORKER_ETA_SAMPLE_EVERY) {
-        clk->eta_wall[clk->eta_next] = now;
-        clk->eta_time[clk->eta_next] = time;
-        clk->eta_next = (clk->eta_next + 1) % WORKER_ETA_SAMPLES;
-        if (clk->eta_count < WORKER_ETA_SAMPLES) clk->eta_count++;
-    }
-    int oldest = clk->eta_count < WORKER_ETA_SAMPLES ? 0 : clk->eta_next;
-    double wall = now - clk->eta_wall[oldest], advanced = time - clk->eta_time[oldest];
-    if (!(wall >= WORKER_ETA_MIN_WINDOW) || !(advanced > 0))
-        return NAN;
-    double left = end - time;
-    return left > 0 ? left * wall / advanced : 0.0;
 }
 
 /* Called with model_lock held (the figures must belong to one step). */
@@ -137,7 +105,7 @@ static void worker_publish(server_case *c, worker_clock *clk, double now, int ru
     }
     fig.steps_per_second = running ? clk->steps_per_second : 0.0;
     fig.cpu_share = running ? clk->cpu_share : NAN;
-    fig.eta = running ? worker_eta(clk, now, fig.time, c->info.end_time) : NAN;
+    fig.eta = running ? eta_window_take(&clk->eta, now, fig.time, c->info.end_time) : NAN;
     fig.snapshots = -1; /* owned by the I/O thread */
     fig.elapsed = clk->elapsed_before + (now - clk->run_started);
     status_figures_stage(&fig, m, &c->info);

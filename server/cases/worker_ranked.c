@@ -25,9 +25,11 @@
 #include <unistd.h>
 
 #include "case_model.h"
+#include "eta_window.h"
 #include "files/persist.h"
 #include "io_thread.h"
 #include "launch.h"
+#include "math/clock.h"
 #include "registry_internal.h"
 
 extern char **environ;
@@ -183,8 +185,9 @@ static pid_t ranked_spawn(server_case *c, int *control)
     return pid;
 }
 
-/* The ranks' status.json into the case's figures, when it changed. */
-static void ranked_follow_status(server_case *c, struct timespec *seen)
+/* The ranks' status.json into the case's figures, when it changed; the
+ * eta from the simulated time it shows, as the worker's (eta_window.h). */
+static void ranked_follow_status(server_case *c, struct timespec *seen, eta_window *eta)
 {
     char path[1200];
     struct stat st;
@@ -202,7 +205,7 @@ static void ranked_follow_status(server_case *c, struct timespec *seen)
     f.counts.dimension = f.counts.dimension ? f.counts.dimension : 2;
     const json_t *sps = json_object_get(o, "steps_per_second");
     f.steps_per_second = json_is_number(sps) ? json_number_value(sps) : 0.0;
-    f.eta = NAN;
+    f.eta = eta_window_take(eta, clock_wall_seconds(), f.time, c->info.end_time);
     f.cpu_share = NAN;
     const char *error = json_string_value(json_object_get(o, "error"));
     if (error && error[0]) {
@@ -358,12 +361,14 @@ case_state worker_ranked_run(server_case *c)
     atomic_store(&c->ranks_running, 1);
     case_log(c, "started on %d ranks (process group %d)", c->info.ranks, (int)pid);
     struct timespec seen = {0, 0};
+    eta_window eta;
+    memset(&eta, 0, sizeof eta);
     int sent = WORKER_GO, status = 0;
     for (;;) {
         pid_t done = waitpid(pid, &status, WNOHANG);
         if (done == pid || (done < 0 && errno != EINTR))
             break;
-        ranked_follow_status(c, &seen);
+        ranked_follow_status(c, &seen, &eta);
         int cmd = atomic_load(&c->command);
         if (cmd != sent && cmd == WORKER_PAUSE)
             ranked_send(control, "pause\n");
@@ -380,7 +385,7 @@ case_state worker_ranked_run(server_case *c)
     unlink(pid_path); /* they are gone: nothing for a later launch to wait for */
     atomic_store(&c->ranks_running, 0);
     seen.tv_sec = seen.tv_nsec = 0;
-    ranked_follow_status(c, &seen);
+    ranked_follow_status(c, &seen, &eta);
     if (atomic_load(&c->command) == WORKER_ABANDON)
         return CASE_STOPPED;
     return ranked_outcome(c, status);

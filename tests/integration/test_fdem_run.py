@@ -310,6 +310,11 @@ class RankedCases(DaemonTestCase):
             st = d.create(self.ranked(tiny_case("orphan", end=5.0, divisions=(4, 4),
                                                 interval=1e-3)), start=True)
             d.wait(st["id"], lambda s: s["snapshots"] > 1, timeout=30, what="the ranks step")
+            # the eta follows the ranks' status.json as the worker's own
+            # (it was always null for a ranked case)
+            st = d.wait(st["id"], lambda s: s.get("eta") is not None, timeout=30,
+                        what="a ranked case's eta")
+            self.assertGreater(st["eta"], 0)
             # while the ranks write, the routes read their file (SWMR); a byte
             # copy of it could catch a write half done: 409 with a sentence
             for route in ("events", "history", "mesh.bin?snapshot=1", "state"):
