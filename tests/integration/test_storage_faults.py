@@ -216,10 +216,11 @@ class StoredFilesTest(unittest.TestCase):
         good = open(path, "rb").read()
         # what that daemon wrote: checkpoint version 5, whose header ends
         # before version 6's time_carry (a double at byte 240), no trailer
-        # (versions 7, 8, 9 and 10 only add sections at the end, the joints'
-        # slip, the stages and the fluid: this case has none of them)
+        # (versions 7 to 11 only add sections at the end, the joints'
+        # slip, the stages and the fluid with its bores: this case has none
+        # of them)
         body = good[:-8]
-        self.assertEqual(int.from_bytes(body[4:8], "little"), 10)
+        self.assertEqual(int.from_bytes(body[4:8], "little"), 11)
         with open(path, "wb") as f:
             f.write(body[:4] + (5).to_bytes(4, "little") + body[8:240] + body[248:])
         self.assert_back_as_paused(cid, paused)
