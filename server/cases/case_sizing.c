@@ -21,6 +21,7 @@
 #include "state/snapshot.h"
 #include "files/checkpoint_file.h"
 #include "math/clock.h"
+#include "common/sample_ring.h"
 
 
 double sizing_steps_to_end(double t0, double end, double dt)
@@ -175,23 +176,15 @@ static int sizing_crack_plane(const fdem_model *model, double normal[3], double 
 #define SIZING_DETECTIONS 5
 #define SIZING_DETECTION_CPU 0.3
 
-static int compare_seconds(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 static double sizing_detection_seconds(fdem_model *model, double steps_left, int *taken)
 {
     double seconds[SIZING_DETECTIONS], spent = 0;
     int n = 0;
     while (n < SIZING_DETECTIONS && n < steps_left && (n == 0 || spent < SIZING_DETECTION_CPU)) {
-        fdem_error err;
-        memset(&err, 0, sizeof err);
         fdem_force_detection(model);
         double detected0 = fdem_get_stage_times(model).detection;
         double wall0 = clock_wall_seconds(), cpu0 = clock_cpu_seconds();
-        if (fdem_step(model, &err) != 0)
+        if (sizing_step(model) != 0)
             return NAN;
         double cpu = clock_cpu_seconds() - cpu0, wall = clock_wall_seconds() - wall0;
         double share = wall > 0 ? (fdem_get_stage_times(model).detection - detected0) / wall : 1;
@@ -200,8 +193,7 @@ static double sizing_detection_seconds(fdem_model *model, double steps_left, int
         (*taken)++;
     }
     if (n == 0) return NAN;
-    qsort(seconds, (size_t)n, sizeof *seconds, compare_seconds);
-    return seconds[n / 2];
+    return median_in_place(seconds, n);
 }
 
 /* CPU seconds a step once the rock has broken: the model is cut by a
@@ -242,9 +234,7 @@ static double sizing_whole_run_seconds(fdem_model *model, double steps, int *tak
     int from = *taken;
     double cpu0 = clock_cpu_seconds(), wall0 = clock_wall_seconds();
     while (*taken < steps) {
-        fdem_error err;
-        memset(&err, 0, sizeof err);
-        if (fdem_step(model, &err) != 0)
+        if (sizing_step(model) != 0)
             return NAN;
         (*taken)++;
         if (((*taken - from) & 63) == 0 && clock_cpu_seconds() - cpu0 > SIZING_WHOLE_CPU_CAP)
@@ -285,9 +275,7 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
     for (int k = 1; k <= SIZING_LOOKS; k++) {
         double target = reach * k / SIZING_LOOKS;
         while (*taken < target) {
-            fdem_error err;
-            memset(&err, 0, sizeof err);
-            if (fdem_step(model, &err) != 0)
+            if (sizing_step(model) != 0)
                 return first; /* the run will say why */
             (*taken)++;
         }
@@ -298,8 +286,7 @@ static double sizing_later_step_seconds(fdem_model *model, case_sizing *out, int
             return first;
         pace_at[looks++] = pace;
     }
-    qsort(pace_at, (size_t)looks, sizeof *pace_at, compare_seconds);
-    double later = out->later_step_seconds = pace_at[looks / 2];
+    double later = out->later_step_seconds = median_in_place(pace_at, looks);
     double done = *taken / out->steps;
     return done * first + (1 - done) * later;
 }

@@ -10,6 +10,8 @@
  */
 #include "io_thread.h"
 
+#include "common/sample_ring.h"
+
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,52 +23,23 @@
  * recent snapshot jobs: the latency from the small ones (where the fsyncs
  * are all of it), the seconds per byte from the
  * large ones, less the latency: each the median of the last
- * IO_COST_SAMPLES. One moving average of every job priced a 2D collision's
+ * SAMPLE_RING_SIZE. One moving average of every job priced a 2D collision's
  * 3 KB snapshots at the 0.1 s the large 3D jobs before it took, five times
  * its run, and one write the disk held up for seconds priced a small 3D
  * case's 76 snapshots at 68 s. */
-#define IO_COST_SAMPLES 9
 #define IO_SMALL_JOB_BYTES 262144.0
-typedef struct io_cost_samples {
-    double value[IO_COST_SAMPLES];
-    int count, next;
-} io_cost_samples;
 static pthread_mutex_t io_cost_lock = PTHREAD_MUTEX_INITIALIZER;
-static io_cost_samples io_latency_samples, io_rate_samples;
+static sample_ring io_latency_samples, io_rate_samples, io_paced_samples;
 static double io_latency_seed;
-
-static void io_cost_add(io_cost_samples *s, double value)
-{
-    s->value[s->next] = value;
-    s->next = (s->next + 1) % IO_COST_SAMPLES;
-    if (s->count < IO_COST_SAMPLES) s->count++;
-}
-
-static int io_compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* The median of the samples (`fallback` when there are none): one write
- * held up for seconds by a busy disk does not price the next case. */
-static double io_cost_median(const io_cost_samples *s, double fallback)
-{
-    if (s->count == 0) return fallback;
-    double v[IO_COST_SAMPLES];
-    memcpy(v, s->value, sizeof(double) * (size_t)s->count);
-    qsort(v, (size_t)s->count, sizeof *v, io_compare_doubles);
-    return v[s->count / 2];
-}
 
 void io_note_snapshot_cost(double seconds, double bytes)
 {
     pthread_mutex_lock(&io_cost_lock);
     if (bytes < IO_SMALL_JOB_BYTES) {
-        io_cost_add(&io_latency_samples, seconds);
+        sample_ring_add(&io_latency_samples, seconds);
     } else {
-        double latency = io_cost_median(&io_latency_samples, io_latency_seed);
-        io_cost_add(&io_rate_samples, (seconds > latency ? seconds - latency : 0.0) / bytes);
+        double latency = sample_ring_median(&io_latency_samples, io_latency_seed);
+        sample_ring_add(&io_rate_samples, (seconds > latency ? seconds - latency : 0.0) / bytes);
     }
     pthread_mutex_unlock(&io_cost_lock);
 }
@@ -85,23 +58,22 @@ void io_seed_snapshot_seconds(double seconds)
  * such runs at a fifth of what they took. */
 #define IO_PACED_SHARE 0.33
 #define IO_PACED_MIN_SNAPSHOTS 10
-static io_cost_samples io_paced_samples;
 
 void io_note_paced_run(double wall, double waited, int snapshots)
 {
     if (snapshots < IO_PACED_MIN_SNAPSHOTS || !(waited > IO_PACED_SHARE * wall))
         return;
     pthread_mutex_lock(&io_cost_lock);
-    io_cost_add(&io_paced_samples, wall / snapshots);
+    sample_ring_add(&io_paced_samples, wall / snapshots);
     pthread_mutex_unlock(&io_cost_lock);
 }
 
 double io_snapshot_seconds(double bytes)
 {
     pthread_mutex_lock(&io_cost_lock);
-    double seconds = io_cost_median(&io_latency_samples, io_latency_seed);
+    double seconds = sample_ring_median(&io_latency_samples, io_latency_seed);
     if (io_paced_samples.count > 0)
-        seconds = io_cost_median(&io_paced_samples, seconds);
+        seconds = sample_ring_median(&io_paced_samples, seconds);
     /* the rate is kept but not charged: on a disk other processes keep
      * busy, large writes stalled for seconds at random and priced a 3D
      * collision's 76 snapshots of 300 KB at 20 to 36 s, which took 2.5 s;

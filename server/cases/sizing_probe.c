@@ -35,6 +35,7 @@
 #include <time.h>
 #include <unistd.h>
 #include "math/clock.h"
+#include "common/sample_ring.h"
 
 /* Untimed warm-up: at least this many steps and this long. */
 #define PROBE_WARM_STEPS 2
@@ -49,17 +50,11 @@
 #define PROBE_MIN_WINDOWS 3
 #define PROBE_BUDGET_SECONDS 0.3
 
-static int probe_step(fdem_model *model)
+int sizing_step(fdem_model *model)
 {
     fdem_error err;
     memset(&err, 0, sizeof err);
     return fdem_step(model, &err);
-}
-
-static int compare_doubles(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* Steps for at least `seconds` and `min_steps`, at most `max_steps`;
@@ -70,7 +65,7 @@ static int probe_run(fdem_model *model, double seconds, int min_steps, int max_s
     double started = clock_wall_seconds(), now = started, cpu0 = clock_cpu_seconds();
     int taken = 0;
     while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
-        if (probe_step(model) != 0)
+        if (sizing_step(model) != 0)
             return -1;
         taken++;
         now = clock_wall_seconds();
@@ -110,62 +105,47 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
         room -= n;
         window[windows++] = cpu / n;
     }
-    qsort(window, (size_t)windows, sizeof *window, compare_doubles);
-    return window[windows / 2];
+    return median_in_place(window, windows);
 }
 
 /* Wall over CPU seconds of the stepping thread in the daemon's recent
  * runs (sizing_note_run): the share of the machine a run really got. */
-#define RUN_SHARE_SAMPLES 9
 #define RUN_SHARE_MIN_SECONDS 0.2
 static pthread_mutex_t run_share_lock = PTHREAD_MUTEX_INITIALIZER;
-static double run_share[RUN_SHARE_SAMPLES];
-static int run_share_count, run_share_next;
+static sample_ring run_share;
 
 void sizing_note_run(double wall, double cpu)
 {
     if (!(wall >= RUN_SHARE_MIN_SECONDS) || !(cpu > 0))
         return;
     pthread_mutex_lock(&run_share_lock);
-    run_share[run_share_next] = wall / cpu;
-    run_share_next = (run_share_next + 1) % RUN_SHARE_SAMPLES;
-    if (run_share_count < RUN_SHARE_SAMPLES) run_share_count++;
+    sample_ring_add(&run_share, wall / cpu);
     pthread_mutex_unlock(&run_share_lock);
 }
 
 /* The median of the recent runs' wall / CPU, or 0 when none ran. */
 static double recent_run_factor(void)
 {
-    double v[RUN_SHARE_SAMPLES];
     pthread_mutex_lock(&run_share_lock);
-    int n = run_share_count;
-    memcpy(v, run_share, sizeof(double) * (size_t)n);
+    double median = sample_ring_median(&run_share, 0);
     pthread_mutex_unlock(&run_share_lock);
-    if (n == 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, compare_doubles);
-    return v[n / 2];
+    return median;
 }
 
 /* The probes' own wall / CPU seconds swing 1x to 4x between two dry runs a
  * second apart on a busy machine (a neighbour's burst lands in one probe's
  * windows and not in the next's): before any run, the median of the last
- * RUN_SHARE_SAMPLES probes' figures stands for them, so a repeated dry run
+ * SAMPLE_RING_SIZE probes' figures stands for them, so a repeated dry run
  * sees nearly the same machine. */
-static double probe_share[RUN_SHARE_SAMPLES];
-static int probe_share_count, probe_share_next;
+static sample_ring probe_share;
 
 static double recent_probe_factor(double seen)
 {
-    double v[RUN_SHARE_SAMPLES];
     pthread_mutex_lock(&run_share_lock);
-    probe_share[probe_share_next] = seen;
-    probe_share_next = (probe_share_next + 1) % RUN_SHARE_SAMPLES;
-    if (probe_share_count < RUN_SHARE_SAMPLES) probe_share_count++;
-    int n = probe_share_count;
-    memcpy(v, probe_share, sizeof(double) * (size_t)n);
+    sample_ring_add(&probe_share, seen);
+    double median = sample_ring_median(&probe_share, seen);
     pthread_mutex_unlock(&run_share_lock);
-    qsort(v, (size_t)n, sizeof *v, compare_doubles);
-    return v[n / 2];
+    return median;
 }
 
 double sizing_load_factor(const sizing_load *load)

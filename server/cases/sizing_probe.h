@@ -18,7 +18,9 @@
  *    mean of (one-minute load average + 1) / cores and the windows' own
  *    wall / CPU seconds (the median of the last 9 probes' including
  *    *load's); at least 1.
- *  The clocks are common/clock.h's.
+ *  - sizing_step() is one untimed step (1 or 0 as fdem_step), for the
+ *    estimate's other walks through the model.
+ *  The clocks are math/clock.h's.
  */
 #ifndef FDEMD_SIZING_PROBE_H
 #define FDEMD_SIZING_PROBE_H
@@ -33,5 +35,6 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
                                  sizing_load *load);
 double sizing_load_factor(const sizing_load *load);
 void sizing_note_run(double wall, double cpu);
+int sizing_step(fdem_model *model);
 
 #endif
