@@ -76,6 +76,19 @@ typedef struct contact_pair_in {
 static inline double min2(double a, double b) { return a < b ? a : b; }
 static inline double max2(double a, double b) { return a > b ? a : b; }
 
+/* A clearance (above) as both kernels finish it: the distance the pair is
+ * apart by less the rounding margin 1e-8 S + 1e-7 L (S the coordinates'
+ * size, L the longer of the two elements' longest edges), or 0; trusted
+ * only of elements no flatter than CONTACT_CLEARANCE_QUALITY (2A >= q L^2,
+ * 6V >= q L^3). Why the margin covers the rounding: contact_tet.c,
+ * pair_clearance. */
+#define CONTACT_CLEARANCE_QUALITY 1e-6
+static inline double contact_clearance_less_margin(double apart, double size, double longest)
+{
+    double clear = apart - (1e-8 * size + 1e-7 * longest);
+    return clear > 0 ? clear : 0;
+}
+
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
 

@@ -550,7 +550,6 @@ static void tet_frame_memo(const double *pos, const int32_t n[4], contact_pair_m
  *    early-outs do; the elements stay that shape (the stage skips only
  *    while no node has moved a hundredth of an element).
  * An inverted element has no potential (apart in any case). */
-#define CLEARANCE_QUALITY 1e-6
 static double tet_longest_edge2(const double *const p[4])
 {
     double most = 0;
@@ -592,14 +591,13 @@ static double pair_clearance(const tet_frame *t, const tet_frame *other, const c
     if (!(best > 0)) return 0;
     double lt2 = tet_longest_edge2(t->p), lo2 = tet_longest_edge2(other->p);
     double lt = sqrt(lt2), lo = sqrt(lo2);
-    if (!(t->bary.det >= CLEARANCE_QUALITY * lt2 * lt) ||
-        !(tet_six_volume(other->p) >= CLEARANCE_QUALITY * lo2 * lo))
+    if (!(t->bary.det >= CONTACT_CLEARANCE_QUALITY * lt2 * lt) ||
+        !(tet_six_volume(other->p) >= CONTACT_CLEARANCE_QUALITY * lo2 * lo))
         return 0;
     double size = 0;
     for (int v = 0; v < 4; v++)
         for (int i = 0; i < 3; i++) size = max2(size, max2(fabs(t->p[v][i]), fabs(other->p[v][i])));
-    double clear = best - (1e-8 * size + 1e-7 * max2(lt, lo));
-    return clear > 0 ? clear : 0;
+    return contact_clearance_less_margin(best, size, max2(lt, lo));
 }
 
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)

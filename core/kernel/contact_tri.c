@@ -213,7 +213,6 @@ static int contactor_against_target(const double *vel, const tri_now *c, const t
  * further apart than that give this kernel no edge with a positive
  * integral (each clipped interval is within such rounding of the target),
  * so it returns 0 with every spring let go, exactly. */
-#define CLEARANCE_QUALITY 1e-6
 static double tri_longest_edge(const tri_now *t)
 {
     double most = 0;
@@ -241,15 +240,14 @@ static double tri_clearance(const tri_now *t, const tri_now *other, const double
     }
     if (!(best > 0)) return 0;
     double lt = tri_longest_edge(t), lo = tri_longest_edge(other);
-    if (!(t->area2 >= CLEARANCE_QUALITY * lt * lt) ||
-        !(other->area2 >= CLEARANCE_QUALITY * lo * lo))
+    if (!(t->area2 >= CONTACT_CLEARANCE_QUALITY * lt * lt) ||
+        !(other->area2 >= CONTACT_CLEARANCE_QUALITY * lo * lo))
         return 0;
     double size = 0;
     for (int v = 0; v < 3; v++)
         size = max2(size, max2(max2(fabs(t->x[v]), fabs(t->y[v])),
                                max2(fabs(other->x[v]), fabs(other->y[v]))));
-    double clear = best - (1e-8 * size + 1e-7 * max2(lt, lo));
-    return clear > 0 ? clear : 0;
+    return contact_clearance_less_margin(best, size, max2(lt, lo));
 }
 
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
