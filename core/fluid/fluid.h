@@ -165,10 +165,6 @@ int fluid_keys_3d(const fdem_model *m, int j, int32_t keys[3][2]);
 /* The same of a boundary facet of nodes n (a bore's wall). */
 int fluid_facet_keys_2d(const fdem_model *m, const int32_t *n, int32_t keys[3][2]);
 int fluid_facet_keys_3d(const fdem_model *m, const int32_t *n, int32_t keys[3][2]);
-/* The area vector of a boundary facet of corners x (outward order),
- * pointing out of the body (into a bore), and its centroid. */
-void fluid_facet_2d(const double *const x[3], double area[3], double centroid[3]);
-void fluid_facet_3d(const double *const x[3], double area[3], double centroid[3]);
 /* The width of a link through key (1 in 2D, the edge's initial length in
  * 3D). */
 double fluid_key_width_2d(const fdem_model *m, const int32_t key[2]);

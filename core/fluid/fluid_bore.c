@@ -37,6 +37,7 @@
 
 #include "model/model.h"
 #include "joint/joint.h"
+#include "math/facet_area.h"
 #include "math/vec3.h"
 #include "fluid.h"
 
@@ -54,8 +55,12 @@ static void facet_geometry(const fdem_model *m, const fluid_net *f, int j, doubl
     const double *x[3] = {NULL, NULL, NULL};
     for (int a = 0; a < D; a++)
         x[a] = f->corner_pos + (size_t)D * (size_t)f->wall_corner[(size_t)D * (size_t)j + a];
-    if (D == 3) fluid_facet_3d(x, area, centroid);
-    else fluid_facet_2d(x, area, centroid);
+    facet_area_vector_of(D, x, area); /* out of the rock, into the bore */
+    for (int d = 0; d < 3; d++) {
+        double sum = d < D ? x[0][d] : 0;
+        for (int a = 1; a < D && d < D; a++) sum += x[a][d];
+        centroid[d] = d < D ? sum / D : 0;
+    }
 }
 
 /* Each corner at the mean of its node copies' current positions. */

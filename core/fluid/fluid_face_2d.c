@@ -1,7 +1,7 @@
 /*
  * fluid_face_2d.c - the 2D kernel of the fluid network: a joint's mean
  * edge as the fluid sees it, and which joints are neighbours (those that
- * share a mesh vertex), and a bore's wall edge. Everything else is shared
+ * share a mesh vertex), and the keys of a bore's wall edge. Everything else is shared
  * with 3D (fluid_flow.c, fluid_network.c, fluid_bore.c).
  *
  * The mean face is the one the joint law uses (joint.c): A's edge a0 -> a1
@@ -43,18 +43,6 @@ int fluid_facet_keys_2d(const fdem_model *m, const int32_t *n, int32_t keys[3][2
         keys[i][1] = -1;
     }
     return 2;
-}
-
-/* A bore's wall edge x0 -> x1 (counter-clockwise around its element):
- * (t_y, -t_x) points out of the element, into the bore. */
-void fluid_facet_2d(const double *const x[3], double area[3], double centroid[3])
-{
-    area[0] = x[1][1] - x[0][1];
-    area[1] = -(x[1][0] - x[0][0]);
-    area[2] = 0;
-    centroid[0] = 0.5 * (x[0][0] + x[1][0]);
-    centroid[1] = 0.5 * (x[0][1] + x[1][1]);
-    centroid[2] = 0;
 }
 
 double fluid_key_width_2d(const fdem_model *m, const int32_t key[2]) { return 1.0; }

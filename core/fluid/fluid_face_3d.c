@@ -2,7 +2,7 @@
  * fluid_face_3d.c - the 3D kernel of the fluid network: a joint's mean
  * triangle as the fluid sees it, and which joints are neighbours (those
  * that share an edge of the mesh, through which the fluid passes with the
- * edge's length as its width), and a bore's wall triangle. Everything
+ * edge's length as its width), and the keys of a bore's wall triangle. Everything
  * else is shared with 2D (fluid_flow.c, fluid_network.c, fluid_bore.c).
  *
  * The mean face is the joint law's (joint_tet.h): corners a_i + d_i / 2,
@@ -51,20 +51,6 @@ int fluid_facet_keys_3d(const fdem_model *m, const int32_t *n, int32_t keys[3][2
         keys[i][1] = p < q ? q : p;
     }
     return 3;
-}
-
-/* A bore's wall triangle, its corners ordered so that half the cross
- * product of its edges points out of its element, into the bore. */
-void fluid_facet_3d(const double *const x[3], double area[3], double centroid[3])
-{
-    double e1[3], e2[3], N[3];
-    vec3_sub(x[1], x[0], e1);
-    vec3_sub(x[2], x[0], e2);
-    vec3_cross(e1, e2, N);
-    for (int k = 0; k < 3; k++) {
-        area[k] = 0.5 * N[k];
-        centroid[k] = (x[0][k] + x[1][k] + x[2][k]) / 3;
-    }
 }
 
 double fluid_key_width_3d(const fdem_model *m, const int32_t key[2])

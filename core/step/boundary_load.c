@@ -51,8 +51,8 @@
 #include <string.h>
 
 #include "model/model.h"
+#include "math/facet_area.h"
 #include "math/node_ids.h"
-#include "math/vec3.h"
 #include "math/voigt.h"
 #include "step.h"
 
@@ -104,19 +104,10 @@ static const int *facet_vertices(const fdem_model *m, int f)
  * thickness), area times it in 3D. */
 static void facet_area_vector(const fdem_model *m, const int32_t *n, double s[3])
 {
-    const double *x = m->pos;
-    if (m->dim == 2) {
-        double dx = x[2 * n[1]] - x[2 * n[0]], dy = x[2 * n[1] + 1] - x[2 * n[0] + 1];
-        s[0] = dy;
-        s[1] = -dx;
-        s[2] = 0;
-        return;
-    }
-    double a[3], b[3];
-    vec3_sub(x + 3 * (size_t)n[1], x + 3 * (size_t)n[0], a);
-    vec3_sub(x + 3 * (size_t)n[2], x + 3 * (size_t)n[0], b);
-    vec3_cross(a, b, s);
-    for (int d = 0; d < 3; d++) s[d] *= 0.5;
+    const size_t D = (size_t)m->dim;
+    const double *x[3] = {m->pos + D * (size_t)n[0], m->pos + D * (size_t)n[1],
+                          D == 3 ? m->pos + D * (size_t)n[2] : NULL};
+    facet_area_vector_of(m->dim, x, s);
 }
 
 /* One element facet, keyed by its sorted mesh vertices. */
