@@ -9,10 +9,10 @@
 #define FDEM_BENCH_PAIR_KINDS_H
 
 #include <stdlib.h>
-#include <time.h>
 
 #include "contact/contact.h"
 #include "kernel/contact_pair.h"
+#include "math/clock.h"
 #include "model/model.h"
 
 enum { PAIR_APART_MESH, PAIR_CORNER, PAIR_EDGE, PAIR_FACE, PAIR_KINDS };
@@ -50,13 +50,11 @@ static inline void pair_kind_kernel(const fdem_model *m, double seconds[PAIR_KIN
     for (size_t k = 0; k < n; k++) kind[k] = (unsigned char)pair_kind(m, m->contact.pairs.a[k], m->contact.pairs.b[k]);
     double out[CONTACT_PAIR_OUT_MAX];
     for (int c = 0; c < PAIR_KINDS; c++) {
-        struct timespec t0, t1;
         int touched = 0;
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+        double t0 = clock_cpu_seconds();
         for (size_t k = 0; k < n; k++)
             if (kind[k] == c) touched += contact_pair_force_now(m, k, out);
-        clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
-        seconds[c] = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+        seconds[c] = clock_cpu_seconds() - t0;
         touching[c] = touched;
     }
     free(kind);

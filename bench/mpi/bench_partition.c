@@ -19,19 +19,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "fdem.h"
+#include "math/clock.h"
 #include "mesh/mesh_3d.h"
 
 /* Process CPU seconds: on a shared machine the wall time of METIS says
  * more about the neighbours than about METIS. */
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
+static double now(void) { return clock_seconds_of(CLOCK_PROCESS_CPUTIME_ID); }
 
 /* rank_engine.c's split_borders: each node on the border of exactly two
  * parts a < b, the first half of the pair's (in node order) to a, the rest

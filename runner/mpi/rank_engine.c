@@ -39,9 +39,9 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "model/model.h"
+#include "math/clock.h"
 #include "element/element.h"
 #include "rank_engine.h"
 #include "rank_halo.h"
@@ -77,9 +77,7 @@ typedef struct stopwatch {
 
 static stopwatch stopwatch_now(void)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return (stopwatch){MPI_Wtime(), (double)t.tv_sec + 1e-9 * (double)t.tv_nsec};
+    return (stopwatch){MPI_Wtime(), clock_seconds_of(CLOCK_PROCESS_CPUTIME_ID)};
 }
 
 static void stopwatch_add(rank_engine *re, stopwatch since)
