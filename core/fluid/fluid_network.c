@@ -115,12 +115,12 @@ static int key_compare(const void *pa, const void *pb)
     return (a->joint > b->joint) - (a->joint < b->joint);
 }
 
-static double centre_distance(const fluid_net *f, int D, int a, int b)
+static double point_distance(int D, const double *x, const double *y)
 {
     double s = 0;
     for (int d = 0; d < D; d++) {
-        double x = f->centre[D * a + d] - f->centre[D * b + d];
-        s += x * x;
+        double u = x[d] - y[d];
+        s += u * u;
     }
     return sqrt(s);
 }
@@ -161,11 +161,10 @@ static double link_length(const fdem_model *m, const fluid_net *f, int a, int b,
                           const int32_t key[2])
 {
     const int D = m->dim;
-    if (b < f->joints) return centre_distance(f, D, a, b);
-    double x[3], s = 0;
+    if (b < f->joints) return point_distance(D, f->centre + D * a, f->centre + D * b);
+    double x[3];
     fluid_key_point(m, key, x);
-    for (int d = 0; d < D; d++) s += (f->centre[D * a + d] - x[d]) * (f->centre[D * a + d] - x[d]);
-    return sqrt(s);
+    return point_distance(D, f->centre + D * a, x);
 }
 
 /* Every two cavities with a key in common, in key order then cavity
