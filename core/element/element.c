@@ -82,12 +82,7 @@ static scatter_block_fn element_forces_loop(const fdem_model *m)
  * partly marked are another process's to give (step_share.block_sums). */
 static void forces_of_marked_runs(fdem_model *m, int begin, int end, double sums[SCATTER_SUMS])
 {
-    const uint8_t *mark = m->share->elem_mark;
-    const scatter_block_fn loop = element_forces_loop(m);
-    int stop;
-    for (int e = share_next_run(mark, begin, end, &stop); e < end;
-         e = share_next_run(mark, stop, end, &stop))
-        loop(m, e, stop, sums);
+    scatter_marked_runs(m, m->share->elem_mark, begin, end, element_forces_loop(m), sums);
 }
 
 /* Runs the element blocks through the model's scatter plan (threads side

@@ -42,4 +42,16 @@ static inline void scatter_sums_add(double totals[SCATTER_SUMS], const double su
         if (sum[i] > totals[i]) totals[i] = sum[i];
 }
 
+/* A block of a step shared between processes (model.h, step_share): fn
+ * over each run of the items in [begin, end) this process marks, in item
+ * order, into the block's sums. */
+static inline void scatter_marked_runs(fdem_model *m, const uint8_t *mark, int begin, int end,
+                                       scatter_block_fn fn, double sums[SCATTER_SUMS])
+{
+    int stop;
+    for (int i = share_next_run(mark, begin, end, &stop); i < end;
+         i = share_next_run(mark, stop, end, &stop))
+        fn(m, i, stop, sums);
+}
+
 #endif

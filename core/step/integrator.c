@@ -313,12 +313,7 @@ static scatter_block_fn central_difference_pass_of(const fdem_model *m)
 static void central_difference_marked_runs(fdem_model *m, int begin, int end,
                                            double sums[SCATTER_SUMS])
 {
-    const uint8_t *mark = m->share->node_mark;
-    const scatter_block_fn pass = central_difference_pass_of(m);
-    int stop;
-    for (int i = share_next_run(mark, begin, end, &stop); i < end;
-         i = share_next_run(mark, stop, end, &stop))
-        pass(m, i, stop, sums);
+    scatter_marked_runs(m, m->share->node_mark, begin, end, central_difference_pass_of(m), sums);
 }
 
 /* Advances every free dof by m->dt (h_next) after a step of m->dt_prev
