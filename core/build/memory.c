@@ -190,7 +190,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     if (m->contact.enabled)
         b += (size_t)m->elem_count * ((3 * D + 2) * sizeof(double) + 5 * sizeof(int32_t) + 1) +
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
-                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
+                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs)) +
+             nbs_classes_memory_bytes(&m->contact.classes);
     /* joints: 2 dim nodes and 2 elements; damage, fracture, h, k; broke;
      * the slip of its dim points; strength_of; elem_joint */
     b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 +
