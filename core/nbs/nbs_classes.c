@@ -15,11 +15,10 @@
  *    of its elements meets the bulk through the bulk's cells.
  *  - One grid's cell is the largest diameter. On a graded mesh (a fine
  *    zone around a crack or a tunnel in a coarse block) the small elements
- *    then crowd into few cells: the penny's 14,196 tetrahedra fell in 36
- *    cells, one of 3,832, and each detection tested ~1e4 candidates an
- *    element (21 us an element against 0.1 on a uniform packing). With the
- *    radii of a class within a factor of 2, a cell holds a bounded number
- *    of its elements again, and each class's detection is O(its count).
+ *    then crowd into few cells, and each meets all its cell's crowd. With
+ *    the radii of a class within a factor of 2, a cell holds a bounded
+ *    number of its elements again (for shapes that are not flat), and each
+ *    class's detection is O(its count).
  *  - A pair of a small element s and a large one l has |cs - cl| <=
  *    rs + rl <= 2 rmax(L), less than the larger class's (padded) cell: s
  *    and l are in neighbouring cells of L's grid. L's elements go onto
@@ -28,17 +27,18 @@
  *    an array over the extent), and each smaller element walks the lists of
  *    its 9 (27) neighbouring cells. Hashing may put two cells on one list;
  *    a list is walked once per element (stamped), so each pair is met once
- *    and the hash only adds walking, never pairs. A smaller element outside L's
+ *    and the hash only adds walking, never pairs. An element outside L's
  *    box widened by a cell meets nothing of L and looks nothing up.
  *  - The pair test is the all-pairs reference's (nbs_internal.h), and it
  *    is symmetric bit for bit (dx and -dx square alike, the sums are in the
  *    same order), so the set is exactly the reference's.
  *  - Classes must pay: a uniform mesh (every radius within a factor of 2
  *    of the largest, found in one pass of compares) goes to the one grid
- *    untouched. Otherwise a class's elements are gathered and its lookups
- *    made; both are priced against the candidates a single grid would test
- *    (about (rmax / r)^dim a uniform packing's for an element of radius r)
- *    and the classes are used only when they cost under 3/4 of that.
+ *    untouched. Otherwise the candidates of one grid and of the classes
+ *    (gathering, each class's grid, the lookups) are estimated from each
+ *    set's count over its box (box_crowd), and the classes are used only
+ *    when they cost under 3/4 of one grid: on the penny (radii 0.08-0.30 m
+ *    with the buffer, in a model 2-3 cells across) they do not.
  *  - Everything is a pure function of the circles, in a fixed order, and
  *    serial: the same list on any thread count and after a restore.
  */
