@@ -55,7 +55,7 @@ static void same_bits(const fdem_model *a, const fdem_model *b, const char *what
 static void restored_cut_block_steps_on_to_the_same_bits(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
-        fdem_model *a = cut_block(dim, dim == 3 ? 5 : 10), *b = cut_block(dim, dim == 3 ? 5 : 10);
+        fdem_model *a = cut_block(dim, dim == 3 ? 4 : 8), *b = cut_block(dim, dim == 3 ? 4 : 8);
         fdem_error err = {0};
         int touched = 0, bulk = 0;
         for (int s = 0; s < 30; s++) {
