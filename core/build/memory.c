@@ -73,15 +73,17 @@ static size_t memory_element(const memory_figures *f, int joints)
  * in 2D, and in 3D its packed copy of the spheres, nbs_packed doubles) and
  * the pair lists at their capacities: a kept pair is two element
  * ids and its spring_of, a near_pair 24 bytes, a set slots doubles and a
- * free-list slot, a record a contact_record. */
+ * free-list slot, a record a contact_record. A fracturing body's detection
+ * takes the bulk path (nbs_classes.c): its member, next and body ids, a
+ * gathered sphere (4 doubles) and about 4 cell heads and stamps. */
 static size_t memory_contact_element(const memory_figures *f)
 {
     double set = (double)(f->slots * sizeof(double) + sizeof(int32_t));
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 2 + f->nbs_packed) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
-           10 * sizeof(int32_t) + (size_t)lists;
+    return (3 * f->D + 2 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
+           (10 + 3 + 4) * sizeof(int32_t) + (size_t)lists;
 }
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;
