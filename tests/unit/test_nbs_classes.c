@@ -123,7 +123,10 @@ static void check_graded(const char *what, const circles *s, int min_classes)
  * class and between classes alike. */
 static void stripe_bodies(circles *s)
 {
-    for (size_t i = 0; i < s->n; i++) s->body[i] = (int32_t)floor(s->p[1][i] * 5.0) - 1;
+    for (size_t i = 0; i < s->n; i++) {
+        double y = s->p[1][i];
+        s->body[i] = isfinite(y) && fabs(y) < 1e3 ? (int32_t)floor(y * 5.0) - 1 : -1;
+    }
 }
 
 static void test_classes_graded_2d(void)
