@@ -42,6 +42,7 @@ fdem_model *fdem_model_create(void)
     m->dim = 2;
     m->elem_nodes = 3;
     nbs_grid_init(&m->contact.grid);
+    nbs_classes_init(&m->contact.classes);
     nbs_pairs_init(&m->contact.pairs);
     return m;
 }

@@ -73,15 +73,17 @@ static size_t memory_element(const memory_figures *f, int joints)
  * in 2D, and in 3D its packed copy of the spheres, nbs_packed doubles) and
  * the pair lists at their capacities: a kept pair is two element
  * ids and its spring_of, a near_pair 24 bytes, a set slots doubles and a
- * free-list slot, a record a contact_record. */
+ * free-list slot, a record a contact_record. A fracturing body's detection
+ * takes the bulk path (nbs_classes.c): its member, next and body ids, a
+ * gathered sphere (4 doubles) and about 4 cell heads and stamps. */
 static size_t memory_contact_element(const memory_figures *f)
 {
     double set = (double)(f->slots * sizeof(double) + sizeof(int32_t));
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 2 + f->nbs_packed) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
-           10 * sizeof(int32_t) + (size_t)lists;
+    return (3 * f->D + 2 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
+           (10 + 3 + 4) * sizeof(int32_t) + (size_t)lists;
 }
 
 /* joint_node (2 dim), joint_elem (2); damage, fracture, h, k; joint_broke;
@@ -190,7 +192,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     if (m->contact.enabled)
         b += (size_t)m->elem_count * ((3 * D + 2) * sizeof(double) + 5 * sizeof(int32_t) + 1) +
              (m->dim == 3 ? nbs_memory_bytes_3d(&m->contact.grid3, &m->contact.pairs)
-                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs));
+                          : nbs_memory_bytes(&m->contact.grid, &m->contact.pairs)) +
+             nbs_classes_memory_bytes(&m->contact.classes);
     /* joints: 2 dim nodes and 2 elements; damage, fracture, h, k; broke;
      * the slip of its dim points; strength_of; elem_joint */
     b += (size_t)m->joint_count * ((2 * (size_t)D + 2) * sizeof(int32_t) + 4 * sizeof(double) + 1 +

@@ -326,10 +326,11 @@ static int contact_detect_at(fdem_model *m, const double *pos)
         cs->r[e] += 0.5 * cs->buffer;
     }
     const int32_t *body = contact_detect_bodies(m);
-    int failed = m->dim == 3 ? nbs_detect_3d(&cs->grid3, (size_t)m->elem_count, cs->cx, cs->cy,
-                                             cs->cz, cs->r, body, &cs->pairs)
-                             : nbs_detect(&cs->grid, (size_t)m->elem_count, cs->cx, cs->cy, cs->r,
-                                          body, &cs->pairs);
+    size_t n = (size_t)m->elem_count;
+    int failed = m->dim == 3 ? nbs_detect_classes_3d(&cs->classes, &cs->grid3, n, cs->cx, cs->cy,
+                                                     cs->cz, cs->r, body, &cs->pairs)
+                             : nbs_detect_classes(&cs->classes, &cs->grid, n, cs->cx, cs->cy,
+                                                  cs->r, body, &cs->pairs);
     if (failed) return -1;
     if (m->elem_active) contact_drop_excavated(m);
     if (m->joint_count) contact_drop_joined(m);
@@ -445,6 +446,7 @@ void contact_free(contact_state *cs)
     free(cs->records);
     nbs_grid_free(&cs->grid);
     nbs_grid_3d_free(&cs->grid3);
+    nbs_classes_free(&cs->classes);
     nbs_pairs_free(&cs->pairs);
     memset(cs, 0, sizeof *cs);
 }

@@ -23,7 +23,7 @@
 #include "fdem.h"
 #include "kernel/contact_pair.h"
 #include "kernel/joint_law.h"
-#include "nbs/nbs.h"
+#include "nbs/nbs_classes.h"
 
 typedef struct material {
     fdem_material_def def;
@@ -234,6 +234,7 @@ typedef struct contact_state {
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;           /* 2D detection */
     nbs_grid_3d grid3;       /* 3D detection */
+    nbs_classes classes;     /* graded meshes: size classes on those grids (nbs_classes.h) */
     nbs_pairs pairs;
 } contact_state;
 
