@@ -90,7 +90,8 @@ static double probe_warm(fdem_model *model, int room, int *taken, sizing_load *w
     int chunk = 2, n = 0;
     *taken = 0;
     while (*taken < room && *taken < PROBE_WARM_MAX_STEPS && spent < PROBE_WARM_SECONDS) {
-        int want = chunk < room - *taken ? chunk : room - *taken;
+        int left = (room < PROBE_WARM_MAX_STEPS ? room : PROBE_WARM_MAX_STEPS) - *taken;
+        int want = chunk < left ? chunk : left;
         n = probe_run(model, 0, want, want, warm_load, &cpu);
         if (n < 0) {
             *taken = -1;
