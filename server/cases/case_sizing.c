@@ -340,6 +340,18 @@ static double sizing_detection_at(const case_sizing *out)
     return at > 0 ? at : 0;
 }
 
+/* The crack's figures (its step, its detections) are timed a second or
+ * so after the run's pace (the first probe and the later looks), and a
+ * shared machine's speed swings by 1.3-1.5x over seconds: the cracked
+ * step's excess over that pace, a difference of two figures timed apart,
+ * swung 3x between dry runs of tunnel-region (0.8e-4 to 2.5e-4 s). So each
+ * is taken as a multiple of the intact step timed just before the cut
+ * (`before`), which saw the same machine, and priced at the run's pace. */
+static double sizing_relative(double seconds, double before, double pace)
+{
+    return seconds / before * pace;
+}
+
 void case_sizing_measure(fdem_model *model, const case_info *info, double model_bytes,
                          int threads, double snapshot_seconds, case_sizing *out)
 {
@@ -368,18 +380,28 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     out->broken_seen = seen;
     double breaking = 0; /* CPU seconds of the detections breaks set off */
     out->cracked_step_seconds = out->break_detection_seconds = NAN;
-    out->intact_detection_seconds = NAN;
+    out->intact_detection_seconds = out->adjacent_step_seconds = NAN;
     if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
+        /* the intact step right before the cut, what the crack's figures
+         * are taken against (sizing_relative) */
+        int more = 0;
+        double before = out->adjacent_step_seconds =
+            sizing_probe_step_seconds(model, out->steps - taken, &more, &load);
+        taken += more;
         /* a detection before the cut: what one costs with (nearly) none broken */
         out->intact_detection_seconds = sizing_detection_seconds(model, out->steps - taken, &taken);
         out->cracked_step_seconds = sizing_cracked_step_seconds(
             model, out->steps - taken, &out->cracked_joints, &out->break_detection_seconds, &load);
+        if (!(before > 0)) /* a step failed: the run will say why */
+            before = per_step;
         if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {
             sizing_price_breaks(out, c.joints, seen, looked);
-            double each = (out->cracked_step_seconds - per_step) / out->cracked_joints;
+            double pace = per_step;
+            double each = sizing_relative(out->cracked_step_seconds - before, before, pace) /
+                          out->cracked_joints;
             if (each > 0)
                 per_step += out->broken_joints * each;
-            breaking = out->breaks * sizing_detection_at(out);
+            breaking = out->breaks * sizing_relative(sizing_detection_at(out), before, pace);
         }
     }
     /* CPU seconds so far; the machine's present load turns them into wall
@@ -448,6 +470,7 @@ json_t *case_sizing_json(const case_sizing *s)
     json_object_set_new(parts, "load_factor", status_number_or_null(s->load_factor));
     json_object_set_new(parts, "probe_wall_over_cpu", status_number_or_null(s->probe_wall_over_cpu));
     json_object_set_new(parts, "later_step_seconds", status_number_or_null(s->later_step_seconds));
+    json_object_set_new(parts, "adjacent_step_seconds", status_number_or_null(s->adjacent_step_seconds));
     json_object_set_new(parts, "cracked_step_seconds", status_number_or_null(s->cracked_step_seconds));
     json_object_set_new(parts, "cracked_joints", json_integer(s->cracked_joints));
     json_object_set_new(parts, "broken_joints", status_number_or_null(s->broken_joints));

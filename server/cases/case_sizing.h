@@ -21,7 +21,8 @@
  *    at the rate its own steps broke them) each breaking once, at the
  *    cost of a detection (a break reruns it; timed before the cut and on
  *    it, interpolated to the joints held broken), and half of them held broken through the whole run, each
- *    at the cost a joint of the crack adds to a step; plus the worker's
+ *    at the cost a joint of the crack adds to a step (the crack's figures as multiples of an intact step
+ *    timed just before the cut, at the run's pace); plus the worker's
  *    copy of each snapshot and its checkpoint. Steps are timed in CPU seconds and turned into
  *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
  *    call it only on a model that is thrown away.
@@ -50,6 +51,7 @@ typedef struct case_sizing {
     double later_step_seconds; /* the same up to 30 % into the run (NAN: not timed) */
     double load_factor;       /* wall / CPU seconds the run will see (sizing_load_factor) */
     double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
+    double adjacent_step_seconds; /* the same just before the cut (what the crack's are taken against) */
     double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
     int cracked_joints;       /* joints the crack broke */
     double broken_joints;     /* joints priced as broken through the run */

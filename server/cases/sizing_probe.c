@@ -37,11 +37,17 @@
 #include "math/clock.h"
 #include "common/sample_ring.h"
 
-/* Untimed warm-up: at least this many steps and this long. */
-#define PROBE_WARM_STEPS 2
+/* Untimed warm-up: chunks of 2, 4, 8... steps until they took this many
+ * CPU seconds, at most PROBE_WARM_MAX_STEPS. */
 #define PROBE_WARM_SECONDS 0.01
-/* Timed windows: each at least PROBE_WINDOW_SECONDS and one step, at most
- * PROBE_WINDOW_STEPS steps. */
+#define PROBE_WARM_MAX_STEPS 1024
+/* Timed windows: each the same number of steps, the power of 2 (at most
+ * PROBE_WINDOW_STEPS) that the warm-up's last chunk says takes about
+ * PROBE_WINDOW_SECONDS. In steps, not until a clock runs out, so that two
+ * dry runs time the same steps: a model whose pace changes in its first
+ * steps (a sphere pile's from 2e-5 to 2e-4 s a step as its spheres land)
+ * gave medians 2.6x apart when a loaded machine fitted fewer steps into
+ * one dry run's windows than into the next one's. */
 #define PROBE_WINDOWS 7
 #define PROBE_WINDOW_SECONDS 0.008
 #define PROBE_WINDOW_STEPS 64
@@ -76,15 +82,46 @@ static int probe_run(fdem_model *model, double seconds, int min_steps, int max_s
     return taken;
 }
 
+/* The untimed warm-up: *taken steps (-1: one failed); returns the CPU
+ * seconds a step of its last chunk took. */
+static double probe_warm(fdem_model *model, int room, int *taken, sizing_load *warm_load)
+{
+    double spent = 0, cpu = 0;
+    int chunk = 2, n = 0;
+    *taken = 0;
+    while (*taken < room && *taken < PROBE_WARM_MAX_STEPS && spent < PROBE_WARM_SECONDS) {
+        int left = (room < PROBE_WARM_MAX_STEPS ? room : PROBE_WARM_MAX_STEPS) - *taken;
+        int want = chunk < left ? chunk : left;
+        n = probe_run(model, 0, want, want, warm_load, &cpu);
+        if (n < 0) {
+            *taken = -1;
+            return NAN;
+        }
+        *taken += n;
+        spent += cpu;
+        chunk *= 2;
+    }
+    return n > 0 ? cpu / n : NAN;
+}
+
+/* The power of 2 of steps, 1 to PROBE_WINDOW_STEPS, that takes about
+ * PROBE_WINDOW_SECONDS at `pace`. */
+static int probe_window_steps(double pace)
+{
+    if (!(pace > 0)) return 1;
+    double fit = PROBE_WINDOW_SECONDS / pace;
+    if (fit >= PROBE_WINDOW_STEPS) return PROBE_WINDOW_STEPS;
+    return fit >= 2 ? (int)exp2(floor(log2(fit))) : 1;
+}
+
 double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *taken,
                                  sizing_load *load)
 {
     *taken = 0;
     double cpu, window[PROBE_WINDOWS], started = clock_wall_seconds();
     sizing_load warm_load = {0, 0};
-    int room = steps_left < 1e9 ? (int)steps_left : 1000000000;
-    int warm = probe_run(model, PROBE_WARM_SECONDS, PROBE_WARM_STEPS,
-                         room < PROBE_WARM_STEPS ? room : 1000, &warm_load, &cpu);
+    int room = steps_left < 1e9 ? (int)steps_left : 1000000000, warm = 0;
+    double warm_pace = probe_warm(model, room, &warm, &warm_load);
     if (warm < 0)
         return NAN;
     *taken += warm;
@@ -92,13 +129,13 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
     if (room <= 0) { /* a run this short: its own steps are the figure */
         load->wall += warm_load.wall;
         load->cpu += warm_load.cpu;
-        return warm > 0 ? cpu / warm : NAN;
+        return warm > 0 ? warm_load.cpu / warm : NAN;
     }
-    int windows = 0;
+    int each = probe_window_steps(warm_pace), windows = 0;
     while (windows < PROBE_WINDOWS && room > 0 &&
            (windows < PROBE_MIN_WINDOWS || clock_wall_seconds() - started < PROBE_BUDGET_SECONDS)) {
-        int n = probe_run(model, PROBE_WINDOW_SECONDS, 1,
-                          room < PROBE_WINDOW_STEPS ? room : PROBE_WINDOW_STEPS, load, &cpu);
+        int want = room < each ? room : each;
+        int n = probe_run(model, 0, want, want, load, &cpu);
         if (n < 0)
             return NAN;
         *taken += n;

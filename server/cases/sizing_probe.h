@@ -5,7 +5,7 @@
  * Contract:
  *  - sizing_probe_step_seconds() steps the model (ADVANCES it: only a
  *    throwaway model) through an untimed warm-up and several short timed
- *    windows, at most steps_left steps in all (*taken says how many), and
+ *    windows of one power-of-2 number of steps each (from the warm-up's pace), at most steps_left steps in all (*taken says how many), and
  *    returns the median window's CPU seconds per step of the stepping
  *    thread: NAN when a step failed. The windows' wall and CPU seconds are
  *    added to *load. It takes about 0.05 s for a small model, and on one

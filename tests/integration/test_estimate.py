@@ -133,6 +133,9 @@ class EstimateTest(DaemonTestCase):
                 bad.append("%s: measured/estimated %.2f" % (name, ratio))
             if spread > 1.3:
                 bad.append("%s: two dry runs differ by x%.2f" % (name, spread))
+            if spread > 1.3 or not 0.5 <= ratio <= 2.0:  # what each was made of
+                for r in (first, second):
+                    print("    %s" % json.dumps(r["estimate"], sort_keys=True), file=sys.stderr)
             self.client.delete(case_id)
         self.assertEqual(bad, [])
 
