@@ -58,10 +58,9 @@ int contact_shut_init(fdem_model *m)
     cs->shut_vertex = malloc(N);
     cs->elem_shut = malloc((size_t)m->elem_count);
     if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut) return -1;
-    /* shut_first doubles as the table origin -> first copy while built */
-    int32_t *first_of = cs->shut_first;
-    int32_t *by_origin = malloc(sizeof(int32_t) * N);
-    if (!by_origin) return -1;
+    /* the tolerances' room holds the table origin -> first copy meanwhile
+     * (no scratch beyond what the memory estimate prices) */
+    int32_t *first_of = cs->shut_first, *by_origin = (int32_t *)cs->shut_tol2;
     for (size_t n = 0; n < N; n++) by_origin[n] = -1;
     for (size_t n = 0; n < N; n++) {
         int32_t o = m->node_origin[n];
@@ -69,7 +68,6 @@ int contact_shut_init(fdem_model *m)
         if (by_origin[o] < 0) by_origin[o] = (int32_t)n;
         first_of[n] = by_origin[o];
     }
-    free(by_origin);
     for (size_t n = 0; n < N; n++) cs->shut_tol2[n] = INFINITY;
     const int K = m->elem_nodes;
     for (int e = 0; e < m->elem_count; e++) {
