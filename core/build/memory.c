@@ -50,13 +50,15 @@ static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_S
  * entry (node, dofs); a quarter of a loaded
  * boundary facet (nodes, element, dim x dim forces; tunnel measures 0.15 a
  * node); with contact pos_detect, pos_near and the contact force (dim
- * each); with joints vertex_broken and vertex_root */
+ * each); with joints vertex_broken and vertex_root, and with both the
+ * shut tables (contact_shut.c: first copy, tolerance, shut flag) */
 static size_t memory_node(const memory_figures *f, int contact, int joints)
 {
     size_t facet = (f->D + 1) * sizeof(int32_t) + f->D * f->D * sizeof(double);
     return sizeof(double) * (5 * f->D + 2) + 2 * sizeof(int32_t) + 1 + sizeof(int32_t) + 1 +
            facet / 4 + (contact ? 3 * f->D * sizeof(double) : 0) +
-           (joints ? 1 + sizeof(int32_t) : 0);
+           (joints ? 1 + sizeof(int32_t) : 0) +
+           (joints && contact ? sizeof(int32_t) + sizeof(double) + 1 : 0);
 }
 
 /* hot record, elem_node, elem_part, elem_h, elem_viscous and elem_stress0
@@ -130,7 +132,8 @@ static size_t memory_estimate(const memory_figures *f, long nodes, long elements
                               int parts)
 {
     int contact = parts > 1 || joints > 0;
-    size_t elem = memory_element(f, joints > 0) + (contact ? memory_contact_element(f) : 0);
+    size_t elem = memory_element(f, joints > 0) + (contact ? memory_contact_element(f) : 0) +
+                  (contact && joints > 0 ? 1 : 0); /* elem_shut */
     return memory_fixed(f, contact) + (size_t)nodes * memory_node(f, contact, joints > 0) +
            (size_t)elements * elem + (size_t)joints * memory_joint(f) +
            (contact ? 0 : memory_finalize(f, nodes, elements));
@@ -179,6 +182,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
      * pos_detect, pos_near, force */
     b += (size_t)m->node_count * (1 + (m->joint_count ? 1 + sizeof(int32_t) : 0) +
                                   (m->contact.enabled ? 3 * D * sizeof(double) : 0));
+    if (m->contact.shut_first) /* contact_shut.c: first copy, tolerance, shut; per element */
+        b += (size_t)m->node_count * (sizeof(int32_t) + sizeof(double) + 1) + (size_t)m->elem_count;
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);

@@ -51,8 +51,8 @@
  * pile: boxes 157M -> 25M instructions in 493 steps, whole step -10 %;
  * 1/128 gained no more). */
 static const contact_kernel contact_kernels[2] = {
-    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, 0.25, 1.0 / 16},
-    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153, 1.0 / 64},
+    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, tri_face_pair_force, 0.25, 1.0 / 16},
+    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, tet_face_pair_force, 0.153, 1.0 / 64},
 };
 
 /* Rows of numbers keyed by a candidate pair, in pair order. */
@@ -106,15 +106,40 @@ static void pair_rows_free(pair_rows *list)
  * softer surface sets the penalty; friction is the larger of the two, so
  * giving it on one material is enough. Returns 1 if they touched. Writes
  * nothing in m. */
-static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
-                              double *out, contact_pair_memo *memo)
+static contact_pair_in pair_input(const fdem_model *m, int e1, int e2, double h,
+                                  contact_pair_memo *memo)
 {
     const material *ma = &m->materials[element_material(m, e1)];
     const material *mb = &m->materials[element_material(m, e2)];
-    contact_pair_in in = {m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
-                          min2(ma->penalty, mb->penalty),
-                          max2(ma->def.friction, mb->def.friction), h, memo};
+    return (contact_pair_in){m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
+                             min2(ma->penalty, mb->penalty),
+                             max2(ma->def.friction, mb->def.friction), h, memo};
+}
+
+static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
+                              double *out, contact_pair_memo *memo)
+{
+    contact_pair_in in = pair_input(m, e1, e2, h, memo);
     return m->contact.kernel->pair_force(&in, springs, out);
+}
+
+/* A pair of shut elements (contact_shut.c) this step: left out (-1, as a
+ * pair apart: springs let go), or the face kernel's answer on the two
+ * sides of a shut broken joint; 2 for the general kernel's pairs. */
+static int shut_pair_force(const fdem_model *m, const near_pair *np, double h, double *springs,
+                           double *out)
+{
+    face_match fm;
+    int kind = contact_shut_kind(m, np, &fm);
+    if (kind == SHUT_GENERAL) return 2;
+    int touched = -1;
+    if (kind == SHUT_FACE) {
+        contact_pair_in in = pair_input(m, np->a, np->b, h, NULL);
+        touched = m->contact.kernel->face_force(&in, &fm, springs, out);
+    } else {
+        for (int s = 0; s < m->contact.slots; s++) springs[s] = 0;
+    }
+    return touched;
 }
 
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
@@ -163,6 +188,25 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     const size_t width = 2 * (size_t)D;
     int32_t a = np->a, b = np->b;
     *pool = SPRINGS_KEPT;
+    /* shut broken rock first: its kernel ignores the gap the general one
+     * found (a clearance says what the general kernel would do) */
+    if (cs->shut_any && np->topology && cs->elem_shut[a] && cs->elem_shut[b]) {
+        int32_t set = cs->spring_of[np->pair];
+        double *springs = fresh;
+        if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
+        else
+            for (int s = 0; s < slots; s++) fresh[s] = 0;
+        int touched = shut_pair_force(m, np, h, springs, out);
+        if (touched != 2) {
+            int any = 0;
+            if (touched > 0)
+                for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+            if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+            if (set < 0 && any) *pool = SPRINGS_ADOPT;
+            np->sprung = any;
+            return touched;
+        }
+    }
     /* a gap over near_apart: apart, boxes not even computed this step */
     if (np->gap > cs->near_apart ||
         !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
@@ -420,6 +464,10 @@ int contact_init(fdem_model *m, fdem_error *err)
         element_sphere(m, m->pos, e, c, &r);
         rmax = fmax(rmax, r);
     }
+    if (contact_shut_init(m)) {
+        model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
+        return -1;
+    }
     cs->buffer = 0.4 * rmax;
     cs->need_detect = 1;
     /* the integrator measures from here until the first near list */
@@ -434,6 +482,7 @@ void contact_free(contact_state *cs)
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
     free(cs->near);
+    contact_shut_free(cs);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
@@ -642,6 +691,7 @@ int contact_forces(fdem_model *m)
         memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = cs->pairs.count == 0;
     if (contact_near_refresh(m)) return -1;
+    contact_shut_refresh(m);
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;

@@ -7,6 +7,7 @@
 #ifndef FDEM_CONTACT_INTERNAL_H
 #define FDEM_CONTACT_INTERNAL_H
 
+#include "kernel/contact_face.h"
 #include "kernel/contact_pair.h"
 #include "model/model.h"
 
@@ -15,6 +16,9 @@ typedef struct contact_kernel {
     int slots;          /* stick springs per pair */
     int pair_out;       /* forces on both elements' nodes, then the dissipation */
     int (*pair_force)(const contact_pair_in *in, double *springs, double *out);
+    /* the two sides of a shut broken joint (contact_shut.c) */
+    int (*face_force)(const contact_pair_in *in, const face_match *fm, double *springs,
+                      double *out);
     double dt_factor;   /* contact_stable_dt: dt_factor h sqrt(rho / p) */
     double near_step;   /* the near list's reach (cs->near_reach) per unit buffer */
 } contact_kernel;
@@ -29,7 +33,10 @@ typedef struct near_pair {
                         its kernel found (pair_evaluate) */
     uint32_t pair;   /* its index among the candidate pairs */
     int32_t a, b;    /* its elements */
-    int32_t sprung;  /* some stick spring of it holds a force */
+    uint8_t sprung;  /* some stick spring of it holds a force */
+    uint8_t topology; /* what its elements share, at the list's build (contact_shut.c:
+                         SHUT_TOPO_*): a break reruns detection, which rebuilds it */
+    uint16_t unused;
 } near_pair;
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
@@ -70,5 +77,17 @@ static inline void element_box(const fdem_model *m, int e, double *b)
 int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
                              size_t count, int32_t *list);
 int contact_near_refresh(fdem_model *m);
+
+/* contact_shut.c: the shut broken joints (see its top). init builds the
+ * vertex tables once (0, or -1 without memory); refresh marks this step's
+ * shut elements; kind says what the walk does with a pair of them: the
+ * general kernel, the face kernel (fm filled) or nothing. */
+enum { SHUT_GENERAL, SHUT_FACE, SHUT_LEFT_OUT };
+enum { SHUT_TOPO_NONE, SHUT_TOPO_FACE, SHUT_TOPO_VERTEX };
+int contact_shut_init(fdem_model *m);
+void contact_shut_free(contact_state *cs);
+void contact_shut_refresh(fdem_model *m);
+int contact_shut_topology(const fdem_model *m, int a, int b);
+int contact_shut_kind(const fdem_model *m, const near_pair *np, face_match *fm);
 
 #endif

@@ -230,6 +230,14 @@ typedef struct contact_state {
     double *elem_gap;        /* per element: the smallest gap of its near pairs */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
+    /* shut broken joints (contact_shut.c): per node its vertex's first copy,
+     * per first copy the squared tolerance and whether it is shut this
+     * step, per element whether all its vertices are; NULL without joints */
+    int32_t *shut_first;
+    double *shut_tol2;
+    uint8_t *shut_vertex, *elem_shut;
+    int shut_any;            /* this step: some broken joint, elem_shut is current */
+    int shut_off;            /* tests and benches: the general kernel on every pair */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */
     nbs_grid grid;           /* 2D detection */

@@ -1,0 +1,205 @@
+/*
+ * contact_shut.c - which candidate pairs of broken rock the contact stage
+ * hands to the shut-joint kernel (kernel/contact_face.h), which it leaves
+ * out, and which go to the general kernel (issue 34). Both dimensions.
+ *
+ * Shut. A mesh vertex is shut while every copy of it (the nodes with its
+ * node_origin) is within SHUT_TOLERANCE x h_v of its first copy, h_v the
+ * smallest height of the elements around it; an element is shut while all
+ * its vertices are. Why 1e-4: the face kernel and the pairs it leaves out
+ * differ from the general kernel by O(s / h) of the force (s the copies'
+ * offset), and a broken block squeezed and sheared (test_contact_shut.c)
+ * measured it: at 1e-4 h its nodes end within 1.4e-4 (2D) and 5e-5 (3D)
+ * of their travel from the general kernel's run and its elastic energy
+ * within 0.03 %; at 1e-3 h, 2 % and 7.5 % in 2D, where rows sliding along
+ * a straight crack press the collinear edges of corner neighbours. And a
+ * joint pressed shut sits at a penalty overlap of sigma h / (2 (D+1) p),
+ * under 1e-4 h for any stress below 6e-3 p (a 30 GPa rock at p = 10 E:
+ * 180 MPa), so a broken joint carrying load across stays shut. Once any
+ * copy moves farther, its elements go back to the general kernel the same
+ * step.
+ *
+ * Pairs (both elements shut): the two sides of a broken joint get the face
+ * kernel; two elements that share a mesh vertex but no broken joint are
+ * left out: around a vertex whose copies all sit together, they touch only
+ * through the hair-apart copies (an area ~ s L at a potential ~ s / h:
+ * second order in s / h), the faces between them being carried by the
+ * face pairs, and everything around both elements is in place up to the
+ * tolerance, so no other part of them can meet. Every other pair, and
+ * every pair with an element not shut, takes the general kernel.
+ *
+ * Determinism: shut is a function of this step's positions alone, so it
+ * needs no checkpoint (a restore recomputes it) and is the same on any
+ * thread count; the face kernel keeps its stick springs in the general
+ * kernel's slots with the same meaning (contact_face.h), so a pair passing
+ * from one kernel to the other keeps its friction. A model with no broken
+ * joint pays one test a step.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "contact_internal.h"
+#include "kernel/contact_face.h"
+#include "kernel/element_tet.h"
+#include "model/model.h"
+
+#define SHUT_TOLERANCE 1e-4
+
+/* Per node: its vertex's first copy; per first copy: the squared
+ * tolerance. Built once, from the mesh (node_origin, elem_h). */
+int contact_shut_init(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (!m->joint_count) return 0;
+    size_t N = (size_t)m->node_count;
+    cs->shut_first = malloc(sizeof(int32_t) * N);
+    cs->shut_tol2 = malloc(sizeof(double) * N);
+    cs->shut_vertex = malloc(N);
+    cs->elem_shut = malloc((size_t)m->elem_count);
+    if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut) return -1;
+    /* the tolerances' room holds the table origin -> first copy meanwhile
+     * (no scratch beyond what the memory estimate prices) */
+    int32_t *first_of = cs->shut_first, *by_origin = (int32_t *)cs->shut_tol2;
+    for (size_t n = 0; n < N; n++) by_origin[n] = -1;
+    for (size_t n = 0; n < N; n++) {
+        int32_t o = m->node_origin[n];
+        if (o < 0 || (size_t)o >= N) o = (int32_t)n;
+        if (by_origin[o] < 0) by_origin[o] = (int32_t)n;
+        first_of[n] = by_origin[o];
+    }
+    for (size_t n = 0; n < N; n++) cs->shut_tol2[n] = INFINITY;
+    const int K = m->elem_nodes;
+    for (int e = 0; e < m->elem_count; e++) {
+        const int32_t *nd = element_nodes(m, e);
+        double t = SHUT_TOLERANCE * m->elem_h[e];
+        for (int c = 0; c < K; c++) {
+            int32_t f = first_of[nd[c]];
+            cs->shut_tol2[f] = fmin(cs->shut_tol2[f], t * t);
+        }
+    }
+    return 0;
+}
+
+void contact_shut_free(contact_state *cs)
+{
+    free(cs->shut_first);
+    free(cs->shut_tol2);
+    free(cs->shut_vertex);
+    free(cs->elem_shut);
+}
+
+/* This step's shut vertices and elements (none without a broken joint). */
+void contact_shut_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    cs->shut_any = cs->elem_shut && m->broken_joints > 0 && !cs->shut_off;
+    if (!cs->shut_any) return;
+    const int D = m->dim, K = m->elem_nodes, N = m->node_count;
+    memset(cs->shut_vertex, 1, (size_t)N);
+    for (int n = 0; n < N; n++) {
+        int32_t f = cs->shut_first[n];
+        if (f == n) continue;
+        double s2 = 0;
+        for (int d = 0; d < D; d++) {
+            double x = m->pos[D * (size_t)n + d] - m->pos[D * (size_t)f + d];
+            s2 += x * x;
+        }
+        if (!(s2 <= cs->shut_tol2[f])) cs->shut_vertex[f] = 0;
+    }
+    for (int e = 0; e < m->elem_count; e++) {
+        const int32_t *nd = element_nodes(m, e);
+        uint8_t shut = 1;
+        for (int c = 0; c < K; c++) shut &= cs->shut_vertex[cs->shut_first[nd[c]]];
+        cs->elem_shut[e] = shut;
+    }
+}
+
+/* The broken joint between a and b, or -1. */
+static int broken_joint_between(const fdem_model *m, int a, int b)
+{
+    const int faces = m->dim + 1;
+    for (int c = 0; c < faces; c++) {
+        int j = m->elem_joint[faces * a + c];
+        if (j >= 0 && m->joint_damage[j] >= 1.0 &&
+            m->joint_elem[2 * j] + m->joint_elem[2 * j + 1] - a == b)
+            return j;
+    }
+    return -1;
+}
+
+static int local_corner(const int32_t *nodes, int K, int32_t node)
+{
+    for (int c = 0; c < K; c++)
+        if (nodes[c] == node) return c;
+    return -1;
+}
+
+/* The corner of an element's K corners that is not among the face's. */
+static int corner_off_face(const int32_t *nodes, int K, const int32_t *face, int D)
+{
+    for (int c = 0; c < K; c++) {
+        int on = 0;
+        for (int i = 0; i < D; i++) on |= nodes[c] == face[i];
+        if (!on) return c;
+    }
+    return -1;
+}
+
+/* Joint j's faces in a and b (face_match); 0, or -1 if the joint's nodes
+ * are not the two elements' (never, for a joint built between them). */
+static int face_match_of(const fdem_model *m, int j, int a, int b, face_match *fm)
+{
+    const int D = m->dim, K = m->elem_nodes;
+    const int32_t *jn = m->joint_node + 2 * (size_t)D * (size_t)j;
+    const int32_t *on_a = m->joint_elem[2 * j] == a ? jn : jn + D;
+    const int32_t *on_b = m->joint_elem[2 * j] == a ? jn + D : jn;
+    const int32_t *na = element_nodes(m, a), *nb = element_nodes(m, b);
+    int off_a = corner_off_face(na, K, on_a, D), off_b = corner_off_face(nb, K, on_b, D);
+    if (off_a < 0 || off_b < 0) return -1;
+    if (D == 3) {
+        fm->face_a = off_a; /* face f is opposite corner f */
+        fm->face_b = off_b;
+    } else {
+        fm->face_a = (off_a + 1) % 3; /* edge i runs from corner i to i + 1 */
+        fm->face_b = (off_b + 1) % 3;
+    }
+    for (int k = 0; k < D; k++) {
+        int corner = D == 3 ? tet_face_nodes[fm->face_a][k] : (fm->face_a + k) % 3;
+        int i = 0;
+        while (i < D && on_a[i] != na[corner]) i++;
+        if (i == D) return -1;
+        fm->copy_in_b[k] = local_corner(nb, K, on_b[i]);
+        if (fm->copy_in_b[k] < 0) return -1;
+    }
+    return 0;
+}
+
+static int share_a_vertex(const fdem_model *m, int a, int b)
+{
+    const int K = m->elem_nodes;
+    const int32_t *na = element_nodes(m, a), *nb = element_nodes(m, b);
+    const int32_t *first = m->contact.shut_first;
+    for (int i = 0; i < K; i++)
+        for (int k = 0; k < K; k++)
+            if (first[na[i]] == first[nb[k]]) return 1;
+    return 0;
+}
+
+/* What a and b share, which only a break changes: a broken joint, a mesh
+ * vertex, or nothing. The near list keeps it (contact_near.c). */
+int contact_shut_topology(const fdem_model *m, int a, int b)
+{
+    if (!m->broken_joints) return SHUT_TOPO_NONE;
+    if (broken_joint_between(m, a, b) >= 0) return SHUT_TOPO_FACE;
+    return share_a_vertex(m, a, b) ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
+}
+
+/* Both elements of np are shut this step (the caller checked). */
+int contact_shut_kind(const fdem_model *m, const near_pair *np, face_match *fm)
+{
+    if (np->topology == SHUT_TOPO_VERTEX) return SHUT_LEFT_OUT;
+    if (np->topology != SHUT_TOPO_FACE) return SHUT_GENERAL;
+    int j = broken_joint_between(m, np->a, np->b);
+    return j >= 0 && !face_match_of(m, j, np->a, np->b, fm) ? SHUT_FACE : SHUT_GENERAL;
+}

@@ -1,0 +1,165 @@
+/*
+ * contact_face_tet.c - the tetrahedron kernel of a shut broken joint
+ * (contact_face.h: the physics, the tolerance is the contact stage's):
+ * the joint's two triangular faces pressed on each other by the depth of
+ * A's face into B's along their mean normal, per role at B's and then A's
+ * potential stiffness 4 p / H, with the general kernel's friction springs.
+ * A few hundred operations where clipping both tetrahedra's eight faces
+ * against the other's sub-tetrahedra took thousands.
+ */
+#include "contact_face.h"
+#include "element_tet.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "math/vec3.h"
+
+/* A target tetrahedron now: its corners, barycentric map (lambda_{1..3} =
+ * rows . (x - p0)), 6 V, and the cross products of its faces (2 A n). */
+typedef struct tet_now {
+    const double *p[4];
+    double rows[3][3], det;
+    double face_len[4]; /* |cross| of face f: twice its area */
+} tet_now;
+
+static int tet_now_of(const double *pos, const int32_t n[4], tet_now *t)
+{
+    for (int v = 0; v < 4; v++) t->p[v] = pos + 3 * (size_t)n[v];
+    double e[3][3], c[3][3];
+    for (int k = 0; k < 3; k++) vec3_sub(t->p[k + 1], t->p[0], e[k]);
+    vec3_cross(e[1], e[2], c[0]);
+    vec3_cross(e[2], e[0], c[1]);
+    vec3_cross(e[0], e[1], c[2]);
+    t->det = vec3_dot(e[0], c[0]);
+    if (!(t->det > 0) || !isfinite(t->det)) return 0;
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++) t->rows[k][i] = c[k][i] / t->det;
+    for (int f = 0; f < 4; f++) {
+        const int *fn = tet_face_nodes[f];
+        double ab[3], ac[3], x[3];
+        vec3_sub(t->p[fn[1]], t->p[fn[0]], ab);
+        vec3_sub(t->p[fn[2]], t->p[fn[0]], ac);
+        vec3_cross(ab, ac, x);
+        t->face_len[f] = sqrt(vec3_dot(x, x));
+    }
+    return 1;
+}
+
+static void bary_in(const tet_now *t, const double x[3], double l[4])
+{
+    double d[3];
+    vec3_sub(x, t->p[0], d);
+    for (int k = 0; k < 3; k++) l[k + 1] = vec3_dot(t->rows[k], d);
+    l[0] = 1.0 - l[1] - l[2] - l[3];
+}
+
+/* One role: the contactor's face (its local corners cf, in the joint's
+ * order) in the target's potential near the target's face ft. n is the
+ * contactor's outward unit normal, area the mean face's, i0 and w the
+ * overlap integral (as a fraction of the area) and its centroid's weights,
+ * touch the fraction that overlaps. */
+typedef struct face_role {
+    const double *pos, *vel;
+    const int32_t *cn, *tn;
+    const int *cf;
+    const tet_now *target;
+    int ft;
+    double n[3];
+} face_role;
+
+static void role_force(const face_role *r, double area, double i0, const double w[3],
+                       double touch, const contact_pair_in *in, double spring[3], double f_c[12],
+                       double f_t[12], double *dissipated)
+{
+    const tet_now *t = r->target;
+    double k_face = 4 * in->penalty * t->face_len[r->ft] / t->det; /* 4 p / H_t */
+    double f_n = k_face * i0 * area, x[3] = {0, 0, 0}, lt[4], force[3];
+    for (int k = 0; k < 3; k++) {
+        const double *p = r->pos + 3 * (size_t)r->cn[r->cf[k]];
+        for (int i = 0; i < 3; i++) x[i] += w[k] * p[i];
+    }
+    bary_in(t, x, lt);
+    for (int i = 0; i < 3; i++) force[i] = -f_n * r->n[i];
+    if (in->friction > 0) {
+        double rel[3] = {0, 0, 0};
+        for (int i = 0; i < 3; i++) {
+            for (int k = 0; k < 3; k++) rel[i] += w[k] * r->vel[3 * (size_t)r->cn[r->cf[k]] + i];
+            for (int v = 0; v < 4; v++) rel[i] -= lt[v] * r->vel[3 * (size_t)r->tn[v] + i];
+        }
+        double largest = 0;
+        for (int f = 0; f < 4; f++) largest = fmax(largest, t->face_len[f]);
+        double k_t = (2.0 / 3.0) * (4 * in->penalty * largest / t->det) * touch * area;
+        double cap = in->friction * f_n, rel_n = vec3_dot(rel, r->n),
+               spring_n = vec3_dot(spring, r->n), f[3];
+        for (int i = 0; i < 3; i++)
+            f[i] = (spring[i] - spring_n * r->n[i]) - k_t * (rel[i] - rel_n * r->n[i]) * in->h;
+        double size = sqrt(vec3_dot(f, f));
+        if (size > cap) {
+            *dissipated += cap * (size - cap) / k_t;
+            for (int i = 0; i < 3; i++) f[i] *= cap / size;
+        }
+        for (int i = 0; i < 3; i++) {
+            spring[i] = f[i];
+            force[i] += f[i];
+        }
+    } else {
+        memset(spring, 0, 3 * sizeof(double));
+    }
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++) f_c[3 * r->cf[k] + i] += w[k] * force[i];
+    for (int v = 0; v < 4; v++)
+        for (int i = 0; i < 3; i++) f_t[3 * v + i] -= lt[v] * force[i];
+}
+
+int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double *springs,
+                        double *out)
+{
+    tet_now a, b;
+    int fa[3], fb[3];
+    for (int k = 0; k < 3; k++) {
+        fa[k] = tet_face_nodes[fm->face_a][k];
+        fb[k] = fm->copy_in_b[k];
+    }
+    double d[3], i0 = 0, w[3], touch = 0, n[3] = {0, 0, 0}, area = 0;
+    int touched = tet_now_of(in->pos, in->node_a, &a) && tet_now_of(in->pos, in->node_b, &b);
+    if (touched) {
+        double m[3][3], e1[3], e2[3];
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < 3; i++) m[k][i] = 0.5 * (a.p[fa[k]][i] + b.p[fb[k]][i]);
+        vec3_sub(m[1], m[0], e1);
+        vec3_sub(m[2], m[0], e2);
+        vec3_cross(e1, e2, n); /* out of a: tet_face_nodes' order */
+        double len = sqrt(vec3_dot(n, n));
+        touched = len > 0;
+        if (touched) {
+            area = 0.5 * len;
+            for (int i = 0; i < 3; i++) n[i] /= len;
+            for (int k = 0; k < 3; k++) {
+                double gap[3];
+                vec3_sub(a.p[fa[k]], b.p[fb[k]], gap);
+                d[k] = vec3_dot(gap, n);
+            }
+            touched = face_overlap_integral(3, d, &i0, w, &touch);
+        }
+    }
+    if (!touched) {
+        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
+        out[0] = 0;
+        return 0;
+    }
+    /* every slot but the two faces' is let go: nothing else touches */
+    double keep_a[3], keep_b[3];
+    memcpy(keep_a, springs + 3 * fm->face_a, sizeof keep_a);
+    memcpy(keep_b, springs + TET_CONTACT_SLOTS / 2 + 3 * fm->face_b, sizeof keep_b);
+    memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
+    for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
+    double *dissipated = &out[TET_PAIR_OUT - 1];
+    face_role ra = {in->pos, in->vel, in->node_a, in->node_b, fa, &b, fm->face_b, {n[0], n[1], n[2]}};
+    face_role rb = {in->pos, in->vel, in->node_b, in->node_a, fb, &a, fm->face_a, {-n[0], -n[1], -n[2]}};
+    role_force(&ra, area, i0, w, touch, in, keep_a, out, out + 12, dissipated);
+    role_force(&rb, area, i0, w, touch, in, keep_b, out + 12, out, dissipated);
+    memcpy(springs + 3 * fm->face_a, keep_a, sizeof keep_a);
+    memcpy(springs + TET_CONTACT_SLOTS / 2 + 3 * fm->face_b, keep_b, sizeof keep_b);
+    return 1;
+}
