@@ -8,6 +8,7 @@
  * against the other's sub-tetrahedra took thousands.
  */
 #include "contact_face.h"
+#include "contact_spring.h"
 #include "element_tet.h"
 
 #include <math.h>
@@ -90,19 +91,7 @@ static void role_force(const face_role *r, double area, double i0, const double 
         double largest = 0;
         for (int f = 0; f < 4; f++) largest = fmax(largest, t->face_len[f]);
         double k_t = (2.0 / 3.0) * (4 * in->penalty * largest / t->det) * touch * area;
-        double cap = in->friction * f_n, rel_n = vec3_dot(rel, r->n),
-               spring_n = vec3_dot(spring, r->n), f[3];
-        for (int i = 0; i < 3; i++)
-            f[i] = (spring[i] - spring_n * r->n[i]) - k_t * (rel[i] - rel_n * r->n[i]) * in->h;
-        double size = sqrt(vec3_dot(f, f));
-        if (size > cap) {
-            *dissipated += cap * (size - cap) / k_t;
-            for (int i = 0; i < 3; i++) f[i] *= cap / size;
-        }
-        for (int i = 0; i < 3; i++) {
-            spring[i] = f[i];
-            force[i] += f[i];
-        }
+        contact_spring_load(spring, r->n, rel, k_t, in->h, in->friction * f_n, dissipated, force);
     } else {
         memset(spring, 0, 3 * sizeof(double));
     }

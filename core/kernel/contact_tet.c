@@ -31,6 +31,7 @@
  */
 #include "contact_tet.h"
 #include "contact_pair.h"
+#include "contact_spring.h"
 #include "element_tet.h"
 
 #include <math.h>
@@ -403,21 +404,9 @@ static void face_friction(const face_touch *ft, int m, double k_n, double f_n, t
         for (int c = 0; c < 3; c++) rel[i] += ft->wf[c] * vc[c][i];
         for (int t = 0; t < 4; t++) rel[i] -= ft->lt[t] * vt[t][i];
     }
-    double *spring = fr->springs + 3 * m;
-    double rel_n = vec3_dot(rel, n), spring_n = vec3_dot(spring, n);
-    double k_t = (2.0 / 3.0) * k_n * ft->area, cap = fr->mu * f_n;
-    double f[3];
-    for (int i = 0; i < 3; i++)
-        f[i] = (spring[i] - spring_n * n[i]) - k_t * (rel[i] - rel_n * n[i]) * fr->h;
-    double size = sqrt(vec3_dot(f, f));
-    if (size > cap) {
-        *fr->dissipated += cap * (size - cap) / k_t;
-        for (int i = 0; i < 3; i++) f[i] *= cap / size;
-    }
-    for (int i = 0; i < 3; i++) {
-        spring[i] = f[i];
-        force[i] += f[i];
-    }
+    double k_t = (2.0 / 3.0) * k_n * ft->area;
+    contact_spring_load(fr->springs + 3 * m, n, rel, k_t, fr->h, fr->mu * f_n, fr->dissipated,
+                        force);
 }
 
 /* A tetrahedron's corner positions and barycentric map, worked out once

@@ -11,7 +11,7 @@
  * taken mid-run restores to the same bits (the clearances start afresh),
  * and the 3D broken block's run with the skips is on two threads.
  */
-#include "build_model.h"
+#include "broken_block.h"
 #include "check.h"
 #include "contact/contact_internal.h"
 #include "fdem.h"
@@ -19,30 +19,6 @@
 
 #include <stdlib.h>
 #include <string.h>
-
-/* A unit block of n cells a side, every joint broken where it stands (as
- * bench_engine.c's broken block), squeezed along x at rate `squeeze` (1/s)
- * and sheared: its pieces press on and slide along each other. */
-static fdem_model *broken_block(int dim, int n, double squeeze)
-{
-    fdem_model *m = fdem_model_create();
-    fdem_error err = {0};
-    if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
-    int mat = build_fracturing_rock(m, 0.0);
-    const double size[3] = {1, 1, 1};
-    const int div[3] = {n, n, n};
-    build_box_part(m, mat, dim, size, div, 1);
-    build_finalize(m, 0.5);
-    for (int i = 0; i < m->node_count; i++) {
-        double *v = m->vel + (size_t)dim * i, *x = m->pos0 + (size_t)dim * i;
-        v[0] = -squeeze * (x[0] - 0.5) + 0.3 * squeeze * x[1];
-        v[1] = 0.2 * squeeze * (x[0] - 0.5);
-    }
-    for (int j = 0; j < m->joint_count; j++) m->joint_damage[j] = 1;
-    m->broken_joints = m->joint_count;
-    m->contact.need_detect = 1;
-    return m;
-}
 
 /* Two blocks about to meet (the 2D pair of build_model.h, or its 3D like). */
 static fdem_model *colliding_blocks(int dim)
@@ -83,15 +59,6 @@ static int skipped_on_clearance(const fdem_model *m)
     return skipped;
 }
 
-static void same_bits(const fdem_model *a, const fdem_model *b, const char *what)
-{
-    size_t n = sizeof(double) * (size_t)a->dim * (size_t)a->node_count;
-    CHECK(memcmp(a->pos, b->pos, n) == 0, "%s: positions differ", what);
-    CHECK(memcmp(a->vel, b->vel, n) == 0, "%s: velocities differ", what);
-    fdem_energy ea = fdem_get_energy(a), eb = fdem_get_energy(b);
-    CHECK(memcmp(&ea, &eb, sizeof ea) == 0, "%s: energies differ", what);
-}
-
 /* The model built twice, stepped `steps` times with the clearance skips
  * and without them (the first on 2 threads when it is to have
  * near_at_least near pairs, the threaded walk's): the same bits, contact
@@ -109,7 +76,7 @@ static void same_bits_with_and_without(fdem_model *(*build)(int), int dim, int s
         skipped += skipped_on_clearance(on);
         touching += on->contact.touching;
     }
-    same_bits(on, off, what);
+    same_state_bits(on, off, what);
     CHECK(on->contact.near_count >= near_at_least, "%s: %zu near pairs, the threaded walk needs %zu",
           what, on->contact.near_count, near_at_least);
     CHECK(touching > 0, "%s: no pair touched", what);
@@ -120,8 +87,8 @@ static void same_bits_with_and_without(fdem_model *(*build)(int), int dim, int s
     fdem_model_destroy(off);
 }
 
-static fdem_model *broken_block_2d(int dim) { return broken_block(dim, 6, 20.0); }
-static fdem_model *broken_block_3d(int dim) { return broken_block(dim, 3, 20.0); }
+static fdem_model *broken_block_2d(int dim) { return broken_in_place_block(dim, 6, 20.0); }
+static fdem_model *broken_block_3d(int dim) { return broken_in_place_block(dim, 3, 20.0); }
 
 static void broken_block_2d_gives_the_same_bits(void)
 {
@@ -159,7 +126,7 @@ static void restored_broken_block_steps_on_to_the_same_bits(void)
             CHECK(fdem_step(a, &err) == 0, "%s", err.message);
             CHECK(fdem_step(b, &err) == 0, "%s", err.message);
         }
-        same_bits(a, b, dim == 2 ? "2D restored" : "3D restored");
+        same_state_bits(a, b, dim == 2 ? "2D restored" : "3D restored");
         fdem_model_destroy(a);
         fdem_model_destroy(b);
     }

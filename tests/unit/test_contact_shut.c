@@ -9,7 +9,7 @@
  * general path untouched); and the shut run stays close to the general
  * kernel's run (the kernels agree to O(s / h)).
  */
-#include "build_model.h"
+#include "broken_block.h"
 #include "check.h"
 #include "contact/contact_internal.h"
 #include "fdem.h"
@@ -18,27 +18,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* As test_contact_clearance.c's: a unit block, n cells a side, every joint
- * broken where it stands, squeezed along x at `squeeze` (1/s) and sheared;
- * `apart` moves each vertex copy but the first by that many tolerances. */
+/* broken_block.h's block broken in place; `apart` moves each vertex copy
+ * but the first by that many tolerances. */
 static fdem_model *broken_block(int dim, int n, double squeeze, double apart)
 {
-    fdem_model *m = fdem_model_create();
-    fdem_error err = {0};
-    if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
-    int mat = build_fracturing_rock(m, 0.0);
-    const double size[3] = {1, 1, 1};
-    const int div[3] = {n, n, n};
-    build_box_part(m, mat, dim, size, div, 1);
-    build_finalize(m, 0.5);
-    for (int i = 0; i < m->node_count; i++) {
-        double *v = m->vel + (size_t)dim * i, *x = m->pos0 + (size_t)dim * i;
-        v[0] = -squeeze * (x[0] - 0.5) + 0.3 * squeeze * x[1];
-        v[1] = 0.2 * squeeze * (x[0] - 0.5);
-    }
-    for (int j = 0; j < m->joint_count; j++) m->joint_damage[j] = 1;
-    m->broken_joints = m->joint_count;
-    m->contact.need_detect = 1;
+    fdem_model *m = broken_in_place_block(dim, n, squeeze);
     if (apart > 0) {
         const contact_state *cs = &m->contact;
         for (int i = 0; i < m->node_count; i++) {
@@ -50,15 +34,6 @@ static fdem_model *broken_block(int dim, int n, double squeeze, double apart)
         }
     }
     return m;
-}
-
-static void same_bits(const fdem_model *a, const fdem_model *b, const char *what)
-{
-    size_t n = sizeof(double) * (size_t)a->dim * (size_t)a->node_count;
-    CHECK(memcmp(a->pos, b->pos, n) == 0, "%s: positions differ", what);
-    CHECK(memcmp(a->vel, b->vel, n) == 0, "%s: velocities differ", what);
-    fdem_energy ea = fdem_get_energy(a), eb = fdem_get_energy(b);
-    CHECK(memcmp(&ea, &eb, sizeof ea) == 0, "%s: energies differ", what);
 }
 
 static int shut_elements(const fdem_model *m)
@@ -111,8 +86,8 @@ static void shut_path_keeps_the_bits(int dim, int n, int steps)
     CHECK(touching > 0, "%dD: no pair touched", dim);
     fprintf(stderr, "  %dD: %ld of %ld element-steps shut, %ld pair-steps touching\n", dim, shut,
             (long)steps * one->elem_count, touching);
-    same_bits(one, two, dim == 2 ? "2D, 2 threads" : "3D, 2 threads");
-    same_bits(one, restored, dim == 2 ? "2D, restored" : "3D, restored");
+    same_state_bits(one, two, dim == 2 ? "2D, 2 threads" : "3D, 2 threads");
+    same_state_bits(one, restored, dim == 2 ? "2D, restored" : "3D, restored");
     fdem_model_destroy(one);
     fdem_model_destroy(two);
     fdem_model_destroy(restored);
@@ -139,7 +114,7 @@ static void open_broken_block_is_the_general_kernel(void)
         }
         CHECK(shut == 0, "%dD: %ld element-steps shut with every copy apart", dim, shut);
         CHECK(touching > 0, "%dD: nothing touched", dim);
-        same_bits(on, off, dim == 2 ? "2D open" : "3D open");
+        same_state_bits(on, off, dim == 2 ? "2D open" : "3D open");
         fdem_model_destroy(on);
         fdem_model_destroy(off);
     }

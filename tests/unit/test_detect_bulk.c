@@ -8,7 +8,7 @@
  * again. 2D and 3D; the test also checks that the bulk path ran and that
  * the pieces touched, or it could not fail.
  */
-#include "build_model.h"
+#include "broken_block.h"
 #include "check.h"
 #include "fdem.h"
 #include "model/model.h"
@@ -21,19 +21,8 @@
  * the rest (about 2/3) one piece. */
 static fdem_model *cut_block(int dim, int n)
 {
-    fdem_model *m = fdem_model_create();
+    fdem_model *m = squeezed_block(dim, n, 5.0);
     fdem_error err = {0};
-    if (dim == 3 && fdem_set_dimension(m, 3, &err)) build_die("dimension", &err);
-    int mat = build_fracturing_rock(m, 0.0);
-    const double size[3] = {1, 1, 1};
-    const int div[3] = {n, n, n};
-    build_box_part(m, mat, dim, size, div, 1);
-    build_finalize(m, 0.5);
-    for (int i = 0; i < m->node_count; i++) {
-        double *v = m->vel + (size_t)dim * i, *x = m->pos0 + (size_t)dim * i;
-        v[0] = -5.0 * (x[0] - 0.5) + 1.5 * x[1];
-        v[1] = 1.0 * (x[0] - 0.5);
-    }
     const double normal[3] = {1, 0, 0};
     if (fdem_break_joints_across(m, normal, 0.2) <= 0) build_die("cut", &err);
     return m;
