@@ -171,6 +171,37 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *ou
  * (the pool is shared; each pair's own set is not). */
 enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
 
+/* A pair's stick springs: its set in the pool (*set >= 0), else `fresh`,
+ * zeroed. Both kernels of the walk read and write them the same way. */
+static inline __attribute__((always_inline)) double *pair_springs(contact_state *cs,
+                                                                  const near_pair *np,
+                                                                  double *fresh, int slots,
+                                                                  int32_t *set)
+{
+    *set = cs->spring_of[np->pair];
+    if (*set >= 0) return cs->slip + (size_t)slots * (size_t)*set;
+    for (int s = 0; s < slots; s++) fresh[s] = 0;
+    return fresh;
+}
+
+/* After either kernel: a pair that did not touch has let every spring go
+ * (contact_pair.h), so the springs are read only after a touch; a set
+ * left holding nothing goes back to the pool, fresh springs holding a
+ * force are adopted. Returns `touched`. */
+static inline __attribute__((always_inline)) int pair_springs_settle(near_pair *np, int32_t set,
+                                                                     const double *springs,
+                                                                     int touched, int slots,
+                                                                     int *pool)
+{
+    int any = 0;
+    if (touched > 0)
+        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+    if (set < 0 && any) *pool = SPRINGS_ADOPT;
+    np->sprung = any;
+    return touched;
+}
+
 /* Near pair np this step: boxes apart, it lets its springs go (-1);
  * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
  * without a set of springs is evaluated on fresh (zeros); *pool says
@@ -191,21 +222,10 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     /* shut broken rock first: its kernel ignores the gap the general one
      * found (a clearance says what the general kernel would do) */
     if (cs->shut_any && np->topology && cs->elem_shut[a] && cs->elem_shut[b]) {
-        int32_t set = cs->spring_of[np->pair];
-        double *springs = fresh;
-        if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
-        else
-            for (int s = 0; s < slots; s++) fresh[s] = 0;
+        int32_t set;
+        double *springs = pair_springs(cs, np, fresh, slots, &set);
         int touched = shut_pair_force(m, np, h, springs, out);
-        if (touched != 2) {
-            int any = 0;
-            if (touched > 0)
-                for (int s = 0; s < slots; s++) any |= springs[s] != 0;
-            if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
-            if (set < 0 && any) *pool = SPRINGS_ADOPT;
-            np->sprung = any;
-            return touched;
-        }
+        if (touched != 2) return pair_springs_settle(np, set, springs, touched, slots, pool);
     }
     /* a gap over near_apart: apart, boxes not even computed this step */
     if (np->gap > cs->near_apart ||
@@ -216,11 +236,8 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
         }
         return -1;
     }
-    int32_t set = cs->spring_of[np->pair];
-    double *springs = fresh;
-    if (set >= 0) springs = cs->slip + (size_t)slots * (size_t)set;
-    else
-        for (int s = 0; s < slots; s++) fresh[s] = 0;
+    int32_t set;
+    double *springs = pair_springs(cs, np, fresh, slots, &set);
     int touched = contact_pair_force(m, a, b, h, springs, out, memo);
     /* Apart with a clearance c (contact_pair.h): the kernel keeps returning
      * 0, every spring let go, while the two elements' nodes travel less
@@ -234,15 +251,7 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
      * kernel would have found what it found now, the same bits. The list's
      * rebuild (and a restore, which rebuilds it) starts from box gaps. */
     if (!touched && out[0] > 0 && !cs->clearance_off) np->gap = max2(np->gap, out[0] - cs->near_apart);
-    /* a pair that did not touch has let every spring go (contact_pair.h):
-     * the springs are read only after a touch */
-    int any = 0;
-    if (touched)
-        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
-    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
-    if (set < 0 && any) *pool = SPRINGS_ADOPT;
-    np->sprung = any;
-    return touched;
+    return pair_springs_settle(np, set, springs, touched, slots, pool);
 }
 
 /* Force between two elements, both roles, added to the contact force
