@@ -63,23 +63,18 @@ int sizing_step(fdem_model *model)
     return fdem_step(model, &err);
 }
 
-/* Steps for at least `seconds` and `min_steps`, at most `max_steps`;
- * the steps taken, -1 when one failed; its wall and CPU time into `load`. */
-static int probe_run(fdem_model *model, double seconds, int min_steps, int max_steps,
-                     sizing_load *load, double *cpu)
+/* Steps `steps` times: the steps taken, -1 when one failed; their wall
+ * and CPU time into `load`. */
+static int probe_run(fdem_model *model, int steps, sizing_load *load, double *cpu)
 {
-    double started = clock_wall_seconds(), now = started, cpu0 = clock_cpu_seconds();
-    int taken = 0;
-    while (taken < max_steps && (taken < min_steps || now - started < seconds)) {
+    double started = clock_wall_seconds(), cpu0 = clock_cpu_seconds();
+    for (int taken = 0; taken < steps; taken++)
         if (sizing_step(model) != 0)
             return -1;
-        taken++;
-        now = clock_wall_seconds();
-    }
     *cpu = clock_cpu_seconds() - cpu0;
-    load->wall += now - started;
+    load->wall += clock_wall_seconds() - started;
     load->cpu += *cpu;
-    return taken;
+    return steps;
 }
 
 /* The untimed warm-up: *taken steps (-1: one failed); returns the CPU
@@ -92,7 +87,7 @@ static double probe_warm(fdem_model *model, int room, int *taken, sizing_load *w
     while (*taken < room && *taken < PROBE_WARM_MAX_STEPS && spent < PROBE_WARM_SECONDS) {
         int left = (room < PROBE_WARM_MAX_STEPS ? room : PROBE_WARM_MAX_STEPS) - *taken;
         int want = chunk < left ? chunk : left;
-        n = probe_run(model, 0, want, want, warm_load, &cpu);
+        n = probe_run(model, want, warm_load, &cpu);
         if (n < 0) {
             *taken = -1;
             return NAN;
@@ -135,7 +130,7 @@ double sizing_probe_step_seconds(fdem_model *model, double steps_left, int *take
     while (windows < PROBE_WINDOWS && room > 0 &&
            (windows < PROBE_MIN_WINDOWS || clock_wall_seconds() - started < PROBE_BUDGET_SECONDS)) {
         int want = room < each ? room : each;
-        int n = probe_run(model, 0, want, want, load, &cpu);
+        int n = probe_run(model, want, load, &cpu);
         if (n < 0)
             return NAN;
         *taken += n;
