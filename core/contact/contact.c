@@ -123,25 +123,6 @@ static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, dou
     return m->contact.kernel->pair_force(&in, springs, out);
 }
 
-/* A pair of shut elements (contact_shut.c) this step: left out (-1, as a
- * pair apart: springs let go), or the face kernel's answer on the two
- * sides of a shut broken joint; 2 for the general kernel's pairs. */
-static int shut_pair_force(const fdem_model *m, const near_pair *np, double h, double *springs,
-                           double *out)
-{
-    face_match fm;
-    int kind = contact_shut_kind(m, np, &fm);
-    if (kind == SHUT_GENERAL) return 2;
-    int touched = -1;
-    if (kind == SHUT_FACE) {
-        contact_pair_in in = pair_input(m, np->a, np->b, h, NULL);
-        touched = m->contact.kernel->face_force(&in, &fm, springs, out);
-    } else {
-        for (int s = 0; s < m->contact.slots; s++) springs[s] = 0;
-    }
-    return touched;
-}
-
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
  * what its friction dissipated to the friction account; called in pair
  * order, so every sum is formed in the same order on any thread count. */
@@ -222,10 +203,20 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     /* shut broken rock first: its kernel ignores the gap the general one
      * found (a clearance says what the general kernel would do) */
     if (cs->shut_any && np->topology && cs->elem_shut[a] && cs->elem_shut[b]) {
+        if (np->topology == SHUT_TOPO_VERTEX) { /* left out: as a pair apart */
+            if (np->sprung) {
+                *pool = SPRINGS_RELEASE;
+                np->sprung = 0;
+            }
+            return -1;
+        }
+        /* the two sides of a shut broken joint */
         int32_t set;
         double *springs = pair_springs(cs, np, fresh, slots, &set);
-        int touched = shut_pair_force(m, np, h, springs, out);
-        if (touched != 2) return pair_springs_settle(np, set, springs, touched, slots, pool);
+        face_match fm = shut_face_unpack(np->face);
+        contact_pair_in in = pair_input(m, a, b, h, NULL);
+        int touched = cs->kernel->face_force(&in, &fm, springs, out);
+        return pair_springs_settle(np, set, springs, touched, slots, pool);
     }
     /* a gap over near_apart: apart, boxes not even computed this step */
     if (np->gap > cs->near_apart ||

@@ -36,7 +36,8 @@ typedef struct near_pair {
     uint8_t sprung;  /* some stick spring of it holds a force */
     uint8_t topology; /* what its elements share, at the list's build (contact_shut.c:
                          SHUT_TOPO_*): a break reruns detection, which rebuilds it */
-    uint16_t unused;
+    uint16_t face;    /* SHUT_TOPO_FACE: where the broken joint lies in a and b
+                         (shut_face_pack), found once at the list's build */
 } near_pair;
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
@@ -82,12 +83,23 @@ int contact_near_refresh(fdem_model *m);
  * vertex tables once (0, or -1 without memory); refresh marks this step's
  * shut elements; kind says what the walk does with a pair of them: the
  * general kernel, the face kernel (fm filled) or nothing. */
-enum { SHUT_GENERAL, SHUT_FACE, SHUT_LEFT_OUT };
 enum { SHUT_TOPO_NONE, SHUT_TOPO_FACE, SHUT_TOPO_VERTEX };
 int contact_shut_init(fdem_model *m);
 void contact_shut_free(contact_state *cs);
 void contact_shut_refresh(fdem_model *m);
-int contact_shut_topology(const fdem_model *m, int a, int b);
-int contact_shut_kind(const fdem_model *m, const near_pair *np, face_match *fm);
+int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face);
+
+/* A face_match in near_pair.face: two bits each for face_a, face_b and
+ * copy_in_b[0..2] (corners and faces number at most 4). */
+static inline uint16_t shut_face_pack(const face_match *fm)
+{
+    return (uint16_t)(fm->face_a | fm->face_b << 2 | fm->copy_in_b[0] << 4 |
+                      fm->copy_in_b[1] << 6 | fm->copy_in_b[2] << 8);
+}
+
+static inline face_match shut_face_unpack(uint16_t face)
+{
+    return (face_match){face & 3, face >> 2 & 3, {face >> 4 & 3, face >> 6 & 3, face >> 8 & 3}};
+}
 
 #endif

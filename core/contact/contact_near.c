@@ -123,9 +123,10 @@ static int contact_near_rebuild(fdem_model *m)
             model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near,
                           CONTACT_FIRST_ROWS))
             return -1;
-        uint8_t topology = cs->elem_shut ? (uint8_t)contact_shut_topology(m, ea, eb) : 0;
-        cs->near[count++] =
-            (near_pair){gap, (uint32_t)k, ea, eb, (uint8_t)contact_pair_sprung(cs, k), topology, 0};
+        uint16_t face = 0;
+        uint8_t topology = cs->elem_shut ? (uint8_t)contact_shut_topology(m, ea, eb, &face) : 0;
+        cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb,
+                                        (uint8_t)contact_pair_sprung(cs, k), topology, face};
         cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
         cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }

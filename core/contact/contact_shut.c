@@ -186,20 +186,21 @@ static int share_a_vertex(const fdem_model *m, int a, int b)
     return 0;
 }
 
-/* What a and b share, which only a break changes: a broken joint, a mesh
- * vertex, or nothing. The near list keeps it (contact_near.c). */
-int contact_shut_topology(const fdem_model *m, int a, int b)
+/* What a and b share, which only a break changes: a broken joint (its
+ * faces in *face, shut_face_pack), a mesh vertex, or nothing. The near
+ * list keeps both (contact_near.c), so the walk reads them and finds
+ * nothing. A broken joint whose nodes are not the two elements' (never,
+ * for a joint built between them) is "nothing": the general kernel. */
+int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
 {
+    *face = 0;
     if (!m->broken_joints) return SHUT_TOPO_NONE;
-    if (broken_joint_between(m, a, b) >= 0) return SHUT_TOPO_FACE;
+    int j = broken_joint_between(m, a, b);
+    if (j >= 0) {
+        face_match fm = {0, 0, {0, 0, 0}};
+        if (face_match_of(m, j, a, b, &fm)) return SHUT_TOPO_NONE;
+        *face = shut_face_pack(&fm);
+        return SHUT_TOPO_FACE;
+    }
     return share_a_vertex(m, a, b) ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
-}
-
-/* Both elements of np are shut this step (the caller checked). */
-int contact_shut_kind(const fdem_model *m, const near_pair *np, face_match *fm)
-{
-    if (np->topology == SHUT_TOPO_VERTEX) return SHUT_LEFT_OUT;
-    if (np->topology != SHUT_TOPO_FACE) return SHUT_GENERAL;
-    int j = broken_joint_between(m, np->a, np->b);
-    return j >= 0 && !face_match_of(m, j, np->a, np->b, fm) ? SHUT_FACE : SHUT_GENERAL;
 }
