@@ -35,6 +35,19 @@ static int segment_overlap(const double d[2], double *i0, double w[3], double *t
  * corners: one line cuts a triangle), then fan sums. */
 static int triangle_overlap(const double d[3], double *i0, double w[3], double *touch)
 {
+    if (d[0] > 0 && d[1] > 0 && d[2] > 0) {
+        /* shut and pressed over the whole face (most shut pairs): the fan
+         * below with one triangle, the weights' corners, frac 1, the same
+         * sums in the same order */
+        double fsum = d[0] + d[1] + d[2];
+        double sum0 = fsum / 3.0;
+        if (!(sum0 > 0)) return 0;
+        *i0 = sum0;
+        for (int i = 0; i < 3; i++) w[i] = 1.0 / 12.0 * (d[i] + fsum) / sum0;
+        *touch = 1;
+        return 1;
+    }
+    if (d[0] <= 0 && d[1] <= 0 && d[2] <= 0) return 0;
     double poly[4][3], depth[4];
     int n = 0;
     for (int a = 0; a < 3; a++) {

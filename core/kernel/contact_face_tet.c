@@ -16,17 +16,24 @@
 
 #include "math/vec3.h"
 
-/* A target tetrahedron now: its corners, barycentric map (lambda_{1..3} =
- * rows . (x - p0)), 6 V, and the cross products of its faces (2 A n). */
+/* A tetrahedron now: its corners' places and velocities (copied once: the
+ * roles then read no array the forces are written to, so the compiler
+ * keeps them in registers), its barycentric map (lambda_{1..3} = rows .
+ * (x - p0)), 6 V, and the squared cross products of its faces ((2 A)^2:
+ * a role takes the root of one face's and of the largest). */
 typedef struct tet_now {
-    const double *p[4];
+    double p[4][3], v[4][3];
     double rows[3][3], det;
-    double face_len[4]; /* |cross| of face f: twice its area */
+    double face_len2[4];
 } tet_now;
 
-static int tet_now_of(const double *pos, const int32_t n[4], tet_now *t)
+static int tet_now_of(const double *pos, const double *vel, const int32_t n[4], tet_now *t)
 {
-    for (int v = 0; v < 4; v++) t->p[v] = pos + 3 * (size_t)n[v];
+    for (int c = 0; c < 4; c++)
+        for (int i = 0; i < 3; i++) {
+            t->p[c][i] = pos[3 * (size_t)n[c] + i];
+            t->v[c][i] = vel[3 * (size_t)n[c] + i];
+        }
     double e[3][3], c[3][3];
     for (int k = 0; k < 3; k++) vec3_sub(t->p[k + 1], t->p[0], e[k]);
     vec3_cross(e[1], e[2], c[0]);
@@ -36,14 +43,12 @@ static int tet_now_of(const double *pos, const int32_t n[4], tet_now *t)
     if (!(t->det > 0) || !isfinite(t->det)) return 0;
     for (int k = 0; k < 3; k++)
         for (int i = 0; i < 3; i++) t->rows[k][i] = c[k][i] / t->det;
-    for (int f = 0; f < 4; f++) {
-        const int *fn = tet_face_nodes[f];
-        double ab[3], ac[3], x[3];
-        vec3_sub(t->p[fn[1]], t->p[fn[0]], ab);
-        vec3_sub(t->p[fn[2]], t->p[fn[0]], ac);
-        vec3_cross(ab, ac, x);
-        t->face_len[f] = sqrt(vec3_dot(x, x));
-    }
+    /* tet_face_nodes' faces: 0 (1,2,3) has cross (e1-e0) x (e2-e0) =
+     * c0 + c1 + c2, faces 1, 2, 3 have -c0, -c1, -c2 */
+    double s[3];
+    for (int i = 0; i < 3; i++) s[i] = c[0][i] + c[1][i] + c[2][i];
+    t->face_len2[0] = vec3_dot(s, s);
+    for (int k = 0; k < 3; k++) t->face_len2[k + 1] = vec3_dot(c[k], c[k]);
     return 1;
 }
 
@@ -61,35 +66,32 @@ static void bary_in(const tet_now *t, const double x[3], double l[4])
  * overlap integral (as a fraction of the area) and its centroid's weights,
  * touch the fraction that overlaps. */
 typedef struct face_role {
-    const double *pos, *vel;
-    const int32_t *cn, *tn;
+    const tet_now *contactor, *target;
     const int *cf;
-    const tet_now *target;
     int ft;
     double n[3];
 } face_role;
 
-static void role_force(const face_role *r, double area, double i0, const double w[3],
-                       double touch, const contact_pair_in *in, double spring[3], double f_c[12],
-                       double f_t[12], double *dissipated)
+static inline void role_force(const face_role *r, double area, double i0, const double w[3],
+                              double touch, const contact_pair_in *in, double spring[3],
+                              double f_c[12], double f_t[12], double *dissipated)
 {
-    const tet_now *t = r->target;
-    double k_face = 4 * in->penalty * t->face_len[r->ft] / t->det; /* 4 p / H_t */
+    const tet_now *c = r->contactor, *t = r->target;
+    double k_face = 4 * in->penalty * sqrt(t->face_len2[r->ft]) / t->det; /* 4 p / H_t */
     double f_n = k_face * i0 * area, x[3] = {0, 0, 0}, lt[4], force[3];
-    for (int k = 0; k < 3; k++) {
-        const double *p = r->pos + 3 * (size_t)r->cn[r->cf[k]];
-        for (int i = 0; i < 3; i++) x[i] += w[k] * p[i];
-    }
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++) x[i] += w[k] * c->p[r->cf[k]][i];
     bary_in(t, x, lt);
     for (int i = 0; i < 3; i++) force[i] = -f_n * r->n[i];
     if (in->friction > 0) {
         double rel[3] = {0, 0, 0};
         for (int i = 0; i < 3; i++) {
-            for (int k = 0; k < 3; k++) rel[i] += w[k] * r->vel[3 * (size_t)r->cn[r->cf[k]] + i];
-            for (int v = 0; v < 4; v++) rel[i] -= lt[v] * r->vel[3 * (size_t)r->tn[v] + i];
+            for (int k = 0; k < 3; k++) rel[i] += w[k] * c->v[r->cf[k]][i];
+            for (int v = 0; v < 4; v++) rel[i] -= lt[v] * t->v[v][i];
         }
-        double largest = 0;
-        for (int f = 0; f < 4; f++) largest = fmax(largest, t->face_len[f]);
+        double largest2 = 0;
+        for (int f = 0; f < 4; f++) largest2 = largest2 > t->face_len2[f] ? largest2 : t->face_len2[f];
+        double largest = sqrt(largest2);
         double k_t = (2.0 / 3.0) * (4 * in->penalty * largest / t->det) * touch * area;
         contact_spring_load(spring, r->n, rel, k_t, in->h, in->friction * f_n, dissipated, force);
     } else {
@@ -111,7 +113,8 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
         fb[k] = fm->copy_in_b[k];
     }
     double d[3], i0 = 0, w[3], touch = 0, n[3] = {0, 0, 0}, area = 0;
-    int touched = tet_now_of(in->pos, in->node_a, &a) && tet_now_of(in->pos, in->node_b, &b);
+    int touched = tet_now_of(in->pos, in->vel, in->node_a, &a) &&
+                  tet_now_of(in->pos, in->vel, in->node_b, &b);
     if (touched) {
         double m[3][3], e1[3], e2[3];
         for (int k = 0; k < 3; k++)
@@ -144,8 +147,8 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
     memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
     for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
     double *dissipated = &out[TET_PAIR_OUT - 1];
-    face_role ra = {in->pos, in->vel, in->node_a, in->node_b, fa, &b, fm->face_b, {n[0], n[1], n[2]}};
-    face_role rb = {in->pos, in->vel, in->node_b, in->node_a, fb, &a, fm->face_a, {-n[0], -n[1], -n[2]}};
+    face_role ra = {&a, &b, fa, fm->face_b, {n[0], n[1], n[2]}};
+    face_role rb = {&b, &a, fb, fm->face_a, {-n[0], -n[1], -n[2]}};
     role_force(&ra, area, i0, w, touch, in, keep_a, out, out + 12, dissipated);
     role_force(&rb, area, i0, w, touch, in, keep_b, out + 12, out, dissipated);
     memcpy(springs + 3 * fm->face_a, keep_a, sizeof keep_a);

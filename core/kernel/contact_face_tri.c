@@ -10,10 +10,13 @@
 #include <math.h>
 #include <string.h>
 
-/* A target triangle now: corners, twice its area, its edges' lengths
- * (edge i from corner i to i + 1). */
+/* A target triangle now: corners, twice its area, its edges' squared
+ * lengths (edge i from corner i to i + 1). Squares: a role needs the
+ * length of one edge and of the longest, and glibc's hypot (exact to the
+ * last bit at any scale, which an element's size never needs) was a
+ * quarter of a broken 2D block's step. */
 typedef struct tri_at {
-    double x[3], y[3], area2, edge[3];
+    double x[3], y[3], area2, edge2[3];
 } tri_at;
 
 static int tri_at_of(const double *pos, const int32_t n[3], tri_at *t)
@@ -23,7 +26,8 @@ static int tri_at_of(const double *pos, const int32_t n[3], tri_at *t)
     if (!(t->area2 > 0) || !isfinite(t->area2)) return 0;
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3;
-        t->edge[i] = hypot(t->x[j] - t->x[i], t->y[j] - t->y[i]);
+        double ex = t->x[j] - t->x[i], ey = t->y[j] - t->y[i];
+        t->edge2[i] = ex * ex + ey * ey;
     }
     return 1;
 }
@@ -53,7 +57,7 @@ static void role_force(const edge_role *r, double len, double i0, const double w
                        double *dissipated)
 {
     const tri_at *t = r->target;
-    double f_n = 3 * in->penalty * t->edge[r->ft] / t->area2 * i0 * len; /* 3 p / H_t */
+    double f_n = 3 * in->penalty * sqrt(t->edge2[r->ft]) / t->area2 * i0 * len; /* 3 p / H_t */
     double px = 0, py = 0, lt[3];
     for (int k = 0; k < 2; k++) {
         px += w[k] * r->pos[2 * r->cn[r->c[k]]];
@@ -71,7 +75,7 @@ static void role_force(const edge_role *r, double len, double i0, const double w
             vx -= lt[v] * r->vel[2 * r->tn[v]];
             vy -= lt[v] * r->vel[2 * r->tn[v] + 1];
         }
-        double longest = fmax(t->edge[0], fmax(t->edge[1], t->edge[2]));
+        double longest = sqrt(fmax(t->edge2[0], fmax(t->edge2[1], t->edge2[2])));
         double k_t = (2.0 / 3.0) * (3 * in->penalty * longest / t->area2) * touch * len;
         double cap = in->friction * f_n;
         double f = *spring - k_t * (vx * r->tangent[0] + vy * r->tangent[1]) * in->h;
@@ -109,7 +113,7 @@ int tri_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
             my[k] = 0.5 * (a.y[ca[k]] + b.y[cb[k]]);
         }
         double ex = mx[1] - mx[0], ey = my[1] - my[0];
-        len = hypot(ex, ey);
+        len = sqrt(ex * ex + ey * ey);
         touched = len > 0;
         if (touched) {
             tan[0] = ex / len, tan[1] = ey / len;
