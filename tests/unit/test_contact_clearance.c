@@ -17,6 +17,7 @@
 #include "fdem.h"
 #include "model/model.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -132,6 +133,53 @@ static void restored_broken_block_steps_on_to_the_same_bits(void)
     }
 }
 
-CHECK_MAIN(T(broken_block_2d_gives_the_same_bits), T(broken_block_3d_gives_the_same_bits),
+/* Two tetrahedra whose nearest parts are an edge of each, crossed: A's top
+ * edge along x at z = 0, B's bottom edge along y at z = g. No face plane of
+ * either separates them (each face through a crossing edge leans over the
+ * other's), only the axis across the two edges does, g apart. The kernel
+ * gives a clearance of g less its margin (before the edge axes, 0: a
+ * broken block's pairs an element apart were clipped every step), and
+ * pressed together (g < 0) it touches. */
+static void orient(double *pos, int32_t *n)
+{
+    double e[3][3];
+    for (int k = 0; k < 3; k++)
+        for (int i = 0; i < 3; i++) e[k][i] = pos[3 * n[k + 1] + i] - pos[3 * n[0] + i];
+    double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
+                 e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
+                 e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+    if (det < 0) {
+        int32_t t = n[2];
+        n[2] = n[3];
+        n[3] = t;
+    }
+}
+
+static void crossed_edges_give_a_clearance(void)
+{
+    const double gaps[] = {0.05, 1e-3, -0.01};
+    for (int g = 0; g < 3; g++) {
+        double z = gaps[g];
+        double pos[24] = {-1, 0, 0,  1, 0, 0,  0, -1, -1,  0, 1, -1,
+                          0, -1, z,  0, 1, z,  -1, 0, 1 + z,  1, 0, 1 + z};
+        double vel[24] = {0};
+        int32_t na[4] = {0, 1, 2, 3}, nb[4] = {4, 5, 6, 7};
+        orient(pos, na);
+        orient(pos, nb);
+        contact_pair_in in = {pos, vel, na, nb, 1e9, 0.5, 1e-6, NULL};
+        double springs[TET_CONTACT_SLOTS] = {0}, out[TET_PAIR_OUT];
+        int touched = tet_contact_pair_force(&in, springs, out);
+        if (z < 0) {
+            CHECK(touched == 1, "pressed by %g: no touch", -z);
+            continue;
+        }
+        double margin = 1e-8 * 2 + 1e-7 * sqrt(6); /* size 1 + z, longest edge sqrt(6) */
+        CHECK(!touched, "%g apart: touched", z);
+        CHECK(out[0] > z - 1.01 * margin && out[0] <= z, "%g apart: clearance %.17g, margin %g", z,
+              out[0], margin);
+    }
+}
+
+CHECK_MAIN(T(crossed_edges_give_a_clearance), T(broken_block_2d_gives_the_same_bits), T(broken_block_3d_gives_the_same_bits),
            T(colliding_blocks_give_the_same_bits),
            T(restored_broken_block_steps_on_to_the_same_bits))
