@@ -144,7 +144,8 @@ static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *ou
     m->friction_energy += out[2 * m->dim * m->elem_nodes];
     /* every 8th step: a body passing into another stays deep for several
      * steps, and every step would cost a dense 2D pile ~10 % */
-    if (m->step % CONTACT_PENETRATION_EVERY == 0) contact_penetration_check(m, e1, e2);
+    if (m->step % CONTACT_PENETRATION_EVERY == 0 && !contact_shut_neighbours(m, e1, e2))
+        contact_penetration_check(m, e1, e2);
 }
 
 /* What a pair's evaluation asks of the spring pool (contact_history.c):

@@ -88,6 +88,7 @@ int contact_shut_init(fdem_model *m);
 void contact_shut_free(contact_state *cs);
 void contact_shut_refresh(fdem_model *m);
 int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face);
+int contact_shut_neighbours(const fdem_model *m, int a, int b);
 
 /* A face_match in near_pair.face: two bits each for face_a, face_b and
  * copy_in_b[0..2] (corners and faces number at most 4). */

@@ -89,20 +89,20 @@ void contact_shut_free(contact_state *cs)
     free(cs->elem_shut);
 }
 
-/* This step's shut vertices and elements (none without a broken joint). */
-void contact_shut_refresh(fdem_model *m)
+/* This step's shut vertices and elements; D and K are constants where it
+ * is called, so each dimension's loops are unrolled. */
+static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D, int K)
 {
     contact_state *cs = &m->contact;
-    cs->shut_any = cs->elem_shut && m->broken_joints > 0 && !cs->shut_off;
-    if (!cs->shut_any) return;
-    const int D = m->dim, K = m->elem_nodes, N = m->node_count;
+    const int N = m->node_count;
+    const double *pos = m->pos;
     memset(cs->shut_vertex, 1, (size_t)N);
     for (int n = 0; n < N; n++) {
         int32_t f = cs->shut_first[n];
         if (f == n) continue;
         double s2 = 0;
         for (int d = 0; d < D; d++) {
-            double x = m->pos[D * (size_t)n + d] - m->pos[D * (size_t)f + d];
+            double x = pos[D * (size_t)n + d] - pos[D * (size_t)f + d];
             s2 += x * x;
         }
         if (!(s2 <= cs->shut_tol2[f])) cs->shut_vertex[f] = 0;
@@ -113,6 +113,16 @@ void contact_shut_refresh(fdem_model *m)
         for (int c = 0; c < K; c++) shut &= cs->shut_vertex[cs->shut_first[nd[c]]];
         cs->elem_shut[e] = shut;
     }
+}
+
+/* This step's shut vertices and elements (none without a broken joint). */
+void contact_shut_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    cs->shut_any = cs->elem_shut && m->broken_joints > 0 && !cs->shut_off;
+    if (!cs->shut_any) return;
+    if (m->dim == 3) shut_mark(m, 3, 4);
+    else shut_mark(m, 2, 3);
 }
 
 /* The broken joint between a and b, or -1. */
@@ -203,4 +213,16 @@ int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
         return SHUT_TOPO_FACE;
     }
     return share_a_vertex(m, a, b) ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
+}
+
+/* a and b are shut this step and neighbours in the mesh (a broken joint or
+ * a vertex between them): then each lies in place against the other up to
+ * the tolerance, as in an intact mesh, so neither is deep in the other and
+ * the penetration check (penetration.c) can pass them by: it was an eighth
+ * of a broken 2D block's contact stage, for a depth of 1e-4 at most. */
+int contact_shut_neighbours(const fdem_model *m, int a, int b)
+{
+    const contact_state *cs = &m->contact;
+    if (!cs->shut_any || !cs->elem_shut[a] || !cs->elem_shut[b]) return 0;
+    return broken_joint_between(m, a, b) >= 0 || share_a_vertex(m, a, b);
 }

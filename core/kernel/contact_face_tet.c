@@ -136,7 +136,7 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
         }
     }
     if (!touched) {
-        memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
+        for (int k = 0; k < TET_CONTACT_SLOTS; k++) springs[k] = 0;
         out[0] = 0;
         return 0;
     }
@@ -144,7 +144,7 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
     double keep_a[3], keep_b[3];
     memcpy(keep_a, springs + 3 * fm->face_a, sizeof keep_a);
     memcpy(keep_b, springs + TET_CONTACT_SLOTS / 2 + 3 * fm->face_b, sizeof keep_b);
-    memset(springs, 0, sizeof(double) * TET_CONTACT_SLOTS);
+    for (int k = 0; k < TET_CONTACT_SLOTS; k++) springs[k] = 0;
     for (int k = 0; k < TET_PAIR_OUT; k++) out[k] = 0;
     double *dissipated = &out[TET_PAIR_OUT - 1];
     face_role ra = {&a, &b, fa, fm->face_b, {n[0], n[1], n[2]}};

@@ -124,12 +124,12 @@ int tri_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
         }
     }
     if (!touched) {
-        memset(springs, 0, sizeof(double) * TRI_CONTACT_SLOTS);
+        for (int k = 0; k < TRI_CONTACT_SLOTS; k++) springs[k] = 0;
         out[0] = 0;
         return 0;
     }
     double keep_a = springs[fm->face_a], keep_b = springs[3 + fm->face_b];
-    memset(springs, 0, sizeof(double) * TRI_CONTACT_SLOTS);
+    for (int k = 0; k < TRI_CONTACT_SLOTS; k++) springs[k] = 0;
     for (int k = 0; k < TRI_PAIR_OUT; k++) out[k] = 0;
     double *dissipated = &out[TRI_PAIR_OUT - 1];
     /* b's edge runs the other way round (both counter-clockwise) */
