@@ -16,7 +16,7 @@
  * last bit at any scale, which an element's size never needs) was a
  * quarter of a broken 2D block's step. */
 typedef struct tri_at {
-    double x[3], y[3], area2, edge2[3];
+    double x[3], y[3], area2, inv_area2, edge2[3];
 } tri_at;
 
 static int tri_at_of(const double *pos, const int32_t n[3], tri_at *t)
@@ -24,6 +24,7 @@ static int tri_at_of(const double *pos, const int32_t n[3], tri_at *t)
     for (int c = 0; c < 3; c++) t->x[c] = pos[2 * n[c]], t->y[c] = pos[2 * n[c] + 1];
     t->area2 = (t->x[1] - t->x[0]) * (t->y[2] - t->y[0]) - (t->y[1] - t->y[0]) * (t->x[2] - t->x[0]);
     if (!(t->area2 > 0) || !isfinite(t->area2)) return 0;
+    t->inv_area2 = 1.0 / t->area2; /* one division a triangle, not five a role */
     for (int i = 0; i < 3; i++) {
         int j = (i + 1) % 3;
         double ex = t->x[j] - t->x[i], ey = t->y[j] - t->y[i];
@@ -36,7 +37,7 @@ static void area_coords(const tri_at *t, double px, double py, double l[3])
 {
     for (int k = 0; k < 3; k++) {
         int i = (k + 1) % 3, j = (k + 2) % 3;
-        l[k] = ((t->x[i] - px) * (t->y[j] - py) - (t->y[i] - py) * (t->x[j] - px)) / t->area2;
+        l[k] = ((t->x[i] - px) * (t->y[j] - py) - (t->y[i] - py) * (t->x[j] - px)) * t->inv_area2;
     }
 }
 
@@ -57,7 +58,7 @@ static void role_force(const edge_role *r, double len, double i0, const double w
                        double *dissipated)
 {
     const tri_at *t = r->target;
-    double f_n = 3 * in->penalty * sqrt(t->edge2[r->ft]) / t->area2 * i0 * len; /* 3 p / H_t */
+    double f_n = 3 * in->penalty * sqrt(t->edge2[r->ft]) * t->inv_area2 * i0 * len; /* 3 p / H_t */
     double px = 0, py = 0, lt[3];
     for (int k = 0; k < 2; k++) {
         px += w[k] * r->pos[2 * r->cn[r->c[k]]];
@@ -76,7 +77,7 @@ static void role_force(const edge_role *r, double len, double i0, const double w
             vy -= lt[v] * r->vel[2 * r->tn[v] + 1];
         }
         double longest = sqrt(fmax(t->edge2[0], fmax(t->edge2[1], t->edge2[2])));
-        double k_t = (2.0 / 3.0) * (3 * in->penalty * longest / t->area2) * touch * len;
+        double k_t = (2.0 / 3.0) * (3 * in->penalty * longest * t->inv_area2) * touch * len;
         double cap = in->friction * f_n;
         double f = *spring - k_t * (vx * r->tangent[0] + vy * r->tangent[1]) * in->h;
         if (fabs(f) > cap) {
