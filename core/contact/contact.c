@@ -113,7 +113,7 @@ static contact_pair_in pair_input(const fdem_model *m, int e1, int e2, double h,
     const material *mb = &m->materials[element_material(m, e2)];
     return (contact_pair_in){m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
                              min2(ma->penalty, mb->penalty),
-                             max2(ma->def.friction, mb->def.friction), h, memo};
+                             max2(ma->def.friction, mb->def.friction), h, memo, 0};
 }
 
 static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
@@ -230,7 +230,10 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     }
     int32_t set;
     double *springs = pair_springs(cs, np, fresh, slots, &set);
-    int touched = contact_pair_force(m, a, b, h, springs, out, memo);
+    contact_pair_in in = pair_input(m, a, b, h, memo);
+    in.edge_clearance = !(np->face & NEAR_EDGES_TRIED);
+    int touched = cs->kernel->pair_force(&in, springs, out);
+    if (!touched) np->face |= NEAR_EDGES_TRIED;
     /* Apart with a clearance c (contact_pair.h): the kernel keeps returning
      * 0, every spring let go, while the two elements' nodes travel less
      * than c together. Each node is within sqrt(near_disp2) of its place at

@@ -37,7 +37,8 @@ typedef struct near_pair {
     uint8_t topology; /* what its elements share, at the list's build (contact_shut.c:
                          SHUT_TOPO_*): a break reruns detection, which rebuilds it */
     uint16_t face;    /* SHUT_TOPO_FACE: where the broken joint lies in a and b
-                         (shut_face_pack), found once at the list's build */
+                         (shut_face_pack, bits 0-9), found once at the list's
+                         build; any pair: NEAR_EDGES_TRIED */
 } near_pair;
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
@@ -89,6 +90,13 @@ void contact_shut_free(contact_state *cs);
 void contact_shut_refresh(fdem_model *m);
 int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face);
 int contact_shut_neighbours(const fdem_model *m, int a, int b);
+
+/* near_pair.face: the kernel has looked for a clearance across two edges
+ * (contact_pair_in.edge_clearance) since the list was built. A pair that
+ * one look found none for (two spheres of a pile resting a hair apart)
+ * would pay for it every step; the rebuild, after the nodes have moved,
+ * looks again. Skips never change bits, so neither does when one looks. */
+#define NEAR_EDGES_TRIED 0x8000u
 
 /* A face_match in near_pair.face: two bits each for face_a, face_b and
  * copy_in_b[0..2] (corners and faces number at most 4). */

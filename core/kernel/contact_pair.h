@@ -58,6 +58,10 @@ typedef struct contact_pair_in {
     const int32_t *node_a, *node_b;
     double penalty, friction, h;
     contact_pair_memo *memo;
+    /* 3D: when the pair is found untouched, look for a clearance across an
+     * edge of each too (contact_tet.c, edge_pair_clearance): ~1,500
+     * instructions, so the walk asks once a pair and near list */
+    int edge_clearance;
 } contact_pair_in;
 
 /* Triangles: one tangential spring per edge, 3 edges x 2 roles; forces

@@ -673,6 +673,6 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     double touched = contact_one_way(&a, &b, &a_in_b, in->penalty, &ab, out, out + 12);
     touched += contact_one_way(&b, &a, &b_in_a, in->penalty, &ba, out + 12, out);
     /* untouched, no face has added anything: out[0] is 0 until a clearance */
-    if (!(touched > 0)) out[0] = edge_pair_clearance(&a, &b);
+    if (!(touched > 0) && in->edge_clearance) out[0] = edge_pair_clearance(&a, &b);
     return touched > 0;
 }
