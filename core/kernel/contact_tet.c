@@ -519,26 +519,6 @@ static void tet_frame_memo(const double *pos, const int32_t n[4], contact_pair_m
     memcpy(memo->numbers[slot], &t->bary, sizeof t->bary);
 }
 
-/* The clearance of a pair found apart by a face plane of t (the corners
- * of `other` all outside it, their coordinates in t's map ci): how far
- * they are from that plane, less a margin for rounding, or 0 when either
- * element is too flat for the figure to be trusted. What the contact
- * stage does with it (contact_pair.h) is exact only if, while the two
- * elements stay further apart than the margin, this kernel cannot find
- * them touching, whatever path it takes:
- *  - the distance is -lambda_f / |grad lambda_f|, from the map's rows;
- *    rounding puts the corners' lambdas and the rows within some hundred
- *    ulps of their values, relative to the coordinates' size S (x - x0
- *    is formed from them) and amplified by the shape, L^3 / (6 V) at most
- *    (L the longest edge): with 6 V >= 1e-6 L^3 (QUALITY) that is under
- *    1e-10 (S + L) of distance, against a margin of 1e-8 S + 1e-7 L;
- *  - two elements apart by more than that margin can never give this
- *    kernel a clipped polygon of 3 vertices: every vertex it forms lies
- *    within such rounding of the face and of the target's planes it kept
- *    it by, so the integral is exactly 0 and every spring let go, as the
- *    early-outs do; the elements stay that shape (the stage skips only
- *    while no node has moved a hundredth of an element).
- * An inverted element has no potential (apart in any case). */
 static double tet_longest_edge2(const double *const p[4])
 {
     double most = 0;
@@ -559,6 +539,44 @@ static double tet_six_volume(const double *const p[4])
     return vec3_dot(e[0], c);
 }
 
+/* A gap `apart` between a and b as a clearance: less the margin, or 0 when
+ * there is none or either element is too flat for the figure to be
+ * trusted (six_a: a's 6 V, which a caller with a's map already has). */
+static double trusted_clearance(const tet_frame *a, const tet_frame *b, double six_a,
+                                double apart)
+{
+    if (!(apart > 0)) return 0;
+    double la2 = tet_longest_edge2(a->p), lb2 = tet_longest_edge2(b->p);
+    double la = sqrt(la2), lb = sqrt(lb2);
+    if (!(six_a >= CONTACT_CLEARANCE_QUALITY * la2 * la) ||
+        !(tet_six_volume(b->p) >= CONTACT_CLEARANCE_QUALITY * lb2 * lb))
+        return 0;
+    double size = 0;
+    for (int v = 0; v < 4; v++)
+        for (int i = 0; i < 3; i++) size = max2(size, max2(fabs(a->p[v][i]), fabs(b->p[v][i])));
+    return contact_clearance_less_margin(apart, size, max2(la, lb));
+}
+
+/* The clearance of a pair found apart by a face plane of t (the corners
+ * of `other` all outside it, their coordinates in t's map ci): how far
+ * they are from that plane, less a margin for rounding, or 0 when either
+ * element is too flat for the figure to be trusted. What the contact
+ * stage does with it (contact_pair.h) is exact only if, while the two
+ * elements stay further apart than the margin, this kernel cannot find
+ * them touching, whatever path it takes:
+ *  - the distance is -lambda_f / |grad lambda_f|, from the map's rows;
+ *    rounding puts the corners' lambdas and the rows within some hundred
+ *    ulps of their values, relative to the coordinates' size S (x - x0
+ *    is formed from them) and amplified by the shape, L^3 / (6 V) at most
+ *    (L the longest edge): with 6 V >= 1e-6 L^3 (QUALITY) that is under
+ *    1e-10 (S + L) of distance, against a margin of 1e-8 S + 1e-7 L;
+ *  - two elements apart by more than that margin can never give this
+ *    kernel a clipped polygon of 3 vertices: every vertex it forms lies
+ *    within such rounding of the face and of the target's planes it kept
+ *    it by, so the integral is exactly 0 and every spring let go, as the
+ *    early-outs do; the elements stay that shape (the stage skips only
+ *    while no node has moved a hundredth of an element).
+ * An inverted element has no potential (apart in any case). */
 static double pair_clearance(const tet_frame *t, const tet_frame *other, const corners_in *ci)
 {
     unsigned common = ci->outside[0] & ci->outside[1] & ci->outside[2] & ci->outside[3];
@@ -577,16 +595,7 @@ static double pair_clearance(const tet_frame *t, const tet_frame *other, const c
         for (int v = 0; v < 4; v++) nearest = max2(nearest, ci->lambda[v][f]);
         if (nearest * nearest > floor2 * g2) best = max2(best, -nearest / sqrt(g2));
     }
-    if (!(best > 0)) return 0;
-    double lt2 = tet_longest_edge2(t->p), lo2 = tet_longest_edge2(other->p);
-    double lt = sqrt(lt2), lo = sqrt(lo2);
-    if (!(t->bary.det >= CONTACT_CLEARANCE_QUALITY * lt2 * lt) ||
-        !(tet_six_volume(other->p) >= CONTACT_CLEARANCE_QUALITY * lo2 * lo))
-        return 0;
-    double size = 0;
-    for (int v = 0; v < 4; v++)
-        for (int i = 0; i < 3; i++) size = max2(size, max2(fabs(t->p[v][i]), fabs(other->p[v][i])));
-    return contact_clearance_less_margin(best, size, max2(lt, lo));
+    return trusted_clearance(t, other, t->bary.det, best);
 }
 
 /* The clearance of a pair that no face plane of either separates and the
@@ -625,16 +634,7 @@ static double edge_pair_clearance(const tet_frame *a, const tet_frame *b)
             double gap = max2(b_lo - a_hi, a_lo - b_hi);
             if (gap > 0 && gap * gap > best * best * c2) best = gap / sqrt(c2);
         }
-    if (!(best > 0)) return 0;
-    double lt2 = tet_longest_edge2(a->p), lo2 = tet_longest_edge2(b->p);
-    double lt = sqrt(lt2), lo = sqrt(lo2);
-    if (!(tet_six_volume(a->p) >= CONTACT_CLEARANCE_QUALITY * lt2 * lt) ||
-        !(tet_six_volume(b->p) >= CONTACT_CLEARANCE_QUALITY * lo2 * lo))
-        return 0;
-    double size = 0;
-    for (int v = 0; v < 4; v++)
-        for (int i = 0; i < 3; i++) size = max2(size, max2(fabs(a->p[v][i]), fabs(b->p[v][i])));
-    return contact_clearance_less_margin(best, size, max2(lt, lo));
+    return trusted_clearance(a, b, tet_six_volume(a->p), best);
 }
 
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
