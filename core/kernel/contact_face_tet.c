@@ -18,12 +18,14 @@
 
 /* A tetrahedron now: its corners' places and velocities (copied once: the
  * roles then read no array the forces are written to, so the compiler
- * keeps them in registers), its barycentric map (lambda_{1..3} = rows .
- * (x - p0)), 6 V, and the squared cross products of its faces ((2 A)^2:
- * a role takes the root of one face's and of the largest). */
+ * keeps them in registers), its barycentric map (lambda_{1..3} = cof .
+ * (x - p0) / det: one division, where a map of rows took nine and a role
+ * uses it at one point), 6 V and its inverse, and the squared cross
+ * products of its faces ((2 A)^2: a role takes the root of one face's and
+ * of the largest). */
 typedef struct tet_now {
     double p[4][3], v[4][3];
-    double rows[3][3], det;
+    double cof[3][3], det, inv_det;
     double face_len2[4];
 } tet_now;
 
@@ -34,15 +36,14 @@ static int tet_now_of(const double *pos, const double *vel, const int32_t n[4], 
             t->p[c][i] = pos[3 * (size_t)n[c] + i];
             t->v[c][i] = vel[3 * (size_t)n[c] + i];
         }
-    double e[3][3], c[3][3];
+    double e[3][3], (*c)[3] = t->cof;
     for (int k = 0; k < 3; k++) vec3_sub(t->p[k + 1], t->p[0], e[k]);
     vec3_cross(e[1], e[2], c[0]);
     vec3_cross(e[2], e[0], c[1]);
     vec3_cross(e[0], e[1], c[2]);
     t->det = vec3_dot(e[0], c[0]);
     if (!(t->det > 0) || !isfinite(t->det)) return 0;
-    for (int k = 0; k < 3; k++)
-        for (int i = 0; i < 3; i++) t->rows[k][i] = c[k][i] / t->det;
+    t->inv_det = 1.0 / t->det;
     /* tet_face_nodes' faces: 0 (1,2,3) has cross (e1-e0) x (e2-e0) =
      * c0 + c1 + c2, faces 1, 2, 3 have -c0, -c1, -c2 */
     double s[3];
@@ -56,7 +57,7 @@ static void bary_in(const tet_now *t, const double x[3], double l[4])
 {
     double d[3];
     vec3_sub(x, t->p[0], d);
-    for (int k = 0; k < 3; k++) l[k + 1] = vec3_dot(t->rows[k], d);
+    for (int k = 0; k < 3; k++) l[k + 1] = vec3_dot(t->cof[k], d) * t->inv_det;
     l[0] = 1.0 - l[1] - l[2] - l[3];
 }
 
@@ -77,7 +78,7 @@ static inline void role_force(const face_role *r, double area, double i0, const 
                               double f_c[12], double f_t[12], double *dissipated)
 {
     const tet_now *c = r->contactor, *t = r->target;
-    double k_face = 4 * in->penalty * sqrt(t->face_len2[r->ft]) / t->det; /* 4 p / H_t */
+    double k_face = 4 * in->penalty * sqrt(t->face_len2[r->ft]) * t->inv_det; /* 4 p / H_t */
     double f_n = k_face * i0 * area, x[3] = {0, 0, 0}, lt[4], force[3];
     for (int k = 0; k < 3; k++)
         for (int i = 0; i < 3; i++) x[i] += w[k] * c->p[r->cf[k]][i];
@@ -92,7 +93,7 @@ static inline void role_force(const face_role *r, double area, double i0, const 
         double largest2 = 0;
         for (int f = 0; f < 4; f++) largest2 = largest2 > t->face_len2[f] ? largest2 : t->face_len2[f];
         double largest = sqrt(largest2);
-        double k_t = (2.0 / 3.0) * (4 * in->penalty * largest / t->det) * touch * area;
+        double k_t = (2.0 / 3.0) * (4 * in->penalty * largest * t->inv_det) * touch * area;
         contact_spring_load(spring, r->n, rel, k_t, in->h, in->friction * f_n, dissipated, force);
     } else {
         memset(spring, 0, 3 * sizeof(double));
