@@ -135,7 +135,7 @@ static int run_case(const char *path, int window, int threads, long max_steps)
                1e3 * fdem_get_time(m), (long long)fdem_get_step(m), c.broken_joints, c.fragments,
                cpu * 1e9 / ((double)steps * E), 1000.0 * (double)(c.detections - det0) / steps,
                100 * fe / sum, 100 * jo / sum, 100 * de / sum, 100 * co / sum, 100 * in / sum,
-               (double)c.contact_pairs / E, (double)m->contact.near_count / E,
+               (double)c.contact_pairs / E, (double)(m->contact.near_count + m->contact.near_vertex_count) / E,
                (double)c.contacts / E, kinds[PAIR_FACE] / E, kinds[PAIR_EDGE] / E,
                kinds[PAIR_CORNER] / E, kinds[PAIR_APART_MESH] / E,
                100.0 * elements_on_crack(m) / E, seconds[PAIR_FACE] * 1e9 / E,

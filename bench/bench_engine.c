@@ -501,7 +501,7 @@ static void bench_broken_block(const fracture_kind *k, double goal, double work)
         printf("%10d %7d %10.1f %10.1f %7.2f %7.1f %7.1f %8.1f %9.1f %8.1f %8.2f %8.2f %9.3f "
                "%9.1f\n", E, steps, t.cpu, intact_cpu, t.cpu / intact_cpu, 100 * fe / sum,
                100 * jo / sum, 100 * de / sum, 100 * co / sum, 100 * in / sum,
-               (double)c.contact_pairs / E, (double)m->contact.near_count / E,
+               (double)c.contact_pairs / E, (double)(m->contact.near_count + m->contact.near_vertex_count) / E,
                (double)c.contacts / E, det);
         double count[PAIR_KINDS], seconds[PAIR_KINDS], touching[PAIR_KINDS];
         pair_kind_counts(m, count);

@@ -133,7 +133,8 @@ static size_t memory_estimate(const memory_figures *f, long nodes, long elements
 {
     int contact = parts > 1 || joints > 0;
     size_t elem = memory_element(f, joints > 0) + (contact ? memory_contact_element(f) : 0) +
-                  (contact && joints > 0 ? 1 : 0); /* elem_shut */
+                  /* elem_shut, elem_due, vertex_start */
+                  (contact && joints > 0 ? 1 + 2 * sizeof(int32_t) : 0);
     return memory_fixed(f, contact) + (size_t)nodes * memory_node(f, contact, joints > 0) +
            (size_t)elements * elem + (size_t)joints * memory_joint(f) +
            (contact ? 0 : memory_finalize(f, nodes, elements));
@@ -182,8 +183,12 @@ size_t fdem_memory_bytes(const fdem_model *m)
      * pos_detect, pos_near, force */
     b += (size_t)m->node_count * (1 + (m->joint_count ? 1 + sizeof(int32_t) : 0) +
                                   (m->contact.enabled ? 3 * D * sizeof(double) : 0));
-    if (m->contact.shut_first) /* contact_shut.c: first copy, tolerance, shut; per element */
-        b += (size_t)m->node_count * (sizeof(int32_t) + sizeof(double) + 1) + (size_t)m->elem_count;
+    /* contact_shut.c: first copy, tolerance, shut; per element shut and due;
+     * contact_near.c: per element the start of its vertex pairs (once any) */
+    if (m->contact.shut_first)
+        b += (size_t)m->node_count * (sizeof(int32_t) + sizeof(double) + 1) +
+             (size_t)m->elem_count * (1 + sizeof(int32_t));
+    if (m->contact.vertex_start) b += ((size_t)m->elem_count + 1) * sizeof(int32_t);
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);

@@ -390,7 +390,8 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     if (m->elem_active) contact_drop_excavated(m);
     if (m->joint_count) contact_drop_joined(m);
     if (contact_history_take_back(cs)) return -1;
-    cs->active_count = contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, cs->active);
+    cs->active_count =
+        contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, NULL, 0, cs->active);
     if (pos != cs->pos_detect)
         memcpy(cs->pos_detect, pos, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->need_detect = 0;
@@ -492,7 +493,11 @@ void contact_free(contact_state *cs)
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece); free(cs->detect_body);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
-    free(cs->near);
+    free(cs->near); /* near_vertex is its end */
+    free(cs->vertex_start);
+    free(cs->vertex_pairs);
+    free(cs->vertex_walk);
+    free(cs->vertex_due);
     contact_shut_free(cs);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
@@ -546,7 +551,9 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->pair_capacity * sizeof(int32_t);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
-    b += cs->near_capacity * sizeof(near_pair);
+    b += cs->near_capacity * sizeof(near_pair); /* near_vertex is its end */
+    b += cs->vertex_pairs_capacity * sizeof(int32_t) + cs->vertex_walk_capacity * sizeof(int32_t);
+    b += cs->vertex_due_capacity; /* vertex_start: an int32 an element, with the element arrays */
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -567,17 +574,30 @@ static int contact_touch_lists(contact_state *cs, int threads)
     return 0;
 }
 
-/* Every candidate pair's force, added to the contact force array in pair
+/* A list of near pairs the walk takes this step: the near list whole, or
+ * this step's vertex pairs (index into near_vertex). */
+typedef struct near_walk {
+    near_pair *pairs;
+    const int32_t *index; /* NULL: pairs[0 .. count) */
+    size_t count;
+} near_walk;
+
+static inline near_pair *walk_pair(const near_walk *w, size_t i)
+{
+    return w->index ? &w->pairs[w->index[i]] : &w->pairs[i];
+}
+
+/* Every pair of a walk's force, added to the contact force array in its
  * order, one pair at a time. Returns the number of pairs that touched. */
 static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
-                                                                     int D)
+                                                                     const near_walk *w, int D)
 {
     contact_state *cs = &m->contact;
     contact_pair_memo memo;
     contact_pair_memo_clear(&memo);
     int touching = 0;
-    for (size_t i = 0; i < cs->near_count; i++) {
-        near_pair *np = &cs->near[i];
+    for (size_t i = 0; i < w->count; i++) {
+        near_pair *np = walk_pair(w, i);
         double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
         int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
@@ -589,9 +609,9 @@ static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model 
     return touching;
 }
 
-static int contact_pairs_forces_serial(fdem_model *m, double h)
+static int contact_pairs_forces_serial(fdem_model *m, double h, const near_walk *w)
 {
-    return m->dim == 3 ? pairs_forces_serial(m, h, 3) : pairs_forces_serial(m, h, 2);
+    return m->dim == 3 ? pairs_forces_serial(m, h, w, 3) : pairs_forces_serial(m, h, w, 2);
 }
 
 /* The same on several threads: each takes a contiguous share of the near
@@ -601,6 +621,7 @@ static int contact_pairs_forces_serial(fdem_model *m, double h)
  * Returns the number of pairs that touched, or -1 if a list could not grow
  * (nothing has been added then). */
 static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
+                                                                     const near_walk *w,
                                                                      long begin, long end,
                                                                      contact_touches *list, int D)
 {
@@ -609,7 +630,7 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     contact_pair_memo_clear(&memo);
     int touching = 0;
     for (long i = begin; i < end; i++) {
-        near_pair *np = &cs->near[i];
+        near_pair *np = walk_pair(w, (size_t)i);
         long k = (long)np->pair;
         double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
         int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
@@ -623,10 +644,10 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     return touching;
 }
 
-static int contact_pairs_forces_threaded(fdem_model *m, double h)
+static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_walk *w)
 {
     contact_state *cs = &m->contact;
-    long n = (long)cs->near_count;
+    long n = (long)w->count;
     int touching = 0, failed = 0, used = 1;
     contact_touches *lists = cs->touches;
 #pragma omp parallel num_threads(m->threads) reduction(+ : touching)
@@ -640,8 +661,8 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, begin, end, list, 3)
-                               : pairs_forces_listed(m, h, begin, end, list, 2);
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3)
+                               : pairs_forces_listed(m, h, w, begin, end, list, 2);
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
@@ -667,19 +688,30 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h)
     return touching;
 }
 
-/* Threads only pay off with enough pairs; without room for their lists the
- * step stays on one thread. Returns the number of pairs that touched, or -1
+/* The near list, then this step's vertex pairs (contact_near.c), each in
+ * pair order: the same sums in the same order on any thread count. Threads
+ * only pay off with enough pairs; without room for their lists a walk
+ * stays on one thread. Returns the number of pairs that touched, or -1
  * when out of memory. */
 static int contact_pairs_forces(fdem_model *m, double h)
 {
     contact_state *cs = &m->contact;
-    if (m->threads > 1 && cs->near_count >= CONTACT_THREADED_PAIRS &&
-        contact_touch_lists(cs, m->threads) == 0) {
-        /* a list that cannot grow has already moved some stick springs:
-         * the step fails rather than run the pairs twice */
-        return contact_pairs_forces_threaded(m, h);
+    const near_walk walks[2] = {{cs->near, NULL, cs->near_count},
+                                {cs->near_vertex, cs->vertex_walk, cs->vertex_walk_count}};
+    int touching = 0;
+    for (int k = 0; k < 2; k++) {
+        int t;
+        if (m->threads > 1 && walks[k].count >= CONTACT_THREADED_PAIRS &&
+            contact_touch_lists(cs, m->threads) == 0)
+            /* a list that cannot grow has already moved some stick springs:
+             * the step fails rather than run the pairs twice */
+            t = contact_pairs_forces_threaded(m, h, &walks[k]);
+        else
+            t = contact_pairs_forces_serial(m, h, &walks[k]);
+        if (t < 0) return -1;
+        touching += t;
     }
-    return contact_pairs_forces_serial(m, h);
+    return touching;
 }
 
 /* Detection when due, then every candidate pair's force. The stick springs
@@ -704,6 +736,7 @@ int contact_forces(fdem_model *m)
     cs->force_is_zero = cs->pairs.count == 0;
     if (contact_near_refresh(m)) return -1;
     contact_shut_refresh(m);
+    contact_vertex_due(m);
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;
     cs->touching = touching;

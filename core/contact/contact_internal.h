@@ -72,12 +72,16 @@ static inline void element_box(const fdem_model *m, int e, double *b)
     else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
 
-/* contact_near.c: the elements of the near pairs (of every candidate pair
- * when near is NULL), once each and in element order, into list (returns
- * how many); and this step's boxes of the elements the near list needs,
- * the list rebuilt first when due (0, or -1 when out of memory). */
+/* contact_near.c: the elements of the near pairs and the `more` pairs (of
+ * every candidate pair when near is NULL), once each and in element order,
+ * into list (returns how many); this step's vertex pairs to walk (after
+ * contact_shut_refresh); and this step's boxes of the elements the near
+ * lists need, the lists rebuilt first when due (0, or -1 when out of
+ * memory). */
 int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
-                             size_t count, int32_t *list);
+                             size_t count, const near_pair *more, size_t more_count,
+                             int32_t *list);
+void contact_vertex_due(fdem_model *m);
 int contact_near_refresh(fdem_model *m);
 
 /* contact_shut.c: the shut broken joints (see its top). init builds the

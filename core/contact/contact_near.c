@@ -20,10 +20,19 @@
  */
 #include <math.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "contact.h"
 #include "contact_internal.h"
+
+static int index_order(const void *x, const void *y)
+{
+    int32_t a = *(const int32_t *)x, b = *(const int32_t *)y;
+    return (a > b) - (a < b);
+}
+
+static void sort_indices(int32_t *v, size_t n) { qsort(v, n, sizeof *v, index_order); }
 
 /* The current box of each listed element: those in some candidate pair
  * when the near list is rebuilt, else those in some near pair. Most
@@ -60,13 +69,15 @@ static void contact_near_boxes(fdem_model *m)
  * NULL), once each and in element order (so that contact_boxes walks the
  * mesh forwards), into list; returns how many. */
 int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
-                                    size_t count, int32_t *list)
+                             size_t count, const near_pair *more, size_t more_count,
+                             int32_t *list)
 {
     memset(cs->in_pair, 0, (size_t)elem_count);
     for (size_t i = 0; i < count; i++) {
         cs->in_pair[near ? near[i].a : cs->pairs.a[i]] = 1;
         cs->in_pair[near ? near[i].b : cs->pairs.b[i]] = 1;
     }
+    for (size_t i = 0; i < more_count; i++) cs->in_pair[more[i].a] = cs->in_pair[more[i].b] = 1;
     int listed = 0;
     for (int e = 0; e < elem_count; e++)
         if (cs->in_pair[e]) list[listed++] = e;
@@ -97,6 +108,112 @@ static int contact_near_due(fdem_model *m)
     return 0;
 }
 
+/* The near array doubled (the first time CONTACT_FIRST_ROWS), its last
+ * `vertex` rows (the vertex pairs so far) moved to its new end. */
+static int near_grow(contact_state *cs, size_t vertex)
+{
+    size_t old = cs->near_capacity, cap = old ? 2 * old : CONTACT_FIRST_ROWS;
+    near_pair *p = realloc(cs->near, cap * sizeof *p);
+    if (!p) return -1;
+    memmove(p + cap - vertex, p + old - vertex, vertex * sizeof *p);
+    cs->near = p;
+    cs->near_capacity = cap;
+    return 0;
+}
+
+/* Room for exactly `need` items (a rebuild fills them whole): the index
+ * arrays of the vertex pairs cost no doubling's slack. */
+static int fit_array(void **array, size_t *capacity, size_t need, size_t size)
+{
+    if (need <= *capacity && need >= *capacity / 2) return 0;
+    void *p = realloc(*array, (need ? need : 1) * size);
+    if (!p) return -1;
+    *array = p;
+    *capacity = need;
+    return 0;
+}
+
+/* Each element's vertex pairs (CSR over near_vertex, a pair under both of
+ * its elements), and every vertex pair due at the first step of the list:
+ * last step's shut marks say nothing of pairs the list did not hold.
+ * Returns 0, or -1 when out of memory. */
+static int near_vertex_index(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    size_t n = cs->near_vertex_count, E = (size_t)m->elem_count;
+    cs->vertex_walk_all = 1;
+    if (!n) return 0;
+    if (!cs->vertex_start && !(cs->vertex_start = malloc(sizeof(int32_t) * (E + 1)))) return -1;
+    if (fit_array((void **)&cs->vertex_pairs, &cs->vertex_pairs_capacity, 2 * n,
+                  sizeof *cs->vertex_pairs) ||
+        fit_array((void **)&cs->vertex_walk, &cs->vertex_walk_capacity, n, sizeof *cs->vertex_walk) ||
+        fit_array((void **)&cs->vertex_due, &cs->vertex_due_capacity, n, sizeof *cs->vertex_due))
+        return -1;
+    int32_t *start = cs->vertex_start;
+    memset(start, 0, sizeof(int32_t) * (E + 1));
+    for (size_t i = 0; i < n; i++) {
+        start[cs->near_vertex[i].a + 1]++;
+        start[cs->near_vertex[i].b + 1]++;
+    }
+    for (size_t e = 0; e < E; e++) start[e + 1] += start[e];
+    for (size_t i = 0; i < n; i++) { /* start[e] runs to e's end, then is set back */
+        cs->vertex_pairs[start[cs->near_vertex[i].a]++] = (int32_t)i;
+        cs->vertex_pairs[start[cs->near_vertex[i].b]++] = (int32_t)i;
+    }
+    for (size_t e = E; e > 0; e--) start[e] = start[e - 1];
+    start[0] = 0;
+    memset(cs->vertex_due, 0, n);
+    return 0;
+}
+
+/* This step's vertex pairs to walk, in pair order (vertex_walk): every one
+ * the step after a rebuild or while shut marks are off; else those of an
+ * element not shut now or last step (elem_due). A pair of two elements
+ * shut now and last step is left out by the walk now and was last step,
+ * which let its springs go: walking it would do nothing. */
+void contact_vertex_due(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    size_t n = cs->near_vertex_count, listed = 0;
+    if (!n) {
+        cs->vertex_walk_count = 0;
+        return;
+    }
+    if (cs->vertex_walk_all || !cs->shut_any || cs->vertex_skip_off) {
+        for (size_t i = 0; i < n; i++) cs->vertex_walk[i] = (int32_t)i;
+        cs->vertex_walk_count = n;
+        cs->vertex_walk_all = 0;
+        return;
+    }
+    uint8_t *due = cs->vertex_due;
+    for (int k = 0; k < cs->elem_due_count; k++) {
+        int e = cs->elem_due[k];
+        for (int32_t j = cs->vertex_start[e]; j < cs->vertex_start[e + 1]; j++)
+            due[cs->vertex_pairs[j]] = 1;
+    }
+    /* a few elements due: their pairs, sorted; many: one pass over the marks */
+    if ((size_t)cs->elem_due_count * 64 < n) {
+        for (int k = 0; k < cs->elem_due_count; k++) {
+            int e = cs->elem_due[k];
+            for (int32_t j = cs->vertex_start[e]; j < cs->vertex_start[e + 1]; j++) {
+                int32_t i = cs->vertex_pairs[j];
+                if (due[i]) {
+                    due[i] = 0;
+                    cs->vertex_walk[listed++] = i;
+                }
+            }
+        }
+        sort_indices(cs->vertex_walk, listed);
+    } else {
+        for (size_t i = 0; i < n; i++)
+            if (due[i]) {
+                due[i] = 0;
+                cs->vertex_walk[listed++] = (int32_t)i;
+            }
+    }
+    cs->vertex_walk_count = listed;
+}
+
 /* The near list (see the top of this file) and its elements from this
  * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
  * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
@@ -110,6 +227,7 @@ static int contact_near_rebuild(fdem_model *m)
     double limit = 2.0 * reach * (1 + 1e-9);
     int dim = m->dim;
     size_t width = 2 * (size_t)dim, count = 0;
+    size_t vertex = 0;
     for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
@@ -118,27 +236,36 @@ static int contact_near_rebuild(fdem_model *m)
             contact_springs_release(cs, k); /* apart now and until the next rebuild */
             continue;
         }
-        /* the list grows as it fills: it holds a tenth or so of the candidates */
-        if (count == cs->near_capacity &&
-            model_reserve((void **)&cs->near, &cs->near_capacity, count + 1, sizeof *cs->near,
-                          CONTACT_FIRST_ROWS))
-            return -1;
         uint16_t face = 0;
         uint8_t topology = cs->elem_shut ? (uint8_t)contact_shut_topology(m, ea, eb, &face) : 0;
-        cs->near[count++] = (near_pair){gap, (uint32_t)k, ea, eb,
-                                        (uint8_t)contact_pair_sprung(cs, k), topology, face};
+        near_pair np = {gap, (uint32_t)k, ea, eb, (uint8_t)contact_pair_sprung(cs, k), topology,
+                        face};
+        /* one array, the vertex pairs filling it from the end (two lists
+         * would each keep their own doubling's room); it grows as it
+         * fills: it holds a tenth or so of the candidates */
+        if (count + vertex == cs->near_capacity && near_grow(cs, vertex)) return -1;
+        if (topology == SHUT_TOPO_VERTEX) cs->near[cs->near_capacity - ++vertex] = np;
+        else cs->near[count++] = np;
         cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
         cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
     }
     memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_disp2 = 0;
+    /* the vertex pairs, from the end in reverse: to pair order */
+    cs->near_vertex = cs->near + (cs->near_capacity - vertex);
+    for (size_t i = 0, j = vertex; i + 1 < j; i++, j--) {
+        near_pair t = cs->near_vertex[i];
+        cs->near_vertex[i] = cs->near_vertex[j - 1];
+        cs->near_vertex[j - 1] = t;
+    }
     cs->near_count = count;
+    cs->near_vertex_count = vertex;
     cs->near_reach = reach;
     cs->near_apart = 0;
     cs->near_stale = 0;
-    cs->near_active_count =
-        contact_collect_elements(cs, m->elem_count, cs->near, count, cs->near_active);
-    return 0;
+    cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near, count,
+                                                     cs->near_vertex, vertex, cs->near_active);
+    return near_vertex_index(m);
 }
 
 /* This step's boxes of the elements the near list needs, the list rebuilt
@@ -148,7 +275,7 @@ int contact_near_refresh(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (cs->pairs.count == 0) { /* nothing to walk: the next pairs come with a detection */
-        cs->near_count = 0;
+        cs->near_count = cs->near_vertex_count = 0;
         return 0;
     }
     if (!contact_near_due(m)) {

@@ -56,8 +56,10 @@ int contact_shut_init(fdem_model *m)
     cs->shut_first = malloc(sizeof(int32_t) * N);
     cs->shut_tol2 = malloc(sizeof(double) * N);
     cs->shut_vertex = malloc(N);
-    cs->elem_shut = malloc((size_t)m->elem_count);
-    if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut) return -1;
+    cs->elem_shut = calloc((size_t)m->elem_count, 1);
+    cs->elem_due = malloc(sizeof(int32_t) * (size_t)m->elem_count);
+    if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut || !cs->elem_due)
+        return -1;
     /* the tolerances' room holds the table origin -> first copy meanwhile
      * (no scratch beyond what the memory estimate prices) */
     int32_t *first_of = cs->shut_first, *by_origin = (int32_t *)cs->shut_tol2;
@@ -87,6 +89,7 @@ void contact_shut_free(contact_state *cs)
     free(cs->shut_tol2);
     free(cs->shut_vertex);
     free(cs->elem_shut);
+    free(cs->elem_due);
 }
 
 /* This step's shut vertices and elements; D and K are constants where it
@@ -107,12 +110,20 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
         }
         if (!(s2 <= cs->shut_tol2[f])) cs->shut_vertex[f] = 0;
     }
+    /* the elements not shut now or last step: only their vertex pairs can
+     * hold a force or a spring (contact_near.c); without last step's marks
+     * every element is */
+    const uint8_t had = (uint8_t)cs->shut_was_any;
+    int due = 0;
     for (int e = 0; e < m->elem_count; e++) {
         const int32_t *nd = element_nodes(m, e);
         uint8_t shut = 1;
         for (int c = 0; c < K; c++) shut &= cs->shut_vertex[cs->shut_first[nd[c]]];
+        uint8_t was = cs->elem_shut[e] & had;
         cs->elem_shut[e] = shut;
+        if (!(shut & was)) cs->elem_due[due++] = e;
     }
+    cs->elem_due_count = due;
 }
 
 /* This step's shut vertices and elements (none without a broken joint). */
@@ -120,9 +131,11 @@ void contact_shut_refresh(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     cs->shut_any = cs->elem_shut && m->broken_joints > 0 && !cs->shut_off;
-    if (!cs->shut_any) return;
-    if (m->dim == 3) shut_mark(m, 3, 4);
-    else shut_mark(m, 2, 3);
+    if (cs->shut_any) {
+        if (m->dim == 3) shut_mark(m, 3, 4);
+        else shut_mark(m, 2, 3);
+    }
+    cs->shut_was_any = cs->shut_any;
 }
 
 /* The broken joint between a and b, or -1. */

@@ -220,6 +220,21 @@ typedef struct contact_state {
                                 moves near_reach from pos_near, in pair order, with what
                                 the walk reads of them (contact.c) */
     size_t near_count, near_capacity;
+    /* The near pairs whose elements share a mesh vertex but no broken
+     * joint (SHUT_TOPO_VERTEX), kept apart: while both elements are shut
+     * the walk leaves such a pair out, so it is walked only where an
+     * element is not shut now or was not last step (contact_near.c);
+     * vertex_start/vertex_pairs list each element's (CSR, a pair under
+     * both elements), vertex_walk this step's, in pair order. */
+    struct near_pair *near_vertex; /* the end of near's array */
+    size_t near_vertex_count;
+    int32_t *vertex_start, *vertex_pairs, *vertex_walk;
+    size_t vertex_pairs_capacity, vertex_walk_capacity;
+    uint8_t *vertex_due;     /* per near_vertex pair: listed this step (scratch) */
+    size_t vertex_due_capacity;
+    size_t vertex_walk_count;
+    int vertex_walk_all;     /* the list was just rebuilt: every vertex pair this step */
+    int vertex_skip_off;     /* tests: every vertex pair every step */
     double near_reach;       /* the list holds while no node is farther than this from */
     double *pos_near;        /* its place when the list was built */
     double near_disp2;       /* largest squared node displacement from pos_near since then
@@ -237,6 +252,9 @@ typedef struct contact_state {
     double *shut_tol2;
     uint8_t *shut_vertex, *elem_shut;
     int shut_any;            /* this step: some broken joint, elem_shut is current */
+    int shut_was_any;        /* last step's shut_any: elem_shut held last step's marks */
+    int32_t *elem_due;       /* this step: the elements not shut now or last step */
+    int elem_due_count;
     int shut_off;            /* tests and benches: the general kernel on every pair */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
     int touch_lists;         /* how many lists touches holds */

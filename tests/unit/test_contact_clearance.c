@@ -89,7 +89,7 @@ static void same_bits_with_and_without(fdem_model *(*build)(int), int dim, int s
 }
 
 static fdem_model *broken_block_2d(int dim) { return broken_in_place_block(dim, 6, 20.0); }
-static fdem_model *broken_block_3d(int dim) { return broken_in_place_block(dim, 3, 20.0); }
+static fdem_model *broken_block_3d(int dim) { return broken_in_place_block(dim, 4, 20.0); }
 
 static void broken_block_2d_gives_the_same_bits(void)
 {

@@ -15,6 +15,7 @@
 #include "fdem.h"
 #include "model/model.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -79,8 +80,10 @@ static void shut_path_keeps_the_bits(int dim, int n, int steps)
             CHECK(fdem_step(restored, &err) == 0, "%s", err.message);
         }
     }
-    CHECK(two->contact.near_count >= 2048, "%dD: %zu near pairs: the threaded walk needs 2048",
-          dim, two->contact.near_count);
+    /* both walks (the near list, the vertex pairs: contact.c) on threads */
+    CHECK(two->contact.near_count >= 2048 && two->contact.near_vertex_count >= 2048,
+          "%dD: %zu near and %zu vertex pairs: the threaded walks need 2048", dim,
+          two->contact.near_count, two->contact.near_vertex_count);
     CHECK(shut >= (long)steps * one->elem_count / 2, "%dD: %ld element-steps shut of %ld", dim,
           shut, (long)steps * one->elem_count);
     CHECK(touching > 0, "%dD: no pair touched", dim);
@@ -95,8 +98,71 @@ static void shut_path_keeps_the_bits(int dim, int n, int steps)
 
 static void shut_broken_block_same_bits_on_threads_and_restore(void)
 {
-    shut_path_keeps_the_bits(2, 20, 40);
+    shut_path_keeps_the_bits(2, 22, 40);
     shut_path_keeps_the_bits(3, 5, 12);
+}
+
+/* Every stride-th vertex copy moved by 3 tolerances, or back: the
+ * elements around it open, or shut again. */
+static void nudge_copies(fdem_model *m, double sign, int stride)
+{
+    const contact_state *cs = &m->contact;
+    for (int i = 0; i < m->node_count; i += stride)
+        if (cs->shut_first[i] != i)
+            m->pos[(size_t)m->dim * i] += sign * 3 * sqrt(cs->shut_tol2[cs->shut_first[i]]);
+}
+
+/* The vertex pairs walked only where an element is not shut now or was
+ * not last step (contact_near.c) against every one of them every step, on
+ * the block squeezed and sheared, with copies nudged open for a few steps
+ * and back (so elements shut again and pairs that took springs meanwhile
+ * come to be left out, and must let them go): the same bits and the same
+ * checkpoint (which holds the springs), with steps that walked some of the
+ * pairs but not all and elements due only for last step (or it could not
+ * fail), 1 thread and 2. */
+static void vertex_pairs_walked_where_due_give_the_same_bits(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        int n = dim == 2 ? 8 : 3, steps = dim == 2 ? 200 : 60;
+        fdem_model *due = broken_block(dim, n, 2.0, 0), *every = broken_block(dim, n, 2.0, 0);
+        fdem_model *two = broken_block(dim, n, 2.0, 0);
+        every->contact.vertex_skip_off = 1;
+        fdem_set_threads(two, 2);
+        long walked = 0, held = 0, partial = 0, back = 0;
+        for (int s = 0; s < steps; s++) {
+            if (s == steps / 4 || s == steps / 4 + 3)
+                for (int k = 0; k < 3; k++)
+                    nudge_copies(k == 0 ? due : k == 1 ? every : two, s == steps / 4 ? 1 : -1,
+                                 dim == 2 ? 7 : 61);
+            if (!step_both(due, every)) break;
+            fdem_error err = {0};
+            CHECK(fdem_step(two, &err) == 0, "%s", err.message);
+            const contact_state *cs = &due->contact;
+            size_t w = cs->vertex_walk_count, h = cs->near_vertex_count;
+            walked += (long)w;
+            held += (long)h;
+            partial += w > 0 && w < h;
+            for (int k = 0; k < cs->elem_due_count; k++) back += cs->elem_shut[cs->elem_due[k]];
+        }
+        CHECK(walked < held, "%dD: %ld of %ld vertex pair-steps walked", dim, walked, held);
+        CHECK(partial > 0, "%dD: no step walked some vertex pairs but not all", dim);
+        CHECK(back > 0, "%dD: no element shut again", dim);
+        fprintf(stderr, "  %dD: %ld of %ld vertex pair-steps walked, %ld steps in part, %ld elements "
+                "shut again\n", dim, walked, held, partial, back);
+        same_state_bits(due, every, dim == 2 ? "2D, vertex pairs where due" : "3D, where due");
+        same_state_bits(due, two, dim == 2 ? "2D, where due, 2 threads" : "3D, 2 threads");
+        size_t size = fdem_checkpoint_size(due);
+        CHECK(size == fdem_checkpoint_size(every), "%dD: checkpoint sizes differ", dim);
+        void *a = malloc(size), *b = malloc(size);
+        CHECK(a && b && fdem_checkpoint_write(due, a, size) == 0 &&
+                  fdem_checkpoint_write(every, b, size) == 0 && memcmp(a, b, size) == 0,
+              "%dD: the checkpoints (springs) differ", dim);
+        free(a);
+        free(b);
+        fdem_model_destroy(due);
+        fdem_model_destroy(every);
+        fdem_model_destroy(two);
+    }
 }
 
 /* Copies 2 tolerances apart: never shut, so every pair takes the general
@@ -152,5 +218,5 @@ static void shut_run_close_to_the_general_kernel(void)
     }
 }
 
-CHECK_MAIN(T(shut_broken_block_same_bits_on_threads_and_restore),
+CHECK_MAIN(T(vertex_pairs_walked_where_due_give_the_same_bits), T(shut_broken_block_same_bits_on_threads_and_restore),
            T(open_broken_block_is_the_general_kernel), T(shut_run_close_to_the_general_kernel))
