@@ -17,6 +17,16 @@
  * In the same way a near pair whose gap is over twice the farthest travel
  * so far is apart without a look at its boxes, and only elements with such
  * a pair closing get their box computed.
+ *
+ * Broken rock: the pairs of elements that share a mesh vertex but no
+ * broken joint are kept apart, at the end of the same array (the walk
+ * leaves such a pair out while both elements are shut: contact_shut.c,
+ * and in a block broken in place they are 41 of 66 near pairs an element
+ * in 3D). Each element lists its own, and a step walks only those of the
+ * elements not shut now or last step, after the rest of the list: a pair
+ * both of whose elements were shut last step too was left out then, which
+ * let its springs go, so walking it would change nothing. The step after a
+ * rebuild (a detection, a restore) walks them all.
  */
 #include <math.h>
 #include <stdint.h>
