@@ -228,14 +228,15 @@ int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
     return share_a_vertex(m, a, b) ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
 }
 
-/* a and b are shut this step and neighbours in the mesh (a broken joint or
- * a vertex between them): then each lies in place against the other up to
- * the tolerance, as in an intact mesh, so neither is deep in the other and
- * the penetration check (penetration.c) can pass them by: it was an eighth
- * of a broken 2D block's contact stage, for a depth of 1e-4 at most. */
+/* a and b are the two sides of a broken joint, both shut this step: then
+ * each lies in place against the other up to the tolerance, as in an
+ * intact mesh, so neither is deep in the other and the penetration check
+ * (penetration.c) can pass them by: it was an eighth of a broken 2D
+ * block's contact stage, for a depth of 1e-4 at most. (Shut elements that
+ * share only a vertex never touch: the walk leaves them out.) */
 int contact_shut_neighbours(const fdem_model *m, int a, int b)
 {
     const contact_state *cs = &m->contact;
     if (!cs->shut_any || !cs->elem_shut[a] || !cs->elem_shut[b]) return 0;
-    return broken_joint_between(m, a, b) >= 0 || share_a_vertex(m, a, b);
+    return broken_joint_between(m, a, b) >= 0;
 }
