@@ -50,13 +50,13 @@ static const memory_figures memory_3d = {3, 4, 6, sizeof(tet_hot), TET_CONTACT_S
  * entry (node, dofs); a quarter of a loaded
  * boundary facet (nodes, element, dim x dim forces; tunnel measures 0.15 a
  * node); with contact pos_detect, pos_near and the contact force (dim
- * each); with joints vertex_broken and vertex_root, and with both the
+ * each) and a graded mesh's travel weight; with joints vertex_broken and vertex_root, and with both the
  * shut tables (contact_shut.c: first copy, tolerance, shut flag) */
 static size_t memory_node(const memory_figures *f, int contact, int joints)
 {
     size_t facet = (f->D + 1) * sizeof(int32_t) + f->D * f->D * sizeof(double);
     return sizeof(double) * (5 * f->D + 2) + 2 * sizeof(int32_t) + 1 + sizeof(int32_t) + 1 +
-           facet / 4 + (contact ? 3 * f->D * sizeof(double) : 0) +
+           facet / 4 + (contact ? (3 * f->D + 1) * sizeof(double) : 0) +
            (joints ? 1 + sizeof(int32_t) : 0) +
            (joints && contact ? sizeof(int32_t) + sizeof(double) + 1 : 0);
 }
@@ -70,7 +70,8 @@ static size_t memory_element(const memory_figures *f, int joints)
            2 * f->stress_comps * sizeof(double) + (joints ? (f->D + 1) * sizeof(int32_t) + 1 : 0);
 }
 
-/* Detection arrays (centre and radius, box, elem_gap; body, piece,
+/* Detection arrays (centre and radius, box, elem_gap, a graded mesh's
+ * skin; body, piece,
  * detect_body, active, near_active; in_pair; the NBS grid's heads, 12 bytes measured in 3D, 40
  * in 2D, and in 3D its packed copy of the spheres, nbs_packed doubles) and
  * the pair lists at their capacities: a kept pair is two element
@@ -84,7 +85,7 @@ static size_t memory_contact_element(const memory_figures *f)
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 2 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
+    return (3 * f->D + 3 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
            (10 + 3 + 4) * sizeof(int32_t) + (size_t)lists;
 }
 
@@ -189,6 +190,9 @@ size_t fdem_memory_bytes(const fdem_model *m)
         b += (size_t)m->node_count * (sizeof(int32_t) + sizeof(double) + 1) +
              (size_t)m->elem_count * (1 + sizeof(int32_t));
     if (m->contact.vertex_start) b += ((size_t)m->elem_count + 1) * sizeof(int32_t);
+    /* contact_travel.c: a graded mesh's skins and travel weights */
+    if (m->contact.skin)
+        b += ((size_t)m->elem_count + (size_t)m->node_count) * sizeof(double);
     b += (size_t)m->elem_capacity * ((m->dim == 3 ? sizeof(tet_hot) : sizeof(element_hot)) +
                                      ((size_t)m->elem_nodes + 1) * sizeof(int32_t));
     b += (size_t)m->elem_count * sizeof(double);

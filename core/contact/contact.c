@@ -378,7 +378,7 @@ static int contact_detect_at(fdem_model *m, const double *pos)
         cs->cx[e] = c[0];
         cs->cy[e] = c[1];
         if (cs->cz) cs->cz[e] = c[2];
-        cs->r[e] += 0.5 * cs->buffer;
+        cs->r[e] += 0.5 * contact_skin(cs, e);
     }
     const int32_t *body = contact_detect_bodies(m);
     size_t n = (size_t)m->elem_count;
@@ -472,15 +472,14 @@ int contact_init(fdem_model *m, fdem_error *err)
     }
     double rmax = 0;
     for (int e = 0; e < m->elem_count; e++) {
-        double c[3], r;
-        element_sphere(m, m->pos, e, c, &r);
-        rmax = fmax(rmax, r);
+        double c[3];
+        element_sphere(m, m->pos, e, c, &cs->r[e]);
+        rmax = fmax(rmax, cs->r[e]);
     }
-    if (contact_shut_init(m)) {
+    if (contact_shut_init(m) || contact_skin_init(m, rmax)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
-    cs->buffer = 0.4 * rmax;
     cs->need_detect = 1;
     /* the integrator measures from here until the first near list */
     memcpy(cs->pos_near, m->pos, sizeof(double) * D * N);
@@ -492,6 +491,7 @@ void contact_free(contact_state *cs)
 {
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece); free(cs->detect_body);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
+    free(cs->skin); free(cs->travel_weight);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
     free(cs->near); /* near_vertex is its end */
     free(cs->vertex_start);
@@ -721,8 +721,7 @@ int contact_forces(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
-    double half = 0.5 * cs->buffer;
-    if (cs->need_detect || contact_travel_past(m, half * half)) {
+    if (cs->need_detect || contact_travel_past(m, cs->travel_limit2)) {
         double t0 = stage_clock();
         if (contact_detect(m)) return -1;
         double spent = stage_clock() - t0;

@@ -73,5 +73,10 @@ size_t contact_record_bytes(const contact_state *cs); /* one record in a checkpo
  * it may be) */
 void contact_travel_step(fdem_model *m, double step2);
 int contact_travel_past(fdem_model *m, double limit2);
+/* each element's skin from its radius (cs->r, unwidened) and the largest:
+ * buffer, and on a graded mesh skin, travel_weight and travel_limit2
+ * (contact_travel.c); 0, or -1 out of memory */
+int contact_skin_init(fdem_model *m, double rmax);
+double contact_skin(const contact_state *cs, int e);
 
 #endif

@@ -184,8 +184,12 @@ typedef struct contact_state {
     const struct contact_kernel *kernel; /* the dimension's pair kernel (contact.c) */
     int slots;               /* stick springs per pair */
     int pair_out;            /* numbers a pair evaluation hands back */
-    double buffer;           /* added to circle diameters; re-detect after buffer/2 */
-    double max_disp2;        /* bound of the squared node displacement since detection,
+    double buffer;           /* the largest skin (0.4 of the largest radius): the near list's */
+    double *skin;            /* per element its skin, added to its circle's diameter, on a
+                                graded mesh; NULL: every element's is buffer (contact_travel.c) */
+    double *travel_weight;   /* per node (smallest allowance / its allowance)^2; NULL with skin */
+    double travel_limit2;    /* re-detect once a node's weighted squared travel passes this */
+    double max_disp2;        /* bound of the weighted squared node displacement since detection,
                                 exact once past the limit (contact_travel.c) */
     int need_detect;
     long detections;

@@ -277,6 +277,7 @@ enforce_node(fdem_model *m, size_t i, unsigned own, const double *prescribed, do
         d2 += u * u;
         n2 += w * w;
     }
+    if (m->contact.travel_weight) d2 *= m->contact.travel_weight[i]; /* contact_travel.c */
     s->max_disp2 = enforce_max(s->max_disp2, d2);
     s->near_disp2 = enforce_max(s->near_disp2, n2);
 }
