@@ -97,15 +97,15 @@ static int run_case(const char *path, int window, int threads, long max_steps)
     int E = m->elem_count;
     printf("\n## %s: %d elements, %d joints, dt %.4g s, %d thread(s), windows of %d steps\n",
            path, E, m->joint_count, fdem_get_dt(m), threads, window);
-    printf("%9s %7s %6s %5s %9s %7s %6s %6s %7s %8s %7s %7s %7s %8s %7s %7s %7s %7s %6s  %s\n",
-           "t ms", "step", "broken", "frag", "ns/el-st", "det/1k", "elem%", "joint%", "detect%",
+    printf("%9s %7s %6s %5s %9s %7s %7s %6s %6s %7s %8s %7s %7s %7s %8s %7s %7s %7s %7s %6s  %s\n",
+           "t ms", "step", "broken", "frag", "ns/el-st", "det/1k", "mend/1k", "elem%", "joint%", "detect%",
            "contact%", "integr%", "pair/el", "near/el", "touch/el", "face/el", "edge/el",
            "corn/el", "none/el", "crack%", "kernel ns/el over each kind once: face edge corner none");
     double total_cpu = 0, total_wall = 0;
     long total_steps = 0;
     while (fdem_get_time(m) < info.end_time && total_steps < max_steps) {
         fdem_stage_times before = fdem_get_stage_times(m);
-        long det0 = m->contact.detections;
+        long det0 = m->contact.detections, mend0 = m->contact.break_mends;
         double c0 = clock_cpu_seconds(), w0 = clock_wall_seconds();
         int steps = 0;
         fdem_error err;
@@ -130,10 +130,11 @@ static int run_case(const char *path, int window, int threads, long max_steps)
         pair_kind_counts(m, kinds);
         pair_kind_kernel(m, seconds, touching);
         fdem_counts c = fdem_get_counts(m);
-        printf("%9.4f %7lld %6d %5d %9.1f %7.1f %6.1f %6.1f %7.1f %8.1f %7.1f %7.2f %7.2f %8.3f "
+        printf("%9.4f %7lld %6d %5d %9.1f %7.1f %7.1f %6.1f %6.1f %7.1f %8.1f %7.1f %7.2f %7.2f %8.3f "
                "%7.3f %7.3f %7.3f %7.3f %6.1f  %.0f %.0f %.0f %.0f\n",
                1e3 * fdem_get_time(m), (long long)fdem_get_step(m), c.broken_joints, c.fragments,
                cpu * 1e9 / ((double)steps * E), 1000.0 * (double)(c.detections - det0) / steps,
+               1000.0 * (double)(m->contact.break_mends - mend0) / steps,
                100 * fe / sum, 100 * jo / sum, 100 * de / sum, 100 * co / sum, 100 * in / sum,
                (double)c.contact_pairs / E, (double)(m->contact.near_count + m->contact.near_vertex_count) / E,
                (double)c.contacts / E, kinds[PAIR_FACE] / E, kinds[PAIR_EDGE] / E,

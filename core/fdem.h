@@ -469,9 +469,14 @@ void fdem_fluid_sources(const fdem_model *model, double *pressure, double *injec
 int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
 /* How many joints fdem_break_joints_across would break, breaking none. */
 int fdem_joints_across(const fdem_model *model, const double *normal, double offset);
-/* The next step reruns the whole contact detection, as one in which a
- * joint breaks does (for timing it). */
+/* The next step reruns the whole contact detection (for timing it). */
 void fdem_force_detection(fdem_model *model);
+/* For run-time estimates too: breaks the first intact joint between two
+ * active elements at or after `from` (wrapping round), as the fracture
+ * law would, with no event and no energy booked; the next step mends the
+ * contact list for it, as a step in which a joint breaks does. Returns
+ * the joint, or -1 when none is left (or out of memory). */
+int fdem_break_one_joint(fdem_model *model, int from);
 
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);

@@ -388,7 +388,10 @@ static int contact_detect_at(fdem_model *m, const double *pos)
                                                   cs->r, body, &cs->pairs);
     if (failed) return -1;
     if (m->elem_active) contact_drop_excavated(m);
-    if (m->joint_count) contact_drop_joined(m);
+    if (m->joint_count) {
+        contact_drop_joined(m);
+        if (contact_pairs_order(m)) return -1; /* the order a break's mending keeps */
+    }
     if (contact_history_take_back(cs)) return -1;
     cs->active_count =
         contact_collect_elements(cs, m->elem_count, NULL, cs->pairs.count, NULL, 0, cs->active);
@@ -397,8 +400,11 @@ static int contact_detect_at(fdem_model *m, const double *pos)
     cs->need_detect = 0;
     cs->near_stale = 1;
     cs->detections++;
+    contact_breaks_remember(m);
     return 0;
 }
+
+int contact_detect_again(fdem_model *m) { return contact_detect_at(m, m->contact.pos_detect); }
 
 static int contact_detect(fdem_model *m)
 {
@@ -419,10 +425,13 @@ int contact_restore_detection(fdem_model *m)
     cs->near_stale = 1;
     memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = 1;
-    if (cs->need_detect) return 0; /* the next step detects anyway */
+    int pending = cs->need_detect;
+    if (pending == CONTACT_DETECT_ALL) return 0; /* the next step detects anyway */
     long detections = cs->detections;
     if (contact_detect_at(m, cs->pos_detect)) return -1;
     cs->detections = detections;
+    /* a break waiting: its step still counts its (now empty) mending */
+    cs->need_detect = pending;
     return 0;
 }
 
@@ -476,7 +485,7 @@ int contact_init(fdem_model *m, fdem_error *err)
         element_sphere(m, m->pos, e, c, &cs->r[e]);
         rmax = fmax(rmax, cs->r[e]);
     }
-    if (contact_shut_init(m) || contact_skin_init(m, rmax)) {
+    if (contact_shut_init(m) || contact_skin_init(m, rmax) || contact_breaks_init(m)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory for contact detection");
         return -1;
     }
@@ -492,6 +501,7 @@ void contact_free(contact_state *cs)
     free(cs->cx); free(cs->cy); free(cs->cz); free(cs->r); free(cs->body); free(cs->piece); free(cs->detect_body);
     free(cs->pos_detect); free(cs->pos_near); free(cs->force);
     free(cs->skin); free(cs->travel_weight);
+    contact_breaks_free(cs);
     free(cs->box); free(cs->active); free(cs->near_active); free(cs->elem_gap); free(cs->in_pair);
     free(cs->near); /* near_vertex is its end */
     free(cs->vertex_start);
@@ -554,6 +564,8 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->near_capacity * sizeof(near_pair); /* near_vertex is its end */
     b += cs->vertex_pairs_capacity * sizeof(int32_t) + cs->vertex_walk_capacity * sizeof(int32_t);
     b += cs->vertex_due_capacity; /* vertex_start: an int32 an element, with the element arrays */
+    /* contact_breaks.c: the spare and mended lists, and its arrays */
+    b += 2 * (cs->spare.capacity + cs->fresh.capacity) * sizeof(int32_t) + cs->breaks_bytes;
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -721,9 +733,10 @@ int contact_forces(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (!cs->enabled) return 0;
-    if (cs->need_detect || contact_travel_past(m, cs->travel_limit2)) {
+    int all = cs->need_detect == CONTACT_DETECT_ALL || contact_travel_past(m, cs->travel_limit2);
+    if (all || cs->need_detect) {
         double t0 = stage_clock();
-        if (contact_detect(m)) return -1;
+        if (all ? contact_detect(m) : contact_detect_breaks(m)) return -1;
         double spent = stage_clock() - t0;
         m->times.detection += spent;
         m->times.contact -= spent; /* the caller books the whole call as contact */

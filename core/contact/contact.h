@@ -67,6 +67,17 @@ int contact_history_checkpoint_read(contact_state *cs, const unsigned char *p, s
 size_t contact_record_bytes(const contact_state *cs); /* one record in a checkpoint */
 
 
+/* contact_breaks.c: the list after joints broke (0, or -1 out of memory),
+ * a jointed model's list in the order of (lo, hi), what a detection saw of
+ * the joints, and the arrays these need */
+int contact_detect_breaks(fdem_model *m);
+int contact_pairs_order(fdem_model *m);
+void contact_breaks_remember(fdem_model *m);
+int contact_breaks_init(fdem_model *m);
+void contact_breaks_free(contact_state *cs);
+/* the whole detection again on the last detection's circles (contact.c) */
+int contact_detect_again(fdem_model *m);
+
 /* the travel since detection (contact.max_disp2, a bound; contact_travel.c):
  * grown by a step's largest squared node step, and whether some node is now
  * farther than sqrt(limit2) from pos_detect (exact, read when the bound says

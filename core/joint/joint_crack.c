@@ -14,6 +14,7 @@
 
 #include "fdem.h"
 #include "joint.h"
+#include "model/model.h"
 
 static void element_centroid(const fdem_model *m, int e, double c[3])
 {
@@ -64,8 +65,28 @@ int fdem_break_joints_across(fdem_model *m, const double *normal, double offset)
     int fragments = joint_fragment_count(m);
     if (fragments < 0) return -1;
     m->fragments = fragments;
-    m->contact.need_detect = 1; /* the crack's faces meet through contact */
+    contact_detect_after_breaks(&m->contact); /* the crack's faces meet through contact */
     return broke;
+}
+
+int fdem_break_one_joint(fdem_model *m, int from)
+{
+    const int J = m->joint_count;
+    for (int k = 0; k < J; k++) {
+        int j = ((from < 0 ? 0 : from) + k) % J;
+        if (m->joint_damage[j] >= 1.0) continue;
+        if (!element_is_active(m, m->joint_elem[2 * j]) ||
+            !element_is_active(m, m->joint_elem[2 * j + 1]))
+            continue;
+        m->joint_damage[j] = 1.0;
+        m->broken_joints++;
+        int fragments = joint_fragment_count(m);
+        if (fragments < 0) return -1;
+        m->fragments = fragments;
+        contact_detect_after_breaks(&m->contact);
+        return j;
+    }
+    return -1;
 }
 
 void fdem_force_detection(fdem_model *m)

@@ -179,6 +179,12 @@ typedef struct contact_record {
     double slip[CONTACT_SLOTS_MAX];
 } contact_record;
 
+/* contact_state.need_detect: detection is due on the current positions
+ * (ALL), or only joints broke since the last (BREAKS: the list is mended
+ * on its circles, contact_breaks.c). A break never lowers a pending ALL. */
+#define CONTACT_DETECT_ALL 1
+#define CONTACT_DETECT_BREAKS 2
+
 typedef struct contact_state {
     int enabled;             /* some pair of elements can ever touch */
     const struct contact_kernel *kernel; /* the dimension's pair kernel (contact.c) */
@@ -191,7 +197,7 @@ typedef struct contact_state {
     double travel_limit2;    /* re-detect once a node's weighted squared travel passes this */
     double max_disp2;        /* bound of the weighted squared node displacement since detection,
                                 exact once past the limit (contact_travel.c) */
-    int need_detect;
+    int need_detect;         /* CONTACT_DETECT_ALL, or _BREAKS: only joints broke (contact.h) */
     long detections;
     int touching;            /* pairs with non-zero force in the last step */
     fdem_penetration pen[FDEM_PENETRATIONS_MAX]; /* pairs found passing into one another,
@@ -249,6 +255,16 @@ typedef struct contact_state {
     double *elem_gap;        /* per element: the smallest gap of its near pairs */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
+    /* after a break (contact_breaks.c): the list's spare and the pairs
+     * found again, an element's count or mark, the pieces after the break,
+     * each element's body in the search, the elements marked, what the
+     * last detection saw of the joints (broken) and vertices (marks) */
+    nbs_pairs spare, fresh;
+    int32_t *break_scratch, *piece_next, *query_body;
+    uint8_t *marked, *seen_joint, *seen_vertex;
+    size_t breaks_bytes;     /* what these arrays hold */
+    int breaks_off;          /* tests: a break reruns the whole detection */
+    long break_mends;        /* breaks the list was mended for (of detections) */
     /* shut broken joints (contact_shut.c): per node its vertex's first copy,
      * per first copy the squared tolerance and whether it is shut this
      * step, per element whether all its vertices are; NULL without joints */
@@ -267,6 +283,11 @@ typedef struct contact_state {
     nbs_classes classes;     /* graded meshes: size classes on those grids (nbs_classes.h) */
     nbs_pairs pairs;
 } contact_state;
+
+static inline void contact_detect_after_breaks(contact_state *cs)
+{
+    if (!cs->need_detect) cs->need_detect = CONTACT_DETECT_BREAKS;
+}
 
 /* A step split between processes (runner/mpi/rank_engine.c: one MPI rank
  * each): the engine stays one process's code, and these hooks let a driver

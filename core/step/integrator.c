@@ -454,7 +454,7 @@ int fdem_step(fdem_model *m, fdem_error *err)
         if (broke) {
             m->broken_joints += broke;
             m->fragments = joint_fragment_count(m);
-            m->contact.need_detect = 1; /* the freed faces must meet through contact */
+            contact_detect_after_breaks(&m->contact); /* the freed faces must meet */
         }
     }
     if (m->fluid) fluid_step(m, h);

@@ -89,13 +89,13 @@ static double sizing_result_bytes(const fdem_model *model, const case_info *info
  * the faces of a crack, and in 3D every pair of tetrahedra around its
  * vertices, are pairs from then on, so a step costs about intact +
  * (broken joints) x (the cost of one), measured on the model with a crack
- * cut through it (sizing_cracked_step_seconds). And through detection:
- * every step in which a joint breaks reruns the whole contact detection
- * (core/step/integrator.c), which after the split of a 2D tunnel wall was
- * 82 % of its CPU (1,100 joints broke, one detection each, at 8 ms a
- * detection of 4,678 triangles against 38 ns an element-step intact): so
- * each joint that breaks is priced one detection, timed before the cut
- * and on it (sizing_detection_at).
+ * cut through it (sizing_cracked_step_seconds). And through the contact
+ * list: every step in which a joint breaks mends it around the break
+ * (core/contact/contact_breaks.c; it reran the whole detection until
+ * stop 36, 82 % of a 2D tunnel's CPU after its wall split, 1,100 joints
+ * broken at 8 ms a detection of 4,678 triangles): so each joint that
+ * breaks is priced one mending, timed before the cut and on it
+ * (sizing_detection_at).
  *
  * How many break by the end: a share of the joints, not known before the
  * run. The bundled examples break 0 to 23 % of their joints by the end
@@ -168,20 +168,25 @@ static int sizing_crack_plane(const fdem_model *model, double normal[3], double 
     return most;
 }
 
-/* The detection a break sets off, timed: up to SIZING_DETECTIONS steps
- * each made to rerun it (fdem_force_detection), as long as they take no
- * more than SIZING_DETECTION_CPU seconds in all; each counts its CPU
- * seconds times the detection's share of its wall time (the engine's
- * stage clock reads wall time). The median; NAN when a step fails. */
+/* What a break costs the contact list, timed: up to SIZING_DETECTIONS
+ * steps each with one more joint broken (fdem_break_one_joint, from the
+ * middle of the joints on), whose list is mended for it
+ * (core/contact/contact_breaks.c), as long as they take no more than
+ * SIZING_DETECTION_CPU seconds in all; each counts its CPU seconds times
+ * the detection stage's share of its wall time (the engine's stage clock
+ * reads wall time). The median; NAN when a step fails. With no joint left
+ * to break, the whole detection is timed instead. */
 #define SIZING_DETECTIONS 5
 #define SIZING_DETECTION_CPU 0.3
 
 static double sizing_detection_seconds(fdem_model *model, double steps_left, int *taken)
 {
     double seconds[SIZING_DETECTIONS], spent = 0;
-    int n = 0;
+    int n = 0, next = fdem_get_counts(model).joints / 2;
     while (n < SIZING_DETECTIONS && n < steps_left && (n == 0 || spent < SIZING_DETECTION_CPU)) {
-        fdem_force_detection(model);
+        int broke = fdem_break_one_joint(model, next);
+        if (broke < 0) fdem_force_detection(model);
+        else next = broke + 1;
         double detected0 = fdem_get_stage_times(model).detection;
         double wall0 = clock_wall_seconds(), cpu0 = clock_cpu_seconds();
         if (sizing_step(model) != 0)
@@ -198,7 +203,7 @@ static double sizing_detection_seconds(fdem_model *model, double steps_left, int
 
 /* CPU seconds a step once the rock has broken: the model is cut by a
  * crack through the middle of its joints (sizing_crack_plane) and timed
- * again; then the detection every step in which a joint breaks reruns,
+ * again; then the mending of the contact list a break sets off,
  * on the cracked model (*detection). NAN when no joint crosses the
  * plane or a step fails. */
 static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
@@ -311,7 +316,7 @@ static double sizing_snapshot_copy_seconds(const fdem_model *model, const case_i
 }
 
 /* How many joints the run breaks (out->breaks, each priced one
- * detection) and how many it holds broken on average over its steps
+ * mending of the contact list) and how many it holds broken on average over its steps
  * (out->broken_joints, each priced its contact every step): the
  * SIZING_BROKEN_SHARE of them, or more when the `seen` that its first
  * `taken` steps broke go on at that rate. */
@@ -326,8 +331,8 @@ static void sizing_price_breaks(case_sizing *out, int joints, int seen, int take
     out->broken_joints = 0.5 * by_end;
 }
 
-/* CPU seconds of one detection while the run holds out->broken_joints
- * broken: a detection's candidate pairs grow with the crack, so it is
+/* CPU seconds of one break's mending while the run holds
+ * out->broken_joints broken: its work grows with the crack, so it is
  * interpolated between the one timed intact and the one timed on the cut
  * (drift-3d: 119 ms with 426 joints cut, 41 ms in its run with 143
  * broken). Either alone when the other was not timed; 0 when neither. */
@@ -378,7 +383,7 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
     /* joints the run's own steps broke so far (before the probe's crack) */
     int seen = fdem_get_counts(model).broken_joints, looked = taken;
     out->broken_seen = seen;
-    double breaking = 0; /* CPU seconds of the detections breaks set off */
+    double breaking = 0; /* CPU seconds of the mendings breaks set off */
     out->cracked_step_seconds = out->break_detection_seconds = NAN;
     out->intact_detection_seconds = out->adjacent_step_seconds = NAN;
     if (c.joints > 0 && isfinite(per_step) && out->steps > taken) {
@@ -388,7 +393,7 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
         double before = out->adjacent_step_seconds =
             sizing_probe_step_seconds(model, out->steps - taken, &more, &load);
         taken += more;
-        /* a detection before the cut: what one costs with (nearly) none broken */
+        /* a mending before the cut: what one costs with (nearly) none broken */
         out->intact_detection_seconds = sizing_detection_seconds(model, out->steps - taken, &taken);
         out->cracked_step_seconds = sizing_cracked_step_seconds(
             model, out->steps - taken, &out->cracked_joints, &out->break_detection_seconds, &load);
