@@ -48,21 +48,6 @@
  * marked: the one-body run then costs about as much. */
 #define BREAKS_MARKED_SHARE 4
 
-static int pairs_room(nbs_pairs *p, size_t want)
-{
-    if (want <= p->capacity) return 0;
-    size_t cap = p->capacity ? p->capacity : 64;
-    while (cap < want) cap *= 2;
-    int32_t *a = realloc(p->a, cap * sizeof *a);
-    if (!a) return -1;
-    p->a = a;
-    int32_t *b = realloc(p->b, cap * sizeof *b);
-    if (!b) return -1;
-    p->b = b;
-    p->capacity = cap;
-    return 0;
-}
-
 /* The spare list becomes the list; the old one is let go (a list of a
  * fracturing body holds its raw detection's capacity, which is not kept
  * twice between detections). */
@@ -74,38 +59,43 @@ static void pairs_take_spare(contact_state *cs)
     nbs_pairs_init(&cs->spare);
 }
 
-/* The list as (lo, hi) in the order of lo then hi: a counting sort on lo
- * into the spare list, each lo's few pairs then put in order of hi. */
-int contact_pairs_order(fdem_model *m)
+/* `in` as (lo, hi) pairs into `out`, in the order of lo then hi: a
+ * counting sort on lo (start: E + 1 counts), each lo's few pairs then put
+ * in order of hi. */
+static int pairs_sorted(const nbs_pairs *in, nbs_pairs *out, int32_t *start, size_t E)
 {
-    contact_state *cs = &m->contact;
-    const size_t n = cs->pairs.count, E = (size_t)m->elem_count;
-    if (pairs_room(&cs->spare, n)) return -1;
-    int32_t *start = cs->break_scratch; /* E + 1 */
+    const size_t n = in->count;
+    if (nbs_pairs_reserve(out, n)) return -1;
     memset(start, 0, sizeof(int32_t) * (E + 1));
     for (size_t k = 0; k < n; k++) {
-        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+        int32_t a = in->a[k], b = in->b[k];
         start[(a < b ? a : b) + 1]++;
     }
     for (size_t e = 0; e < E; e++) start[e + 1] += start[e];
     for (size_t k = 0; k < n; k++) {
-        int32_t a = cs->pairs.a[k], b = cs->pairs.b[k];
+        int32_t a = in->a[k], b = in->b[k];
         int32_t lo = a < b ? a : b, hi = a < b ? b : a;
         int32_t at = start[lo]++;
-        cs->spare.a[at] = lo;
-        cs->spare.b[at] = hi;
+        out->a[at] = lo;
+        out->b[at] = hi;
     }
     /* start[e] is now the end of e's run, the start of e + 1's */
-    for (size_t e = 0, from = 0; e < E; from = (size_t)start[e++]) {
-        int32_t *hi = cs->spare.b;
+    int32_t *hi = out->b;
+    for (size_t e = 0, from = 0; e < E; from = (size_t)start[e++])
         for (size_t i = from + 1; i < (size_t)start[e]; i++) {
             int32_t v = hi[i];
             size_t j = i;
             for (; j > from && hi[j - 1] > v; j--) hi[j] = hi[j - 1];
             hi[j] = v;
         }
-    }
-    cs->spare.count = n;
+    out->count = n;
+    return 0;
+}
+
+int contact_pairs_order(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    if (pairs_sorted(&cs->pairs, &cs->spare, cs->break_scratch, (size_t)m->elem_count)) return -1;
     pairs_take_spare(cs);
     return 0;
 }
@@ -210,22 +200,16 @@ static int breaks_find(fdem_model *m)
         if (m->elem_part[a] == m->elem_part[b] &&
             joint_contact_excluded(m, cs->piece_next, a, b))
             continue;
-        cs->fresh.a[kept] = a < b ? a : b;
-        cs->fresh.b[kept] = a < b ? b : a;
+        cs->fresh.a[kept] = a;
+        cs->fresh.b[kept] = b;
         kept++;
     }
     cs->fresh.count = kept;
-    /* few: an insertion sort on (lo, hi) */
-    for (size_t i = 1; i < kept; i++) {
-        int32_t lo = cs->fresh.a[i], hi = cs->fresh.b[i];
-        size_t j = i;
-        for (; j > 0 && (cs->fresh.a[j - 1] > lo || (cs->fresh.a[j - 1] == lo && cs->fresh.b[j - 1] > hi)); j--) {
-            cs->fresh.a[j] = cs->fresh.a[j - 1];
-            cs->fresh.b[j] = cs->fresh.b[j - 1];
-        }
-        cs->fresh.a[j] = lo;
-        cs->fresh.b[j] = hi;
-    }
+    /* in order through the spare list, which the merge then fills */
+    if (pairs_sorted(&cs->fresh, &cs->spare, cs->break_scratch, (size_t)E)) return -1;
+    nbs_pairs t = cs->fresh;
+    cs->fresh = cs->spare;
+    cs->spare = t;
     return 0;
 }
 
@@ -234,7 +218,7 @@ static int breaks_merge(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     const uint8_t *marked = cs->marked;
-    if (pairs_room(&cs->spare, cs->pairs.count + cs->fresh.count)) return -1;
+    if (nbs_pairs_reserve(&cs->spare, cs->pairs.count + cs->fresh.count)) return -1;
     size_t i = 0, f = 0, out = 0;
     const nbs_pairs *old = &cs->pairs, *fresh = &cs->fresh;
     for (;;) {

@@ -90,6 +90,8 @@ void nbs_pairs_free(nbs_pairs *pairs)
     nbs_pairs_init(pairs);
 }
 
+int nbs_pairs_reserve(nbs_pairs *pairs, size_t want) { return nbs_pairs_grow(pairs, want); }
+
 /* cell_head holds two tables (this row, the row below) of nx + 2 slots each */
 static size_t nbs_cell_slots(size_t table) { return 2 * (table + 2); }
 

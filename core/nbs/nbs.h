@@ -54,6 +54,8 @@ void nbs_grid_init(nbs_grid *grid);
 void nbs_grid_free(nbs_grid *grid);
 void nbs_pairs_init(nbs_pairs *pairs);
 void nbs_pairs_free(nbs_pairs *pairs);
+/* Room for `want` pairs (capacity doubles); 0, or -1 out of memory. */
+int nbs_pairs_reserve(nbs_pairs *pairs, size_t want);
 
 /* Finds all overlapping pairs; pairs->count is reset first. Returns 0, or -1
  * on allocation failure. body may be NULL. */

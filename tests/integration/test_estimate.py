@@ -154,7 +154,7 @@ class EstimateTest(DaemonTestCase):
     def test_dry_run_prices_breaks_on_the_joints_plane_and_repeats(self):
         # at rest: nothing breaks in the probe's own steps, so the share
         # (docs/api.md, Dry run): 3 % of the joints break, each with its
-        # detection, half that held broken on average
+        # mending of the contact list, half that held broken on average
         first = self.client.dry_run(self.fracturing_band("band", [0, 0]))
         second = self.client.dry_run(self.fracturing_band("band", [0, 0]))
         self.assertEqual(first["joints"], 48)
