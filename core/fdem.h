@@ -467,16 +467,33 @@ void fdem_fluid_sources(const fdem_model *model, double *pressure, double *injec
  * would, with no fracture event and no energy booked. Returns how many
  * broke, or -1 out of memory. */
 int fdem_break_joints_across(fdem_model *model, const double *normal, double offset);
+/* The same crack held inside the body: of the joints
+ * fdem_break_joints_across would break, the `share` whose midpoints (the
+ * mean of their two elements' centroids) lie nearest `centre`. A cut
+ * through the whole body parts it in two, and only the faces meet; a
+ * crack inside it, as a growing crack is, also brings the elements
+ * around its vertices into contact. Returns how many broke, or -1 out of
+ * memory. */
+int fdem_break_joints_near(fdem_model *model, const double *normal, double offset,
+                           const double *centre, double share);
+/* For run-time estimates: treats every broken joint's faces and vertex
+ * copies as open (1) or as they are (0). A crack cut at rest is shut, and
+ * its pairs take the cheap path of shut joints; a run's cracks open,
+ * slide and wedge, and their pairs take the general kernel. */
+void fdem_price_cracks_open(fdem_model *model, int open);
 /* How many joints fdem_break_joints_across would break, breaking none. */
 int fdem_joints_across(const fdem_model *model, const double *normal, double offset);
 /* The next step reruns the whole contact detection (for timing it). */
 void fdem_force_detection(fdem_model *model);
 /* For run-time estimates too: breaks the first intact joint between two
- * active elements at or after `from` (wrapping round), as the fracture
- * law would, with no event and no energy booked; the next step mends the
- * contact list for it, as a step in which a joint breaks does. Returns
- * the joint, or -1 when none is left (or out of memory). */
-int fdem_break_one_joint(fdem_model *model, int from);
+ * active elements at or after `from` (wrapping round) that
+ * fdem_break_joints_across(model, avoid_normal, avoid_offset) would not
+ * break (any, when avoid_normal is NULL), as the fracture law would, with
+ * no event and no energy booked; the next step mends the contact list for
+ * it, as a step in which a joint breaks does. Returns the joint, or -1
+ * when none is left (or out of memory). */
+int fdem_break_one_joint(fdem_model *model, int from, const double *avoid_normal,
+                         double avoid_offset);
 
 int64_t fdem_get_step(const fdem_model *model);
 double fdem_get_time(const fdem_model *model);

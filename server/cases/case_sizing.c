@@ -175,16 +175,19 @@ static int sizing_crack_plane(const fdem_model *model, double normal[3], double 
  * SIZING_DETECTION_CPU seconds in all; each counts its CPU seconds times
  * the detection stage's share of its wall time (the engine's stage clock
  * reads wall time). The median; NAN when a step fails. With no joint left
- * to break, the whole detection is timed instead. */
+ * to break, the whole detection is timed instead. Before the cut, the
+ * joints it will break are left to it (avoid_normal, avoid_offset: its
+ * plane), so the cut's figures are those of the plane's joints. */
 #define SIZING_DETECTIONS 5
 #define SIZING_DETECTION_CPU 0.3
 
-static double sizing_detection_seconds(fdem_model *model, double steps_left, int *taken)
+static double sizing_detection_seconds(fdem_model *model, double steps_left, int *taken,
+                                       const double *avoid_normal, double avoid_offset)
 {
     double seconds[SIZING_DETECTIONS], spent = 0;
     int n = 0, next = fdem_get_counts(model).joints / 2;
     while (n < SIZING_DETECTIONS && n < steps_left && (n == 0 || spent < SIZING_DETECTION_CPU)) {
-        int broke = fdem_break_one_joint(model, next);
+        int broke = fdem_break_one_joint(model, next, avoid_normal, avoid_offset);
         if (broke < 0) fdem_force_detection(model);
         else next = broke + 1;
         double detected0 = fdem_get_stage_times(model).detection;
@@ -201,25 +204,47 @@ static double sizing_detection_seconds(fdem_model *model, double steps_left, int
     return median_in_place(seconds, n);
 }
 
+/* The crack of the probe is the half of the plane's joints nearest the
+ * joints' centre: a crack inside the body, as one that grows in the run.
+ * Cut through the whole body, the crack parted it in two and only its
+ * faces met (a face pair each, shut: the cheapest pair there is), while
+ * the cracks of a run lie inside a piece and bring the elements around
+ * their vertices into contact too: drift-3d and the arc-loaded 3D disc
+ * ran 3.5-7x their estimate (100x the probe's price of a broken joint in
+ * drift-3d). */
+#define SIZING_CRACK_SHARE 0.5
+
+/* A crack cut at rest is shut: its faces and the vertex pairs around it
+ * take the cheap path of shut joints (docs/physics.md). A run's cracks
+ * open, slide and wedge, and then every pair around them takes the
+ * general kernel, in 3D ~25x the price (drift-3d: 0.8 and 22 us a broken
+ * joint a step; its run paid ~60). How much of a run's cracks is open is
+ * not known before it, so a broken joint is priced open, its upper bound:
+ * priced shut, drift-3d and the arc-loaded 3D disc ran 4.9x and 6.9x their
+ * estimates; priced open, the 3D discs and prism ran 0.41-0.73x (and the
+ * geometric mean of the two left drift-3d and the arc disc at 2.5-2.9x). */
+
 /* CPU seconds a step once the rock has broken: the model is cut by a
- * crack through the middle of its joints (sizing_crack_plane) and timed
- * again; then the mending of the contact list a break sets off,
- * on the cracked model (*detection). NAN when no joint crosses the
- * plane or a step fails. */
-static double sizing_cracked_step_seconds(fdem_model *model, double steps_left, int *broke,
+ * crack inside its joints (sizing_crack_plane, SIZING_CRACK_SHARE), its
+ * cracks priced open (fdem_price_cracks_open), and timed again; then the
+ * mending of the contact list a break sets off, on the cracked model
+ * (*detection). NAN when no joint crosses the plane or a step fails. */
+static double sizing_cracked_step_seconds(fdem_model *model, double steps_left,
+                                          const double normal[3], double offset, int *broke,
                                           double *detection, sizing_load *load)
 {
-    double normal[3] = {1, 0, 0}, offset = 0;
     *detection = NAN;
     *broke = 0;
-    if (sizing_crack_plane(model, normal, &offset) <= 0 || steps_left < 2)
-        return NAN;
-    *broke = fdem_break_joints_across(model, normal, offset);
+    if (steps_left < 2) return NAN;
+    double centre[3];
+    sizing_joint_centre(model, centre);
+    *broke = fdem_break_joints_near(model, normal, offset, centre, SIZING_CRACK_SHARE);
     if (*broke <= 0) return NAN;
+    fdem_price_cracks_open(model, 1);
     int taken = 0;
     double pace = sizing_probe_step_seconds(model, steps_left, &taken, load);
     if (isfinite(pace))
-        *detection = sizing_detection_seconds(model, steps_left - taken, &taken);
+        *detection = sizing_detection_seconds(model, steps_left - taken, &taken, NULL, 0);
     return pace;
 }
 
@@ -393,10 +418,17 @@ void case_sizing_measure(fdem_model *model, const case_info *info, double model_
         double before = out->adjacent_step_seconds =
             sizing_probe_step_seconds(model, out->steps - taken, &more, &load);
         taken += more;
-        /* a mending before the cut: what one costs with (nearly) none broken */
-        out->intact_detection_seconds = sizing_detection_seconds(model, out->steps - taken, &taken);
-        out->cracked_step_seconds = sizing_cracked_step_seconds(
-            model, out->steps - taken, &out->cracked_joints, &out->break_detection_seconds, &load);
+        /* a mending before the cut: what one costs with (nearly) none
+         * broken, on joints off the cut's plane */
+        double normal[3] = {1, 0, 0}, offset = 0;
+        int planed = sizing_crack_plane(model, normal, &offset) > 0;
+        out->intact_detection_seconds =
+            sizing_detection_seconds(model, out->steps - taken, &taken, planed ? normal : NULL,
+                                     offset);
+        if (planed)
+            out->cracked_step_seconds = sizing_cracked_step_seconds(
+                model, out->steps - taken, normal, offset, &out->cracked_joints,
+                &out->break_detection_seconds, &load);
         if (!(before > 0)) /* a step failed: the run will say why */
             before = per_step;
         if (isfinite(out->cracked_step_seconds) && out->cracked_joints > 0) {

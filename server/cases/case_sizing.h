@@ -16,10 +16,11 @@
  *    is priced from the model's own steps timed here (sizing_probe.h: a
  *    warm-up, then the median of short windows) at t = 0 and at three points up to 30 %
  *    into the run when that is quickly reached; for a fracturing model,
- *    on a crack cut through the model (fdem_break_joints_across, on the
- *    axis plane that crosses the most joints): 3 % of its joints (or more,
+ *    on a crack cut inside the model (fdem_break_joints_near, on the
+ *    axis plane that crosses the most joints, the half of its joints
+ *    nearest their centre): 3 % of its joints (or more,
  *    at the rate its own steps broke them) each breaking once, at the
- *    cost of a detection (a break reruns it; timed before the cut and on
+ *    cost of a mending of the contact list (timed before the cut and on
  *    it, interpolated to the joints held broken), and half of them held broken through the whole run, each
  *    at the cost a joint of the crack adds to a step (the crack's figures as multiples of an intact step
  *    timed just before the cut, at the run's pace); plus the worker's
@@ -52,7 +53,8 @@ typedef struct case_sizing {
     double load_factor;       /* wall / CPU seconds the run will see (sizing_load_factor) */
     double probe_wall_over_cpu; /* the same, as the probe's own windows saw it */
     double adjacent_step_seconds; /* the same just before the cut (what the crack's are taken against) */
-    double cracked_step_seconds; /* the same with a crack cut through its joints; NAN: none */
+    double cracked_step_seconds; /* the same with a crack cut inside its joints, priced
+                                    open (fdem_price_cracks_open); NAN: none */
     int cracked_joints;       /* joints the crack broke */
     double broken_joints;     /* joints priced as broken through the run */
     int broken_seen;          /* joints the probe's own steps broke (before its crack) */

@@ -160,8 +160,9 @@ class EstimateTest(DaemonTestCase):
         self.assertEqual(first["joints"], 48)
         for r in (first, second):
             e = r["estimate"]
-            # the crack runs along the band (y), not across it (x: 2)
-            self.assertEqual(e["cracked_joints"], 10, e)
+            # the crack runs along the band (y: 10 joints), not across it
+            # (x: 2), and is the half of them nearest the joints' centre
+            self.assertEqual(e["cracked_joints"], 5, e)
             self.assertEqual(e["broken_seen"], 0, e)
             self.assertAlmostEqual(e["breaks"], 0.03 * 48, places=9)
             self.assertAlmostEqual(e["broken_joints"], 0.5 * 0.03 * 48, places=9)

@@ -356,6 +356,38 @@ static void crack_across_a_plane_breaks_the_joints_on_it(void)
     }
 }
 
+/* fdem_break_joints_near (the daemon's cracked estimate since stop 36):
+ * of the joints on a plane between two columns of cells, the half nearest
+ * the block's centre break (more where two lie equally far), which leaves
+ * a crack inside one piece, not two fragments. */
+static void crack_near_a_point_stays_inside_the_body(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = fdem_model_create();
+        fdem_error err;
+        if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
+        int mat = fracture_material(m, 10);
+        const double size[3] = {0.04, 0.06, 0.02};
+        const int div[3] = {4, 8, 2};
+        build_box_part(m, mat, dim, size, div, 1);
+        build_finalize(m, 0.5);
+        const double normal[3] = {1, 0, 0}, centre[3] = {0.02, 0.03, 0.01};
+        int across = fdem_joints_across(m, normal, 0.02);
+        int broke = fdem_break_joints_near(m, normal, 0.02, centre, 0.5);
+        CHECK(broke >= (across + 1) / 2 && broke < across, "%dD: %d of %d joints broke", dim,
+              broke, across);
+        fdem_counts c = fdem_get_counts(m);
+        CHECK(c.broken_joints == broke && c.fragments == 1, "%dD: %d broken, %d fragments", dim,
+              c.broken_joints, c.fragments);
+        /* the ones left on the plane are those farther from the centre */
+        CHECK(fdem_joints_across(m, normal, 0.02) == across - broke, "%dD: left %d", dim,
+              fdem_joints_across(m, normal, 0.02));
+        for (int k = 0; k < 20; k++)
+            CHECK(fdem_step(m, &err) == 0, "%dD: step after the cut: %s", dim, err.message);
+        fdem_model_destroy(m);
+    }
+}
+
 /* Tip period of a fixed-free bar with nu = 0: fracturing (every triangle on
  * its own nodes, joints everywhere) against the same bar without fracture. */
 static double bar_period(int fracture, double penalty_factor)
@@ -404,5 +436,5 @@ CHECK_MAIN(T(softening_curve_ends), T(mode_I_energy_matches_softening_curve),
            T(elastic_joint_is_a_penalty_spring_in_any_orientation),
            T(damaged_joint_shut_at_one_end_resists_along_the_shut_part),
            T(block_of_fracturing_triangles_is_built_right),
-           T(broken_joints_make_fragments), T(crack_across_a_plane_breaks_the_joints_on_it),
+           T(broken_joints_make_fragments), T(crack_across_a_plane_breaks_the_joints_on_it), T(crack_near_a_point_stays_inside_the_body),
            T(intact_fracturing_bar_vibrates_like_continuum))
