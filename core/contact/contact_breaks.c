@@ -65,7 +65,7 @@ static void pairs_take_spare(contact_state *cs)
 static int pairs_sorted(const nbs_pairs *in, nbs_pairs *out, int32_t *start, size_t E)
 {
     const size_t n = in->count;
-    if (nbs_pairs_reserve(out, n)) return -1;
+    if (nbs_pairs_reserve(out, n ? n : 1)) return -1; /* a list is never NULL */
     memset(start, 0, sizeof(int32_t) * (E + 1));
     for (size_t k = 0; k < n; k++) {
         int32_t a = in->a[k], b = in->b[k];
@@ -218,7 +218,7 @@ static int breaks_merge(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     const uint8_t *marked = cs->marked;
-    if (nbs_pairs_reserve(&cs->spare, cs->pairs.count + cs->fresh.count)) return -1;
+    if (nbs_pairs_reserve(&cs->spare, cs->pairs.count + cs->fresh.count + 1)) return -1;
     size_t i = 0, f = 0, out = 0;
     const nbs_pairs *old = &cs->pairs, *fresh = &cs->fresh;
     for (;;) {

@@ -22,8 +22,9 @@
 static int same_list(const fdem_model *a, const fdem_model *b)
 {
     const nbs_pairs *p = &a->contact.pairs, *q = &b->contact.pairs;
-    return p->count == q->count && !memcmp(p->a, q->a, p->count * sizeof(int32_t)) &&
-           !memcmp(p->b, q->b, p->count * sizeof(int32_t));
+    if (p->count != q->count) return 0;
+    return p->count == 0 || (!memcmp(p->a, q->a, p->count * sizeof(int32_t)) &&
+                             !memcmp(p->b, q->b, p->count * sizeof(int32_t)));
 }
 
 /* Block of n cells a side squeezed hard enough that joints break step
