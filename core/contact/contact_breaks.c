@@ -26,7 +26,7 @@
  * in which only pairs with a marked element are listed: the rest share
  * one body id) and judged under the new joints. Marking more than that
  * costs time, never a pair; past a quarter of the elements (a split of
- * a large piece, the estimate's cut) the whole detection runs, on the same
+ * a large piece, a cut across the body) the whole detection runs, on the same
  * circles.
  *
  * The list must be the one a whole detection on those circles gives, in
