@@ -321,8 +321,7 @@ static void contact_drop_joined(fdem_model *m)
     size_t kept = 0;
     for (size_t k = 0; k < cs->pairs.count; k++) {
         int a = cs->pairs.a[k], b = cs->pairs.b[k];
-        if (m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, cs->piece, a, b))
-            continue;
+        if (contact_pair_joined(m, cs->piece, a, b)) continue;
         cs->pairs.a[kept] = cs->pairs.a[k];
         cs->pairs.b[kept] = cs->pairs.b[k];
         kept++;
@@ -352,15 +351,21 @@ int contact_pair_force_now(const fdem_model *m, size_t k, double *out)
  * inside a piece away from its cracks, which contact_drop_joined would
  * drop: an intact fracturing block's detection was almost all listing and
  * dropping those (3D: ~100 pairs an element, each looked up in the joints). */
+void contact_mark_cracks(fdem_model *m, int32_t *piece)
+{
+    contact_state *cs = &m->contact;
+    /* the contact force array (D doubles a node) is free until this step's
+     * pairs fill it: the crack marks take 4 int32 a node of it as scratch */
+    joint_mark_cracks(m, piece, (int32_t *)cs->force);
+    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    cs->force_is_zero = 1;
+}
+
 static const int32_t *contact_detect_bodies(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     if (!m->joint_count) return cs->body;
-    /* the contact force array (D doubles a node) is free until this step's
-     * pairs fill it: the crack marks take 4 int32 a node of it as scratch */
-    joint_mark_cracks(m, cs->piece, (int32_t *)cs->force);
-    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
-    cs->force_is_zero = 1;
+    contact_mark_cracks(m, cs->piece);
     joint_contact_bodies(m, cs->piece, cs->body, cs->detect_body);
     return cs->detect_body;
 }

@@ -156,10 +156,7 @@ static int breaks_mark(fdem_model *m)
         if (broken == cs->seen_joint[j]) continue;
         marked[m->joint_elem[2 * j]] = marked[m->joint_elem[2 * j + 1]] = 1;
     }
-    /* the force array is scratch until this step's pairs fill it */
-    joint_mark_cracks(m, cs->piece_next, (int32_t *)cs->force);
-    memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
-    cs->force_is_zero = 1;
+    contact_mark_cracks(m, cs->piece_next);
     breaks_mark_splits(m, marked);
     int count = 0;
     for (int e = 0; e < E; e++) {
@@ -197,9 +194,7 @@ static int breaks_find(fdem_model *m)
         int32_t a = cs->fresh.a[k], b = cs->fresh.b[k];
         if (body[a] >= 0 && body[a] == body[b]) continue;
         if (m->elem_active && (!m->elem_active[a] || !m->elem_active[b])) continue;
-        if (m->elem_part[a] == m->elem_part[b] &&
-            joint_contact_excluded(m, cs->piece_next, a, b))
-            continue;
+        if (contact_pair_joined(m, cs->piece_next, a, b)) continue;
         cs->fresh.a[kept] = a;
         cs->fresh.b[kept] = b;
         kept++;

@@ -9,6 +9,7 @@
 
 #include "kernel/contact_face.h"
 #include "kernel/contact_pair.h"
+#include "joint/joint.h"
 #include "model/model.h"
 
 /* A dimension's pair kernel and the numbers the shared stage sizes by. */
@@ -40,6 +41,18 @@ typedef struct near_pair {
                          (shut_face_pack, bits 0-9), found once at the list's
                          build; any pair: NEAR_EDGES_TRIED */
 } near_pair;
+
+/* Elements a and b of one part glued by intact joints (joint_contact_excluded
+ * on the pieces `piece`): never a candidate pair. */
+static inline int contact_pair_joined(const fdem_model *m, const int32_t *piece, int a, int b)
+{
+    return m->elem_part[a] == m->elem_part[b] && joint_contact_excluded(m, piece, a, b);
+}
+
+/* The crack marks of this moment (joint_mark_cracks: broken vertices, their
+ * groups, the pieces into `piece`), with the contact force array as their
+ * scratch, zeroed after (contact.c). */
+void contact_mark_cracks(fdem_model *m, int32_t *piece);
 
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
 static inline int boxes_overlap(const double *a, const double *b, int dim)

@@ -139,12 +139,7 @@ int fdem_break_one_joint(fdem_model *m, int from, const double *avoid_normal,
             !element_is_active(m, m->joint_elem[2 * j + 1]))
             continue;
         m->joint_damage[j] = 1.0;
-        m->broken_joints++;
-        int fragments = joint_fragment_count(m);
-        if (fragments < 0) return -1;
-        m->fragments = fragments;
-        contact_detect_after_breaks(&m->contact);
-        return j;
+        return joints_broken_by_a_cut(m, 1) < 0 ? -1 : j;
     }
     return -1;
 }
