@@ -503,9 +503,8 @@ static void joint_forces_general(const joint_law *law, const double d0[2], const
         joint_point_measure(law, dx * nx + dy * ny, slide, &slip[i], &g[i]);
     }
     double D = joint_points_damage(g, 2, *damage);
-    /* z(D) is not monotone to the last bit: damage that grew must not
-     * book a release below zero */
-    double z_old = joint_softening(*damage), z = fmin(z_old, joint_softening(D));
+    double z_old, z;
+    joint_softening_step(*damage, D, &z_old, &z);
     *damage = D;
     if (D >= 1) e->broke = joint_points_mode(law, g, 2);
     double w = 0.5 * L; /* Gauss weight */

@@ -61,6 +61,17 @@ enum { JOINT_MODE_TENSILE = 1, JOINT_MODE_SHEAR = 2, JOINT_MODE_MIXED = 3 };
 /* Munjiza's softening curve z(D), 1 at D <= 0, 0 at D >= 1. */
 double joint_softening(double D);
 
+/* The softening before (z_old) and after (z) a joint's damage went from
+ * `before` to D. z(D) is not monotone to the last bit, so damage that grew
+ * must not book a release below zero: z is at most z_old. Damage that did
+ * not grow (most steps of a damaged joint) needs one evaluation, not two:
+ * a damaged 3D joint's exp and pow were 3 % of a split disc's run. */
+static inline void joint_softening_step(double before, double D, double *z_old, double *z)
+{
+    *z_old = joint_softening(before);
+    *z = D == before ? *z_old : fmin(*z_old, joint_softening(D));
+}
+
 /* The area under Munjiza's curve, integral of z(D) over [0, 1] (held to a
  * Simpson sum of joint_softening in test_joint.c). */
 #define JOINT_Z_INTEGRAL 0.38630729474388764

@@ -183,9 +183,8 @@ static void joint_tet_general(const joint_law *law, const double d[3][3], const 
         joint_point_measure(law, vec3_dot(gap, n), slide, &slip[p], &g[p]);
     }
     double D = joint_points_damage(g, 3, *damage);
-    /* z(D) is not monotone to the last bit: damage that grew must not
-     * book a release below zero */
-    double z_old = joint_softening(*damage), z = fmin(z_old, joint_softening(D));
+    double z_old, z;
+    joint_softening_step(*damage, D, &z_old, &z);
     *damage = D;
     if (D >= 1) e->broke = joint_points_mode(law, g, 3);
     double w = area / 3;
