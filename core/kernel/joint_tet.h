@@ -115,6 +115,7 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #define JT_FN(name) name
 #define JT_SQRT sqrt
 #define JT_LOAD(pos, n0, n1, k, c) JOINT_TET_AT(pos, n0, k, c)
+#define JT_IF(mask, x) ((mask) ? (x) : 0)
 #include "joint_tet_fast_body.h"
 
 #define JT_T joint_pair
@@ -123,6 +124,7 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 #define JT_SQRT joint_pair_sqrt
 #define JT_LOAD(pos, n0, n1, k, c) \
     ((joint_pair){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, n1, k, c)})
+#define JT_IF(mask, x) ((joint_pair)((joint_pair_mask)(x) & (mask)))
 #include "joint_tet_fast_body.h"
 
 /* Four joints side by side exist only as AVX2 code (GCC on x86-64;
@@ -148,6 +150,7 @@ JOINT_TET_INLINE fdem_quad joint_quad_sqrt(fdem_quad x)
 #define JT_LOAD(pos, n0, n1, k, c)                                                               \
     ((fdem_quad){JOINT_TET_AT(pos, n0, k, c), JOINT_TET_AT(pos, (n0) + 6, k, c),               \
                   JOINT_TET_AT(pos, (n0) + 12, k, c), JOINT_TET_AT(pos, (n0) + 18, k, c)})
+#define JT_IF(mask, x) ((fdem_quad)((fdem_quad_mask)(x) & (mask)))
 #include "joint_tet_fast_body.h"
 #pragma GCC pop_options
 #endif

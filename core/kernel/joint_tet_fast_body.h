@@ -8,7 +8,7 @@
  * bits it gets alone, as element_tet_kernel_body.h does for tetrahedra.
  * Not a header of its own: include joint_tet.h.
  */
-#if !defined(JT_T) || !defined(JT_FN) || !defined(JT_SQRT) || !defined(JT_LOAD)
+#if !defined(JT_T) || !defined(JT_FN) || !defined(JT_SQRT) || !defined(JT_LOAD) || !defined(JT_IF)
 #error "include joint_tet.h, not this file"
 #endif
 
@@ -62,6 +62,41 @@ JOINT_TET_INLINE JT_MASK JT_FN(joint_tet_surely_elastic_of)(JT_T k, JT_T ft, JT_
     return sure;
 }
 
+/* joint_tet.c's elastic test itself, the same operations in the same order
+ * on each lane (so the same verdict, bit for bit): every point of the
+ * three-point rule within joint_point_elastic's strengths, projected on
+ * the unnormalised normal N (|N| = N_len). For what the test above cannot
+ * pass: a pressed joint. Its gaps are as large as its compression makes
+ * them, far over f_t / k, while its shear strength grows with the
+ * pressure; each such joint went through the kernel's call and point law,
+ * which made a loaded 3D disc's joints 3.5x dearer a step before any
+ * broke. Needs k >= 0 (then |k sl| is k sl). */
+JOINT_TET_INLINE JT_MASK JT_FN(joint_tet_elastic_points_of)(JT_T k, JT_T ft, JT_T c, JT_T tan_phi,
+                                                           const JT_T d[3][3], const JT_T N[3],
+                                                           JT_T N_len)
+{
+    const double rule[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6},
+                               {1.0 / 6, 2.0 / 3, 1.0 / 6},
+                               {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+    JT_MASK elastic = k >= 0;
+    JOINT_TET_UNROLL
+    for (int p = 0; p < 3; p++) {
+        JT_T g[3], slide[3];
+        JOINT_TET_UNROLL
+        for (int i = 0; i < 3; i++)
+            g[i] = rule[p][0] * d[0][i] + rule[p][1] * d[1][i] + rule[p][2] * d[2][i];
+        slide[0] = g[1] * N[2] - g[2] * N[1];
+        slide[1] = g[2] * N[0] - g[0] * N[2];
+        slide[2] = g[0] * N[1] - g[1] * N[0];
+        JT_T on = g[0] * N[0] + g[1] * N[1] + g[2] * N[2];
+        JT_T sl = JT_SQRT(slide[0] * slide[0] + slide[1] * slide[1] + slide[2] * slide[2]);
+        JT_T ksig = k * on;
+        JT_T shear_limit = c * N_len + JT_IF(on < 0, -ksig * tan_phi);
+        elastic &= (ksig <= ft * N_len) & (k * sl <= shear_limit);
+    }
+    return elastic;
+}
+
 /* The faces' elastic forces fa, k d integrated exactly against the linear
  * shape functions (f_a_i = k A/12 (2 d_i + d_j + d_k)); returns the stored
  * energy 1/2 integral k |d|^2. */
@@ -87,3 +122,4 @@ JOINT_TET_INLINE JT_T JT_FN(joint_tet_elastic_forces_of)(JT_T k, JT_T area, cons
 #undef JT_FN
 #undef JT_SQRT
 #undef JT_LOAD
+#undef JT_IF

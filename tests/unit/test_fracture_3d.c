@@ -199,6 +199,77 @@ static void joint_loop_gives_the_bits_of_the_kernel(void)
     fdem_model_destroy(reference);
 }
 
+/* A small fracturing box squeezed: every tetrahedron moved towards the
+ * box's centre by a share of its centroid's distance from it, so that
+ * neighbours press into each other by about 3 f_t / k, with a slight shear
+ * (every 4th tetrahedron's 20 times more): most joints are pressed far past
+ * what the inline path's first test (k |d_i| below the strengths) passes,
+ * yet elastic; the sheared ones are not. */
+static fdem_model *squeezed_box(void)
+{
+    const double size[3] = {0.03, 0.03, 0.03};
+    const int div[3] = {3, 3, 3};
+    fdem_model *m = box_model(size, div, rock(0, 0.1), 1);
+    build_finalize(m, 0.5);
+    double limit = 1e6 / m->joint_k[0], cell = size[0] / div[0];
+    double share = 3 * limit / cell * 3; /* tetrahedra centroids lie about a third of a cell apart */
+    uint64_t state = 777;
+    for (int e = 0; e < m->elem_count; e++) {
+        double centroid[3] = {0, 0, 0};
+        for (int k = 0; k < 4; k++)
+            for (int c = 0; c < 3; c++) centroid[c] += 0.25 * m->pos[3 * m->tet[e].node[k] + c];
+        double shear = (e % 4 == 0 ? 6 : 0.3) * limit * build_uniform(&state);
+        for (int k = 0; k < 4; k++) {
+            int32_t node = m->tet[e].node[k];
+            for (int c = 0; c < 3; c++)
+                m->pos[3 * node + c] -= share * (centroid[c] - 0.5 * size[c]);
+            m->pos[3 * node + 1] += shear;
+        }
+    }
+    return m;
+}
+
+/* Pressed joints (a loaded specimen's) take the inline path through the
+ * point test itself (joint_tet_elastic_points_of) and get the bits the
+ * kernel gives them, as joint_loop_gives_the_bits_of_the_kernel for the
+ * rest; the test counts them, so that it cannot pass without any. */
+static void pressed_joints_get_the_bits_of_the_kernel(void)
+{
+    fdem_model *fast = squeezed_box(), *reference = squeezed_box();
+    int pressed = 0;
+    for (int j = 0; j < fast->joint_count; j++) {
+        const joint_strength *s = &fast->joint_strengths[fast->joint_strength_of[j]];
+        double d[3][3], N[3], k = fast->joint_k[j];
+        double N_len = joint_tet_gaps(fast->pos, fast->joint_node + 6 * (size_t)j, d, N);
+        double on = (d[0][0] + d[1][0] + d[2][0]) * N[0] + (d[0][1] + d[1][1] + d[2][1]) * N[1] +
+                    (d[0][2] + d[1][2] + d[2][2]) * N[2];
+        pressed += on < 0 &&
+                   !joint_tet_surely_elastic_of(k, s->tensile_strength, s->cohesion, s->tan_phi, d) &&
+                   joint_tet_elastic_points_of(k, s->tensile_strength, s->cohesion, s->tan_phi, d, N,
+                                               N_len);
+    }
+    double sums_fast[SCATTER_SUMS] = {0}, sums_reference[SCATTER_SUMS] = {0};
+    size_t bytes = sizeof(double) * 3 * (size_t)fast->node_count;
+    memset(fast->force, 0, bytes);
+    memset(reference->force, 0, bytes);
+    joint_forces_range_3d(fast, 0, fast->joint_count, sums_fast);
+    reference_joint_range(reference, 0, reference->joint_count, sums_reference);
+    int damaged = 0;
+    for (int j = 0; j < fast->joint_count; j++) damaged += fast->joint_damage[j] > 0;
+    CHECK(pressed >= fast->joint_count / 4 && damaged > 0,
+          "the test needs both: %d pressed and elastic, %d past their strength, of %d joints",
+          pressed, damaged, fast->joint_count);
+    CHECK(memcmp(fast->force, reference->force, bytes) == 0, "forces differ");
+    CHECK(memcmp(fast->joint_damage, reference->joint_damage,
+                 sizeof(double) * (size_t)fast->joint_count) == 0, "damage differs");
+    CHECK(memcmp(sums_fast, sums_reference, sizeof sums_fast) == 0,
+          "sums differ: stored %.17g vs %.17g", sums_fast[1], sums_reference[1]);
+    fprintf(stderr, "  %d joints: %d pressed and elastic, %d damaged\n", fast->joint_count,
+            pressed, damaged);
+    fdem_model_destroy(fast);
+    fdem_model_destroy(reference);
+}
+
 /* The static excess compliance of the intact joints of a bar loaded
  * along x, relative to the elements': under a uniform stress sigma along x
  * a face of area A and normal n opens by sigma n_x n / k, which stores
@@ -582,7 +653,7 @@ static void crack_keeps_only_the_pairs_across_it(void)
     }
 }
 
-CHECK_MAIN(T(joints_on_interior_faces), T(joint_loop_gives_the_bits_of_the_kernel), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
+CHECK_MAIN(T(joints_on_interior_faces), T(joint_loop_gives_the_bits_of_the_kernel), T(pressed_joints_get_the_bits_of_the_kernel), T(stable_step_bounds_the_fastest_jointed_mode), T(intact_fracturing_bar_vibrates_like_continuum),
            T(pulled_bar_breaks_with_the_balance_closed), T(two_threads_give_the_same_bits),
            T(fracturing_impact_on_two_threads_gives_the_bits_of_one),
            T(earlier_3d_joint_numbering_is_refused), T(crack_keeps_only_the_pairs_across_it))
