@@ -222,7 +222,7 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
         int32_t set;
         double *springs = pair_springs(cs, np, fresh, slots, &set);
         face_match fm = shut_face_unpack(np->face);
-        contact_pair_in in = pair_input(m, a, b, h, NULL);
+        contact_pair_in in = pair_input(m, a, b, h, memo);
         int touched = cs->kernel->face_force(&in, &fm, springs, out);
         return pair_springs_settle(np, set, springs, touched, slots, pool);
     }

@@ -12,6 +12,8 @@
 #include "element_tet.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "math/vec3.h"
@@ -20,36 +22,68 @@
  * roles then read no array the forces are written to, so the compiler
  * keeps them in registers), its barycentric map (lambda_{1..3} = cof .
  * (x - p0) / det: one division, where a map of rows took nine and a role
- * uses it at one point), 6 V and its inverse, and the squared cross
+ * uses it at one point), the inverse of 6 V, and the squared cross
  * products of its faces ((2 A)^2: a role takes the root of one face's and
- * of the largest). */
+ * of the largest). The map and the faces are TET_NOW_MAP numbers in a row,
+ * as the walk's memo keeps them. */
 typedef struct tet_now {
     double p[4][3], v[4][3];
-    double cof[3][3], det, inv_det;
+    double cof[3][3], inv_det;
     double face_len2[4];
 } tet_now;
+#define TET_NOW_MAP 14
 
-static int tet_now_of(const double *pos, const double *vel, const int32_t n[4], tet_now *t)
+/* The map and face sizes from the corners: 0 when the tetrahedron is
+ * inverted or flat (no potential). */
+static int tet_now_map(tet_now *t)
 {
-    for (int c = 0; c < 4; c++)
-        for (int i = 0; i < 3; i++) {
-            t->p[c][i] = pos[3 * (size_t)n[c] + i];
-            t->v[c][i] = vel[3 * (size_t)n[c] + i];
-        }
     double e[3][3], (*c)[3] = t->cof;
     for (int k = 0; k < 3; k++) vec3_sub(t->p[k + 1], t->p[0], e[k]);
     vec3_cross(e[1], e[2], c[0]);
     vec3_cross(e[2], e[0], c[1]);
     vec3_cross(e[0], e[1], c[2]);
-    t->det = vec3_dot(e[0], c[0]);
-    if (!(t->det > 0) || !isfinite(t->det)) return 0;
-    t->inv_det = 1.0 / t->det;
+    double det = vec3_dot(e[0], c[0]);
+    if (!(det > 0) || !isfinite(det)) return 0;
+    t->inv_det = 1.0 / det;
     /* tet_face_nodes' faces: 0 (1,2,3) has cross (e1-e0) x (e2-e0) =
      * c0 + c1 + c2, faces 1, 2, 3 have -c0, -c1, -c2 */
     double s[3];
     for (int i = 0; i < 3; i++) s[i] = c[0][i] + c[1][i] + c[2][i];
     t->face_len2[0] = vec3_dot(s, s);
     for (int k = 0; k < 3; k++) t->face_len2[k + 1] = vec3_dot(c[k], c[k]);
+    return 1;
+}
+
+/* Tetrahedron n now. An element is in about four shut faces, two of them
+ * met as the pair's first element, so its map is kept in the walk's memo
+ * (contact_pair.h; one slot per element, by a hash of its node list's
+ * address) for the pairs after: the map and face sizes were a sixth of a
+ * broken 3D block's step, worked out twice a face pair. What the memo gives
+ * is what tet_now_map would work out again, bit for bit. */
+static int tet_now_of(const double *pos, const double *vel, const int32_t n[4],
+                      contact_pair_memo *memo, tet_now *t)
+{
+    _Static_assert(offsetof(tet_now, face_len2) - offsetof(tet_now, cof) ==
+                       (TET_NOW_MAP - 4) * sizeof(double),
+                   "the map and face sizes are TET_NOW_MAP numbers in a row");
+    _Static_assert(TET_NOW_MAP <= sizeof memo->face_numbers[0] / sizeof(double),
+                   "memo too small for a map");
+    for (int c = 0; c < 4; c++)
+        for (int i = 0; i < 3; i++) {
+            t->p[c][i] = pos[3 * (size_t)n[c] + i];
+            t->v[c][i] = vel[3 * (size_t)n[c] + i];
+        }
+    if (!memo) return tet_now_map(t);
+    unsigned slot = (unsigned)(((uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15u) >> 58);
+    _Static_assert(CONTACT_MEMO_SLOTS == 64, "slot is 6 bits");
+    double *map = &t->cof[0][0];
+    if (memo->face_node[slot] == n) {
+        memcpy(map, memo->face_numbers[slot], TET_NOW_MAP * sizeof(double));
+        return 1;
+    }
+    if (!tet_now_map(t)) return 0;
+    memo->face_node[slot] = n;
+    memcpy(memo->face_numbers[slot], map, TET_NOW_MAP * sizeof(double));
     return 1;
 }
 
@@ -114,8 +148,8 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
         fb[k] = fm->copy_in_b[k];
     }
     double d[3], i0 = 0, w[3], touch = 0, n[3] = {0, 0, 0}, area = 0;
-    int touched = tet_now_of(in->pos, in->vel, in->node_a, &a) &&
-                  tet_now_of(in->pos, in->vel, in->node_b, &b);
+    int touched = tet_now_of(in->pos, in->vel, in->node_a, in->memo, &a) &&
+                  tet_now_of(in->pos, in->vel, in->node_b, in->memo, &b);
     if (touched) {
         double m[3][3], e1[3], e2[3];
         for (int k = 0; k < 3; k++)

@@ -46,11 +46,15 @@
 typedef struct contact_pair_memo {
     const int32_t *node[CONTACT_MEMO_SLOTS]; /* whose numbers a slot holds (its node list) */
     double numbers[CONTACT_MEMO_SLOTS][14];
+    /* the shut-face kernel's own (contact_face_tet.c): its numbers differ
+     * from the general kernel's, and an element meets both in one walk */
+    const int32_t *face_node[CONTACT_MEMO_SLOTS];
+    double face_numbers[CONTACT_MEMO_SLOTS][14];
 } contact_pair_memo;
 
 static inline void contact_pair_memo_clear(contact_pair_memo *memo)
 {
-    for (int s = 0; s < CONTACT_MEMO_SLOTS; s++) memo->node[s] = 0;
+    for (int s = 0; s < CONTACT_MEMO_SLOTS; s++) memo->node[s] = memo->face_node[s] = 0;
 }
 
 typedef struct contact_pair_in {
