@@ -53,8 +53,8 @@ static inline int joint_is_excavated(const fdem_model *m, int j)
 /* The cohesive constants of a joint of strength s at stiffness k. */
 static inline joint_law joint_law_of(const joint_strength *s, double k)
 {
-    return (joint_law){k, s->tensile_strength, s->cohesion, s->tan_phi, s->energy_I,
-                       s->energy_II};
+    return joint_law_make(k, s->tensile_strength, s->cohesion, s->tan_phi, s->energy_I,
+                          s->energy_II);
 }
 /* The central-difference limit of a joint node of mass `mass` held by
  * stiffness k (all its joints, both faces), with a 0.9 margin. */

@@ -32,13 +32,18 @@
 #include <float.h>
 #include <math.h>
 
-/* One material's cohesive constants for one joint. */
+/* One material's cohesive constants for one joint, and two figures of
+ * them that a damaged joint's points asked for again and again (a damaged
+ * 3D joint worked out f_t / k four times a point): make it with
+ * joint_law_make, which works them out once, by the same operations. */
 typedef struct joint_law {
     double k;                /* penalty / h: traction per unit opening or sliding */
     double tensile_strength; /* f_t */
     double cohesion;         /* c */
     double tan_phi;          /* tan of the friction angle */
     double energy_I, energy_II;
+    double dp;               /* f_t / k: the opening at the elastic limit */
+    double span_I;           /* softening_span(f_t, dp, energy_I) */
 } joint_law;
 
 /* What a joint's points book over one evaluation. */
@@ -88,6 +93,15 @@ static inline double softening_span(double f, double p, double G)
     return span > p ? span : p;
 }
 
+static inline joint_law joint_law_make(double k, double tensile_strength, double cohesion,
+                                       double tan_phi, double energy_I, double energy_II)
+{
+    joint_law law = {k, tensile_strength, cohesion, tan_phi, energy_I, energy_II, 0, 0};
+    law.dp = tensile_strength / k;
+    law.span_I = softening_span(tensile_strength, law.dp, energy_I);
+    return law;
+}
+
 /* What one integration point keeps from step to step: its plastic slide
  * (the part of the sliding that friction let through, in the face's own
  * frame) and its accumulated slip (the length of the path that plastic
@@ -120,9 +134,8 @@ typedef struct joint_point {
 static inline void joint_point_parts(const joint_law *law, const joint_point *g, double *dn,
                                      double *ds)
 {
-    double k = law->k, ft = law->tensile_strength;
-    double dp = ft / k, sp = g->fs / k;
-    *dn = g->delta > dp ? (g->delta - dp) / softening_span(ft, dp, law->energy_I) : 0;
+    double k = law->k, dp = law->dp, sp = g->fs / k;
+    *dn = g->delta > dp ? (g->delta - dp) / law->span_I : 0;
     *ds = g->slip.path > 0 ? g->slip.path / softening_span(g->fs, sp, law->energy_II) : 0;
 }
 
@@ -208,7 +221,7 @@ static inline double joint_points_damage(const joint_point *g, int count, double
  * as friction. Each of the three is >= 0 at every step. */
 static inline double joint_phi(const joint_law *law, const joint_point *g)
 {
-    double k = law->k, ft = law->tensile_strength, dp = ft / k, phi = 0;
+    double k = law->k, ft = law->tensile_strength, dp = law->dp, phi = 0;
     if (g->delta > 0)
         phi += g->delta <= dp ? 0.5 * k * g->delta * g->delta : ft * (g->delta - 0.5 * dp);
     double e0 = g->slide[0] - g->slip.plastic[0], e1 = g->slide[1] - g->slip.plastic[1];
@@ -220,7 +233,7 @@ static inline double joint_phi(const joint_law *law, const joint_point *g)
 static inline void joint_point_traction(const joint_law *law, const joint_point *g, double z,
                                         double *sigma, double tau[2])
 {
-    double k = law->k, ft = law->tensile_strength, dp = ft / k;
+    double k = law->k, ft = law->tensile_strength, dp = law->dp;
     /* compression is resisted over the shut part of the face by each
      * dimension's kernel, integrated exactly */
     *sigma = g->delta > 0 ? ft * fmin(g->delta / dp, 1.0) * z : 0;

@@ -241,7 +241,7 @@ static void checkpoint_keeps_events(void)
  * limits, over the softening spans. */
 static void mode_rule(void)
 {
-    joint_law law = {1e12, 1e6, 3e6, tan(30 * M_PI / 180), 10, 50};
+    joint_law law = joint_law_make(1e12, 1e6, 3e6, tan(30 * M_PI / 180), 10, 50);
     double dp = 1e6 / 1e12, sp = 3e6 / 1e12;
     double span_n = softening_span(1e6, dp, 10), span_s = softening_span(3e6, sp, 50);
     struct { double dn, ds; int mode; } cases[] = {

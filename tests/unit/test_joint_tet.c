@@ -22,7 +22,7 @@ static const double FT = 1e6, COHESION = 3e6, PHI_DEG = 30, GI = 10, GII = 50;
 
 static joint_law law_of(void)
 {
-    joint_law L = {10 * 3e10 / 0.01, FT, COHESION, tan(PHI_DEG * M_PI / 180), GI, GII};
+    joint_law L = joint_law_make(10 * 3e10 / 0.01, FT, COHESION, tan(PHI_DEG * M_PI / 180), GI, GII);
     return L;
 }
 
