@@ -4,7 +4,7 @@
  * (issue 37 item 5). METIS k-way on the element dual graph (elements
  * sharing an edge in 2D, a face in 3D); then, with each node owned by the
  * part of its first element and the border of two parts split between
- * them, as runner/mpi/rank_engine.c owns them (split_borders):
+ * them, as the rank engine owns them (runner/mpi/rank_borders.h):
  *   halo    elements a part computes beside its own (they touch a node it
  *           owns), as a fraction of its own: the redundant work;
  *   bytes   what a part receives each step in a halo-only exchange of
@@ -23,30 +23,11 @@
 #include "fdem.h"
 #include "math/clock.h"
 #include "mesh/mesh_3d.h"
+#include "../../runner/mpi/rank_borders.h"
 
 /* Process CPU seconds: on a shared machine the wall time of METIS says
  * more about the neighbours than about METIS. */
 static double now(void) { return clock_seconds_of(CLOCK_PROCESS_CPUTIME_ID); }
-
-/* rank_engine.c's split_borders: each node on the border of exactly two
- * parts a < b, the first half of the pair's (in node order) to a, the rest
- * to b (parts <= 64). */
-static void split_borders(const int32_t *en, int ne, int K, int nn, const idx_t *part,
-                          int parts, int32_t *owner)
-{
-    uint64_t *touch = calloc((size_t)nn, sizeof *touch);
-    int *count = calloc((size_t)parts * parts * 2, sizeof(int)), *seen = count + parts * parts;
-    for (int e = 0; e < ne; e++)
-        for (int c = 0; c < K; c++) touch[en[(size_t)K * e + c]] |= (uint64_t)1 << part[e];
-    for (int pass = 0; pass < 2; pass++)
-        for (int n = 0; n < nn; n++) {
-            if (__builtin_popcountll(touch[n]) != 2) continue;
-            int a = __builtin_ctzll(touch[n]), b = 63 - __builtin_clzll(touch[n]);
-            if (pass == 0) count[a * parts + b]++;
-            else owner[n] = seen[a * parts + b]++ < count[a * parts + b] / 2 ? a : b;
-        }
-    free(touch), free(count);
-}
 
 /* Halo and bytes of one partition (part per element). */
 static void halo_figures(const int32_t *en, int ne, int K, int nn, int D, const idx_t *part,
@@ -61,7 +42,10 @@ static void halo_figures(const int32_t *en, int ne, int K, int nn, int D, const 
     for (int e = 0; e < ne; e++)
         for (int c = 0; c < K; c++)
             if (owner[en[(size_t)K * e + c]] < 0) owner[en[(size_t)K * e + c]] = (int32_t)part[e];
-    split_borders(en, ne, K, nn, part, parts, owner);
+    int32_t *part32 = malloc(sizeof(int32_t) * (size_t)ne);
+    for (int e = 0; e < ne; e++) part32[e] = (int32_t)part[e];
+    rank_split_borders(en, ne, K, nn, part32, 1, parts, owner);
+    free(part32);
     for (int e = 0; e < ne; e++) own[part[e]]++;
     /* per part p: the elements touching a node of p that are not p's */
     for (int p = 0; p < parts; p++) {

@@ -9,7 +9,7 @@
  * unit of ownership (rank_partition.c): a rank computes every element of
  * its blocks, so their block sums are whole, and it owns the nodes whose
  * first element (lowest index) lies in one of its blocks, but for the
- * border of two ranks, which they split (split_borders). It also computes
+ * border of two ranks, which they split (rank_borders.h). It also computes
  * every element touching an owned node (the halo), in the same plan order
  * (step_share.elem_mark, core/element/element.c), so an owned node's force
  * is the one process's sum, bit for bit. Two exchanges complete a step:
@@ -44,6 +44,7 @@
 #include "math/clock.h"
 #include "element/element.h"
 #include "rank_engine.h"
+#include "rank_borders.h"
 #include "rank_halo.h"
 
 struct rank_engine {
@@ -203,41 +204,6 @@ static int list_by_owner(const int32_t *owner, int n, int size, int width, int32
     return 0;
 }
 
-/* The nodes on the border of exactly two ranks a < b, split between them:
- * the first half of each pair's (in node order) to a, the rest to b. The
- * owner of a node computes the other rank's elements around it, so giving
- * all of a border to one side (its first element's, as node_owner holds
- * on entry) puts the whole halo on that side: 5 % more elements on one of
- * two ranks for a 384k-tetrahedron box. Meshes numbered in space order
- * make each half one piece of the border, so the halo splits in two
- * rather than growing. Every rank gets the same owners. Up to 64 ranks
- * (a mask per node); -1 when out of memory. */
-static int split_borders(const rank_engine *re, const fdem_model *m, int32_t *node_owner)
-{
-    if (re->size > 64 || re->size < 2) return 0;
-    const int K = m->elem_nodes, N = m->node_count, P = re->size;
-    uint64_t *touch = calloc((size_t)N + 1, sizeof *touch);
-    int *pair_count = calloc((size_t)P * P * 2, sizeof(int));
-    if (!touch || !pair_count) {
-        free(touch), free(pair_count);
-        return -1;
-    }
-    int *pair_seen = pair_count + P * P;
-    for (int e = 0; e < m->elem_count; e++)
-        for (int c = 0; c < K; c++)
-            touch[m->elem_node[(size_t)K * e + c]] |= (uint64_t)1 << re->block_owner[block_of(re, e)];
-    for (int pass = 0; pass < 2; pass++)
-        for (int n = 0; n < N; n++) {
-            uint64_t t = touch[n];
-            if (__builtin_popcountll(t) != 2) continue;
-            int a = __builtin_ctzll(t), b = 63 - __builtin_clzll(t), k = a * P + b;
-            if (pass == 0) pair_count[k]++;
-            else node_owner[n] = pair_seen[k]++ < pair_count[k] / 2 ? a : b;
-        }
-    free(touch), free(pair_count);
-    return 0;
-}
-
 /* Node owners (the owner of the block of each node's first element, the
  * border of two ranks split between them, rank 0 for a node of no
  * element) and the marks of the elements this rank computes: its blocks'
@@ -251,7 +217,9 @@ static int assign_nodes_and_marks(rank_engine *re, const fdem_model *m, int32_t 
             int32_t n = m->elem_node[(size_t)K * e + c];
             if (node_owner[n] < 0) node_owner[n] = re->block_owner[block_of(re, e)];
         }
-    if (split_borders(re, m, node_owner)) return -1;
+    if (rank_split_borders(m->elem_node, E, K, m->node_count, re->block_owner, re->block_size,
+                           re->size, node_owner))
+        return -1;
     long owned_nodes = 0;
     for (int i = 0; i < m->node_count; i++) {
         if (node_owner[i] < 0) node_owner[i] = 0;
