@@ -11,6 +11,7 @@
  * formed in the order the serial loop forms it, the same bits on any
  * thread count.
  */
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,9 +40,11 @@ typedef struct pair_rows {
  * by pair: the scatter after the threads would otherwise look each up in
  * the candidate arrays, a cache miss a pair, a tenth of a broken 3D
  * block's 2-thread step on one thread), those whose springs the pool is
- * to adopt (slots each) or let go. */
+ * to adopt (slots each) or let go, and in a split walk those that kept
+ * their set with its springs as the kernel left them (slots each: the
+ * kernel updates a set in place, and the other processes hold it too). */
 typedef struct contact_touches {
-    pair_rows touched, adopt, release;
+    pair_rows touched, adopt, release, kept;
 } contact_touches;
 
 static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
@@ -266,7 +269,8 @@ static int contact_pairs_forces_serial(fdem_model *m, double h, const near_walk 
 static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
                                                                      const near_walk *w,
                                                                      long begin, long end,
-                                                                     contact_touches *list, int D)
+                                                                     contact_touches *list, int D,
+                                                                     int split)
 {
     const contact_state *cs = &m->contact;
     contact_pair_memo memo;
@@ -279,6 +283,10 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
         int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
+        if (split && pool == SPRINGS_KEPT && cs->spring_of[k] >= 0 &&
+            pair_rows_push(&list->kept, k, cs->slip + (size_t)cs->slots * (size_t)cs->spring_of[k],
+                           cs->slots))
+            return -1;
         if (touched <= 0) continue;
         touching++;
         if (pair_rows_push(&list->touched, touched_key(np->a, np->b), force, cs->pair_out))
@@ -304,8 +312,8 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3)
-                               : pairs_forces_listed(m, h, w, begin, end, list, 2);
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3, 0)
+                               : pairs_forces_listed(m, h, w, begin, end, list, 2, 0);
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
@@ -331,6 +339,222 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
     return touching;
 }
 
+/*
+ * The walk split between processes (step_share.contact_ranks > 1: the rank
+ * engine, runner/mpi). Process r of R evaluates the near pairs at indices
+ * [n r / R, n (r + 1) / R) of the near list and the vertex pairs whose index
+ * in near_vertex lies in the same share of near_vertex (this step's
+ * vertex_walk changes every step; its values, being ascending, give each
+ * process one run of it), on its threads as above, and lists what they did;
+ * contact_gather hands every process every list, and each applies them,
+ * the near list's in process order, then the vertex pairs' in process
+ * order: pair order, so every node's sum and every spring-pool operation
+ * come in the order the threaded walk makes them, the same bits on any
+ * process count.
+ *
+ * A process always evaluates the same pairs between two rebuilds of the
+ * near list (the shares are fixed index ranges of arrays that change only
+ * at a rebuild), so the hints the walk leaves in a near pair (gap raised by
+ * a clearance, sprung, NEAR_EDGES_TRIED) are always its own; a rebuild
+ * derives them from what every process holds alike (the boxes, the spring
+ * pool, the shut marks). The springs a pair keeps are updated in place by
+ * its kernel: they travel in the kept lists, so every process's pool stays
+ * the one process's.
+ *
+ * On the wire (8-byte items), for each of the two walks: the counts of
+ * touched, kept, released and adopted pairs (4 uint64), then the touched
+ * keys (int64) and forces (pair_out doubles each), the kept pairs (int64)
+ * and springs (slots doubles each), the released pairs (int64), the
+ * adopted pairs (int64) and springs (slots doubles each).
+ */
+
+/* Room for `need` bytes on the wire; -1 when out of memory. */
+static int wire_reserve(contact_state *cs, size_t need)
+{
+    if (need <= cs->wire_capacity) return 0;
+    size_t cap = cs->wire_capacity ? 2 * cs->wire_capacity : 4096;
+    while (cap < need) cap *= 2;
+    unsigned char *w = realloc(cs->wire, cap);
+    if (!w) return -1;
+    cs->wire = w;
+    cs->wire_capacity = cap;
+    return 0;
+}
+
+static unsigned char *wire_put(unsigned char *at, const void *data, size_t bytes)
+{
+    if (bytes) memcpy(at, data, bytes);
+    return at + bytes;
+}
+
+/* The keys and then the rows of one kind of list of threads [0, used), in
+ * thread order. */
+static unsigned char *wire_put_rows(unsigned char *at, const contact_touches *lists, int used,
+                                    size_t kind, int width)
+{
+    for (int t = 0; t < used; t++) {
+        const pair_rows *r = (const pair_rows *)((const char *)&lists[t] + kind);
+        at = wire_put(at, r->pair, sizeof(long) * r->count);
+    }
+    for (int t = 0; t < used; t++) {
+        const pair_rows *r = (const pair_rows *)((const char *)&lists[t] + kind);
+        at = wire_put(at, r->row, sizeof(double) * (size_t)width * r->count);
+    }
+    return at;
+}
+
+/* The lists of threads [0, used) appended to the wire at *bytes; -1 when
+ * out of memory. */
+static int wire_append(contact_state *cs, const contact_touches *lists, int used, size_t *bytes)
+{
+    const size_t kinds[4] = {offsetof(contact_touches, touched), offsetof(contact_touches, kept),
+                             offsetof(contact_touches, release), offsetof(contact_touches, adopt)};
+    const int width[4] = {cs->pair_out, cs->slots, 0, cs->slots};
+    uint64_t count[4] = {0, 0, 0, 0};
+    size_t need = sizeof count;
+    for (int k = 0; k < 4; k++) {
+        for (int t = 0; t < used; t++)
+            count[k] += ((const pair_rows *)((const char *)&lists[t] + kinds[k]))->count;
+        need += (size_t)count[k] * (sizeof(long) + sizeof(double) * (size_t)width[k]);
+    }
+    if (wire_reserve(cs, *bytes + need)) return -1;
+    unsigned char *at = wire_put(cs->wire + *bytes, count, sizeof count);
+    for (int k = 0; k < 4; k++) at = wire_put_rows(at, lists, used, kinds[k], width[k]);
+    *bytes += need;
+    return 0;
+}
+
+/* One walk's lists of one process, as wire_append laid them out at p,
+ * applied: the touched pairs' forces added, the kept springs written back,
+ * the released sets let go, the adopted ones taken (touching NULL: only
+ * stepped over). Returns the pointer past them and adds the touched pairs
+ * to *touching; NULL when the pool cannot grow or the bytes run past end. */
+static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
+                                       const unsigned char *end, int *touching)
+{
+    contact_state *cs = &m->contact;
+    uint64_t count[4];
+    if ((size_t)(end - p) < sizeof count) return NULL;
+    memcpy(count, p, sizeof count);
+    p += sizeof count;
+    const size_t out = (size_t)cs->pair_out, slots = (size_t)cs->slots;
+    const size_t row[4] = {out, slots, 0, slots};
+    size_t need = 0;
+    for (int k = 0; k < 4; k++) {
+        if (count[k] > (size_t)(end - p)) return NULL;
+        need += (size_t)count[k] * (sizeof(long) + sizeof(double) * row[k]);
+    }
+    if (need > (size_t)(end - p)) return NULL;
+    if (!touching) return p + need;
+    const long *key = (const long *)p;
+    const double *rows = (const double *)(key + count[0]);
+    for (size_t i = 0; i < count[0]; i++)
+        contact_pair_scatter(m, touched_a(key[i]), touched_b(key[i]), rows + i * out);
+    *touching += (int)count[0];
+    const long *kept = (const long *)(rows + count[0] * out);
+    const double *springs = (const double *)(kept + count[1]);
+    for (size_t i = 0; i < count[1]; i++)
+        memcpy(cs->slip + slots * (size_t)cs->spring_of[kept[i]], springs + i * slots,
+               sizeof(double) * slots);
+    const long *release = (const long *)(springs + count[1] * slots);
+    for (size_t i = 0; i < count[2]; i++) contact_springs_release(cs, (size_t)release[i]);
+    const long *adopt = release + count[2];
+    springs = (const double *)(adopt + count[3]);
+    for (size_t i = 0; i < count[3]; i++)
+        if (contact_springs_adopt(cs, (size_t)adopt[i], springs + i * slots)) return NULL;
+    return (const unsigned char *)(springs + count[3] * slots);
+}
+
+/* The first position of an ascending index list at or past value v. */
+static size_t lower_bound(const int32_t *v, size_t n, long x)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (v[mid] < x) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* This process's share [begin, end) of pairs [0, n) of the near array
+ * (or of near_vertex, by index value, when w->index is set). */
+static void walk_share(const near_walk *w, size_t n, int rank, int ranks, long *begin, long *end)
+{
+    long lo = (long)(n * (size_t)rank / (size_t)ranks);
+    long hi = (long)(n * (size_t)(rank + 1) / (size_t)ranks);
+    if (!w->index) {
+        *begin = lo;
+        *end = hi;
+        return;
+    }
+    *begin = (long)lower_bound(w->index, w->count, lo);
+    *end = (long)lower_bound(w->index, w->count, hi);
+}
+
+/* Pairs [begin, end) of walk w listed on this process's threads; *used the
+ * lists filled (thread order). 0, or -1 when a list cannot grow. */
+static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
+                       int *used)
+{
+    contact_state *cs = &m->contact;
+    long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
+    int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
+    if (contact_touch_lists(cs, threads)) return -1;
+    contact_touches *lists = cs->touches;
+    int failed = 0, nt_used = 1;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        if (t == 0) nt_used = nt;
+        contact_touches *list = &lists[t];
+        list->touched.count = list->adopt.count = list->release.count = list->kept.count = 0;
+        long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3, 1)
+                               : pairs_forces_listed(m, h, w, b, e, list, 2, 1);
+        if (mine < 0) {
+#pragma omp atomic write
+            failed = 1;
+        }
+    }
+    *used = nt_used;
+    cs->split_threaded += nt_used > 1;
+    return failed ? -1 : 0;
+}
+
+static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk walks[2])
+{
+    contact_state *cs = &m->contact;
+    const step_share *share = m->share;
+    const size_t totals[2] = {cs->near_count, cs->near_vertex_count};
+    size_t bytes = 0;
+    int ok = 1;
+    for (int k = 0; k < 2 && ok; k++) {
+        long begin, end;
+        int used;
+        walk_share(&walks[k], totals[k], share->contact_rank, share->contact_ranks, &begin, &end);
+        cs->pairs_walked += end - begin;
+        ok = walk_listed(m, h, &walks[k], begin, end, &used) == 0 &&
+             wire_append(cs, cs->touches, used, &bytes) == 0;
+    }
+    /* every process takes part, failed or not: none is left waiting */
+    const unsigned char *all;
+    const size_t *at;
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, &all, &at)) return -1;
+    int touching = 0;
+    for (int k = 0; k < 2; k++)
+        for (int r = 0; r < share->contact_ranks; r++) {
+            const unsigned char *p = all + at[r], *end = all + at[r + 1];
+            if (k == 1 && !(p = wire_apply(m, p, end, NULL))) return -1; /* past the near list's */
+            if (!wire_apply(m, p, end, &touching)) return -1;
+        }
+    return touching;
+}
+
 /* The near list, then this step's vertex pairs (contact_near.c), each in
  * pair order: the same sums in the same order on any thread count. Threads
  * only pay off with enough pairs; without room for their lists a walk
@@ -341,6 +565,8 @@ int contact_pairs_forces(fdem_model *m, double h)
     contact_state *cs = &m->contact;
     const near_walk walks[2] = {{cs->near, NULL, cs->near_count},
                                 {cs->near_vertex, cs->vertex_walk, cs->vertex_walk_count}};
+    if (m->share && m->share->contact_ranks > 1) return contact_pairs_forces_split(m, h, walks);
+    cs->pairs_walked += (long)(walks[0].count + walks[1].count);
     int touching = 0;
     for (int k = 0; k < 2; k++) {
         int t;
@@ -366,8 +592,9 @@ size_t contact_walk_bytes(const contact_state *cs)
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
         b += pair_rows_bytes(&cs->touches[t].release, 0);
+        b += pair_rows_bytes(&cs->touches[t].kept, cs->slots);
     }
-    return b;
+    return b + cs->wire_capacity;
 }
 
 void contact_walk_free(contact_state *cs)
@@ -376,6 +603,8 @@ void contact_walk_free(contact_state *cs)
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
         pair_rows_free(&cs->touches[t].release);
+        pair_rows_free(&cs->touches[t].kept);
     }
     free(cs->touches);
+    free(cs->wire);
 }
