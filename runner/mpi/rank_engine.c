@@ -71,6 +71,7 @@ struct rank_engine {
     int contact_gathered;            /* its lists were exchanged in this step */
     int contact_fault;               /* rank_engine_set_contact_fault */
     int contact_turn;                /* the rotation fault: rank r takes share r + turn */
+    long long fault_step;            /* the step being made (the failure fault) */
     long long *contact_sizes;        /* per rank: the bytes of its lists, -1 failed */
     int *contact_counts, *contact_displs; /* per rank, for MPI_Allgatherv */
     size_t *contact_at;              /* per rank and one past: where its lists start */
@@ -204,6 +205,9 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     rank_engine *re = ctx;
     re->contact_gathered = 1;
     const int P = re->size, me = re->rank;
+    if (re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
+        re->fault_step == RANK_CONTACT_FAIL_STEP)
+        ok = 0; /* as if a list could not grow here */
     long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
     stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgather(&size, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
@@ -494,6 +498,7 @@ int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
     re->exchanged = re->agreed = re->local_bad = re->others_bad = re->contact_gathered = 0;
     if (re->size == 1) return fdem_step(m, err); /* nothing to share */
+    re->fault_step = m->step + 1;
     /* the rotation fault: each step another share of the pairs */
     if (re->contact_fault == RANK_CONTACT_FAULT_ROTATE) {
         re->contact_turn = (int)(m->step % re->size);

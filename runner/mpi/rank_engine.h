@@ -93,8 +93,12 @@ void rank_engine_set_border_order_fault(rank_engine *re, int on);
  * pool's order change); ROTATE gives each rank another share of the pairs
  * every step (the hints the walk keeps in a near pair go stale). Either
  * must make the state differ from one process where pairs of two ranks
- * meet at a node. */
-enum { RANK_CONTACT_FAULT_NONE, RANK_CONTACT_FAULT_ORDER, RANK_CONTACT_FAULT_ROTATE };
+ * meet at a node. FAIL makes the last rank's walk fail at step
+ * RANK_CONTACT_FAIL_STEP, as if its lists could not grow: every rank must
+ * fail that step, none left waiting. */
+enum { RANK_CONTACT_FAULT_NONE, RANK_CONTACT_FAULT_ORDER, RANK_CONTACT_FAULT_ROTATE,
+       RANK_CONTACT_FAULT_FAIL };
+#define RANK_CONTACT_FAIL_STEP 9
 void rank_engine_set_contact_fault(rank_engine *re, int fault);
 
 #endif

@@ -13,7 +13,8 @@ plain process stepping with fdem_step; a rank engine that adds its halo
 elements after its own (rank_compare --fault) must not, nor one that splits
 the contact pair walk wrongly (--contact-fault: the ranks' lists applied in
 reverse rank order, or each rank given another share of the pairs every
-step). The contact cases split their pair walk between the ranks (each rank
+step), and a walk failing on one rank fails the step on every rank. The
+contact cases split their pair walk between the ranks (each rank
 evaluates a share, on 2 ranks of 2 threads on both threads): every rank
 evaluates some pairs, and each pair is evaluated once. A checkpoint written
 on 3 ranks restarts on 2 with the same bits.
@@ -190,6 +191,9 @@ class RanksSameBits(unittest.TestCase):
         cls.fault = cls.run_ranks(4, "--fault")
         cls.contact_faults = {kind: cls.run_ranks(2, "--contact-fault", kind, cases=cls.cases[:2])
                               for kind in ("order", "rotate")}
+        cls.contact_fail = {n: cls.run_ranks(n, "--contact-fault", "fail",
+                                             cases=["--expect-failure"] + cls.cases[:2])
+                            for n in (2, 3)}
 
     @classmethod
     def tearDownClass(cls):
@@ -272,6 +276,20 @@ class RanksSameBits(unittest.TestCase):
             with self.subTest(fault=kind):
                 self.assertEqual(len(lines), len(plain))
                 self.assertNotEqual(lines, plain)
+
+    def test_a_failed_contact_walk_fails_every_rank_together(self):
+        """The last rank's walk failing at step 9 (as if its lists could not
+        grow) fails the step on every rank with one process's bits until
+        then; the run goes on to its next case (no rank left waiting)."""
+        for ranks, lines in self.contact_fail.items():
+            with self.subTest(ranks=ranks):
+                expected = []
+                for case in self.cases[:2]:
+                    plain = self.case_lines(self.plain, case)
+                    expected += [l for l in plain if not l.startswith("step ") or
+                                 int(l.split()[1]) < 9]
+                    expected.append("step 9 failed: out of memory in contact detection at step 9")
+                self.assertEqual(lines, expected)
 
     def test_same_bits_on_1_2_3_4_ranks(self):
         """(and 8, and 2 of one thread, with FDEM_RANKS_FULL=1: make test-ranks;

@@ -23,7 +23,9 @@
  * plain run's, which shows the comparison can fail. --contact-fault order
  * or rotate splits the contact walk wrongly (rank_engine_set_contact_fault:
  * the ranks' lists applied in reverse rank order, or each rank given
- * another share of the pairs every step): the same.
+ * another share of the pairs every step): the same. --contact-fault fail
+ * makes the last rank's walk fail at step 9 (with --expect-failure: every
+ * rank must fail there).
  *
  * --split-threads-min N: a rank's share of the contact walk goes to its
  * threads from N pairs (contact.split_threads_min; small cases' shares are
@@ -176,6 +178,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         MPI_Abort(MPI_COMM_WORLD, 2);
     }
     const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
+    const int stepped = steps - first + 1; /* the figures are per step stepped */
     /* the batch loop's way (made at the first step), but for the fault,
      * which is set before it, and the figures, which time steps only */
     rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
@@ -236,7 +239,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     }
     if (figures && lazy.re) {
         rank_figures f = rank_engine_figures(lazy.re);
-        double most = f.bytes_sent_per_step, step_s = t_step / steps;
+        double most = f.bytes_sent_per_step, step_s = t_step / stepped;
         MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         /* work: the CPU outside the exchanges, where MPI polls for a
@@ -250,12 +253,12 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
                 f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
                                        (double)f.owned_elements : 0.0,
                 f.owned_nodes, f.kept_nodes, f.split_update ? "split" : "replicated",
-                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build, t_step / steps,
-                c_step / steps, f.exchange_seconds / steps, f.exchange_cpu_seconds / steps,
-                (c_step - f.exchange_cpu_seconds) / steps,
+                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build, t_step / stepped,
+                c_step / stepped, f.exchange_seconds / stepped, f.exchange_cpu_seconds / stepped,
+                (c_step - f.exchange_cpu_seconds) / stepped,
                 peak_bytes() / fdem_get_counts(m).elements,
-                (double)f.contact_pairs_walked / (steps - first + 1),
-                f.contact_bytes_sent / (steps - first + 1));
+                (double)f.contact_pairs_walked / stepped,
+                f.contact_bytes_sent / stepped);
         if (rank == 0)
             printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
                    most);
@@ -263,9 +266,9 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     if (figures && rank == 0) {
         fdem_stage_times st = fdem_get_stage_times(m);
         printf("stages per step (s): elements %.6f joints %.6f detection %.6f contact %.6f "
-               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / steps, st.joints / steps,
-               st.detection / steps, st.contact / steps, st.integration / steps, t_step / steps,
-               c_step / steps);
+               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / stepped, st.joints / stepped,
+               st.detection / stepped, st.contact / stepped, st.integration / stepped, t_step / stepped,
+               c_step / stepped);
     }
     rank_engine_lazy_free(&lazy);
     fdem_model_destroy(m);
@@ -280,7 +283,7 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (argc < 4) {
         if (rank == 0) fprintf(stderr, "usage: rank_compare STEPS EVERY [--plain] [--threads T] "
-                                       "[--fault] [--contact-fault order|rotate] [--figures] "
+                                       "[--fault] [--contact-fault order|rotate|fail] [--figures] "
                                        "[--split-threads-min N] "
                                        "[--save-at K FILE] [--restore FILE] "
                                        "CASE.json...\n");
@@ -299,6 +302,7 @@ int main(int argc, char **argv)
             const char *kind = argv[++i];
             o.contact_fault = !strcmp(kind, "order")    ? RANK_CONTACT_FAULT_ORDER
                               : !strcmp(kind, "rotate") ? RANK_CONTACT_FAULT_ROTATE
+                              : !strcmp(kind, "fail")   ? RANK_CONTACT_FAULT_FAIL
                                                         : -1;
             if (o.contact_fault < 0) MPI_Abort(MPI_COMM_WORLD, 2);
         }
