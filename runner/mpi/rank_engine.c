@@ -135,6 +135,22 @@ static void add_halo_after(rank_engine *re, fdem_model *m)
     m->damping_work = damping;
 }
 
+/* The D numbers of each of `count` nodes between a node array (rows
+ * nodes[k]) and a packed one (row k): out = 1 packs, 0 unpacks. A loop of
+ * D copies, not memcpy: a call for each 16 or 24 bytes of 55 k nodes was
+ * a tenth of a contact pile's step on 2 ranks (perf). */
+static void copy_rows(double *node_array, double *packed, const int32_t *nodes, int count, int D,
+                      int out)
+{
+    for (int k = 0; k < count; k++) {
+        double *a = node_array + (size_t)D * nodes[k], *p = packed + (size_t)D * k;
+        if (out)
+            for (int d = 0; d < D; d++) p[d] = a[d];
+        else
+            for (int d = 0; d < D; d++) a[d] = p[d];
+    }
+}
+
 /* Every rank's owned nodes' forces to every rank, each rank's list led by
  * one number saying whether it got here in order (1) or failed before (0,
  * sent by rank_engine_step): a failure on one rank fails the step on all,
@@ -145,8 +161,7 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     const int32_t *mine = re->node_order + re->node_displs[me] / D;
     const int count = ok ? re->node_counts[me] / D : 0;
     re->send[0] = ok;
-    for (int k = 0; k < count; k++)
-        memcpy(re->send + 1 + (size_t)D * k, m->force + (size_t)D * mine[k], sizeof(double) * D);
+    copy_rows(m->force, re->send + 1, mine, count, D, 1);
     stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
                             re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
@@ -154,12 +169,9 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     if (rc != MPI_SUCCESS) return -1;
     for (int r = 0; r < re->size; r++)
         if (re->recv[re->flag_displs[r]] != 1) return -1;
-    for (int r = 0; r < re->size; r++) {
-        const double *from = re->recv + re->flag_displs[r] + 1;
-        const int32_t *nodes = re->node_order + re->node_displs[r] / D;
-        for (int k = 0; k < re->node_counts[r] / D; k++)
-            memcpy(m->force + (size_t)D * nodes[k], from + (size_t)D * k, sizeof(double) * D);
-    }
+    for (int r = 0; r < re->size; r++)
+        copy_rows(m->force, re->recv + re->flag_displs[r] + 1, re->node_order + re->node_displs[r] / D,
+                  re->node_counts[r] / D, D, 0);
     return 0;
 }
 
