@@ -20,11 +20,17 @@
  *  - forces: once every force is added, each rank's owned nodes' forces go
  *    to every rank (MPI_Allgatherv), so every rank holds the whole force.
  * Everything after (the update, constraints, energies) and the joints,
- * contact and fluid run on every rank on the same numbers: the whole state
- * stays replicated, bit-identical on every rank, and nothing of it needs
- * moving when bodies travel. Exchanging the forces (dim doubles a node)
- * rather than positions and velocities (twice that) is what lets the
- * update run everywhere.
+ * contact detection and fluid run on every rank on the same numbers: the
+ * whole state stays replicated, bit-identical on every rank, and nothing
+ * of it needs moving when bodies travel. Exchanging the forces (dim
+ * doubles a node) rather than positions and velocities (twice that) is
+ * what lets the update run everywhere.
+ *
+ * The contact pair walk is split too (step_share.contact_gather,
+ * core/contact/contact_walk.c): each rank evaluates a fixed share of the
+ * near pairs and lists what they did; share_contact_gather hands every
+ * rank every rank's lists (MPI_Allgather of their sizes, MPI_Allgatherv
+ * of their bytes), which every rank applies in rank order, pair order.
  *
  * In a model where nothing after the forces reads nodes anywhere (no
  * contact, joints, fluid, stages: rank_halo_wanted) the update is split

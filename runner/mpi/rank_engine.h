@@ -18,8 +18,8 @@
  *    every rank's lists in rank order: core/contact/contact_walk.c) and, in
  *    models without contact, joints, fluid, stages, fixed parts or a
  *    gravity amplitude (rank_halo.h), the update: a rank updates the nodes
- *    it keeps and receives only border forces. Otherwise joints, contact,
- *    fluid and the update run on every rank (see rank_engine.c).
+ *    it keeps and receives only border forces. Otherwise joints, contact
+ *    detection, fluid and the update run on every rank (see rank_engine.c).
  *  - Errors: -1 with err filled; an error on one rank fails the step on
  *    every rank (collective). MPI and METIS live only in runner/mpi.
  */
