@@ -176,8 +176,8 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     for (int r = 0; r < re->size; r++)
         if (re->recv[re->flag_displs[r]] != 1) return -1;
     for (int r = 0; r < re->size; r++)
-        copy_rows(m->force, re->recv + re->flag_displs[r] + 1, re->node_order + re->node_displs[r] / D,
-                  re->node_counts[r] / D, D, 0);
+        copy_rows(m->force, re->recv + re->flag_displs[r] + 1,
+                  re->node_order + re->node_displs[r] / D, re->node_counts[r] / D, D, 0);
     return 0;
 }
 

@@ -266,9 +266,9 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     if (figures && rank == 0) {
         fdem_stage_times st = fdem_get_stage_times(m);
         printf("stages per step (s): elements %.6f joints %.6f detection %.6f contact %.6f "
-               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / stepped, st.joints / stepped,
-               st.detection / stepped, st.contact / stepped, st.integration / stepped, t_step / stepped,
-               c_step / stepped);
+               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / stepped,
+               st.joints / stepped, st.detection / stepped, st.contact / stepped,
+               st.integration / stepped, t_step / stepped, c_step / stepped);
     }
     rank_engine_lazy_free(&lazy);
     fdem_model_destroy(m);
