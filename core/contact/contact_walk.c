@@ -348,9 +348,10 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
  * process one run of it), on its threads as above, and lists what they did;
  * contact_gather hands every process every list, and each applies them,
  * the near list's in process order, then the vertex pairs' in process
- * order: pair order, so every node's sum and every spring-pool operation
- * come in the order the threaded walk makes them, the same bits on any
- * process count.
+ * order: pair order, so every node's sum is formed as the serial walk forms
+ * it, and the spring pool ends holding the same springs for the same pairs
+ * (which set of the pool holds them may differ, as with threads; nothing
+ * reads that): the same bits on any process count.
  *
  * A process always evaluates the same pairs between two rebuilds of the
  * near list (the shares are fixed index ranges of arrays that change only
