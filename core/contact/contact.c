@@ -1,9 +1,10 @@
 /*
  * contact.c - the contact stage of either dimension: when to run detection,
- * which candidate pairs to evaluate, and how their forces reach the nodes.
- * The force between two elements is a dimension's kernel (contact_pair.h):
- * triangles in contact_tri.c, tetrahedra in contact_tet.c; everything else
- * is the same algorithm for both and is written here once.
+ * which candidate pairs it finds, and the stage's entry point (detection,
+ * then the near list, then the pair walk of contact_walk.c). The force
+ * between two elements is a dimension's kernel (contact_pair.h): triangles
+ * in contact_tri.c, tetrahedra in contact_tet.c; everything else is the
+ * same algorithm for both and is written here once.
  *
  * Detection (nbs.c, nbs_3d.c) runs on bounding circles or spheres inflated
  * by a buffer, and only again once some node has moved more than half the
@@ -26,9 +27,6 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "kernel/contact_pair.h"
 #include "model/model.h"
@@ -36,10 +34,6 @@
 #include "contact_internal.h"
 #include "joint/joint.h"
 #include "parallel/scatter_plan.h"
-
-/* Fewer candidate pairs than this are evaluated on one thread: below it the
- * threads' start-up costs more than they share. */
-#define CONTACT_THREADED_PAIRS 2048
 
 /* The near list (see the top of contact_near.c) is rebuilt every near_step x
  * buffer of travel (detection comes at buffer/2) and holds the pairs whose
@@ -55,205 +49,15 @@ static const contact_kernel contact_kernels[2] = {
     {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, tet_face_pair_force, 0.153, 1.0 / 64},
 };
 
-/* Rows of numbers keyed by a candidate pair, in pair order. */
-typedef struct pair_rows {
-    long *pair;
-    double *row;
-    size_t count, capacity;
-} pair_rows;
-
-/* A thread's share of the pairs: those that touched with their forces
- * (pair_out numbers each; keyed by their two elements, touched_key, not
- * by pair: the scatter after the threads would otherwise look each up in
- * the candidate arrays, a cache miss a pair, a tenth of a broken 3D
- * block's 2-thread step on one thread), those whose springs the pool is
- * to adopt (slots each) or let go. */
-typedef struct contact_touches {
-    pair_rows touched, adopt, release;
-} contact_touches;
-
-static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
-{
-    if (list->count == list->capacity) {
-        size_t cap = list->capacity ? 2 * list->capacity : CONTACT_FIRST_ROWS;
-        long *p = realloc(list->pair, cap * sizeof *p);
-        if (!p) return -1;
-        list->pair = p;
-        if (width) {
-            double *f = realloc(list->row, cap * (size_t)width * sizeof *f);
-            if (!f) return -1;
-            list->row = f;
-        }
-        list->capacity = cap;
-    }
-    list->pair[list->count] = pair;
-    if (width) memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
-    list->count++;
-    return 0;
-}
-
-static long touched_key(int32_t a, int32_t b) { return (long)((uint64_t)(uint32_t)a << 32 | (uint32_t)b); }
-static int32_t touched_a(long key) { return (int32_t)((uint64_t)key >> 32); }
-static int32_t touched_b(long key) { return (int32_t)(uint32_t)key; }
-
-static size_t pair_rows_bytes(const pair_rows *list, int width)
-{
-    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)width);
-}
-
-static void pair_rows_free(pair_rows *list)
-{
-    free(list->pair);
-    free(list->row);
-}
-
 /* Force between two elements whose boxes overlap, both roles, into out
  * (pair_out numbers); springs are the pair's stick springs (updated), h the
- * last step's size, memo the walk's (contact_pair.h; NULL: none). The
- * softer surface sets the penalty; friction is the larger of the two, so
- * giving it on one material is enough. Returns 1 if they touched. Writes
- * nothing in m. */
-static contact_pair_in pair_input(const fdem_model *m, int e1, int e2, double h,
-                                  contact_pair_memo *memo)
-{
-    const material *ma = &m->materials[element_material(m, e1)];
-    const material *mb = &m->materials[element_material(m, e2)];
-    return (contact_pair_in){m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
-                             min2(ma->penalty, mb->penalty),
-                             max2(ma->def.friction, mb->def.friction), h, memo, 0};
-}
-
+ * last step's size, memo the walk's (contact_pair.h; NULL: none). Returns
+ * 1 if they touched. Writes nothing in m. */
 static int contact_pair_force(const fdem_model *m, int e1, int e2, double h, double *springs,
                               double *out, contact_pair_memo *memo)
 {
-    contact_pair_in in = pair_input(m, e1, e2, h, memo);
+    contact_pair_in in = contact_pair_input(m, e1, e2, h, memo);
     return m->contact.kernel->pair_force(&in, springs, out);
-}
-
-/* Adds a pair's forces (contact_pair_force) to the contact force array and
- * what its friction dissipated to the friction account; called in pair
- * order, so every sum is formed in the same order on any thread count. */
-static inline __attribute__((always_inline)) void scatter_nodes(double *f, const int32_t *n1,
-                                                                 const int32_t *n2, int D, int K,
-                                                                 const double *out)
-{
-    for (int c = 0; c < K; c++)
-        for (int d = 0; d < D; d++) f[D * n1[c] + d] += out[D * c + d];
-    for (int c = 0; c < K; c++)
-        for (int d = 0; d < D; d++) f[D * n2[c] + d] += out[D * (K + c) + d];
-}
-
-static void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
-{
-    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
-    if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
-    else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
-    m->friction_energy += out[2 * m->dim * m->elem_nodes];
-    /* every 8th step: a body passing into another stays deep for several
-     * steps, and every step would cost a dense 2D pile ~10 % */
-    if (m->step % CONTACT_PENETRATION_EVERY == 0 && !contact_shut_neighbours(m, e1, e2))
-        contact_penetration_check(m, e1, e2);
-}
-
-/* What a pair's evaluation asks of the spring pool (contact_history.c):
- * done at once on one thread, after the threads in pair order otherwise
- * (the pool is shared; each pair's own set is not). */
-enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
-
-/* A pair's stick springs: its set in the pool (*set >= 0), else `fresh`,
- * zeroed. Both kernels of the walk read and write them the same way. */
-static inline __attribute__((always_inline)) double *pair_springs(contact_state *cs,
-                                                                  const near_pair *np,
-                                                                  double *fresh, int slots,
-                                                                  int32_t *set)
-{
-    *set = cs->spring_of[np->pair];
-    if (*set >= 0) return cs->slip + (size_t)slots * (size_t)*set;
-    for (int s = 0; s < slots; s++) fresh[s] = 0;
-    return fresh;
-}
-
-/* After either kernel: a pair that did not touch has let every spring go
- * (contact_pair.h), so the springs are read only after a touch; a set
- * left holding nothing goes back to the pool, fresh springs holding a
- * force are adopted. Returns `touched`. */
-static inline __attribute__((always_inline)) int pair_springs_settle(near_pair *np, int32_t set,
-                                                                     const double *springs,
-                                                                     int touched, int slots,
-                                                                     int *pool)
-{
-    int any = 0;
-    if (touched > 0)
-        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
-    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
-    if (set < 0 && any) *pool = SPRINGS_ADOPT;
-    np->sprung = any;
-    return touched;
-}
-
-/* Near pair np this step: boxes apart, it lets its springs go (-1);
- * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
- * without a set of springs is evaluated on fresh (zeros); *pool says
- * whether fresh is to be adopted or the pair's set let go (np->sprung
- * says so at once). D is a constant where it is called, so each
- * dimension's walk is compiled on its own with the box and spring loops
- * unrolled. */
-static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, near_pair *np,
-                                                               double h, double *out,
-                                                               double *fresh, int *pool,
-                                                               contact_pair_memo *memo, int D)
-{
-    contact_state *cs = &m->contact;
-    const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
-    const size_t width = 2 * (size_t)D;
-    int32_t a = np->a, b = np->b;
-    *pool = SPRINGS_KEPT;
-    /* shut broken rock first: its kernel ignores the gap the general one
-     * found (a clearance says what the general kernel would do) */
-    if (cs->shut_any && np->topology && cs->elem_shut[a] && cs->elem_shut[b]) {
-        if (np->topology == SHUT_TOPO_VERTEX) { /* left out: as a pair apart */
-            if (np->sprung) {
-                *pool = SPRINGS_RELEASE;
-                np->sprung = 0;
-            }
-            return -1;
-        }
-        /* the two sides of a shut broken joint */
-        int32_t set;
-        double *springs = pair_springs(cs, np, fresh, slots, &set);
-        face_match fm = shut_face_unpack(np->face);
-        contact_pair_in in = pair_input(m, a, b, h, memo);
-        int touched = cs->kernel->face_force(&in, &fm, springs, out);
-        return pair_springs_settle(np, set, springs, touched, slots, pool);
-    }
-    /* a gap over near_apart: apart, boxes not even computed this step */
-    if (np->gap > cs->near_apart ||
-        !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
-        if (np->sprung) {
-            *pool = SPRINGS_RELEASE;
-            np->sprung = 0;
-        }
-        return -1;
-    }
-    int32_t set;
-    double *springs = pair_springs(cs, np, fresh, slots, &set);
-    contact_pair_in in = pair_input(m, a, b, h, memo);
-    in.edge_clearance = !(np->face & NEAR_EDGES_TRIED);
-    int touched = cs->kernel->pair_force(&in, springs, out);
-    if (!touched) np->face |= NEAR_EDGES_TRIED;
-    /* Apart with a clearance c (contact_pair.h): the kernel keeps returning
-     * 0, every spring let go, while the two elements' nodes travel less
-     * than c together. Each node is within sqrt(near_disp2) of its place at
-     * the list's build, now and later, so between now and a later step it
-     * moves less than the two figures' sum, and a node of either element
-     * less than near_apart / 2 now plus near_apart / 2 then (near_apart is
-     * twice the figure, a hair over). As the gap c - near_apart_now the
-     * pair then passes the walk's test above (gap > near_apart) exactly
-     * while c > near_apart_now + near_apart_then: skipped only where the
-     * kernel would have found what it found now, the same bits. The list's
-     * rebuild (and a restore, which rebuilds it) starts from box gaps. */
-    if (!touched && out[0] > 0 && !cs->clearance_off) np->gap = max2(np->gap, out[0] - cs->near_apart);
-    return pair_springs_settle(np, set, springs, touched, slots, pool);
 }
 
 /* Force between two elements, both roles, added to the contact force
@@ -514,12 +318,7 @@ void contact_free(contact_state *cs)
     free(cs->vertex_walk);
     free(cs->vertex_due);
     contact_shut_free(cs);
-    for (int t = 0; t < cs->touch_lists; t++) {
-        pair_rows_free(&cs->touches[t].touched);
-        pair_rows_free(&cs->touches[t].adopt);
-        pair_rows_free(&cs->touches[t].release);
-    }
-    free(cs->touches);
+    contact_walk_free(cs);
     free(cs->slip);
     free(cs->spring_of);
     free(cs->slip_free);
@@ -557,12 +356,12 @@ double contact_stable_dt(const fdem_model *m)
     return dt;
 }
 
-/* The threaded runs' lists, the stick springs (a set index per candidate
+/* The walk's lists (contact_walk.c), the stick springs (a set index per candidate
  * pair, slots doubles per set in the pool: only pairs that touch hold a
  * set), the records set aside across a detection and the near list. */
 size_t contact_memory_bytes(const contact_state *cs)
 {
-    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    size_t b = contact_walk_bytes(cs);
     b += cs->pair_capacity * sizeof(int32_t);
     b += cs->slip_capacity * (sizeof(double) * (size_t)cs->slots + sizeof(int32_t));
     b += cs->record_capacity * sizeof(contact_record);
@@ -571,164 +370,7 @@ size_t contact_memory_bytes(const contact_state *cs)
     b += cs->vertex_due_capacity; /* vertex_start: an int32 an element, with the element arrays */
     /* contact_breaks.c: the spare and mended lists, and its arrays */
     b += 2 * (cs->spare.capacity + cs->fresh.capacity) * sizeof(int32_t) + cs->breaks_bytes;
-    for (int t = 0; t < cs->touch_lists; t++) {
-        b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
-        b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
-        b += pair_rows_bytes(&cs->touches[t].release, 0);
-    }
     return b;
-}
-
-/* One list per thread; 0, or -1 if they cannot be had. */
-static int contact_touch_lists(contact_state *cs, int threads)
-{
-    if (threads <= cs->touch_lists) return 0;
-    contact_touches *t = realloc(cs->touches, sizeof *t * (size_t)threads);
-    if (!t) return -1;
-    memset(t + cs->touch_lists, 0, sizeof *t * (size_t)(threads - cs->touch_lists));
-    cs->touches = t;
-    cs->touch_lists = threads;
-    return 0;
-}
-
-/* A list of near pairs the walk takes this step: the near list whole, or
- * this step's vertex pairs (index into near_vertex). */
-typedef struct near_walk {
-    near_pair *pairs;
-    const int32_t *index; /* NULL: pairs[0 .. count) */
-    size_t count;
-} near_walk;
-
-static inline near_pair *walk_pair(const near_walk *w, size_t i)
-{
-    return w->index ? &w->pairs[w->index[i]] : &w->pairs[i];
-}
-
-/* Every pair of a walk's force, added to the contact force array in its
- * order, one pair at a time. Returns the number of pairs that touched. */
-static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
-                                                                     const near_walk *w, int D)
-{
-    contact_state *cs = &m->contact;
-    contact_pair_memo memo;
-    contact_pair_memo_clear(&memo);
-    int touching = 0;
-    for (size_t i = 0; i < w->count; i++) {
-        near_pair *np = walk_pair(w, i);
-        double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
-        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
-        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, np->pair, fresh)) return -1;
-        if (touched <= 0) continue;
-        contact_pair_scatter(m, np->a, np->b, out);
-        touching++;
-    }
-    return touching;
-}
-
-static int contact_pairs_forces_serial(fdem_model *m, double h, const near_walk *w)
-{
-    return m->dim == 3 ? pairs_forces_serial(m, h, w, 3) : pairs_forces_serial(m, h, w, 2);
-}
-
-/* The same on several threads: each takes a contiguous share of the near
- * pairs and lists the ones that touched with their forces; the lists are then
- * added in thread order, which is pair order. Every node's sum is formed in
- * the order the serial loop forms it: the same bits on any thread count.
- * Returns the number of pairs that touched, or -1 if a list could not grow
- * (nothing has been added then). */
-static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
-                                                                     const near_walk *w,
-                                                                     long begin, long end,
-                                                                     contact_touches *list, int D)
-{
-    const contact_state *cs = &m->contact;
-    contact_pair_memo memo;
-    contact_pair_memo_clear(&memo);
-    int touching = 0;
-    for (long i = begin; i < end; i++) {
-        near_pair *np = walk_pair(w, (size_t)i);
-        long k = (long)np->pair;
-        double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
-        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
-        if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
-        if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
-        if (touched <= 0) continue;
-        touching++;
-        if (pair_rows_push(&list->touched, touched_key(np->a, np->b), force, cs->pair_out))
-            return -1;
-    }
-    return touching;
-}
-
-static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_walk *w)
-{
-    contact_state *cs = &m->contact;
-    long n = (long)w->count;
-    int touching = 0, failed = 0, used = 1;
-    contact_touches *lists = cs->touches;
-#pragma omp parallel num_threads(m->threads) reduction(+ : touching)
-    {
-        int t = 0, nt = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        nt = omp_get_num_threads();
-#endif
-        if (t == 0) used = nt;
-        contact_touches *list = &lists[t];
-        list->touched.count = list->adopt.count = list->release.count = 0;
-        long begin = n * t / nt, end = n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3)
-                               : pairs_forces_listed(m, h, w, begin, end, list, 2);
-        if (mine < 0) {
-#pragma omp atomic write
-            failed = 1;
-        } else {
-            touching += mine;
-        }
-    }
-    if (failed) return -1;
-    for (int t = 0; t < used; t++) {
-        const pair_rows *touched = &lists[t].touched;
-        for (size_t i = 0; i < touched->count; i++) {
-            long key = touched->pair[i];
-            contact_pair_scatter(m, touched_a(key), touched_b(key),
-                                 touched->row + i * (size_t)cs->pair_out);
-        }
-        for (size_t i = 0; i < lists[t].release.count; i++)
-            contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
-        const pair_rows *adopt = &lists[t].adopt;
-        for (size_t i = 0; i < adopt->count; i++)
-            if (contact_springs_adopt(cs, (size_t)adopt->pair[i], adopt->row + i * (size_t)cs->slots))
-                return -1;
-    }
-    return touching;
-}
-
-/* The near list, then this step's vertex pairs (contact_near.c), each in
- * pair order: the same sums in the same order on any thread count. Threads
- * only pay off with enough pairs; without room for their lists a walk
- * stays on one thread. Returns the number of pairs that touched, or -1
- * when out of memory. */
-static int contact_pairs_forces(fdem_model *m, double h)
-{
-    contact_state *cs = &m->contact;
-    const near_walk walks[2] = {{cs->near, NULL, cs->near_count},
-                                {cs->near_vertex, cs->vertex_walk, cs->vertex_walk_count}};
-    int touching = 0;
-    for (int k = 0; k < 2; k++) {
-        int t;
-        if (m->threads > 1 && walks[k].count >= CONTACT_THREADED_PAIRS &&
-            contact_touch_lists(cs, m->threads) == 0)
-            /* a list that cannot grow has already moved some stick springs:
-             * the step fails rather than run the pairs twice */
-            t = contact_pairs_forces_threaded(m, h, &walks[k]);
-        else
-            t = contact_pairs_forces_serial(m, h, &walks[k]);
-        if (t < 0) return -1;
-        touching += t;
-    }
-    return touching;
 }
 
 /* Detection when due, then every candidate pair's force. The stick springs

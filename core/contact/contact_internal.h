@@ -1,6 +1,6 @@
 /*
- * contact_internal.h - what contact.c and contact_near.c share and no other
- * folder needs: a dimension's pair-kernel record, the near-pair record the
+ * contact_internal.h - what contact.c, contact_walk.c and contact_near.c
+ * share and no other folder needs: a dimension's pair-kernel record, the near-pair record the
  * per-step walk streams, the element boxes (inline: the walk's box test is
  * on its hot path), and the near list's two entry points.
  */
@@ -84,6 +84,30 @@ static inline void element_box(const fdem_model *m, int e, double *b)
     if (m->dim == 3) box_of_nodes(m->pos, m->tet[e].node, 3, 4, b);
     else box_of_nodes(m->pos, m->elem[e].node, 2, 3, b);
 }
+
+/* The kernel's input for elements e1 and e2 (contact_pair.h): h the last
+ * step's size, memo the walk's (NULL: none). The softer surface sets the
+ * penalty; friction is the larger of the two, so giving it on one material
+ * is enough. */
+static inline contact_pair_in contact_pair_input(const fdem_model *m, int e1, int e2, double h,
+                                                 contact_pair_memo *memo)
+{
+    const material *ma = &m->materials[element_material(m, e1)];
+    const material *mb = &m->materials[element_material(m, e2)];
+    return (contact_pair_in){m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
+                             min2(ma->penalty, mb->penalty),
+                             max2(ma->def.friction, mb->def.friction), h, memo, 0};
+}
+
+
+/* contact_walk.c: a pair's forces (pair_out numbers, both roles) added to
+ * the contact force array and the friction account, with the penetration
+ * look; every near pair's force this step (the pairs that touched, or -1
+ * when out of memory); what its lists hold, and freeing them. */
+void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out);
+int contact_pairs_forces(fdem_model *m, double h);
+size_t contact_walk_bytes(const contact_state *cs);
+void contact_walk_free(contact_state *cs);
 
 /* contact_near.c: the elements of the near pairs and the `more` pairs (of
  * every candidate pair when near is NULL), once each and in element order,

@@ -276,8 +276,15 @@ typedef struct contact_state {
     int32_t *elem_due;       /* this step: the elements not shut now or last step */
     int elem_due_count;
     int shut_off;            /* tests and benches: the general kernel on every pair */
-    struct contact_touches *touches; /* threaded runs: one list per thread (contact.c) */
+    struct contact_touches *touches; /* threaded runs: one list per thread (contact_walk.c) */
     int touch_lists;         /* how many lists touches holds */
+    unsigned char *wire;     /* a split walk (step_share.contact_gather): this process's lists */
+    size_t wire_capacity;
+    long pairs_walked;       /* near pairs in this process's share of the walks, all steps
+                                (a figure: every pair on one process) */
+    int split_threads_min;   /* tests: the pairs a process's share of a split walk needs
+                                to take threads (0: as one process, contact_walk.c) */
+    long split_threaded;     /* a figure: split walks whose share went to several threads */
     nbs_grid grid;           /* 2D detection */
     nbs_grid_3d grid3;       /* 3D detection */
     nbs_classes classes;     /* graded meshes: size classes on those grids (nbs_classes.h) */
@@ -311,7 +318,18 @@ static inline void contact_detect_after_breaks(contact_state *cs)
  *    as it was, for their owners to hand on.
  *  - update_done: called by fdem_step after the update with this
  *    process's verdict (nonzero: some value it updated is not finite);
- *    returns the verdict of all processes, so that they fail together. */
+ *    returns the verdict of all processes, so that they fail together.
+ *  - contact_ranks, contact_rank: the contact pair walk is split between
+ *    contact_ranks processes (under 2: not split), this one being
+ *    contact_rank (core/contact/contact_walk.c): each evaluates a fixed
+ *    share of the near pairs, lists what they did, and every process
+ *    applies every list in process order.
+ *  - contact_gather: called once a step by a split contact walk on every
+ *    process, with the bytes this process listed (ok 0: it failed, the
+ *    bytes say nothing). Returns 0 with *all every process's bytes one
+ *    after another in process order, process p's from (*at)[p] to
+ *    (*at)[p + 1] (kept until the next call); nonzero when some process
+ *    failed or the exchange did: the step then fails on every process. */
 typedef struct step_share {
     void *ctx;
     const uint8_t *elem_mark;
@@ -319,6 +337,9 @@ typedef struct step_share {
     int (*forces_done)(void *ctx, fdem_model *m);
     const uint8_t *node_mark;
     int (*update_done)(void *ctx, fdem_model *m, int bad);
+    int contact_ranks, contact_rank;
+    int (*contact_gather)(void *ctx, const void *mine, size_t bytes, int ok,
+                          const unsigned char **all, const size_t **at);
 } step_share;
 
 /* The next run of marked items (mark[i] 1, others 0) in [from, end): its

@@ -20,11 +20,17 @@
  *  - forces: once every force is added, each rank's owned nodes' forces go
  *    to every rank (MPI_Allgatherv), so every rank holds the whole force.
  * Everything after (the update, constraints, energies) and the joints,
- * contact and fluid run on every rank on the same numbers: the whole state
- * stays replicated, bit-identical on every rank, and nothing of it needs
- * moving when bodies travel. Exchanging the forces (dim doubles a node)
- * rather than positions and velocities (twice that) is what lets the
- * update run everywhere.
+ * contact detection and fluid run on every rank on the same numbers: the
+ * whole state stays replicated, bit-identical on every rank, and nothing
+ * of it needs moving when bodies travel. Exchanging the forces (dim
+ * doubles a node) rather than positions and velocities (twice that) is
+ * what lets the update run everywhere.
+ *
+ * The contact pair walk is split too (step_share.contact_gather,
+ * core/contact/contact_walk.c): each rank evaluates a fixed share of the
+ * near pairs and lists what they did; share_contact_gather hands every
+ * rank every rank's lists (MPI_Allgather of their sizes, MPI_Allgatherv
+ * of their bytes), which every rank applies in rank order, pair order.
  *
  * In a model where nothing after the forces reads nodes anywhere (no
  * contact, joints, fluid, stages: rank_halo_wanted) the update is split
@@ -37,6 +43,7 @@
  * The elements' viscous history (elem_viscous) is kept only where an
  * element is computed; rank_engine_gather hands rank 0 the owners' values.
  */
+#include <limits.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -67,6 +74,16 @@ struct rank_engine {
     int split;                       /* the update is split (rank_halo.c): border forces only */
     rank_halo border;                /* its nodes and lists */
     int agreed, local_bad, others_bad; /* this step's update verdicts (split) */
+    int contact_split;               /* the contact walk is split (step_share.contact_gather) */
+    int contact_gathered;            /* its lists were exchanged in this step */
+    int contact_fault;               /* rank_engine_set_contact_fault */
+    int contact_turn;                /* the rotation fault: rank r takes share r + turn */
+    long long fault_step;            /* the step being made (the failure fault) */
+    long long *contact_sizes;        /* per rank: the bytes of its lists, -1 failed */
+    int *contact_counts, *contact_displs; /* per rank, for MPI_Allgatherv */
+    size_t *contact_at;              /* per rank and one past: where its lists start */
+    unsigned char *contact_buf;      /* every rank's lists */
+    size_t contact_cap, contact_agreed; /* its size here, and the size every rank has */
     rank_figures fig;
 };
 
@@ -125,6 +142,22 @@ static void add_halo_after(rank_engine *re, fdem_model *m)
     m->damping_work = damping;
 }
 
+/* The D numbers of each of `count` nodes between a node array (rows
+ * nodes[k]) and a packed one (row k): out = 1 packs, 0 unpacks. A loop of
+ * D copies, not memcpy: a call for each 16 or 24 bytes of 55 k nodes was
+ * a tenth of a contact pile's step on 2 ranks (perf). */
+static void copy_rows(double *node_array, double *packed, const int32_t *nodes, int count, int D,
+                      int out)
+{
+    for (int k = 0; k < count; k++) {
+        double *a = node_array + (size_t)D * nodes[k], *p = packed + (size_t)D * k;
+        if (out)
+            for (int d = 0; d < D; d++) p[d] = a[d];
+        else
+            for (int d = 0; d < D; d++) a[d] = p[d];
+    }
+}
+
 /* Every rank's owned nodes' forces to every rank, each rank's list led by
  * one number saying whether it got here in order (1) or failed before (0,
  * sent by rank_engine_step): a failure on one rank fails the step on all,
@@ -135,8 +168,7 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     const int32_t *mine = re->node_order + re->node_displs[me] / D;
     const int count = ok ? re->node_counts[me] / D : 0;
     re->send[0] = ok;
-    for (int k = 0; k < count; k++)
-        memcpy(re->send + 1 + (size_t)D * k, m->force + (size_t)D * mine[k], sizeof(double) * D);
+    copy_rows(m->force, re->send + 1, mine, count, D, 1);
     stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
                             re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
@@ -144,12 +176,9 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     if (rc != MPI_SUCCESS) return -1;
     for (int r = 0; r < re->size; r++)
         if (re->recv[re->flag_displs[r]] != 1) return -1;
-    for (int r = 0; r < re->size; r++) {
-        const double *from = re->recv + re->flag_displs[r] + 1;
-        const int32_t *nodes = re->node_order + re->node_displs[r] / D;
-        for (int k = 0; k < re->node_counts[r] / D; k++)
-            memcpy(m->force + (size_t)D * nodes[k], from + (size_t)D * k, sizeof(double) * D);
-    }
+    for (int r = 0; r < re->size; r++)
+        copy_rows(m->force, re->recv + re->flag_displs[r] + 1,
+                  re->node_order + re->node_displs[r] / D, re->node_counts[r] / D, D, 0);
     return 0;
 }
 
@@ -181,6 +210,70 @@ static int share_update_done(void *ctx, fdem_model *m, int bad)
     stopwatch_add(re, t0);
     re->others_bad = any && !re->local_bad;
     return any;
+}
+
+/* The contact walk's lists (step_share.contact_gather): every rank's
+ * sizes, then their bytes, in rank order (or, for the order fault, in the
+ * reverse order). Every rank sees the same sizes, so each takes the same
+ * path through the collectives: a rank that failed (size -1) fails the
+ * step on all, and the buffer grows on all at the same steps, one
+ * reduction then telling whether it grew everywhere. */
+static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int ok,
+                                const unsigned char **all, const size_t **at)
+{
+    rank_engine *re = ctx;
+    re->contact_gathered = 1;
+    const int P = re->size, me = re->rank;
+    if (re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
+        re->fault_step == RANK_CONTACT_FAIL_STEP)
+        ok = 0; /* as if a list could not grow here */
+    long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
+    stopwatch t0 = stopwatch_now();
+    int rc = MPI_Allgather(&size, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
+    size_t total = 0;
+    for (int r = 0; r < P && rc == MPI_SUCCESS; r++) {
+        if (re->contact_sizes[r] < 0) rc = -1;
+        else total += (size_t)re->contact_sizes[r];
+    }
+    if (rc == MPI_SUCCESS && total > INT_MAX) rc = -1;
+    if (rc == MPI_SUCCESS && total > re->contact_agreed) {
+        size_t cap = total > 2 * re->contact_agreed ? total : 2 * re->contact_agreed;
+        int grown = 1;
+        if (cap > re->contact_cap) {
+            unsigned char *b = realloc(re->contact_buf, cap);
+            if (b) {
+                re->contact_buf = b;
+                re->contact_cap = cap;
+            }
+            grown = b != NULL;
+        }
+        MPI_Allreduce(MPI_IN_PLACE, &grown, 1, MPI_INT, MPI_MIN, re->comm);
+        if (grown) re->contact_agreed = cap;
+        else rc = -1;
+    }
+    if (rc != MPI_SUCCESS) {
+        stopwatch_add(re, t0);
+        return -1;
+    }
+    size_t from = 0;
+    for (int k = 0; k < P; k++) {
+        int r = k; /* the rank whose lists come k-th: the one with share k */
+        if (re->contact_fault == RANK_CONTACT_FAULT_ORDER) r = P - 1 - k;
+        if (re->contact_fault == RANK_CONTACT_FAULT_ROTATE)
+            r = (int)(((k - re->contact_turn) % P + P) % P);
+        re->contact_at[k] = from;
+        re->contact_counts[r] = (int)re->contact_sizes[r];
+        re->contact_displs[r] = (int)from;
+        from += (size_t)re->contact_sizes[r];
+    }
+    re->contact_at[P] = from;
+    rc = MPI_Allgatherv(mine, re->contact_counts[me], MPI_BYTE, re->contact_buf,
+                        re->contact_counts, re->contact_displs, MPI_BYTE, re->comm);
+    stopwatch_add(re, t0);
+    re->fig.contact_bytes_sent += (double)bytes * (P - 1);
+    *all = re->contact_buf;
+    *at = re->contact_at;
+    return rc == MPI_SUCCESS ? 0 : -1;
 }
 
 /* Lists of owned items rank by rank (owner[i] of n items), with the
@@ -318,6 +411,15 @@ static int setup(rank_engine *re, fdem_model *m)
     re->fig.bytes_sent_per_step = re->split ? re->border.bytes_per_step + others * 8.0 * sums
                                             : others * 8.0 * (re->node_counts[re->rank] + sums);
     re->fig.split_update = re->split;
+    re->contact_split = m->contact.enabled && re->size > 1;
+    if (re->contact_split) {
+        re->contact_sizes = malloc(sizeof(long long) * (size_t)re->size);
+        re->contact_counts = malloc(sizeof(int) * 2 * (size_t)re->size);
+        re->contact_at = malloc(sizeof(size_t) * ((size_t)re->size + 1));
+        if (!re->contact_sizes || !re->contact_counts || !re->contact_at) goto done;
+        re->contact_displs = re->contact_counts + re->size;
+    }
+    re->fig.contact_split = re->contact_split;
     re->fig.kept_nodes = re->split ? re->border.kept_nodes : N;
     rc = 0;
 done:
@@ -351,6 +453,11 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
                              .update_done = re->split ? share_update_done : NULL};
     re->halo_share = (step_share){.ctx = re, .elem_mark = re->halo};
     if (m->elem_plan.color_count == 0) re->share.block_sums = NULL;
+    if (re->contact_split) {
+        re->share.contact_ranks = re->size;
+        re->share.contact_rank = re->rank;
+        re->share.contact_gather = share_contact_gather;
+    }
     return re;
 }
 
@@ -358,6 +465,11 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
  * step: it takes part in them saying so, so that none waits for it. */
 static void fail_collectives(rank_engine *re, fdem_model *m)
 {
+    if (re->contact_split && !re->contact_gathered) {
+        const unsigned char *all;
+        const size_t *at;
+        share_contact_gather(re, NULL, 0, 0, &all, &at);
+    }
     if (!re->exchanged) {
         if (re->split) rank_halo_exchange(&re->border, m, 0);
         else exchange_forces(re, m, 0);
@@ -370,11 +482,18 @@ static void fail_collectives(rank_engine *re, fdem_model *m)
 
 int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
-    re->exchanged = re->agreed = re->local_bad = re->others_bad = 0;
+    re->exchanged = re->agreed = re->local_bad = re->others_bad = re->contact_gathered = 0;
     if (re->size == 1) return fdem_step(m, err); /* nothing to share */
+    re->fault_step = m->step + 1;
+    /* the rotation fault: each step another share of the pairs */
+    if (re->contact_fault == RANK_CONTACT_FAULT_ROTATE) {
+        re->contact_turn = (int)(m->step % re->size);
+        re->share.contact_rank = (re->rank + re->contact_turn) % re->size;
+    }
     m->share = &re->share; /* only while stepping: outside a step nothing is collective */
     int rc = fdem_step(m, err);
     m->share = NULL;
+    re->fig.contact_pairs_walked = m->contact.pairs_walked;
     if (rc) fail_collectives(re, m);
     if (rc && re->others_bad) /* this rank's nodes are finite: say whose are not */
         model_error(err, FDEM_ITEM_NONE, -1, "the solution became non-finite at step %lld on "
@@ -479,9 +598,15 @@ void rank_engine_set_border_order_fault(rank_engine *re, int on)
         if (re->halo[e]) re->mark[e] = 0;
 }
 
+void rank_engine_set_contact_fault(rank_engine *re, int fault) { re->contact_fault = fault; }
+
 void rank_engine_free(rank_engine *re)
 {
     if (!re) return;
+    free(re->contact_sizes);
+    free(re->contact_counts);
+    free(re->contact_at);
+    free(re->contact_buf);
     free(re->block_owner);
     free(re->block_order);
     free(re->block_counts);

@@ -13,11 +13,13 @@
  *    makes rank 0's model whole before it writes output or a checkpoint.
  *  - What is split: the element forces (the element blocks of the model's
  *    scatter plan are partitioned with METIS; a rank computes the elements
- *    of its blocks and every element touching a node it owns) and, in
+ *    of its blocks and every element touching a node it owns), the contact
+ *    pair walk (a fixed share of the near pairs a rank; every rank applies
+ *    every rank's lists in rank order: core/contact/contact_walk.c) and, in
  *    models without contact, joints, fluid, stages, fixed parts or a
  *    gravity amplitude (rank_halo.h), the update: a rank updates the nodes
- *    it keeps and receives only border forces. Otherwise joints, contact,
- *    fluid and the update run on every rank (see rank_engine.c).
+ *    it keeps and receives only border forces. Otherwise joints, contact
+ *    detection, fluid and the update run on every rank (see rank_engine.c).
  *  - Errors: -1 with err filled; an error on one rank fails the step on
  *    every rank (collective). MPI and METIS live only in runner/mpi.
  */
@@ -43,6 +45,10 @@ typedef struct rank_figures {
     double exchange_cpu_seconds; /* CPU time there (MPI polling), all steps */
     int split_update;           /* 1: the update is split (rank_halo.h), 0: replicated */
     long kept_nodes;            /* nodes this rank updates (all when replicated) */
+    int contact_split;          /* 1: the contact pair walk is split (rank_engine.c) */
+    long contact_pairs_walked;  /* near pairs in this rank's share, all steps (every pair
+                                   walked, on one rank) */
+    double contact_bytes_sent;  /* the walk's lists sent to the other ranks, all steps */
 } rank_figures;
 
 rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err);
@@ -81,5 +87,18 @@ int rank_partition_blocks(const int32_t *elem_node, int elem_count, int K, int n
  * node sums at the borders are formed in another order; the state then
  * must differ from one process, and the test shows that it does. */
 void rank_engine_set_border_order_fault(rank_engine *re, int on);
+
+/* Tests' knobs for the split contact walk (tests/mpi): ORDER hands the
+ * ranks' lists over in the reverse rank order (border sums and the spring
+ * pool's order change); ROTATE gives each rank another share of the pairs
+ * every step (the hints the walk keeps in a near pair go stale). Either
+ * must make the state differ from one process where pairs of two ranks
+ * meet at a node. FAIL makes the last rank's walk fail at step
+ * RANK_CONTACT_FAIL_STEP, as if its lists could not grow: every rank must
+ * fail that step, none left waiting. */
+enum { RANK_CONTACT_FAULT_NONE, RANK_CONTACT_FAULT_ORDER, RANK_CONTACT_FAULT_ROTATE,
+       RANK_CONTACT_FAULT_FAIL };
+#define RANK_CONTACT_FAIL_STEP 9
+void rank_engine_set_contact_fault(rank_engine *re, int fault);
 
 #endif

@@ -10,7 +10,13 @@ the same positions and velocities. The lines of 1, 2 (of 2 threads each), 3
 and 4 ranks, and with FDEM_RANKS_FULL=1 (make test-ranks) of 8
 oversubscribed and 2 of one thread, must equal those of one
 plain process stepping with fdem_step; a rank engine that adds its halo
-elements after its own (rank_compare --fault) must not. A checkpoint written
+elements after its own (rank_compare --fault) must not, nor one that splits
+the contact pair walk wrongly (--contact-fault: the ranks' lists applied in
+reverse rank order, or each rank given another share of the pairs every
+step), and a walk failing on one rank fails the step on every rank. The
+contact cases split their pair walk between the ranks (each rank
+evaluates a share, on 2 ranks of 2 threads on both threads): every rank
+evaluates some pairs, and each pair is evaluated once. A checkpoint written
 on 3 ranks restarts on 2 with the same bits.
 
 mpirun as root needs OMPI_ALLOW_RUN_AS_ROOT=1 and
@@ -26,6 +32,10 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 STEPS, EVERY = "24", "4"
+# the 2-rank run: 2 threads a rank, each rank's share of the contact walk on
+# both from 64 pairs (a share of these small cases is under the 2048 a walk
+# needs to take threads otherwise)
+TWO = ("--threads", "2", "--split-threads-min", "64")
 # 8 ranks (oversubscribed) and 2 ranks of one thread too: make test-ranks
 FULL = os.environ.get("FDEM_RANKS_FULL") == "1"
 # under the sanitizers (bin-san): 2 and 3 ranks only, unless FULL
@@ -164,7 +174,7 @@ class RanksSameBits(unittest.TestCase):
         cls.plain = cls.run_ranks(0, "--plain")
         # 2 ranks of 2 threads each; the 3-rank run saves the 2D cases after
         # step 10 ("--save-at 0 -" then turns saving off for the 3D cases)
-        cls.ranked = {2: cls.run_ranks(2, "--threads", "2"),
+        cls.ranked = {2: cls.run_ranks(2, *TWO),
                       3: cls.run_ranks(3, cases=["--save-at", "10", cls.checkpoint, cls.cases[0],
                                                  "--save-at", "0", "-", cls.cases[1],
                                                  "--save-at", "10", cls.checkpoint_split,
@@ -179,6 +189,11 @@ class RanksSameBits(unittest.TestCase):
         cls.restarted = cls.run_ranks(2, cases=["--restore", cls.checkpoint, cls.cases[0],
                                                 "--restore", cls.checkpoint_split, cls.cases[2]])
         cls.fault = cls.run_ranks(4, "--fault")
+        cls.contact_faults = {kind: cls.run_ranks(2, "--contact-fault", kind, cases=cls.cases[:2])
+                              for kind in ("order", "rotate")}
+        cls.contact_fail = {n: cls.run_ranks(n, "--contact-fault", "fail",
+                                             cases=["--expect-failure"] + cls.cases[:2])
+                            for n in (2, 3)}
 
     @classmethod
     def tearDownClass(cls):
@@ -222,10 +237,59 @@ class RanksSameBits(unittest.TestCase):
     def test_update_split_without_contact(self):
         """The elastic cases ran the split update (border forces only), the
         contact cases the replicated one: the comparison covers both."""
-        err = self.stderr[(2, "--threads", "2")]
+        err = self.stderr[(2,) + TWO]
         for k, case in enumerate(self.cases):
             mode = "split" if k >= 2 else "replicated"
             self.assertIn("update %s: %s" % (mode, case), err)
+
+    def walked(self, key, case):
+        """Per rank: the near pairs it evaluated and its walks on threads."""
+        for line in self.stderr[key].splitlines():
+            if line.startswith("contact pairs walked ") and line.endswith(": " + case):
+                pairs, threads = line[len("contact pairs walked "):-len(": " + case)].split(" (walks on threads ")
+                return [int(n) for n in pairs.split()], [int(n) for n in threads.rstrip(")").split()]
+        self.fail("no contact pairs walked line for %s on %s" % (case, key))
+
+    def test_contact_walk_split(self):
+        """The contact cases split their pair walk: on 2 ranks each rank
+        evaluated a share (on its 2 threads), and the shares add up to the
+        same pairs on 2, 3 (and 4) ranks: each pair once."""
+        for case in self.cases[:2]:
+            with self.subTest(case=case):
+                pairs, threads = self.walked((2,) + TWO, case)
+                self.assertEqual(len(pairs), 2)
+                self.assertTrue(all(n > 0 for n in pairs), pairs)
+                self.assertTrue(all(n > 0 for n in threads), threads)
+                self.assertLess(max(pairs), 0.6 * sum(pairs))
+                for key in [k for k in self.stderr if k and k[0] in (3, 4) and len(k) == 1]:
+                    self.assertEqual(sum(self.walked(key, case)[0]), sum(pairs), key)
+        for case in self.cases[2:]:  # no contact: nothing to split
+            self.assertFalse([l for l in self.stderr[(2,) + TWO].splitlines()
+                              if l.startswith("contact pairs walked") and l.endswith(": " + case)])
+
+    def test_contact_walk_split_wrongly_differs(self):
+        """The ranks' lists applied in reverse rank order, or each rank
+        evaluating another share every step (the near pairs' hints it keeps
+        go stale): the comparison must see both."""
+        plain = [l for case in self.cases[:2] for l in self.case_lines(self.plain, case)]
+        for kind, lines in self.contact_faults.items():
+            with self.subTest(fault=kind):
+                self.assertEqual(len(lines), len(plain))
+                self.assertNotEqual(lines, plain)
+
+    def test_a_failed_contact_walk_fails_every_rank_together(self):
+        """The last rank's walk failing at step 9 (as if its lists could not
+        grow) fails the step on every rank with one process's bits until
+        then; the run goes on to its next case (no rank left waiting)."""
+        for ranks, lines in self.contact_fail.items():
+            with self.subTest(ranks=ranks):
+                expected = []
+                for case in self.cases[:2]:
+                    plain = self.case_lines(self.plain, case)
+                    expected += [l for l in plain if not l.startswith("step ") or
+                                 int(l.split()[1]) < 9]
+                    expected.append("step 9 failed: out of memory in contact detection at step 9")
+                self.assertEqual(lines, expected)
 
     def test_same_bits_on_1_2_3_4_ranks(self):
         """(and 8, and 2 of one thread, with FDEM_RANKS_FULL=1: make test-ranks;

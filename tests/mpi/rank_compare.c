@@ -20,7 +20,20 @@
  *
  * --fault turns on rank_engine_set_border_order_fault (each rank sums its
  * halo elements after its own blocks): its lines must differ from the
- * plain run's, which shows the comparison can fail.
+ * plain run's, which shows the comparison can fail. --contact-fault order
+ * or rotate splits the contact walk wrongly (rank_engine_set_contact_fault:
+ * the ranks' lists applied in reverse rank order, or each rank given
+ * another share of the pairs every step): the same. --contact-fault fail
+ * makes the last rank's walk fail at step 9 (with --expect-failure: every
+ * rank must fail there).
+ *
+ * --split-threads-min N: a rank's share of the contact walk goes to its
+ * threads from N pairs (contact.split_threads_min; small cases' shares are
+ * otherwise too few for threads).
+ *
+ * With the contact walk split, rank 0 prints to stderr how many near pairs
+ * each rank evaluated and how many of its walks went to several threads
+ * ("contact pairs walked N0 N1 ... (walks on threads T0 T1 ...): CASE").
  */
 #include <mpi.h>
 #include <stdint.h>
@@ -30,6 +43,7 @@
 #include <time.h>
 
 #include "case/case.h"
+#include "model/model.h"
 #include "mpi/rank_engine.h"
 #include "read_file.h"
 
@@ -107,6 +121,8 @@ static int ranks_agree(const fdem_model *m, const uint8_t *mark, MPI_Comm comm)
 
 typedef struct compare_options {
     int steps, every, plain, fault, threads, figures;
+    int contact_fault;        /* RANK_CONTACT_FAULT_*: a wrong split of the contact walk */
+    int split_threads_min;    /* contact.split_threads_min: threads inside a rank's share */
     int expect_failure;       /* the cases must fail at some step (and then pass) */
     int save_at;              /* the step after which rank 0 writes save_path; 0: none */
     const char *save_path;
@@ -154,6 +170,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     }
     problems_free(&out);
     fdem_set_threads(m, o->threads);
+    m->contact.split_threads_min = o->split_threads_min;
     double t_build = MPI_Wtime() - t0;
     fdem_error err = {0};
     if (o->restore_path && restore_checkpoint(m, o->restore_path, &err)) {
@@ -161,17 +178,19 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         MPI_Abort(MPI_COMM_WORLD, 2);
     }
     const int first = (int)fdem_get_step(m) + 1; /* after a restore, the step it holds */
+    const int stepped = steps - first + 1; /* the figures are per step stepped */
     /* the batch loop's way (made at the first step), but for the fault,
      * which is set before it, and the figures, which time steps only */
     rank_engine_lazy lazy = {MPI_COMM_WORLD, NULL, NULL};
     double t_setup = MPI_Wtime();
-    if (!plain && (o->fault || figures)) {
+    if (!plain && (o->fault || o->contact_fault || figures)) {
         if (!(lazy.re = rank_engine_create(m, MPI_COMM_WORLD, &err))) {
             fprintf(stderr, "rank %d: %s\n", rank, err.message);
             MPI_Abort(MPI_COMM_WORLD, 2);
         }
         lazy.model = m;
         if (o->fault) rank_engine_set_border_order_fault(lazy.re, 1);
+        if (o->contact_fault) rank_engine_set_contact_fault(lazy.re, o->contact_fault);
     }
     t_setup = MPI_Wtime() - t_setup;
     if (rank == 0) printf("case %s\n", path);
@@ -202,9 +221,25 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
             if (s == o->save_at && save_checkpoint(m, o->save_path)) status = 1;
         }
     }
+    if (lazy.re && rank_engine_figures(lazy.re).contact_split) {
+        /* how many near pairs each rank evaluated, for the test: each
+         * rank's share of the split walk */
+        long walked[2] = {rank_engine_figures(lazy.re).contact_pairs_walked,
+                          m->contact.split_threaded};
+        long *each = rank == 0 ? malloc(sizeof(long) * 2 * (size_t)size) : NULL;
+        MPI_Gather(walked, 2, MPI_LONG, each, 2, MPI_LONG, 0, MPI_COMM_WORLD);
+        if (rank == 0 && each) {
+            fprintf(stderr, "contact pairs walked");
+            for (int r = 0; r < size; r++) fprintf(stderr, " %ld", each[2 * r]);
+            fprintf(stderr, " (walks on threads");
+            for (int r = 0; r < size; r++) fprintf(stderr, " %ld", each[2 * r + 1]);
+            fprintf(stderr, "): %s\n", path);
+        }
+        free(each);
+    }
     if (figures && lazy.re) {
         rank_figures f = rank_engine_figures(lazy.re);
-        double most = f.bytes_sent_per_step, step_s = t_step / steps;
+        double most = f.bytes_sent_per_step, step_s = t_step / stepped;
         MPI_Allreduce(MPI_IN_PLACE, &most, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         MPI_Allreduce(MPI_IN_PLACE, &step_s, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
         /* work: the CPU outside the exchanges, where MPI polls for a
@@ -212,15 +247,18 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
         fprintf(stderr, "rank %d: blocks %d of %d, elements owned %ld computed %ld (halo %.3f), "
                 "nodes owned %ld kept %ld (update %s), bytes sent/step %.0f, "
                 "partition %.4f s, engine set-up %.2f s, build %.2f s, step %.6f s (cpu %.6f s, "
-                "exchanges %.6f s, cpu there %.6f s: work %.6f s), peak %.0f bytes/element\n",
+                "exchanges %.6f s, cpu there %.6f s: work %.6f s), peak %.0f bytes/element, "
+                "contact pairs walked/step %.0f, contact bytes sent/step %.0f\n",
                 rank, f.owned_blocks, f.blocks, f.owned_elements, f.computed_elements,
                 f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
                                        (double)f.owned_elements : 0.0,
                 f.owned_nodes, f.kept_nodes, f.split_update ? "split" : "replicated",
-                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build, t_step / steps,
-                c_step / steps, f.exchange_seconds / steps, f.exchange_cpu_seconds / steps,
-                (c_step - f.exchange_cpu_seconds) / steps,
-                peak_bytes() / fdem_get_counts(m).elements);
+                f.bytes_sent_per_step, f.partition_seconds, t_setup, t_build, t_step / stepped,
+                c_step / stepped, f.exchange_seconds / stepped, f.exchange_cpu_seconds / stepped,
+                (c_step - f.exchange_cpu_seconds) / stepped,
+                peak_bytes() / fdem_get_counts(m).elements,
+                (double)f.contact_pairs_walked / stepped,
+                f.contact_bytes_sent / stepped);
         if (rank == 0)
             printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
                    most);
@@ -228,9 +266,9 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     if (figures && rank == 0) {
         fdem_stage_times st = fdem_get_stage_times(m);
         printf("stages per step (s): elements %.6f joints %.6f detection %.6f contact %.6f "
-               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / steps, st.joints / steps,
-               st.detection / steps, st.contact / steps, st.integration / steps, t_step / steps,
-               c_step / steps);
+               "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / stepped,
+               st.joints / stepped, st.detection / stepped, st.contact / stepped,
+               st.integration / stepped, t_step / stepped, c_step / stepped);
     }
     rank_engine_lazy_free(&lazy);
     fdem_model_destroy(m);
@@ -245,7 +283,9 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (argc < 4) {
         if (rank == 0) fprintf(stderr, "usage: rank_compare STEPS EVERY [--plain] [--threads T] "
-                                       "[--fault] [--figures] [--save-at K FILE] [--restore FILE] "
+                                       "[--fault] [--contact-fault order|rotate|fail] [--figures] "
+                                       "[--split-threads-min N] "
+                                       "[--save-at K FILE] [--restore FILE] "
                                        "CASE.json...\n");
         MPI_Finalize();
         return 2;
@@ -256,6 +296,16 @@ int main(int argc, char **argv)
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--plain")) o.plain = 1;
         else if (!strcmp(argv[i], "--fault")) o.fault = 1;
+        else if (!strcmp(argv[i], "--split-threads-min") && i + 1 < argc)
+            o.split_threads_min = atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--contact-fault") && i + 1 < argc) {
+            const char *kind = argv[++i];
+            o.contact_fault = !strcmp(kind, "order")    ? RANK_CONTACT_FAULT_ORDER
+                              : !strcmp(kind, "rotate") ? RANK_CONTACT_FAULT_ROTATE
+                              : !strcmp(kind, "fail")   ? RANK_CONTACT_FAULT_FAIL
+                                                        : -1;
+            if (o.contact_fault < 0) MPI_Abort(MPI_COMM_WORLD, 2);
+        }
         else if (!strcmp(argv[i], "--expect-failure")) o.expect_failure = 1;
         else if (!strcmp(argv[i], "--figures")) o.figures = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) o.threads = atoi(argv[++i]);

@@ -1,0 +1,611 @@
+/*
+ * contact_walk.c - the contact stage's per-step pair walk (both
+ * dimensions): each near pair (contact_near.c) whose boxes overlap goes to
+ * its dimension's kernel, its forces are added to the contact force array
+ * and its stick springs kept, adopted or let go, in pair order, on one
+ * thread or several. It is kept apart from detection (contact.c) because it
+ * is the stage's hot loop and the part that is shared out: each thread
+ * takes a contiguous share of the pairs and lists the ones that touched
+ * with their forces and what they ask of the spring pool, and the lists
+ * are applied in thread order, which is pair order: every node's sum is
+ * formed in the order the serial loop forms it, the same bits on any
+ * thread count.
+ */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "kernel/contact_pair.h"
+#include "model/model.h"
+#include "contact.h"
+#include "contact_internal.h"
+
+/* Fewer candidate pairs than this are evaluated on one thread: below it the
+ * threads' start-up costs more than they share. */
+#define CONTACT_THREADED_PAIRS 2048
+
+/* Rows of numbers keyed by a candidate pair, in pair order. */
+typedef struct pair_rows {
+    long *pair;
+    double *row;
+    size_t count, capacity;
+} pair_rows;
+
+/* A thread's share of the pairs: those that touched with their forces
+ * (pair_out numbers each; keyed by their two elements, touched_key, not
+ * by pair: the scatter after the threads would otherwise look each up in
+ * the candidate arrays, a cache miss a pair, a tenth of a broken 3D
+ * block's 2-thread step on one thread), those whose springs the pool is
+ * to adopt (slots each) or let go, and in a split walk those that kept
+ * their set with its springs as the kernel left them (slots each: the
+ * kernel updates a set in place, and the other processes hold it too). */
+typedef struct contact_touches {
+    pair_rows touched, adopt, release, kept;
+} contact_touches;
+
+static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
+{
+    if (list->count == list->capacity) {
+        size_t cap = list->capacity ? 2 * list->capacity : CONTACT_FIRST_ROWS;
+        long *p = realloc(list->pair, cap * sizeof *p);
+        if (!p) return -1;
+        list->pair = p;
+        if (width) {
+            double *f = realloc(list->row, cap * (size_t)width * sizeof *f);
+            if (!f) return -1;
+            list->row = f;
+        }
+        list->capacity = cap;
+    }
+    list->pair[list->count] = pair;
+    if (width) memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
+    list->count++;
+    return 0;
+}
+
+static long touched_key(int32_t a, int32_t b) { return (long)((uint64_t)(uint32_t)a << 32 | (uint32_t)b); }
+static int32_t touched_a(long key) { return (int32_t)((uint64_t)key >> 32); }
+static int32_t touched_b(long key) { return (int32_t)(uint32_t)key; }
+
+static size_t pair_rows_bytes(const pair_rows *list, int width)
+{
+    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)width);
+}
+
+static void pair_rows_free(pair_rows *list)
+{
+    free(list->pair);
+    free(list->row);
+}
+
+/* Adds a pair's forces (contact_pair_force) to the contact force array and
+ * what its friction dissipated to the friction account; called in pair
+ * order, so every sum is formed in the same order on any thread count. */
+static inline __attribute__((always_inline)) void scatter_nodes(double *f, const int32_t *n1,
+                                                                 const int32_t *n2, int D, int K,
+                                                                 const double *out)
+{
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n1[c] + d] += out[D * c + d];
+    for (int c = 0; c < K; c++)
+        for (int d = 0; d < D; d++) f[D * n2[c] + d] += out[D * (K + c) + d];
+}
+
+void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
+{
+    const int32_t *n1 = element_nodes(m, e1), *n2 = element_nodes(m, e2);
+    if (m->dim == 3) scatter_nodes(m->contact.force, n1, n2, 3, 4, out);
+    else scatter_nodes(m->contact.force, n1, n2, 2, 3, out);
+    m->friction_energy += out[2 * m->dim * m->elem_nodes];
+    /* every 8th step: a body passing into another stays deep for several
+     * steps, and every step would cost a dense 2D pile ~10 % */
+    if (m->step % CONTACT_PENETRATION_EVERY == 0 && !contact_shut_neighbours(m, e1, e2))
+        contact_penetration_check(m, e1, e2);
+}
+
+/* What a pair's evaluation asks of the spring pool (contact_history.c):
+ * done at once on one thread, after the threads in pair order otherwise
+ * (the pool is shared; each pair's own set is not). */
+enum { SPRINGS_KEPT, SPRINGS_RELEASE, SPRINGS_ADOPT };
+
+/* A pair's stick springs: its set in the pool (*set >= 0), else `fresh`,
+ * zeroed. Both kernels of the walk read and write them the same way. */
+static inline __attribute__((always_inline)) double *pair_springs(contact_state *cs,
+                                                                  const near_pair *np,
+                                                                  double *fresh, int slots,
+                                                                  int32_t *set)
+{
+    *set = cs->spring_of[np->pair];
+    if (*set >= 0) return cs->slip + (size_t)slots * (size_t)*set;
+    for (int s = 0; s < slots; s++) fresh[s] = 0;
+    return fresh;
+}
+
+/* After either kernel: a pair that did not touch has let every spring go
+ * (contact_pair.h), so the springs are read only after a touch; a set
+ * left holding nothing goes back to the pool, fresh springs holding a
+ * force are adopted. Returns `touched`. */
+static inline __attribute__((always_inline)) int pair_springs_settle(near_pair *np, int32_t set,
+                                                                     const double *springs,
+                                                                     int touched, int slots,
+                                                                     int *pool)
+{
+    int any = 0;
+    if (touched > 0)
+        for (int s = 0; s < slots; s++) any |= springs[s] != 0;
+    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+    if (set < 0 && any) *pool = SPRINGS_ADOPT;
+    np->sprung = any;
+    return touched;
+}
+
+/* Near pair np this step: boxes apart, it lets its springs go (-1);
+ * otherwise its force into out (pair_out numbers), 1 if it touched. A pair
+ * without a set of springs is evaluated on fresh (zeros); *pool says
+ * whether fresh is to be adopted or the pair's set let go (np->sprung
+ * says so at once). D is a constant where it is called, so each
+ * dimension's walk is compiled on its own with the box and spring loops
+ * unrolled. */
+static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, near_pair *np,
+                                                               double h, double *out,
+                                                               double *fresh, int *pool,
+                                                               contact_pair_memo *memo, int D)
+{
+    contact_state *cs = &m->contact;
+    const int slots = D == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
+    const size_t width = 2 * (size_t)D;
+    int32_t a = np->a, b = np->b;
+    *pool = SPRINGS_KEPT;
+    /* shut broken rock first: its kernel ignores the gap the general one
+     * found (a clearance says what the general kernel would do) */
+    if (cs->shut_any && np->topology && cs->elem_shut[a] && cs->elem_shut[b]) {
+        if (np->topology == SHUT_TOPO_VERTEX) { /* left out: as a pair apart */
+            if (np->sprung) {
+                *pool = SPRINGS_RELEASE;
+                np->sprung = 0;
+            }
+            return -1;
+        }
+        /* the two sides of a shut broken joint */
+        int32_t set;
+        double *springs = pair_springs(cs, np, fresh, slots, &set);
+        face_match fm = shut_face_unpack(np->face);
+        contact_pair_in in = contact_pair_input(m, a, b, h, memo);
+        int touched = cs->kernel->face_force(&in, &fm, springs, out);
+        return pair_springs_settle(np, set, springs, touched, slots, pool);
+    }
+    /* a gap over near_apart: apart, boxes not even computed this step */
+    if (np->gap > cs->near_apart ||
+        !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
+        if (np->sprung) {
+            *pool = SPRINGS_RELEASE;
+            np->sprung = 0;
+        }
+        return -1;
+    }
+    int32_t set;
+    double *springs = pair_springs(cs, np, fresh, slots, &set);
+    contact_pair_in in = contact_pair_input(m, a, b, h, memo);
+    in.edge_clearance = !(np->face & NEAR_EDGES_TRIED);
+    int touched = cs->kernel->pair_force(&in, springs, out);
+    if (!touched) np->face |= NEAR_EDGES_TRIED;
+    /* Apart with a clearance c (contact_pair.h): the kernel keeps returning
+     * 0, every spring let go, while the two elements' nodes travel less
+     * than c together. Each node is within sqrt(near_disp2) of its place at
+     * the list's build, now and later, so between now and a later step it
+     * moves less than the two figures' sum, and a node of either element
+     * less than near_apart / 2 now plus near_apart / 2 then (near_apart is
+     * twice the figure, a hair over). As the gap c - near_apart_now the
+     * pair then passes the walk's test above (gap > near_apart) exactly
+     * while c > near_apart_now + near_apart_then: skipped only where the
+     * kernel would have found what it found now, the same bits. The list's
+     * rebuild (and a restore, which rebuilds it) starts from box gaps. */
+    if (!touched && out[0] > 0 && !cs->clearance_off) np->gap = max2(np->gap, out[0] - cs->near_apart);
+    return pair_springs_settle(np, set, springs, touched, slots, pool);
+}
+
+/* One list per thread; 0, or -1 if they cannot be had. */
+static int contact_touch_lists(contact_state *cs, int threads)
+{
+    if (threads <= cs->touch_lists) return 0;
+    contact_touches *t = realloc(cs->touches, sizeof *t * (size_t)threads);
+    if (!t) return -1;
+    memset(t + cs->touch_lists, 0, sizeof *t * (size_t)(threads - cs->touch_lists));
+    cs->touches = t;
+    cs->touch_lists = threads;
+    return 0;
+}
+
+/* A list of near pairs the walk takes this step: the near list whole, or
+ * this step's vertex pairs (index into near_vertex). */
+typedef struct near_walk {
+    near_pair *pairs;
+    const int32_t *index; /* NULL: pairs[0 .. count) */
+    size_t count;
+} near_walk;
+
+static inline near_pair *walk_pair(const near_walk *w, size_t i)
+{
+    return w->index ? &w->pairs[w->index[i]] : &w->pairs[i];
+}
+
+/* Every pair of a walk's force, added to the contact force array in its
+ * order, one pair at a time. Returns the number of pairs that touched. */
+static inline __attribute__((always_inline)) int pairs_forces_serial(fdem_model *m, double h,
+                                                                     const near_walk *w, int D)
+{
+    contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
+    int touching = 0;
+    for (size_t i = 0; i < w->count; i++) {
+        near_pair *np = walk_pair(w, i);
+        double out[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, np, h, out, fresh, &pool, &memo, D);
+        if (pool == SPRINGS_RELEASE) contact_springs_release(cs, np->pair);
+        else if (pool == SPRINGS_ADOPT && contact_springs_adopt(cs, np->pair, fresh)) return -1;
+        if (touched <= 0) continue;
+        contact_pair_scatter(m, np->a, np->b, out);
+        touching++;
+    }
+    return touching;
+}
+
+static int contact_pairs_forces_serial(fdem_model *m, double h, const near_walk *w)
+{
+    return m->dim == 3 ? pairs_forces_serial(m, h, w, 3) : pairs_forces_serial(m, h, w, 2);
+}
+
+/* The same on several threads: each takes a contiguous share of the near
+ * pairs and lists the ones that touched with their forces; the lists are then
+ * added in thread order, which is pair order. Every node's sum is formed in
+ * the order the serial loop forms it: the same bits on any thread count.
+ * Returns the number of pairs that touched, or -1 if a list could not grow
+ * (nothing has been added then). */
+static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
+                                                                     const near_walk *w,
+                                                                     long begin, long end,
+                                                                     contact_touches *list, int D,
+                                                                     int split)
+{
+    const contact_state *cs = &m->contact;
+    contact_pair_memo memo;
+    contact_pair_memo_clear(&memo);
+    int touching = 0;
+    for (long i = begin; i < end; i++) {
+        near_pair *np = walk_pair(w, (size_t)i);
+        long k = (long)np->pair;
+        double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
+        if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
+        if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
+        if (split && pool == SPRINGS_KEPT && cs->spring_of[k] >= 0 &&
+            pair_rows_push(&list->kept, k, cs->slip + (size_t)cs->slots * (size_t)cs->spring_of[k],
+                           cs->slots))
+            return -1;
+        if (touched <= 0) continue;
+        touching++;
+        if (pair_rows_push(&list->touched, touched_key(np->a, np->b), force, cs->pair_out))
+            return -1;
+    }
+    return touching;
+}
+
+static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_walk *w)
+{
+    contact_state *cs = &m->contact;
+    long n = (long)w->count;
+    int touching = 0, failed = 0, used = 1;
+    contact_touches *lists = cs->touches;
+#pragma omp parallel num_threads(m->threads) reduction(+ : touching)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        if (t == 0) used = nt;
+        contact_touches *list = &lists[t];
+        list->touched.count = list->adopt.count = list->release.count = 0;
+        long begin = n * t / nt, end = n * (t + 1) / nt;
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3, 0)
+                               : pairs_forces_listed(m, h, w, begin, end, list, 2, 0);
+        if (mine < 0) {
+#pragma omp atomic write
+            failed = 1;
+        } else {
+            touching += mine;
+        }
+    }
+    if (failed) return -1;
+    for (int t = 0; t < used; t++) {
+        const pair_rows *touched = &lists[t].touched;
+        for (size_t i = 0; i < touched->count; i++) {
+            long key = touched->pair[i];
+            contact_pair_scatter(m, touched_a(key), touched_b(key),
+                                 touched->row + i * (size_t)cs->pair_out);
+        }
+        for (size_t i = 0; i < lists[t].release.count; i++)
+            contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
+        const pair_rows *adopt = &lists[t].adopt;
+        for (size_t i = 0; i < adopt->count; i++)
+            if (contact_springs_adopt(cs, (size_t)adopt->pair[i], adopt->row + i * (size_t)cs->slots))
+                return -1;
+    }
+    return touching;
+}
+
+/*
+ * The walk split between processes (step_share.contact_ranks > 1: the rank
+ * engine, runner/mpi). Process r of R evaluates the near pairs at indices
+ * [n r / R, n (r + 1) / R) of the near list and the vertex pairs whose index
+ * in near_vertex lies in the same share of near_vertex (this step's
+ * vertex_walk changes every step; its values, being ascending, give each
+ * process one run of it), on its threads as above, and lists what they did;
+ * contact_gather hands every process every list, and each applies them,
+ * the near list's in process order, then the vertex pairs' in process
+ * order: pair order, so every node's sum is formed as the serial walk forms
+ * it, and the spring pool ends holding the same springs for the same pairs
+ * (which set of the pool holds them may differ, as with threads; nothing
+ * reads that): the same bits on any process count.
+ *
+ * A process always evaluates the same pairs between two rebuilds of the
+ * near list (the shares are fixed index ranges of arrays that change only
+ * at a rebuild), so the hints the walk leaves in a near pair (gap raised by
+ * a clearance, sprung, NEAR_EDGES_TRIED) are always its own; a rebuild
+ * derives them from what every process holds alike (the boxes, the spring
+ * pool, the shut marks). The springs a pair keeps are updated in place by
+ * its kernel: they travel in the kept lists, so every process's pool stays
+ * the one process's.
+ *
+ * On the wire (8-byte items), for each of the two walks: the counts of
+ * touched, kept, released and adopted pairs (4 uint64), then the touched
+ * keys (int64) and forces (pair_out doubles each), the kept pairs (int64)
+ * and springs (slots doubles each), the released pairs (int64), the
+ * adopted pairs (int64) and springs (slots doubles each).
+ */
+
+/* Room for `need` bytes on the wire; -1 when out of memory. */
+static int wire_reserve(contact_state *cs, size_t need)
+{
+    if (need <= cs->wire_capacity) return 0;
+    size_t cap = cs->wire_capacity ? 2 * cs->wire_capacity : 4096;
+    while (cap < need) cap *= 2;
+    unsigned char *w = realloc(cs->wire, cap);
+    if (!w) return -1;
+    cs->wire = w;
+    cs->wire_capacity = cap;
+    return 0;
+}
+
+static unsigned char *wire_put(unsigned char *at, const void *data, size_t bytes)
+{
+    if (bytes) memcpy(at, data, bytes);
+    return at + bytes;
+}
+
+/* The keys and then the rows of one kind of list of threads [0, used), in
+ * thread order. */
+static unsigned char *wire_put_rows(unsigned char *at, const contact_touches *lists, int used,
+                                    size_t kind, int width)
+{
+    for (int t = 0; t < used; t++) {
+        const pair_rows *r = (const pair_rows *)((const char *)&lists[t] + kind);
+        at = wire_put(at, r->pair, sizeof(long) * r->count);
+    }
+    for (int t = 0; t < used; t++) {
+        const pair_rows *r = (const pair_rows *)((const char *)&lists[t] + kind);
+        at = wire_put(at, r->row, sizeof(double) * (size_t)width * r->count);
+    }
+    return at;
+}
+
+/* The lists of threads [0, used) appended to the wire at *bytes; -1 when
+ * out of memory. */
+static int wire_append(contact_state *cs, const contact_touches *lists, int used, size_t *bytes)
+{
+    const size_t kinds[4] = {offsetof(contact_touches, touched), offsetof(contact_touches, kept),
+                             offsetof(contact_touches, release), offsetof(contact_touches, adopt)};
+    const int width[4] = {cs->pair_out, cs->slots, 0, cs->slots};
+    uint64_t count[4] = {0, 0, 0, 0};
+    size_t need = sizeof count;
+    for (int k = 0; k < 4; k++) {
+        for (int t = 0; t < used; t++)
+            count[k] += ((const pair_rows *)((const char *)&lists[t] + kinds[k]))->count;
+        need += (size_t)count[k] * (sizeof(long) + sizeof(double) * (size_t)width[k]);
+    }
+    if (wire_reserve(cs, *bytes + need)) return -1;
+    unsigned char *at = wire_put(cs->wire + *bytes, count, sizeof count);
+    for (int k = 0; k < 4; k++) at = wire_put_rows(at, lists, used, kinds[k], width[k]);
+    *bytes += need;
+    return 0;
+}
+
+/* One walk's lists of one process, as wire_append laid them out at p,
+ * applied: the touched pairs' forces added, the kept springs written back,
+ * the released sets let go, the adopted ones taken (touching NULL: only
+ * stepped over). Returns the pointer past them and adds the touched pairs
+ * to *touching; NULL when the pool cannot grow or the bytes run past end. */
+static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
+                                       const unsigned char *end, int *touching)
+{
+    contact_state *cs = &m->contact;
+    uint64_t count[4];
+    if ((size_t)(end - p) < sizeof count) return NULL;
+    memcpy(count, p, sizeof count);
+    p += sizeof count;
+    const size_t out = (size_t)cs->pair_out, slots = (size_t)cs->slots;
+    const size_t row[4] = {out, slots, 0, slots};
+    size_t need = 0;
+    for (int k = 0; k < 4; k++) {
+        if (count[k] > (size_t)(end - p)) return NULL;
+        need += (size_t)count[k] * (sizeof(long) + sizeof(double) * row[k]);
+    }
+    if (need > (size_t)(end - p)) return NULL;
+    if (!touching) return p + need;
+    const long *key = (const long *)p;
+    const double *rows = (const double *)(key + count[0]);
+    for (size_t i = 0; i < count[0]; i++)
+        contact_pair_scatter(m, touched_a(key[i]), touched_b(key[i]), rows + i * out);
+    *touching += (int)count[0];
+    const long *kept = (const long *)(rows + count[0] * out);
+    const double *springs = (const double *)(kept + count[1]);
+    for (size_t i = 0; i < count[1]; i++)
+        memcpy(cs->slip + slots * (size_t)cs->spring_of[kept[i]], springs + i * slots,
+               sizeof(double) * slots);
+    const long *release = (const long *)(springs + count[1] * slots);
+    for (size_t i = 0; i < count[2]; i++) contact_springs_release(cs, (size_t)release[i]);
+    const long *adopt = release + count[2];
+    springs = (const double *)(adopt + count[3]);
+    for (size_t i = 0; i < count[3]; i++)
+        if (contact_springs_adopt(cs, (size_t)adopt[i], springs + i * slots)) return NULL;
+    return (const unsigned char *)(springs + count[3] * slots);
+}
+
+/* The first position of an ascending index list at or past value v. */
+static size_t lower_bound(const int32_t *v, size_t n, long x)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (v[mid] < x) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo;
+}
+
+/* This process's share [begin, end) of pairs [0, n) of the near array
+ * (or of near_vertex, by index value, when w->index is set). */
+static void walk_share(const near_walk *w, size_t n, int rank, int ranks, long *begin, long *end)
+{
+    long lo = (long)(n * (size_t)rank / (size_t)ranks);
+    long hi = (long)(n * (size_t)(rank + 1) / (size_t)ranks);
+    if (!w->index) {
+        *begin = lo;
+        *end = hi;
+        return;
+    }
+    *begin = (long)lower_bound(w->index, w->count, lo);
+    *end = (long)lower_bound(w->index, w->count, hi);
+}
+
+/* Pairs [begin, end) of walk w listed on this process's threads; *used the
+ * lists filled (thread order). 0, or -1 when a list cannot grow. */
+static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
+                       int *used)
+{
+    contact_state *cs = &m->contact;
+    long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
+    int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
+    if (contact_touch_lists(cs, threads)) return -1;
+    contact_touches *lists = cs->touches;
+    int failed = 0, nt_used = 1;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        if (t == 0) nt_used = nt;
+        contact_touches *list = &lists[t];
+        list->touched.count = list->adopt.count = list->release.count = list->kept.count = 0;
+        long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3, 1)
+                               : pairs_forces_listed(m, h, w, b, e, list, 2, 1);
+        if (mine < 0) {
+#pragma omp atomic write
+            failed = 1;
+        }
+    }
+    *used = nt_used;
+    cs->split_threaded += nt_used > 1;
+    return failed ? -1 : 0;
+}
+
+static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk walks[2])
+{
+    contact_state *cs = &m->contact;
+    const step_share *share = m->share;
+    const size_t totals[2] = {cs->near_count, cs->near_vertex_count};
+    size_t bytes = 0;
+    int ok = 1;
+    for (int k = 0; k < 2 && ok; k++) {
+        long begin, end;
+        int used;
+        walk_share(&walks[k], totals[k], share->contact_rank, share->contact_ranks, &begin, &end);
+        cs->pairs_walked += end - begin;
+        ok = walk_listed(m, h, &walks[k], begin, end, &used) == 0 &&
+             wire_append(cs, cs->touches, used, &bytes) == 0;
+    }
+    /* every process takes part, failed or not: none is left waiting */
+    const unsigned char *all;
+    const size_t *at;
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, &all, &at)) return -1;
+    int touching = 0;
+    for (int k = 0; k < 2; k++)
+        for (int r = 0; r < share->contact_ranks; r++) {
+            const unsigned char *p = all + at[r], *end = all + at[r + 1];
+            if (k == 1 && !(p = wire_apply(m, p, end, NULL))) return -1; /* past the near list's */
+            if (!wire_apply(m, p, end, &touching)) return -1;
+        }
+    return touching;
+}
+
+/* The near list, then this step's vertex pairs (contact_near.c), each in
+ * pair order: the same sums in the same order on any thread count. Threads
+ * only pay off with enough pairs; without room for their lists a walk
+ * stays on one thread. Returns the number of pairs that touched, or -1
+ * when out of memory. */
+int contact_pairs_forces(fdem_model *m, double h)
+{
+    contact_state *cs = &m->contact;
+    const near_walk walks[2] = {{cs->near, NULL, cs->near_count},
+                                {cs->near_vertex, cs->vertex_walk, cs->vertex_walk_count}};
+    if (m->share && m->share->contact_ranks > 1) return contact_pairs_forces_split(m, h, walks);
+    cs->pairs_walked += (long)(walks[0].count + walks[1].count);
+    int touching = 0;
+    for (int k = 0; k < 2; k++) {
+        int t;
+        if (m->threads > 1 && walks[k].count >= CONTACT_THREADED_PAIRS &&
+            contact_touch_lists(cs, m->threads) == 0)
+            /* a list that cannot grow has already moved some stick springs:
+             * the step fails rather than run the pairs twice */
+            t = contact_pairs_forces_threaded(m, h, &walks[k]);
+        else
+            t = contact_pairs_forces_serial(m, h, &walks[k]);
+        if (t < 0) return -1;
+        touching += t;
+    }
+    return touching;
+}
+
+
+/* What the lists hold (contact_memory_bytes). */
+size_t contact_walk_bytes(const contact_state *cs)
+{
+    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    for (int t = 0; t < cs->touch_lists; t++) {
+        b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
+        b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
+        b += pair_rows_bytes(&cs->touches[t].release, 0);
+        b += pair_rows_bytes(&cs->touches[t].kept, cs->slots);
+    }
+    return b + cs->wire_capacity;
+}
+
+void contact_walk_free(contact_state *cs)
+{
+    for (int t = 0; t < cs->touch_lists; t++) {
+        pair_rows_free(&cs->touches[t].touched);
+        pair_rows_free(&cs->touches[t].adopt);
+        pair_rows_free(&cs->touches[t].release);
+        pair_rows_free(&cs->touches[t].kept);
+    }
+    free(cs->touches);
+    free(cs->wire);
+}
