@@ -273,6 +273,7 @@ static int contact_near_rebuild(fdem_model *m)
     cs->near_reach = reach;
     cs->near_apart = 0;
     cs->near_stale = 0;
+    cs->near_builds++;
     cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near, count,
                                                      cs->near_vertex, vertex, cs->near_active);
     return near_vertex_index(m);
@@ -292,6 +293,8 @@ int contact_near_refresh(fdem_model *m)
         contact_near_boxes(m);
         return 0;
     }
+    /* new shares of a split walk: each process's springs handed over first */
+    if (contact_springs_sync(m)) return -1;
     contact_boxes(m, cs->active, cs->active_count);
     return contact_near_rebuild(m);
 }
