@@ -87,6 +87,8 @@ struct rank_engine {
     size_t *contact_at;              /* per rank: where its lists start and end */
     unsigned char *contact_buf;      /* every rank's lists */
     size_t contact_cap, contact_agreed; /* its size here, and the size every rank has */
+    unsigned char *merged_send;      /* the walk's exchange with the forces: this rank's */
+    size_t merged_cap;
     int merged;                      /* the forces went with the walk's lists this step */
     fdem_model *model;               /* the model being stepped (the merged exchange) */
     rank_figures fig;
@@ -252,6 +254,14 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     const int merge = merging && re->model; /* not in fail_collectives, which sends size -1 */
     const int D = re->dim;
     size_t mine_force = merge ? sizeof(double) * (size_t)re->node_counts[me] : 0;
+    if (merge && ok && mine_force + bytes > re->merged_cap) {
+        unsigned char *b = realloc(re->merged_send, mine_force + bytes);
+        if (b) {
+            re->merged_send = b;
+            re->merged_cap = mine_force + bytes;
+        }
+        ok = b != NULL;
+    }
     long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
     stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgather(&size, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
@@ -297,24 +307,14 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
         from += force + (size_t)re->contact_sizes[r];
     }
     const void *send = mine;
-    int send_count = re->contact_counts[me];
-    MPI_Datatype send_type = MPI_BYTE, both = MPI_DATATYPE_NULL;
-    if (merge) { /* the packed forces, then the lists where they lie: no copy of them */
-        copy_rows(re->model->force, re->send, re->node_order + re->node_displs[me] / D,
-                  re->node_counts[me] / D, D, 1);
-        MPI_Aint where[2];
-        int length[2] = {(int)mine_force, (int)bytes};
-        MPI_Get_address(re->send, &where[0]);
-        MPI_Get_address(bytes ? mine : (const void *)re->send, &where[1]);
-        MPI_Type_create_hindexed(2, length, where, MPI_BYTE, &both);
-        MPI_Type_commit(&both);
-        send = MPI_BOTTOM;
-        send_count = 1;
-        send_type = both;
+    if (merge) {
+        copy_rows(re->model->force, (double *)re->merged_send,
+                  re->node_order + re->node_displs[me] / D, re->node_counts[me] / D, D, 1);
+        if (bytes) memcpy(re->merged_send + mine_force, mine, bytes);
+        send = re->merged_send;
     }
-    rc = MPI_Allgatherv(send, send_count, send_type, re->contact_buf, re->contact_counts,
-                        re->contact_displs, MPI_BYTE, re->comm);
-    if (both != MPI_DATATYPE_NULL) MPI_Type_free(&both);
+    rc = MPI_Allgatherv(send, re->contact_counts[me], MPI_BYTE, re->contact_buf,
+                        re->contact_counts, re->contact_displs, MPI_BYTE, re->comm);
     stopwatch_add(re, t0);
     if (merge && rc == MPI_SUCCESS) {
         for (int r = 0; r < P; r++)
@@ -675,6 +675,7 @@ void rank_engine_free(rank_engine *re)
     free(re->contact_counts);
     free(re->contact_at);
     free(re->contact_buf);
+    free(re->merged_send);
     free(re->block_owner);
     free(re->block_order);
     free(re->block_counts);
