@@ -550,7 +550,7 @@ static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk w
     int touching = 0;
     for (int k = 0; k < 2; k++)
         for (int r = 0; r < share->contact_ranks; r++) {
-            const unsigned char *p = all + at[2 * r], *end = all + at[2 * r + 1];
+            const unsigned char *p = all + at[r], *end = all + at[r + 1];
             if (k == 1 && !(p = wire_apply(m, p, end, NULL))) return -1; /* past the near list's */
             if (!wire_apply(m, p, end, &touching)) return -1;
         }
@@ -627,7 +627,7 @@ int contact_springs_sync(fdem_model *m)
     cs->springs_behind = 0;
     cs->springs_synced++;
     for (size_t p = 0; p < R; p++) /* its own too: they are what it holds */
-        if (sync_apply(cs, all + at[2 * p], all + at[2 * p + 1])) return -1;
+        if (sync_apply(cs, all + at[p], all + at[p + 1])) return -1;
     return 0;
 }
 

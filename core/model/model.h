@@ -332,12 +332,10 @@ static inline void contact_detect_after_breaks(contact_state *cs)
  *    process (walk 1), and before the spring pool is read by anything but
  *    the walk (walk 0: contact_springs_sync, in a step or at a gather),
  *    with the bytes this process listed (ok 0: it failed, the bytes say
- *    nothing). Returns 0 with *all every process's bytes in process order,
- *    process p's from (*at)[2 p] to (*at)[2 p + 1] (kept until the next
- *    call; the driver may put other numbers between them: the walk's
- *    exchange may carry the forces too, m->force being whole by then);
- *    nonzero when some process failed or the exchange did: the step then
- *    fails on every process. */
+ *    nothing). Returns 0 with *all every process's bytes one after another
+ *    in process order, process p's from (*at)[p] to (*at)[p + 1] (kept
+ *    until the next call); nonzero when some process failed or the
+ *    exchange did: the step then fails on every process. */
 typedef struct step_share {
     void *ctx;
     const uint8_t *elem_mark;

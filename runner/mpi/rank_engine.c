@@ -84,13 +84,9 @@ struct rank_engine {
     long long fault_step;            /* the step being made (the failure fault) */
     long long *contact_sizes;        /* per rank: the bytes of its lists, -1 failed */
     int *contact_counts, *contact_displs; /* per rank, for MPI_Allgatherv */
-    size_t *contact_at;              /* per rank: where its lists start and end */
+    size_t *contact_at;              /* per rank and one past: where its lists start */
     unsigned char *contact_buf;      /* every rank's lists */
     size_t contact_cap, contact_agreed; /* its size here, and the size every rank has */
-    unsigned char *merged_send;      /* the walk's exchange with the forces: this rank's */
-    size_t merged_cap;
-    int merged;                      /* the forces went with the walk's lists this step */
-    fdem_model *model;               /* the model being stepped (the merged exchange) */
     rank_figures fig;
 };
 
@@ -194,7 +190,6 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
 static int share_forces_done(void *ctx, fdem_model *m)
 {
     rank_engine *re = ctx;
-    if (re->merged) return 0; /* they went with the contact walk's lists */
     re->exchanged = 1;
     if (re->border_fault) add_halo_after(re, m);
     if (!re->split) return exchange_forces(re, m, 1);
@@ -237,7 +232,7 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     const int skip = re->gathering ? RANK_CONTACT_FAULT_SKIP_GATHER_SYNC
                                    : RANK_CONTACT_FAULT_SKIP_SYNC;
     if (!walk && re->contact_fault == skip && ok) {
-        for (int k = 0; k < 2 * P; k++) re->contact_at[k] = 0; /* nothing handed over */
+        for (int k = 0; k <= P; k++) re->contact_at[k] = 0; /* nothing handed over */
         *all = re->contact_buf;
         *at = re->contact_at;
         return 0;
@@ -246,30 +241,13 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     if (walk && re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
         re->fault_step == RANK_CONTACT_FAIL_STEP)
         ok = 0; /* as if a list could not grow here */
-    /* The walk's lists go with the owned nodes' forces (whole when the
-     * walk ends: contact forces have their own array) in one exchange
-     * instead of two; not with the border-order fault, which adds to the
-     * forces at forces_done. Each rank's part: its forces, then its lists. */
-    const int merging = walk && !re->split && !re->border_fault; /* on every rank alike */
-    const int merge = merging && re->model; /* not in fail_collectives, which sends size -1 */
-    const int D = re->dim;
-    size_t mine_force = merge ? sizeof(double) * (size_t)re->node_counts[me] : 0;
-    if (merge && ok && mine_force + bytes > re->merged_cap) {
-        unsigned char *b = realloc(re->merged_send, mine_force + bytes);
-        if (b) {
-            re->merged_send = b;
-            re->merged_cap = mine_force + bytes;
-        }
-        ok = b != NULL;
-    }
     long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
     stopwatch t0 = stopwatch_now();
     int rc = MPI_Allgather(&size, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
     size_t total = 0;
     for (int r = 0; r < P && rc == MPI_SUCCESS; r++) {
         if (re->contact_sizes[r] < 0) rc = -1;
-        else total += (size_t)re->contact_sizes[r] +
-                      (merge ? sizeof(double) * (size_t)re->node_counts[r] : 0);
+        else total += (size_t)re->contact_sizes[r];
     }
     if (rc == MPI_SUCCESS && total > INT_MAX) rc = -1;
     if (rc == MPI_SUCCESS && total > re->contact_agreed) {
@@ -290,7 +268,6 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     if (rc != MPI_SUCCESS) {
         stopwatch_add(re, t0);
         re->contact_gathered = 1; /* every rank knows: none waits in another */
-        if (merging) re->exchanged = 1; /* nor in the force exchange */
         return -1;
     }
     size_t from = 0;
@@ -299,29 +276,15 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
         if (re->contact_fault == RANK_CONTACT_FAULT_ORDER) r = P - 1 - k;
         if (re->contact_fault == RANK_CONTACT_FAULT_ROTATE)
             r = (int)(((k - re->contact_turn) % P + P) % P);
-        size_t force = merge ? sizeof(double) * (size_t)re->node_counts[r] : 0;
-        re->contact_counts[r] = (int)(force + (size_t)re->contact_sizes[r]);
+        re->contact_at[k] = from;
+        re->contact_counts[r] = (int)re->contact_sizes[r];
         re->contact_displs[r] = (int)from;
-        re->contact_at[2 * k] = from + force;
-        re->contact_at[2 * k + 1] = from + force + (size_t)re->contact_sizes[r];
-        from += force + (size_t)re->contact_sizes[r];
+        from += (size_t)re->contact_sizes[r];
     }
-    const void *send = mine;
-    if (merge) {
-        copy_rows(re->model->force, (double *)re->merged_send,
-                  re->node_order + re->node_displs[me] / D, re->node_counts[me] / D, D, 1);
-        if (bytes) memcpy(re->merged_send + mine_force, mine, bytes);
-        send = re->merged_send;
-    }
-    rc = MPI_Allgatherv(send, re->contact_counts[me], MPI_BYTE, re->contact_buf,
+    re->contact_at[P] = from;
+    rc = MPI_Allgatherv(mine, re->contact_counts[me], MPI_BYTE, re->contact_buf,
                         re->contact_counts, re->contact_displs, MPI_BYTE, re->comm);
     stopwatch_add(re, t0);
-    if (merge && rc == MPI_SUCCESS) {
-        for (int r = 0; r < P; r++)
-            copy_rows(re->model->force, (double *)(re->contact_buf + re->contact_displs[r]),
-                      re->node_order + re->node_displs[r] / D, re->node_counts[r] / D, D, 0);
-        re->merged = re->exchanged = 1;
-    }
     re->fig.contact_bytes_sent += (double)bytes * (P - 1);
     if (!walk) re->fig.contact_sync_bytes_sent += (double)bytes * (P - 1);
     *all = re->contact_buf;
@@ -468,7 +431,7 @@ static int setup(rank_engine *re, fdem_model *m)
     if (re->contact_split) {
         re->contact_sizes = malloc(sizeof(long long) * (size_t)re->size);
         re->contact_counts = malloc(sizeof(int) * 2 * (size_t)re->size);
-        re->contact_at = malloc(sizeof(size_t) * 2 * (size_t)re->size);
+        re->contact_at = malloc(sizeof(size_t) * ((size_t)re->size + 1));
         if (!re->contact_sizes || !re->contact_counts || !re->contact_at) goto done;
         re->contact_displs = re->contact_counts + re->size;
     }
@@ -536,7 +499,6 @@ static void fail_collectives(rank_engine *re, fdem_model *m)
 int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 {
     re->exchanged = re->agreed = re->local_bad = re->others_bad = re->contact_gathered = 0;
-    re->merged = 0;
     if (re->size == 1) return fdem_step(m, err); /* nothing to share */
     re->fault_step = m->step + 1;
     /* the rotation fault: each step another share of the pairs */
@@ -545,9 +507,7 @@ int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
         re->share.contact_rank = (re->rank + re->contact_turn) % re->size;
     }
     m->share = &re->share; /* only while stepping: outside a step nothing is collective */
-    re->model = m;
     int rc = fdem_step(m, err);
-    re->model = NULL;
     m->share = NULL;
     re->fig.contact_pairs_walked = m->contact.pairs_walked;
     if (rc) fail_collectives(re, m);
@@ -675,7 +635,6 @@ void rank_engine_free(rank_engine *re)
     free(re->contact_counts);
     free(re->contact_at);
     free(re->contact_buf);
-    free(re->merged_send);
     free(re->block_owner);
     free(re->block_order);
     free(re->block_counts);
