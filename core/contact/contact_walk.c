@@ -9,7 +9,10 @@
  * with their forces and what they ask of the spring pool, and the lists
  * are applied in thread order, which is pair order: every node's sum is
  * formed in the order the serial loop forms it, the same bits on any
- * thread count.
+ * thread count. Split between processes (step_share.contact_ranks), each
+ * takes a fixed share and every process applies every process's lists;
+ * the springs a kernel updates in place are handed over only before
+ * something other than the walk reads the pool (contact_springs_sync).
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -612,6 +615,10 @@ int contact_springs_sync(fdem_model *m)
     contact_state *cs = &m->contact;
     const step_share *share = m->share;
     if (!cs->springs_behind || !share || share->contact_ranks < 2) return 0;
+    if (cs->slip_count == cs->free_count) { /* no pair holds a set (every process alike) */
+        cs->springs_behind = 0;
+        return 0;
+    }
     /* this process's shares as walk_share cut them: the near list's by
      * index, the vertex pairs' by index into near_vertex */
     const size_t totals[2] = {cs->near_count, cs->near_vertex_count};

@@ -31,6 +31,10 @@
  * near pairs and lists what they did; share_contact_gather hands every
  * rank every rank's lists (MPI_Allgather of their sizes, MPI_Allgatherv
  * of their bytes), which every rank applies in rank order, pair order.
+ * The springs a pair keeps, updated in place by the rank walking it, go
+ * through the same exchange only when something else is to read them
+ * (core's contact_springs_sync: before a detection, a rebuild of the near
+ * list, an excavation, and at rank_engine_gather).
  *
  * In a model where nothing after the forces reads nodes anywhere (no
  * contact, joints, fluid, stages: rank_halo_wanted) the update is split
