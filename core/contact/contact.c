@@ -180,7 +180,7 @@ static const int32_t *contact_detect_bodies(fdem_model *m)
 static int contact_detect_at(fdem_model *m, const double *pos)
 {
     contact_state *cs = &m->contact;
-    if (contact_history_set_aside(cs)) return -1;
+    if (contact_springs_sync(m) || contact_history_set_aside(cs)) return -1;
     for (int e = 0; e < m->elem_count; e++) {
         double c[3];
         element_sphere(m, pos, e, c, &cs->r[e]);
@@ -232,6 +232,7 @@ int contact_restore_detection(fdem_model *m)
     if (!cs->enabled) return 0;
     cs->pairs.count = 0;
     cs->near_stale = 1;
+    cs->springs_behind = 0; /* the checkpoint's records hold every spring */
     memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
     cs->force_is_zero = 1;
     int pending = cs->need_detect;

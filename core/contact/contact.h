@@ -37,6 +37,10 @@ int contact_forces(fdem_model *m);
 double contact_penetration(const fdem_model *m, int a, int b);
 void contact_penetration_check(fdem_model *m, int a, int b);
 int contact_restore_detection(fdem_model *m);
+/* contact_walk.c: a split walk's springs updated in place handed to every
+ * process (collective on the processes of m->share; nothing to do on one
+ * process or when none fell behind). 0, or -1 when some process failed. */
+int contact_springs_sync(fdem_model *m);
 size_t contact_memory_bytes(const contact_state *c); /* touch lists and stick springs */
 int contact_pair_force_now(const fdem_model *m, size_t k, double *out);
 

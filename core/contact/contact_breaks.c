@@ -238,6 +238,7 @@ static int breaks_merge(fdem_model *m)
 int contact_detect_breaks(fdem_model *m)
 {
     contact_state *cs = &m->contact;
+    if (contact_springs_sync(m)) return -1; /* set aside below, or by a detection */
     int marked = breaks_mark(m);
     if (cs->breaks_off || marked > m->elem_count / BREAKS_MARKED_SHARE)
         return contact_detect_again(m);

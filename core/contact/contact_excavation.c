@@ -46,6 +46,7 @@ void contact_drop_excavated(fdem_model *m)
 
 int contact_excavation_forces(fdem_model *m, const uint8_t *removed, double *f)
 {
+    if (contact_springs_sync(m)) return -1; /* it reads every pair's springs */
     const contact_state *cs = &m->contact;
     const int D = m->dim, K = m->elem_nodes;
     double out[CONTACT_PAIR_OUT_MAX];

@@ -273,8 +273,19 @@ static int contact_near_rebuild(fdem_model *m)
     cs->near_reach = reach;
     cs->near_apart = 0;
     cs->near_stale = 0;
-    cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near, count,
-                                                     cs->near_vertex, vertex, cs->near_active);
+    cs->near_builds++;
+    /* A process of a split walk (contact_walk.c) reads the boxes of its
+     * shares' pairs only, until the next rebuild (which computes every
+     * candidate's first): it keeps only those up to date. */
+    size_t lo = 0, hi = count, vlo = 0, vhi = vertex;
+    if (m->share && m->share->contact_ranks > 1) {
+        const size_t r = (size_t)m->share->contact_rank, R = (size_t)m->share->contact_ranks;
+        lo = count * r / R, hi = count * (r + 1) / R;
+        vlo = vertex * r / R, vhi = vertex * (r + 1) / R;
+    }
+    cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near + lo, hi - lo,
+                                                     cs->near_vertex + vlo, vhi - vlo,
+                                                     cs->near_active);
     return near_vertex_index(m);
 }
 
@@ -292,6 +303,8 @@ int contact_near_refresh(fdem_model *m)
         contact_near_boxes(m);
         return 0;
     }
+    /* new shares of a split walk: each process's springs handed over first */
+    if (contact_springs_sync(m)) return -1;
     contact_boxes(m, cs->active, cs->active_count);
     return contact_near_rebuild(m);
 }

@@ -9,7 +9,10 @@
  * with their forces and what they ask of the spring pool, and the lists
  * are applied in thread order, which is pair order: every node's sum is
  * formed in the order the serial loop forms it, the same bits on any
- * thread count.
+ * thread count. Split between processes (step_share.contact_ranks), each
+ * takes a fixed share and every process applies every process's lists;
+ * the springs a kernel updates in place are handed over only before
+ * something other than the walk reads the pool (contact_springs_sync).
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -39,12 +42,12 @@ typedef struct pair_rows {
  * (pair_out numbers each; keyed by their two elements, touched_key, not
  * by pair: the scatter after the threads would otherwise look each up in
  * the candidate arrays, a cache miss a pair, a tenth of a broken 3D
- * block's 2-thread step on one thread), those whose springs the pool is
- * to adopt (slots each) or let go, and in a split walk those that kept
- * their set with its springs as the kernel left them (slots each: the
- * kernel updates a set in place, and the other processes hold it too). */
+ * block's 2-thread step on one thread) and those whose springs the pool is
+ * to adopt (slots each) or let go. The springs a pair keeps, updated in
+ * place, are not listed: in a split walk contact_springs_sync hands them
+ * to the other processes when something other than the walk reads them. */
 typedef struct contact_touches {
-    pair_rows touched, adopt, release, kept;
+    pair_rows touched, adopt, release;
 } contact_touches;
 
 static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
@@ -269,8 +272,7 @@ static int contact_pairs_forces_serial(fdem_model *m, double h, const near_walk 
 static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model *m, double h,
                                                                      const near_walk *w,
                                                                      long begin, long end,
-                                                                     contact_touches *list, int D,
-                                                                     int split)
+                                                                     contact_touches *list, int D)
 {
     const contact_state *cs = &m->contact;
     contact_pair_memo memo;
@@ -283,10 +285,6 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
         int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
-        if (split && pool == SPRINGS_KEPT && cs->spring_of[k] >= 0 &&
-            pair_rows_push(&list->kept, k, cs->slip + (size_t)cs->slots * (size_t)cs->spring_of[k],
-                           cs->slots))
-            return -1;
         if (touched <= 0) continue;
         touching++;
         if (pair_rows_push(&list->touched, touched_key(np->a, np->b), force, cs->pair_out))
@@ -312,8 +310,8 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;
         long begin = n * t / nt, end = n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3, 0)
-                               : pairs_forces_listed(m, h, w, begin, end, list, 2, 0);
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3)
+                               : pairs_forces_listed(m, h, w, begin, end, list, 2);
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
@@ -358,15 +356,25 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
  * at a rebuild), so the hints the walk leaves in a near pair (gap raised by
  * a clearance, sprung, NEAR_EDGES_TRIED) are always its own; a rebuild
  * derives them from what every process holds alike (the boxes, the spring
- * pool, the shut marks). The springs a pair keeps are updated in place by
- * its kernel: they travel in the kept lists, so every process's pool stays
- * the one process's.
+ * pool, the shut marks).
+ *
+ * The springs a pair keeps are updated in place by its kernel, on the
+ * process evaluating it only; the others' copies fall behind
+ * (springs_behind). Only that process reads them until the near list is
+ * rebuilt, so they are handed over (contact_springs_sync) only before
+ * something else reads the pool: a detection or a break's mending (which
+ * set it aside), a rebuild of the near list (which gives the pairs new
+ * shares), an excavation (which evaluates pairs itself) and a gather
+ * before output or a checkpoint (the rank engine's). Which set of the pool
+ * holds a pair's springs is the same everywhere: adopting and letting go
+ * are applied on every process in pair order.
  *
  * On the wire (8-byte items), for each of the two walks: the counts of
- * touched, kept, released and adopted pairs (4 uint64), then the touched
- * keys (int64) and forces (pair_out doubles each), the kept pairs (int64)
- * and springs (slots doubles each), the released pairs (int64), the
- * adopted pairs (int64) and springs (slots doubles each).
+ * touched, released and adopted pairs (3 uint64), then the touched keys
+ * (int64) and forces (pair_out doubles each), the released pairs (int64),
+ * the adopted pairs (int64) and springs (slots doubles each). A sync's
+ * wire: the count of pairs (uint64), their pairs (int64), their springs
+ * (slots doubles each).
  */
 
 /* Room for `need` bytes on the wire; -1 when out of memory. */
@@ -408,40 +416,40 @@ static unsigned char *wire_put_rows(unsigned char *at, const contact_touches *li
  * out of memory. */
 static int wire_append(contact_state *cs, const contact_touches *lists, int used, size_t *bytes)
 {
-    const size_t kinds[4] = {offsetof(contact_touches, touched), offsetof(contact_touches, kept),
+    const size_t kinds[3] = {offsetof(contact_touches, touched),
                              offsetof(contact_touches, release), offsetof(contact_touches, adopt)};
-    const int width[4] = {cs->pair_out, cs->slots, 0, cs->slots};
-    uint64_t count[4] = {0, 0, 0, 0};
+    const int width[3] = {cs->pair_out, 0, cs->slots};
+    uint64_t count[3] = {0, 0, 0};
     size_t need = sizeof count;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 3; k++) {
         for (int t = 0; t < used; t++)
             count[k] += ((const pair_rows *)((const char *)&lists[t] + kinds[k]))->count;
         need += (size_t)count[k] * (sizeof(long) + sizeof(double) * (size_t)width[k]);
     }
     if (wire_reserve(cs, *bytes + need)) return -1;
     unsigned char *at = wire_put(cs->wire + *bytes, count, sizeof count);
-    for (int k = 0; k < 4; k++) at = wire_put_rows(at, lists, used, kinds[k], width[k]);
+    for (int k = 0; k < 3; k++) at = wire_put_rows(at, lists, used, kinds[k], width[k]);
     *bytes += need;
     return 0;
 }
 
 /* One walk's lists of one process, as wire_append laid them out at p,
- * applied: the touched pairs' forces added, the kept springs written back,
- * the released sets let go, the adopted ones taken (touching NULL: only
+ * applied: the touched pairs' forces added, the released sets let go, the
+ * adopted ones taken (touching NULL: only
  * stepped over). Returns the pointer past them and adds the touched pairs
  * to *touching; NULL when the pool cannot grow or the bytes run past end. */
 static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
                                        const unsigned char *end, int *touching)
 {
     contact_state *cs = &m->contact;
-    uint64_t count[4];
+    uint64_t count[3];
     if ((size_t)(end - p) < sizeof count) return NULL;
     memcpy(count, p, sizeof count);
     p += sizeof count;
     const size_t out = (size_t)cs->pair_out, slots = (size_t)cs->slots;
-    const size_t row[4] = {out, slots, 0, slots};
+    const size_t row[3] = {out, 0, slots};
     size_t need = 0;
-    for (int k = 0; k < 4; k++) {
+    for (int k = 0; k < 3; k++) {
         if (count[k] > (size_t)(end - p)) return NULL;
         need += (size_t)count[k] * (sizeof(long) + sizeof(double) * row[k]);
     }
@@ -452,18 +460,13 @@ static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
     for (size_t i = 0; i < count[0]; i++)
         contact_pair_scatter(m, touched_a(key[i]), touched_b(key[i]), rows + i * out);
     *touching += (int)count[0];
-    const long *kept = (const long *)(rows + count[0] * out);
-    const double *springs = (const double *)(kept + count[1]);
-    for (size_t i = 0; i < count[1]; i++)
-        memcpy(cs->slip + slots * (size_t)cs->spring_of[kept[i]], springs + i * slots,
-               sizeof(double) * slots);
-    const long *release = (const long *)(springs + count[1] * slots);
-    for (size_t i = 0; i < count[2]; i++) contact_springs_release(cs, (size_t)release[i]);
-    const long *adopt = release + count[2];
-    springs = (const double *)(adopt + count[3]);
-    for (size_t i = 0; i < count[3]; i++)
+    const long *release = (const long *)(rows + count[0] * out);
+    for (size_t i = 0; i < count[1]; i++) contact_springs_release(cs, (size_t)release[i]);
+    const long *adopt = release + count[1];
+    const double *springs = (const double *)(adopt + count[2]);
+    for (size_t i = 0; i < count[2]; i++)
         if (contact_springs_adopt(cs, (size_t)adopt[i], springs + i * slots)) return NULL;
-    return (const unsigned char *)(springs + count[3] * slots);
+    return (const unsigned char *)(springs + count[2] * slots);
 }
 
 /* The first position of an ascending index list at or past value v. */
@@ -513,10 +516,10 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
 #endif
         if (t == 0) nt_used = nt;
         contact_touches *list = &lists[t];
-        list->touched.count = list->adopt.count = list->release.count = list->kept.count = 0;
+        list->touched.count = list->adopt.count = list->release.count = 0;
         long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3, 1)
-                               : pairs_forces_listed(m, h, w, b, e, list, 2, 1);
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3)
+                               : pairs_forces_listed(m, h, w, b, e, list, 2);
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
@@ -545,7 +548,8 @@ static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk w
     /* every process takes part, failed or not: none is left waiting */
     const unsigned char *all;
     const size_t *at;
-    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, &all, &at)) return -1;
+    cs->springs_behind = 1; /* once gathered, failed or not (a failed step fails everywhere) */
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 1, &all, &at)) return -1;
     int touching = 0;
     for (int k = 0; k < 2; k++)
         for (int r = 0; r < share->contact_ranks; r++) {
@@ -554,6 +558,84 @@ static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk w
             if (!wire_apply(m, p, end, &touching)) return -1;
         }
     return touching;
+}
+
+/* The springs of the pairs of pairs[lo, hi) that hold a set, appended to
+ * the wire at *bytes as one run: their count (uint64), their pairs (int64),
+ * their springs (slots doubles each). -1 when out of memory. */
+static int sync_append(contact_state *cs, const near_pair *pairs, size_t lo, size_t hi,
+                       size_t *bytes)
+{
+    const size_t slots = (size_t)cs->slots;
+    uint64_t n = 0;
+    for (size_t i = lo; i < hi; i++) n += cs->spring_of[pairs[i].pair] >= 0;
+    size_t need = sizeof n + (size_t)n * (sizeof(long) + sizeof(double) * slots);
+    if (wire_reserve(cs, *bytes + need)) return -1;
+    unsigned char *at = wire_put(cs->wire + *bytes, &n, sizeof n);
+    long *key = (long *)at;
+    double *springs = (double *)(key + n);
+    size_t j = 0;
+    for (size_t i = lo; i < hi; i++) {
+        int32_t set = cs->spring_of[pairs[i].pair];
+        if (set < 0) continue;
+        key[j] = (long)pairs[i].pair;
+        memcpy(springs + j * slots, cs->slip + slots * (size_t)set, sizeof(double) * slots);
+        j++;
+    }
+    *bytes += need;
+    return 0;
+}
+
+/* One process's runs (sync_append) written into the pool; -1 when the
+ * bytes do not hold whole runs of pairs that hold a set. */
+static int sync_apply(contact_state *cs, const unsigned char *p, const unsigned char *end)
+{
+    const size_t slots = (size_t)cs->slots, row = sizeof(long) + sizeof(double) * slots;
+    while (p < end) {
+        uint64_t n;
+        if ((size_t)(end - p) < sizeof n) return -1;
+        memcpy(&n, p, sizeof n);
+        p += sizeof n;
+        if (n > (size_t)(end - p) / row) return -1;
+        const long *key = (const long *)p;
+        const double *springs = (const double *)(key + n);
+        for (size_t i = 0; i < n; i++) {
+            if (key[i] < 0 || (size_t)key[i] >= cs->pairs.count) return -1;
+            int32_t set = cs->spring_of[key[i]];
+            if (set < 0) return -1;
+            memcpy(cs->slip + slots * (size_t)set, springs + i * slots, sizeof(double) * slots);
+        }
+        p += (size_t)n * row;
+    }
+    return 0;
+}
+
+int contact_springs_sync(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    const step_share *share = m->share;
+    if (!cs->springs_behind || !share || share->contact_ranks < 2) return 0;
+    if (cs->slip_count == cs->free_count) { /* no pair holds a set (every process alike) */
+        cs->springs_behind = 0;
+        return 0;
+    }
+    /* this process's shares as walk_share cut them: the near list's by
+     * index, the vertex pairs' by index into near_vertex */
+    const size_t totals[2] = {cs->near_count, cs->near_vertex_count};
+    const near_pair *arrays[2] = {cs->near, cs->near_vertex};
+    const size_t r = (size_t)share->contact_rank, R = (size_t)share->contact_ranks;
+    size_t bytes = 0;
+    int ok = 1;
+    for (int k = 0; k < 2 && ok; k++)
+        ok = sync_append(cs, arrays[k], totals[k] * r / R, totals[k] * (r + 1) / R, &bytes) == 0;
+    const unsigned char *all;
+    const size_t *at;
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 0, &all, &at)) return -1;
+    cs->springs_behind = 0;
+    cs->springs_synced++;
+    for (size_t p = 0; p < R; p++) /* its own too: they are what it holds */
+        if (sync_apply(cs, all + at[p], all + at[p + 1])) return -1;
+    return 0;
 }
 
 /* The near list, then this step's vertex pairs (contact_near.c), each in
@@ -593,7 +675,6 @@ size_t contact_walk_bytes(const contact_state *cs)
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
         b += pair_rows_bytes(&cs->touches[t].release, 0);
-        b += pair_rows_bytes(&cs->touches[t].kept, cs->slots);
     }
     return b + cs->wire_capacity;
 }
@@ -604,7 +685,6 @@ void contact_walk_free(contact_state *cs)
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);
         pair_rows_free(&cs->touches[t].release);
-        pair_rows_free(&cs->touches[t].kept);
     }
     free(cs->touches);
     free(cs->wire);

@@ -285,6 +285,10 @@ typedef struct contact_state {
     int split_threads_min;   /* tests: the pairs a process's share of a split walk needs
                                 to take threads (0: as one process, contact_walk.c) */
     long split_threaded;     /* a figure: split walks whose share went to several threads */
+    long near_builds;        /* a figure: rebuilds of the near list */
+    int springs_behind;      /* a split walk updated springs in place since the last
+                                contact_springs_sync: other processes' copies are behind */
+    long springs_synced;     /* a figure: contact_springs_sync's exchanges */
     nbs_grid grid;           /* 2D detection */
     nbs_grid_3d grid3;       /* 3D detection */
     nbs_classes classes;     /* graded meshes: size classes on those grids (nbs_classes.h) */
@@ -325,11 +329,13 @@ static inline void contact_detect_after_breaks(contact_state *cs)
  *    share of the near pairs, lists what they did, and every process
  *    applies every list in process order.
  *  - contact_gather: called once a step by a split contact walk on every
- *    process, with the bytes this process listed (ok 0: it failed, the
- *    bytes say nothing). Returns 0 with *all every process's bytes one
- *    after another in process order, process p's from (*at)[p] to
- *    (*at)[p + 1] (kept until the next call); nonzero when some process
- *    failed or the exchange did: the step then fails on every process. */
+ *    process (walk 1), and before the spring pool is read by anything but
+ *    the walk (walk 0: contact_springs_sync, in a step or at a gather),
+ *    with the bytes this process listed (ok 0: it failed, the bytes say
+ *    nothing). Returns 0 with *all every process's bytes one after another
+ *    in process order, process p's from (*at)[p] to (*at)[p + 1] (kept
+ *    until the next call); nonzero when some process failed or the
+ *    exchange did: the step then fails on every process. */
 typedef struct step_share {
     void *ctx;
     const uint8_t *elem_mark;
@@ -338,7 +344,7 @@ typedef struct step_share {
     const uint8_t *node_mark;
     int (*update_done)(void *ctx, fdem_model *m, int bad);
     int contact_ranks, contact_rank;
-    int (*contact_gather)(void *ctx, const void *mine, size_t bytes, int ok,
+    int (*contact_gather)(void *ctx, const void *mine, size_t bytes, int ok, int walk,
                           const unsigned char **all, const size_t **at);
 } step_share;
 

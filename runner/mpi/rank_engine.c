@@ -31,6 +31,10 @@
  * near pairs and lists what they did; share_contact_gather hands every
  * rank every rank's lists (MPI_Allgather of their sizes, MPI_Allgatherv
  * of their bytes), which every rank applies in rank order, pair order.
+ * The springs a pair keeps, updated in place by the rank walking it, go
+ * through the same exchange only when something else is to read them
+ * (core's contact_springs_sync: before a detection, a rebuild of the near
+ * list, an excavation, and at rank_engine_gather).
  *
  * In a model where nothing after the forces reads nodes anywhere (no
  * contact, joints, fluid, stages: rank_halo_wanted) the update is split
@@ -49,6 +53,7 @@
 
 #include "model/model.h"
 #include "math/clock.h"
+#include "contact/contact.h"
 #include "element/element.h"
 #include "rank_engine.h"
 #include "rank_borders.h"
@@ -75,9 +80,11 @@ struct rank_engine {
     rank_halo border;                /* its nodes and lists */
     int agreed, local_bad, others_bad; /* this step's update verdicts (split) */
     int contact_split;               /* the contact walk is split (step_share.contact_gather) */
-    int contact_gathered;            /* its lists were exchanged in this step */
+    int contact_gathered;            /* the walk's lists were exchanged in this step, or an
+                                        exchange of springs before it told of a failure */
     int contact_fault;               /* rank_engine_set_contact_fault */
     int contact_turn;                /* the rotation fault: rank r takes share r + turn */
+    int gathering;                   /* in rank_engine_gather (the skip-sync faults) */
     long long fault_step;            /* the step being made (the failure fault) */
     long long *contact_sizes;        /* per rank: the bytes of its lists, -1 failed */
     int *contact_counts, *contact_displs; /* per rank, for MPI_Allgatherv */
@@ -212,19 +219,30 @@ static int share_update_done(void *ctx, fdem_model *m, int bad)
     return any;
 }
 
-/* The contact walk's lists (step_share.contact_gather): every rank's
- * sizes, then their bytes, in rank order (or, for the order fault, in the
- * reverse order). Every rank sees the same sizes, so each takes the same
- * path through the collectives: a rank that failed (size -1) fails the
- * step on all, and the buffer grows on all at the same steps, one
- * reduction then telling whether it grew everywhere. */
-static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int ok,
+/* The contact walk's lists or a hand-over of its springs
+ * (step_share.contact_gather; walk 1 and 0): every rank's sizes, then
+ * their bytes, in rank order (or, for the order fault, in the reverse
+ * order). Every rank sees the same sizes, so each takes the same path
+ * through the collectives: a rank that failed (size -1) fails the step on
+ * all, and the buffer grows on all at the same steps, one reduction then
+ * telling whether it grew everywhere. A step's last contact exchange is
+ * the walk's: a rank failing before it takes part in it (fail_collectives)
+ * unless an exchange of springs before it told every rank of a failure. */
+static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int ok, int walk,
                                 const unsigned char **all, const size_t **at)
 {
     rank_engine *re = ctx;
-    re->contact_gathered = 1;
     const int P = re->size, me = re->rank;
-    if (re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
+    const int skip = re->gathering ? RANK_CONTACT_FAULT_SKIP_GATHER_SYNC
+                                   : RANK_CONTACT_FAULT_SKIP_SYNC;
+    if (!walk && re->contact_fault == skip && ok) {
+        for (int k = 0; k <= P; k++) re->contact_at[k] = 0; /* nothing handed over */
+        *all = re->contact_buf;
+        *at = re->contact_at;
+        return 0;
+    }
+    if (walk) re->contact_gathered = 1;
+    if (walk && re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
         re->fault_step == RANK_CONTACT_FAIL_STEP)
         ok = 0; /* as if a list could not grow here */
     long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
@@ -253,6 +271,7 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
     }
     if (rc != MPI_SUCCESS) {
         stopwatch_add(re, t0);
+        re->contact_gathered = 1; /* every rank knows: none waits in another */
         return -1;
     }
     size_t from = 0;
@@ -271,6 +290,7 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
                         re->contact_counts, re->contact_displs, MPI_BYTE, re->comm);
     stopwatch_add(re, t0);
     re->fig.contact_bytes_sent += (double)bytes * (P - 1);
+    if (!walk) re->fig.contact_sync_bytes_sent += (double)bytes * (P - 1);
     *all = re->contact_buf;
     *at = re->contact_at;
     return rc == MPI_SUCCESS ? 0 : -1;
@@ -468,7 +488,7 @@ static void fail_collectives(rank_engine *re, fdem_model *m)
     if (re->contact_split && !re->contact_gathered) {
         const unsigned char *all;
         const size_t *at;
-        share_contact_gather(re, NULL, 0, 0, &all, &at);
+        share_contact_gather(re, NULL, 0, 0, 1, &all, &at);
     }
     if (!re->exchanged) {
         if (re->split) rank_halo_exchange(&re->border, m, 0);
@@ -506,6 +526,18 @@ int rank_engine_step(rank_engine *re, fdem_model *m, fdem_error *err)
 /* The viscous history of each block from its owner to rank 0. */
 int rank_engine_gather(rank_engine *re, fdem_model *m, fdem_error *err)
 {
+    if (re->contact_split) { /* the springs the walk updated in place, for rank 0's output */
+        m->share = &re->share;
+        re->gathering = 1;
+        int rc = contact_springs_sync(m);
+        re->gathering = 0;
+        m->share = NULL;
+        if (rc) {
+            model_error(err, FDEM_ITEM_NONE, -1, "out of memory handing the ranks' contact "
+                        "springs over");
+            return -1;
+        }
+    }
     if (re->split &&
         rank_halo_gather(&re->border, m, re->node_order, re->node_counts, re->node_displs)) {
         model_error(err, FDEM_ITEM_NONE, -1, "out of memory gathering the ranks' nodes");

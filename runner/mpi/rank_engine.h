@@ -49,6 +49,7 @@ typedef struct rank_figures {
     long contact_pairs_walked;  /* near pairs in this rank's share, all steps (every pair
                                    walked, on one rank) */
     double contact_bytes_sent;  /* the walk's lists sent to the other ranks, all steps */
+    double contact_sync_bytes_sent; /* of which the springs handed over (contact_springs_sync) */
 } rank_figures;
 
 rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err);
@@ -95,9 +96,14 @@ void rank_engine_set_border_order_fault(rank_engine *re, int on);
  * must make the state differ from one process where pairs of two ranks
  * meet at a node. FAIL makes the last rank's walk fail at step
  * RANK_CONTACT_FAIL_STEP, as if its lists could not grow: every rank must
- * fail that step, none left waiting. */
+ * fail that step, none left waiting. SKIP_SYNC leaves out the hand-overs
+ * of the springs the walk updated in place (contact_springs_sync) inside
+ * the steps (before a detection, a break's mending, a near list's rebuild,
+ * an excavation), SKIP_GATHER_SYNC the one at rank_engine_gather: each
+ * rank then holds the other ranks' springs as they were. */
 enum { RANK_CONTACT_FAULT_NONE, RANK_CONTACT_FAULT_ORDER, RANK_CONTACT_FAULT_ROTATE,
-       RANK_CONTACT_FAULT_FAIL };
+       RANK_CONTACT_FAULT_FAIL, RANK_CONTACT_FAULT_SKIP_SYNC,
+       RANK_CONTACT_FAULT_SKIP_GATHER_SYNC };
 #define RANK_CONTACT_FAIL_STEP 9
 void rank_engine_set_contact_fault(rank_engine *re, int fault);
 

@@ -12,8 +12,9 @@ oversubscribed and 2 of one thread, must equal those of one
 plain process stepping with fdem_step; a rank engine that adds its halo
 elements after its own (rank_compare --fault) must not, nor one that splits
 the contact pair walk wrongly (--contact-fault: the ranks' lists applied in
-reverse rank order, or each rank given another share of the pairs every
-step), and a walk failing on one rank fails the step on every rank. The
+reverse rank order, each rank given another share of the pairs every
+step, or the springs the walk updates in place not handed over in the
+steps or at the gather), and a walk failing on one rank fails the step on every rank. The
 contact cases split their pair walk between the ranks (each rank
 evaluates a share, on 2 ranks of 2 threads on both threads): every rank
 evaluates some pairs, and each pair is evaluated once. A checkpoint written
@@ -190,7 +191,7 @@ class RanksSameBits(unittest.TestCase):
                                                 "--restore", cls.checkpoint_split, cls.cases[2]])
         cls.fault = cls.run_ranks(4, "--fault")
         cls.contact_faults = {kind: cls.run_ranks(2, "--contact-fault", kind, cases=cls.cases[:2])
-                              for kind in ("order", "rotate")}
+                              for kind in ("order", "rotate", "skip-sync", "skip-gather-sync")}
         cls.contact_fail = {n: cls.run_ranks(n, "--contact-fault", "fail",
                                              cases=["--expect-failure"] + cls.cases[:2])
                             for n in (2, 3)}
@@ -268,9 +269,12 @@ class RanksSameBits(unittest.TestCase):
                               if l.startswith("contact pairs walked") and l.endswith(": " + case)])
 
     def test_contact_walk_split_wrongly_differs(self):
-        """The ranks' lists applied in reverse rank order, or each rank
+        """The ranks' lists applied in reverse rank order, each rank
         evaluating another share every step (the near pairs' hints it keeps
-        go stale): the comparison must see both."""
+        go stale), or the springs the walk updates in place not handed over
+        in the steps (before a detection, a break's mending or a rebuild of
+        the near list) or at the gather before output: the comparison must
+        see each."""
         plain = [l for case in self.cases[:2] for l in self.case_lines(self.plain, case)]
         for kind, lines in self.contact_faults.items():
             with self.subTest(fault=kind):

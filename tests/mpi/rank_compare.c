@@ -25,7 +25,10 @@
  * the ranks' lists applied in reverse rank order, or each rank given
  * another share of the pairs every step): the same. --contact-fault fail
  * makes the last rank's walk fail at step 9 (with --expect-failure: every
- * rank must fail there).
+ * rank must fail there). --contact-fault skip-sync (skip-gather-sync)
+ * leaves out the hand-overs of the springs the walk updates in place
+ * (contact_springs_sync) in the steps (at the gather): the lines must
+ * differ.
  *
  * --split-threads-min N: a rank's share of the contact walk goes to its
  * threads from N pairs (contact.split_threads_min; small cases' shares are
@@ -248,7 +251,8 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
                 "nodes owned %ld kept %ld (update %s), bytes sent/step %.0f, "
                 "partition %.4f s, engine set-up %.2f s, build %.2f s, step %.6f s (cpu %.6f s, "
                 "exchanges %.6f s, cpu there %.6f s: work %.6f s), peak %.0f bytes/element, "
-                "contact pairs walked/step %.0f, contact bytes sent/step %.0f\n",
+                "contact pairs walked/step %.0f, contact bytes sent/step %.0f "
+                "(springs handed over %.0f)\n",
                 rank, f.owned_blocks, f.blocks, f.owned_elements, f.computed_elements,
                 f.owned_elements ? (double)(f.computed_elements - f.owned_elements) /
                                        (double)f.owned_elements : 0.0,
@@ -258,7 +262,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
                 (c_step - f.exchange_cpu_seconds) / stepped,
                 peak_bytes() / fdem_get_counts(m).elements,
                 (double)f.contact_pairs_walked / stepped,
-                f.contact_bytes_sent / stepped);
+                f.contact_bytes_sent / stepped, f.contact_sync_bytes_sent / stepped);
         if (rank == 0)
             printf("figures ranks %d step_s %.6f max_bytes_sent_per_step %.0f\n", size, step_s,
                    most);
@@ -269,6 +273,9 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
                "integration %.6f, all %.6f (cpu %.6f)\n", st.elements / stepped,
                st.joints / stepped, st.detection / stepped, st.contact / stepped,
                st.integration / stepped, t_step / stepped, c_step / stepped);
+    if (figures && rank == 0 && m->contact.enabled)
+        printf("contact: %ld detections, %ld near-list builds, %ld hand-overs of springs in "
+               "all\n", m->contact.detections, m->contact.near_builds, m->contact.springs_synced);
     }
     rank_engine_lazy_free(&lazy);
     fdem_model_destroy(m);
@@ -283,7 +290,7 @@ int main(int argc, char **argv)
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (argc < 4) {
         if (rank == 0) fprintf(stderr, "usage: rank_compare STEPS EVERY [--plain] [--threads T] "
-                                       "[--fault] [--contact-fault order|rotate|fail] [--figures] "
+                                       "[--fault] [--contact-fault order|rotate|fail|skip-sync|skip-gather-sync] [--figures] "
                                        "[--split-threads-min N] "
                                        "[--save-at K FILE] [--restore FILE] "
                                        "CASE.json...\n");
@@ -303,7 +310,10 @@ int main(int argc, char **argv)
             o.contact_fault = !strcmp(kind, "order")    ? RANK_CONTACT_FAULT_ORDER
                               : !strcmp(kind, "rotate") ? RANK_CONTACT_FAULT_ROTATE
                               : !strcmp(kind, "fail")   ? RANK_CONTACT_FAULT_FAIL
-                                                        : -1;
+                              : !strcmp(kind, "skip-sync") ? RANK_CONTACT_FAULT_SKIP_SYNC
+                              : !strcmp(kind, "skip-gather-sync")
+                                  ? RANK_CONTACT_FAULT_SKIP_GATHER_SYNC
+                                  : -1;
             if (o.contact_fault < 0) MPI_Abort(MPI_COMM_WORLD, 2);
         }
         else if (!strcmp(argv[i], "--expect-failure")) o.expect_failure = 1;
