@@ -99,11 +99,12 @@ static void rank_wait_for_writer(MPI_Comm comm)
 
 int main(int argc, char **argv)
 {
-    enum { OPT_CONTROL = 256, OPT_QUIET };
+    enum { OPT_CONTROL = 256, OPT_QUIET, OPT_PAUSE_AT };
     static const struct option longs[] = {
         {"out", required_argument, 0, 'o'}, {"ranks", required_argument, 0, 'n'},
         {"threads", required_argument, 0, 'j'}, {"control", required_argument, 0, OPT_CONTROL},
-        {"quiet", no_argument, 0, OPT_QUIET}, {0, 0, 0, 0},
+        {"quiet", no_argument, 0, OPT_QUIET}, {"pause-at-step", required_argument, 0, OPT_PAUSE_AT},
+        {0, 0, 0, 0},
     };
     run_options o = {.threads = 1, .ranks = 1, .control_fd = -1};
     int c;
@@ -114,12 +115,14 @@ int main(int argc, char **argv)
         case 'j': o.threads = atoi(optarg); break;
         case OPT_CONTROL: o.control_fd = strcmp(optarg, "stdin") == 0 ? 0 : -1; break;
         case OPT_QUIET: o.quiet = 1; break;
+        case OPT_PAUSE_AT: o.pause_at_step = atoll(optarg); break; /* checked by fdem-run */
         default: return 2;
         }
     }
     if (optind != argc - 1 || !o.out_dir) {
         fprintf(stderr, "usage: fdem-rank CASE.json --out DIR [--threads T] [--ranks N] "
-                "[--control stdin] (started by fdem-run --ranks N or the daemon)\n");
+                "[--control stdin] [--pause-at-step S] [--quiet] (started by fdem-run --ranks N or the "
+                "daemon)\n");
         return 2;
     }
     o.case_path = argv[optind];

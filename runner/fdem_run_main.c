@@ -53,10 +53,22 @@ static int run_ranks(const run_options *o, const char *launcher, int control)
                 "all` where mpicc is installed (Debian: openmpi-bin libopenmpi-dev)\n");
         return 1;
     }
+    char pause[24];
     snprintf(threads, sizeof threads, "%d", o->threads);
     snprintf(ranks, sizeof ranks, "%d", o->ranks);
-    const char *extra[] = {rank_bin, o->case_path, "--out", o->out_dir, "--threads", threads,
-                           "--ranks", ranks, control ? "--control" : NULL, "stdin", NULL};
+    snprintf(pause, sizeof pause, "%lld", o->pause_at_step);
+    /* every option a rank's loop reads goes on to fdem-rank: --pause-at-step
+     * was left behind, and ranked runs went on to their end */
+    const char *extra[16] = {rank_bin, o->case_path, "--out", o->out_dir, "--threads", threads,
+                             "--ranks", ranks};
+    int k = 8;
+    if (control)
+        extra[k++] = "--control", extra[k++] = "stdin";
+    if (o->pause_at_step > 0)
+        extra[k++] = "--pause-at-step", extra[k++] = pause;
+    if (o->quiet)
+        extra[k++] = "--quiet";
+    extra[k] = NULL;
     char **argv = launch_argv(launcher, o->ranks, extra, err, sizeof err);
     if (!argv) {
         fprintf(stderr, "fdem-run: %s\n", err);

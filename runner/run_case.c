@@ -63,6 +63,7 @@ typedef struct run_ctx {
     char h5_path[1200], xdmf_path[1200];
     double next_output, next_history;
     int64_t last_snapshot_step, last_checkpoint_step;
+    int at_end_already;         /* resumed at its end: nothing stepped, nothing to write */
     history_row **rows;
     int row_count, row_capacity;
     run_status status;
@@ -339,10 +340,19 @@ static int run_any_failed(run_ctx *r, int failed)
     return r->st && r->st->agree ? r->st->agree(r->st->ctx, failed) : failed;
 }
 
-/* Steps until the end, a command or a failure. */
+/* Steps until the end, a command or a failure. A directory resumed at
+ * its end (run again after it finished) takes no step: it took one past
+ * its end before, and wrote it. */
 static run_outcome run_loop(run_ctx *r)
 {
     const double end = r->info.end_time;
+    if (output_at_end(fdem_get_time(r->m), fdem_get_dt(r->m), end)) {
+        if (r->writer && !r->o->quiet)
+            fprintf(stderr, "fdem-run: %s already finished at step %lld (t = %.6g s): nothing to do\n",
+                    r->o->out_dir, (long long)fdem_get_step(r->m), fdem_get_time(r->m));
+        r->at_end_already = 1;
+        return RUN_FINISHED;
+    }
     for (;;) {
         double now = clock_wall_seconds();
         int cmd = run_poll(r, now);
@@ -399,6 +409,15 @@ static run_outcome run_loop(run_ctx *r)
  * the loop ended, then result.h5's views and its close. */
 static void run_wind_down(run_ctx *r, run_outcome why)
 {
+    if (r->at_end_already && !r->error[0]) { /* its files are as its finish left them */
+        if (r->writer && r->result && result_close(r->result) != 0)
+            run_fail(r, "closing result.h5 failed (disk full or I/O error)");
+        r->result = NULL;
+        result_free_history(r->rows, r->row_count);
+        r->rows = NULL;
+        if (!r->error[0])
+            return;
+    }
     int64_t step = fdem_get_step(r->m);
     int stopping = why == RUN_STOPPED, pausing = why == RUN_PAUSED;
     if ((stopping || pausing) && run_gather(r) != 0)

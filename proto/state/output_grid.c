@@ -11,6 +11,11 @@ int output_is_last_step(double t0, double dt, double end)
     return t0 + dt >= end - 1e-9 * dt; /* no sliver of a step left over */
 }
 
+int output_at_end(double t, double dt, double end)
+{
+    return !(end - t > 1e-9 * dt);
+}
+
 double output_snapshot_interval(const case_info *info)
 {
     double interval = info->output_interval;

@@ -8,6 +8,8 @@
  * Contract:
  *  - output_is_last_step(t0, dt, end): the step from t0 is the last; it is
  *    cut to end - t0 (no sliver of a step is left over).
+ *  - output_at_end(t, dt, end): a run at t has no step left (the cut step
+ *    lands on end up to rounding, within 1e-9 dt).
  *  - output_snapshot_interval(info): the case's output interval, else a
  *    hundredth of its end time.
  *  - output_next_time(interval, t): the first multiple of `interval`
@@ -30,6 +32,7 @@
 #include "case/case.h"
 
 int output_is_last_step(double t0, double dt, double end);
+int output_at_end(double t, double dt, double end);
 double output_snapshot_interval(const case_info *info);
 double output_next_time(double interval, double t);
 int output_is_due(double t, double next, double dt);

@@ -136,6 +136,29 @@ class FdemRunFiles(DaemonTestCase):
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assert_same_files(whole, parts, "paused at step 37 and resumed")
 
+    def test_a_finished_directory_run_again_takes_no_step(self):
+        case = bar_with_history(2)
+        path = self.write_case(case, "twice.json")
+        out = os.path.join(self.tmp, "twice")
+        self.assertEqual(fdem_run([path, "--out", out, "--quiet"]).returncode, 0)
+
+        def files():
+            with open(os.path.join(out, "status.json")) as f:
+                st = json.load(f)
+            with open(os.path.join(out, "checkpoint.bin"), "rb") as f:
+                return st, f.read(), datasets(os.path.join(out, "result.h5"))
+        st, ckpt, d = files()
+        r = fdem_run([path, "--out", out])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("already finished", r.stderr)
+        st2, ckpt2, d2 = files()
+        # it took one step past its end before (step 54 of 53)
+        self.assertEqual((st2["state"], st2["step"], st2["finished_at"]),
+                         (st["state"], st["step"], st["finished_at"]))
+        self.assertEqual(ckpt2, ckpt, "checkpoint.bin changed")
+        self.assertEqual(len(d2["snapshots/time"]), len(d["snapshots/time"]))
+        self.assertEqual(len(d2["history/time"]), len(d["history/time"]))
+
     def test_pause_and_stop_lines_on_stdin(self):
         path = self.write_case(tiny_case("lines", end=5.0, divisions=(4, 4), interval=1e-3),
                                "lines.json")
@@ -278,6 +301,29 @@ class RankedCases(DaemonTestCase):
         b = datasets(os.path.join(self.d.data_dir, two["id"], "result.h5"))
         for name in a:
             self.assertEqual(a[name].tobytes(), b[name].tobytes(), "extended: " + name)
+
+    def test_fdem_run_on_ranks_pauses_at_a_step_and_goes_on(self):
+        case = bar_with_history(2)
+        path = os.path.join(self.tmp, "paused-ranks.json")
+        with open(path, "w") as f:
+            json.dump(case, f)
+        whole, parts = os.path.join(self.tmp, "whole-one"), os.path.join(self.tmp, "parts-two")
+        env = dict(os.environ, **MPI_ENV)
+        self.assertEqual(fdem_run([path, "--out", whole, "--quiet"]).returncode, 0)
+        # --pause-at-step was not handed on to the ranks: they ran to the end
+        r = fdem_run([path, "--out", parts, "--ranks", "2", "--quiet", "--pause-at-step", "13"],
+                     env=env)
+        self.assertEqual(r.returncode, 3, r.stderr)
+        with open(os.path.join(parts, "status.json")) as f:
+            st = json.load(f)
+        self.assertEqual((st["state"], st["step"]), ("paused", 13))
+        r = fdem_run([path, "--out", parts, "--ranks", "2", "--quiet"], env=env)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        a = datasets(os.path.join(whole, "result.h5"))
+        b = datasets(os.path.join(parts, "result.h5"))
+        self.assertEqual(sorted(a), sorted(b))
+        for name in a:
+            self.assertEqual(a[name].tobytes(), b[name].tobytes(), name)
 
     def test_a_missing_launcher_fails_the_case_with_a_sentence(self):
         d = Daemon(args=("--launcher", "/nonexistent/mpirun -np {ranks}")).start()
