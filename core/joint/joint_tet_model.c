@@ -265,10 +265,10 @@ JOINT_TET_INLINE void joint_pair_undamaged(fdem_model *m, int j, joint_totals *t
     joint_pair k = {m->joint_k[j], m->joint_k[j + 1]};
     joint_pair ft = {s0->tensile_strength, s1->tensile_strength};
     joint_pair c = {s0->cohesion, s1->cohesion}, tan_phi = {s0->tan_phi, s1->tan_phi};
-    joint_pair_mask sure = joint_tet_surely_elastic_of_pair(k, ft, c, tan_phi, d);
+    joint_pair_mask sized = N_len > JOINT_TET_TINY_NORMAL;
+    joint_pair_mask sure = joint_tet_surely_elastic_of_pair(k, ft, c, tan_phi, d) & sized;
     if (!(sure[0] && sure[1])) /* pressed joints: the point test itself */
-        sure |= joint_tet_elastic_points_of_pair(k, ft, c, tan_phi, d, N, N_len);
-    sure &= N_len > JOINT_TET_TINY_NORMAL;
+        sure |= joint_tet_elastic_points_of_pair(k, ft, c, tan_phi, d, N, N_len) & sized;
     joint_pair fa[9];
     joint_pair e = joint_tet_elastic_forces_of_pair(k, 0.5 * N_len, d, fa);
     JOINT_TET_UNROLL
@@ -318,11 +318,12 @@ __attribute__((target("avx2"))) static int joint_quad_elastic(fdem_model *m, int
     }
     fdem_quad d[3][3], N[3];
     fdem_quad N_len = joint_tet_gaps_at_quad(m->pos, n, n, d, N);
-    fdem_quad_mask sure = joint_tet_surely_elastic_of_quad(k, ft, c, tan_phi, d);
-    if (!(sure[0] && sure[1] && sure[2] && sure[3])) /* pressed joints: the point test */
-        sure |= joint_quad_pressed(k, ft, c, tan_phi, d, N, N_len);
-    sure &= N_len > JOINT_TET_TINY_NORMAL;
-    if (!(sure[0] && sure[1] && sure[2] && sure[3])) return 0;
+    fdem_quad_mask sized = N_len > JOINT_TET_TINY_NORMAL;
+    fdem_quad_mask sure = joint_tet_surely_elastic_of_quad(k, ft, c, tan_phi, d) & sized;
+    if (!(sure[0] && sure[1] && sure[2] && sure[3])) { /* pressed joints: the point test */
+        sure |= joint_quad_pressed(k, ft, c, tan_phi, d, N, N_len) & sized;
+        if (!(sure[0] && sure[1] && sure[2] && sure[3])) return 0;
+    }
     fdem_quad fa[9];
     fdem_quad e = joint_tet_elastic_forces_of_quad(k, 0.5 * N_len, d, fa);
     JOINT_TET_UNROLL
