@@ -13,7 +13,6 @@
 
 #include <math.h>
 #include <stddef.h>
-#include <stdint.h>
 #include <string.h>
 
 #include "math/vec3.h"
@@ -74,8 +73,7 @@ static int tet_now_of(const double *pos, const double *vel, const int32_t n[4],
             t->v[c][i] = vel[3 * (size_t)n[c] + i];
         }
     if (!memo) return tet_now_map(t);
-    unsigned slot = (unsigned)(((uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15u) >> 58);
-    _Static_assert(CONTACT_MEMO_SLOTS == 64, "slot is 6 bits");
+    unsigned slot = contact_memo_slot(n);
     double *map = &t->cof[0][0];
     if (memo->face_node[slot] == n) {
         memcpy(map, memo->face_numbers[slot], TET_NOW_MAP * sizeof(double));

@@ -52,6 +52,15 @@ typedef struct contact_pair_memo {
     double face_numbers[CONTACT_MEMO_SLOTS][14];
 } contact_pair_memo;
 
+/* The memo slot of the element whose node list is n: the top 6 bits of its
+ * address times 2^64 / phi (Fibonacci hashing), the address standing for
+ * the element. One rule for both kernels' memos. */
+static inline unsigned contact_memo_slot(const int32_t *n)
+{
+    _Static_assert(CONTACT_MEMO_SLOTS == 64, "slot is 6 bits");
+    return (unsigned)(((uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15u) >> 58);
+}
+
 static inline void contact_pair_memo_clear(contact_pair_memo *memo)
 {
     for (int s = 0; s < CONTACT_MEMO_SLOTS; s++) memo->node[s] = memo->face_node[s] = 0;

@@ -507,9 +507,7 @@ static void tet_frame_memo(const double *pos, const int32_t n[4], contact_pair_m
         t->bary = bary_of(t->p);
         return;
     }
-    /* Fibonacci hashing: the top bits of the address times 2^64 / phi */
-    unsigned slot = (unsigned)(((uint64_t)(uintptr_t)n * 0x9E3779B97F4A7C15u) >> 58);
-    _Static_assert(CONTACT_MEMO_SLOTS == 64, "slot is 6 bits");
+    unsigned slot = contact_memo_slot(n);
     if (memo->node[slot] == n) {
         memcpy(&t->bary, memo->numbers[slot], sizeof t->bary);
         return;
