@@ -54,6 +54,22 @@ static inline int contact_pair_joined(const fdem_model *m, const int32_t *piece,
  * scratch, zeroed after (contact.c). */
 void contact_mark_cracks(fdem_model *m, int32_t *piece);
 
+/* This process's share [*lo, *hi) of n items when the contact walk is
+ * split between processes (step_share.contact_ranks; all n otherwise):
+ * process r of R takes [n r / R, n (r + 1) / R). The walk evaluates the
+ * pairs of its share (contact_walk.c), the near list keeps their boxes
+ * (contact_near.c) and contact_springs_sync hands over their springs, so
+ * all three cut here. */
+static inline void contact_share(const step_share *share, size_t n, size_t *lo, size_t *hi)
+{
+    if (!share || share->contact_ranks < 2) {
+        *lo = 0, *hi = n;
+        return;
+    }
+    const size_t r = (size_t)share->contact_rank, R = (size_t)share->contact_ranks;
+    *lo = n * r / R, *hi = n * (r + 1) / R;
+}
+
 /* Axis-aligned boxes (lo, hi per axis) that overlap or touch. */
 static inline int boxes_overlap(const double *a, const double *b, int dim)
 {

@@ -277,12 +277,9 @@ static int contact_near_rebuild(fdem_model *m)
     /* A process of a split walk (contact_walk.c) reads the boxes of its
      * shares' pairs only, until the next rebuild (which computes every
      * candidate's first): it keeps only those up to date. */
-    size_t lo = 0, hi = count, vlo = 0, vhi = vertex;
-    if (m->share && m->share->contact_ranks > 1) {
-        const size_t r = (size_t)m->share->contact_rank, R = (size_t)m->share->contact_ranks;
-        lo = count * r / R, hi = count * (r + 1) / R;
-        vlo = vertex * r / R, vhi = vertex * (r + 1) / R;
-    }
+    size_t lo, hi, vlo, vhi;
+    contact_share(m->share, count, &lo, &hi);
+    contact_share(m->share, vertex, &vlo, &vhi);
     cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near + lo, hi - lo,
                                                      cs->near_vertex + vlo, vhi - vlo,
                                                      cs->near_active);

@@ -483,17 +483,18 @@ static size_t lower_bound(const int32_t *v, size_t n, long x)
 
 /* This process's share [begin, end) of pairs [0, n) of the near array
  * (or of near_vertex, by index value, when w->index is set). */
-static void walk_share(const near_walk *w, size_t n, int rank, int ranks, long *begin, long *end)
+static void walk_share(const near_walk *w, size_t n, const step_share *share, long *begin,
+                       long *end)
 {
-    long lo = (long)(n * (size_t)rank / (size_t)ranks);
-    long hi = (long)(n * (size_t)(rank + 1) / (size_t)ranks);
+    size_t lo, hi;
+    contact_share(share, n, &lo, &hi);
     if (!w->index) {
-        *begin = lo;
-        *end = hi;
+        *begin = (long)lo;
+        *end = (long)hi;
         return;
     }
-    *begin = (long)lower_bound(w->index, w->count, lo);
-    *end = (long)lower_bound(w->index, w->count, hi);
+    *begin = (long)lower_bound(w->index, w->count, (long)lo);
+    *end = (long)lower_bound(w->index, w->count, (long)hi);
 }
 
 /* Pairs [begin, end) of walk w listed on this process's threads; *used the
@@ -540,7 +541,7 @@ static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk w
     for (int k = 0; k < 2 && ok; k++) {
         long begin, end;
         int used;
-        walk_share(&walks[k], totals[k], share->contact_rank, share->contact_ranks, &begin, &end);
+        walk_share(&walks[k], totals[k], share, &begin, &end);
         cs->pairs_walked += end - begin;
         ok = walk_listed(m, h, &walks[k], begin, end, &used) == 0 &&
              wire_append(cs, cs->touches, used, &bytes) == 0;
@@ -623,17 +624,19 @@ int contact_springs_sync(fdem_model *m)
      * index, the vertex pairs' by index into near_vertex */
     const size_t totals[2] = {cs->near_count, cs->near_vertex_count};
     const near_pair *arrays[2] = {cs->near, cs->near_vertex};
-    const size_t r = (size_t)share->contact_rank, R = (size_t)share->contact_ranks;
     size_t bytes = 0;
     int ok = 1;
-    for (int k = 0; k < 2 && ok; k++)
-        ok = sync_append(cs, arrays[k], totals[k] * r / R, totals[k] * (r + 1) / R, &bytes) == 0;
+    for (int k = 0; k < 2 && ok; k++) {
+        size_t lo, hi;
+        contact_share(share, totals[k], &lo, &hi);
+        ok = sync_append(cs, arrays[k], lo, hi, &bytes) == 0;
+    }
     const unsigned char *all;
     const size_t *at;
     if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 0, &all, &at)) return -1;
     cs->springs_behind = 0;
     cs->springs_synced++;
-    for (size_t p = 0; p < R; p++) /* its own too: they are what it holds */
+    for (int p = 0; p < share->contact_ranks; p++) /* its own too: they are what it holds */
         if (sync_apply(cs, all + at[p], all + at[p + 1])) return -1;
     return 0;
 }
