@@ -28,11 +28,6 @@
 #include <math.h>
 #include <string.h>
 
-/* The symmetric three-point rule on the triangle, barycentric. */
-static const double rule[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6},
-                                  {1.0 / 6, 2.0 / 3, 1.0 / 6},
-                                  {1.0 / 6, 1.0 / 6, 2.0 / 3}};
-
 static const double *node_at(const double *xyz, int32_t n) { return xyz + 3 * (size_t)n; }
 
 /* The gap sum_i lambda_i d_i at barycentric point lambda. */
@@ -40,23 +35,6 @@ static void gap_at(const double d[3][3], const double lambda[3], double out[3])
 {
     for (int c = 0; c < 3; c++)
         out[c] = lambda[0] * d[0][c] + lambda[1] * d[1][c] + lambda[2] * d[2][c];
-}
-
-/* ------------------------------------------------------------- elastic */
-
-/* True when every point of an undamaged joint is within its strengths,
- * tested on projections against the unnormalised normal N (|N| = 2A). */
-static int joint_tet_elastic(const joint_law *law, const double d[3][3], const double N[3],
-                             double N_len)
-{
-    for (int p = 0; p < 3; p++) {
-        double g[3], slide[3];
-        gap_at(d, rule[p], g);
-        vec3_cross(g, N, slide);
-        if (!joint_point_elastic(law, N_len, vec3_dot(g, N), sqrt(vec3_dot(slide, slide))))
-            return 0;
-    }
-    return 1;
 }
 
 /* ---------------------------------------------------------- compression */
@@ -74,7 +52,8 @@ static double shut_triangle(double k, double area, const double P[3][3], const d
     for (int q = 0; q < 3; q++) {
         double lambda[3];
         for (int i = 0; i < 3; i++)
-            lambda[i] = rule[q][0] * P[0][i] + rule[q][1] * P[1][i] + rule[q][2] * P[2][i];
+            lambda[i] = joint_tet_rule[q][0] * P[0][i] + joint_tet_rule[q][1] * P[1][i] +
+                        joint_tet_rule[q][2] * P[2][i];
         double dq = vec3_dot(lambda, delta);
         energy += w * 0.5 * k * dq * dq;
         for (int i = 0; i < 3; i++)
@@ -178,7 +157,7 @@ static void joint_tet_general(const joint_law *law, const double d[3][3], const 
     joint_point g[3];
     for (int p = 0; p < 3; p++) {
         double gap[3];
-        gap_at(d, rule[p], gap);
+        gap_at(d, joint_tet_rule[p], gap);
         const double slide[2] = {vec3_dot(gap, t1), vec3_dot(gap, t2)};
         joint_point_measure(law, vec3_dot(gap, n), slide, &slip[p], &g[p]);
     }
@@ -195,7 +174,7 @@ static void joint_tet_general(const joint_law *law, const double d[3][3], const 
         slip[p] = g[p].slip;
         for (int c = 0; c < 3; c++) {
             double T = w * (sigma * n[c] + tau[0] * t1[c] + tau[1] * t2[c]);
-            for (int i = 0; i < 3; i++) fa[3 * i + c] += rule[p][i] * T;
+            for (int i = 0; i < 3; i++) fa[3 * i + c] += joint_tet_rule[p][i] * T;
         }
     }
     double delta[3] = {vec3_dot(d[0], n), vec3_dot(d[1], n), vec3_dot(d[2], n)};
@@ -224,7 +203,8 @@ int joint_tet_forces_of_gaps(const joint_law *law, const double *pos, const doub
     if (*damage >= 1.0) return 0;
     double area = 0.5 * N_len;
     if (!(N_len > 0)) return 1; /* a face squashed flat carries nothing this step */
-    if (*damage == 0 && joint_tet_elastic(law, d, N, N_len)) {
+    if (*damage == 0 && joint_tet_elastic_points_of(law->k, law->tensile_strength, law->cohesion,
+                                                    law->tan_phi, d, N, N_len)) {
         e->stored += joint_tet_elastic_forces(law->k, area, d, fa);
         return 1;
     }

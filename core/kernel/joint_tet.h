@@ -110,6 +110,12 @@ JOINT_TET_INLINE joint_pair joint_pair_sqrt(joint_pair x)
 /* Coordinate c of corner k (0-2 face A, 3-5 face B) of the joint(s). */
 #define JOINT_TET_AT(pos, n, k, c) (pos)[3 * (size_t)(n)[k] + (c)]
 
+/* The symmetric three-point rule on the triangle, barycentric: the points
+ * of the law (joint_tet.c) and of the elastic test (joint_tet_fast_body.h). */
+static const double joint_tet_rule[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6},
+                                            {1.0 / 6, 2.0 / 3, 1.0 / 6},
+                                            {1.0 / 6, 1.0 / 6, 2.0 / 3}};
+
 #define JT_T double
 #define JT_MASK int
 #define JT_FN(name) name

@@ -62,11 +62,11 @@ JOINT_TET_INLINE JT_MASK JT_FN(joint_tet_surely_elastic_of)(JT_T k, JT_T ft, JT_
     return sure;
 }
 
-/* joint_tet.c's elastic test itself, the same operations in the same order
- * on each lane (so the same verdict, bit for bit): every point of the
- * three-point rule within joint_point_elastic's strengths, projected on
- * the unnormalised normal N (|N| = N_len). For what the test above cannot
- * pass: a pressed joint. Its gaps are as large as its compression makes
+/* The elastic test of an undamaged joint, the kernel's own (joint_tet.c
+ * calls the one-joint form) and, lane by lane with the same operations,
+ * the side-by-side paths': every point of the three-point rule within
+ * joint_point_elastic's strengths, projected on the unnormalised normal N
+ * (|N| = N_len). For what the test above cannot pass: a pressed joint. Its gaps are as large as its compression makes
  * them, far over f_t / k, while its shear strength grows with the
  * pressure; each such joint went through the kernel's call and point law,
  * which made a loaded 3D disc's joints 3.5x dearer a step before any
@@ -75,16 +75,14 @@ JOINT_TET_INLINE JT_MASK JT_FN(joint_tet_elastic_points_of)(JT_T k, JT_T ft, JT_
                                                            const JT_T d[3][3], const JT_T N[3],
                                                            JT_T N_len)
 {
-    const double rule[3][3] = {{2.0 / 3, 1.0 / 6, 1.0 / 6},
-                               {1.0 / 6, 2.0 / 3, 1.0 / 6},
-                               {1.0 / 6, 1.0 / 6, 2.0 / 3}};
     JT_MASK elastic = k >= 0;
     JOINT_TET_UNROLL
     for (int p = 0; p < 3; p++) {
         JT_T g[3], slide[3];
         JOINT_TET_UNROLL
         for (int i = 0; i < 3; i++)
-            g[i] = rule[p][0] * d[0][i] + rule[p][1] * d[1][i] + rule[p][2] * d[2][i];
+            g[i] = joint_tet_rule[p][0] * d[0][i] + joint_tet_rule[p][1] * d[1][i] +
+                   joint_tet_rule[p][2] * d[2][i];
         slide[0] = g[1] * N[2] - g[2] * N[1];
         slide[1] = g[2] * N[0] - g[0] * N[2];
         slide[2] = g[0] * N[1] - g[1] * N[0];
