@@ -315,6 +315,18 @@ static void broken_joints_make_fragments(void)
     fdem_model_destroy(m);
 }
 
+/* A fracturing box of `div` cells over `size` (2D: the first two),
+ * finalized. */
+static fdem_model *fracturing_box(int dim, const double size[3], const int div[3])
+{
+    fdem_model *m = fdem_model_create();
+    fdem_error err;
+    if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
+    build_box_part(m, fracture_material(m, 10), dim, size, div, 1);
+    build_finalize(m, 0.5);
+    return m;
+}
+
 /* fdem_break_joints_across (the daemon's cracked estimate): a plane
  * between two columns of cells breaks exactly the joints on it, ny in 2D
  * (one vertical edge a row) and 2 ny nz in 3D (two triangles a cube face),
@@ -324,14 +336,9 @@ static void broken_joints_make_fragments(void)
 static void crack_across_a_plane_breaks_the_joints_on_it(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
-        fdem_model *m = fdem_model_create();
-        fdem_error err;
-        if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
-        int mat = fracture_material(m, 10);
-        const double size[3] = {0.04, 0.03, 0.02};
         const int div[3] = {4, 3, 2};
-        build_box_part(m, mat, dim, size, div, 1);
-        build_finalize(m, 0.5);
+        fdem_model *m = fracturing_box(dim, (const double[3]){0.04, 0.03, 0.02}, div);
+        fdem_error err;
         const double normal[3] = {1, 0, 0};
         int want = dim == 2 ? div[1] : 2 * div[1] * div[2];
         /* counting first breaks nothing, and counts what the cut breaks */
@@ -363,14 +370,9 @@ static void crack_across_a_plane_breaks_the_joints_on_it(void)
 static void crack_near_a_point_stays_inside_the_body(void)
 {
     for (int dim = 2; dim <= 3; dim++) {
-        fdem_model *m = fdem_model_create();
+        fdem_model *m = fracturing_box(dim, (const double[3]){0.04, 0.06, 0.02},
+                                       (const int[3]){4, 8, 2});
         fdem_error err;
-        if (fdem_set_dimension(m, dim, &err)) build_die("dimension", &err);
-        int mat = fracture_material(m, 10);
-        const double size[3] = {0.04, 0.06, 0.02};
-        const int div[3] = {4, 8, 2};
-        build_box_part(m, mat, dim, size, div, 1);
-        build_finalize(m, 0.5);
         const double normal[3] = {1, 0, 0}, centre[3] = {0.02, 0.03, 0.01};
         int across = fdem_joints_across(m, normal, 0.02);
         int broke = fdem_break_joints_near(m, normal, 0.02, centre, 0.5);
