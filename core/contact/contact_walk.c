@@ -293,33 +293,49 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     return touching;
 }
 
-static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_walk *w)
+/* Pairs [begin, end) of walk w listed on this process's threads; *used the
+ * lists filled (thread order). 0, or -1 when a list cannot grow. */
+static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
+                       int *used)
 {
     contact_state *cs = &m->contact;
-    long n = (long)w->count;
-    int touching = 0, failed = 0, used = 1;
+    long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
+    int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
+    if (contact_touch_lists(cs, threads)) return -1;
     contact_touches *lists = cs->touches;
-#pragma omp parallel num_threads(m->threads) reduction(+ : touching)
+    int failed = 0, nt_used = 1;
+#pragma omp parallel num_threads(threads) if (threads > 1)
     {
         int t = 0, nt = 1;
 #ifdef _OPENMP
         t = omp_get_thread_num();
         nt = omp_get_num_threads();
 #endif
-        if (t == 0) used = nt;
+        if (t == 0) nt_used = nt;
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;
-        long begin = n * t / nt, end = n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, begin, end, list, 3)
-                               : pairs_forces_listed(m, h, w, begin, end, list, 2);
+        long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
+        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3)
+                               : pairs_forces_listed(m, h, w, b, e, list, 2);
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
-        } else {
-            touching += mine;
         }
     }
-    if (failed) return -1;
+    *used = nt_used;
+    return failed ? -1 : 0;
+}
+
+/* A walk of one process on its threads: listed (walk_listed), then the
+ * lists applied in thread order, which is pair order. Returns the number
+ * of pairs that touched, or -1 if a list could not grow (nothing has been
+ * added then). */
+static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_walk *w)
+{
+    contact_state *cs = &m->contact;
+    int used, touching = 0;
+    if (walk_listed(m, h, w, 0, (long)w->count, &used)) return -1;
+    const contact_touches *lists = cs->touches;
     for (int t = 0; t < used; t++) {
         const pair_rows *touched = &lists[t].touched;
         for (size_t i = 0; i < touched->count; i++) {
@@ -327,6 +343,7 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
             contact_pair_scatter(m, touched_a(key), touched_b(key),
                                  touched->row + i * (size_t)cs->pair_out);
         }
+        touching += (int)touched->count;
         for (size_t i = 0; i < lists[t].release.count; i++)
             contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
         const pair_rows *adopt = &lists[t].adopt;
@@ -497,40 +514,6 @@ static void walk_share(const near_walk *w, size_t n, const step_share *share, lo
     *end = (long)lower_bound(w->index, w->count, (long)hi);
 }
 
-/* Pairs [begin, end) of walk w listed on this process's threads; *used the
- * lists filled (thread order). 0, or -1 when a list cannot grow. */
-static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
-                       int *used)
-{
-    contact_state *cs = &m->contact;
-    long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
-    int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
-    if (contact_touch_lists(cs, threads)) return -1;
-    contact_touches *lists = cs->touches;
-    int failed = 0, nt_used = 1;
-#pragma omp parallel num_threads(threads) if (threads > 1)
-    {
-        int t = 0, nt = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        nt = omp_get_num_threads();
-#endif
-        if (t == 0) nt_used = nt;
-        contact_touches *list = &lists[t];
-        list->touched.count = list->adopt.count = list->release.count = 0;
-        long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
-        int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3)
-                               : pairs_forces_listed(m, h, w, b, e, list, 2);
-        if (mine < 0) {
-#pragma omp atomic write
-            failed = 1;
-        }
-    }
-    *used = nt_used;
-    cs->split_threaded += nt_used > 1;
-    return failed ? -1 : 0;
-}
-
 static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk walks[2])
 {
     contact_state *cs = &m->contact;
@@ -545,6 +528,7 @@ static int contact_pairs_forces_split(fdem_model *m, double h, const near_walk w
         cs->pairs_walked += end - begin;
         ok = walk_listed(m, h, &walks[k], begin, end, &used) == 0 &&
              wire_append(cs, cs->touches, used, &bytes) == 0;
+        cs->split_threaded += ok && used > 1;
     }
     /* every process takes part, failed or not: none is left waiting */
     const unsigned char *all;
