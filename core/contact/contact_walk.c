@@ -22,6 +22,7 @@
 #include <omp.h>
 #endif
 
+#include "kernel/contact_face.h"
 #include "kernel/contact_pair.h"
 #include "model/model.h"
 #include "contact.h"
@@ -132,6 +133,15 @@ static inline __attribute__((always_inline)) double *pair_springs(contact_state 
  * (contact_pair.h), so the springs are read only after a touch; a set
  * left holding nothing goes back to the pool, fresh springs holding a
  * force are adopted. Returns `touched`. */
+static inline __attribute__((always_inline)) int pair_springs_held(near_pair *np, int32_t set,
+                                                                   int any, int touched, int *pool)
+{
+    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
+    if (set < 0 && any) *pool = SPRINGS_ADOPT;
+    np->sprung = any;
+    return touched;
+}
+
 static inline __attribute__((always_inline)) int pair_springs_settle(near_pair *np, int32_t set,
                                                                      const double *springs,
                                                                      int touched, int slots,
@@ -140,10 +150,7 @@ static inline __attribute__((always_inline)) int pair_springs_settle(near_pair *
     int any = 0;
     if (touched > 0)
         for (int s = 0; s < slots; s++) any |= springs[s] != 0;
-    if (set >= 0 && !any) *pool = SPRINGS_RELEASE;
-    if (set < 0 && any) *pool = SPRINGS_ADOPT;
-    np->sprung = any;
-    return touched;
+    return pair_springs_held(np, set, any, touched, pool);
 }
 
 /* Near pair np this step: boxes apart, it lets its springs go (-1);
@@ -178,8 +185,17 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
         double *springs = pair_springs(cs, np, fresh, slots, &set);
         face_match fm = shut_face_unpack(np->face);
         contact_pair_in in = contact_pair_input(m, a, b, h, memo);
-        int touched = cs->kernel->face_force(&in, &fm, springs, out);
-        return pair_springs_settle(np, set, springs, touched, slots, pool);
+        int touched = D == 3 ? tet_face_pair_force(&in, &fm, springs, out)
+                             : tri_face_pair_force(&in, &fm, springs, out);
+        /* the face kernel keeps only the two faces' slots (contact_face.h:
+         * per face 1 in 2D, 3 in 3D) */
+        const int per = slots / (2 * (D + 1));
+        int any = 0;
+        if (touched > 0)
+            for (int k = 0; k < per; k++)
+                any |= (springs[per * fm.face_a + k] != 0) |
+                       (springs[slots / 2 + per * fm.face_b + k] != 0);
+        return pair_springs_held(np, set, any, touched, pool);
     }
     /* a gap over near_apart: apart, boxes not even computed this step */
     if (np->gap > cs->near_apart ||

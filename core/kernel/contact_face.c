@@ -11,26 +11,6 @@
 
 #include <math.h>
 
-static int segment_overlap(const double d[2], double *i0, double w[3], double *touch)
-{
-    double s0 = 0, s1 = 1;
-    if (d[0] <= 0 && d[1] <= 0) return 0;
-    if (d[0] <= 0) s0 = d[0] / (d[0] - d[1]);
-    else if (d[1] <= 0) s1 = d[0] / (d[0] - d[1]);
-    double e0 = d[0] + s0 * (d[1] - d[0]), e1 = d[0] + s1 * (d[1] - d[0]);
-    double len = s1 - s0;
-    double sum0 = 0.5 * len * (e0 + e1);
-    double sum1 = len / 6.0 * (e0 * (2 * s0 + s1) + e1 * (s0 + 2 * s1));
-    if (!(sum0 > 0)) return 0;
-    double s = sum1 / sum0;
-    *i0 = sum0;
-    w[0] = 1.0 - s;
-    w[1] = s;
-    w[2] = 0;
-    *touch = len;
-    return 1;
-}
-
 /* The triangle's part where d > 0 in barycentric weights (at most 4
  * corners: one line cuts a triangle), then fan sums. */
 static int triangle_overlap(const double d[3], double *i0, double w[3], double *touch)
@@ -86,6 +66,6 @@ static int triangle_overlap(const double d[3], double *i0, double w[3], double *
 int face_overlap_integral(int corners, const double depth[3], double *i0, double w[3],
                           double *touch)
 {
-    return corners == 2 ? segment_overlap(depth, i0, w, touch)
+    return corners == 2 ? face_segment_overlap(depth, i0, w, touch)
                         : triangle_overlap(depth, i0, w, touch);
 }

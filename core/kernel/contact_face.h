@@ -83,4 +83,38 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
 int face_overlap_integral(int corners, const double depth[3], double *i0, double w[3],
                           double *touch);
 
+/* The segment's case, inline: the 2D kernel's call to the function above
+ * (a call and a branch on `corners`) was 8 % of a broken 2D block's step. */
+static inline int face_segment_overlap(const double d[2], double *i0, double w[3], double *touch)
+{
+    if (d[0] > 0 && d[1] > 0) {
+        /* pressed along the whole edge (most shut pairs): the sums below
+         * with s0 = 0, s1 = 1, and one division for the centroid */
+        double sum0 = 0.5 * (d[0] + d[1]);
+        double s = (d[0] + 2 * d[1]) / (3 * (d[0] + d[1]));
+        *i0 = sum0;
+        w[0] = 1.0 - s;
+        w[1] = s;
+        w[2] = 0;
+        *touch = 1;
+        return 1;
+    }
+    double s0 = 0, s1 = 1;
+    if (d[0] <= 0 && d[1] <= 0) return 0;
+    if (d[0] <= 0) s0 = d[0] / (d[0] - d[1]);
+    else if (d[1] <= 0) s1 = d[0] / (d[0] - d[1]);
+    double e0 = d[0] + s0 * (d[1] - d[0]), e1 = d[0] + s1 * (d[1] - d[0]);
+    double len = s1 - s0;
+    double sum0 = 0.5 * len * (e0 + e1);
+    double sum1 = len / 6.0 * (e0 * (2 * s0 + s1) + e1 * (s0 + 2 * s1));
+    if (!(sum0 > 0)) return 0;
+    double s = sum1 / sum0;
+    *i0 = sum0;
+    w[0] = 1.0 - s;
+    w[1] = s;
+    w[2] = 0;
+    *touch = len;
+    return 1;
+}
+
 #endif /* FDEM_CONTACT_FACE_H */
