@@ -27,6 +27,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include "kernel/contact_pair.h"
 #include "model/model.h"
@@ -377,6 +380,25 @@ size_t contact_memory_bytes(const contact_state *cs)
 /* Detection when due, then every candidate pair's force. The stick springs
  * are loaded by the motion of the last step (m->dt_prev). Returns 0, or -1
  * when out of memory. */
+/* The contact force array zeroed, in a share per thread: on one thread
+ * alone it was a thirtieth of a broken 2D block's step on two. */
+static void contact_force_clear(fdem_model *m)
+{
+    double *f = m->contact.force;
+    const size_t n = (size_t)m->dim * (size_t)m->node_count;
+    const int threads = m->threads > 1 && n > 65536 ? m->threads : 1;
+#pragma omp parallel num_threads(threads) if (threads > 1)
+    {
+        int t = 0, nt = 1;
+#ifdef _OPENMP
+        t = omp_get_thread_num();
+        nt = omp_get_num_threads();
+#endif
+        size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
+        memset(f + lo, 0, sizeof(double) * (hi - lo));
+    }
+}
+
 int contact_forces(fdem_model *m)
 {
     contact_state *cs = &m->contact;
@@ -391,8 +413,7 @@ int contact_forces(fdem_model *m)
     }
     /* With no candidate pair (bodies apart, an intact fracturing block) the
      * force array stays zero, and the integrator skips reading it. */
-    if (!cs->force_is_zero)
-        memset(cs->force, 0, sizeof(double) * (size_t)m->dim * (size_t)m->node_count);
+    if (!cs->force_is_zero) contact_force_clear(m);
     cs->force_is_zero = cs->pairs.count == 0;
     if (contact_near_refresh(m)) return -1;
     contact_shut_refresh(m);

@@ -36,6 +36,9 @@
 typedef struct pair_rows {
     long *pair;
     double *row;
+    double *last; /* touched rows: each row's last number (the dissipation) again, so
+                     the account summed in pair order on one thread reads 8 bytes a
+                     pair, not the row's cache lines */
     size_t count, capacity;
 } pair_rows;
 
@@ -51,7 +54,8 @@ typedef struct contact_touches {
     pair_rows touched, adopt, release;
 } contact_touches;
 
-static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
+/* Room for one more row; -1 when out of memory. */
+static int pair_rows_room(pair_rows *list, int width)
 {
     if (list->count == list->capacity) {
         size_t cap = list->capacity ? 2 * list->capacity : CONTACT_FIRST_ROWS;
@@ -62,11 +66,23 @@ static int pair_rows_push(pair_rows *list, long pair, const double *row, int wid
             double *f = realloc(list->row, cap * (size_t)width * sizeof *f);
             if (!f) return -1;
             list->row = f;
+            double *l = realloc(list->last, cap * sizeof *l);
+            if (!l) return -1;
+            list->last = l;
         }
         list->capacity = cap;
     }
+    return 0;
+}
+
+static int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
+{
+    if (pair_rows_room(list, width)) return -1;
     list->pair[list->count] = pair;
-    if (width) memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
+    if (width) {
+        memcpy(list->row + list->count * (size_t)width, row, sizeof(double) * (size_t)width);
+        list->last[list->count] = row[width - 1];
+    }
     list->count++;
     return 0;
 }
@@ -77,13 +93,14 @@ static int32_t touched_b(long key) { return (int32_t)(uint32_t)key; }
 
 static size_t pair_rows_bytes(const pair_rows *list, int width)
 {
-    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)width);
+    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)(width ? width + 1 : 0));
 }
 
 static void pair_rows_free(pair_rows *list)
 {
     free(list->pair);
     free(list->row);
+    free(list->last);
 }
 
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
@@ -115,6 +132,122 @@ void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out)
      * steps, and every step would cost a dense 2D pile ~10 % */
     if (m->step % CONTACT_PENETRATION_EVERY == 0 && !contact_shut_neighbours(m, e1, e2))
         contact_penetration_check(m, e1, e2);
+}
+
+/* The lists of a threaded walk applied on its threads, each adding the
+ * forces on the nodes it owns (a contiguous share of the node indices):
+ * every node's sum is still formed in pair order, by one thread, as the
+ * serial scatter forms it, so the same bits; applied on one thread, the
+ * scatter was a fifth of a broken 2D block's step on two. An element
+ * whose nodes all lie in one share is that thread's alone (apply_owner);
+ * a thread passes over the pairs with no node of its own at the cost of
+ * two bytes. The friction account and the penetration look stay in pair
+ * order on one thread. */
+static int apply_owners(fdem_model *m, int threads)
+{
+    contact_state *cs = &m->contact;
+    if (cs->apply_owner_threads == threads && cs->apply_owner_elems == m->elem_count &&
+        cs->apply_owner_nodes == m->node_count)
+        return 0;
+    if (cs->apply_owner_bytes < (size_t)m->elem_count) {
+        int8_t *o = realloc(cs->apply_owner, (size_t)m->elem_count);
+        if (!o) return -1;
+        cs->apply_owner = o;
+        cs->apply_owner_bytes = (size_t)m->elem_count;
+    }
+    const long N = m->node_count;
+    for (int e = 0; e < m->elem_count; e++) {
+        const int32_t *n = element_nodes(m, e);
+        int owner = (int)((long)n[0] * threads / N);
+        for (int c = 1; c < m->elem_nodes; c++)
+            if ((int)((long)n[c] * threads / N) != owner) owner = -1;
+        cs->apply_owner[e] = (int8_t)owner;
+    }
+    cs->apply_owner_threads = threads;
+    cs->apply_owner_elems = m->elem_count;
+    cs->apply_owner_nodes = m->node_count;
+    return 0;
+}
+
+/* Element e's share of a pair's forces (out: its K nodes' rows) onto the
+ * nodes of [lo, hi); all its nodes when mine. */
+static inline __attribute__((always_inline)) void scatter_owned(double *f, const int32_t *n,
+                                                                const double *out, int mine,
+                                                                int32_t lo, int32_t hi, int D,
+                                                                int K)
+{
+#pragma GCC unroll 4
+    for (int c = 0; c < K; c++)
+        if (mine || (n[c] >= lo && n[c] < hi))
+#pragma GCC unroll 3
+            for (int d = 0; d < D; d++) f[D * n[c] + d] += out[D * c + d];
+}
+
+static inline __attribute__((always_inline)) void
+apply_share(fdem_model *m, const contact_touches *lists, int used, int t, int nt, int D)
+{
+    contact_state *cs = &m->contact;
+    const int K = D + 1, width = cs->pair_out;
+    const int32_t lo = (int32_t)((long)m->node_count * t / nt);
+    const int32_t hi = (int32_t)((long)m->node_count * (t + 1) / nt);
+    const int8_t *owner = cs->apply_owner;
+    double *f = cs->force;
+    for (int l = 0; l < used; l++) {
+        const pair_rows *touched = &lists[l].touched;
+        for (size_t i = 0; i < touched->count; i++) {
+            long key = touched->pair[i];
+            int32_t a = touched_a(key), b = touched_b(key);
+            int oa = owner[a], ob = owner[b];
+            if (oa != t && ob != t && oa >= 0 && ob >= 0) continue;
+            const double *row = touched->row + i * (size_t)width;
+            if (oa == t || oa < 0) scatter_owned(f, element_nodes(m, a), row, oa == t, lo, hi, D, K);
+            if (ob == t || ob < 0)
+                scatter_owned(f, element_nodes(m, b), row + D * K, ob == t, lo, hi, D, K);
+        }
+    }
+}
+
+static void touched_apply(fdem_model *m, const contact_touches *lists, int used)
+{
+    contact_state *cs = &m->contact;
+    int shared = used > 1 && apply_owners(m, used) == 0;
+    if (shared) {
+#pragma omp parallel num_threads(used)
+        {
+            int t = 0, nt = 1;
+#ifdef _OPENMP
+            t = omp_get_thread_num();
+            nt = omp_get_num_threads();
+#endif
+            if (nt == used) { /* the owners were made for `used` shares */
+                if (m->dim == 3) apply_share(m, lists, used, t, nt, 3);
+                else apply_share(m, lists, used, t, nt, 2);
+            } else if (t == 0) {
+                for (int s = 0; s < used; s++)
+                    if (m->dim == 3) apply_share(m, lists, used, s, used, 3);
+                    else apply_share(m, lists, used, s, used, 2);
+            }
+        }
+    }
+    const int look = m->step % CONTACT_PENETRATION_EVERY == 0;
+    for (int l = 0; l < used; l++) {
+        const pair_rows *touched = &lists[l].touched;
+        if (!shared) {
+            for (size_t i = 0; i < touched->count; i++) {
+                long key = touched->pair[i];
+                contact_pair_scatter(m, touched_a(key), touched_b(key),
+                                     touched->row + i * (size_t)cs->pair_out);
+            }
+            continue;
+        }
+        for (size_t i = 0; i < touched->count; i++) m->friction_energy += touched->last[i];
+        /* every 8th step, as contact_pair_scatter */
+        for (size_t i = 0; look && i < touched->count; i++) {
+            long key = touched->pair[i];
+            if (!contact_shut_neighbours(m, touched_a(key), touched_b(key)))
+                contact_penetration_check(m, touched_a(key), touched_b(key));
+        }
+    }
 }
 
 /* What a pair's evaluation asks of the spring pool (contact_history.c):
@@ -303,17 +436,24 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     contact_pair_memo memo;
     contact_pair_memo_clear(&memo);
     int touching = 0;
+    pair_rows *rows = &list->touched;
+    const int width = cs->pair_out;
     for (long i = begin; i < end; i++) {
         near_pair *np = walk_pair(w, (size_t)i);
         long k = (long)np->pair;
-        double force[CONTACT_PAIR_OUT_MAX], fresh[CONTACT_SLOTS_MAX];
+        /* the kernel writes the forces into the list's next row itself,
+         * kept if the pair touched: copying them after was 5 % of a
+         * broken 2D block's step on two threads */
+        if (pair_rows_room(rows, width)) return -1;
+        double *force = rows->row + rows->count * (size_t)width, fresh[CONTACT_SLOTS_MAX];
         int pool, touched = pair_evaluate(m, np, h, force, fresh, &pool, &memo, D);
         if (pool == SPRINGS_RELEASE && pair_rows_push(&list->release, k, NULL, 0)) return -1;
         if (pool == SPRINGS_ADOPT && pair_rows_push(&list->adopt, k, fresh, cs->slots)) return -1;
         if (touched <= 0) continue;
         touching++;
-        if (pair_rows_push(&list->touched, touched_key(np->a, np->b), force, cs->pair_out))
-            return -1;
+        rows->pair[rows->count] = touched_key(np->a, np->b);
+        rows->last[rows->count] = force[width - 1];
+        rows->count++;
     }
     return touching;
 }
@@ -361,14 +501,9 @@ static int contact_pairs_forces_threaded(fdem_model *m, double h, const near_wal
     int used, touching = 0;
     if (walk_listed(m, h, w, 0, (long)w->count, &used)) return -1;
     const contact_touches *lists = cs->touches;
+    touched_apply(m, lists, used);
     for (int t = 0; t < used; t++) {
-        const pair_rows *touched = &lists[t].touched;
-        for (size_t i = 0; i < touched->count; i++) {
-            long key = touched->pair[i];
-            contact_pair_scatter(m, touched_a(key), touched_b(key),
-                                 touched->row + i * (size_t)cs->pair_out);
-        }
-        touching += (int)touched->count;
+        touching += (int)lists[t].touched.count;
         for (size_t i = 0; i < lists[t].release.count; i++)
             contact_springs_release(cs, (size_t)lists[t].release.pair[i]);
         const pair_rows *adopt = &lists[t].adopt;
@@ -682,7 +817,8 @@ int contact_pairs_forces(fdem_model *m, double h)
 /* What the lists hold (contact_memory_bytes). */
 size_t contact_walk_bytes(const contact_state *cs)
 {
-    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches);
+    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches) +
+               cs->apply_owner_bytes;
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -693,6 +829,7 @@ size_t contact_walk_bytes(const contact_state *cs)
 
 void contact_walk_free(contact_state *cs)
 {
+    free(cs->apply_owner);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);
         pair_rows_free(&cs->touches[t].adopt);

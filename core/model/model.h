@@ -278,6 +278,12 @@ typedef struct contact_state {
     int shut_off;            /* tests and benches: the general kernel on every pair */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact_walk.c) */
     int touch_lists;         /* how many lists touches holds */
+    int8_t *apply_owner;     /* threaded runs: per element, the thread whose nodes
+                                all its nodes are, or -1 (contact_walk.c) */
+    int apply_owner_threads; /* the thread count apply_owner was made for (0: none), */
+    int apply_owner_elems;   /* the elements and nodes it was made for; */
+    int apply_owner_nodes;
+    size_t apply_owner_bytes; /* its size */
     unsigned char *wire;     /* a split walk (step_share.contact_gather): this process's lists */
     size_t wire_capacity;
     long pairs_walked;       /* near pairs in this process's share of the walks, all steps
