@@ -85,7 +85,8 @@ static size_t memory_contact_element(const memory_figures *f)
     double lists = f->kept_pairs * 3 * sizeof(int32_t) +
                    f->near_pairs * (sizeof(double) + 4 * sizeof(int32_t)) + f->spring_sets * set +
                    f->records * (double)sizeof(contact_record);
-    return (3 * f->D + 3 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 +
+    /* + 1: on threads, the owner of each element's nodes (contact_rows.c) */
+    return (3 * f->D + 3 + f->nbs_packed + 4) * sizeof(double) + 5 * sizeof(int32_t) + 1 + 1 +
            (10 + 3 + 4) * sizeof(int32_t) + (size_t)lists;
 }
 
@@ -162,13 +163,14 @@ size_t fdem_memory_estimate_of(const fdem_counts *n)
 }
 
 /* A thread's touch lists hold at least CONTACT_FIRST_ROWS rows of each kind
- * once the pairs run threaded (contact.c pair_rows_push): pairs touched with
- * their forces, springs adopted, springs released. */
+ * once the pairs run threaded (contact_rows.c pair_rows_grow): pairs touched
+ * with their forces, springs adopted, springs released; a row of numbers
+ * keeps its last number again. */
 size_t fdem_memory_per_thread(int dimension)
 {
     size_t out = dimension == 3 ? TET_PAIR_OUT : TRI_PAIR_OUT;
     size_t slots = dimension == 3 ? TET_CONTACT_SLOTS : TRI_CONTACT_SLOTS;
-    return CONTACT_FIRST_ROWS * (3 * sizeof(long) + (out + slots) * sizeof(double));
+    return CONTACT_FIRST_ROWS * (3 * sizeof(long) + (out + slots + 2) * sizeof(double));
 }
 
 static size_t scatter_plan_bytes(const scatter_plan *p)

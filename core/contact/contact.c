@@ -386,7 +386,7 @@ static void contact_force_clear(fdem_model *m)
 {
     double *f = m->contact.force;
     const size_t n = (size_t)m->dim * (size_t)m->node_count;
-    const int threads = m->threads > 1 && n > 65536 ? m->threads : 1;
+    const int threads = m->threads > 1 && m->node_count > CONTACT_THREADED_NODES ? m->threads : 1;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
         int t = 0, nt = 1;

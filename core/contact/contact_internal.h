@@ -116,6 +116,11 @@ static inline contact_pair_in contact_pair_input(const fdem_model *m, int e1, in
 }
 
 
+/* Fewer nodes than this are marked shut (contact_shut.c) and have their
+ * contact force cleared (contact.c) on one thread: below it the threads'
+ * start-up costs more than they share. */
+#define CONTACT_THREADED_NODES 8192
+
 /* contact_walk.c: a pair's forces (pair_out numbers, both roles) added to
  * the contact force array and the friction account, with the penetration
  * look; every near pair's force this step (the pairs that touched, or -1

@@ -128,7 +128,7 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
     const uint8_t had = (uint8_t)cs->shut_was_any;
     memset(vertex, 1, (size_t)N);
     int count = 0;
-    if (m->threads > 1 && N > 4096) {
+    if (m->threads > 1 && N > CONTACT_THREADED_NODES) {
 #pragma omp parallel num_threads(m->threads)
         {
 #pragma omp for schedule(static)

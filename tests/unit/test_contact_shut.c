@@ -3,6 +3,7 @@
  * (contact/contact_shut.c), 2D and 3D, on a block with every joint broken
  * in place and squeezed: the shut path engages (shut elements, face-kernel
  * pairs touching, the edge and corner pairs left out); a run on 2 threads
+ * (the walk, its lists' application, the shut marks all threaded)
  * and a run restored from a mid-run checkpoint give the bits of the run on
  * 1 thread; the same block with every vertex copy moved 2 tolerances apart
  * never engages it and gives the bits of a run with it switched off (the
@@ -80,10 +81,16 @@ static void shut_path_keeps_the_bits(int dim, int n, int steps)
             CHECK(fdem_step(restored, &err) == 0, "%s", err.message);
         }
     }
-    /* both walks (the near list, the vertex pairs: contact.c) on threads */
+    /* both walks (the near list, the vertex pairs: contact.c) on threads,
+     * their lists applied on threads (contact_rows.c), and the shut marks
+     * and the force array's clearing on threads */
     CHECK(two->contact.near_count >= 2048 && two->contact.near_vertex_count >= 2048,
           "%dD: %zu near and %zu vertex pairs: the threaded walks need 2048", dim,
           two->contact.near_count, two->contact.near_vertex_count);
+    CHECK(dim == 3 || (two->node_count > CONTACT_THREADED_NODES &&
+                       two->contact.apply_owner_threads == 2),
+          "%dD: %d nodes, lists applied on %d threads: the threaded marks need %d", dim,
+          two->node_count, two->contact.apply_owner_threads, CONTACT_THREADED_NODES);
     CHECK(shut >= (long)steps * one->elem_count / 2, "%dD: %ld element-steps shut of %ld", dim,
           shut, (long)steps * one->elem_count);
     CHECK(touching > 0, "%dD: no pair touched", dim);
@@ -98,7 +105,8 @@ static void shut_path_keeps_the_bits(int dim, int n, int steps)
 
 static void shut_broken_block_same_bits_on_threads_and_restore(void)
 {
-    shut_path_keeps_the_bits(2, 22, 40);
+    /* 2D: 7,200 triangles, 21,600 nodes (past CONTACT_THREADED_NODES) */
+    shut_path_keeps_the_bits(2, 60, 40);
     shut_path_keeps_the_bits(3, 5, 12);
 }
 
