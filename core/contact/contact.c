@@ -27,12 +27,10 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "kernel/contact_pair.h"
 #include "model/model.h"
+#include "parallel/team.h"
 #include "contact.h"
 #include "contact_internal.h"
 #include "joint/joint.h"
@@ -389,11 +387,8 @@ static void contact_force_clear(fdem_model *m)
     const int threads = m->threads > 1 && m->node_count > CONTACT_THREADED_NODES ? m->threads : 1;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
-        int t = 0, nt = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        nt = omp_get_num_threads();
-#endif
+        int t, nt;
+        parallel_team(&t, &nt);
         size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
         memset(f + lo, 0, sizeof(double) * (hi - lo));
     }

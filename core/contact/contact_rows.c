@@ -9,11 +9,9 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "model/model.h"
+#include "parallel/team.h"
 #include "contact.h"
 #include "contact_internal.h"
 #include "contact_rows.h"
@@ -173,11 +171,8 @@ void touched_apply(fdem_model *m, const contact_touches *lists, int used)
     if (shared) {
 #pragma omp parallel num_threads(used)
         {
-            int t = 0, nt = 1;
-#ifdef _OPENMP
-            t = omp_get_thread_num();
-            nt = omp_get_num_threads();
-#endif
+            int t, nt;
+            parallel_team(&t, &nt);
             if (nt == used) { /* the owners were made for `used` shares */
                 if (m->dim == 3) apply_share(m, lists, used, t, nt, 3);
                 else apply_share(m, lists, used, t, nt, 2);

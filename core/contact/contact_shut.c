@@ -113,6 +113,21 @@ static inline __attribute__((always_inline)) int vertex_away(const double *pos,
     return !(s2 <= tol2[f]);
 }
 
+/* Element e's mark this step (all its vertices shut); 1 if it is due: not
+ * shut now or not last step (`had`: last step's marks hold). */
+static inline __attribute__((always_inline)) int element_mark(uint8_t *elem_shut,
+                                                              const uint8_t *vertex,
+                                                              const int32_t *first,
+                                                              const int32_t *nd, int K,
+                                                              uint8_t had, int e)
+{
+    uint8_t shut = 1;
+    for (int c = 0; c < K; c++) shut &= vertex[first[nd[c]]];
+    uint8_t was = elem_shut[e] & had;
+    elem_shut[e] = shut;
+    return !(shut & was);
+}
+
 static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D, int K)
 {
     contact_state *cs = &m->contact;
@@ -138,28 +153,19 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
                     vertex[first[n]] = 0;
                 }
 #pragma omp for schedule(static)
-            for (int e = 0; e < E; e++) {
-                const int32_t *nd = element_nodes(m, e);
-                uint8_t shut = 1;
-                for (int c = 0; c < K; c++) shut &= vertex[first[nd[c]]];
-                uint8_t was = elem_shut[e] & had;
-                elem_shut[e] = shut;
-                due[e] = shut & was ? -1 : e;
-            }
+            for (int e = 0; e < E; e++)
+                due[e] = element_mark(elem_shut, vertex, first, element_nodes(m, e), K, had, e)
+                             ? e
+                             : -1;
         }
         for (int e = 0; e < E; e++)
             if (due[e] >= 0) due[count++] = due[e];
     } else {
         for (int n = 0; n < N; n++)
             if (vertex_away(pos, first, tol2, n, D)) vertex[first[n]] = 0;
-        for (int e = 0; e < E; e++) {
-            const int32_t *nd = element_nodes(m, e);
-            uint8_t shut = 1;
-            for (int c = 0; c < K; c++) shut &= vertex[first[nd[c]]];
-            uint8_t was = elem_shut[e] & had;
-            elem_shut[e] = shut;
-            if (!(shut & was)) due[count++] = e;
-        }
+        for (int e = 0; e < E; e++)
+            if (element_mark(elem_shut, vertex, first, element_nodes(m, e), K, had, e))
+                due[count++] = e;
     }
     cs->elem_due_count = count;
 }

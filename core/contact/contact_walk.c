@@ -18,13 +18,11 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "kernel/contact_face.h"
 #include "kernel/contact_pair.h"
 #include "model/model.h"
+#include "parallel/team.h"
 #include "contact.h"
 #include "contact_internal.h"
 #include "contact_rows.h"
@@ -254,11 +252,8 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
     int failed = 0, nt_used = 1;
 #pragma omp parallel num_threads(threads) if (threads > 1)
     {
-        int t = 0, nt = 1;
-#ifdef _OPENMP
-        t = omp_get_thread_num();
-        nt = omp_get_num_threads();
-#endif
+        int t, nt;
+        parallel_team(&t, &nt);
         if (t == 0) nt_used = nt;
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;

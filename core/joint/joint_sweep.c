@@ -34,11 +34,9 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#ifdef _OPENMP
-#include <omp.h>
-#endif
 
 #include "model/model.h"
+#include "parallel/team.h"
 #include "joint.h"
 
 /* Frees a cut's joint and slot lists. */
@@ -298,11 +296,8 @@ void joint_sweep_run(fdem_model *m, scatter_block_fn range_fn, joint_one_fn one_
     if (s->ranges > 1) {
 #pragma omp parallel num_threads(s->ranges)
         {
-            int t = 0, nt = 1;
-#ifdef _OPENMP
-            t = omp_get_thread_num();
-            nt = omp_get_num_threads();
-#endif
+            int t, nt;
+            parallel_team(&t, &nt);
             for (int r = t; r < s->ranges; r += nt) sweep_range(m, s, r, range_fn, one_fn);
 #pragma omp barrier
             for (int r = t; r < s->ranges; r += nt) sweep_settle(m, s, r);
