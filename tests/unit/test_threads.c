@@ -173,6 +173,10 @@ static void contact_on_two_threads_gives_the_bits_of_one(void)
     CHECK(c1.contact_pairs >= 4096, "only %d candidate pairs", c1.contact_pairs);
     CHECK(c1.contacts > 100, "only %d pairs touching", c1.contacts);
     CHECK(c1.contacts == c2.contacts, "touching %d vs %d", c1.contacts, c2.contacts);
+    /* the lists applied on the threads too, each to its own nodes
+     * (contact_rows.c), on a mesh whose discs share nodes */
+    CHECK(two->contact.apply_owner_threads == 2, "lists applied on %d threads",
+          two->contact.apply_owner_threads);
     size_t bytes = sizeof(double) * 2 * (size_t)one->node_count;
     CHECK(memcmp(one->pos, two->pos, bytes) == 0, "positions differ");
     CHECK(memcmp(one->contact.force, two->contact.force, bytes) == 0, "contact forces differ");
