@@ -38,6 +38,8 @@ typedef struct pair_rows {
  * to the other processes when something other than the walk reads them. */
 typedef struct contact_touches {
     pair_rows touched, adopt, release;
+    double work; /* what the share cost, CPU seconds of its thread (contact_walk.c
+                    balances the next step's shares by it) */
 } contact_touches;
 
 static inline long touched_key(int32_t a, int32_t b)

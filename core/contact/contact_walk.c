@@ -23,6 +23,7 @@
 #include "kernel/contact_pair.h"
 #include "model/model.h"
 #include "parallel/team.h"
+#include "math/clock.h"
 #include "contact.h"
 #include "contact_internal.h"
 #include "contact_rows.h"
@@ -241,6 +242,48 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
 
 /* Pairs [begin, end) of walk w listed on this process's threads; *used the
  * lists filled (thread order). 0, or -1 when a list cannot grow. */
+/* Where the threads' shares of walk `which` start this step, as fractions
+ * of it (cut[0] = 0 .. cut[threads] = 1): even the first time, then each
+ * step from the last one's work (each share's CPU seconds), so that each
+ * share holds as much of it as the work was spread over the shares (evenly
+ * within each). A sphere pile's costly pairs sit in a few runs of its near
+ * list: split by count, one thread had nearly all of them, and 2 threads
+ * were no faster than one (kernel calls counted instead of seconds
+ * balanced it less: a call ended by a face plane costs a tenth of one that
+ * clips). Which thread walks a pair changes nothing in what it gives (the
+ * lists are applied in pair order, every hint a pair keeps is in the pair,
+ * and a kernel's memo gives what it would work out again): the same bits
+ * however the shares fall, which test_threads checks with shares moved at
+ * random. NULL when out of memory. */
+static double *walk_cuts(contact_state *cs, int which, int threads)
+{
+    if (cs->walk_cuts[which] == threads) return cs->walk_cut[which];
+    double *cut = realloc(cs->walk_cut[which], sizeof *cut * 2 * (size_t)(threads + 1));
+    if (!cut) return NULL;
+    for (int t = 0; t <= threads; t++) cut[t] = (double)t / threads;
+    cs->walk_cut[which] = cut;
+    cs->walk_cuts[which] = threads;
+    return cut;
+}
+
+/* The next step's cuts from this step's work per share (cut's second half,
+ * threads + 1 numbers, is the scratch). */
+static void walk_cuts_balance(double *cut, const contact_touches *lists, int threads)
+{
+    double total = 0, *next = cut + threads + 1;
+    for (int t = 0; t < threads; t++) total += lists[t].work;
+    if (!(total > 0)) return;
+    int s = 0;
+    double before = 0; /* the work of the shares before s */
+    for (int t = 1; t < threads; t++) {
+        double want = total * t / threads;
+        while (s < threads - 1 && before + lists[s].work < want) before += lists[s++].work;
+        double inside = lists[s].work > 0 ? (want - before) / lists[s].work : 0;
+        next[t] = cut[s] + (cut[s + 1] - cut[s]) * (inside < 0 ? 0 : inside > 1 ? 1 : inside);
+    }
+    for (int t = 1; t < threads; t++) cut[t] = next[t] > cut[t - 1] ? next[t] : cut[t - 1];
+}
+
 static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
                        int *used)
 {
@@ -248,6 +291,9 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
     long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
     int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
     if (contact_touch_lists(cs, threads)) return -1;
+    const int which = w->index != NULL;
+    double *cut = threads > 1 ? walk_cuts(cs, which, threads) : NULL;
+    if (threads > 1 && !cut) return -1;
     contact_touches *lists = cs->touches;
     int failed = 0, nt_used = 1;
 #pragma omp parallel num_threads(threads) if (threads > 1)
@@ -258,14 +304,21 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
         contact_touches *list = &lists[t];
         list->touched.count = list->adopt.count = list->release.count = 0;
         long n = end - begin, b = begin + n * t / nt, e = begin + n * (t + 1) / nt;
+        if (cut && nt == threads) { /* the shares as last step's work spread */
+            b = t ? begin + (long)(n * cut[t]) : begin;
+            e = t + 1 < nt ? begin + (long)(n * cut[t + 1]) : end;
+        }
+        double started = clock_cpu_seconds();
         int mine = m->dim == 3 ? pairs_forces_listed(m, h, w, b, e, list, 3)
                                : pairs_forces_listed(m, h, w, b, e, list, 2);
+        list->work = clock_cpu_seconds() - started;
         if (mine < 0) {
 #pragma omp atomic write
             failed = 1;
         }
     }
     *used = nt_used;
+    if (cut && nt_used == threads && !failed) walk_cuts_balance(cut, lists, threads);
     return failed ? -1 : 0;
 }
 
@@ -595,8 +648,9 @@ int contact_pairs_forces(fdem_model *m, double h)
 /* What the lists hold (contact_memory_bytes). */
 size_t contact_walk_bytes(const contact_state *cs)
 {
-    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches) +
-               cs->apply_owner_bytes;
+    size_t b = (size_t)cs->touch_lists * sizeof(contact_touches) + cs->apply_owner_bytes;
+    for (int k = 0; k < 2; k++)
+        if (cs->walk_cut[k]) b += sizeof(double) * 2 * (size_t)(cs->walk_cuts[k] + 1);
     for (int t = 0; t < cs->touch_lists; t++) {
         b += pair_rows_bytes(&cs->touches[t].touched, cs->pair_out);
         b += pair_rows_bytes(&cs->touches[t].adopt, cs->slots);
@@ -607,6 +661,8 @@ size_t contact_walk_bytes(const contact_state *cs)
 
 void contact_walk_free(contact_state *cs)
 {
+    free(cs->walk_cut[0]);
+    free(cs->walk_cut[1]);
     free(cs->apply_owner);
     for (int t = 0; t < cs->touch_lists; t++) {
         pair_rows_free(&cs->touches[t].touched);

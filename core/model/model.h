@@ -278,6 +278,10 @@ typedef struct contact_state {
     int shut_off;            /* tests and benches: the general kernel on every pair */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact_walk.c) */
     int touch_lists;         /* how many lists touches holds */
+    double *walk_cut[2];     /* threaded runs, per walk (near list, vertex pairs): where
+                                each thread's share starts, as a fraction of the walk
+                                (walk_cuts + 1 numbers), set from last step's work */
+    int walk_cuts[2];        /* the thread count walk_cut was made for (0: none) */
     int8_t *apply_owner;     /* threaded runs: per element, the thread whose nodes
                                 all its nodes are, or -1 (contact_walk.c) */
     int apply_owner_threads; /* the thread count apply_owner was made for (0: none), */
