@@ -249,8 +249,8 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
  * within each). A sphere pile's costly pairs sit in a few runs of its near
  * list: split by count, one thread had nearly all of them, and 2 threads
  * were no faster than one (kernel calls counted instead of seconds
- * balanced it less: a call ended by a face plane costs a tenth of one that
- * clips). Which thread walks a pair changes nothing in what it gives (the
+ * balanced it less: 83 -> 69 ns an element-step on 2 threads, against 65:
+ * calls differ in cost, a pair ended by a face plane against one clipped). Which thread walks a pair changes nothing in what it gives (the
  * lists are applied in pair order, every hint a pair keeps is in the pair,
  * and a kernel's memo gives what it would work out again): the same bits
  * however the shares fall, which test_threads checks with shares moved at
