@@ -46,8 +46,8 @@
  * pile: boxes 157M -> 25M instructions in 493 steps, whole step -10 %;
  * 1/128 gained no more). */
 static const contact_kernel contact_kernels[2] = {
-    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, tri_face_pair_force, 0.25, 1.0 / 16},
-    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, tet_face_pair_force, 0.153, 1.0 / 64},
+    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, 0.25, 1.0 / 16},
+    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153, 1.0 / 64},
 };
 
 /* Force between two elements whose boxes overlap, both roles, into out
@@ -375,9 +375,6 @@ size_t contact_memory_bytes(const contact_state *cs)
     return b;
 }
 
-/* Detection when due, then every candidate pair's force. The stick springs
- * are loaded by the motion of the last step (m->dt_prev). Returns 0, or -1
- * when out of memory. */
 /* The contact force array zeroed, in a share per thread: on one thread
  * alone it was a thirtieth of a broken 2D block's step on two. */
 static void contact_force_clear(fdem_model *m)
@@ -394,6 +391,9 @@ static void contact_force_clear(fdem_model *m)
     }
 }
 
+/* Detection when due, then every candidate pair's force. The stick springs
+ * are loaded by the motion of the last step (m->dt_prev). Returns 0, or -1
+ * when out of memory. */
 int contact_forces(fdem_model *m)
 {
     contact_state *cs = &m->contact;

@@ -173,14 +173,11 @@ void touched_apply(fdem_model *m, const contact_touches *lists, int used)
         {
             int t, nt;
             parallel_team(&t, &nt);
-            if (nt == used) { /* the owners were made for `used` shares */
-                if (m->dim == 3) apply_share(m, lists, used, t, nt, 3);
-                else apply_share(m, lists, used, t, nt, 2);
-            } else if (t == 0) {
-                for (int s = 0; s < used; s++)
-                    if (m->dim == 3) apply_share(m, lists, used, s, used, 3);
-                    else apply_share(m, lists, used, s, used, 2);
-            }
+            /* the owners were made for `used` shares: a team given fewer
+             * threads takes several each (the shares' nodes are apart) */
+            for (int s = t; s < used; s += nt)
+                if (m->dim == 3) apply_share(m, lists, used, s, used, 3);
+                else apply_share(m, lists, used, s, used, 2);
         }
     }
     const int look = m->step % CONTACT_PENETRATION_EVERY == 0;

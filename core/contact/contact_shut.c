@@ -92,13 +92,8 @@ void contact_shut_free(contact_state *cs)
     free(cs->elem_due);
 }
 
-/* This step's shut vertices and elements; D and K are constants where it
- * is called, so each dimension's loops are unrolled. On the model's
- * threads (serial, it was a twelfth of a broken 2D block's step on two):
- * a vertex is cleared by whichever of its copies is away (an atomic store
- * of the same 0, so the marks do not depend on which), each element's mark
- * is its own, and the list of elements due is compacted in element order
- * afterwards: the same marks and list on any thread count. */
+/* Whether copy n of a vertex is away from its first copy (past the shut
+ * tolerance). */
 static inline __attribute__((always_inline)) int vertex_away(const double *pos,
                                                              const int32_t *first,
                                                              const double *tol2, int n, int D)
@@ -128,6 +123,13 @@ static inline __attribute__((always_inline)) int element_mark(uint8_t *elem_shut
     return !(shut & was);
 }
 
+/* This step's shut vertices and elements; D and K are constants where it
+ * is called, so each dimension's loops are unrolled. On the model's
+ * threads (serial, it was a twelfth of a broken 2D block's step on two):
+ * a vertex is cleared by whichever of its copies is away (an atomic store
+ * of the same 0, so the marks do not depend on which), each element's mark
+ * is its own, and the list of elements due is compacted in element order
+ * afterwards: the same marks and list on any thread count. */
 static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D, int K)
 {
     contact_state *cs = &m->contact;

@@ -44,12 +44,9 @@ static inline __attribute__((always_inline)) double *pair_springs(contact_state 
                                                                   double *fresh, int slots,
                                                                   int32_t *set)
 {
-    /* zeros copied as stores GCC can see whole: a loop or memset of 24
-     * slots became `rep stos`, whose start-up a 3D walk paid per pair */
-    static const double zeros[CONTACT_SLOTS_MAX];
     *set = cs->spring_of[np->pair];
     if (*set >= 0) return cs->slip + (size_t)slots * (size_t)*set;
-    memcpy(fresh, zeros, sizeof(double) * (size_t)slots);
+    contact_zero(fresh, (size_t)slots);
     return fresh;
 }
 
@@ -240,8 +237,6 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     return touching;
 }
 
-/* Pairs [begin, end) of walk w listed on this process's threads; *used the
- * lists filled (thread order). 0, or -1 when a list cannot grow. */
 /* Where the threads' shares of walk `which` start this step, as fractions
  * of it (cut[0] = 0 .. cut[threads] = 1): even the first time, then each
  * step from the last one's work (each share's CPU seconds), so that each
@@ -250,11 +245,12 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
  * list: split by count, one thread had nearly all of them, and 2 threads
  * were no faster than one (kernel calls counted instead of seconds
  * balanced it less: 83 -> 69 ns an element-step on 2 threads, against 65:
- * calls differ in cost, a pair ended by a face plane against one clipped). Which thread walks a pair changes nothing in what it gives (the
- * lists are applied in pair order, every hint a pair keeps is in the pair,
- * and a kernel's memo gives what it would work out again): the same bits
- * however the shares fall, which test_threads checks with shares moved at
- * random. NULL when out of memory. */
+ * calls differ in cost, a pair ended by a face plane against one clipped).
+ * Which thread walks a pair changes nothing in what it gives (the lists
+ * are applied in pair order, every hint a pair keeps is in the pair, and a
+ * kernel's memo gives what it would work out again): the same bits however
+ * the shares fall, which test_threads checks with shares moved at random.
+ * NULL when out of memory. */
 static double *walk_cuts(contact_state *cs, int which, int threads)
 {
     if (cs->walk_cuts[which] == threads) return cs->walk_cut[which];
@@ -284,6 +280,8 @@ static void walk_cuts_balance(double *cut, const contact_touches *lists, int thr
     for (int t = 1; t < threads; t++) cut[t] = next[t] > cut[t - 1] ? next[t] : cut[t - 1];
 }
 
+/* Pairs [begin, end) of walk w listed on this process's threads; *used the
+ * lists filled (thread order). 0, or -1 when a list cannot grow. */
 static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
                        int *used)
 {

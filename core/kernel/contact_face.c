@@ -11,6 +11,8 @@
 
 #include <math.h>
 
+const double contact_zeros[CONTACT_PAIR_OUT_MAX] = {0};
+
 /* The triangle's part where d > 0 in barycentric weights (at most 4
  * corners: one line cuts a triangle), then fan sums. */
 static int triangle_overlap(const double d[3], double *i0, double w[3], double *touch)

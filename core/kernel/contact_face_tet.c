@@ -105,9 +105,10 @@ typedef struct face_role {
     double n[3];
 } face_role;
 
-static inline __attribute__((always_inline)) void role_force(const face_role *r, double area, double i0, const double w[3],
-                              double touch, const contact_pair_in *in, double spring[3],
-                              double f_c[12], double f_t[12], double *dissipated)
+static inline __attribute__((always_inline)) void
+role_force(const face_role *r, double area, double i0, const double w[3], double touch,
+           const contact_pair_in *in, double spring[3], double f_c[12], double f_t[12],
+           double *dissipated)
 {
     const tet_now *c = r->contactor, *t = r->target;
     double k_face = 4 * in->penalty * sqrt(t->face_len2[r->ft]) * t->inv_det; /* 4 p / H_t */
@@ -168,11 +169,8 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
             touched = face_overlap_integral(3, d, &i0, w, &touch);
         }
     }
-    /* zeros copied as stores GCC can see whole: a loop or memset became
-     * `rep stos`, whose start-up was a fifth of this function's time */
-    static const double zeros[TET_PAIR_OUT];
     if (!touched) {
-        memcpy(springs, zeros, sizeof(double) * TET_CONTACT_SLOTS);
+        contact_zero(springs, TET_CONTACT_SLOTS);
         out[0] = 0;
         return 0;
     }
@@ -180,8 +178,8 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
     double keep_a[3], keep_b[3];
     memcpy(keep_a, springs + 3 * fm->face_a, sizeof keep_a);
     memcpy(keep_b, springs + TET_CONTACT_SLOTS / 2 + 3 * fm->face_b, sizeof keep_b);
-    memcpy(springs, zeros, sizeof(double) * TET_CONTACT_SLOTS);
-    memcpy(out, zeros, sizeof(double) * TET_PAIR_OUT);
+    contact_zero(springs, TET_CONTACT_SLOTS);
+    contact_zero(out, TET_PAIR_OUT);
     double *dissipated = &out[TET_PAIR_OUT - 1];
     face_role ra = {&a, &b, fa, fm->face_b, {n[0], n[1], n[2]}};
     face_role rb = {&b, &a, fb, fm->face_a, {-n[0], -n[1], -n[2]}};

@@ -658,15 +658,12 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
             clear = pair_clearance(&b, &a, &a_in_b);
         }
     }
-    /* zeros copied as stores GCC can see whole: a loop or memset of 24
-     * or 25 numbers became `rep stos`, whose start-up every pair paid */
-    static const double zeros[TET_PAIR_OUT];
     if (apart) {
-        memcpy(springs, zeros, sizeof(double) * TET_CONTACT_SLOTS);
+        contact_zero(springs, TET_CONTACT_SLOTS);
         out[0] = clear;
         return 0;
     }
-    memcpy(out, zeros, sizeof(double) * TET_PAIR_OUT);
+    contact_zero(out, TET_PAIR_OUT);
     double *dissipated = &out[TET_PAIR_OUT - 1];
     tet_friction ab = {in->vel, in->node_a, in->node_b, in->friction, in->h, springs, dissipated};
     tet_friction ba = {in->vel, in->node_b, in->node_a, in->friction, in->h,

@@ -260,10 +260,7 @@ int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *o
         out[0] = 0;
         return 0;
     }
-    /* zeros copied as stores GCC can see whole: the loop became `rep
-     * stos`, whose start-up every touching pair paid */
-    static const double zeros[TRI_PAIR_OUT];
-    memcpy(out, zeros, sizeof zeros);
+    contact_zero(out, TRI_PAIR_OUT);
     double *dissipated = &out[TRI_PAIR_OUT - 1];
     double a_in_b[3][3], b_in_a[3][3];
     corners_in(&a, &b, a_in_b);

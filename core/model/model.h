@@ -283,7 +283,7 @@ typedef struct contact_state {
                                 (walk_cuts + 1 numbers), set from last step's work */
     int walk_cuts[2];        /* the thread count walk_cut was made for (0: none) */
     int8_t *apply_owner;     /* threaded runs: per element, the thread whose nodes
-                                all its nodes are, or -1 (contact_walk.c) */
+                                all its nodes are, or -1 (contact_rows.c) */
     int apply_owner_threads; /* the thread count apply_owner was made for (0: none), */
     int apply_owner_elems;   /* the elements and nodes it was made for; */
     int apply_owner_nodes;
