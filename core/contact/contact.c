@@ -410,8 +410,9 @@ int contact_forces(fdem_model *m)
      * force array stays zero, and the integrator skips reading it. */
     if (!cs->force_is_zero) contact_force_clear(m);
     cs->force_is_zero = cs->pairs.count == 0;
-    if (contact_near_refresh(m)) return -1;
+    /* the shut marks first: they say which boxes the near list needs */
     contact_shut_refresh(m);
+    if (contact_near_refresh(m)) return -1;
     contact_vertex_due(m);
     int touching = contact_pairs_forces(m, m->dt_prev);
     if (touching < 0) return -1;

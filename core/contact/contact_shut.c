@@ -58,7 +58,9 @@ int contact_shut_init(fdem_model *m)
     cs->shut_vertex = malloc(N);
     cs->elem_shut = calloc((size_t)m->elem_count, 1);
     cs->elem_due = malloc(sizeof(int32_t) * (size_t)m->elem_count);
-    if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut || !cs->elem_due)
+    cs->elem_topo = calloc((size_t)m->elem_count, 1);
+    if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut || !cs->elem_due ||
+        !cs->elem_topo)
         return -1;
     /* the tolerances' room holds the table origin -> first copy meanwhile
      * (no scratch beyond what the memory estimate prices) */
@@ -90,6 +92,7 @@ void contact_shut_free(contact_state *cs)
     free(cs->shut_vertex);
     free(cs->elem_shut);
     free(cs->elem_due);
+    free(cs->elem_topo);
 }
 
 /* Whether copy n of a vertex is away from its first copy (past the shut

@@ -252,7 +252,8 @@ typedef struct contact_state {
     double near_apart;       /* this step, a near_gap over this is still open */
     int32_t *near_active;    /* the elements in some near pair, once each: their boxes */
     int near_active_count;   /* are all a step needs while the list holds */
-    double *elem_gap;        /* per element: the smallest gap of its near pairs */
+    double *elem_gap;        /* per element: the smallest gap of its near pairs of no
+                                shut topology (those go by elem_topo) */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
     /* after a break (contact_breaks.c): the list's spare and the pairs
@@ -275,6 +276,9 @@ typedef struct contact_state {
     int shut_was_any;        /* last step's shut_any: elem_shut held last step's marks */
     int32_t *elem_due;       /* this step: the elements not shut now or last step */
     int elem_due_count;
+    uint8_t *elem_topo;      /* per element: in a near pair of shut topology (bit 0, set
+                                at the list's build), whose general kernel may read its
+                                box this step (bit 1: contact_near.c) */
     int shut_off;            /* tests and benches: the general kernel on every pair */
     struct contact_touches *touches; /* threaded runs: one list per thread (contact_walk.c) */
     int touch_lists;         /* how many lists touches holds */
