@@ -135,9 +135,11 @@ static size_t memory_estimate(const memory_figures *f, long nodes, long elements
 {
     int contact = parts > 1 || joints > 0;
     size_t elem = memory_element(f, joints > 0) + (contact ? memory_contact_element(f) : 0) +
-                  /* elem_shut, elem_topo, elem_due, vertex_start; contact_breaks.c:
-                   * a count, the next pieces, a search body, a mark */
-                  (contact && joints > 0 ? 2 + 2 * sizeof(int32_t) + 3 * sizeof(int32_t) + 1 : 0);
+                  /* elem_shut, elem_topo, elem_due, vertex_start, elem_first;
+                   * contact_breaks.c: a count, the next pieces, a search body, a mark */
+                  (contact && joints > 0 ? 2 + (2 + f->elem_nodes) * sizeof(int32_t) +
+                                               3 * sizeof(int32_t) + 1
+                                         : 0);
     /* contact_breaks.c: what the last detection saw of each joint and vertex */
     size_t seen = contact && joints > 0 ? (size_t)joints + (size_t)nodes : 0;
     return memory_fixed(f, contact) + (size_t)nodes * memory_node(f, contact, joints > 0) +

@@ -92,6 +92,28 @@ static void near_topology_open(fdem_model *m)
     }
 }
 
+/* elem_gap found again from the near pairs' gaps, after the walk raised
+ * some by a clearance its kernel found: the boxes' gaps at the list's
+ * build are lower, and kept every element of a block broken in place
+ * computing its box (the pairs across each square's diagonal, apart by
+ * their clearance, but not by their boxes). This process's share of the
+ * list, as the walk takes it; a step without a raise pays nothing. */
+static void near_gaps_refresh(fdem_model *m)
+{
+    contact_state *cs = &m->contact;
+    double *elem_gap = cs->elem_gap;
+    for (int k = 0; k < cs->near_active_count; k++) elem_gap[cs->near_active[k]] = INFINITY;
+    size_t lo, hi;
+    contact_share(m->share, cs->near_count, &lo, &hi);
+    for (size_t i = lo; i < hi; i++) {
+        const near_pair *np = &cs->near[i];
+        if (np->topology) continue;
+        elem_gap[np->a] = min2(elem_gap[np->a], np->gap);
+        elem_gap[np->b] = min2(elem_gap[np->b], np->gap);
+    }
+    cs->gaps_raised = 0;
+}
+
 /* The same for the near pairs' elements whose boxes can touch another's:
  * an element whose every near pair had a gap over near_apart keeps its
  * box from before, which no pair reads (pair_evaluate). So does one whose
@@ -109,6 +131,7 @@ static void contact_near_boxes(fdem_model *m)
     const uint8_t *topo = cs->elem_topo;
     const uint8_t open = cs->shut_any ? TOPO_OPEN : TOPO_LISTED;
     if (topo && cs->shut_any) near_topology_open(m);
+    if (cs->gaps_raised) near_gaps_refresh(m);
 #pragma omp parallel for num_threads(m->threads) if (m->threads > 1 && count > 4096) \
     schedule(static)
     for (int k = 0; k < count; k++) {
@@ -321,6 +344,7 @@ static int contact_near_rebuild(fdem_model *m)
     cs->near_reach = reach;
     cs->near_apart = 0;
     cs->near_stale = 0;
+    cs->gaps_raised = 0;
     cs->near_builds++;
     /* A process of a split walk (contact_walk.c) reads the boxes of its
      * shares' pairs only, until the next rebuild (which computes every

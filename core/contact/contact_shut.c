@@ -59,8 +59,9 @@ int contact_shut_init(fdem_model *m)
     cs->elem_shut = calloc((size_t)m->elem_count, 1);
     cs->elem_due = malloc(sizeof(int32_t) * (size_t)m->elem_count);
     cs->elem_topo = calloc((size_t)m->elem_count, 1);
+    cs->elem_first = malloc(sizeof(int32_t) * (size_t)m->elem_nodes * (size_t)m->elem_count);
     if (!cs->shut_first || !cs->shut_tol2 || !cs->shut_vertex || !cs->elem_shut || !cs->elem_due ||
-        !cs->elem_topo)
+        !cs->elem_topo || !cs->elem_first)
         return -1;
     /* the tolerances' room holds the table origin -> first copy meanwhile
      * (no scratch beyond what the memory estimate prices) */
@@ -80,6 +81,7 @@ int contact_shut_init(fdem_model *m)
         for (int c = 0; c < K; c++) {
             int32_t f = first_of[nd[c]];
             cs->shut_tol2[f] = fmin(cs->shut_tol2[f], t * t);
+            cs->elem_first[(size_t)K * e + c] = f;
         }
     }
     return 0;
@@ -93,6 +95,7 @@ void contact_shut_free(contact_state *cs)
     free(cs->elem_shut);
     free(cs->elem_due);
     free(cs->elem_topo);
+    free(cs->elem_first);
 }
 
 /* Whether copy n of a vertex is away from its first copy (past the shut
@@ -115,12 +118,11 @@ static inline __attribute__((always_inline)) int vertex_away(const double *pos,
  * shut now or not last step (`had`: last step's marks hold). */
 static inline __attribute__((always_inline)) int element_mark(uint8_t *elem_shut,
                                                               const uint8_t *vertex,
-                                                              const int32_t *first,
-                                                              const int32_t *nd, int K,
+                                                              const int32_t *elem_first, int K,
                                                               uint8_t had, int e)
 {
     uint8_t shut = 1;
-    for (int c = 0; c < K; c++) shut &= vertex[first[nd[c]]];
+    for (int c = 0; c < K; c++) shut &= vertex[elem_first[(size_t)K * e + c]];
     uint8_t was = elem_shut[e] & had;
     elem_shut[e] = shut;
     return !(shut & was);
@@ -138,7 +140,7 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
     contact_state *cs = &m->contact;
     const int N = m->node_count, E = m->elem_count;
     const double *pos = m->pos;
-    const int32_t *first = cs->shut_first;
+    const int32_t *first = cs->shut_first, *elem_first = cs->elem_first;
     const double *tol2 = cs->shut_tol2;
     uint8_t *vertex = cs->shut_vertex, *elem_shut = cs->elem_shut;
     int32_t *due = cs->elem_due;
@@ -159,9 +161,7 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
                 }
 #pragma omp for schedule(static)
             for (int e = 0; e < E; e++)
-                due[e] = element_mark(elem_shut, vertex, first, element_nodes(m, e), K, had, e)
-                             ? e
-                             : -1;
+                due[e] = element_mark(elem_shut, vertex, elem_first, K, had, e) ? e : -1;
         }
         for (int e = 0; e < E; e++)
             if (due[e] >= 0) due[count++] = due[e];
@@ -169,7 +169,7 @@ static inline __attribute__((always_inline)) void shut_mark(fdem_model *m, int D
         for (int n = 0; n < N; n++)
             if (vertex_away(pos, first, tol2, n, D)) vertex[first[n]] = 0;
         for (int e = 0; e < E; e++)
-            if (element_mark(elem_shut, vertex, first, element_nodes(m, e), K, had, e))
+            if (element_mark(elem_shut, vertex, elem_first, K, had, e))
                 due[count++] = e;
     }
     cs->elem_due_count = count;

@@ -144,7 +144,13 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
      * while c > near_apart_now + near_apart_then: skipped only where the
      * kernel would have found what it found now, the same bits. The list's
      * rebuild (and a restore, which rebuilds it) starts from box gaps. */
-    if (!touched && out[0] > 0 && !cs->clearance_off) np->gap = max2(np->gap, out[0] - cs->near_apart);
+    if (!touched && out[0] > 0 && !cs->clearance_off && out[0] - cs->near_apart > np->gap) {
+        np->gap = out[0] - cs->near_apart;
+        /* its elements' elem_gap may be lower than any of their pairs'
+         * gaps now: found again before the next boxes (contact_near.c) */
+#pragma omp atomic write
+        cs->gaps_raised = 1;
+    }
     return pair_springs_settle(np, set, springs, touched, slots, pool);
 }
 

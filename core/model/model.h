@@ -254,6 +254,7 @@ typedef struct contact_state {
     int near_active_count;   /* are all a step needs while the list holds */
     double *elem_gap;        /* per element: the smallest gap of its near pairs of no
                                 shut topology (those go by elem_topo) */
+    int gaps_raised;         /* the walk raised some pair's gap since elem_gap was found */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
     /* after a break (contact_breaks.c): the list's spare and the pairs
@@ -270,6 +271,8 @@ typedef struct contact_state {
      * per first copy the squared tolerance and whether it is shut this
      * step, per element whether all its vertices are; NULL without joints */
     int32_t *shut_first;
+    int32_t *elem_first;     /* per element, its corners' first copies (elem_nodes each):
+                                the marks read these, not the element records */
     double *shut_tol2;
     uint8_t *shut_vertex, *elem_shut;
     int shut_any;            /* this step: some broken joint, elem_shut is current */
