@@ -144,6 +144,12 @@ int contact_near_refresh(fdem_model *m);
  * shut elements; kind says what the walk does with a pair of them: the
  * general kernel, the face kernel (fm filled) or nothing. */
 enum { SHUT_TOPO_NONE, SHUT_TOPO_FACE, SHUT_TOPO_VERTEX };
+
+/* elem_topo's bits: the element is in a near pair of shut topology (face
+ * or vertex), and this step such a pair of it may take the general kernel
+ * (contact_near.c). */
+#define TOPO_LISTED 1u
+#define TOPO_OPEN 2u
 int contact_shut_init(fdem_model *m);
 void contact_shut_free(contact_state *cs);
 void contact_shut_refresh(fdem_model *m);

@@ -58,11 +58,6 @@ static void contact_boxes(fdem_model *m, const int32_t *list, int count)
     for (int k = 0; k < count; k++) element_box(m, list[k], box + width * (size_t)list[k]);
 }
 
-/* elem_topo's bits: the element is in a near pair of shut topology (face
- * or vertex), and this step that pair may take the general kernel. */
-#define TOPO_LISTED 1u
-#define TOPO_OPEN 2u
-
 /* This step's TOPO_OPEN marks. A pair of shut topology reads its boxes
  * only on the general kernel, where one of its elements is not shut
  * (pair_evaluate): each element not shut now is marked, with its

@@ -8,7 +8,8 @@
  * 1 thread; the same block with every vertex copy moved 2 tolerances apart
  * never engages it and gives the bits of a run with it switched off (the
  * general path untouched); and the shut run stays close to the general
- * kernel's run (the kernels agree to O(s / h)).
+ * kernel's run (the kernels agree to O(s / h)); and a shut block
+ * computes no element's box, from a restore too.
  */
 #include "broken_block.h"
 #include "check.h"
@@ -226,5 +227,54 @@ static void shut_run_close_to_the_general_kernel(void)
     }
 }
 
-CHECK_MAIN(T(vertex_pairs_walked_where_due_give_the_same_bits), T(shut_broken_block_same_bits_on_threads_and_restore),
+/* The elements whose boxes this step computed (contact_near_boxes' test). */
+static int boxes_computed(const fdem_model *m)
+{
+    const contact_state *cs = &m->contact;
+    int n = 0;
+    for (int k = 0; k < cs->near_active_count; k++) {
+        int e = cs->near_active[k];
+        n += cs->elem_gap[e] <= cs->near_apart || (cs->elem_topo[e] & TOPO_OPEN);
+    }
+    return n;
+}
+
+/* A shut broken block computes no element's box: its face pairs and vertex
+ * pairs read none between shut elements, and the pairs across its
+ * squares' diagonals, their boxes a hair apart (1e-12 m) when the near
+ * list is built, are found apart by their clearance, which elem_gap then
+ * follows (in 2D the first step after a rebuild asks their kernel for it;
+ * in 3D a pair is asked only if its boxes overlap). Once copies are
+ * nudged open, the open elements and their neighbours get boxes again.
+ * From a restore too (which rebuilds the near list). */
+static void shut_block_computes_no_boxes(void)
+{
+    fdem_model *m = broken_block(2, 8, 2.0, 0);
+    fdem_error err = {0};
+    for (int s = 0; s < 5; s++) CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+    CHECK(shut_elements(m) == m->elem_count, "%d of %d shut", shut_elements(m), m->elem_count);
+    CHECK(boxes_computed(m) == 0, "2D: %d of %d elements computed their boxes", boxes_computed(m),
+          m->elem_count);
+    size_t size = fdem_checkpoint_size(m);
+    void *state = malloc(size);
+    CHECK(state && fdem_checkpoint_write(m, state, size) == 0, "checkpoint");
+    CHECK(fdem_checkpoint_read(m, state, size, &err) == 0, "%s", err.message);
+    int after[3];
+    for (int s = 0; s < 3; s++) {
+        CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+        after[s] = boxes_computed(m);
+    }
+    CHECK(after[2] == 0, "2D, restored: %d, %d, %d elements computed their boxes", after[0],
+          after[1], after[2]);
+    nudge_copies(m, 1, 7);
+    CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+    int open = m->elem_count - shut_elements(m), boxes = boxes_computed(m);
+    CHECK(open > 0 && boxes >= open, "2D, nudged: %d elements open, %d boxes", open, boxes);
+    fprintf(stderr, "  2D: after a restore %d, %d, %d boxes; nudged open %d elements, %d boxes\n",
+            after[0], after[1], after[2], open, boxes);
+    free(state);
+    fdem_model_destroy(m);
+}
+
+CHECK_MAIN(T(shut_block_computes_no_boxes), T(vertex_pairs_walked_where_due_give_the_same_bits), T(shut_broken_block_same_bits_on_threads_and_restore),
            T(open_broken_block_is_the_general_kernel), T(shut_run_close_to_the_general_kernel))
