@@ -247,15 +247,19 @@ static int face_match_of(const fdem_model *m, int j, int a, int b, face_match *f
     return 0;
 }
 
-static int share_a_vertex(const fdem_model *m, int a, int b)
+/* How many mesh vertices a and b share, from elem_first (each element's
+ * K first copies in a row), not the element records and first[]: a near
+ * list's rebuild asks this of every pair (66 an element in a broken 3D
+ * block). */
+static int shared_vertices(const fdem_model *m, int a, int b)
 {
     const int K = m->elem_nodes;
-    const int32_t *na = element_nodes(m, a), *nb = element_nodes(m, b);
-    const int32_t *first = m->contact.shut_first;
+    const int32_t *fa = m->contact.elem_first + (size_t)K * a;
+    const int32_t *fb = m->contact.elem_first + (size_t)K * b;
+    int shared = 0;
     for (int i = 0; i < K; i++)
-        for (int k = 0; k < K; k++)
-            if (first[na[i]] == first[nb[k]]) return 1;
-    return 0;
+        for (int k = 0; k < K; k++) shared += fa[i] == fb[k];
+    return shared;
 }
 
 /* What a and b share, which only a break changes: a broken joint (its
@@ -266,7 +270,13 @@ static int share_a_vertex(const fdem_model *m, int a, int b)
 int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
 {
     *face = 0;
+    /* a joint's two faces are copies of the same dim vertices
+     * (node_origin), so only two elements that share that many can have
+     * one between them: the pairs of a rebuild are told apart without
+     * looking at the joints, but for the few sides of a face */
     if (!m->broken_joints) return SHUT_TOPO_NONE;
+    int shared = shared_vertices(m, a, b);
+    if (shared < m->dim) return shared ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
     int j = broken_joint_between(m, a, b);
     if (j >= 0) {
         face_match fm = {0, 0, {0, 0, 0}};
@@ -274,7 +284,7 @@ int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
         *face = shut_face_pack(&fm);
         return SHUT_TOPO_FACE;
     }
-    return share_a_vertex(m, a, b) ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
+    return SHUT_TOPO_VERTEX;
 }
 
 /* a and b are the two sides of a broken joint, both shut this step: then
