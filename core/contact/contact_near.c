@@ -16,7 +16,9 @@
  * they would have gone that step: the same bits as walking every pair.
  * In the same way a near pair whose gap is over twice the farthest travel
  * so far is apart without a look at its boxes, and only elements with such
- * a pair closing get their box computed.
+ * a pair closing get their box computed; a pair of shut topology (below)
+ * reads boxes only where one of its elements is not shut, so its elements
+ * get theirs only then (elem_topo).
  *
  * Broken rock: the pairs of elements that share a mesh vertex but no
  * broken joint are kept apart, at the end of the same array (the walk
