@@ -139,6 +139,17 @@ int contact_collect_elements(contact_state *cs, int elem_count, const near_pair 
 void contact_vertex_due(fdem_model *m);
 int contact_near_refresh(fdem_model *m);
 
+/* A near pair whose gap is over this stays apart until the list is rebuilt
+ * (contact_near_due: near_apart is at most twice the reach before then;
+ * a margin over the rebuild's own limit, for the rounding of that root),
+ * so the walk would only step over it: contact_near_compact takes such
+ * pairs out of the list, in order (the walk counts them in near_dead). */
+static inline double contact_near_dead(const contact_state *cs)
+{
+    return 2.0 * cs->near_reach * (1 + 4e-9);
+}
+void contact_near_compact(fdem_model *m);
+
 /* contact_shut.c: the shut broken joints (see its top). init builds the
  * vertex tables once (0, or -1 without memory); refresh marks this step's
  * shut elements; kind says what the walk does with a pair of them: the

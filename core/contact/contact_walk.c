@@ -84,6 +84,10 @@ static inline void pair_gap_raise(contact_state *cs, near_pair *np, double c)
      * now: found again before the next boxes (contact_near.c) */
 #pragma omp atomic write
     cs->gaps_raised = 1;
+    if (np->gap > contact_near_dead(cs)) {
+#pragma omp atomic update
+        cs->near_dead++;
+    }
 }
 
 /* Broken rock: a pair across a crack whose boxes are a hair apart when the
@@ -189,6 +193,12 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
      * rebuild (and a restore, which rebuilds it) starts from box gaps. */
     if (!touched) pair_gap_raise(cs, np, out[0]);
     return pair_springs_settle(np, set, springs, touched, slots, pool);
+}
+
+/* The pairs a walk needs to take threads. */
+static inline long walk_threads_least(const contact_state *cs)
+{
+    return cs->walk_threads_min > 0 ? cs->walk_threads_min : CONTACT_THREADED_PAIRS;
 }
 
 /* One list per thread; 0, or -1 if they cannot be had. */
@@ -329,7 +339,7 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
                        int *used)
 {
     contact_state *cs = &m->contact;
-    long least = cs->split_threads_min > 0 ? cs->split_threads_min : CONTACT_THREADED_PAIRS;
+    long least = walk_threads_least(cs);
     int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
     if (contact_touch_lists(cs, threads)) return -1;
     const int which = w->index != NULL;
@@ -672,7 +682,7 @@ int contact_pairs_forces(fdem_model *m, double h)
     int touching = 0;
     for (int k = 0; k < 2; k++) {
         int t;
-        if (m->threads > 1 && walks[k].count >= CONTACT_THREADED_PAIRS &&
+        if (m->threads > 1 && (long)walks[k].count >= walk_threads_least(cs) &&
             contact_touch_lists(cs, m->threads) == 0)
             /* a list that cannot grow has already moved some stick springs:
              * the step fails rather than run the pairs twice */
@@ -682,6 +692,7 @@ int contact_pairs_forces(fdem_model *m, double h)
         if (t < 0) return -1;
         touching += t;
     }
+    if (cs->near_dead > cs->near_count / 8) contact_near_compact(m);
     return touching;
 }
 

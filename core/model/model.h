@@ -255,6 +255,9 @@ typedef struct contact_state {
     double *elem_gap;        /* per element: the smallest gap of its near pairs of no
                                 shut topology (those go by elem_topo) */
     int gaps_raised;         /* the walk raised some pair's gap since elem_gap was found */
+    size_t near_dead;        /* near pairs raised past contact_near_dead since the list
+                                was built or compacted */
+    long near_compacted;     /* a figure: near pairs taken out that way, all steps */
     int near_stale;          /* a detection or a restore: the list is rebuilt next step */
     int clearance_off;       /* tests: never skip a pair on its kernel's clearance (contact.c) */
     /* after a break (contact_breaks.c): the list's spare and the pairs
@@ -299,8 +302,8 @@ typedef struct contact_state {
     size_t wire_capacity;
     long pairs_walked;       /* near pairs in this process's share of the walks, all steps
                                 (a figure: every pair on one process) */
-    int split_threads_min;   /* tests: the pairs a process's share of a split walk needs
-                                to take threads (0: as one process, contact_walk.c) */
+    int walk_threads_min;    /* tests: the pairs a walk (or a process's share of a split
+                                walk) needs to take threads (0: CONTACT_THREADED_PAIRS) */
     long split_threaded;     /* a figure: split walks whose share went to several threads */
     long near_builds;        /* a figure: rebuilds of the near list */
     int springs_behind;      /* a split walk updated springs in place since the last

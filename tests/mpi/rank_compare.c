@@ -31,7 +31,7 @@
  * differ.
  *
  * --split-threads-min N: a rank's share of the contact walk goes to its
- * threads from N pairs (contact.split_threads_min; small cases' shares are
+ * threads from N pairs (contact.walk_threads_min; small cases' shares are
  * otherwise too few for threads).
  *
  * With the contact walk split, rank 0 prints to stderr how many near pairs
@@ -125,7 +125,7 @@ static int ranks_agree(const fdem_model *m, const uint8_t *mark, MPI_Comm comm)
 typedef struct compare_options {
     int steps, every, plain, fault, threads, figures;
     int contact_fault;        /* RANK_CONTACT_FAULT_*: a wrong split of the contact walk */
-    int split_threads_min;    /* contact.split_threads_min: threads inside a rank's share */
+    int split_threads_min;    /* contact.walk_threads_min: threads inside a rank's share */
     int expect_failure;       /* the cases must fail at some step (and then pass) */
     int save_at;              /* the step after which rank 0 writes save_path; 0: none */
     const char *save_path;
@@ -173,7 +173,7 @@ static int run_case(const char *path, const compare_options *o, int rank, int si
     }
     problems_free(&out);
     fdem_set_threads(m, o->threads);
-    m->contact.split_threads_min = o->split_threads_min;
+    m->contact.walk_threads_min = o->split_threads_min;
     double t_build = MPI_Wtime() - t0;
     fdem_error err = {0};
     if (o->restore_path && restore_checkpoint(m, o->restore_path, &err)) {

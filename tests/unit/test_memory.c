@@ -16,6 +16,7 @@
 
 #include "case/case.h"
 #include "check.h"
+#include "model/model.h"
 #include "fdem.h"
 #include "heap_count.h"
 #include "json/problems.h"
@@ -115,6 +116,9 @@ static void threads_add_their_touch_lists(void)
     fdem_model *m = memory_build("examples/uniaxial-prism-3d.json");
     if (!m) return;
     fdem_set_threads(m, 2);
+    /* its walk, 654 near pairs once the pairs apart leave the list, takes
+     * threads from 64 pairs here, so that the lists are exercised */
+    m->contact.walk_threads_min = 64;
     double peak = (double)memory_peak(m, 300);
     double priced = gated_estimate + 2.0 * (double)fdem_memory_per_thread(3);
     printf("  two threads: estimate %.0f + threads %.0f, peak %.0f\n", gated_estimate,
