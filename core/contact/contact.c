@@ -46,8 +46,10 @@
  * pile: boxes 157M -> 25M instructions in 493 steps, whole step -10 %;
  * 1/128 gained no more). */
 static const contact_kernel contact_kernels[2] = {
-    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, 0.25, 1.0 / 16},
-    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, 0.153, 1.0 / 64},
+    {TRI_CONTACT_SLOTS, TRI_PAIR_OUT, tri_contact_pair_force, tri_contact_pair_clearance, 0.25,
+     1.0 / 16},
+    {TET_CONTACT_SLOTS, TET_PAIR_OUT, tet_contact_pair_force, tet_contact_pair_clearance, 0.153,
+     1.0 / 64},
 };
 
 /* Force between two elements whose boxes overlap, both roles, into out

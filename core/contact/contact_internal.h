@@ -17,6 +17,7 @@ typedef struct contact_kernel {
     int slots;          /* stick springs per pair */
     int pair_out;       /* forces on both elements' nodes, then the dissipation */
     int (*pair_force)(const contact_pair_in *in, double *springs, double *out);
+    double (*pair_clearance)(const contact_pair_in *in); /* by a face plane alone */
     double dt_factor;   /* contact_stable_dt: dt_factor h sqrt(rho / p) */
     double near_step;   /* the near list's reach (cs->near_reach) per unit buffer */
 } contact_kernel;

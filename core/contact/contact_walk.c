@@ -93,26 +93,22 @@ static inline void pair_gap_raise(contact_state *cs, near_pair *np, double c)
 /* Broken rock: a pair across a crack whose boxes are a hair apart when the
  * list is built (1e-12 m in a block broken in place: corners of a mesh
  * square) keeps that box gap, is turned away by the box test every step,
- * and so keeps both its elements computing their boxes, where its kernel
- * would find the two elements apart by their size. Its kernel is asked
- * once a list, on zeroed springs and a scratch row whose forces are
- * dropped (a hair apart, rounding could find a touch the box test did
- * not), for a clearance only: the pair is still apart this step as
- * before, springs and all, and a clearance skips it only where its
- * kernel would find it apart, the same bits. Triangles only: a look costs
- * about what 8 steps of boxes save (broken 2D block at 1e5, the bench's
- * 49-step window from a restore: 208 -> 203 ns an element-step), but a
- * tetrahedron's general kernel costs a list's life of boxes (broken 3D
- * block at 1e4, 96 steps: 968 -> 1036). */
-static void pair_clearance_look(fdem_model *m, near_pair *np, double h, contact_pair_memo *memo)
+ * and so stays in the near list and keeps both its elements computing
+ * their boxes, where its kernel would find the two elements apart by
+ * their size. The first box test that turns one away asks its kernel,
+ * once a list, for the clearance of a face plane alone (no forces: the
+ * pair is apart this step as before, springs and all), and a clearance
+ * skips it only where its kernel would find it apart, the same bits. The
+ * whole kernel was measured first: in 3D it cost more than the boxes it
+ * saved (broken 3D block at 1e4, 96 steps from a restore: 968 -> 1036 ns
+ * an element-step), where clipping a pair no face plane separates came
+ * first. */
+static void pair_clearance_look(fdem_model *m, near_pair *np, contact_pair_memo *memo)
 {
     contact_state *cs = &m->contact;
-    double springs[CONTACT_SLOTS_MAX], out[CONTACT_PAIR_OUT_MAX];
-    contact_zero(springs, (size_t)cs->slots);
-    contact_pair_in in = contact_pair_input(m, np->a, np->b, h, memo);
-    in.edge_clearance = 1;
+    contact_pair_in in = contact_pair_input(m, np->a, np->b, 0, memo);
     np->face |= NEAR_EDGES_TRIED;
-    if (!cs->kernel->pair_force(&in, springs, out)) pair_gap_raise(cs, np, out[0]);
+    pair_gap_raise(cs, np, cs->kernel->pair_clearance(&in));
 }
 
 /* Near pair np this step: boxes apart, it lets its springs go (-1);
@@ -163,9 +159,8 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     int apart = np->gap > cs->near_apart;
     if (!apart && !boxes_overlap(cs->box + width * (size_t)a, cs->box + width * (size_t)b, D)) {
         apart = 1;
-        if (D == 2 && cs->elem_topo && !(np->face & NEAR_EDGES_TRIED) && cs->elem_topo[a] &&
-            cs->elem_topo[b])
-            pair_clearance_look(m, np, h, memo);
+        if (cs->elem_topo && !(np->face & NEAR_EDGES_TRIED) && cs->elem_topo[a] && cs->elem_topo[b])
+            pair_clearance_look(m, np, memo);
     }
     if (apart) {
         if (np->sprung) {

@@ -122,4 +122,11 @@ static inline double contact_clearance_less_margin(double apart, double size, do
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out);
 
+/* The clearance the kernel above would return for a pair a plane of an
+ * element's face (2D: edge) separates, without the pair's forces (in's
+ * velocities and springs unread), or 0 when none does: a few dozen
+ * operations where the kernel may clip both elements in full. */
+double tri_contact_pair_clearance(const contact_pair_in *in);
+double tet_contact_pair_clearance(const contact_pair_in *in);
+
 #endif /* FDEM_CONTACT_PAIR_H */

@@ -635,29 +635,45 @@ static double edge_pair_clearance(const tet_frame *a, const tet_frame *b)
     return trusted_clearance(a, b, tet_six_volume(a->p), best);
 }
 
+/* Inverted: no potential; a face plane of either apart: no touch, and
+ * *clear its clearance. a's map first, most often kept from the last pair,
+ * so that most pairs, apart by one of a's faces, never look at b's.
+ * Otherwise both maps and the corners in them, for the clipping. */
+static int tet_pair_apart(const contact_pair_in *in, tet_frame *a, tet_frame *b,
+                          corners_in *a_in_b, corners_in *b_in_a, double *clear)
+{
+    *clear = 0;
+    tet_frame_memo(in->pos, in->node_a, in->memo, a);
+    if (!(a->bary.valid && a->bary.det > 0)) return 1;
+    tet_corners_of(in->pos, in->node_b, b);
+    if (corners_in_target(b, a, b_in_a)) {
+        *clear = pair_clearance(a, b, b_in_a);
+        return 1;
+    }
+    tet_frame_memo(in->pos, in->node_b, in->memo, b);
+    if (!(b->bary.valid && b->bary.det > 0)) return 1;
+    if (corners_in_target(a, b, a_in_b)) {
+        *clear = pair_clearance(b, a, a_in_b);
+        return 1;
+    }
+    return 0;
+}
+
+double tet_contact_pair_clearance(const contact_pair_in *in)
+{
+    tet_frame a, b;
+    corners_in a_in_b, b_in_a;
+    double clear;
+    tet_pair_apart(in, &a, &b, &a_in_b, &b_in_a, &clear);
+    return clear;
+}
+
 int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tet_frame a, b;
     corners_in a_in_b, b_in_a;
-    /* inverted: no potential; a face plane of either apart: no touch. a's
-     * map first, most often kept from the last pair, so that most pairs,
-     * apart by one of a's faces, never look at b's. */
-    tet_frame_memo(in->pos, in->node_a, in->memo, &a);
-    int apart = !(a.bary.valid && a.bary.det > 0);
-    double clear = 0;
-    if (!apart) {
-        tet_corners_of(in->pos, in->node_b, &b);
-        apart = corners_in_target(&b, &a, &b_in_a);
-        if (apart) clear = pair_clearance(&a, &b, &b_in_a);
-    }
-    if (!apart) {
-        tet_frame_memo(in->pos, in->node_b, in->memo, &b);
-        apart = !(b.bary.valid && b.bary.det > 0);
-        if (!apart && corners_in_target(&a, &b, &a_in_b)) {
-            apart = 1;
-            clear = pair_clearance(&b, &a, &a_in_b);
-        }
-    }
+    double clear;
+    int apart = tet_pair_apart(in, &a, &b, &a_in_b, &b_in_a, &clear);
     if (apart) {
         contact_zero(springs, TET_CONTACT_SLOTS);
         out[0] = clear;

@@ -250,6 +250,19 @@ static double tri_clearance(const tri_now *t, const tri_now *other, const double
     return contact_clearance_less_margin(best, size, max2(lt, lo));
 }
 
+double tri_contact_pair_clearance(const contact_pair_in *in)
+{
+    tri_now a, b;
+    tri_gather(in->pos, in->node_a, &a);
+    tri_gather(in->pos, in->node_b, &b);
+    if (!(a.area2 > 0) || !(b.area2 > 0)) return 0;
+    double a_in_b[3][3], b_in_a[3][3];
+    corners_in(&a, &b, a_in_b);
+    corners_in(&b, &a, b_in_a);
+    return max2(tri_clearance(&a, &b, (const double(*)[3])b_in_a),
+                tri_clearance(&b, &a, (const double(*)[3])a_in_b));
+}
+
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tri_now a, b;

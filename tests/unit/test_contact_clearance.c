@@ -9,7 +9,8 @@
  * each other, and two blocks colliding. Each test also checks that the
  * skips happened (kernel calls saved), or it could not fail. A checkpoint
  * taken mid-run restores to the same bits (the clearances start afresh),
- * and the 3D broken block's run with the skips is on two threads.
+ * and the 3D broken block's run with the skips is on two threads. The
+ * kernels' clearance alone (no forces) is their own figure.
  */
 #include "broken_block.h"
 #include "check.h"
@@ -187,6 +188,42 @@ static void crossed_edges_give_a_clearance(void)
     }
 }
 
-CHECK_MAIN(T(crossed_edges_give_a_clearance), T(broken_block_2d_gives_the_same_bits), T(broken_block_3d_gives_the_same_bits),
+/* The kernels' clearance alone (contact_pair.h: a face or edge plane
+ * that separates the pair, no forces) against the kernel's own answer
+ * without the edge axes: the same figure for every pair apart, 0 for every
+ * pair that touches. On the colliding blocks, mid-impact, every candidate
+ * pair; some of each kind, or it could not fail. */
+static void clearance_alone_is_the_kernels(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = colliding_blocks(dim);
+        fdem_error err = {0};
+        int apart = 0, touching = 0;
+        for (int s = 0; s < (dim == 2 ? 600 : 300); s++) {
+            CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+            if (s % 50) continue;
+            const contact_state *cs = &m->contact;
+            for (size_t k = 0; k < cs->pairs.count; k++) {
+                contact_pair_in in = contact_pair_input(m, cs->pairs.a[k], cs->pairs.b[k],
+                                                        m->dt, NULL);
+                double springs[CONTACT_SLOTS_MAX] = {0}, out[CONTACT_PAIR_OUT_MAX];
+                int touched = cs->kernel->pair_force(&in, springs, out);
+                double alone = cs->kernel->pair_clearance(&in);
+                CHECK(touched ? alone == 0 : alone == out[0],
+                      "%dD pair %zu: touched %d, kernel %.17g, alone %.17g", dim, k, touched,
+                      touched ? 0.0 : out[0], alone);
+                apart += !touched && alone > 0;
+                touching += touched;
+            }
+        }
+        CHECK(apart > 0 && touching > 0, "%dD: %d apart with a clearance, %d touching", dim,
+              apart, touching);
+        fprintf(stderr, "  %dD: %d pair-looks apart with a clearance, %d touching\n", dim, apart,
+                touching);
+        fdem_model_destroy(m);
+    }
+}
+
+CHECK_MAIN(T(clearance_alone_is_the_kernels), T(crossed_edges_give_a_clearance), T(broken_block_2d_gives_the_same_bits), T(broken_block_3d_gives_the_same_bits),
            T(colliding_blocks_give_the_same_bits),
            T(restored_broken_block_steps_on_to_the_same_bits))

@@ -242,38 +242,48 @@ static int boxes_computed(const fdem_model *m)
 /* A shut broken block computes no element's box: its face pairs and vertex
  * pairs read none between shut elements, and the pairs across its
  * squares' diagonals, their boxes a hair apart (1e-12 m) when the near
- * list is built, are found apart by their clearance, which elem_gap then
- * follows (in 2D the first step after a rebuild asks their kernel for it;
- * in 3D a pair is asked only if its boxes overlap). Once copies are
- * nudged open, the open elements and their neighbours get boxes again.
- * From a restore too (which rebuilds the near list). */
+ * list is built, are found apart by their clearance (the first step after
+ * a rebuild that turns one away on its boxes asks its kernel for it),
+ * which elem_gap then follows. Once copies are nudged open, the open
+ * elements and their neighbours get boxes again. From a restore too
+ * (which rebuilds the near list), in 2D. */
 static void shut_block_computes_no_boxes(void)
 {
-    fdem_model *m = broken_block(2, 8, 2.0, 0);
-    fdem_error err = {0};
-    for (int s = 0; s < 5; s++) CHECK(fdem_step(m, &err) == 0, "%s", err.message);
-    CHECK(shut_elements(m) == m->elem_count, "%d of %d shut", shut_elements(m), m->elem_count);
-    CHECK(boxes_computed(m) == 0, "2D: %d of %d elements computed their boxes", boxes_computed(m),
-          m->elem_count);
-    size_t size = fdem_checkpoint_size(m);
-    void *state = malloc(size);
-    CHECK(state && fdem_checkpoint_write(m, state, size) == 0, "checkpoint");
-    CHECK(fdem_checkpoint_read(m, state, size, &err) == 0, "%s", err.message);
-    int after[3];
-    for (int s = 0; s < 3; s++) {
+    for (int dim = 2; dim <= 3; dim++) {
+        fdem_model *m = broken_block(dim, dim == 2 ? 8 : 3, 2.0, 0);
+        fdem_error err = {0};
+        for (int s = 0; s < 5; s++) CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+        CHECK(shut_elements(m) == m->elem_count, "%dD: %d of %d shut", dim, shut_elements(m),
+              m->elem_count);
+        CHECK(boxes_computed(m) == 0, "%dD: %d of %d elements computed their boxes", dim,
+              boxes_computed(m), m->elem_count);
+        size_t size = fdem_checkpoint_size(m);
+        void *state = malloc(size);
+        CHECK(state && fdem_checkpoint_write(m, state, size) == 0, "checkpoint");
+        CHECK(fdem_checkpoint_read(m, state, size, &err) == 0, "%s", err.message);
+        int after[3];
+        for (int s = 0; s < 3; s++) {
+            CHECK(fdem_step(m, &err) == 0, "%s", err.message);
+            after[s] = boxes_computed(m);
+        }
+        /* 3D: from the restore's state some pairs across a diagonal are
+         * apart only along an oblique axis that the kernel's clearance
+         * cannot certify there (every separating face plane passes
+         * through a corner of both), so their elements keep their boxes
+         * (126 of 162 here): only fewer than before the looks */
+        CHECK(dim == 3 ? after[2] < after[0] : after[2] == 0,
+              "%dD, restored: %d, %d, %d elements computed their boxes", dim, after[0], after[1],
+              after[2]);
+        nudge_copies(m, 1, dim == 2 ? 7 : 61);
         CHECK(fdem_step(m, &err) == 0, "%s", err.message);
-        after[s] = boxes_computed(m);
+        int open = m->elem_count - shut_elements(m), boxes = boxes_computed(m);
+        CHECK(open > 0 && boxes >= open, "%dD, nudged: %d elements open, %d boxes", dim, open,
+              boxes);
+        fprintf(stderr, "  %dD: after a restore %d, %d, %d boxes; nudged open %d elements, %d "
+                "boxes\n", dim, after[0], after[1], after[2], open, boxes);
+        free(state);
+        fdem_model_destroy(m);
     }
-    CHECK(after[2] == 0, "2D, restored: %d, %d, %d elements computed their boxes", after[0],
-          after[1], after[2]);
-    nudge_copies(m, 1, 7);
-    CHECK(fdem_step(m, &err) == 0, "%s", err.message);
-    int open = m->elem_count - shut_elements(m), boxes = boxes_computed(m);
-    CHECK(open > 0 && boxes >= open, "2D, nudged: %d elements open, %d boxes", open, boxes);
-    fprintf(stderr, "  2D: after a restore %d, %d, %d boxes; nudged open %d elements, %d boxes\n",
-            after[0], after[1], after[2], open, boxes);
-    free(state);
-    fdem_model_destroy(m);
 }
 
 CHECK_MAIN(T(shut_block_computes_no_boxes), T(vertex_pairs_walked_where_due_give_the_same_bits), T(shut_broken_block_same_bits_on_threads_and_restore),
