@@ -175,6 +175,15 @@ int contact_shut_neighbours(const fdem_model *m, int a, int b);
  * looks again. Skips never change bits, so neither does when one looks. */
 #define NEAR_EDGES_TRIED 0x8000u
 
+/* near_pair.face, bits 10-13: how often the box test has turned the pair
+ * away since the list was built, up to the dimension's count, when broken
+ * rock's pair asks its kernel for a clearance (contact_walk.c,
+ * pair_turned_away). */
+#define NEAR_TURNED_SHIFT 10
+#define NEAR_TURNED_MASK (15u << NEAR_TURNED_SHIFT)
+#define NEAR_LOOK_AFTER_2D 4
+#define NEAR_LOOK_AFTER_3D 16
+
 /* A face_match in near_pair.face: two bits each for face_a, face_b and
  * copy_in_b[0..2] (corners and faces number at most 4). */
 static inline uint16_t shut_face_pack(const face_match *fm)
