@@ -177,12 +177,13 @@ int contact_shut_neighbours(const fdem_model *m, int a, int b);
 
 /* near_pair.face, bits 10-13: how often the box test has turned the pair
  * away since the list was built, up to the dimension's count, when broken
- * rock's pair asks its kernel for a clearance (contact_walk.c,
- * pair_turned_away). */
+ * rock's pair asks its kernel for a face plane's clearance (contact_walk.c,
+ * pair_turned_away), then NEAR_TURNED_LOOKED. */
 #define NEAR_TURNED_SHIFT 10
 #define NEAR_TURNED_MASK (15u << NEAR_TURNED_SHIFT)
+#define NEAR_TURNED_LOOKED 15u
 #define NEAR_LOOK_AFTER_2D 4
-#define NEAR_LOOK_AFTER_3D 16
+#define NEAR_LOOK_AFTER_3D 14
 
 /* A face_match in near_pair.face: two bits each for face_a, face_b and
  * copy_in_b[0..2] (corners and faces number at most 4). */

@@ -264,7 +264,7 @@ static void shut_block_computes_no_boxes(void)
         CHECK(fdem_checkpoint_read(m, state, size, &err) == 0, "%s", err.message);
         /* the looks come once a pair has been turned away by its boxes
          * NEAR_LOOK_AFTER_* times (contact_walk.c) */
-        int after[3], steps = NEAR_LOOK_AFTER_3D + 4;
+        int after[3], steps = NEAR_LOOK_AFTER_3D + 6;
         for (int s = 0; s < steps; s++) {
             CHECK(fdem_step(m, &err) == 0, "%s", err.message);
             if (s < 2) after[s] = boxes_computed(m);
