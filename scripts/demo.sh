@@ -34,7 +34,11 @@ rm -rf "$DATA"
 mkdir -p "$DATA"
 
 say "starting $BIN/fdemd on a free port (log: $LOG)"
-"$BIN/fdemd" --listen 127.0.0.1:0 --data "$DATA" >"$LOG" 2>&1 &
+# the log exists before the daemon does: the loop below may read it before
+# the background shell has opened it (sed then failed the demo on a busy
+# machine)
+: >"$LOG"
+"$BIN/fdemd" --listen 127.0.0.1:0 --data "$DATA" >>"$LOG" 2>&1 &
 daemon=$!
 # Whatever goes wrong below, the daemon must not outlive the demo.
 trap 'kill -TERM "$daemon" 2>/dev/null || true; wait "$daemon" 2>/dev/null || true' EXIT
