@@ -95,14 +95,14 @@ static inline void pair_gap_raise(contact_state *cs, near_pair *np, double c)
  * square) keeps that box gap, is turned away by the box test every step,
  * and so stays in the near list and keeps both its elements computing
  * their boxes, where its kernel would find the two elements apart by
- * their size. The first box test that turns one away asks its kernel,
- * once a list, for the clearance of a face plane alone (no forces: the
- * pair is apart this step as before, springs and all), and a clearance
- * skips it only where its kernel would find it apart, the same bits. The
- * whole kernel was measured first: in 3D it cost more than the boxes it
- * saved (broken 3D block at 1e4, 96 steps from a restore: 968 -> 1036 ns
- * an element-step), where clipping a pair no face plane separates came
- * first. */
+ * their size. Once its boxes have turned it away often enough
+ * (pair_turned_away), it asks its kernel, once a list, for the clearance
+ * of a face plane alone (no forces: the pair is apart this step as
+ * before, springs and all), and a clearance skips it only where its
+ * kernel would find it apart, the same bits. The whole kernel was
+ * measured first: in 3D it cost more than the boxes it saved (broken 3D
+ * block at 1e4, 96 steps from a restore: 968 -> 1036 ns an element-step),
+ * where clipping a pair no face plane separates came first. */
 static void pair_clearance_look(fdem_model *m, near_pair *np, contact_pair_memo *memo)
 {
     contact_state *cs = &m->contact;
@@ -112,11 +112,11 @@ static void pair_clearance_look(fdem_model *m, near_pair *np, contact_pair_memo 
 
 /* Such a pair turned away by its boxes once more: it looks only once the
  * list has lived long enough to pay for the look, about half the steps it
- * takes (4 in 2D, 14 in 3D). A look costs what 8 steps of boxes save in 2D and 20 in 3D (the
- * broken blocks, harness), and a rock that is breaking rebuilds its list
- * at every break: looked at on the first turn away, the broken 3D block at
- * 1e5 read 1,511 -> 1,589 ns an element-step over the bench's 9 steps from
- * a restore, where 96 steps at 1e4 gained. */
+ * takes (4 in 2D, 14 in 3D). A look costs what 8 steps of boxes save in
+ * 2D and 20 in 3D (the broken blocks, harness), and a rock that is
+ * breaking rebuilds its list at every break: looked at on the first turn
+ * away, the broken 3D block at 1e5 read 1,511 -> 1,589 ns an element-step
+ * over the bench's 9 steps from a restore, where 96 steps at 1e4 gained. */
 static void pair_turned_away(fdem_model *m, near_pair *np, contact_pair_memo *memo)
 {
     const unsigned after = m->dim == 3 ? NEAR_LOOK_AFTER_3D : NEAR_LOOK_AFTER_2D;

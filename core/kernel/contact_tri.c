@@ -28,7 +28,6 @@
  * sliding dissipates, cap x slip, is booked in the friction account.
  */
 #include <math.h>
-#include <string.h>
 
 #include "contact_pair.h"
 
@@ -250,34 +249,47 @@ static double tri_clearance(const tri_now *t, const tri_now *other, const double
     return contact_clearance_less_margin(best, size, max2(lt, lo));
 }
 
+/* Both triangles now and each one's corners in the other's area
+ * coordinates; 0 if either is inverted (no potential defined). */
+static int tri_pair_frames(const contact_pair_in *in, tri_now *a, tri_now *b,
+                           double a_in_b[3][3], double b_in_a[3][3])
+{
+    tri_gather(in->pos, in->node_a, a);
+    tri_gather(in->pos, in->node_b, b);
+    if (!(a->area2 > 0) || !(b->area2 > 0)) return 0;
+    corners_in(a, b, a_in_b);
+    corners_in(b, a, b_in_a);
+    return 1;
+}
+
+/* The pair's clearance by an edge line of either (tri_clearance), 0 if
+ * none separates them. */
+static double tri_pair_clearance(const tri_now *a, const tri_now *b, double a_in_b[3][3],
+                                 double b_in_a[3][3])
+{
+    return max2(tri_clearance(a, b, (const double(*)[3])b_in_a),
+                tri_clearance(b, a, (const double(*)[3])a_in_b));
+}
+
 double tri_contact_pair_clearance(const contact_pair_in *in)
 {
     tri_now a, b;
-    tri_gather(in->pos, in->node_a, &a);
-    tri_gather(in->pos, in->node_b, &b);
-    if (!(a.area2 > 0) || !(b.area2 > 0)) return 0;
     double a_in_b[3][3], b_in_a[3][3];
-    corners_in(&a, &b, a_in_b);
-    corners_in(&b, &a, b_in_a);
-    return max2(tri_clearance(&a, &b, (const double(*)[3])b_in_a),
-                tri_clearance(&b, &a, (const double(*)[3])a_in_b));
+    return tri_pair_frames(in, &a, &b, a_in_b, b_in_a) ? tri_pair_clearance(&a, &b, a_in_b, b_in_a)
+                                                        : 0;
 }
 
 int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *out)
 {
     tri_now a, b;
-    tri_gather(in->pos, in->node_a, &a);
-    tri_gather(in->pos, in->node_b, &b);
-    if (!(a.area2 > 0) || !(b.area2 > 0)) { /* inverted: no potential defined */
-        memset(springs, 0, sizeof(double) * TRI_CONTACT_SLOTS);
+    double a_in_b[3][3], b_in_a[3][3];
+    if (!tri_pair_frames(in, &a, &b, a_in_b, b_in_a)) {
+        contact_zero(springs, TRI_CONTACT_SLOTS);
         out[0] = 0;
         return 0;
     }
     contact_zero(out, TRI_PAIR_OUT);
     double *dissipated = &out[TRI_PAIR_OUT - 1];
-    double a_in_b[3][3], b_in_a[3][3];
-    corners_in(&a, &b, a_in_b);
-    corners_in(&b, &a, b_in_a);
     int touched = contactor_against_target(in->vel, &a, &b, (const double(*)[3])a_in_b,
                                            in->penalty, in->friction, in->h, springs, out,
                                            out + 6, dissipated);
@@ -285,8 +297,6 @@ int tri_contact_pair_force(const contact_pair_in *in, double *springs, double *o
                                         in->penalty, in->friction, in->h, springs + 3, out + 6,
                                         out, dissipated);
     /* untouched, nothing was added: out[0] is 0 unless a clearance is found */
-    if (!touched)
-        out[0] = max2(tri_clearance(&a, &b, (const double(*)[3])b_in_a),
-                      tri_clearance(&b, &a, (const double(*)[3])a_in_b));
+    if (!touched) out[0] = tri_pair_clearance(&a, &b, a_in_b, b_in_a);
     return touched;
 }
