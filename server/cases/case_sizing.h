@@ -22,7 +22,8 @@
  *    at the rate its own steps broke them) each breaking once, at the
  *    cost of a mending of the contact list (timed before the cut and on
  *    it, interpolated to the joints held broken), and half of them held broken through the whole run, each
- *    at the cost a joint of the crack adds to a step (the crack's figures as multiples of an intact step
+ *    at half the cost a joint of the crack, priced open, adds to a step
+ *    (SIZING_OPEN_CRACK_SHARE; the crack's figures as multiples of an intact step
  *    timed just before the cut, at the run's pace); plus the worker's
  *    copy of each snapshot and its checkpoint. Steps are timed in CPU seconds and turned into
  *    wall seconds by the machine's load (sizing_probe.h). It ADVANCES and CRACKS the model:
