@@ -103,8 +103,8 @@ typedef struct server_case {
 
     /* touched by the I/O thread only */
     result_file *result;
-    int xdmf_dirty;
     double xdmf_written_at;    /* monotonic seconds */
+    double xdmf_write_seconds; /* what the last rewrite of result.xdmf took */
 
     /* storage faults (section 5.5): the first failed write of this case,
      * set by whoever hit it; the worker ends the case failed with it */
