@@ -231,7 +231,7 @@ static double sizing_detection_seconds(fdem_model *model, double steps_left, int
  * cut and stepped as the dry run does), 2026-12-07: the arc-loaded 3D disc
  * 0.27 (42 against 157: its split opens), drift-3d 0.58 (97 against 168:
  * its cracks pressed in situ), the 3D disc 0.63, tunnel-region 0.60,
- * staged-tunnel 0.57, jointed-block 0.79, the 2D disc 0.84: about half,
+ * staged-tunnel 0.57, jointed-block 0.80, the 2D disc 0.84: about half,
  * SIZING_OPEN_CRACK_SHARE. Priced whole, the 3D discs and prism ran
  * 0.35-0.41x their estimates (every pair of the crack within reach is
  * their upper bound); priced at half, each of the seven is within 1.9x
