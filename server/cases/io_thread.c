@@ -28,7 +28,7 @@
 
 typedef enum io_job_kind {
     IO_CREATE, IO_REOPEN, IO_APPEND, IO_CLOSE, IO_FETCH, IO_DESCRIBE, IO_EVENTS, IO_HISTORY,
-    IO_HISTORY_READ, IO_FRAME, IO_QUIT,
+    IO_HISTORY_READ, IO_FRAME, IO_XDMF, IO_QUIT,
 } io_job_kind;
 
 typedef struct io_job {
@@ -91,6 +91,16 @@ static void io_write_xdmf(server_case *c, int force)
         case_record_io_failure(c, "result.xdmf", err);
     c->xdmf_written_at = clock_wall_seconds();
     c->xdmf_write_seconds = c->xdmf_written_at - now;
+    c->xdmf_listed = result_snapshot_count(c->result);
+}
+
+/* GET result.xdmf of a running case: the sidecar listing every row written
+ * so far, as a client that has just seen the snapshot count expects. */
+static void io_do_xdmf(io_job *j)
+{
+    server_case *c = j->c;
+    if (c->result && !c->deleted && c->xdmf_listed != result_snapshot_count(c->result))
+        io_write_xdmf(c, 1);
 }
 
 /* After a failed write no checkpoint may follow: a restart from it would
@@ -420,6 +430,7 @@ static void io_run_job(io_job *j)
     case IO_HISTORY: io_do_history(j); break;
     case IO_HISTORY_READ: io_do_history_read(j); break;
     case IO_FRAME: io_do_frame(j); break;
+    case IO_XDMF: io_do_xdmf(j); break;
     case IO_QUIT: break;
     }
     if (writes_snapshot && j->rc == 0)
@@ -450,7 +461,8 @@ static void io_list_append(io_job **head, io_job **tail, io_job *j)
 }
 
 /* The next job to run; a held case's jobs (but for fetches, which write
- * nothing) are set aside. */
+ * nothing, and the sidecar's refresh, which writes no result.h5) are set
+ * aside. */
 static io_job *io_next_locked(void)
 {
     for (;;) {
@@ -460,7 +472,8 @@ static io_job *io_next_locked(void)
         io_head = j->next;
         if (!io_head)
             io_tail = NULL;
-        if (j->c && j->kind != IO_FETCH && atomic_load(&j->c->io_hold) > 0) {
+        if (j->c && j->kind != IO_FETCH && j->kind != IO_XDMF &&
+            atomic_load(&j->c->io_hold) > 0) {
             io_list_append(&io_deferred_head, &io_deferred_tail, j);
             continue;
         }
@@ -713,6 +726,14 @@ void io_close(server_case *c)
     io_job *j = io_job_new(IO_CLOSE, c);
     if (!j)
         return;
+    io_run_and_wait(j);
+    io_job_free(j);
+}
+
+void io_refresh_xdmf(server_case *c)
+{
+    io_job *j = io_job_new(IO_XDMF, c);
+    if (!j) return; /* the sidecar as it is: a moment behind at most */
     io_run_and_wait(j);
     io_job_free(j);
 }

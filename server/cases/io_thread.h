@@ -38,6 +38,11 @@ int io_reopen(server_case *c, int64_t keep_until_step, int close_after,
  * events of the steps up to a snapshot are in result.h5 before it. */
 void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s, void *ckpt,
                size_t ckpt_size);
+/* Rewrites result.xdmf of a case whose result.h5 is open if it lists
+ * fewer rows than the file holds after the jobs queued before this call
+ * (a running case's sidecar trails its file by up to ten times what a
+ * rewrite takes, io_thread.c); waits for it. For GET result.xdmf. */
+void io_refresh_xdmf(server_case *c);
 /* The case's fracture events with time > since from result.h5 (the open
  * file of a running case, else the file on disk; none when there is no
  * file yet): *out (free() it), *count, *dimension. -1 with the reason in

@@ -105,6 +105,7 @@ typedef struct server_case {
     result_file *result;
     double xdmf_written_at;    /* monotonic seconds */
     double xdmf_write_seconds; /* what the last rewrite of result.xdmf took */
+    int xdmf_listed;           /* the rows the sidecar lists */
 
     /* storage faults (section 5.5): the first failed write of this case,
      * set by whoever hit it; the worker ends the case failed with it */

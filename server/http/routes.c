@@ -726,6 +726,7 @@ static enum MHD_Result route_case(struct MHD_Connection *conn, server_case *c, r
     case ROUTE_CASE_RESULT_H5:
         return download_reply(conn, c, strcmp(method, "HEAD") == 0);
     case ROUTE_CASE_RESULT_XDMF:
+        io_refresh_xdmf(c);
         return routes_serve_file(conn, c, "result.xdmf", "application/xml");
     case ROUTE_CASE_EXTEND:
         return route_extend(conn, c, body, body_size);
