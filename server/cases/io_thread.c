@@ -66,41 +66,12 @@ static io_job *io_deferred_head, *io_deferred_tail;
 static pthread_t io_thread;
 static int io_running;
 
-/* Rewriting the XDMF costs O(snapshots) (about 30 us a snapshot it lists, for
- * a 2D bar): rewritten after every snapshot, the 161st snapshot of a
- * small case cost 7 ms where the first cost 2, its run's writes twice
- * what the first snapshots of any case said a snapshot costs (the run-time
- * estimate's price of a write, io_snapshot_seconds). So a rewrite waits
- * until IO_XDMF_COST_RATIO times what the last one took has passed: the
- * sidecar costs the I/O thread at most a tenth of its time at any size,
- * and lags the file by at most that (a 161-entry sidecar: 40 ms). A case
- * whose snapshots come seldom still gets it after each; the close always
- * writes it. */
-#define IO_XDMF_COST_RATIO 10.0
-
-static void io_write_xdmf(server_case *c, int force)
-{
-    if (!c->result || !c->model)
-        return;
-    double now = clock_wall_seconds();
-    if (!force && now - c->xdmf_written_at < IO_XDMF_COST_RATIO * c->xdmf_write_seconds)
-        return;
-    char path[1200], err[256] = "";
-    snprintf(path, sizeof path, "%s/result.xdmf", c->dir);
-    if (xdmf_write(path, "result.h5", c->model, &c->info, c->result, err, sizeof err) != 0)
-        case_record_io_failure(c, "result.xdmf", err);
-    c->xdmf_written_at = clock_wall_seconds();
-    c->xdmf_write_seconds = c->xdmf_written_at - now;
-    c->xdmf_listed = result_snapshot_count(c->result);
-}
-
 /* GET result.xdmf of a running case: the sidecar listing every row written
  * so far, as a client that has just seen the snapshot count expects. */
 static void io_do_xdmf(io_job *j)
 {
-    server_case *c = j->c;
-    if (c->result && !c->deleted && c->xdmf_listed != result_snapshot_count(c->result))
-        io_write_xdmf(c, 1);
+    if (!j->c->deleted)
+        io_sidecar_catch_up(j->c);
 }
 
 /* After a failed write no checkpoint may follow: a restart from it would
@@ -133,7 +104,7 @@ static void io_sync_result(server_case *c)
  * a readable file (the flags of an open SWMR writer are cleared on close). */
 static void io_close_after_failure(server_case *c)
 {
-    io_write_xdmf(c, 1);
+    io_sidecar_write(c, 1);
     if (result_close(c->result) != 0)
         fprintf(stderr, "fdemd: case %s: closing result.h5 after a failed write also failed\n",
                 c->id);
@@ -168,7 +139,7 @@ static void io_do_create(io_job *j)
         return;
     }
     case_set_snapshots(c, result_snapshot_count(c->result));
-    io_write_xdmf(c, 1);
+    io_sidecar_write(c, 1);
     if (j->ckpt && persist_write_atomic(c->dir, "checkpoint.bin", j->ckpt, j->ckpt_size) != 0) {
         snprintf(j->err, sizeof j->err, "writing checkpoint.bin: %s", strerror(errno));
         j->rc = -1;
@@ -186,7 +157,7 @@ static void io_do_reopen(io_job *j)
         return;
     }
     case_set_snapshots(c, result_snapshot_count(c->result));
-    io_write_xdmf(c, 1);
+    io_sidecar_write(c, 1);
     if (j->close_after) {
         result_close(c->result);
         c->result = NULL;
@@ -220,7 +191,7 @@ static void io_do_append(io_job *j)
             io_close_after_failure(c);
         } else {
             appended = result_snapshot_count(c->result);
-            io_write_xdmf(c, 0);
+            io_sidecar_write(c, 0);
             io_sync_result(c);
         }
     }
@@ -273,7 +244,7 @@ static void io_do_close(io_job *j)
         snprintf(path, sizeof path, "%s/result.h5", c->dir);
         if (result_finish(c->result, path, fdem_get_dimension(c->model), err, sizeof err) != 0)
             case_record_io_failure(c, "result.h5", err);
-        io_write_xdmf(c, 1);
+        io_sidecar_write(c, 1);
     }
     if (result_close(c->result) != 0 && !c->deleted)
         case_record_io_failure(c, "result.h5", "its final flush failed (disk full or I/O error)");

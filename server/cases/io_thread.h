@@ -91,6 +91,12 @@ void io_release_hold(server_case *c);
 void io_note_paced_run(double wall, double waited, int snapshots);
 double io_snapshot_seconds(double checkpoint_bytes);
 void io_seed_snapshot_seconds(double seconds);
+/* On the I/O thread only (io_sidecar.c): rewrites result.xdmf of a case
+ * whose result.h5 is open, at once (force) or once ten times what its last
+ * rewrite took has passed; io_sidecar_catch_up rewrites it if it lists
+ * fewer rows than the file holds. */
+void io_sidecar_write(server_case *c, int force);
+void io_sidecar_catch_up(server_case *c);
 /* The I/O thread's own timing of one snapshot job of `bytes` (the
  * checkpoint's size), io_snapshot_cost.c. */
 void io_note_snapshot_cost(double seconds, double bytes);
