@@ -381,16 +381,8 @@ size_t contact_memory_bytes(const contact_state *cs)
  * alone it was a thirtieth of a broken 2D block's step on two. */
 static void contact_force_clear(fdem_model *m)
 {
-    double *f = m->contact.force;
-    const size_t n = (size_t)m->dim * (size_t)m->node_count;
     const int threads = m->threads > 1 && m->node_count > CONTACT_THREADED_NODES ? m->threads : 1;
-#pragma omp parallel num_threads(threads) if (threads > 1)
-    {
-        int t, nt;
-        parallel_team(&t, &nt);
-        size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
-        memset(f + lo, 0, sizeof(double) * (hi - lo));
-    }
+    parallel_zero(m->contact.force, (size_t)m->dim * (size_t)m->node_count, threads);
 }
 
 /* Detection when due, then every candidate pair's force. The stick springs

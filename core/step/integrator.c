@@ -409,21 +409,12 @@ static void report_non_finite(fdem_model *m, double h, fdem_error *err)
  * it a team costs more than the memset (as CONTACT_THREADED_NODES). */
 #define FORCES_THREADED_NODES 8192
 
-/* force[D from, D to) zeroed, in a share per thread when there are many:
- * on one thread it was a twentieth of a broken 2D block's step on two
- * (1e5 triangles: 4.8 MB a step), while the other thread waited. */
+/* force[D from, D to) zeroed, on the step's threads when there are many
+ * (parallel_zero). */
 static void forces_zero(fdem_model *m, size_t from, size_t to)
 {
-    double *f = m->force + (size_t)m->dim * from;
-    const size_t n = (size_t)m->dim * (to - from);
     const int threads = m->threads > 1 && to - from > FORCES_THREADED_NODES ? m->threads : 1;
-#pragma omp parallel num_threads(threads) if (threads > 1)
-    {
-        int t, nt;
-        parallel_team(&t, &nt);
-        size_t lo = n * (size_t)t / (size_t)nt, hi = n * (size_t)(t + 1) / (size_t)nt;
-        memset(f + lo, 0, sizeof(double) * (hi - lo));
-    }
+    parallel_zero(m->force + (size_t)m->dim * from, (size_t)m->dim * (to - from), threads);
 }
 
 /* Zeroes the force of every node the element pass adds to; the nodes of
