@@ -703,6 +703,14 @@ void io_close(server_case *c)
 
 void io_refresh_xdmf(server_case *c)
 {
+    /* result.h5 is open only while a worker runs (it closes the file,
+     * through this queue, before it clears worker_active): any other
+     * case's sidecar was written whole at its close, and its GET need not
+     * wait behind the other cases' writes */
+    pthread_mutex_lock(&c->lock);
+    int running = c->worker_active;
+    pthread_mutex_unlock(&c->lock);
+    if (!running) return;
     io_job *j = io_job_new(IO_XDMF, c);
     if (!j) return; /* the sidecar as it is: a moment behind at most */
     io_run_and_wait(j);

@@ -41,7 +41,8 @@ void io_append(server_case *c, fdem_event *events, int event_count, snapshot *s,
 /* Rewrites result.xdmf of a case whose result.h5 is open if it lists
  * fewer rows than the file holds after the jobs queued before this call
  * (a running case's sidecar trails its file by up to ten times what a
- * rewrite takes, io_thread.c); waits for it. For GET result.xdmf. */
+ * rewrite takes, io_sidecar.c); waits for it. A case without a worker
+ * has no open file: nothing is queued. For GET result.xdmf. */
 void io_refresh_xdmf(server_case *c);
 /* The case's fracture events with time > since from result.h5 (the open
  * file of a running case, else the file on disk; none when there is no
