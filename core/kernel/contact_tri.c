@@ -30,6 +30,7 @@
 #include <math.h>
 
 #include "contact_pair.h"
+#include "math/norm2.h"
 
 static inline double min3(double a, double b, double c) { return min2(a, min2(b, c)); }
 static inline double max3(double a, double b, double c) { return max2(a, max2(b, c)); }
@@ -163,7 +164,7 @@ static int contactor_against_target(const double *vel, const tri_now *c, const t
         }
         acted = 1;
         double ex = c->x[j] - c->x[i], ey = c->y[j] - c->y[i];
-        double len = hypot(ex, ey);
+        double len = norm2(ex, ey);
         double sbar = i1 / i0;
         /* normal: -p * i0 * (length-scaled outward normal) */
         double fx = -penalty * i0 * ey, fy = penalty * i0 * ex;

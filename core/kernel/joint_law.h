@@ -32,6 +32,8 @@
 #include <float.h>
 #include <math.h>
 
+#include "math/norm2.h"
+
 /* One material's cohesive constants for one joint, and two figures of
  * them that a damaged joint's points asked for again and again (a damaged
  * 3D joint worked out f_t / k four times a point): make it with
@@ -147,13 +149,13 @@ static inline void joint_point_parts(const joint_law *law, const joint_point *g,
  * the traction was f_s clamp(s / s_p): a joint that slid out under low
  * compression and was driven back under high compression gave back more
  * work than it took (18.7x the platen work as kinetic energy in an
- * undamped Brazilian disc). hypot(x, 0) is |x| exactly (C11 F.10.4.3): a
+ * undamped Brazilian disc). norm2(x, 0) is |x| exactly (math/norm2.h): a
  * 2D point gets the bits of a one-component return. */
 static inline void joint_point_return(const joint_law *law, joint_point *g,
                                       const joint_slip *before)
 {
     double e0 = g->slide[0] - before->plastic[0], e1 = g->slide[1] - before->plastic[1];
-    double trial = hypot(e0, e1), sp = g->fs / law->k;
+    double trial = norm2(e0, e1), sp = g->fs / law->k;
     g->slip = *before;
     g->flow = 0;
     if (!(trial > sp)) return;

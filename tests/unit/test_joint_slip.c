@@ -325,7 +325,32 @@ static void checkpoint_keeps_the_slip_and_reads_version_6(void)
     fdem_model_destroy(b);
 }
 
-CHECK_MAIN(T(crushed_bar_2d_makes_no_energy), T(brazilian_disc_2d_undamped_makes_no_energy),
+/* The slide's length (math/norm2.h) within an ulp of hypot() across the
+ * scales a joint meets and beyond, and |x| exactly along one axis (a 2D
+ * point's return keeps the bits of a one-component one); tiny and huge
+ * components go to hypot(), so no length underflows to 0 or overflows. */
+static void slide_length_is_hypot(void)
+{
+    double worst = 0;
+    unsigned long long seed = 88172645463325252ull;
+    for (int k = 0; k < 200000; k++) {
+        seed ^= seed << 13, seed ^= seed >> 7, seed ^= seed << 17;
+        double x = ldexp((double)(seed >> 11) * 0x1p-53 - 0.5, (int)(seed % 120) - 80);
+        seed ^= seed << 13, seed ^= seed >> 7, seed ^= seed << 17;
+        double y = ldexp((double)(seed >> 11) * 0x1p-53 - 0.5, (int)(seed % 120) - 80);
+        double want = hypot(x, y), got = norm2(x, y);
+        if (want > 0) worst = fmax(worst, fabs(got - want) / want);
+        CHECK(norm2(x, 0) == fabs(x) && norm2(0, y) == fabs(y), "one axis: %.17g, %.17g", x, y);
+    }
+    CHECK(worst <= 0x1p-52, "worst relative error against hypot: %.3g", worst);
+    double edge[][2] = {{1e-160, 0}, {3e-170, 4e-170}, {1e160, 1e160}, {0, 0}, {-5e-324, 0}};
+    for (int k = 0; k < 5; k++)
+        CHECK(norm2(edge[k][0], edge[k][1]) == hypot(edge[k][0], edge[k][1]),
+              "(%g, %g): %.17g against hypot's %.17g", edge[k][0], edge[k][1],
+              norm2(edge[k][0], edge[k][1]), hypot(edge[k][0], edge[k][1]));
+}
+
+CHECK_MAIN(T(slide_length_is_hypot), T(crushed_bar_2d_makes_no_energy), T(brazilian_disc_2d_undamped_makes_no_energy),
            T(crushed_prism_3d_makes_no_energy),
            T(slip_cycled_under_changing_compression_makes_no_energy),
            T(kept_slip_turns_with_the_joint), T(checkpoint_keeps_the_slip_and_reads_version_6))
