@@ -178,15 +178,6 @@ int contact_collect_elements(contact_state *cs, int elem_count, const near_pair 
     return listed;
 }
 
-/* The widest gap between two boxes along an axis (negative: they overlap
- * on every axis). */
-static inline double boxes_gap(const double *a, const double *b, int dim)
-{
-    double gap = -INFINITY;
-    for (int d = 0; d < dim; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
-    return gap;
-}
-
 /* The near list is to be rebuilt: a detection or a restore made it stale,
  * or some node has gone past its reach since it was built. */
 static int contact_near_due(fdem_model *m)
@@ -308,6 +299,65 @@ void contact_vertex_due(fdem_model *m)
     cs->vertex_walk_count = listed;
 }
 
+/* The widest gap between two boxes along an axis (negative: they overlap
+ * on every axis); D a constant where it is called (the rebuild's loop,
+ * unrolled). */
+static inline __attribute__((always_inline)) double boxes_gap_of(const double *a, const double *b,
+                                                                  const int D)
+{
+    double gap = max2(b[0] - a[1], a[0] - b[1]);
+    for (int d = 1; d < D; d++) gap = max2(gap, max2(b[2 * d] - a[2 * d + 1], a[2 * d] - b[2 * d + 1]));
+    return gap;
+}
+
+/* The rebuild's pass over the candidate pairs: each within reach listed
+ * with its gap and topology, the others' springs let go (apart now and
+ * until the next rebuild). D and K are constants where it is called, so
+ * the boxes' gap and the shared-vertex count are unrolled. Returns 0, or
+ * -1 when out of memory; *count and *vertex the pairs listed. */
+static inline __attribute__((always_inline)) int
+near_list_pairs(fdem_model *m, double limit, size_t *count_out, size_t *vertex_out, const int D,
+                const int K)
+{
+    contact_state *cs = &m->contact;
+    const size_t width = 2 * (size_t)D, n = cs->pairs.count;
+    const int32_t *pa = cs->pairs.a, *pb = cs->pairs.b, *spring_of = cs->spring_of;
+    const double *box = cs->box;
+    /* topology only where some joint is broken (without one, every pair
+     * is "nothing") */
+    const int32_t *elem_first = cs->elem_shut && m->broken_joints ? cs->elem_first : NULL;
+    uint8_t *topo = cs->elem_topo;
+    double *elem_gap = cs->elem_gap;
+    size_t count = 0, vertex = 0;
+    for (size_t k = 0; k < n; k++) {
+        int32_t ea = pa[k], eb = pb[k];
+        double gap = boxes_gap_of(box + width * (size_t)ea, box + width * (size_t)eb, D);
+        if (gap > limit) {
+            if (spring_of[k] >= 0) contact_springs_release(cs, k);
+            continue;
+        }
+        uint16_t face = 0;
+        uint8_t topology =
+            elem_first ? (uint8_t)contact_shut_topology(m, elem_first, ea, eb, &face, D, K) : 0;
+        near_pair np = {gap, (uint32_t)k, ea, eb, (uint8_t)(spring_of[k] >= 0), topology, face};
+        /* one array, the vertex pairs filling it from the end (two lists
+         * would each keep their own doubling's room); it grows as it
+         * fills: it holds a tenth or so of the candidates */
+        if (count + vertex == cs->near_capacity && near_grow(cs, vertex)) return -1;
+        if (topology == SHUT_TOPO_VERTEX) cs->near[cs->near_capacity - ++vertex] = np;
+        else cs->near[count++] = np;
+        if (topology) { /* its boxes by the marks (contact_near_boxes) */
+            topo[ea] = topo[eb] = TOPO_LISTED;
+            continue;
+        }
+        elem_gap[ea] = min2(elem_gap[ea], gap);
+        elem_gap[eb] = min2(elem_gap[eb], gap);
+    }
+    *count_out = count;
+    *vertex_out = vertex;
+    return 0;
+}
+
 /* The near list (see the top of this file) and its elements from this
  * step's boxes. Returns 0, or -1 when out of memory (or past 2^32
  * candidate pairs, which near_pair cannot name: 32 GB of pair lists). */
@@ -320,34 +370,12 @@ static int contact_near_rebuild(fdem_model *m)
      * that could touch */
     double limit = 2.0 * reach * (1 + 1e-9);
     int dim = m->dim;
-    size_t width = 2 * (size_t)dim, count = 0;
-    size_t vertex = 0;
+    size_t count = 0, vertex = 0;
     for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
     if (cs->elem_topo) memset(cs->elem_topo, 0, (size_t)m->elem_count);
-    for (size_t k = 0; k < cs->pairs.count; k++) {
-        int32_t ea = cs->pairs.a[k], eb = cs->pairs.b[k];
-        double gap = boxes_gap(cs->box + width * (size_t)ea, cs->box + width * (size_t)eb, dim);
-        if (gap > limit) {
-            contact_springs_release(cs, k); /* apart now and until the next rebuild */
-            continue;
-        }
-        uint16_t face = 0;
-        uint8_t topology = cs->elem_shut ? (uint8_t)contact_shut_topology(m, ea, eb, &face) : 0;
-        near_pair np = {gap, (uint32_t)k, ea, eb, (uint8_t)contact_pair_sprung(cs, k), topology,
-                        face};
-        /* one array, the vertex pairs filling it from the end (two lists
-         * would each keep their own doubling's room); it grows as it
-         * fills: it holds a tenth or so of the candidates */
-        if (count + vertex == cs->near_capacity && near_grow(cs, vertex)) return -1;
-        if (topology == SHUT_TOPO_VERTEX) cs->near[cs->near_capacity - ++vertex] = np;
-        else cs->near[count++] = np;
-        if (topology) { /* its boxes by the marks (contact_near_boxes) */
-            cs->elem_topo[ea] = cs->elem_topo[eb] = TOPO_LISTED;
-            continue;
-        }
-        cs->elem_gap[ea] = min2(cs->elem_gap[ea], gap);
-        cs->elem_gap[eb] = min2(cs->elem_gap[eb], gap);
-    }
+    if (dim == 3 ? near_list_pairs(m, limit, &count, &vertex, 3, 4)
+                 : near_list_pairs(m, limit, &count, &vertex, 2, 3))
+        return -1;
     memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_disp2 = 0;
     /* the vertex pairs, from the end in reverse: to pair order */

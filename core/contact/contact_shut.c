@@ -247,36 +247,14 @@ static int face_match_of(const fdem_model *m, int j, int a, int b, face_match *f
     return 0;
 }
 
-/* How many mesh vertices a and b share, from elem_first (each element's
- * K first copies in a row), not the element records and first[]: a near
- * list's rebuild asks this of every pair (66 an element in a broken 3D
- * block). */
-static int shared_vertices(const fdem_model *m, int a, int b)
+/* The topology of two elements that share a face's worth of mesh
+ * vertices (contact_shut_topology, contact_internal.h, tells the rest
+ * apart inline): a broken joint between them (its faces in *face,
+ * shut_face_pack), else a vertex pair. A broken joint whose nodes are not
+ * the two elements' (never, for a joint built between them) is "nothing":
+ * the general kernel. */
+int contact_shut_face_topology(const fdem_model *m, int a, int b, uint16_t *face)
 {
-    const int K = m->elem_nodes;
-    const int32_t *fa = m->contact.elem_first + (size_t)K * a;
-    const int32_t *fb = m->contact.elem_first + (size_t)K * b;
-    int shared = 0;
-    for (int i = 0; i < K; i++)
-        for (int k = 0; k < K; k++) shared += fa[i] == fb[k];
-    return shared;
-}
-
-/* What a and b share, which only a break changes: a broken joint (its
- * faces in *face, shut_face_pack), a mesh vertex, or nothing. The near
- * list keeps both (contact_near.c), so the walk reads them and finds
- * nothing. A broken joint whose nodes are not the two elements' (never,
- * for a joint built between them) is "nothing": the general kernel. */
-int contact_shut_topology(const fdem_model *m, int a, int b, uint16_t *face)
-{
-    *face = 0;
-    /* a joint's two faces are copies of the same dim vertices
-     * (node_origin), so only two elements that share that many can have
-     * one between them: the pairs of a rebuild are told apart without
-     * looking at the joints, but for the few sides of a face */
-    if (!m->broken_joints) return SHUT_TOPO_NONE;
-    int shared = shared_vertices(m, a, b);
-    if (shared < m->dim) return shared ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
     int j = broken_joint_between(m, a, b);
     if (j >= 0) {
         face_match fm = {0, 0, {0, 0, 0}};
