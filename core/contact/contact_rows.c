@@ -31,6 +31,11 @@ int pair_rows_grow(pair_rows *list, int width)
         if (!l) return -1;
         list->last = l;
     }
+    if (list->node_width) {
+        int32_t *n = realloc(list->nodes, cap * (size_t)list->node_width * sizeof *n);
+        if (!n) return -1;
+        list->nodes = n;
+    }
     list->capacity = cap;
     return 0;
 }
@@ -50,7 +55,8 @@ int pair_rows_push(pair_rows *list, long pair, const double *row, int width)
 
 size_t pair_rows_bytes(const pair_rows *list, int width)
 {
-    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)(width ? width + 1 : 0));
+    return list->capacity * (sizeof(long) + sizeof(double) * (size_t)(width ? width + 1 : 0) +
+                             sizeof(int32_t) * (size_t)list->node_width);
 }
 
 void pair_rows_free(pair_rows *list)
@@ -58,6 +64,7 @@ void pair_rows_free(pair_rows *list)
     free(list->pair);
     free(list->row);
     free(list->last);
+    free(list->nodes);
 }
 
 /* Adds a pair's forces (contact_pair_force) to the contact force array and
@@ -157,9 +164,9 @@ apply_share(fdem_model *m, const contact_touches *lists, int used, int t, int nt
             int oa = owner[a], ob = owner[b];
             if (oa != t && ob != t && oa >= 0 && ob >= 0) continue;
             const double *row = touched->row + i * (size_t)width;
-            if (oa == t || oa < 0) scatter_owned(f, element_nodes(m, a), row, oa == t, lo, hi, D, K);
-            if (ob == t || ob < 0)
-                scatter_owned(f, element_nodes(m, b), row + D * K, ob == t, lo, hi, D, K);
+            const int32_t *na = touched->nodes + 2 * (size_t)K * i, *nb = na + K;
+            if (oa == t || oa < 0) scatter_owned(f, na, row, oa == t, lo, hi, D, K);
+            if (ob == t || ob < 0) scatter_owned(f, nb, row + D * K, ob == t, lo, hi, D, K);
         }
     }
 }

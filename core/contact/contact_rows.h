@@ -25,6 +25,11 @@ typedef struct pair_rows {
     double *last; /* touched rows: each row's last number (the dissipation) again, so
                      the account summed in pair order on one thread reads 8 bytes a
                      pair, not the row's cache lines */
+    int32_t *nodes; /* touched rows: the two elements' nodes (node_width ids a row),
+                       so the threads applying the rows read no element record: they
+                       were a cache miss a pair and element, half of the apply's time
+                       on a broken 2D block on two threads */
+    int node_width;
     size_t count, capacity;
 } pair_rows;
 

@@ -284,7 +284,13 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     contact_pair_memo_clear(&memo);
     int touching = 0;
     pair_rows *rows = &list->touched;
-    const int width = cs->pair_out;
+    const int width = cs->pair_out, K = D + 1;
+    if (rows->node_width != 2 * K) { /* first use, or a model of the other dimension */
+        free(rows->nodes);
+        rows->nodes = NULL;
+        rows->count = rows->capacity = 0;
+        rows->node_width = 2 * K;
+    }
     for (long i = begin; i < end; i++) {
         near_pair *np = walk_pair(w, (size_t)i);
         long k = (long)np->pair;
@@ -300,6 +306,9 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
         touching++;
         rows->pair[rows->count] = touched_key(np->a, np->b);
         rows->last[rows->count] = force[width - 1];
+        int32_t *nodes = rows->nodes + 2 * (size_t)K * rows->count;
+        memcpy(nodes, element_nodes(m, np->a), sizeof(int32_t) * (size_t)K);
+        memcpy(nodes + K, element_nodes(m, np->b), sizeof(int32_t) * (size_t)K);
         rows->count++;
     }
     return touching;
