@@ -130,13 +130,15 @@ void contact_walk_free(contact_state *cs);
 
 /* contact_near.c: the elements of the near pairs and the `more` pairs (of
  * every candidate pair when near is NULL), once each and in element order,
- * into list (returns how many); this step's vertex pairs to walk (after
+ * into list (returns how many; contact_listed_elements: those in_pair
+ * marks already); this step's vertex pairs to walk (after
  * contact_shut_refresh); and this step's boxes of the elements the near
  * lists need, the lists rebuilt first when due (0, or -1 when out of
  * memory). */
 int contact_collect_elements(contact_state *cs, int elem_count, const near_pair *near,
                              size_t count, const near_pair *more, size_t more_count,
                              int32_t *list);
+int contact_listed_elements(const contact_state *cs, int elem_count, int32_t *list);
 void contact_vertex_due(fdem_model *m);
 int contact_near_refresh(fdem_model *m);
 

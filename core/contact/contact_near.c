@@ -172,6 +172,11 @@ int contact_collect_elements(contact_state *cs, int elem_count, const near_pair 
         cs->in_pair[near ? near[i].b : cs->pairs.b[i]] = 1;
     }
     for (size_t i = 0; i < more_count; i++) cs->in_pair[more[i].a] = cs->in_pair[more[i].b] = 1;
+    return contact_listed_elements(cs, elem_count, list);
+}
+
+int contact_listed_elements(const contact_state *cs, int elem_count, int32_t *list)
+{
     int listed = 0;
     for (int e = 0; e < elem_count; e++)
         if (cs->in_pair[e]) list[listed++] = e;
@@ -220,9 +225,14 @@ static int fit_array(void **array, size_t *capacity, size_t need, size_t size)
 
 /* Each element's vertex pairs (CSR over near_vertex, a pair under both of
  * its elements), and every vertex pair due at the first step of the list:
- * last step's shut marks say nothing of pairs the list did not hold.
+ * last step's shut marks say nothing of pairs the list did not hold. The
+ * pairs arrive from near_list_pairs in reverse pair order, each element's
+ * count in start[e + 1] already (`counted`: the pass counted them as it
+ * listed them; else counted here), and are turned to pair order as they
+ * are indexed, in one pass (an element's pairs are then not in ascending
+ * order in vertex_pairs: contact_vertex_due sorts what it takes).
  * Returns 0, or -1 when out of memory. */
-static int near_vertex_index(fdem_model *m)
+static int near_vertex_index(fdem_model *m, int counted)
 {
     contact_state *cs = &m->contact;
     size_t n = cs->near_vertex_count, E = (size_t)m->elem_count;
@@ -234,16 +244,27 @@ static int near_vertex_index(fdem_model *m)
         fit_array((void **)&cs->vertex_walk, &cs->vertex_walk_capacity, n, sizeof *cs->vertex_walk) ||
         fit_array((void **)&cs->vertex_due, &cs->vertex_due_capacity, n, sizeof *cs->vertex_due))
         return -1;
-    int32_t *start = cs->vertex_start;
-    memset(start, 0, sizeof(int32_t) * (E + 1));
-    for (size_t i = 0; i < n; i++) {
-        start[cs->near_vertex[i].a + 1]++;
-        start[cs->near_vertex[i].b + 1]++;
+    int32_t *start = cs->vertex_start, *index = cs->vertex_pairs;
+    near_pair *v = cs->near_vertex;
+    if (!counted) {
+        memset(start, 0, sizeof(int32_t) * (E + 1));
+        for (size_t i = 0; i < n; i++) {
+            start[v[i].a + 1]++;
+            start[v[i].b + 1]++;
+        }
     }
     for (size_t e = 0; e < E; e++) start[e + 1] += start[e];
-    for (size_t i = 0; i < n; i++) { /* start[e] runs to e's end, then is set back */
-        cs->vertex_pairs[start[cs->near_vertex[i].a]++] = (int32_t)i;
-        cs->vertex_pairs[start[cs->near_vertex[i].b]++] = (int32_t)i;
+    /* start[e] runs to e's end, then is set back; v[i] and v[n - 1 - i]
+     * swap places, each indexed at its new one */
+    for (size_t i = 0, j = n - 1; i <= j && j < n; i++, j--) {
+        near_pair p = v[i], q = v[j];
+        index[start[q.a]++] = (int32_t)i;
+        index[start[q.b]++] = (int32_t)i;
+        if (i == j) break;
+        index[start[p.a]++] = (int32_t)j;
+        index[start[p.b]++] = (int32_t)j;
+        v[i] = q;
+        v[j] = p;
     }
     for (size_t e = E; e > 0; e--) start[e] = start[e - 1];
     start[0] = 0;
@@ -313,11 +334,15 @@ static inline __attribute__((always_inline)) double boxes_gap_of(const double *a
 /* The rebuild's pass over the candidate pairs: each within reach listed
  * with its gap and topology, the others' springs let go (apart now and
  * until the next rebuild). D and K are constants where it is called, so
- * the boxes' gap and the shared-vertex count are unrolled. Returns 0, or
- * -1 when out of memory; *count and *vertex the pairs listed. */
+ * the boxes' gap and the shared-vertex count are unrolled. Each vertex
+ * pair is counted under both its elements (vertex_count[e + 1], zeroed:
+ * near_vertex_index), and with in_pair each listed pair's elements are
+ * marked (contact_collect_elements' marks, without a pass over the list).
+ * Returns 0, or -1 when out of memory; *count and *vertex the pairs
+ * listed. */
 static inline __attribute__((always_inline)) int
-near_list_pairs(fdem_model *m, double limit, size_t *count_out, size_t *vertex_out, const int D,
-                const int K)
+near_list_pairs(fdem_model *m, double limit, uint8_t *in_pair, int32_t *vertex_count,
+                size_t *count_out, size_t *vertex_out, const int D, const int K)
 {
     contact_state *cs = &m->contact;
     const size_t width = 2 * (size_t)D, n = cs->pairs.count;
@@ -344,8 +369,14 @@ near_list_pairs(fdem_model *m, double limit, size_t *count_out, size_t *vertex_o
          * would each keep their own doubling's room); it grows as it
          * fills: it holds a tenth or so of the candidates */
         if (count + vertex == cs->near_capacity && near_grow(cs, vertex)) return -1;
-        if (topology == SHUT_TOPO_VERTEX) cs->near[cs->near_capacity - ++vertex] = np;
-        else cs->near[count++] = np;
+        if (topology == SHUT_TOPO_VERTEX) {
+            cs->near[cs->near_capacity - ++vertex] = np;
+            vertex_count[ea + 1]++;
+            vertex_count[eb + 1]++;
+        } else {
+            cs->near[count++] = np;
+        }
+        if (in_pair) in_pair[ea] = in_pair[eb] = 1;
         if (topology) { /* its boxes by the marks (contact_near_boxes) */
             topo[ea] = topo[eb] = TOPO_LISTED;
             continue;
@@ -370,21 +401,26 @@ static int contact_near_rebuild(fdem_model *m)
      * that could touch */
     double limit = 2.0 * reach * (1 + 1e-9);
     int dim = m->dim;
-    size_t count = 0, vertex = 0;
-    for (int e = 0; e < m->elem_count; e++) cs->elem_gap[e] = INFINITY;
-    if (cs->elem_topo) memset(cs->elem_topo, 0, (size_t)m->elem_count);
-    if (dim == 3 ? near_list_pairs(m, limit, &count, &vertex, 3, 4)
-                 : near_list_pairs(m, limit, &count, &vertex, 2, 3))
+    size_t count = 0, vertex = 0, E = (size_t)m->elem_count;
+    for (size_t e = 0; e < E; e++) cs->elem_gap[e] = INFINITY;
+    if (cs->elem_topo) memset(cs->elem_topo, 0, E);
+    /* the vertex pairs' counts (only broken rock has any) */
+    if (cs->elem_topo && !cs->vertex_start &&
+        !(cs->vertex_start = malloc(sizeof(int32_t) * (E + 1))))
+        return -1;
+    int32_t *vertex_count = cs->elem_topo ? cs->vertex_start : NULL;
+    if (vertex_count) memset(vertex_count, 0, sizeof(int32_t) * (E + 1));
+    /* one process takes the whole list: its elements marked as listed */
+    uint8_t *in_pair = m->share ? NULL : cs->in_pair;
+    if (in_pair) memset(in_pair, 0, E);
+    if (dim == 3 ? near_list_pairs(m, limit, in_pair, vertex_count, &count, &vertex, 3, 4)
+                 : near_list_pairs(m, limit, in_pair, vertex_count, &count, &vertex, 2, 3))
         return -1;
     memcpy(cs->pos_near, m->pos, sizeof(double) * (size_t)dim * (size_t)m->node_count);
     cs->near_disp2 = 0;
-    /* the vertex pairs, from the end in reverse: to pair order */
+    /* the vertex pairs, from the end in reverse (near_vertex_index turns
+     * them to pair order) */
     cs->near_vertex = cs->near + (cs->near_capacity - vertex);
-    for (size_t i = 0, j = vertex; i + 1 < j; i++, j--) {
-        near_pair t = cs->near_vertex[i];
-        cs->near_vertex[i] = cs->near_vertex[j - 1];
-        cs->near_vertex[j - 1] = t;
-    }
     cs->near_count = count;
     cs->near_vertex_count = vertex;
     cs->near_reach = reach;
@@ -396,13 +432,18 @@ static int contact_near_rebuild(fdem_model *m)
     /* A process of a split walk (contact_walk.c) reads the boxes of its
      * shares' pairs only, until the next rebuild (which computes every
      * candidate's first): it keeps only those up to date. */
+    if (near_vertex_index(m, vertex_count != NULL)) return -1;
+    if (in_pair) {
+        cs->near_active_count = contact_listed_elements(cs, m->elem_count, cs->near_active);
+        return 0;
+    }
     size_t lo, hi, vlo, vhi;
     contact_share(m->share, count, &lo, &hi);
     contact_share(m->share, vertex, &vlo, &vhi);
     cs->near_active_count = contact_collect_elements(cs, m->elem_count, cs->near + lo, hi - lo,
                                                      cs->near_vertex + vlo, vhi - vlo,
                                                      cs->near_active);
-    return near_vertex_index(m);
+    return 0;
 }
 
 /* This step's boxes of the elements the near list needs, the list rebuilt
