@@ -192,7 +192,8 @@ size_t fdem_memory_bytes(const fdem_model *m)
     b += (size_t)m->node_count * (1 + (m->joint_count ? 1 + sizeof(int32_t) : 0) +
                                   (m->contact.enabled ? 3 * D * sizeof(double) : 0));
     /* contact_shut.c: first copy, tolerance, shut; per element shut and due;
-     * contact_near.c: per element the start of its vertex pairs (once any) */
+     * contact_near.c: per element the start of its vertex pairs (from the
+     * first rebuild of a jointed model's near list) */
     if (m->contact.shut_first)
         b += (size_t)m->node_count * (sizeof(int32_t) + sizeof(double) + 1) +
              (size_t)m->elem_count * (1 + sizeof(int32_t));
