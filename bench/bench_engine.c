@@ -146,26 +146,12 @@ static step_time timed_steps(fdem_model *m, int steps)
     return (step_time){clock_wall_seconds() - t0, clock_cpu_seconds() - c0};
 }
 
-/* The best of three runs of the same `steps` steps from m's state; m is
- * left at the end of them. */
-static step_time best_of_three(fdem_model *m, int steps)
-{
-    window_start w = window_mark(m);
-    step_time best = {INFINITY, INFINITY};
-    for (int rep = 0; rep < 3; rep++) {
-        window_rewind(m, &w);
-        step_time t = timed_steps(m, steps);
-        best = (step_time){fmin(best.wall, t.wall), fmin(best.cpu, t.cpu)};
-    }
-    free(w.state);
-    double scale = 1e9 / ((double)steps * m->elem_count);
-    return (step_time){best.wall * scale, best.cpu * scale};
-}
-
-/* best_of_three for a window whose first step rebuilds what a restore
- * left stale (the broken blocks' near list): the whole window as
- * best_of_three gives it, and CPU ns per element of that first step and
- * per element-step of the rest, each the best of the three replays. */
+/* The best of three runs of the same `steps` steps from m's state (m is
+ * left at the end of them), as wall and CPU ns per element-step of the
+ * whole window; and, for a window whose first step rebuilds what a
+ * restore left stale (the broken blocks' near list), CPU ns per element
+ * of that first step and per element-step of the rest, each the best of
+ * the three replays. */
 typedef struct split_time {
     step_time whole;
     double first_cpu, rest_cpu;
@@ -188,8 +174,13 @@ static split_time best_of_three_split(fdem_model *m, int steps)
     double E = m->elem_count, scale = 1e9 / ((double)steps * E);
     best.whole = (step_time){best.whole.wall * scale, best.whole.cpu * scale};
     best.first_cpu *= 1e9 / E;
-    best.rest_cpu *= 1e9 / ((double)(steps - 1) * E);
+    best.rest_cpu = steps > 1 ? best.rest_cpu * 1e9 / ((double)(steps - 1) * E) : 0;
     return best;
+}
+
+static step_time best_of_three(fdem_model *m, int steps)
+{
+    return best_of_three_split(m, steps).whole;
 }
 
 static void bench_elastic_block(const block_kind *k, double bandwidth_gbs)

@@ -227,18 +227,18 @@ static int fit_array(void **array, size_t *capacity, size_t need, size_t size)
  * its elements), and every vertex pair due at the first step of the list:
  * last step's shut marks say nothing of pairs the list did not hold. The
  * pairs arrive from near_list_pairs in reverse pair order, each element's
- * count in start[e + 1] already (`counted`: the pass counted them as it
- * listed them; else counted here), and are turned to pair order as they
- * are indexed, in one pass (an element's pairs are then not in ascending
- * order in vertex_pairs: contact_vertex_due sorts what it takes).
- * Returns 0, or -1 when out of memory. */
-static int near_vertex_index(fdem_model *m, int counted)
+ * count in vertex_start[e + 1] already (only a model with shut marks has
+ * vertex pairs, and its rebuild counts them as it lists them), and are
+ * turned to pair order as they are indexed, in one pass (an element's
+ * pairs are then not in ascending order in vertex_pairs:
+ * contact_vertex_due sorts what it takes). Returns 0, or -1 when out of
+ * memory. */
+static int near_vertex_index(fdem_model *m)
 {
     contact_state *cs = &m->contact;
     size_t n = cs->near_vertex_count, E = (size_t)m->elem_count;
     cs->vertex_walk_all = 1;
     if (!n) return 0;
-    if (!cs->vertex_start && !(cs->vertex_start = malloc(sizeof(int32_t) * (E + 1)))) return -1;
     if (fit_array((void **)&cs->vertex_pairs, &cs->vertex_pairs_capacity, 2 * n,
                   sizeof *cs->vertex_pairs) ||
         fit_array((void **)&cs->vertex_walk, &cs->vertex_walk_capacity, n, sizeof *cs->vertex_walk) ||
@@ -246,13 +246,6 @@ static int near_vertex_index(fdem_model *m, int counted)
         return -1;
     int32_t *start = cs->vertex_start, *index = cs->vertex_pairs;
     near_pair *v = cs->near_vertex;
-    if (!counted) {
-        memset(start, 0, sizeof(int32_t) * (E + 1));
-        for (size_t i = 0; i < n; i++) {
-            start[v[i].a + 1]++;
-            start[v[i].b + 1]++;
-        }
-    }
     for (size_t e = 0; e < E; e++) start[e + 1] += start[e];
     /* start[e] runs to e's end, then is set back; v[i] and v[n - 1 - i]
      * swap places, each indexed at its new one */
@@ -432,7 +425,7 @@ static int contact_near_rebuild(fdem_model *m)
     /* A process of a split walk (contact_walk.c) reads the boxes of its
      * shares' pairs only, until the next rebuild (which computes every
      * candidate's first): it keeps only those up to date. */
-    if (near_vertex_index(m, vertex_count != NULL)) return -1;
+    if (near_vertex_index(m)) return -1;
     if (in_pair) {
         cs->near_active_count = contact_listed_elements(cs, m->elem_count, cs->near_active);
         return 0;

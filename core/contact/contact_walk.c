@@ -216,13 +216,16 @@ static inline long walk_threads_least(const contact_state *cs)
     return cs->walk_threads_min > 0 ? cs->walk_threads_min : CONTACT_THREADED_PAIRS;
 }
 
-/* One list per thread; 0, or -1 if they cannot be had. */
-static int contact_touch_lists(contact_state *cs, int threads)
+/* One list per thread, its touched rows with room for the two elements'
+ * nodes; 0, or -1 if they cannot be had. */
+static int contact_touch_lists(fdem_model *m, int threads)
 {
+    contact_state *cs = &m->contact;
     if (threads <= cs->touch_lists) return 0;
     contact_touches *t = realloc(cs->touches, sizeof *t * (size_t)threads);
     if (!t) return -1;
     memset(t + cs->touch_lists, 0, sizeof *t * (size_t)(threads - cs->touch_lists));
+    for (int k = cs->touch_lists; k < threads; k++) t[k].touched.node_width = 2 * m->elem_nodes;
     cs->touches = t;
     cs->touch_lists = threads;
     return 0;
@@ -306,12 +309,6 @@ static inline __attribute__((always_inline)) int pairs_forces_listed(fdem_model 
     int touching = 0;
     pair_rows *rows = &list->touched;
     const int width = cs->pair_out, K = D + 1;
-    if (rows->node_width != 2 * K) { /* first use, or a model of the other dimension */
-        free(rows->nodes);
-        rows->nodes = NULL;
-        rows->count = rows->capacity = 0;
-        rows->node_width = 2 * K;
-    }
     for (long i = begin; i < end; i++) {
         if (D == 3) walk_prefetch(cs, w, (size_t)i, (size_t)end, cs->slots);
         near_pair *np = walk_pair(w, (size_t)i);
@@ -387,7 +384,7 @@ static int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, 
     contact_state *cs = &m->contact;
     long least = walk_threads_least(cs);
     int threads = m->threads > 1 && end - begin >= least ? m->threads : 1;
-    if (contact_touch_lists(cs, threads)) return -1;
+    if (contact_touch_lists(m, threads)) return -1;
     const int which = w->index != NULL;
     double *cut = threads > 1 ? walk_cuts(cs, which, threads) : NULL;
     if (threads > 1 && !cut) return -1;
@@ -729,7 +726,7 @@ int contact_pairs_forces(fdem_model *m, double h)
     for (int k = 0; k < 2; k++) {
         int t;
         if (m->threads > 1 && (long)walks[k].count >= walk_threads_least(cs) &&
-            contact_touch_lists(cs, m->threads) == 0)
+            contact_touch_lists(m, m->threads) == 0)
             /* a list that cannot grow has already moved some stick springs:
              * the step fails rather than run the pairs twice */
             t = contact_pairs_forces_threaded(m, h, &walks[k]);
