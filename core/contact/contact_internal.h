@@ -167,7 +167,8 @@ enum { SHUT_TOPO_NONE, SHUT_TOPO_FACE, SHUT_TOPO_VERTEX };
 int contact_shut_init(fdem_model *m);
 void contact_shut_free(contact_state *cs);
 void contact_shut_refresh(fdem_model *m);
-int contact_shut_face_topology(const fdem_model *m, int a, int b, uint16_t *face);
+int contact_shut_face_topology(const fdem_model *m, int a, int b, const int8_t *copy_in_b,
+                               uint16_t *face);
 
 /* What a and b share, which only a break changes: a broken joint (its
  * faces in *face), a mesh vertex, or nothing; the near list keeps both
@@ -189,7 +190,11 @@ contact_shut_topology(const fdem_model *m, const int32_t *elem_first, int a, int
         for (int k = 0; k < K; k++) shared += fa[i] == fb[k];
     *face = 0;
     if (shared < D) return shared ? SHUT_TOPO_VERTEX : SHUT_TOPO_NONE;
-    return contact_shut_face_topology(m, a, b, face);
+    int8_t copy_in_b[4] = {-1, -1, -1, -1}; /* per corner of a, b's corner on its vertex */
+    for (int i = 0; i < K; i++)
+        for (int k = 0; k < K; k++)
+            if (fa[i] == fb[k]) copy_in_b[i] = (int8_t)k;
+    return contact_shut_face_topology(m, a, b, copy_in_b, face);
 }
 int contact_shut_neighbours(const fdem_model *m, int a, int b);
 
