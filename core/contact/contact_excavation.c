@@ -119,7 +119,7 @@ static double pair_energy(const fdem_model *m, int gone, int other)
     const material *ma = &m->materials[element_material(m, gone)];
     const material *mb = &m->materials[element_material(m, other)];
     contact_pair_in in = {moved, vel, local, local + K, fmin(ma->penalty, mb->penalty), 0,
-                          m->dt_prev, NULL, 0};
+                          m->dt_prev, NULL, 0, 0};
     /* drawn out along the pair's force on it */
     double springs[CONTACT_SLOTS_MAX] = {0}, out[CONTACT_PAIR_OUT_MAX];
     memcpy(moved, x, sizeof(double) * (size_t)(2 * K * D));

@@ -110,7 +110,7 @@ static inline contact_pair_in contact_pair_input(const fdem_model *m, int e1, in
     const material *mb = &m->materials[element_material(m, e2)];
     return (contact_pair_in){m->pos, m->vel, element_nodes(m, e1), element_nodes(m, e2),
                              min2(ma->penalty, mb->penalty),
-                             max2(ma->def.friction, mb->def.friction), h, memo, 0};
+                             max2(ma->def.friction, mb->def.friction), h, memo, 0, 0};
 }
 
 

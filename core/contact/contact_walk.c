@@ -225,6 +225,16 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     double *springs = pair_springs(cs, np, fresh, slots, &set);
     contact_pair_in in = contact_pair_input(m, a, b, h, memo);
     in.edge_clearance = !(np->face & NEAR_EDGES_TRIED);
+    /* its 3D counterpart (pair_first_look): the kernel looks across the
+     * edges before it clips, once a list; the same bits, since a pair apart
+     * across an edge-edge plane is one the clipping finds untouched, with
+     * that clearance (contact_tet.c): restore step 4,000 -> 3,870 ns an
+     * element at 1e4 tetrahedra, 4,760 -> 4,570 at 1e5 */
+    if (D == 3 && cs->shut_any && np->topology == SHUT_TOPO_NONE && cs->elem_shut[a] &&
+        cs->elem_shut[b] && (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT != NEAR_TURNED_LOOKED) {
+        in.edges_first = in.edge_clearance;
+        np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
+    }
     int touched = cs->kernel->pair_force(&in, springs, out);
     if (!touched) np->face |= NEAR_EDGES_TRIED;
     /* Apart with a clearance c (contact_pair.h): the kernel keeps returning

@@ -674,6 +674,12 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
     corners_in a_in_b, b_in_a;
     double clear;
     int apart = tet_pair_apart(in, &a, &b, &a_in_b, &b_in_a, &clear);
+    /* apart across an edge of each by more than the margin: what the
+     * clipping below would find, untouched, and the clearance after it */
+    if (!apart && in->edges_first) {
+        clear = edge_pair_clearance(&a, &b);
+        apart = clear > 0;
+    }
     if (apart) {
         contact_zero(springs, TET_CONTACT_SLOTS);
         out[0] = clear;

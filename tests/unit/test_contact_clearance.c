@@ -174,7 +174,7 @@ static void crossed_edges_give_a_clearance(void)
         int32_t na[4] = {0, 1, 2, 3}, nb[4] = {4, 5, 6, 7};
         orient(pos, na);
         orient(pos, nb);
-        contact_pair_in in = {pos, vel, na, nb, 1e9, 0.5, 1e-6, NULL, 1};
+        contact_pair_in in = {pos, vel, na, nb, 1e9, 0.5, 1e-6, NULL, 1, 0};
         double springs[TET_CONTACT_SLOTS] = {0}, out[TET_PAIR_OUT];
         int touched = tet_contact_pair_force(&in, springs, out);
         if (z < 0) {

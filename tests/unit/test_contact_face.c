@@ -92,7 +92,7 @@ static void test_contact_face_pressed_closed_form(void)
     double pos[24], vel[24] = {0}, springs[TET_CONTACT_SLOTS] = {0}, out[TET_PAIR_OUT], F[3], M[3];
     pair_3d(pos);
     for (int v = 4; v < 8; v++) pos[3 * v + 2] -= d;
-    contact_pair_in in = {pos, vel, A3, B3, p, 0.0, 1e-6, NULL, 0};
+    contact_pair_in in = {pos, vel, A3, B3, p, 0.0, 1e-6, NULL, 0, 0};
     CHECK(tet_face_pair_force(&in, &MATCH_3D, springs, out) == 1, "3D: not touching");
     double fb = out[14] + out[17] + out[20] + out[23];
     CHECK_REL(fb, 4 * p * d, 1e-12);
@@ -119,7 +119,7 @@ static void test_contact_face_pressed_closed_form(void)
     double p2[12], v2[12] = {0}, s2[TRI_CONTACT_SLOTS] = {0}, o2[TRI_PAIR_OUT], g2[TRI_PAIR_OUT];
     pair_2d(p2);
     for (int v = 3; v < 6; v++) p2[2 * v + 1] -= d;
-    contact_pair_in in2 = {p2, v2, A2, B2, p, 0.0, 1e-6, NULL, 0};
+    contact_pair_in in2 = {p2, v2, A2, B2, p, 0.0, 1e-6, NULL, 0, 0};
     CHECK(tri_face_pair_force(&in2, &MATCH_2D, s2, o2) == 1, "2D: not touching");
     double fb2 = o2[7] + o2[9] + o2[11];
     CHECK_REL(fb2, 6 * p * d, 1e-12);
@@ -145,7 +145,7 @@ static void test_contact_face_momentum(void)
         pos[k] += 1e-5 * jiggle[k];
         vel[k] = 0.1 * jiggle[(k * 7) % 24] + (k >= 12 ? 0.5 : 0);
     }
-    contact_pair_in in = {pos, vel, A3, B3, 1e10, 0.6, 1e-6, NULL, 0};
+    contact_pair_in in = {pos, vel, A3, B3, 1e10, 0.6, 1e-6, NULL, 0, 0};
     for (int step = 0; step < 3; step++) {
         CHECK(tet_face_pair_force(&in, &MATCH_3D, springs, out) == 1, "3D: not touching");
         double largest = 0;
@@ -160,7 +160,7 @@ static void test_contact_face_momentum(void)
     double p2[12], v2[12], s2[TRI_CONTACT_SLOTS] = {0}, o2[TRI_PAIR_OUT];
     pair_2d(p2);
     for (int k = 0; k < 12; k++) p2[k] += 1e-5 * j2[k], v2[k] = 0.1 * j2[(k * 5) % 12] + (k >= 6);
-    contact_pair_in in2 = {p2, v2, A2, B2, 1e10, 0.6, 1e-6, NULL, 0};
+    contact_pair_in in2 = {p2, v2, A2, B2, 1e10, 0.6, 1e-6, NULL, 0, 0};
     for (int step = 0; step < 3; step++) {
         CHECK(tri_face_pair_force(&in2, &MATCH_2D, s2, o2) == 1, "2D: not touching");
         double largest = 0;
@@ -184,7 +184,7 @@ static int coulomb_steps(int D, double mu, double *force_stuck, double *force_sl
     if (D == 3) pair_3d(pos);
     else pair_2d(pos);
     for (int c = K; c < 2 * K; c++) pos[D * c + D - 1] -= d, vel[D * c] = v;
-    contact_pair_in in = {pos, vel, D == 3 ? A3 : A2, D == 3 ? B3 : B2, p, mu, h, NULL, 0};
+    contact_pair_in in = {pos, vel, D == 3 ? A3 : A2, D == 3 ? B3 : B2, p, mu, h, NULL, 0, 0};
     int stuck = 0;
     double last = 0, first = 0;
     *dissipated = 0;
