@@ -14,21 +14,10 @@
 const double contact_zeros[CONTACT_PAIR_OUT_MAX] = {0};
 
 /* The triangle's part where d > 0 in barycentric weights (at most 4
- * corners: one line cuts a triangle), then fan sums. */
-static int triangle_overlap(const double d[3], double *i0, double w[3], double *touch)
+ * corners: one line cuts a triangle), then fan sums; the whole face's
+ * case is face_triangle_overlap's (contact_face.h). */
+int face_triangle_overlap_cut(const double d[3], double *i0, double w[3], double *touch)
 {
-    if (d[0] > 0 && d[1] > 0 && d[2] > 0) {
-        /* shut and pressed over the whole face (most shut pairs): the fan
-         * below with one triangle, the weights' corners, frac 1, the same
-         * sums in the same order */
-        double fsum = d[0] + d[1] + d[2];
-        double sum0 = fsum / 3.0;
-        if (!(sum0 > 0)) return 0;
-        *i0 = sum0;
-        for (int i = 0; i < 3; i++) w[i] = 1.0 / 12.0 * (d[i] + fsum) / sum0;
-        *touch = 1;
-        return 1;
-    }
     if (d[0] <= 0 && d[1] <= 0 && d[2] <= 0) return 0;
     double poly[4][3], depth[4];
     int n = 0;
@@ -69,5 +58,5 @@ int face_overlap_integral(int corners, const double depth[3], double *i0, double
                           double *touch)
 {
     return corners == 2 ? face_segment_overlap(depth, i0, w, touch)
-                        : triangle_overlap(depth, i0, w, touch);
+                        : face_triangle_overlap(depth, i0, w, touch);
 }

@@ -166,7 +166,7 @@ int tet_face_pair_force(const contact_pair_in *in, const face_match *fm, double 
                 vec3_sub(a.p[fa[k]], b.p[fb[k]], gap);
                 d[k] = vec3_dot(gap, n);
             }
-            touched = face_overlap_integral(3, d, &i0, w, &touch);
+            touched = face_triangle_overlap(d, &i0, w, &touch);
         }
     }
     if (!touched) {
