@@ -153,6 +153,10 @@ static int pair_first_look(fdem_model *m, near_pair *np, contact_pair_memo *memo
     contact_pair_in in = contact_pair_input(m, np->a, np->b, 0, memo);
     double c = cs->kernel->pair_clearance(&in);
     pair_gap_raise(cs, np, c);
+    if (c > 0) {
+#pragma omp atomic update
+        cs->first_looks++;
+    }
     return c > 0;
 }
 
@@ -213,8 +217,8 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
         }
         return -1;
     }
-    if (D == 2 && cs->shut_any && np->topology == SHUT_TOPO_NONE && cs->elem_shut[a] &&
-        cs->elem_shut[b] && pair_first_look(m, np, memo)) {
+    if (D == 2 && cs->shut_any && !cs->first_look_off && np->topology == SHUT_TOPO_NONE &&
+        cs->elem_shut[a] && cs->elem_shut[b] && pair_first_look(m, np, memo)) {
         if (np->sprung) {
             *pool = SPRINGS_RELEASE;
             np->sprung = 0;
@@ -230,10 +234,13 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
      * across an edge-edge plane is one the clipping finds untouched, with
      * that clearance (contact_tet.c): restore step 4,000 -> 3,870 ns an
      * element at 1e4 tetrahedra, 4,760 -> 4,570 at 1e5 */
-    if (D == 3 && cs->shut_any && np->topology == SHUT_TOPO_NONE && cs->elem_shut[a] &&
-        cs->elem_shut[b] && (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT != NEAR_TURNED_LOOKED) {
+    if (D == 3 && cs->shut_any && !cs->first_look_off && np->topology == SHUT_TOPO_NONE &&
+        cs->elem_shut[a] && cs->elem_shut[b] &&
+        (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT != NEAR_TURNED_LOOKED) {
         in.edges_first = in.edge_clearance;
         np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
+#pragma omp atomic update
+        cs->first_looks++;
     }
     int touched = cs->kernel->pair_force(&in, springs, out);
     if (!touched) np->face |= NEAR_EDGES_TRIED;

@@ -245,6 +245,9 @@ typedef struct contact_state {
     size_t vertex_walk_count;
     int vertex_walk_all;     /* the list was just rebuilt: every vertex pair this step */
     int vertex_skip_off;     /* tests: every vertex pair every step */
+    int first_look_off;      /* tests: no first look (contact_walk.c, pair_first_look) */
+    long first_looks;        /* a figure: pairs a first look found apart, or (3D) looked at
+                                across their edges before clipping */
     double near_reach;       /* the list holds while no node is farther than this from */
     double *pos_near;        /* its place when the list was built */
     double near_disp2;       /* largest squared node displacement from pos_near since then

@@ -174,6 +174,38 @@ static void vertex_pairs_walked_where_due_give_the_same_bits(void)
     }
 }
 
+/* The first look at two shut elements that share no vertex (contact_walk.c,
+ * pair_first_look: 2D an edge line's clearance before the kernel, 3D the
+ * edge-edge planes before clipping) against the kernel alone, on the block
+ * squeezed and sheared, restored half way (a restore rebuilds the list,
+ * so the looks run again): the same bits, with looks that decided pairs
+ * (or it could not fail). */
+static void first_look_gives_the_kernels_bits(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        int n = dim == 2 ? 8 : 3, steps = dim == 2 ? 200 : 60;
+        fdem_model *look = broken_block(dim, n, 2.0, 0), *whole = broken_block(dim, n, 2.0, 0);
+        whole->contact.first_look_off = 1;
+        for (int s = 0; s < steps && step_both(look, whole); s++) {
+            if (s != steps / 2) continue;
+            size_t size = fdem_checkpoint_size(look);
+            void *buf = malloc(size);
+            fdem_error err = {0};
+            CHECK(buf && fdem_checkpoint_write(look, buf, size) == 0, "write");
+            CHECK(buf && fdem_checkpoint_read(look, buf, size, &err) == 0, "%s", err.message);
+            CHECK(buf && fdem_checkpoint_read(whole, buf, size, &err) == 0, "%s", err.message);
+            free(buf);
+        }
+        CHECK(look->contact.first_looks > 0, "%dD: no first look decided a pair", dim);
+        CHECK(whole->contact.first_looks == 0, "%dD: %ld looks with them off", dim,
+              whole->contact.first_looks);
+        fprintf(stderr, "  %dD: %ld pairs decided by a first look\n", dim, look->contact.first_looks);
+        same_state_bits(look, whole, dim == 2 ? "2D, first look" : "3D, first look");
+        fdem_model_destroy(look);
+        fdem_model_destroy(whole);
+    }
+}
+
 /* Copies 2 tolerances apart: never shut, so every pair takes the general
  * kernel, bit for bit as with the shut path switched off. */
 static void open_broken_block_is_the_general_kernel(void)
@@ -291,4 +323,5 @@ static void shut_block_computes_no_boxes(void)
 }
 
 CHECK_MAIN(T(shut_block_computes_no_boxes), T(vertex_pairs_walked_where_due_give_the_same_bits), T(shut_broken_block_same_bits_on_threads_and_restore),
-           T(open_broken_block_is_the_general_kernel), T(shut_run_close_to_the_general_kernel))
+           T(first_look_gives_the_kernels_bits), T(open_broken_block_is_the_general_kernel),
+           T(shut_run_close_to_the_general_kernel))
