@@ -110,6 +110,18 @@ static void pair_clearance_look(fdem_model *m, near_pair *np, contact_pair_memo 
     pair_gap_raise(cs, np, cs->kernel->pair_clearance(&in));
 }
 
+/* How often the pair's boxes have turned it away since the list was
+ * built, or NEAR_TURNED_LOOKED once it has had its one look. */
+static inline unsigned pair_turned(const near_pair *np)
+{
+    return (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT;
+}
+
+static inline void pair_mark_looked(near_pair *np)
+{
+    np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
+}
+
 /* Such a pair turned away by its boxes once more: it looks only once the
  * list has lived long enough to pay for the look, about half the steps it
  * takes (4 in 2D, 14 in 3D). A look costs what 8 steps of boxes save in
@@ -120,7 +132,7 @@ static void pair_clearance_look(fdem_model *m, near_pair *np, contact_pair_memo 
 static void pair_turned_away(fdem_model *m, near_pair *np, contact_pair_memo *memo)
 {
     const unsigned after = m->dim == 3 ? NEAR_LOOK_AFTER_3D : NEAR_LOOK_AFTER_2D;
-    unsigned turned = (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT;
+    unsigned turned = pair_turned(np);
     if (turned == NEAR_TURNED_LOOKED) return;
     if (turned + 1 < after) {
         np->face = (uint16_t)(np->face + (1u << NEAR_TURNED_SHIFT));
@@ -128,27 +140,39 @@ static void pair_turned_away(fdem_model *m, near_pair *np, contact_pair_memo *me
     }
     /* looked, once: not NEAR_EDGES_TRIED, which the look did not try, so
      * the kernel still looks across edges when the boxes meet */
-    np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
+    pair_mark_looked(np);
     pair_clearance_look(m, np, memo);
 }
 
-/* Broken 2D rock: two shut triangles that share no vertex and whose boxes
+/* Broken rock: two shut elements that share no vertex and whose boxes
  * meet, met for the first time since the list was built (a rebuild after
- * every detection, break and restore): an edge line's clearance first,
- * as pair_turned_away looks, before the whole kernel (the same bits: a
- * clearance c > 0 is what the kernel would find, apart, and the pair is
- * then apart as the walk's gap test makes it); 1 if one was found. Once a
- * list. Two triangles apart are always parted by the line of one of
- * their edges, so in 2D the look finds nearly every such pair's clearance
- * (a pair within the rounding margin takes the kernel after it): the
- * broken block's restore step went 470 -> 452 ns an element. Not in 3D,
- * where tetrahedra are often apart only across a plane through an edge of
- * each, which the look does not try: 3,990 -> 4,380 at 1e4. */
+ * every detection, break and restore): 1 once a list, and the pair is
+ * marked looked (as pair_turned_away marks it). Such a pair is more likely
+ * apart than not, so it gets a first look before the whole kernel (the
+ * same bits: a clearance c > 0 is what the kernel would find, apart):
+ *  - 2D (pair_first_look): an edge line's clearance. Two triangles apart
+ *    are always parted by the line of one of their edges, so the look
+ *    finds nearly every such pair's clearance (a pair within the rounding
+ *    margin takes the kernel after it): the broken block's restore step
+ *    went 470 -> 452 ns an element;
+ *  - 3D (contact_pair_in.edges_first): the kernel tries the planes across
+ *    an edge of each before it clips (contact_tet.c), where the face
+ *    planes' look alone read 3,990 -> 4,380, tetrahedra being often apart
+ *    only across such a plane: restore step 4,000 -> 3,870 ns an element
+ *    at 1e4 tetrahedra, 4,760 -> 4,570 at 1e5. */
+static inline int pair_first_met(const contact_state *cs, near_pair *np, int32_t a, int32_t b)
+{
+    if (!cs->shut_any || cs->first_look_off || np->topology != SHUT_TOPO_NONE ||
+        !cs->elem_shut[a] || !cs->elem_shut[b] || pair_turned(np) == NEAR_TURNED_LOOKED)
+        return 0;
+    pair_mark_looked(np);
+    return 1;
+}
+
+/* The 2D first look: 1 if an edge line's clearance found the pair apart
+ * (its gap raised by it). */
 static int pair_first_look(fdem_model *m, near_pair *np, contact_pair_memo *memo)
 {
-    unsigned turned = (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT;
-    if (turned == NEAR_TURNED_LOOKED) return 0;
-    np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
     contact_state *cs = &m->contact;
     contact_pair_in in = contact_pair_input(m, np->a, np->b, 0, memo);
     double c = cs->kernel->pair_clearance(&in);
@@ -210,15 +234,9 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
         apart = 1;
         if (cs->elem_topo && cs->elem_topo[a] && cs->elem_topo[b]) pair_turned_away(m, np, memo);
     }
+    const int first_met = !apart && pair_first_met(cs, np, a, b);
+    if (D == 2 && first_met) apart = pair_first_look(m, np, memo);
     if (apart) {
-        if (np->sprung) {
-            *pool = SPRINGS_RELEASE;
-            np->sprung = 0;
-        }
-        return -1;
-    }
-    if (D == 2 && cs->shut_any && !cs->first_look_off && np->topology == SHUT_TOPO_NONE &&
-        cs->elem_shut[a] && cs->elem_shut[b] && pair_first_look(m, np, memo)) {
         if (np->sprung) {
             *pool = SPRINGS_RELEASE;
             np->sprung = 0;
@@ -229,16 +247,8 @@ static inline __attribute__((always_inline)) int pair_evaluate(fdem_model *m, ne
     double *springs = pair_springs(cs, np, fresh, slots, &set);
     contact_pair_in in = contact_pair_input(m, a, b, h, memo);
     in.edge_clearance = !(np->face & NEAR_EDGES_TRIED);
-    /* its 3D counterpart (pair_first_look): the kernel looks across the
-     * edges before it clips, once a list; the same bits, since a pair apart
-     * across an edge-edge plane is one the clipping finds untouched, with
-     * that clearance (contact_tet.c): restore step 4,000 -> 3,870 ns an
-     * element at 1e4 tetrahedra, 4,760 -> 4,570 at 1e5 */
-    if (D == 3 && cs->shut_any && !cs->first_look_off && np->topology == SHUT_TOPO_NONE &&
-        cs->elem_shut[a] && cs->elem_shut[b] &&
-        (np->face & NEAR_TURNED_MASK) >> NEAR_TURNED_SHIFT != NEAR_TURNED_LOOKED) {
+    if (D == 3 && first_met) { /* the 3D first look (pair_first_met) */
         in.edges_first = in.edge_clearance;
-        np->face = (uint16_t)(np->face | NEAR_TURNED_LOOKED << NEAR_TURNED_SHIFT);
 #pragma omp atomic update
         cs->first_looks++;
     }
@@ -313,20 +323,22 @@ static inline int walk_elements_far(const fdem_model *m)
            WALK_FAR_BYTES;
 }
 
-/* The pair WALK_AHEAD * 3 on: its second element's record, and two
+/* The pair WALK_AHEAD * 3 on: its second element's record; and two
  * WALK_AHEAD on, if it is the two sides of a broken joint (the pairs whose
- * kernel runs every step), that element's node places and velocities:
- * reading the node ids of every pair's record, most of them skipped by
- * their gap, stalled the 3D walk on the records not yet in (a restore
- * step at 1e5 tetrahedra 4,540 -> 4,400 ns an element without it). The near list runs in the first element's order, so the
- * first's come in order and the memory system streams them; the second is
- * a neighbour up to a row of the mesh ahead, a cache miss a pair when the
- * model is large: waiting for its material was a quarter of the broken 2D
- * block's walk at 1e5 triangles. Measured (harness, alternating rounds,
- * broken blocks from the break): 2D 1e5 triangles 189-193 -> 186-189 ns
- * an element-step, 3D 1e5 tetrahedra 778-799 -> 757-765; at 1e4 (the
- * elements near in cache) the prefetches cost 1-2 % and saved no miss,
- * hence only for far elements. Same bits: a prefetch changes no value. */
+ * kernel runs every step), that element's node places and velocities. The
+ * near list runs in the first element's order, so the first's come in
+ * order and the memory system streams them; the second is a neighbour up
+ * to a row of the mesh ahead, a cache miss a pair when the model is large:
+ * waiting for its material was a quarter of the broken 2D block's walk at
+ * 1e5 triangles. Measured (harness, alternating rounds, broken blocks from
+ * the break): 2D 1e5 triangles 189-193 -> 186-189 ns an element-step, 3D
+ * 1e5 tetrahedra 778-799 -> 757-765; at 1e4 (the elements near in cache)
+ * the prefetches cost 1-2 % and saved no miss, hence only for far
+ * elements. The nodes only for joints' sides: reading the node ids of
+ * every pair's record, most of them skipped by their gap, stalled the 3D
+ * walk on records not yet in (restore step at 1e5 tetrahedra 4,540 ->
+ * 4,400 ns an element without it). Same bits: a prefetch changes no
+ * value. */
 static inline void walk_prefetch_elements(const fdem_model *m, const near_walk *w, size_t i,
                                           size_t end, int D)
 {
@@ -334,14 +346,15 @@ static inline void walk_prefetch_elements(const fdem_model *m, const near_walk *
         int b = walk_pair(w, i + 3 * WALK_AHEAD)->b;
         __builtin_prefetch(D == 3 ? (const void *)&m->tet[b] : (const void *)&m->elem[b]);
     }
-    if (i + 2 * WALK_AHEAD < end && walk_pair(w, i + 2 * WALK_AHEAD)->topology == SHUT_TOPO_FACE) {
-        const int32_t *n = element_nodes(m, walk_pair(w, i + 2 * WALK_AHEAD)->b);
-        __builtin_prefetch(m->pos + D * (size_t)n[0]);
-        __builtin_prefetch(m->vel + D * (size_t)n[0]);
-        if (D == 3) { /* four private corners span two lines */
-            __builtin_prefetch(m->pos + D * (size_t)n[3]);
-            __builtin_prefetch(m->vel + D * (size_t)n[3]);
-        }
+    if (i + 2 * WALK_AHEAD >= end) return;
+    const near_pair *np = walk_pair(w, i + 2 * WALK_AHEAD);
+    if (np->topology != SHUT_TOPO_FACE) return;
+    const int32_t *n = element_nodes(m, np->b);
+    __builtin_prefetch(m->pos + D * (size_t)n[0]);
+    __builtin_prefetch(m->vel + D * (size_t)n[0]);
+    if (D == 3) { /* four private corners span two lines */
+        __builtin_prefetch(m->pos + D * (size_t)n[3]);
+        __builtin_prefetch(m->vel + D * (size_t)n[3]);
     }
 }
 
@@ -462,8 +475,7 @@ static void walk_cuts_balance(double *cut, const contact_touches *lists, int thr
 
 /* Pairs [begin, end) of walk w listed on this process's threads; *used the
  * lists filled (thread order). 0, or -1 when a list cannot grow. */
-int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end,
-                       int *used)
+int walk_listed(fdem_model *m, double h, const near_walk *w, long begin, long end, int *used)
 {
     contact_state *cs = &m->contact;
     long least = walk_threads_least(cs);

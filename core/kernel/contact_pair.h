@@ -77,8 +77,8 @@ typedef struct contact_pair_in {
      * edge of each too (contact_tet.c, edge_pair_clearance): ~1,500
      * instructions, so the walk asks once a pair and near list */
     int edge_clearance;
-    /* 3D: look across the edges before clipping (contact_tet.c): for a
-     * pair more likely apart than not, once a near list */
+    /* 3D: look across the edges before clipping (contact_tet.c), instead
+     * of after: for a pair more likely apart than not, once a near list */
     int edges_first;
 } contact_pair_in;
 

@@ -692,7 +692,9 @@ int tet_contact_pair_force(const contact_pair_in *in, double *springs, double *o
                        springs + TET_CONTACT_SLOTS / 2, dissipated};
     double touched = contact_one_way(&a, &b, &a_in_b, in->penalty, &ab, out, out + 12);
     touched += contact_one_way(&b, &a, &b_in_a, in->penalty, &ba, out + 12, out);
-    /* untouched, no face has added anything: out[0] is 0 until a clearance */
-    if (!(touched > 0) && in->edge_clearance) out[0] = edge_pair_clearance(&a, &b);
+    /* untouched, no face has added anything: out[0] is 0 until a clearance
+     * (none across the edges if edges_first found none above) */
+    if (!(touched > 0) && in->edge_clearance && !in->edges_first)
+        out[0] = edge_pair_clearance(&a, &b);
     return touched > 0;
 }

@@ -245,7 +245,7 @@ typedef struct contact_state {
     size_t vertex_walk_count;
     int vertex_walk_all;     /* the list was just rebuilt: every vertex pair this step */
     int vertex_skip_off;     /* tests: every vertex pair every step */
-    int first_look_off;      /* tests: no first look (contact_walk.c, pair_first_look) */
+    int first_look_off;      /* tests: no first look (contact_walk.c, pair_first_met) */
     long first_looks;        /* a figure: pairs a first look found apart, or (3D) looked at
                                 across their edges before clipping */
     double near_reach;       /* the list holds while no node is farther than this from */

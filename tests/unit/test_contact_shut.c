@@ -175,7 +175,7 @@ static void vertex_pairs_walked_where_due_give_the_same_bits(void)
 }
 
 /* The first look at two shut elements that share no vertex (contact_walk.c,
- * pair_first_look: 2D an edge line's clearance before the kernel, 3D the
+ * pair_first_met: 2D an edge line's clearance before the kernel, 3D the
  * edge-edge planes before clipping) against the kernel alone, on the block
  * squeezed and sheared, restored half way (a restore rebuilds the list,
  * so the looks run again): the same bits, with looks that decided pairs
@@ -199,7 +199,8 @@ static void first_look_gives_the_kernels_bits(void)
         CHECK(look->contact.first_looks > 0, "%dD: no first look decided a pair", dim);
         CHECK(whole->contact.first_looks == 0, "%dD: %ld looks with them off", dim,
               whole->contact.first_looks);
-        fprintf(stderr, "  %dD: %ld pairs decided by a first look\n", dim, look->contact.first_looks);
+        fprintf(stderr, "  %dD: %ld first looks (2D: found apart; 3D: across edges first)\n", dim,
+                look->contact.first_looks);
         same_state_bits(look, whole, dim == 2 ? "2D, first look" : "3D, first look");
         fdem_model_destroy(look);
         fdem_model_destroy(whole);
