@@ -197,14 +197,15 @@ int contact_pairs_forces_split(fdem_model *m, double h, const near_walk walks[2]
         cs->split_threaded += ok && used > 1;
     }
     /* every process takes part, failed or not: none is left waiting */
-    const unsigned char *all;
-    const size_t *at;
+    const unsigned char *const *from;
+    const size_t *size;
     cs->springs_behind = 1; /* once gathered, failed or not (a failed step fails everywhere) */
-    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 1, &all, &at)) return -1;
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 1, &from, &size))
+        return -1;
     int touching = 0;
     for (int k = 0; k < 2; k++)
         for (int r = 0; r < share->contact_ranks; r++) {
-            const unsigned char *p = all + at[r], *end = all + at[r + 1];
+            const unsigned char *p = from[r], *end = from[r] + size[r];
             if (k == 1 && !(p = wire_apply(m, p, end, NULL))) return -1; /* past the near list's */
             if (!wire_apply(m, p, end, &touching)) return -1;
         }
@@ -281,12 +282,13 @@ int contact_springs_sync(fdem_model *m)
         contact_share(share, totals[k], &lo, &hi);
         ok = sync_append(cs, arrays[k], lo, hi, &bytes) == 0;
     }
-    const unsigned char *all;
-    const size_t *at;
-    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 0, &all, &at)) return -1;
+    const unsigned char *const *from;
+    const size_t *size;
+    if (share->contact_gather(share->ctx, cs->wire, ok ? bytes : 0, ok, 0, &from, &size))
+        return -1;
     cs->springs_behind = 0;
     cs->springs_synced++;
     for (int p = 0; p < share->contact_ranks; p++) /* its own too: they are what it holds */
-        if (sync_apply(cs, all + at[p], all + at[p + 1])) return -1;
+        if (sync_apply(cs, from[p], from[p] + size[p])) return -1;
     return 0;
 }

@@ -355,10 +355,10 @@ static inline void contact_detect_after_breaks(contact_state *cs)
  *    process (walk 1), and before the spring pool is read by anything but
  *    the walk (walk 0: contact_springs_sync, in a step or at a gather),
  *    with the bytes this process listed (ok 0: it failed, the bytes say
- *    nothing). Returns 0 with *all every process's bytes one after another
- *    in process order, process p's from (*at)[p] to (*at)[p + 1] (kept
- *    until the next call); nonzero when some process failed or the
- *    exchange did: the step then fails on every process. */
+ *    nothing). Returns 0 with process p's bytes at (*from)[p], (*size)[p]
+ *    of them, in process order (kept until the next call; this process's
+ *    own may be `mine` itself, not a copy); nonzero when some process
+ *    failed or the exchange did: the step then fails on every process. */
 typedef struct step_share {
     void *ctx;
     const uint8_t *elem_mark;
@@ -368,7 +368,7 @@ typedef struct step_share {
     int (*update_done)(void *ctx, fdem_model *m, int bad);
     int contact_ranks, contact_rank;
     int (*contact_gather)(void *ctx, const void *mine, size_t bytes, int ok, int walk,
-                          const unsigned char **all, const size_t **at);
+                          const unsigned char *const **from, const size_t **size);
 } step_share;
 
 /* The next run of marked items (mark[i] 1, others 0) in [from, end): its

@@ -18,7 +18,11 @@
  *    at most 64 blocks: under 4 KB), and every rank totals them in block
  *    order as one process does;
  *  - forces: once every force is added, each rank's owned nodes' forces go
- *    to every rank (MPI_Allgatherv), so every rank holds the whole force.
+ *    to every rank, so every rank holds the whole force. A rank's owned
+ *    nodes are a few runs of consecutive indices (its blocks' elements'
+ *    nodes), so the exchange is one MPI type a rank over m->force itself:
+ *    MPI reads and writes the force rows where they are, and nothing is
+ *    packed or unpacked here.
  * Everything after (the update, constraints, energies) and the joints,
  * contact detection and fluid run on every rank on the same numbers: the
  * whole state stays replicated, bit-identical on every rank, and nothing
@@ -29,8 +33,9 @@
  * The contact pair walk is split too (step_share.contact_gather,
  * core/contact/contact_walk.c): each rank evaluates a fixed share of the
  * near pairs and lists what they did; share_contact_gather hands every
- * rank every rank's lists (MPI_Allgather of their sizes, MPI_Allgatherv
- * of their bytes), which every rank applies in rank order, pair order.
+ * rank every rank's lists (MPI_Allgather of their sizes, then one message
+ * from each rank to each other), which every rank applies in rank order,
+ * pair order.
  * The springs a pair keeps, updated in place by the rank walking it, go
  * through the same exchange only when something else is to read them
  * (core's contact_springs_sync: before a detection, a rebuild of the near
@@ -48,6 +53,7 @@
  * element is computed; rank_engine_gather hands rank 0 the owners' values.
  */
 #include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -59,6 +65,9 @@
 #include "rank_borders.h"
 #include "rank_halo.h"
 
+#define FORCE_TAG 3702   /* rank_halo.c's border forces are 3701 */
+#define CONTACT_TAG 3703
+
 struct rank_engine {
     MPI_Comm comm;
     int rank, size, dim, elem_count;
@@ -68,11 +77,16 @@ struct rank_engine {
     int *block_counts, *block_displs; /* per rank, in doubles of block sums */
     int32_t *node_order;             /* nodes rank by rank (owned), ascending in each */
     int *node_counts, *node_displs;  /* per rank, in doubles (dim a node) */
-    int *flag_counts, *flag_displs;  /* the same with each rank's leading flag */
     uint8_t *mark;                   /* elements this rank computes */
     uint8_t *halo;                   /* the border-order fault: halo elements only */
-    double *send, *recv;             /* force and block-sum buffers */
+    double *send, *recv;             /* block-sum buffers */
     size_t send_len, recv_len;
+    MPI_Datatype *force_type;        /* per rank: its flag and owned force rows (force_types) */
+    const double *force_typed;       /* the m->force they point into; NULL: none made */
+    double *flags;                   /* per rank: its flag in the force exchange */
+    MPI_Request *requests;           /* the force exchange's, 2 (size - 1) */
+    int *run_len;                    /* force_types' scratch: a rank's runs and its flag */
+    MPI_Aint *run_at;
     step_share share, halo_share;
     int border_fault;
     int exchanged;                   /* the force exchange ran in this step */
@@ -87,9 +101,10 @@ struct rank_engine {
     int gathering;                   /* in rank_engine_gather (the skip-sync faults) */
     long long fault_step;            /* the step being made (the failure fault) */
     long long *contact_sizes;        /* per rank: the bytes of its lists, -1 failed */
-    int *contact_counts, *contact_displs; /* per rank, for MPI_Allgatherv */
-    size_t *contact_at;              /* per rank and one past: where its lists start */
-    unsigned char *contact_buf;      /* every rank's lists */
+    const unsigned char **contact_from; /* per share: its rank's lists (this rank's: the
+                                        caller's own bytes) */
+    size_t *contact_bytes;           /* per share: their size */
+    unsigned char *contact_buf;      /* the other ranks' lists */
     size_t contact_cap, contact_agreed; /* its size here, and the size every rank has */
     rank_figures fig;
 };
@@ -149,43 +164,78 @@ static void add_halo_after(rank_engine *re, fdem_model *m)
     m->damping_work = damping;
 }
 
-/* The D numbers of each of `count` nodes between a node array (rows
- * nodes[k]) and a packed one (row k): out = 1 packs, 0 unpacks. A loop of
- * D copies, not memcpy: a call for each 16 or 24 bytes of 55 k nodes was
- * a tenth of a contact pile's step on 2 ranks (perf). */
-static void copy_rows(double *node_array, double *packed, const int32_t *nodes, int count, int D,
-                      int out)
+/* Each rank's owned nodes' forces as one MPI type of absolute addresses
+ * (used with MPI_BOTTOM): its flag (flags[r]), then each run of consecutive
+ * owned nodes as one block of m->force. The exchange then sends and
+ * receives the rows where they lie: packing them into a buffer and out of
+ * it again, node by node, was as long as the transfer itself (2 ranks, a
+ * contact pile of 55 k nodes: 0.13 ms a step of 2.6). Made again if
+ * m->force ever moves; -1 when MPI cannot make a type. */
+static void force_types_free(rank_engine *re)
 {
-    for (int k = 0; k < count; k++) {
-        double *a = node_array + (size_t)D * nodes[k], *p = packed + (size_t)D * k;
-        if (out)
-            for (int d = 0; d < D; d++) p[d] = a[d];
-        else
-            for (int d = 0; d < D; d++) a[d] = p[d];
-    }
+    if (!re->force_typed) return;
+    for (int r = 0; r < re->size; r++) MPI_Type_free(&re->force_type[r]);
+    re->force_typed = NULL;
 }
 
-/* Every rank's owned nodes' forces to every rank, each rank's list led by
- * one number saying whether it got here in order (1) or failed before (0,
- * sent by rank_engine_step): a failure on one rank fails the step on all,
- * in the same one collective, and no rank waits for a partner that left. */
+static int force_types(rank_engine *re, const fdem_model *m)
+{
+    const int D = re->dim;
+    force_types_free(re);
+    for (int r = 0; r < re->size; r++) {
+        const int32_t *nodes = re->node_order + re->node_displs[r] / D;
+        const int count = re->node_counts[r] / D;
+        int blocks = 1;
+        MPI_Get_address(&re->flags[r], &re->run_at[0]);
+        re->run_len[0] = 1;
+        for (int k = 0; k < count; k++) {
+            if (k > 0 && nodes[k] == nodes[k - 1] + 1) {
+                re->run_len[blocks - 1] += D;
+                continue;
+            }
+            MPI_Get_address(m->force + (size_t)D * nodes[k], &re->run_at[blocks]);
+            re->run_len[blocks++] = D;
+        }
+        if (MPI_Type_create_hindexed(blocks, re->run_len, re->run_at, MPI_DOUBLE,
+                                     &re->force_type[r]) != MPI_SUCCESS ||
+            MPI_Type_commit(&re->force_type[r]) != MPI_SUCCESS) {
+            for (int q = 0; q < r; q++) MPI_Type_free(&re->force_type[q]);
+            return -1;
+        }
+    }
+    re->force_typed = m->force;
+    return 0;
+}
+
+/* Every rank's owned nodes' forces to every rank (one message to each
+ * other rank: force_types), each led by one number saying whether its
+ * rank got here in order (1) or failed before (0, sent by
+ * rank_engine_step): a failure on one rank fails the step on all, in the
+ * same exchange, and no rank waits for a partner that left. */
 static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
 {
-    const int D = re->dim, me = re->rank;
-    const int32_t *mine = re->node_order + re->node_displs[me] / D;
-    const int count = ok ? re->node_counts[me] / D : 0;
-    re->send[0] = ok;
-    copy_rows(m->force, re->send + 1, mine, count, D, 1);
+    const int P = re->size, me = re->rank;
+    /* m->force never moves after set-up (an excavation swaps it only inside
+     * its own pass), but if it did the rows must follow it */
+    if (re->force_typed != m->force && force_types(re, m)) {
+        fprintf(stderr, "rank %d: MPI could not describe the force rows\n", me);
+        MPI_Abort(re->comm, 2); /* the others would wait for this rank's message */
+    }
+    re->flags[me] = ok;
     stopwatch t0 = stopwatch_now();
-    int rc = MPI_Allgatherv(re->send, re->node_counts[me] + 1, MPI_DOUBLE, re->recv,
-                            re->flag_counts, re->flag_displs, MPI_DOUBLE, re->comm);
+    int n = 0;
+    for (int r = 0; r < P; r++)
+        if (r != me)
+            MPI_Irecv(MPI_BOTTOM, 1, re->force_type[r], r, FORCE_TAG, re->comm, &re->requests[n++]);
+    for (int r = 0; r < P; r++)
+        if (r != me)
+            MPI_Isend(MPI_BOTTOM, 1, re->force_type[me], r, FORCE_TAG, re->comm,
+                      &re->requests[n++]);
+    int rc = MPI_Waitall(n, re->requests, MPI_STATUSES_IGNORE);
     stopwatch_add(re, t0);
     if (rc != MPI_SUCCESS) return -1;
-    for (int r = 0; r < re->size; r++)
-        if (re->recv[re->flag_displs[r]] != 1) return -1;
-    for (int r = 0; r < re->size; r++)
-        copy_rows(m->force, re->recv + re->flag_displs[r] + 1,
-                  re->node_order + re->node_displs[r] / D, re->node_counts[r] / D, D, 0);
+    for (int r = 0; r < P; r++)
+        if (re->flags[r] != 1) return -1;
     return 0;
 }
 
@@ -221,39 +271,45 @@ static int share_update_done(void *ctx, fdem_model *m, int bad)
 
 /* The contact walk's lists or a hand-over of its springs
  * (step_share.contact_gather; walk 1 and 0): every rank's sizes, then
- * their bytes, in rank order (or, for the order fault, in the reverse
- * order). Every rank sees the same sizes, so each takes the same path
- * through the collectives: a rank that failed (size -1) fails the step on
- * all, and the buffer grows on all at the same steps, one reduction then
- * telling whether it grew everywhere. A step's last contact exchange is
- * the walk's: a rank failing before it takes part in it (fail_collectives)
- * unless an exchange of springs before it told every rank of a failure. */
+ * their bytes, one message from each rank to each other, into contact_buf
+ * (a rank's own lists are handed back where they lie: copying them
+ * there too was a sixth of the bytes a step moved in memory), in rank order
+ * (or, for the order fault, in the reverse order). Every rank sees the
+ * same sizes, so each takes the same path: a rank that failed (size -1)
+ * fails the step on all, and the buffer grows on all at the same steps,
+ * one reduction then telling whether it grew everywhere. A step's last
+ * contact exchange is the walk's: a rank failing before it takes part in
+ * it (fail_collectives) unless an exchange of springs before it told every
+ * rank of a failure. */
 static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int ok, int walk,
-                                const unsigned char **all, const size_t **at)
+                                const unsigned char *const **from, const size_t **size)
 {
     rank_engine *re = ctx;
     const int P = re->size, me = re->rank;
     const int skip = re->gathering ? RANK_CONTACT_FAULT_SKIP_GATHER_SYNC
                                    : RANK_CONTACT_FAULT_SKIP_SYNC;
+    *from = re->contact_from;
+    *size = re->contact_bytes;
     if (!walk && re->contact_fault == skip && ok) {
-        for (int k = 0; k <= P; k++) re->contact_at[k] = 0; /* nothing handed over */
-        *all = re->contact_buf;
-        *at = re->contact_at;
+        for (int k = 0; k < P; k++) { /* nothing handed over */
+            re->contact_from[k] = re->contact_buf;
+            re->contact_bytes[k] = 0;
+        }
         return 0;
     }
     if (walk) re->contact_gathered = 1;
     if (walk && re->contact_fault == RANK_CONTACT_FAULT_FAIL && re->rank == P - 1 &&
         re->fault_step == RANK_CONTACT_FAIL_STEP)
         ok = 0; /* as if a list could not grow here */
-    long long size = ok && bytes <= INT_MAX ? (long long)bytes : -1;
+    long long own = ok && bytes <= INT_MAX ? (long long)bytes : -1;
     stopwatch t0 = stopwatch_now();
-    int rc = MPI_Allgather(&size, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
-    size_t total = 0;
+    int rc = MPI_Allgather(&own, 1, MPI_LONG_LONG, re->contact_sizes, 1, MPI_LONG_LONG, re->comm);
+    size_t total = 0; /* every rank's, own included: the same on every rank, so that all
+                         take the same path through the growth's reduction */
     for (int r = 0; r < P && rc == MPI_SUCCESS; r++) {
         if (re->contact_sizes[r] < 0) rc = -1;
         else total += (size_t)re->contact_sizes[r];
     }
-    if (rc == MPI_SUCCESS && total > INT_MAX) rc = -1;
     if (rc == MPI_SUCCESS && total > re->contact_agreed) {
         size_t cap = total > 2 * re->contact_agreed ? total : 2 * re->contact_agreed;
         int grown = 1;
@@ -274,25 +330,30 @@ static int share_contact_gather(void *ctx, const void *mine, size_t bytes, int o
         re->contact_gathered = 1; /* every rank knows: none waits in another */
         return -1;
     }
-    size_t from = 0;
+    size_t at = 0;
+    int n = 0;
     for (int k = 0; k < P; k++) {
         int r = k; /* the rank whose lists come k-th: the one with share k */
         if (re->contact_fault == RANK_CONTACT_FAULT_ORDER) r = P - 1 - k;
         if (re->contact_fault == RANK_CONTACT_FAULT_ROTATE)
             r = (int)(((k - re->contact_turn) % P + P) % P);
-        re->contact_at[k] = from;
-        re->contact_counts[r] = (int)re->contact_sizes[r];
-        re->contact_displs[r] = (int)from;
-        from += (size_t)re->contact_sizes[r];
+        re->contact_bytes[k] = (size_t)re->contact_sizes[r];
+        if (r == me) {
+            re->contact_from[k] = mine;
+            continue;
+        }
+        re->contact_from[k] = re->contact_buf + at;
+        MPI_Irecv(re->contact_buf + at, (int)re->contact_sizes[r], MPI_BYTE, r, CONTACT_TAG,
+                  re->comm, &re->requests[n++]);
+        at += (size_t)re->contact_sizes[r];
     }
-    re->contact_at[P] = from;
-    rc = MPI_Allgatherv(mine, re->contact_counts[me], MPI_BYTE, re->contact_buf,
-                        re->contact_counts, re->contact_displs, MPI_BYTE, re->comm);
+    for (int r = 0; r < P; r++)
+        if (r != me)
+            MPI_Isend(mine, (int)own, MPI_BYTE, r, CONTACT_TAG, re->comm, &re->requests[n++]);
+    rc = MPI_Waitall(n, re->requests, MPI_STATUSES_IGNORE);
     stopwatch_add(re, t0);
     re->fig.contact_bytes_sent += (double)bytes * (P - 1);
     if (!walk) re->fig.contact_sync_bytes_sent += (double)bytes * (P - 1);
-    *all = re->contact_buf;
-    *at = re->contact_at;
     return rc == MPI_SUCCESS ? 0 : -1;
 }
 
@@ -381,27 +442,29 @@ static int setup(rank_engine *re, fdem_model *m)
     re->block_size = plan->color_count ? plan->block_size : (m->elem_count > 0 ? m->elem_count : 1);
     re->block_owner = malloc(sizeof(int32_t) * (size_t)re->blocks);
     re->block_order = malloc(sizeof(int32_t) * (size_t)re->blocks);
-    re->block_counts = malloc(sizeof(int) * (size_t)re->size * 6);
+    re->block_counts = malloc(sizeof(int) * (size_t)re->size * 4);
     re->node_order = malloc(sizeof(int32_t) * ((size_t)N + 1));
     re->mark = malloc((size_t)m->elem_count + 1);
     re->halo = malloc((size_t)m->elem_count + 1);
     int32_t *node_owner = malloc(sizeof(int32_t) * ((size_t)N + 1));
     re->split = plan->color_count && rank_halo_wanted(m, re->size);
-    /* the replicated update's buffers hold every force; the split one's
-     * only block sums (rank_halo.c has its own) */
-    re->send_len = re->recv_len = (re->split ? 0 : (size_t)D * N) +
-                                  (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
+    /* block sums (the forces go where they lie: force_types) */
+    re->send_len = re->recv_len = (size_t)SCATTER_SUMS * re->blocks + (size_t)re->size;
     re->send = malloc(sizeof(double) * re->send_len);
     re->recv = malloc(sizeof(double) * re->recv_len);
+    re->force_type = malloc(sizeof(MPI_Datatype) * (size_t)re->size);
+    re->flags = malloc(sizeof(double) * (size_t)re->size);
+    re->requests = malloc(sizeof(MPI_Request) * 2 * (size_t)re->size);
+    re->run_len = malloc(sizeof(int) * ((size_t)N + 2));
+    re->run_at = malloc(sizeof(MPI_Aint) * ((size_t)N + 2));
     int rc = -1;
     if (!re->block_owner || !re->block_order || !re->block_counts || !re->node_order ||
-        !re->mark || !re->halo || !node_owner || !re->send || !re->recv)
+        !re->mark || !re->halo || !node_owner || !re->send || !re->recv || !re->force_type ||
+        !re->flags || !re->requests || !re->run_len || !re->run_at)
         goto done;
     re->block_displs = re->block_counts + re->size;
     re->node_counts = re->block_counts + 2 * re->size;
     re->node_displs = re->block_counts + 3 * re->size;
-    re->flag_counts = re->block_counts + 4 * re->size;
-    re->flag_displs = re->block_counts + 5 * re->size;
     if (partition(re, m)) goto done;
     if (m->elem_plan.color_count == 0) { /* no blocks: every rank computes every element */
         memset(re->mark, 1, (size_t)m->elem_count + 1);
@@ -419,10 +482,7 @@ static int setup(rank_engine *re, fdem_model *m)
     list_by_owner(re->block_owner, re->blocks, re->size, SCATTER_SUMS, re->block_order,
                   re->block_counts, re->block_displs);
     list_by_owner(node_owner, N, re->size, D, re->node_order, re->node_counts, re->node_displs);
-    for (int r = 0; r < re->size; r++) {
-        re->flag_counts[r] = re->node_counts[r] + 1;
-        re->flag_displs[r] = re->node_displs[r] + r;
-    }
+    if (!re->split && force_types(re, m)) goto done;
     re->fig.ranks = re->size;
     re->fig.blocks = re->blocks;
     re->fig.owned_blocks = re->block_counts[re->rank] / SCATTER_SUMS;
@@ -434,10 +494,9 @@ static int setup(rank_engine *re, fdem_model *m)
     re->contact_split = m->contact.enabled && re->size > 1;
     if (re->contact_split) {
         re->contact_sizes = malloc(sizeof(long long) * (size_t)re->size);
-        re->contact_counts = malloc(sizeof(int) * 2 * (size_t)re->size);
-        re->contact_at = malloc(sizeof(size_t) * ((size_t)re->size + 1));
-        if (!re->contact_sizes || !re->contact_counts || !re->contact_at) goto done;
-        re->contact_displs = re->contact_counts + re->size;
+        re->contact_from = malloc(sizeof(*re->contact_from) * (size_t)re->size);
+        re->contact_bytes = malloc(sizeof(size_t) * (size_t)re->size);
+        if (!re->contact_sizes || !re->contact_from || !re->contact_bytes) goto done;
     }
     re->fig.contact_split = re->contact_split;
     re->fig.kept_nodes = re->split ? re->border.kept_nodes : N;
@@ -486,9 +545,9 @@ rank_engine *rank_engine_create(fdem_model *m, MPI_Comm comm, fdem_error *err)
 static void fail_collectives(rank_engine *re, fdem_model *m)
 {
     if (re->contact_split && !re->contact_gathered) {
-        const unsigned char *all;
-        const size_t *at;
-        share_contact_gather(re, NULL, 0, 0, 1, &all, &at);
+        const unsigned char *const *from;
+        const size_t *size;
+        share_contact_gather(re, NULL, 0, 0, 1, &from, &size);
     }
     if (!re->exchanged) {
         if (re->split) rank_halo_exchange(&re->border, m, 0);
@@ -636,8 +695,8 @@ void rank_engine_free(rank_engine *re)
 {
     if (!re) return;
     free(re->contact_sizes);
-    free(re->contact_counts);
-    free(re->contact_at);
+    free(re->contact_from);
+    free(re->contact_bytes);
     free(re->contact_buf);
     free(re->block_owner);
     free(re->block_order);
@@ -647,6 +706,12 @@ void rank_engine_free(rank_engine *re)
     free(re->halo);
     free(re->send);
     free(re->recv);
+    force_types_free(re);
+    free(re->force_type);
+    free(re->flags);
+    free(re->requests);
+    free(re->run_len);
+    free(re->run_at);
     if (re->split) rank_halo_free(&re->border);
     free(re);
 }
