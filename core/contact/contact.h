@@ -36,6 +36,10 @@ int contact_forces(fdem_model *m);
 #define CONTACT_PENETRATION_EVERY 8 /* steps between two looks (contact_pair_scatter) */
 double contact_penetration(const fdem_model *m, int a, int b);
 void contact_penetration_check(fdem_model *m, int a, int b);
+/* check's second half, for a depth found elsewhere (a split walk's
+ * process that walked the pair: contact_walk_split.c); kept when past
+ * FDEM_PENETRATION_WARN */
+void contact_penetration_record(fdem_model *m, int a, int b, double fraction);
 int contact_restore_detection(fdem_model *m);
 /* contact_walk.c: a split walk's springs updated in place handed to every
  * process (collective on the processes of m->share; nothing to do on one

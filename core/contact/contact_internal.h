@@ -119,10 +119,14 @@ static inline contact_pair_in contact_pair_input(const fdem_model *m, int e1, in
  * start-up costs more than they share. */
 #define CONTACT_THREADED_NODES 8192
 
-/* contact_walk.c: a pair's forces (pair_out numbers, both roles) added to
- * the contact force array and the friction account, with the penetration
- * look; every near pair's force this step (the pairs that touched, or -1
- * when out of memory); what its lists hold, and freeing them. */
+/* contact_rows.c: a pair's forces (pair_out numbers, both roles) added to
+ * the contact force array and the friction account (add), and with the
+ * penetration look where it is due (scatter: every 8th step, not between
+ * neighbours across a broken joint: looks). contact_walk.c: every near
+ * pair's force this step (the pairs that touched, or -1 when out of
+ * memory); what its lists hold, and freeing them. */
+void contact_pair_add(fdem_model *m, int e1, int e2, const double *out);
+int contact_penetration_looks(const fdem_model *m, int e1, int e2);
 void contact_pair_scatter(fdem_model *m, int e1, int e2, const double *out);
 int contact_pairs_forces(fdem_model *m, double h);
 size_t contact_walk_bytes(const contact_state *cs);

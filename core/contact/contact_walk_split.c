@@ -55,7 +55,9 @@
  * On the wire (8-byte items), for each of the two walks: the counts of
  * touched, released and adopted pairs (3 uint64), then the touched keys
  * (int64) and forces (pair_out doubles each), the released pairs (int64),
- * the adopted pairs (int64) and springs (slots doubles each). A sync's
+ * the adopted pairs (int64) and springs (slots doubles each), then the
+ * touched pairs found deep (wire_put_deep: a count, then a key and a
+ * depth each). A sync's
  * wire: the count of pairs (uint64), their pairs (int64), their springs
  * (slots doubles each).
  */
@@ -95,10 +97,41 @@ static unsigned char *wire_put_rows(unsigned char *at, const contact_touches *li
     return at;
 }
 
+/* The touched pairs of threads [0, used) found deep, as their count
+ * (uint64) and each one's key (int64) and depth (double), in pair order,
+ * written at `at`; returns the end. The process that walked a pair looks
+ * (contact_penetration_looks), and every process keeps what it found
+ * (contact_penetration_record, in pair order as one process keeps them):
+ * every process looking at every touched pair was 2 % of a contact pile's
+ * step on two. At most 8 + 16 bytes a touched pair. */
+static unsigned char *wire_put_deep(fdem_model *m, unsigned char *at, const contact_touches *lists,
+                                    int used)
+{
+    unsigned char *count_at = at;
+    uint64_t n = 0;
+    at += sizeof n;
+    for (int t = 0; t < used && m->step % CONTACT_PENETRATION_EVERY == 0; t++) {
+        const pair_rows *touched = &lists[t].touched;
+        for (size_t i = 0; i < touched->count; i++) {
+            long key = touched->pair[i];
+            int a = touched_a(key), b = touched_b(key);
+            if (!contact_penetration_looks(m, a, b)) continue;
+            double depth = contact_penetration(m, a, b);
+            if (!(depth > FDEM_PENETRATION_WARN)) continue;
+            at = wire_put(at, &key, sizeof key);
+            at = wire_put(at, &depth, sizeof depth);
+            n++;
+        }
+    }
+    memcpy(count_at, &n, sizeof n);
+    return at;
+}
+
 /* The lists of threads [0, used) appended to the wire at *bytes; -1 when
  * out of memory. */
-static int wire_append(contact_state *cs, const contact_touches *lists, int used, size_t *bytes)
+static int wire_append(fdem_model *m, const contact_touches *lists, int used, size_t *bytes)
 {
+    contact_state *cs = &m->contact;
     const size_t kinds[3] = {offsetof(contact_touches, touched),
                              offsetof(contact_touches, release), offsetof(contact_touches, adopt)};
     const int width[3] = {cs->pair_out, 0, cs->slots};
@@ -109,17 +142,44 @@ static int wire_append(contact_state *cs, const contact_touches *lists, int used
             count[k] += ((const pair_rows *)((const char *)&lists[t] + kinds[k]))->count;
         need += (size_t)count[k] * (sizeof(long) + sizeof(double) * (size_t)width[k]);
     }
-    if (wire_reserve(cs, *bytes + need)) return -1;
+    const size_t deep_most = sizeof(uint64_t) + (size_t)count[0] * (sizeof(long) + sizeof(double));
+    if (wire_reserve(cs, *bytes + need + deep_most)) return -1;
     unsigned char *at = wire_put(cs->wire + *bytes, count, sizeof count);
     for (int k = 0; k < 3; k++) at = wire_put_rows(at, lists, used, kinds[k], width[k]);
-    *bytes += need;
+    at = wire_put_deep(m, at, lists, used);
+    *bytes = (size_t)(at - cs->wire);
     return 0;
+}
+
+/* The touched pairs of another process's lists arrive in pair order but
+ * land on elements and nodes anywhere in the mesh: applying them, every
+ * process over every pair, waited on the element records and the force
+ * rows. Their keys are known ahead, so the records are asked for two
+ * WIRE_AHEADs ahead and the force rows of their nodes one ahead. Same
+ * bits: a prefetch changes no value. */
+#define WIRE_AHEAD 8
+
+static inline void wire_prefetch_records(const fdem_model *m, long key)
+{
+    int a = touched_a(key), b = touched_b(key);
+    __builtin_prefetch(m->dim == 3 ? (const void *)&m->tet[a] : (const void *)&m->elem[a]);
+    __builtin_prefetch(m->dim == 3 ? (const void *)&m->tet[b] : (const void *)&m->elem[b]);
+}
+
+static inline void wire_prefetch_nodes(const fdem_model *m, long key)
+{
+    const int D = m->dim;
+    const int32_t *na = element_nodes(m, touched_a(key)), *nb = element_nodes(m, touched_b(key));
+    for (int c = 0; c <= D; c++) {
+        __builtin_prefetch(m->contact.force + D * (size_t)na[c], 1);
+        __builtin_prefetch(m->contact.force + D * (size_t)nb[c], 1);
+    }
 }
 
 /* One walk's lists of one process, as wire_append laid them out at p,
  * applied: the touched pairs' forces added, the released sets let go, the
- * adopted ones taken (touching NULL: only
- * stepped over). Returns the pointer past them and adds the touched pairs
+ * adopted ones taken, the deep pairs kept (touching NULL: only stepped
+ * over). Returns the pointer past them and adds the touched pairs
  * to *touching; NULL when the pool cannot grow or the bytes run past end. */
 static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
                                        const unsigned char *end, int *touching)
@@ -137,11 +197,21 @@ static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
         need += (size_t)count[k] * (sizeof(long) + sizeof(double) * row[k]);
     }
     if (need > (size_t)(end - p)) return NULL;
-    if (!touching) return p + need;
+    const unsigned char *deep = p + need;
+    uint64_t deep_count;
+    if ((size_t)(end - deep) < sizeof deep_count) return NULL;
+    memcpy(&deep_count, deep, sizeof deep_count);
+    deep += sizeof deep_count;
+    const size_t deep_row = sizeof(long) + sizeof(double);
+    if (deep_count > (size_t)(end - deep) / deep_row) return NULL;
+    if (!touching) return deep + deep_count * deep_row;
     const long *key = (const long *)p;
     const double *rows = (const double *)(key + count[0]);
-    for (size_t i = 0; i < count[0]; i++)
-        contact_pair_scatter(m, touched_a(key[i]), touched_b(key[i]), rows + i * out);
+    for (size_t i = 0; i < count[0]; i++) {
+        if (i + 2 * WIRE_AHEAD < count[0]) wire_prefetch_records(m, key[i + 2 * WIRE_AHEAD]);
+        if (i + WIRE_AHEAD < count[0]) wire_prefetch_nodes(m, key[i + WIRE_AHEAD]);
+        contact_pair_add(m, touched_a(key[i]), touched_b(key[i]), rows + i * out);
+    }
     *touching += (int)count[0];
     const long *release = (const long *)(rows + count[0] * out);
     for (size_t i = 0; i < count[1]; i++) contact_springs_release(cs, (size_t)release[i]);
@@ -149,7 +219,14 @@ static const unsigned char *wire_apply(fdem_model *m, const unsigned char *p,
     const double *springs = (const double *)(adopt + count[2]);
     for (size_t i = 0; i < count[2]; i++)
         if (contact_springs_adopt(cs, (size_t)adopt[i], springs + i * slots)) return NULL;
-    return (const unsigned char *)(springs + count[2] * slots);
+    for (uint64_t i = 0; i < deep_count; i++, deep += deep_row) {
+        long pair;
+        double depth;
+        memcpy(&pair, deep, sizeof pair);
+        memcpy(&depth, deep + sizeof pair, sizeof depth);
+        contact_penetration_record(m, touched_a(pair), touched_b(pair), depth);
+    }
+    return deep;
 }
 
 /* The first position of an ascending index list at or past value v. */
@@ -193,7 +270,7 @@ int contact_pairs_forces_split(fdem_model *m, double h, const near_walk walks[2]
         walk_share(&walks[k], totals[k], share, &begin, &end);
         cs->pairs_walked += end - begin;
         ok = walk_listed(m, h, &walks[k], begin, end, &used) == 0 &&
-             wire_append(cs, cs->touches, used, &bytes) == 0;
+             wire_append(m, cs->touches, used, &bytes) == 0;
         cs->split_threaded += ok && used > 1;
     }
     /* every process takes part, failed or not: none is left waiting */

@@ -97,8 +97,12 @@ double contact_penetration(const fdem_model *m, int a, int b)
 
 void contact_penetration_check(fdem_model *m, int a, int b)
 {
+    contact_penetration_record(m, a, b, contact_penetration(m, a, b));
+}
+
+void contact_penetration_record(fdem_model *m, int a, int b, double fraction)
+{
     contact_state *cs = &m->contact;
-    double fraction = contact_penetration(m, a, b);
     if (!(fraction > FDEM_PENETRATION_WARN)) return;
     int lo = a < b ? a : b, hi = a < b ? b : a;
     for (int i = 0; i < cs->pen_count; i++)

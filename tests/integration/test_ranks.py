@@ -137,6 +137,33 @@ def case_3d():
             "time": {"end": 1.0, "dt": "auto", "safety": 0.5}}
 
 
+def case_deep(dim):
+    """A 10 mm steel block at 3000 m/s into a steel slab held at its ends,
+    penalty young / 100 (tests/unit/test_warnings.c's case): pairs pass
+    into one another, which the rank walking a pair finds and hands to all
+    (the penetration warnings, not in the checkpoint: rank_compare prints
+    their count and hash)."""
+    steel = {"density": 7800, "young": 2e11, "poisson": 0.3, "penalty": 2e9}
+    if dim == 2:
+        parts = [{"name": "slab", "material": "steel",
+                  "rectangle": {"origin": [0, 0], "size": [0.06, 0.01], "divisions": [12, 2]}},
+                 {"name": "bullet", "material": "steel", "velocity": [0, -3000],
+                  "rectangle": {"origin": [0.0263, 0.0125], "size": [0.01, 0.01],
+                                "divisions": [2, 2]}}]
+        fixed = [[-1, -1, 0.001, 1], [0.059, -1, 1, 1]]
+    else:
+        parts = [{"name": "slab", "material": "steel",
+                  "box": {"origin": [0, 0, 0], "size": [0.04, 0.04, 0.01], "divisions": [8, 8, 2]}},
+                 {"name": "bullet", "material": "steel", "velocity": [0, 0, -3000],
+                  "box": {"origin": [0.0163, 0.0171, 0.0125], "size": [0.01, 0.01, 0.01],
+                          "divisions": [2, 2, 2]}}]
+        fixed = [[-1, -1, -1, 0.001, 1, 1], [0.039, -1, -1, 1, 1, 1]]
+    axes = ["x", "y", "z"][:dim]
+    return {"name": "ranks-%dd-deep" % dim, "dimension": dim, "materials": {"steel": steel},
+            "parts": parts, "constraints": [{"box": b, "fix": axes} for b in fixed],
+            "time": {"end": 1e-5}}
+
+
 def same_failure(lines):
     """The lines without the element a failure names: each rank looks for
     the first non-finite value among the nodes it updates, one process
@@ -169,6 +196,12 @@ class RanksSameBits(unittest.TestCase):
         with open(cls.blowing, "w") as f:
             json.dump(case_2d_blowing_up(), f)
         cls.failing = ["--expect-failure", cls.blowing]
+        cls.deep_cases = []
+        for dim in (2, 3):
+            path = os.path.join(cls.tmp, "%dd-deep.json" % dim)
+            with open(path, "w") as f:
+                json.dump(case_deep(dim), f)
+            cls.deep_cases.append(path)
         cls.checkpoint = os.path.join(cls.tmp, "2d-step10-3-ranks.bin")
         cls.checkpoint_split = os.path.join(cls.tmp, "2d-elastic-step10-3-ranks.bin")
         cls.stderr = {}
@@ -192,6 +225,8 @@ class RanksSameBits(unittest.TestCase):
         cls.fault = cls.run_ranks(4, "--fault")
         cls.contact_faults = {kind: cls.run_ranks(2, "--contact-fault", kind, cases=cls.cases[:2])
                               for kind in ("order", "rotate", "skip-sync", "skip-gather-sync")}
+        cls.deep = {n: cls.run_ranks(n, *(() if n else ("--plain",)), cases=cls.deep_cases,
+                                     tag=("deep",)) for n in (0, 2, 3)}
         cls.contact_fail = {n: cls.run_ranks(n, "--contact-fault", "fail",
                                              cases=["--expect-failure"] + cls.cases[:2])
                             for n in (2, 3)}
@@ -201,8 +236,9 @@ class RanksSameBits(unittest.TestCase):
         shutil.rmtree(getattr(cls, "tmp", ""), ignore_errors=True)
 
     @classmethod
-    def run_ranks(cls, ranks, *flags, cases=None):
-        """The driver's lines on `ranks` ranks (0: one process, no mpirun)."""
+    def run_ranks(cls, ranks, *flags, cases=None, tag=()):
+        """The driver's lines on `ranks` ranks (0: one process, no mpirun);
+        its stderr kept under (ranks,) + flags + tag."""
         cmd = [cls.exe, STEPS, EVERY] + list(flags) + (cases or cls.cases + cls.failing)
         if ranks:
             cmd = ["mpirun", "-np", str(ranks), "--oversubscribe"] + cmd
@@ -210,7 +246,7 @@ class RanksSameBits(unittest.TestCase):
         if p.returncode:
             raise AssertionError("%s failed (%d): %s %s" % (" ".join(cmd), p.returncode,
                                                            p.stdout[-2000:], p.stderr[-2000:]))
-        cls.stderr[(ranks,) + flags] = p.stderr
+        cls.stderr[(ranks,) + flags + tag] = p.stderr
         return p.stdout.splitlines()
 
     def case_lines(self, lines, case):
@@ -294,6 +330,19 @@ class RanksSameBits(unittest.TestCase):
                                  int(l.split()[1]) < 9]
                     expected.append("step 9 failed: out of memory in contact detection at step 9")
                 self.assertEqual(lines, expected)
+
+    def test_penetrations_found_alike_on_any_rank_count(self):
+        """Pairs passing into one another are looked at by the rank that
+        walked them and kept by every rank in pair order: rank 0 takes the
+        same penetrations (count and hash on each line) as one process, in
+        2D and 3D, and the cases have some."""
+        plain = self.deep[0]
+        for case in self.deep_cases:
+            last = self.case_lines(plain, case)[-1].split()
+            self.assertGreater(int(last[last.index("deep") + 1]), 0, last)
+        for ranks in (2, 3):
+            with self.subTest(ranks=ranks):
+                self.assertEqual(self.deep[ranks], plain)
 
     def test_same_bits_on_1_2_3_4_ranks(self):
         """(and 8, and 2 of one thread, with FDEM_RANKS_FULL=1: make test-ranks;
