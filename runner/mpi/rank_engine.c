@@ -84,9 +84,7 @@ struct rank_engine {
     MPI_Datatype *force_type;        /* per rank: its flag and owned force rows (force_types) */
     const double *force_typed;       /* the m->force they point into; NULL: none made */
     double *flags;                   /* per rank: its flag in the force exchange */
-    MPI_Request *requests;           /* the force exchange's, 2 (size - 1) */
-    int *run_len;                    /* force_types' scratch: a rank's runs and its flag */
-    MPI_Aint *run_at;
+    MPI_Request *requests;           /* the force and list exchanges', 2 (size - 1) */
     step_share share, halo_share;
     int border_fault;
     int exchanged;                   /* the force exchange ran in this step */
@@ -170,7 +168,7 @@ static void add_halo_after(rank_engine *re, fdem_model *m)
  * receives the rows where they lie: packing them into a buffer and out of
  * it again, node by node, was as long as the transfer itself (2 ranks, a
  * contact pile of 55 k nodes: 0.13 ms a step of 2.6). Made again if
- * m->force ever moves; -1 when MPI cannot make a type. */
+ * m->force ever moves; -1 when out of memory or MPI cannot make a type. */
 static void force_types_free(rank_engine *re)
 {
     if (!re->force_typed) return;
@@ -182,26 +180,37 @@ static int force_types(rank_engine *re, const fdem_model *m)
 {
     const int D = re->dim;
     force_types_free(re);
-    for (int r = 0; r < re->size; r++) {
-        const int32_t *nodes = re->node_order + re->node_displs[r] / D;
-        const int count = re->node_counts[r] / D;
+    /* a rank's flag and its runs: at most one run a node */
+    int *run_len = malloc(sizeof(int) * ((size_t)m->node_count + 1));
+    MPI_Aint *run_at = malloc(sizeof(MPI_Aint) * ((size_t)m->node_count + 1));
+    int made = 0;
+    for (; run_len && run_at && made < re->size; made++) {
+        const int32_t *nodes = re->node_order + re->node_displs[made] / D;
+        const int count = re->node_counts[made] / D;
         int blocks = 1;
-        MPI_Get_address(&re->flags[r], &re->run_at[0]);
-        re->run_len[0] = 1;
+        MPI_Get_address(&re->flags[made], &run_at[0]);
+        run_len[0] = 1;
         for (int k = 0; k < count; k++) {
             if (k > 0 && nodes[k] == nodes[k - 1] + 1) {
-                re->run_len[blocks - 1] += D;
+                run_len[blocks - 1] += D;
                 continue;
             }
-            MPI_Get_address(m->force + (size_t)D * nodes[k], &re->run_at[blocks]);
-            re->run_len[blocks++] = D;
+            MPI_Get_address(m->force + (size_t)D * nodes[k], &run_at[blocks]);
+            run_len[blocks++] = D;
         }
-        if (MPI_Type_create_hindexed(blocks, re->run_len, re->run_at, MPI_DOUBLE,
-                                     &re->force_type[r]) != MPI_SUCCESS ||
-            MPI_Type_commit(&re->force_type[r]) != MPI_SUCCESS) {
-            for (int q = 0; q < r; q++) MPI_Type_free(&re->force_type[q]);
-            return -1;
+        if (MPI_Type_create_hindexed(blocks, run_len, run_at, MPI_DOUBLE,
+                                     &re->force_type[made]) != MPI_SUCCESS)
+            break;
+        if (MPI_Type_commit(&re->force_type[made]) != MPI_SUCCESS) {
+            MPI_Type_free(&re->force_type[made]);
+            break;
         }
+    }
+    free(run_len);
+    free(run_at);
+    if (made < re->size) {
+        for (int q = 0; q < made; q++) MPI_Type_free(&re->force_type[q]);
+        return -1;
     }
     re->force_typed = m->force;
     return 0;
@@ -218,7 +227,8 @@ static int exchange_forces(rank_engine *re, fdem_model *m, int ok)
     /* m->force never moves after set-up (an excavation swaps it only inside
      * its own pass), but if it did the rows must follow it */
     if (re->force_typed != m->force && force_types(re, m)) {
-        fprintf(stderr, "rank %d: MPI could not describe the force rows\n", me);
+        fprintf(stderr, "rank %d: the force rows could not be described (out of memory or "
+                "an MPI failure)\n", me);
         MPI_Abort(re->comm, 2); /* the others would wait for this rank's message */
     }
     re->flags[me] = ok;
@@ -455,12 +465,10 @@ static int setup(rank_engine *re, fdem_model *m)
     re->force_type = malloc(sizeof(MPI_Datatype) * (size_t)re->size);
     re->flags = malloc(sizeof(double) * (size_t)re->size);
     re->requests = malloc(sizeof(MPI_Request) * 2 * (size_t)re->size);
-    re->run_len = malloc(sizeof(int) * ((size_t)N + 2));
-    re->run_at = malloc(sizeof(MPI_Aint) * ((size_t)N + 2));
     int rc = -1;
     if (!re->block_owner || !re->block_order || !re->block_counts || !re->node_order ||
         !re->mark || !re->halo || !node_owner || !re->send || !re->recv || !re->force_type ||
-        !re->flags || !re->requests || !re->run_len || !re->run_at)
+        !re->flags || !re->requests)
         goto done;
     re->block_displs = re->block_counts + re->size;
     re->node_counts = re->block_counts + 2 * re->size;
@@ -710,8 +718,6 @@ void rank_engine_free(rank_engine *re)
     free(re->force_type);
     free(re->flags);
     free(re->requests);
-    free(re->run_len);
-    free(re->run_at);
     if (re->split) rank_halo_free(&re->border);
     free(re);
 }

@@ -67,15 +67,17 @@ static uint64_t deep_hash = 1469598103934665603ull;
 static void take_penetrations(fdem_model *m)
 {
     fdem_penetration p[64];
-    long more = 0;
+    long more;
     int n;
-    while ((n = fdem_take_penetrations(m, p, 64, &more)) > 0 || more) {
+    do { /* `more` counts those past the kept list, once; a call that takes
+          * nothing leaves the hash alone (lines are printed at other steps
+          * on some runs: --save-at) */
+        n = fdem_take_penetrations(m, p, 64, &more);
+        if (!n && !more) break;
         deep_hash = fnv1a(p, sizeof *p * (size_t)n, deep_hash);
         deep_hash = fnv1a(&more, sizeof more, deep_hash);
         deep_count += n + more;
-        more = 0;
-        if (n < 64) break;
-    }
+    } while (n == 64);
 }
 
 /* The hash of the checkpoint (rank 0) and of the energies. */
